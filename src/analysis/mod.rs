@@ -1,0 +1,3 @@
+//! Analysis of any `&dyn Brdf`: albedo, physical plausibility, accuracy metrics.
+
+pub mod albedo;

@@ -1,0 +1,220 @@
+//! The [`Brdf`] trait: the one interface every source of reflectance implements.
+//!
+//! Analytic models, tables baked from them, and measured data all implement `Brdf`, so a renderer
+//! or an analysis swaps one for another without changing a line. The interface follows pbrt-v4's
+//! `BxDF` (f, Sample_f, PDF, Flags) with the conventions of `DESIGN.md`:
+//!
+//! - local shading frame, `z` = surface normal; both directions point **away** from the surface;
+//! - `wi` is the direction to the light (the lecture's L, ω′, θ′), `wo` to the viewer (V, ω, θ);
+//! - [`Brdf::eval`] returns f_r in 1/sr, **not** multiplied by a cosine;
+//! - either direction at or below the horizon gives 0; directions need not be normalized; NaN or
+//!   zero vectors give 0, never a panic.
+//!
+//! Directions are `f64` ([`DVec3`]) so that sharp lobes (Phong n = 1000) are evaluated to full
+//! accuracy; values are written as `f32` into a caller's buffer, one per channel, so evaluation
+//! never allocates.
+
+use glam::{DVec2, DVec3};
+use serde::Serialize;
+
+use crate::geometry;
+use crate::spectrum::{Channels, MAX_CHANNELS};
+
+/// What a model declares about itself. Tables use these to choose symmetry reductions (after
+/// verifying them); analysis reports compare them with what is measured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct Flags {
+    /// Reflection only along a single direction (a Dirac delta): `eval` returns 0 and
+    /// [`Brdf::sample`] returns the direction and its weight.
+    pub delta: bool,
+    /// Helmholtz reciprocity: f(wi, wo) = f(wo, wi).
+    pub reciprocal: bool,
+    /// Invariant under a common rotation of both directions about the normal.
+    pub isotropic: bool,
+    /// Bilateral (mirror) symmetry about the plane of incidence: f is unchanged when both
+    /// directions are reflected through the x–z plane (for isotropic models: when φo − φi flips sign).
+    pub bilateral: bool,
+    /// Transmits light to the other side of the surface (refraction).
+    pub transmission: bool,
+}
+
+impl Flags {
+    /// Flags of a smooth, reciprocal, isotropic, bilaterally symmetric reflection model — the
+    /// common case.
+    pub const SMOOTH_SYMMETRIC: Flags = Flags {
+        delta: false,
+        reciprocal: true,
+        isotropic: true,
+        bilateral: true,
+        transmission: false,
+    };
+}
+
+/// A direction drawn by [`Brdf::sample`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BrdfSample {
+    /// The sampled incident direction (towards the light), unit length. For a refractor it lies
+    /// on the other side of the surface from `wo`.
+    pub wi: DVec3,
+    /// The solid-angle density of `wi` given `wo`. For delta samples this is 1 by convention
+    /// (a discrete choice probability when a delta sampler picks among several lobes).
+    pub pdf: f64,
+    /// True when `wi` is a delta direction (the weight is then the lobe's reflectance, e.g. k_r).
+    pub delta: bool,
+}
+
+/// A bidirectional reflectance distribution function.
+///
+/// Object safe and `Send + Sync`, so `Box<dyn Brdf>` and `&dyn Brdf` work everywhere.
+///
+/// # Example
+/// ```
+/// use brdftab::{Brdf, models::lambert::Lambert, spectrum::{Channels, Value}};
+/// use glam::DVec3;
+///
+/// let brdf = Lambert::new(Value::Grey(0.25), &Channels::Rgb).unwrap();
+/// let mut f = [0.0f32; 3];
+/// brdf.eval(DVec3::new(0.3, 0.1, 1.0), DVec3::Z, &mut f);
+/// assert_eq!(f, [0.25; 3]);
+/// ```
+pub trait Brdf: Send + Sync {
+    /// The channels this BRDF returns (RGB or wavelengths).
+    fn channels(&self) -> &Channels;
+
+    /// Writes f_r(wi, wo) for every channel into `out[..channels().len()]`, in 1/sr.
+    ///
+    /// Below the horizon, for NaN or zero directions, and for delta models, writes 0.
+    /// `out` must hold at least `channels().len()` values.
+    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]);
+
+    /// What the model declares about itself.
+    fn flags(&self) -> Flags;
+
+    /// A short human-readable description (model name and parameters, or table and source).
+    fn describe(&self) -> String;
+
+    /// f_r at one wavelength in nm. The default interpolates linearly between the channels
+    /// (constant outside them); analytic models with spectral parameters override it to use
+    /// their spectral data directly.
+    fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        let mut buf = [0.0f32; MAX_CHANNELS];
+        let n = self.channels().len().min(MAX_CHANNELS);
+        self.eval(wi, wo, &mut buf[..n]);
+        let (i0, i1, t) = self.channels().lerp_at(nm);
+        (1.0 - t) * buf[i0] as f64 + t * buf[i1] as f64
+    }
+
+    /// Evaluates many pairs: `out[k * c .. (k + 1) * c]` receives f_r(wi[k], wo[k]) where `c` is
+    /// the channel count. Tables override this for throughput.
+    fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
+        let c = self.channels().len();
+        for ((a, b), o) in wi.iter().zip(wo).zip(out.chunks_exact_mut(c)) {
+            self.eval(*a, *b, o);
+        }
+    }
+
+    /// Directional albedo a(wi) = ∫ f_r(wi, wo) cos θo dωo for every channel into `out`.
+    ///
+    /// The default integrates numerically ([`crate::analysis::albedo::quadrature`]); models with
+    /// a closed form override it. For delta models it is the reflectance of the delta lobe.
+    fn albedo(&self, wi: DVec3, out: &mut [f64]) {
+        crate::analysis::albedo::quadrature(self, wi, out);
+    }
+
+    /// Draws an incident direction `wi` for the outgoing direction `wo` from two uniform numbers
+    /// `u` in [0,1)², writing the per-channel weight f_r·cos θi / pdf (for delta samples the
+    /// lobe's reflectance) into `weight`. Returns `None` when no direction can be drawn (e.g. `wo`
+    /// below the horizon, total internal reflection) — the weight is then unspecified.
+    ///
+    /// The default draws cosine-weighted directions; models override with importance sampling.
+    fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+        let wo = geometry::normalize(wo)?;
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = geometry::cosine_hemisphere(u);
+        let pdf = wi.z * std::f64::consts::FRAC_1_PI;
+        if pdf <= 0.0 {
+            return None;
+        }
+        let c = self.channels().len();
+        self.eval(wi, wo, &mut weight[..c]);
+        for w in &mut weight[..c] {
+            *w = (*w as f64 * std::f64::consts::PI) as f32;
+        }
+        Some(BrdfSample {
+            wi,
+            pdf,
+            delta: false,
+        })
+    }
+
+    /// The density with which [`Brdf::sample`] draws `wi` given `wo` (solid angle, 1/sr);
+    /// 0 for delta models and for directions the sampler never produces.
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        match (geometry::normalize(wi), geometry::normalize(wo)) {
+            (Some(wi), Some(wo)) if wi.z > 0.0 && wo.z > 0.0 => wi.z * std::f64::consts::FRAC_1_PI,
+            _ => 0.0,
+        }
+    }
+}
+
+impl<B: Brdf + ?Sized> Brdf for Box<B> {
+    fn channels(&self) -> &Channels {
+        (**self).channels()
+    }
+    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+        (**self).eval(wi, wo, out)
+    }
+    fn flags(&self) -> Flags {
+        (**self).flags()
+    }
+    fn describe(&self) -> String {
+        (**self).describe()
+    }
+    fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        (**self).eval_wavelength(wi, wo, nm)
+    }
+    fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
+        (**self).eval_batch(wi, wo, out)
+    }
+    fn albedo(&self, wi: DVec3, out: &mut [f64]) {
+        (**self).albedo(wi, out)
+    }
+    fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+        (**self).sample(wo, u, weight)
+    }
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        (**self).pdf(wi, wo)
+    }
+}
+
+impl<B: Brdf + ?Sized> Brdf for std::sync::Arc<B> {
+    fn channels(&self) -> &Channels {
+        (**self).channels()
+    }
+    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+        (**self).eval(wi, wo, out)
+    }
+    fn flags(&self) -> Flags {
+        (**self).flags()
+    }
+    fn describe(&self) -> String {
+        (**self).describe()
+    }
+    fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        (**self).eval_wavelength(wi, wo, nm)
+    }
+    fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
+        (**self).eval_batch(wi, wo, out)
+    }
+    fn albedo(&self, wi: DVec3, out: &mut [f64]) {
+        (**self).albedo(wi, out)
+    }
+    fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+        (**self).sample(wo, u, weight)
+    }
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        (**self).pdf(wi, wo)
+    }
+}

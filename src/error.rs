@@ -1,0 +1,163 @@
+//! The crate's one error type.
+//!
+//! Every fallible operation in brdftab returns [`Result`]. Errors carry the context a user needs to
+//! fix the input: the file, the field, the byte offset or the line. Library code never panics on
+//! input a user can influence; it returns one of these instead.
+
+use std::path::Path;
+
+/// Everything that can go wrong in brdftab.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// An operating-system I/O error, with what we were doing (usually the path).
+    #[error("{context}: {source}")]
+    Io {
+        /// What was being done, e.g. the file name.
+        context: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// A model spec (JSON) is invalid: an unknown model or field, a negative or NaN parameter.
+    #[error("invalid spec: field `{field}`: {msg}")]
+    Spec {
+        /// The offending field, dotted path when nested (`terms[1].fresnel.n`).
+        field: String,
+        /// What is wrong with it.
+        msg: String,
+    },
+
+    /// JSON that does not parse (spec files, headers).
+    #[error("{context}: invalid JSON: {source}")]
+    Json {
+        /// Where the JSON came from.
+        context: String,
+        /// The parser's message (with line and column).
+        #[source]
+        source: serde_json::Error,
+    },
+
+    /// A line of text input (stdin pairs, TSV files) that does not parse.
+    #[error("{source_name}: line {line}: {msg}")]
+    Parse {
+        /// Name of the input (`stdin`, a file name).
+        source_name: String,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        msg: String,
+    },
+
+    /// A binary file whose content is malformed (wrong magic, truncated, bad sizes, ...).
+    #[error("{file}: {}{}{msg}", field.as_ref().map(|f| format!("field `{f}`: ")).unwrap_or_default(), offset.map(|o| format!("at byte {o}: ")).unwrap_or_default())]
+    Format {
+        /// The file (or `<memory>`).
+        file: String,
+        /// The field or section concerned, if any.
+        field: Option<String>,
+        /// The byte offset concerned, if any.
+        offset: Option<u64>,
+        /// What is wrong.
+        msg: String,
+    },
+
+    /// Stored data does not match its checksum.
+    #[error(
+        "{file}: checksum mismatch in {what} (stored {stored:#018x}, computed {computed:#018x})"
+    )]
+    Checksum {
+        /// The file.
+        file: String,
+        /// Which block (table and chunk).
+        what: String,
+        /// The checksum in the file.
+        stored: u64,
+        /// The checksum of the data read.
+        computed: u64,
+    },
+
+    /// A declared symmetry that the source breaks beyond tolerance.
+    #[error(
+        "source is not {symmetry}: relative difference {error:.3e} > tolerance {tolerance:.1e} at {at} (use --force to bake anyway, or --symmetry none)"
+    )]
+    Symmetry {
+        /// Name of the symmetry (`isotropic`, `reciprocal`, `bilateral`).
+        symmetry: String,
+        /// Worst relative difference found.
+        error: f64,
+        /// The tolerance in force.
+        tolerance: f64,
+        /// Where it was found (a human-readable direction pair).
+        at: String,
+    },
+
+    /// An argument out of its valid range or otherwise unusable.
+    #[error("invalid argument `{name}`: {msg}")]
+    InvalidArgument {
+        /// The argument's name (`--grid`, `wavelengths`, ...).
+        name: String,
+        /// What is wrong.
+        msg: String,
+    },
+
+    /// A value that cannot be represented by the chosen encoding (e.g. above the f16 range).
+    #[error("cannot encode: {msg}")]
+    Encode {
+        /// What is wrong and, where possible, a hint.
+        msg: String,
+    },
+
+    /// The operation is not available for this source or build.
+    #[error("unsupported: {0}")]
+    Unsupported(String),
+
+    /// A named entry does not exist (a table in a database, a metal, ...).
+    #[error("not found: {0}")]
+    NotFound(String),
+}
+
+/// Shorthand for `std::result::Result<T, brdftab::Error>`.
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// An I/O error with the path it concerns.
+    pub fn io(path: impl AsRef<Path>, source: std::io::Error) -> Self {
+        Error::Io {
+            context: path.as_ref().display().to_string(),
+            source,
+        }
+    }
+
+    /// A spec error naming `field`.
+    pub fn spec(field: impl Into<String>, msg: impl Into<String>) -> Self {
+        Error::Spec {
+            field: field.into(),
+            msg: msg.into(),
+        }
+    }
+
+    /// A format error in `file`, with optional field and offset.
+    pub fn format(
+        file: impl Into<String>,
+        field: Option<&str>,
+        offset: Option<u64>,
+        msg: impl Into<String>,
+    ) -> Self {
+        Error::Format {
+            file: file.into(),
+            field: field.map(str::to_owned),
+            offset,
+            msg: msg.into(),
+        }
+    }
+
+    /// An invalid-argument error.
+    pub fn arg(name: impl Into<String>, msg: impl Into<String>) -> Self {
+        Error::InvalidArgument {
+            name: name.into(),
+            msg: msg.into(),
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! Least-squares fitting of model parameters to any source.

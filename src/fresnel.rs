@@ -1,0 +1,432 @@
+//! Fresnel reflectance: exact dielectric and conductor formulas for unpolarized light.
+//!
+//! The lecture writes, for a wave arriving at angle θ′ and refracted to θ in a medium of complex
+//! index n + kj,
+//!
+//! ```text
+//! F∥ = |(cos θ − (n+kj) cos θ′) / (cos θ + (n+kj) cos θ′)|²
+//! F⊥ = |(cos θ′ − (n+kj) cos θ) / (cos θ′ + (n+kj) cos θ)|²
+//! k_r = (F∥ + F⊥) / 2
+//! ```
+//!
+//! with Snell's law n = sin θ′ / sin θ giving the (complex) refraction angle. [`conductor`]
+//! evaluates exactly this with complex arithmetic; [`dielectric`] is the k = 0 case with total
+//! internal reflection handled. [`schlick`] exists as a separate, approximate option.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::spectrum::{Channels, Value};
+
+#[derive(Debug, Clone, Copy)]
+struct C {
+    re: f64,
+    im: f64,
+}
+
+impl C {
+    #[inline]
+    fn new(re: f64, im: f64) -> Self {
+        C { re, im }
+    }
+    #[inline]
+    fn mul(self, o: C) -> C {
+        C::new(
+            self.re * o.re - self.im * o.im,
+            self.re * o.im + self.im * o.re,
+        )
+    }
+    #[inline]
+    fn add(self, o: C) -> C {
+        C::new(self.re + o.re, self.im + o.im)
+    }
+    #[inline]
+    fn sub(self, o: C) -> C {
+        C::new(self.re - o.re, self.im - o.im)
+    }
+    #[inline]
+    fn scale(self, s: f64) -> C {
+        C::new(self.re * s, self.im * s)
+    }
+    #[inline]
+    fn norm2(self) -> f64 {
+        self.re * self.re + self.im * self.im
+    }
+    #[inline]
+    fn div(self, o: C) -> C {
+        let d = o.norm2();
+        C::new(
+            (self.re * o.re + self.im * o.im) / d,
+            (self.im * o.re - self.re * o.im) / d,
+        )
+    }
+    /// Principal square root.
+    #[inline]
+    fn sqrt(self) -> C {
+        let r = self.norm2().sqrt();
+        let re = ((r + self.re) * 0.5).max(0.0).sqrt();
+        let im = ((r - self.re) * 0.5).max(0.0).sqrt().copysign(self.im);
+        C::new(re, im)
+    }
+}
+
+/// The parallel and perpendicular reflectances (F∥, F⊥) at a conductor (or dielectric) surface
+/// of complex relative index `n + k j`, for incidence cosine `cos_i` ∈ [0, 1] (θ′ of the lecture).
+pub fn conductor_polarized(cos_i: f64, n: f64, k: f64) -> (f64, f64) {
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let eta = C::new(n, k);
+    let sin2_i = 1.0 - cos_i * cos_i;
+    // Snell: sin θ = sin θ′ / η, cos θ = sqrt(1 − sin² θ′ / η²) (complex for conductors).
+    let eta2 = eta.mul(eta);
+    let cos_t = C::new(1.0, 0.0).sub(C::new(sin2_i, 0.0).div(eta2)).sqrt();
+    let ci = C::new(cos_i, 0.0);
+    // F∥ = |(cos θ − η cos θ′) / (cos θ + η cos θ′)|²
+    let f_par = cos_t
+        .sub(eta.scale(cos_i))
+        .div(cos_t.add(eta.scale(cos_i)))
+        .norm2();
+    // F⊥ = |(cos θ′ − η cos θ) / (cos θ′ + η cos θ)|²
+    let et = eta.mul(cos_t);
+    let f_perp = ci.sub(et).div(ci.add(et)).norm2();
+    (f_par, f_perp)
+}
+
+/// Unpolarized conductor reflectance k_r = (F∥ + F⊥)/2 for incidence cosine `cos_i` and complex
+/// index `n + k j`. At normal incidence this is ((n−1)² + k²) / ((n+1)² + k²).
+#[inline]
+pub fn conductor(cos_i: f64, n: f64, k: f64) -> f64 {
+    if cos_i.is_nan() || cos_i <= 0.0 {
+        return 1.0;
+    }
+    let (a, b) = conductor_polarized(cos_i, n, k);
+    0.5 * (a + b)
+}
+
+/// Unpolarized dielectric reflectance for incidence cosine `cos_i` and relative index
+/// `eta` = n_transmitted / n_incident. A negative `cos_i` means the light arrives from inside
+/// (the other side of the normal); then the relative index is 1/eta. Total internal reflection
+/// gives 1.
+pub fn dielectric(cos_i: f64, eta: f64) -> f64 {
+    let (cos_i, eta) = if cos_i < 0.0 {
+        (-cos_i, 1.0 / eta)
+    } else {
+        (cos_i, eta)
+    };
+    let cos_i = cos_i.min(1.0);
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let r_par = (cos_t - eta * cos_i) / (cos_t + eta * cos_i);
+    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    0.5 * (r_par * r_par + r_perp * r_perp)
+}
+
+/// Schlick's approximation F0 + (1 − F0)(1 − cos)^5 — an option, not the default.
+#[inline]
+pub fn schlick(cos_i: f64, f0: f64) -> f64 {
+    let m = (1.0 - cos_i.clamp(0.0, 1.0)).powi(5);
+    f0 + (1.0 - f0) * m
+}
+
+/// The Fresnel term of a model spec, in JSON:
+/// `"none"` (F = 1), `{"conductor": "Au"}` (named metal), `{"n": X, "k": X}` (complex index),
+/// `{"eta": X}` (dielectric), `{"schlick": X}` (Schlick with F0 = X).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum FresnelSpec {
+    /// F = 1.
+    #[default]
+    None,
+    /// A named metal from [`crate::metals`].
+    Conductor(String),
+    /// A complex index n + k j.
+    Complex {
+        /// Real part n.
+        n: Value,
+        /// Extinction coefficient k.
+        k: Value,
+    },
+    /// A dielectric of relative index eta.
+    Dielectric(Value),
+    /// Schlick's approximation with normal-incidence reflectance F0.
+    Schlick(Value),
+}
+
+impl Serialize for FresnelSpec {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        match self {
+            FresnelSpec::None => s.serialize_str("none"),
+            FresnelSpec::Conductor(name) => {
+                let mut m = s.serialize_map(Some(1))?;
+                m.serialize_entry("conductor", name)?;
+                m.end()
+            }
+            FresnelSpec::Complex { n, k } => {
+                let mut m = s.serialize_map(Some(2))?;
+                m.serialize_entry("n", n)?;
+                m.serialize_entry("k", k)?;
+                m.end()
+            }
+            FresnelSpec::Dielectric(eta) => {
+                let mut m = s.serialize_map(Some(1))?;
+                m.serialize_entry("eta", eta)?;
+                m.end()
+            }
+            FresnelSpec::Schlick(f0) => {
+                let mut m = s.serialize_map(Some(1))?;
+                m.serialize_entry("schlick", f0)?;
+                m.end()
+            }
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for FresnelSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        #[derive(Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Obj {
+            conductor: Option<String>,
+            n: Option<Value>,
+            k: Option<Value>,
+            eta: Option<Value>,
+            schlick: Option<Value>,
+        }
+        let v = serde_json::Value::deserialize(d)?;
+        match v {
+            serde_json::Value::String(s) if s == "none" => Ok(FresnelSpec::None),
+            serde_json::Value::Object(_) => {
+                let o: Obj = serde_json::from_value(v).map_err(D::Error::custom)?;
+                match o {
+                    Obj {
+                        conductor: Some(c),
+                        n: None,
+                        k: None,
+                        eta: None,
+                        schlick: None,
+                    } => Ok(FresnelSpec::Conductor(c)),
+                    Obj {
+                        conductor: None,
+                        n: Some(n),
+                        k,
+                        eta: None,
+                        schlick: None,
+                    } => Ok(FresnelSpec::Complex {
+                        n,
+                        k: k.unwrap_or(Value::Grey(0.0)),
+                    }),
+                    Obj {
+                        conductor: None,
+                        n: None,
+                        k: None,
+                        eta: Some(eta),
+                        schlick: None,
+                    } => Ok(FresnelSpec::Dielectric(eta)),
+                    Obj {
+                        conductor: None,
+                        n: None,
+                        k: None,
+                        eta: None,
+                        schlick: Some(f0),
+                    } => Ok(FresnelSpec::Schlick(f0)),
+                    _ => Err(D::Error::custom(
+                        "expected exactly one of {\"conductor\": NAME}, {\"n\": X, \"k\": X}, {\"eta\": X}, {\"schlick\": X}",
+                    )),
+                }
+            }
+            other => Err(D::Error::custom(format!(
+                "expected \"none\", {{\"conductor\": NAME}}, {{\"n\": X, \"k\": X}}, {{\"eta\": X}} or {{\"schlick\": X}}, got {other}"
+            ))),
+        }
+    }
+}
+
+/// A Fresnel term resolved for a channel set: per-channel constants, ready to evaluate without
+/// allocation, plus the spectral data for evaluation at arbitrary wavelengths.
+#[derive(Debug, Clone)]
+pub enum Fresnel {
+    /// F = 1.
+    None,
+    /// Complex index per channel.
+    Conductor {
+        /// n per channel.
+        n: Vec<f64>,
+        /// k per channel.
+        k: Vec<f64>,
+        /// n as a spectrum.
+        n_spec: Value,
+        /// k as a spectrum.
+        k_spec: Value,
+    },
+    /// Relative index per channel.
+    Dielectric {
+        /// eta per channel.
+        eta: Vec<f64>,
+        /// eta as a spectrum.
+        eta_spec: Value,
+    },
+    /// Schlick's approximation, F0 per channel.
+    Schlick {
+        /// F0 per channel.
+        f0: Vec<f64>,
+        /// F0 as a spectrum.
+        f0_spec: Value,
+    },
+}
+
+impl Fresnel {
+    /// Resolves a spec for `channels`, validating it; `field` names the spec field in errors.
+    pub fn new(spec: &FresnelSpec, channels: &Channels, field: &str) -> Result<Self> {
+        Ok(match spec {
+            FresnelSpec::None => Fresnel::None,
+            FresnelSpec::Conductor(name) => {
+                let (n, k) = crate::metals::metal(name).ok_or_else(|| {
+                    Error::spec(
+                        format!("{field}.conductor"),
+                        format!(
+                            "unknown metal `{name}` (known: {})",
+                            crate::metals::NAMES.join(", ")
+                        ),
+                    )
+                })?;
+                Fresnel::Conductor {
+                    n: n.resolve(channels),
+                    k: k.resolve(channels),
+                    n_spec: n,
+                    k_spec: k,
+                }
+            }
+            FresnelSpec::Complex { n, k } => {
+                n.validate(&format!("{field}.n"), 0.0)?;
+                k.validate(&format!("{field}.k"), 0.0)?;
+                if n.numbers().iter().any(|&x| x <= 0.0) {
+                    return Err(Error::spec(format!("{field}.n"), "must be positive"));
+                }
+                Fresnel::Conductor {
+                    n: n.resolve(channels),
+                    k: k.resolve(channels),
+                    n_spec: n.clone(),
+                    k_spec: k.clone(),
+                }
+            }
+            FresnelSpec::Dielectric(eta) => {
+                eta.validate(&format!("{field}.eta"), 0.0)?;
+                if eta.numbers().iter().any(|&x| x <= 0.0) {
+                    return Err(Error::spec(format!("{field}.eta"), "must be positive"));
+                }
+                Fresnel::Dielectric {
+                    eta: eta.resolve(channels),
+                    eta_spec: eta.clone(),
+                }
+            }
+            FresnelSpec::Schlick(f0) => {
+                f0.validate(&format!("{field}.schlick"), 0.0)?;
+                if f0.numbers().iter().any(|&x| x > 1.0) {
+                    return Err(Error::spec(format!("{field}.schlick"), "F0 must be ≤ 1"));
+                }
+                Fresnel::Schlick {
+                    f0: f0.resolve(channels),
+                    f0_spec: f0.clone(),
+                }
+            }
+        })
+    }
+
+    /// F for channel `c` at incidence cosine `cos_i` (the lecture's L·H or N·V).
+    #[inline]
+    pub fn eval(&self, cos_i: f64, c: usize) -> f64 {
+        match self {
+            Fresnel::None => 1.0,
+            Fresnel::Conductor { n, k, .. } => conductor(cos_i, n[c], k[c]),
+            Fresnel::Dielectric { eta, .. } => dielectric(cos_i, eta[c]),
+            Fresnel::Schlick { f0, .. } => schlick(cos_i, f0[c]),
+        }
+    }
+
+    /// F at wavelength `nm` from the spectral data.
+    pub fn eval_at(&self, cos_i: f64, nm: f64) -> f64 {
+        match self {
+            Fresnel::None => 1.0,
+            Fresnel::Conductor { n_spec, k_spec, .. } => {
+                conductor(cos_i, n_spec.at(nm), k_spec.at(nm))
+            }
+            Fresnel::Dielectric { eta_spec, .. } => dielectric(cos_i, eta_spec.at(nm)),
+            Fresnel::Schlick { f0_spec, .. } => schlick(cos_i, f0_spec.at(nm)),
+        }
+    }
+
+    /// True for F = 1.
+    pub fn is_none(&self) -> bool {
+        matches!(self, Fresnel::None)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normal_incidence_closed_form() {
+        for &(n, k) in &[(1.5, 0.0), (0.2, 3.0), (0.15, 3.6), (1.1, 7.0), (2.5, 0.3)] {
+            let expect = ((n - 1.0) * (n - 1.0) + k * k) / ((n + 1.0) * (n + 1.0) + k * k);
+            let got = conductor(1.0, n, k);
+            assert!(
+                (got - expect).abs() < 1e-14,
+                "n={n} k={k}: {got} vs {expect}"
+            );
+        }
+        let expect = (0.5f64 / 2.5).powi(2);
+        assert!((dielectric(1.0, 1.5) - expect).abs() < 1e-14);
+    }
+
+    #[test]
+    fn brewster_angle_zeroes_parallel() {
+        for &eta in &[1.33, 1.5, 2.4] {
+            let theta_b = f64::atan(eta);
+            let (f_par, f_perp) = conductor_polarized(theta_b.cos(), eta, 0.0);
+            assert!(f_par < 1e-15, "eta={eta}: F∥ = {f_par}");
+            assert!(f_perp > 0.01);
+        }
+    }
+
+    #[test]
+    fn dielectric_matches_conductor_with_k_zero() {
+        for i in 0..=100 {
+            let c = i as f64 / 100.0;
+            assert!((dielectric(c, 1.5) - conductor(c, 1.5, 0.0)).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn total_internal_reflection() {
+        // From inside glass (cos_i < 0), beyond the critical angle asin(1/1.5) ≈ 41.8°.
+        let theta = 50f64.to_radians();
+        assert_eq!(dielectric(-theta.cos(), 1.5), 1.0);
+        let theta = 30f64.to_radians();
+        assert!(dielectric(-theta.cos(), 1.5) < 1.0);
+    }
+
+    #[test]
+    fn grazing_incidence_reflects_everything() {
+        assert!((conductor(1e-9, 0.2, 3.0) - 1.0).abs() < 1e-6);
+        assert!((dielectric(1e-9, 1.5) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn spec_json_forms() {
+        let a: FresnelSpec = serde_json::from_str("\"none\"").unwrap();
+        assert_eq!(a, FresnelSpec::None);
+        let b: FresnelSpec = serde_json::from_str(r#"{"n": 0.2, "k": 3}"#).unwrap();
+        assert!(matches!(b, FresnelSpec::Complex { .. }));
+        let c: FresnelSpec = serde_json::from_str(r#"{"eta": 1.5}"#).unwrap();
+        assert!(matches!(c, FresnelSpec::Dielectric(_)));
+        assert!(serde_json::from_str::<FresnelSpec>(r#"{"eta": 1.5, "n": 2}"#).is_err());
+        assert!(serde_json::from_str::<FresnelSpec>(r#"{"bogus": 1}"#).is_err());
+        assert!(serde_json::from_str::<FresnelSpec>("\"schlick\"").is_err());
+        let back = serde_json::to_string(&b).unwrap();
+        assert_eq!(serde_json::from_str::<FresnelSpec>(&back).unwrap(), b);
+    }
+}

@@ -1,0 +1,267 @@
+//! Directions in the local shading frame: validation, spherical angles, reflection, the
+//! Rusinkiewicz half/difference transform, orthonormal frames and the basic warps.
+//!
+//! Everything here is small, `Copy` and allocation-free, because it sits on the hot path of every
+//! evaluation and lookup. Where vector algebra suffices it is used instead of trigonometry
+//! (e.g. the half/diff rotation uses cos θh = h_z and sin θh = |h_xy|, not `acos` and `sin`).
+
+use glam::{DVec2, DVec3};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+/// Normalizes `v`, or returns `None` for zero, infinite or NaN vectors.
+#[inline]
+pub fn normalize(v: DVec3) -> Option<DVec3> {
+    let l2 = v.length_squared();
+    if l2 > 0.0 && l2.is_finite() {
+        Some(v / l2.sqrt())
+    } else {
+        None
+    }
+}
+
+/// Normalizes a pair of directions and checks that both lie strictly above the horizon
+/// (z > 0). Returns `None` otherwise — the caller then returns 0 (see the `Brdf` conventions).
+#[inline]
+pub fn upper_pair(wi: DVec3, wo: DVec3) -> Option<(DVec3, DVec3)> {
+    let wi = normalize(wi)?;
+    let wo = normalize(wo)?;
+    if wi.z > 0.0 && wo.z > 0.0 {
+        Some((wi, wo))
+    } else {
+        None
+    }
+}
+
+/// The unit direction with polar angle `theta` from +z and azimuth `phi` from +x:
+/// (sin θ cos φ, sin θ sin φ, cos θ).
+#[inline]
+pub fn spherical(theta: f64, phi: f64) -> DVec3 {
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = phi.sin_cos();
+    DVec3::new(st * cp, st * sp, ct)
+}
+
+/// Polar angle θ ∈ [0, π] and azimuth φ ∈ (−π, π] of a unit direction.
+#[inline]
+pub fn to_spherical(w: DVec3) -> (f64, f64) {
+    (w.z.clamp(-1.0, 1.0).acos(), w.y.atan2(w.x))
+}
+
+/// Ideal mirror reflection of `w` about the normal `n` (both unit): 2 (n·w) n − w.
+/// With n = z this is the lecture's ω_r = 2 cos α N − ω.
+#[inline]
+pub fn reflect(w: DVec3, n: DVec3) -> DVec3 {
+    2.0 * n.dot(w) * n - w
+}
+
+/// Mirror reflection about the local normal z: (−x, −y, z).
+#[inline]
+pub fn reflect_z(w: DVec3) -> DVec3 {
+    DVec3::new(-w.x, -w.y, w.z)
+}
+
+/// Rusinkiewicz (1998) half/difference angles of a direction pair, as in the MERL reader.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HalfDiff {
+    /// Polar angle of the half vector, [0, π/2].
+    pub theta_h: f64,
+    /// Azimuth of the half vector, (−π, π].
+    pub phi_h: f64,
+    /// Polar angle of the difference vector, [0, π/2].
+    pub theta_d: f64,
+    /// Azimuth of the difference vector, (−π, π].
+    pub phi_d: f64,
+}
+
+/// Half vector and difference vector (unit) of a pair: h = normalize(wi + wo); d is `wi` rotated
+/// by −φh about z and then by −θh about y. Computed with vector algebra only.
+///
+/// `wi` and `wo` must be unit; returns `None` when they are opposite (no half vector).
+#[inline]
+pub fn half_diff_vectors(wi: DVec3, wo: DVec3) -> Option<(DVec3, DVec3)> {
+    let h = normalize(wi + wo)?;
+    let sin_th = (h.x * h.x + h.y * h.y).sqrt();
+    let cos_th = h.z;
+    // cos φh, sin φh (φh = 0 at the pole, as atan2(0, 0) = 0 in the MERL reader).
+    let (cos_ph, sin_ph) = if sin_th > 1e-12 {
+        (h.x / sin_th, h.y / sin_th)
+    } else {
+        (1.0, 0.0)
+    };
+    // Rotate wi by −φh about z.
+    let tx = wi.x * cos_ph + wi.y * sin_ph;
+    let ty = -wi.x * sin_ph + wi.y * cos_ph;
+    let tz = wi.z;
+    // Rotate by −θh about y.
+    let d = DVec3::new(tx * cos_th - tz * sin_th, ty, tz * cos_th + tx * sin_th);
+    Some((h, d))
+}
+
+/// Half/difference angles of a pair of unit directions (see [`half_diff_vectors`]).
+#[inline]
+pub fn to_half_diff(wi: DVec3, wo: DVec3) -> Option<HalfDiff> {
+    let (h, d) = half_diff_vectors(wi, wo)?;
+    let (theta_h, phi_h) = to_spherical(h);
+    let (theta_d, phi_d) = to_spherical(d);
+    Some(HalfDiff {
+        theta_h,
+        phi_h,
+        theta_d,
+        phi_d,
+    })
+}
+
+/// The direction pair `(wi, wo)` of half/difference angles (inverse of [`to_half_diff`]).
+pub fn from_half_diff(hd: HalfDiff) -> (DVec3, DVec3) {
+    let d = spherical(hd.theta_d, hd.phi_d);
+    let rot = |v: DVec3| -> DVec3 {
+        // Rotate by +θh about y, then by +φh about z.
+        let (st, ct) = hd.theta_h.sin_cos();
+        let x = v.x * ct + v.z * st;
+        let z = -v.x * st + v.z * ct;
+        let (sp, cp) = hd.phi_h.sin_cos();
+        DVec3::new(x * cp - v.y * sp, x * sp + v.y * cp, z)
+    };
+    (rot(d), rot(DVec3::new(-d.x, -d.y, d.z)))
+}
+
+/// An orthonormal frame (tangent `s`, bitangent `t`, normal `n`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// Tangent (local x).
+    pub s: DVec3,
+    /// Bitangent (local y).
+    pub t: DVec3,
+    /// Normal (local z).
+    pub n: DVec3,
+}
+
+impl Frame {
+    /// A frame around the unit normal `n` (Duff et al. 2017, branchless and continuous except
+    /// across n.z = 0).
+    pub fn from_normal(n: DVec3) -> Self {
+        let sign = 1.0f64.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let s = DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let t = DVec3::new(b, sign + n.y * n.y * a, -n.y);
+        Frame { s, t, n }
+    }
+
+    /// World → local coordinates.
+    #[inline]
+    pub fn to_local(&self, v: DVec3) -> DVec3 {
+        DVec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
+
+    /// Local → world coordinates.
+    #[inline]
+    pub fn to_world(&self, v: DVec3) -> DVec3 {
+        self.s * v.x + self.t * v.y + self.n * v.z
+    }
+}
+
+/// Maps the unit square to the unit disk, preserving area (Shirley & Chiu's concentric map).
+#[inline]
+pub fn concentric_disk(u: DVec2) -> DVec2 {
+    let a = 2.0 * u - DVec2::ONE;
+    if a.x == 0.0 && a.y == 0.0 {
+        return DVec2::ZERO;
+    }
+    let (r, theta) = if a.x.abs() > a.y.abs() {
+        (a.x, FRAC_PI_4 * (a.y / a.x))
+    } else {
+        (a.y, FRAC_PI_2 - FRAC_PI_4 * (a.x / a.y))
+    };
+    let (s, c) = theta.sin_cos();
+    DVec2::new(r * c, r * s)
+}
+
+/// Cosine-weighted direction on the upper hemisphere (density cos θ / π).
+#[inline]
+pub fn cosine_hemisphere(u: DVec2) -> DVec3 {
+    let d = concentric_disk(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    DVec3::new(d.x, d.y, z)
+}
+
+/// Uniform direction on the upper hemisphere (density 1 / 2π).
+#[inline]
+pub fn uniform_hemisphere(u: DVec2) -> DVec3 {
+    let z = u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    DVec3::new(r * c, r * s, z)
+}
+
+/// Uniform direction on the whole sphere (density 1 / 4π).
+#[inline]
+pub fn uniform_sphere(u: DVec2) -> DVec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    DVec3::new(r * c, r * s, z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Pcg32;
+
+    #[test]
+    fn half_diff_round_trip() {
+        let mut rng = Pcg32::new(7);
+        for _ in 0..10_000 {
+            let wi = uniform_hemisphere(rng.next_dvec2());
+            let wo = uniform_hemisphere(rng.next_dvec2());
+            let hd = to_half_diff(wi, wo).unwrap();
+            let (a, b) = from_half_diff(hd);
+            assert!((a - wi).length() < 1e-9, "{wi} {a}");
+            assert!((b - wo).length() < 1e-9, "{wo} {b}");
+        }
+    }
+
+    #[test]
+    fn half_diff_of_specular_pair_has_theta_h_zero() {
+        let wi = spherical(0.7, 0.3);
+        let hd = to_half_diff(wi, reflect_z(wi)).unwrap();
+        assert!(hd.theta_h.abs() < 1e-7);
+        assert!((hd.theta_d - 0.7).abs() < 1e-9);
+    }
+
+    #[test]
+    fn reciprocity_is_phi_d_plus_pi() {
+        let mut rng = Pcg32::new(3);
+        for _ in 0..1000 {
+            let wi = uniform_hemisphere(rng.next_dvec2());
+            let wo = uniform_hemisphere(rng.next_dvec2());
+            let a = to_half_diff(wi, wo).unwrap();
+            let b = to_half_diff(wo, wi).unwrap();
+            assert!((a.theta_h - b.theta_h).abs() < 1e-9);
+            assert!((a.theta_d - b.theta_d).abs() < 1e-9);
+            let dphi = (a.phi_d - b.phi_d).rem_euclid(2.0 * PI);
+            assert!((dphi - PI).abs() < 1e-7, "{dphi}");
+        }
+    }
+
+    #[test]
+    fn frame_is_orthonormal() {
+        let mut rng = Pcg32::new(1);
+        for _ in 0..1000 {
+            let n = uniform_sphere(rng.next_dvec2());
+            let f = Frame::from_normal(n);
+            assert!((f.s.length() - 1.0).abs() < 1e-12);
+            assert!((f.t.length() - 1.0).abs() < 1e-12);
+            assert!(f.s.dot(f.t).abs() < 1e-12 && f.s.dot(n).abs() < 1e-12);
+            let v = uniform_sphere(rng.next_dvec2());
+            assert!((f.to_world(f.to_local(v)) - v).length() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn invalid_directions_are_rejected() {
+        assert!(normalize(DVec3::ZERO).is_none());
+        assert!(normalize(DVec3::new(f64::NAN, 0.0, 1.0)).is_none());
+        assert!(upper_pair(DVec3::Z, DVec3::new(0.0, 1.0, -0.1)).is_none());
+    }
+}

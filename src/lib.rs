@@ -1,0 +1,43 @@
+//! # brdftab — tabulated BRDFs
+//!
+//! A library of BRDF models behind one [`Brdf`] trait, dense symmetry-reduced compressed tables
+//! that sample any `Brdf` or load measured data, and the tools around them.
+//!
+//! Data flows one way (see `DESIGN.md`): a source — an analytic model ([`models`], described by a
+//! [`spec::ModelSpec`]) or a measurement ([`measured`]) — is baked on a grid into a dense table
+//! ([`table`]); the table is split into chunks that the [`codec`] turns into bytes; the [`store`]
+//! writes chunks and metadata; opening gives back a `TabulatedBrdf` that implements `Brdf` again.
+//! Every consumer — [`analysis`], [`render`], the `brdftab` CLI — sees only `Brdf`.
+//!
+//! ```
+//! use brdftab::{Brdf, spec::ModelSpec, spectrum::Channels};
+//! use glam::DVec3;
+//!
+//! let brdf = ModelSpec::parse(r#"{"model": "lambert", "kd": 0.2}"#)?.build(&Channels::Rgb)?;
+//! let mut f = [0.0f32; 3];
+//! brdf.eval(DVec3::new(0.0, 0.6, 0.8), DVec3::Z, &mut f);
+//! assert_eq!(f, [0.2; 3]);
+//! # Ok::<(), brdftab::Error>(())
+//! ```
+
+pub mod analysis;
+pub mod brdf;
+pub mod codec;
+pub mod error;
+pub mod fit;
+pub mod fresnel;
+pub mod geometry;
+pub mod measured;
+pub mod metals;
+pub mod models;
+pub mod render;
+pub mod rng;
+pub mod spec;
+pub mod spectrum;
+pub mod store;
+pub mod table;
+
+pub use brdf::{Brdf, BrdfSample, Flags};
+pub use error::{Error, Result};
+pub use spec::ModelSpec;
+pub use spectrum::{Channels, Value};

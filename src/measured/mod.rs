@@ -1,0 +1,1 @@
+//! Measured BRDF data: MERL and RGL-EPFL readers.

@@ -1,0 +1,120 @@
+//! Lambert's diffuse model: the BRDF is a constant, f_r = k_d.
+//!
+//! Lecture: "Radiance is independent of the out direction; Helmholtz: independent of the in
+//! direction; BRDF is constant". The albedo has the closed form
+//! a = ∫ k_d cos θ dω = k_d π, so energy is conserved only for k_d ≤ 1/π.
+
+use glam::DVec3;
+
+use crate::brdf::{Brdf, Flags};
+use crate::error::Result;
+use crate::geometry;
+use crate::spectrum::{Channels, Value};
+
+/// Lambertian (diffuse) reflection, f_r = k_d(λ).
+#[derive(Debug, Clone)]
+pub struct Lambert {
+    channels: Channels,
+    kd_spec: Value,
+    kd: Vec<f32>,
+}
+
+impl Lambert {
+    /// A Lambert model with diffuse coefficient `kd` (the BRDF value; albedo kd·π).
+    pub fn new(kd: Value, channels: &Channels) -> Result<Self> {
+        kd.validate("kd", 0.0)?;
+        Ok(Lambert {
+            channels: channels.clone(),
+            kd: kd.resolve(channels).iter().map(|&x| x as f32).collect(),
+            kd_spec: kd,
+        })
+    }
+}
+
+impl Brdf for Lambert {
+    fn channels(&self) -> &Channels {
+        &self.channels
+    }
+
+    #[inline]
+    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+        // Only the horizon test needs the directions; no normalization is needed for the sign.
+        let above = wi.z > 0.0 && wo.z > 0.0 && wi.is_finite() && wo.is_finite();
+        let out = &mut out[..self.kd.len()];
+        if above {
+            out.copy_from_slice(&self.kd);
+        } else {
+            out.fill(0.0);
+        }
+    }
+
+    fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        if geometry::upper_pair(wi, wo).is_some() {
+            self.kd_spec.at(nm)
+        } else {
+            0.0
+        }
+    }
+
+    fn flags(&self) -> Flags {
+        Flags::SMOOTH_SYMMETRIC
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "lambert kd={}",
+            serde_json::to_string(&self.kd_spec).unwrap_or_default()
+        )
+    }
+
+    /// Closed form: a = k_d · π for every incident direction above the horizon.
+    fn albedo(&self, wi: DVec3, out: &mut [f64]) {
+        let above = geometry::normalize(wi).is_some_and(|w| w.z > 0.0);
+        for (o, &k) in out.iter_mut().zip(&self.kd) {
+            *o = if above {
+                k as f64 * std::f64::consts::PI
+            } else {
+                0.0
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::albedo::quadrature;
+
+    #[test]
+    fn albedo_is_kd_pi_at_several_angles() {
+        let l = Lambert::new(Value::Rgb([0.1, 0.2, 0.3]), &Channels::Rgb).unwrap();
+        for deg in [0.0f64, 30.0, 60.0, 85.0] {
+            let wi = geometry::spherical(deg.to_radians(), 0.4);
+            let mut a = [0.0; 3];
+            l.albedo(wi, &mut a);
+            let mut q = [0.0; 3];
+            quadrature(&l, wi, &mut q);
+            for c in 0..3 {
+                let expect = [0.1, 0.2, 0.3][c] as f32 as f64 * std::f64::consts::PI;
+                assert!((a[c] - expect).abs() < 1e-12);
+                // The default quadrature must agree with the closed form to 1e-4.
+                assert!(
+                    (q[c] - expect).abs() < 1e-4 * expect,
+                    "{deg}: {} vs {expect}",
+                    q[c]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn below_horizon_and_nan_give_zero() {
+        let l = Lambert::new(Value::Grey(0.3), &Channels::Rgb).unwrap();
+        let mut f = [1.0f32; 3];
+        l.eval(DVec3::new(0.0, 0.0, -1.0), DVec3::Z, &mut f);
+        assert_eq!(f, [0.0; 3]);
+        let mut f = [1.0f32; 3];
+        l.eval(DVec3::new(f64::NAN, 0.0, 1.0), DVec3::Z, &mut f);
+        assert_eq!(f, [0.0; 3]);
+    }
+}

@@ -1,0 +1,1 @@
+//! Preview renderer: path tracing and lit spheres for looking at materials.

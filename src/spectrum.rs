@@ -1,0 +1,380 @@
+//! Channel sets and spectrally varying parameters.
+//!
+//! A BRDF in brdftab returns one value per *channel*. A channel set is either RGB or an explicit
+//! list of wavelengths in nanometres ([`Channels`]). Model parameters ([`Value`]) may be grey, RGB
+//! or sampled spectra; they are resolved once, when a model is built for a channel set, so that
+//! evaluation never allocates or interpolates parameters.
+//!
+//! RGB and wavelengths meet at the *representative wavelengths* [`RGB_WAVELENGTHS`]: an RGB
+//! channel is treated as the spectrum at that wavelength when spectral data (e.g. a metal's n, k)
+//! must be evaluated for RGB, and an RGB parameter is interpolated piecewise linearly between
+//! those wavelengths (constant outside) when a spectral channel set asks for it. This is the
+//! "representative wavelength" convention of simple spectral renderers; it keeps a grey parameter
+//! exactly grey in either mode.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+
+/// Representative wavelengths (nm) of the R, G and B channels, used to convert between RGB and
+/// spectral data (red 645 nm, green 526 nm, blue 444 nm).
+pub const RGB_WAVELENGTHS: [f64; 3] = [645.0, 526.0, 444.0];
+
+/// The most channels a channel set may have (keeps stack buffers possible for callers).
+pub const MAX_CHANNELS: usize = 64;
+
+/// The channel set of a BRDF: RGB, or wavelengths in nm (strictly increasing).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Channels {
+    /// Three channels, red, green, blue (linear sRGB primaries).
+    #[default]
+    Rgb,
+    /// Sampled spectrum: the wavelengths in nm, strictly increasing.
+    Wavelengths(Vec<f64>),
+}
+
+impl Channels {
+    /// A spectral channel set; checks that the wavelengths are finite, positive, strictly
+    /// increasing, and at most [`MAX_CHANNELS`].
+    pub fn wavelengths(nm: Vec<f64>) -> Result<Self> {
+        if nm.is_empty() {
+            return Err(Error::arg(
+                "wavelengths",
+                "at least one wavelength is needed",
+            ));
+        }
+        if nm.len() > MAX_CHANNELS {
+            return Err(Error::arg(
+                "wavelengths",
+                format!("{} wavelengths given, at most {MAX_CHANNELS}", nm.len()),
+            ));
+        }
+        for (i, &w) in nm.iter().enumerate() {
+            if !(w.is_finite() && w > 0.0) {
+                return Err(Error::arg("wavelengths", format!("wavelength {i} is {w}")));
+            }
+            if i > 0 && w <= nm[i - 1] {
+                return Err(Error::arg(
+                    "wavelengths",
+                    "wavelengths must be strictly increasing",
+                ));
+            }
+        }
+        Ok(Channels::Wavelengths(nm))
+    }
+
+    /// `n` wavelengths evenly spaced from `start` to `end` nm inclusive.
+    pub fn linspace(start: f64, end: f64, n: usize) -> Result<Self> {
+        if n == 1 {
+            return Self::wavelengths(vec![start]);
+        }
+        Self::wavelengths(
+            (0..n)
+                .map(|i| start + (end - start) * i as f64 / (n - 1) as f64)
+                .collect(),
+        )
+    }
+
+    /// Number of channels.
+    pub fn len(&self) -> usize {
+        match self {
+            Channels::Rgb => 3,
+            Channels::Wavelengths(w) => w.len(),
+        }
+    }
+
+    /// Always false: a channel set has at least one channel.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The wavelength (nm) of channel `i`: the representative wavelength for RGB.
+    pub fn wavelength(&self, i: usize) -> f64 {
+        match self {
+            Channels::Rgb => RGB_WAVELENGTHS[i],
+            Channels::Wavelengths(w) => w[i],
+        }
+    }
+
+    /// Short names of the channels: `R G B`, or the wavelengths (`550nm`).
+    pub fn names(&self) -> Vec<String> {
+        match self {
+            Channels::Rgb => vec!["R".into(), "G".into(), "B".into()],
+            Channels::Wavelengths(w) => w.iter().map(|x| format!("{x}nm")).collect(),
+        }
+    }
+
+    /// Interpolation weights to evaluate channel data at wavelength `nm`:
+    /// returns `(i0, i1, t)` so that `value = (1 - t) v[i0] + t v[i1]`. Outside the range the
+    /// nearest end channel is used. For RGB the channels are ordered by their representative
+    /// wavelengths (B < G < R).
+    pub fn lerp_at(&self, nm: f64) -> (usize, usize, f64) {
+        match self {
+            Channels::Rgb => {
+                // Wavelength order: B (2) at 444, G (1) at 526, R (0) at 645.
+                let order = [2usize, 1, 0];
+                let w = [444.0, 526.0, 645.0];
+                lerp_sorted(&w, nm, |k| order[k])
+            }
+            Channels::Wavelengths(w) => lerp_sorted(w, nm, |k| k),
+        }
+    }
+}
+
+fn lerp_sorted(w: &[f64], nm: f64, map: impl Fn(usize) -> usize) -> (usize, usize, f64) {
+    let n = w.len();
+    if n == 1 || nm.is_nan() || nm <= w[0] {
+        return (map(0), map(0), 0.0);
+    }
+    if nm >= w[n - 1] {
+        return (map(n - 1), map(n - 1), 0.0);
+    }
+    let k = w.partition_point(|&x| x <= nm).clamp(1, n - 1);
+    let t = (nm - w[k - 1]) / (w[k] - w[k - 1]);
+    (map(k - 1), map(k), t)
+}
+
+/// A model parameter that may vary with wavelength: grey, RGB, or a sampled spectrum.
+///
+/// In JSON: a number (`0.5`), an array of three (`[0.8, 0.6, 0.2]`), or
+/// `{"wavelengths": [..], "values": [..]}`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    /// The same value in every channel.
+    Grey(f64),
+    /// One value per R, G, B channel.
+    Rgb([f64; 3]),
+    /// A sampled spectrum, interpolated linearly (constant outside the samples).
+    Spectral {
+        /// Wavelengths in nm, strictly increasing.
+        wavelengths: Vec<f64>,
+        /// Values at those wavelengths.
+        values: Vec<f64>,
+    },
+}
+
+impl Value {
+    /// The value at wavelength `nm` (RGB values are placed at [`RGB_WAVELENGTHS`]).
+    pub fn at(&self, nm: f64) -> f64 {
+        match self {
+            Value::Grey(v) => *v,
+            Value::Rgb(rgb) => {
+                let (i0, i1, t) = Channels::Rgb.lerp_at(nm);
+                (1.0 - t) * rgb[i0] + t * rgb[i1]
+            }
+            Value::Spectral {
+                wavelengths,
+                values,
+            } => {
+                let (i0, i1, t) = lerp_sorted(wavelengths, nm, |k| k);
+                (1.0 - t) * values[i0] + t * values[i1]
+            }
+        }
+    }
+
+    /// The value for every channel of `channels`.
+    ///
+    /// RGB values on RGB channels are taken as they are; everything else is evaluated at the
+    /// channels' wavelengths.
+    pub fn resolve(&self, channels: &Channels) -> Vec<f64> {
+        match (self, channels) {
+            (Value::Rgb(rgb), Channels::Rgb) => rgb.to_vec(),
+            _ => (0..channels.len())
+                .map(|i| self.at(channels.wavelength(i)))
+                .collect(),
+        }
+    }
+
+    /// Every number in the value (for validation).
+    pub fn numbers(&self) -> Vec<f64> {
+        match self {
+            Value::Grey(v) => vec![*v],
+            Value::Rgb(v) => v.to_vec(),
+            Value::Spectral { values, .. } => values.clone(),
+        }
+    }
+
+    /// Checks the value: finite, and `>= min` (use `f64::NEG_INFINITY` for no bound); spectra
+    /// need matching lengths and increasing wavelengths. `field` names the value in the error.
+    pub fn validate(&self, field: &str, min: f64) -> Result<()> {
+        if let Value::Spectral {
+            wavelengths,
+            values,
+        } = self
+        {
+            if wavelengths.is_empty() || wavelengths.len() != values.len() {
+                return Err(Error::spec(
+                    field,
+                    format!(
+                        "spectrum needs as many values ({}) as wavelengths ({}), at least one",
+                        values.len(),
+                        wavelengths.len()
+                    ),
+                ));
+            }
+            if wavelengths
+                .windows(2)
+                .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+                || wavelengths.iter().any(|w| !w.is_finite() || *w <= 0.0)
+            {
+                return Err(Error::spec(
+                    field,
+                    "wavelengths must be positive and strictly increasing",
+                ));
+            }
+        }
+        for v in self.numbers() {
+            if !v.is_finite() {
+                return Err(Error::spec(field, format!("{v} is not a finite number")));
+            }
+            if v < min {
+                return Err(Error::spec(
+                    field,
+                    format!("{v} is below the minimum {min}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The mean over channels of `channels` (used e.g. for mixture weights).
+    pub fn mean(&self, channels: &Channels) -> f64 {
+        let v = self.resolve(channels);
+        v.iter().sum::<f64>() / v.len() as f64
+    }
+}
+
+impl From<f64> for Value {
+    fn from(v: f64) -> Self {
+        Value::Grey(v)
+    }
+}
+
+impl Serialize for Value {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        match self {
+            Value::Grey(v) => s.serialize_f64(*v),
+            Value::Rgb(v) => v.serialize(s),
+            Value::Spectral {
+                wavelengths,
+                values,
+            } => {
+                let mut m = s.serialize_map(Some(2))?;
+                m.serialize_entry("wavelengths", wavelengths)?;
+                m.serialize_entry("values", values)?;
+                m.end()
+            }
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Value {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let v = serde_json::Value::deserialize(d)?;
+        match v {
+            serde_json::Value::Number(n) => n
+                .as_f64()
+                .map(Value::Grey)
+                .ok_or_else(|| D::Error::custom("number out of range")),
+            serde_json::Value::Array(a) => {
+                if a.len() != 3 {
+                    return Err(D::Error::custom(format!(
+                        "an RGB value needs 3 numbers, got {}",
+                        a.len()
+                    )));
+                }
+                let mut rgb = [0.0; 3];
+                for (i, x) in a.iter().enumerate() {
+                    rgb[i] = x.as_f64().ok_or_else(|| {
+                        D::Error::custom(format!("RGB entry {i} is not a number"))
+                    })?;
+                }
+                Ok(Value::Rgb(rgb))
+            }
+            serde_json::Value::Object(o) => {
+                #[derive(Deserialize)]
+                #[serde(deny_unknown_fields)]
+                struct Spec {
+                    wavelengths: Vec<f64>,
+                    values: Vec<f64>,
+                }
+                let s: Spec = serde_json::from_value(serde_json::Value::Object(o))
+                    .map_err(|e| D::Error::custom(format!("spectrum: {e}")))?;
+                Ok(Value::Spectral {
+                    wavelengths: s.wavelengths,
+                    values: s.values,
+                })
+            }
+            other => Err(D::Error::custom(format!(
+                "expected a number, an array of 3 (RGB) or {{\"wavelengths\": [..], \"values\": [..]}}, got {other}"
+            ))),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rgb_value_on_rgb_channels_is_exact() {
+        let v = Value::Rgb([0.1, 0.2, 0.3]);
+        assert_eq!(v.resolve(&Channels::Rgb), vec![0.1, 0.2, 0.3]);
+    }
+
+    #[test]
+    fn grey_stays_grey_in_every_mode() {
+        let v = Value::Grey(0.25);
+        let ch = Channels::linspace(400.0, 700.0, 7).unwrap();
+        assert!(v.resolve(&ch).iter().all(|&x| x == 0.25));
+    }
+
+    #[test]
+    fn spectral_interpolates_linearly_and_clamps() {
+        let v = Value::Spectral {
+            wavelengths: vec![400.0, 500.0],
+            values: vec![1.0, 3.0],
+        };
+        assert_eq!(v.at(450.0), 2.0);
+        assert_eq!(v.at(300.0), 1.0);
+        assert_eq!(v.at(900.0), 3.0);
+    }
+
+    #[test]
+    fn rgb_at_representative_wavelengths() {
+        let v = Value::Rgb([1.0, 2.0, 3.0]);
+        for (i, &nm) in RGB_WAVELENGTHS.iter().enumerate() {
+            assert!((v.at(nm) - (i as f64 + 1.0)).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn json_forms_parse_and_bad_forms_fail() {
+        let a: Value = serde_json::from_str("0.5").unwrap();
+        assert_eq!(a, Value::Grey(0.5));
+        let b: Value = serde_json::from_str("[1,2,3]").unwrap();
+        assert_eq!(b, Value::Rgb([1.0, 2.0, 3.0]));
+        let c: Value = serde_json::from_str(r#"{"wavelengths":[400,500],"values":[1,2]}"#).unwrap();
+        assert!(matches!(c, Value::Spectral { .. }));
+        assert!(serde_json::from_str::<Value>("[1,2]").is_err());
+        assert!(serde_json::from_str::<Value>("\"x\"").is_err());
+        assert!(
+            serde_json::from_str::<Value>(r#"{"wavelengths":[1],"values":[1],"z":1}"#).is_err()
+        );
+    }
+
+    #[test]
+    fn validation_names_the_field() {
+        let e = Value::Grey(-1.0).validate("kd", 0.0).unwrap_err();
+        assert!(e.to_string().contains("kd"), "{e}");
+        assert!(Value::Grey(f64::NAN).validate("kd", 0.0).is_err());
+        let bad = Value::Spectral {
+            wavelengths: vec![500.0, 400.0],
+            values: vec![1.0, 1.0],
+        };
+        assert!(bad.validate("k", 0.0).is_err());
+    }
+}

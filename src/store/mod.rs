@@ -1,0 +1,1 @@
+//! The brdftab file format and database of named tables.

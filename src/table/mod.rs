@@ -1,0 +1,1 @@
+//! Dense 5D tables: grids, symmetry reduction, baking, interpolated lookup.

@@ -1,0 +1,39 @@
+//! `brdftab`: the command-line tool. Thin over the library: parse arguments, call the library,
+//! print. Errors print as `error: ...` on stderr with exit code 1.
+
+mod models;
+mod source;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Tabulated BRDFs: analytic models, dense compressed tables, measured data.
+#[derive(Parser)]
+#[command(name = "brdftab", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Evaluate f_r for direction pairs read from stdin (`wix wiy wiz wox woy woz` per line).
+    Eval(models::EvalArgs),
+    /// List every model with its parameters.
+    Models(models::ModelsArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Eval(a) => models::eval(a),
+        Command::Models(a) => models::models(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
