@@ -1,7 +1,38 @@
-//! Opening a SOURCE argument: an inline JSON spec (starts with `{`) or a `.json` spec file.
-//! Later: table files, databases (`DB#NAME`), MERL `.binary` and RGL `.bsdf` files.
+//! Opening a SOURCE argument as a `Brdf`.
+//!
+//! A SOURCE is one of: an inline JSON model spec (starts with `{`), a `.json` spec file, a
+//! brdftab table file or database entry (`FILE` / `DB#NAME`), a MERL `.binary` file, or an RGL
+//! `.bsdf` file. Each kind is handled by the library; this module only dispatches.
 
 use brdftab::{Brdf, Channels, Error, ModelSpec, Result};
+
+/// What a SOURCE argument names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Inline JSON or a `.json` file.
+    Spec,
+    /// A MERL `.binary` file.
+    Merl,
+    /// An RGL `.bsdf` tensor file.
+    Rgl,
+    /// A brdftab table file or database (optionally `#NAME`).
+    Table,
+}
+
+/// Classifies a SOURCE argument.
+pub fn kind(source: &str) -> Kind {
+    let s = source.trim_start();
+    let lower = s.to_ascii_lowercase();
+    if s.starts_with('{') || lower.ends_with(".json") {
+        Kind::Spec
+    } else if lower.ends_with(".binary") {
+        Kind::Merl
+    } else if lower.ends_with(".bsdf") {
+        Kind::Rgl
+    } else {
+        Kind::Table
+    }
+}
 
 /// Parses `--wavelengths 400,500,600` into a channel set (RGB when absent).
 pub fn channels(wavelengths: Option<&str>) -> Result<Channels> {
@@ -21,12 +52,28 @@ pub fn channels(wavelengths: Option<&str>) -> Result<Channels> {
     }
 }
 
-/// Opens SOURCE as a `Brdf` with the given channels.
-pub fn open(source: &str, channels: &Channels) -> Result<Box<dyn Brdf>> {
-    let spec = if source.trim_start().starts_with('{') {
-        ModelSpec::parse(source)?
+/// Parses a spec SOURCE (inline JSON or a .json file).
+pub fn spec(source: &str) -> Result<ModelSpec> {
+    if source.trim_start().starts_with('{') {
+        ModelSpec::parse(source)
     } else {
-        ModelSpec::from_file(source)?
-    };
-    spec.build(channels)
+        ModelSpec::from_file(source)
+    }
+}
+
+/// Opens SOURCE as a `Brdf`. `channels` applies to model specs (tables and measurements have
+/// their own channel sets).
+pub fn open(source: &str, channels: &Channels) -> Result<Box<dyn Brdf>> {
+    match kind(source) {
+        Kind::Spec => spec(source)?.build(channels),
+        Kind::Merl => Err(Error::Unsupported(format!(
+            "{source}: MERL files are not supported yet"
+        ))),
+        Kind::Rgl => Err(Error::Unsupported(format!(
+            "{source}: RGL files are not supported yet"
+        ))),
+        Kind::Table => Err(Error::Unsupported(format!(
+            "{source}: table files are not supported yet"
+        ))),
+    }
 }
