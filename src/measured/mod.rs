@@ -1,1 +1,10 @@
 //! Measured BRDF data: MERL and RGL-EPFL readers.
+//!
+//! - [`tensor`]: the RGL tensor-file container (bounds-checked reader, writer for tests);
+//! - [`rgl`]: RGL-EPFL `.bsdf` measurements evaluated natively ([`RglBrdf`]);
+//! - [`merl`]: MERL `.binary` files, read and write ([`MerlBrdf`]).
+
+pub mod rgl;
+pub mod tensor;
+
+pub use rgl::RglBrdf;
