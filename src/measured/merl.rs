@@ -63,7 +63,7 @@ pub const SCALE: [f64; 3] = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
 /// θh index: `int(sqrt(θh / (π/2)) · 90)`, 0 for θh ≤ 0, clamped to [0, 89].
 #[inline]
 pub fn theta_h_index(theta_h: f64) -> usize {
-    if !(theta_h > 0.0) {
+    if theta_h.is_nan() || theta_h <= 0.0 {
         return 0;
     }
     let x = (theta_h / FRAC_PI_2).sqrt() * RES_THETA_H as f64;
@@ -74,7 +74,7 @@ pub fn theta_h_index(theta_h: f64) -> usize {
 #[inline]
 pub fn theta_d_index(theta_d: f64) -> usize {
     let x = theta_d / FRAC_PI_2 * RES_THETA_D as f64;
-    if !(x > 0.0) {
+    if x.is_nan() || x <= 0.0 {
         return 0;
     }
     (x as usize).min(RES_THETA_D - 1)
@@ -85,7 +85,7 @@ pub fn theta_d_index(theta_d: f64) -> usize {
 pub fn phi_d_index(phi_d: f64) -> usize {
     let p = if phi_d < 0.0 { phi_d + PI } else { phi_d };
     let x = p / PI * RES_PHI_D as f64;
-    if !(x > 0.0) {
+    if x.is_nan() || x <= 0.0 {
         return 0;
     }
     (x as usize).min(RES_PHI_D - 1)

@@ -549,7 +549,7 @@ impl RglBrdf {
         let scale = if self.jacobian {
             let ndf = bilinear(&self.ndf, &NO_PARAMS, 0, 0, u_wm);
             let sigma = bilinear(&self.sigma, &NO_PARAMS, 0, 0, u_wi);
-            if !(sigma > 0.0) {
+            if sigma.is_nan() || sigma <= 0.0 {
                 return None;
             }
             ndf / (4.0 * sigma)
