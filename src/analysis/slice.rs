@@ -67,21 +67,23 @@ fn render(
 ) -> SliceImage {
     let c = brdf.channels().len().min(MAX_CHANNELS);
     let mut data = vec![0.0f32; width * height * c];
-    data.par_chunks_mut(width * c).enumerate().for_each(|(y, row)| {
-        let mut f = [0.0f32; MAX_CHANNELS];
-        for x in 0..width {
-            let px = &mut row[x * c..(x + 1) * c];
-            match pair(x, y) {
-                Some((wi, wo, w)) => {
-                    brdf.eval(wi, wo, &mut f[..c]);
-                    for k in 0..c {
-                        px[k] = (f[k] as f64 * w) as f32;
+    data.par_chunks_mut(width * c)
+        .enumerate()
+        .for_each(|(y, row)| {
+            let mut f = [0.0f32; MAX_CHANNELS];
+            for x in 0..width {
+                let px = &mut row[x * c..(x + 1) * c];
+                match pair(x, y) {
+                    Some((wi, wo, w)) => {
+                        brdf.eval(wi, wo, &mut f[..c]);
+                        for k in 0..c {
+                            px[k] = (f[k] as f64 * w) as f32;
+                        }
                     }
+                    None => px.fill(f32::NAN),
                 }
-                None => px.fill(f32::NAN),
             }
-        }
-    });
+        });
     SliceImage {
         width,
         height,
@@ -156,13 +158,41 @@ pub struct Legend {
 /// Viridis, polynomial approximation (t in [0, 1]).
 pub fn viridis(t: f64) -> [u8; 3] {
     const C: [[f64; 3]; 7] = [
-        [0.277_727_327_223_417_7, 0.005_407_344_544_966_578, 0.334_099_805_335_306_1],
-        [0.105_093_043_108_577_4, 1.404_613_529_898_575, 1.384_590_162_594_685],
-        [-0.330_861_828_725_556_3, 0.214_847_559_468_213, 0.095_095_163_028_236_59],
-        [-4.634_230_498_983_486, -5.799_100_973_351_585, -19.332_440_956_279_87],
-        [6.228_269_936_347_081, 14.179_933_366_805_09, 56.690_552_600_681_05],
-        [4.776_384_997_670_288, -13.745_145_377_746_01, -65.353_032_633_372_34],
-        [-5.435_455_855_934_631, 4.645_852_612_178_535, 26.312_435_249_583_2],
+        [
+            0.277_727_327_223_417_7,
+            0.005_407_344_544_966_578,
+            0.334_099_805_335_306_1,
+        ],
+        [
+            0.105_093_043_108_577_4,
+            1.404_613_529_898_575,
+            1.384_590_162_594_685,
+        ],
+        [
+            -0.330_861_828_725_556_3,
+            0.214_847_559_468_213,
+            0.095_095_163_028_236_59,
+        ],
+        [
+            -4.634_230_498_983_486,
+            -5.799_100_973_351_585,
+            -19.332_440_956_279_87,
+        ],
+        [
+            6.228_269_936_347_081,
+            14.179_933_366_805_09,
+            56.690_552_600_681_05,
+        ],
+        [
+            4.776_384_997_670_288,
+            -13.745_145_377_746_01,
+            -65.353_032_633_372_34,
+        ],
+        [
+            -5.435_455_855_934_631,
+            4.645_852_612_178_535,
+            26.312_435_249_583_2,
+        ],
     ];
     let t = t.clamp(0.0, 1.0);
     let mut rgb = [0u8; 3];
@@ -179,11 +209,19 @@ pub fn viridis(t: f64) -> [u8; 3] {
 /// Writes one channel (or luminance) as a tone-mapped PNG: log10 scale between the largest
 /// value and max(smallest positive value, largest / 10⁶), viridis colors, a colorbar on the right.
 /// Returns the range for a legend line.
-pub fn write_png(img: &SliceImage, channel: Option<usize>, path: impl AsRef<Path>) -> Result<Legend> {
+pub fn write_png(
+    img: &SliceImage,
+    channel: Option<usize>,
+    path: impl AsRef<Path>,
+) -> Result<Legend> {
     let path = path.as_ref();
     let rgb = img.channel_names == Channels::Rgb.names();
     let vals = img.scalar(channel, rgb);
-    let max = vals.iter().copied().filter(|v| v.is_finite()).fold(0.0f32, f32::max);
+    let max = vals
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0f32, f32::max);
     let min_pos = vals
         .iter()
         .copied()
