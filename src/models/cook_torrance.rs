@@ -15,10 +15,14 @@
 //! V-cavity G lets the albedo grow at grazing angles.)
 //!
 //! Importance sampling draws H with density D(H) cos α and reflects V about it; the density of L
-//! is D cos α / (4 |V·H|). The weight f·cos θ′/pdf = k_s G F (V·H) / ((N·V)(N·H)) ≤ 2 k_s F, so no
-//! mixture is needed.
+//! is D cos α / (4 |V·H|), and the weight of that strategy alone, f·cos θ′/pdf =
+//! k_s G F (V·H) / ((N·V)(N·H)) ≤ 2 k_s F, is bounded. For rough surfaces many reflected
+//! directions fall below the horizon (more than half at m = 1.2 and normal incidence), so a
+//! fraction [`CookTorrance::cosine_prob`] = min(m/2, 1/2) of the samples is drawn cosine-weighted
+//! instead; the reported pdf is the exact mixture density.
 
 use glam::{DVec2, DVec3};
+use std::f64::consts::FRAC_1_PI;
 
 use crate::brdf::{Brdf, BrdfSample, Flags};
 use crate::error::Result;
@@ -37,6 +41,7 @@ pub struct CookTorrance {
     ks: Vec<f64>,
     fresnel_spec: FresnelSpec,
     fresnel: Fresnel,
+    cos_prob: f64,
 }
 
 /// The geometric part D·G / (4 (N·V)(N·L)) and the Fresnel cosine L·H of a pair, or `None` when
@@ -60,7 +65,27 @@ impl CookTorrance {
             ks_spec: ks,
             fresnel: Fresnel::new(fresnel, channels, "fresnel")?,
             fresnel_spec: fresnel.clone(),
+            cos_prob: (0.5 * m).min(0.5),
         })
+    }
+
+    /// Probability with which [`Brdf::sample`] draws a cosine-weighted direction instead of a
+    /// Beckmann half vector: min(m/2, 1/2).
+    pub fn cosine_prob(&self) -> f64 {
+        self.cos_prob
+    }
+
+    /// Density of the half-vector strategy alone for unit `l`, `v` above the horizon.
+    #[inline]
+    fn half_vector_pdf(&self, l: DVec3, v: DVec3) -> f64 {
+        let Some(h) = geometry::normalize(l + v) else {
+            return 0.0;
+        };
+        let v_dot_h = v.dot(h);
+        if !(v_dot_h > 0.0) {
+            return 0.0;
+        }
+        self.d.pdf_h(h) / (4.0 * v_dot_h)
     }
 
     /// The microfacet distribution.
@@ -132,22 +157,29 @@ impl Brdf for CookTorrance {
         )
     }
 
-    /// Half-vector sampling of D(H) cos θh; L = 2(V·H)H − V; pdf = D cos θh / (4 |V·H|).
+    /// Half-vector sampling of D(H) cos θh (L = 2(V·H)H − V, density D cos θh / (4 |V·H|)),
+    /// mixed with cosine sampling with probability [`CookTorrance::cosine_prob`].
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let v = geometry::normalize(wo)?;
         if v.z <= 0.0 {
             return None;
         }
-        let h = self.d.sample_h(u);
-        let v_dot_h = v.dot(h);
-        if !(v_dot_h > 0.0) {
+        let p = self.cos_prob;
+        let l = if u.x >= p {
+            let u0 = ((u.x - p) / (1.0 - p)).min(1.0 - f64::EPSILON);
+            let h = self.d.sample_h(DVec2::new(u0, u.y));
+            let v_dot_h = v.dot(h);
+            if !(v_dot_h > 0.0) {
+                return None;
+            }
+            2.0 * v_dot_h * h - v
+        } else {
+            geometry::cosine_hemisphere(DVec2::new(u.x / p, u.y))
+        };
+        if !(l.z > 0.0) {
             return None;
         }
-        let l = 2.0 * v_dot_h * h - v;
-        if l.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.d.pdf_h(h) / (4.0 * v_dot_h);
+        let pdf = self.pdf(l, v);
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
@@ -168,14 +200,8 @@ impl Brdf for CookTorrance {
         let Some((l, v)) = geometry::upper_pair(wi, wo) else {
             return 0.0;
         };
-        let Some(h) = geometry::normalize(l + v) else {
-            return 0.0;
-        };
-        let v_dot_h = v.dot(h);
-        if !(v_dot_h > 0.0) {
-            return 0.0;
-        }
-        self.d.pdf_h(h) / (4.0 * v_dot_h)
+        let p = self.cos_prob;
+        (1.0 - p) * self.half_vector_pdf(l, v) + p * l.z * FRAC_1_PI
     }
 }
 
