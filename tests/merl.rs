@@ -243,3 +243,34 @@ fn embedded_manifest_matches_tsv() {
     }
     assert_eq!(merl::material_of("00"), None);
 }
+
+#[test]
+fn table_on_the_merl_grid_holds_the_cells_and_indexes_like_the_reader() {
+    let data = random_data(9);
+    let m = MerlBrdf::from_raw("random", data.clone()).unwrap();
+    let t = m.to_table();
+    let mut rng = Pcg32::new(10);
+    for _ in 0..10_000 {
+        let (i, j, k) = (
+            rng.below(90) as usize,
+            rng.below(90) as usize,
+            rng.below(180) as usize,
+        );
+        let node = t.node([i, 0, j, k]).unwrap();
+        assert_eq!(node, &m.cell(i, j, k)[..]);
+        if !m.is_valid(i, j, k) {
+            assert!(node.iter().any(|&v| v == 0.0));
+        }
+    }
+    // The grid's nearest lookup takes the reader's indices.
+    let ax = t.grid().stored_axes();
+    for _ in 0..100_000 {
+        let th = rng.next_f64() * PI / 2.0;
+        let td = rng.next_f64() * PI / 2.0;
+        let pd = (rng.next_f64() * 2.0 - 1.0) * PI;
+        assert_eq!(ax[0].nearest(th), ref_theta_half_index(th), "θh {th}");
+        assert_eq!(ax[2].nearest(td), ref_theta_diff_index(td), "θd {td}");
+        let pd_folded = if pd < 0.0 { pd + PI } else { pd };
+        assert_eq!(ax[3].nearest(pd_folded), ref_phi_diff_index(pd), "φd {pd}");
+    }
+}

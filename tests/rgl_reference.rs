@@ -302,3 +302,43 @@ fn anisotropic_reductions_fold_by_symmetry() {
         assert_eq!(a, b);
     }
 }
+
+#[test]
+fn corrupted_headers_never_panic() {
+    // Flip random header bytes (names, dtypes, offsets, shapes) of a real file: every outcome must
+    // be Ok or a typed error, never a panic or a huge allocation.
+    let orig = std::fs::read(format!("{DIR}paper_white_rgb.bsdf")).unwrap();
+    let mut rng = brdftab::rng::Pcg32::new(5);
+    for _ in 0..3000 {
+        let mut b = orig.clone();
+        for _ in 0..1 + rng.below(3) {
+            let at = rng.below(420) as usize;
+            b[at] = rng.below(256) as u8;
+        }
+        if let Ok(t) = TensorFile::from_bytes("fuzz", b) {
+            if let Ok(brdf) = RglBrdf::from_tensor(&t, None) {
+                let mut f = [0f32; 3];
+                brdf.eval(dir(40.0, 10.0), dir(30.0, 200.0), &mut f);
+                assert!(f.iter().all(|x| x.is_finite() && *x >= 0.0));
+            }
+        }
+    }
+}
+
+#[test]
+fn random_pairs_are_finite_and_non_negative() {
+    let mut rng = brdftab::rng::Pcg32::new(8);
+    for file in ["cg_sunflower_rgb.bsdf", "satin_rosaline_rgb.bsdf"] {
+        let b = RglBrdf::open(format!("{DIR}{file}")).unwrap();
+        let mut f = [0f32; 3];
+        for _ in 0..20_000 {
+            let wi = brdftab::geometry::uniform_hemisphere(rng.next_dvec2());
+            let wo = brdftab::geometry::uniform_hemisphere(rng.next_dvec2());
+            b.eval(wi, wo, &mut f);
+            assert!(
+                f.iter().all(|x| x.is_finite() && *x >= 0.0),
+                "{wi} {wo} {f:?}"
+            );
+        }
+    }
+}

@@ -357,6 +357,22 @@ impl MerlBrdf {
     }
 }
 
+impl MerlBrdf {
+    /// The measurement as a dense table on [`Grid::merl`](crate::table::Grid::merl): stored
+    /// node (θh i, φh 0, θd j, φd k) holds cell (i, j, k) scaled to f_r, unmeasured cells as 0.
+    ///
+    /// The grid's nodes use [`Nodes::CellStart`](crate::table::Nodes::CellStart), so a *nearest*
+    /// lookup takes the same indices as [`MerlBrdf::eval`] (value for value); a *linear* lookup
+    /// interpolates between cells and, next to an unmeasured cell, towards 0 (see the module
+    /// docs).
+    pub fn to_table(&self) -> crate::table::Table {
+        let grid = crate::table::Grid::merl(Channels::Rgb);
+        crate::table::Table::from_fn(grid, self.describe(), |idx, _, out| {
+            out.copy_from_slice(&self.cell(idx[0], idx[2], idx[3]));
+        })
+    }
+}
+
 fn dims(h: &[u8]) -> [i32; 3] {
     let r = |i: usize| i32::from_le_bytes([h[i], h[i + 1], h[i + 2], h[i + 3]]);
     [r(0), r(4), r(8)]

@@ -608,7 +608,9 @@ impl Brdf for RglBrdf {
                 v = (1.0 - t) * v + t * self.channel(sample, &k, c1);
             }
             let f = v * scale / cos_o;
-            *o = if f.is_finite() { f as f32 } else { 0.0 };
+            // Negative ndf/sigma (only in corrupt files) or overflow must not leak out.
+            let f = f as f32;
+            *o = if f.is_finite() && f > 0.0 { f } else { 0.0 };
         }
     }
 
@@ -622,7 +624,7 @@ impl Brdf for RglBrdf {
         };
         let v = (1.0 - t) * self.channel(sample, &k, c0) + t * self.channel(sample, &k, c1);
         let f = v * scale / cos_o;
-        if f.is_finite() { f } else { 0.0 }
+        if f.is_finite() && f > 0.0 { f } else { 0.0 }
     }
 
     fn flags(&self) -> Flags {
