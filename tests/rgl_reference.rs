@@ -342,3 +342,25 @@ fn random_pairs_are_finite_and_non_negative() {
         }
     }
 }
+
+#[test]
+fn sampler_passes_chi_square() {
+    use brdftab::analysis::chi2::{self, Chi2Options};
+    let files = ["paper_white_rgb.bsdf", "cc_ibiza_sunset_rgb.bsdf"];
+    let wos = [dir(30.0, 20.0), dir(70.0, -100.0)];
+    let alpha = chi2::sidak(0.01, files.len() * wos.len());
+    let opts = Chi2Options {
+        samples: 100_000,
+        cos_bins: 20,
+        phi_bins: 40,
+        ..Chi2Options::default()
+    };
+    for file in files {
+        let b = RglBrdf::open(format!("{DIR}{file}")).unwrap();
+        for wo in wos {
+            let r = chi2::test(&b, wo, &opts);
+            eprintln!("{file} wo={wo}: {r:?}");
+            assert!(r.passes(alpha), "{file} wo={wo}: p = {}", r.p_value);
+        }
+    }
+}
