@@ -108,11 +108,16 @@ pub fn put(
     w.finish()
 }
 
-/// Writes a single-table file holding `data` (all values in memory), replacing `path`.
-pub fn write_table(path: impl AsRef<Path>, header: TableHeader, data: &[f32]) -> Result<()> {
+/// Writes a single-table file from chunks in memory (each with its predictor layout),
+/// replacing `path`.
+pub fn write_table(
+    path: impl AsRef<Path>,
+    header: TableHeader,
+    chunks: &[(&[f32], crate::codec::Layout)],
+) -> Result<()> {
     let mut w = Writer::create(path)?;
     w.begin_table(header)?;
-    w.chunks_par(data)?;
+    w.chunks_par(chunks)?;
     w.end_table()?;
     w.finish()
 }

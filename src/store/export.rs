@@ -30,22 +30,68 @@ pub fn npy_header(shape: &[u64]) -> Vec<u8> {
     out
 }
 
-/// Writes the dense table as `.npy` (shape = stored grid dims + channels, dtype `<f4`).
-pub fn npy(table: &StoredTable, out: impl AsRef<Path>) -> Result<()> {
+/// Maps the index of a node (one per angular axis of the stored shape) to the flat offset of its
+/// channel 0, or `None` when the node is not stored (packed layouts). `None` as a whole means the
+/// plain row-major layout of the stored shape.
+pub type NodeOffset<'a> = Option<&'a (dyn Fn(&[usize]) -> Option<usize> + Sync)>;
+
+/// Writes the table as `.npy`: shape = stored grid dims + channels, dtype `<f4`, C order. Dense
+/// tables stream chunk by chunk; packed tables (fewer values than the shape) are expanded with
+/// `offset`, unstored nodes written as NaN.
+pub fn npy(table: &StoredTable, out: impl AsRef<Path>, offset: NodeOffset<'_>) -> Result<()> {
     let path = out.as_ref();
+    let h = table.header();
     let f = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
     let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
     let io = |e| Error::io(path, e);
-    w.write_all(&npy_header(&table.header().shape)).map_err(io)?;
+    w.write_all(&npy_header(&h.shape)).map_err(io)?;
     let mut buf = Vec::new();
-    for i in 0..table.chunk_count() {
-        let c = table.decode_chunk(i)?;
-        buf.clear();
-        for v in c.iter() {
-            buf.extend_from_slice(&v.to_le_bytes());
+    if offset.is_none() || Some(h.values) == h.dense_values() {
+        if Some(h.values) != h.dense_values() {
+            return Err(Error::Unsupported(format!(
+                "table `{}` is packed ({} of {:?} values) and no layout was given",
+                h.name, h.values, h.shape
+            )));
         }
-        w.write_all(&buf).map_err(io)?;
+        for i in 0..table.chunk_count() {
+            let c = table.decode_chunk(i)?;
+            buf.clear();
+            for v in c.iter() {
+                buf.extend_from_slice(&v.to_le_bytes());
+            }
+            w.write_all(&buf).map_err(io)?;
+        }
+        return w.flush().map_err(io);
     }
+    let offset = offset.expect("checked");
+    let axes: Vec<usize> = h.shape[..h.shape.len() - 1].iter().map(|&d| d as usize).collect();
+    let nc = *h.shape.last().expect("non-empty") as usize;
+    let nodes: usize = axes.iter().product();
+    let mut idx = vec![0usize; axes.len()];
+    for _ in 0..nodes {
+        match offset(&idx) {
+            Some(o) => {
+                let (ci, off) = table.locate(o as u64)?;
+                let c = table.chunk(ci)?;
+                for v in &c[off..off + nc] {
+                    buf.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+            None => (0..nc).for_each(|_| buf.extend_from_slice(&f32::NAN.to_le_bytes())),
+        }
+        if buf.len() > 1 << 20 {
+            w.write_all(&buf).map_err(io)?;
+            buf.clear();
+        }
+        for a in (0..axes.len()).rev() {
+            idx[a] += 1;
+            if idx[a] < axes[a] {
+                break;
+            }
+            idx[a] = 0;
+        }
+    }
+    w.write_all(&buf).map_err(io)?;
     w.flush().map_err(io)
 }
 
@@ -89,8 +135,9 @@ impl Slice {
     }
 }
 
-/// Extracts a slice: returns (width, height, values as `[y][x][channel]`).
-pub fn slice(table: &StoredTable, s: &Slice) -> Result<(usize, usize, Vec<f32>)> {
+/// Extracts a slice: returns (width, height, values as `[y][x][channel]`). Unstored nodes of
+/// packed layouts are NaN.
+pub fn slice(table: &StoredTable, s: &Slice, offset: NodeOffset<'_>) -> Result<(usize, usize, Vec<f32>)> {
     let h = table.header();
     let (axes, nc) = (&h.shape[..h.shape.len() - 1], *h.shape.last().unwrap_or(&1) as usize);
     if s.x >= axes.len() || s.y >= axes.len() || s.fixed.len() != axes.len() {
@@ -109,22 +156,19 @@ pub fn slice(table: &StoredTable, s: &Slice) -> Result<(usize, usize, Vec<f32>)>
         stride[a] = acc;
         acc *= axes[a];
     }
-    let base: u64 = (0..axes.len())
-        .filter(|&a| a != s.x && a != s.y)
-        .map(|a| s.fixed[a] * stride[a])
-        .sum();
-    let cl = h.chunk_len.max(1);
-    let mut out = vec![0.0f32; w * ht * nc];
-    let mut cur: Option<(u64, std::sync::Arc<[f32]>)> = None;
+    let mut out = vec![f32::NAN; w * ht * nc];
+    let mut idx: Vec<usize> = s.fixed.iter().map(|&i| i as usize).collect();
     for yy in 0..ht {
         for xx in 0..w {
-            let flat = base + xx as u64 * stride[s.x] + yy as u64 * stride[s.y];
-            let ci = flat / cl;
-            if cur.as_ref().is_none_or(|(c, _)| *c != ci) {
-                cur = Some((ci, table.chunk(ci as usize)?));
-            }
-            let c = &cur.as_ref().expect("set").1;
-            let off = (flat % cl) as usize;
+            idx[s.x] = xx;
+            idx[s.y] = yy;
+            let flat = match offset {
+                Some(f) => f(&idx),
+                None => Some(idx.iter().zip(&stride).map(|(&i, &st)| i as u64 * st).sum::<u64>() as usize),
+            };
+            let Some(flat) = flat else { continue };
+            let (ci, off) = table.locate(flat as u64)?;
+            let c = table.chunk(ci)?;
             let o = (yy * w + xx) * nc;
             out[o..o + nc].copy_from_slice(&c[off..off + nc]);
         }
@@ -142,9 +186,15 @@ fn channel_names(c: &Channels, n: usize) -> Vec<String> {
 }
 
 /// Writes a 2D slice as OpenEXR, channels as EXR channels, f32 or f16 (`half`), ZIP-compressed.
-pub fn exr(table: &StoredTable, s: &Slice, out: impl AsRef<Path>, half: bool) -> Result<()> {
+pub fn exr(
+    table: &StoredTable,
+    s: &Slice,
+    offset: NodeOffset<'_>,
+    out: impl AsRef<Path>,
+    half: bool,
+) -> Result<()> {
     use exr::prelude::*;
-    let (w, ht, v) = slice(table, s)?;
+    let (w, ht, v) = slice(table, s, offset)?;
     let nc = *table.header().shape.last().unwrap_or(&1) as usize;
     if w == 0 || ht == 0 {
         return Err(crate::Error::arg("--slice", "empty slice"));

@@ -91,33 +91,42 @@ pub struct TableHeader {
     pub codec: Codec,
     /// The tool that wrote the table (`brdftab 0.1.0`).
     pub tool: String,
-    /// Stored dimensions, outermost first, channels last.
+    /// Stored dimensions, outermost first, channels last. Chunks are slabs of the outermost
+    /// axis; the chunk index gives each chunk's length.
     pub shape: Vec<u64>,
-    /// Values per chunk (all but the last chunk); chunks are slabs of the outermost axis.
-    pub chunk_len: u64,
-    /// The layout the predictor used.
+    /// Total number of stored values (the product of `shape`, or fewer for packed layouts such
+    /// as the reciprocal upper triangle of in/out tables).
+    pub values: u64,
+    /// The default layout the predictor used (each chunk header records its own).
     pub layout: Layout,
 }
 
 impl TableHeader {
-    /// Total number of values (product of `shape`), or `None` on overflow.
-    pub fn total_values(&self) -> Option<u64> {
-        self.shape.iter().try_fold(1u64, |a, &d| a.checked_mul(d))
-    }
-
-    /// The number of chunks the shape and `chunk_len` imply.
-    pub fn chunk_count(&self) -> Option<u64> {
-        let t = self.total_values()?;
-        if self.chunk_len == 0 {
-            return (t == 0).then_some(0);
+    /// A header for a dense table of `shape` (angular axes outermost first, channels last) with
+    /// the predictor layout taken from the shape; grid, parameterization and symmetry are left
+    /// empty for the caller to fill in.
+    pub fn new(name: impl Into<String>, source: Source, shape: Vec<u64>, channels: Channels, codec: Codec) -> TableHeader {
+        let dim = |k: usize| shape.len().checked_sub(k).map_or(1, |i| shape[i] as usize);
+        let values = shape.iter().try_fold(1u64, |a, &d| a.checked_mul(d)).unwrap_or(u64::MAX);
+        TableHeader {
+            name: name.into(),
+            source,
+            grid: serde_json::Value::Null,
+            parameterization: String::new(),
+            symmetry: String::new(),
+            channels,
+            units: "1/sr".into(),
+            codec,
+            tool: concat!("brdftab ", env!("CARGO_PKG_VERSION")).into(),
+            layout: Layout::new(dim(1), dim(2), dim(3)),
+            shape,
+            values,
         }
-        Some(t.div_ceil(self.chunk_len))
     }
 
-    /// The number of values in chunk `i`.
-    pub fn chunk_values(&self, i: u64) -> u64 {
-        let t = self.total_values().unwrap_or(0);
-        (t - (i * self.chunk_len).min(t)).min(self.chunk_len)
+    /// The product of `shape`, or `None` on overflow.
+    pub fn dense_values(&self) -> Option<u64> {
+        self.shape.iter().try_fold(1u64, |a, &d| a.checked_mul(d))
     }
 }
 
@@ -337,27 +346,21 @@ pub fn json<T: serde::de::DeserializeOwned>(file: &str, what: &str, b: &[u8]) ->
 pub fn check_table(file: &str, data_len: u64, h: &TableHeader, index: &[u8], n: u64) -> Result<Vec<ChunkEntry>> {
     let what = |f: &str| format!("table `{}` {f}", h.name);
     let err = |f: &str, msg: String| Error::format(file, Some(&what(f)), None, msg);
-    let total = h
-        .total_values()
-        .filter(|&t| t <= MAX_VALUES)
-        .ok_or_else(|| err("shape", format!("{:?} has more than {MAX_VALUES} values", h.shape)))?;
-    if h.shape.is_empty() {
-        return Err(err("shape", "empty shape".into()));
+    let dense = h.dense_values().unwrap_or(u64::MAX);
+    if h.shape.is_empty() || h.values > MAX_VALUES || h.values > dense {
+        return Err(err(
+            "shape",
+            format!("{:?} / {} values: empty, inconsistent or more than {MAX_VALUES}", h.shape, h.values),
+        ));
     }
-    if h.chunk_len > MAX_CHUNK_VALUES || (h.chunk_len == 0 && total > 0) {
-        return Err(err("chunk_len", format!("{} values per chunk", h.chunk_len)));
-    }
-    let expect = h.chunk_count().unwrap_or(u64::MAX);
-    if n != expect || index.len() as u64 != n.saturating_mul(INDEX_ENTRY_LEN as u64) {
+    if index.len() as u64 != n.saturating_mul(INDEX_ENTRY_LEN as u64) || n > h.values.max(1) {
         return Err(err(
             "index",
-            format!(
-                "{n} chunks in an index of {} bytes; the shape and chunk length need {expect}",
-                index.len()
-            ),
+            format!("{n} chunks in an index of {} bytes for {} values", index.len(), h.values),
         ));
     }
     let mut out = Vec::with_capacity(n as usize);
+    let mut sum = 0u64;
     for (i, b) in index.chunks_exact(INDEX_ENTRY_LEN).enumerate() {
         let e = ChunkEntry::read(b);
         let ok_range = e
@@ -370,18 +373,17 @@ pub fn check_table(file: &str, data_len: u64, h: &TableHeader, index: &[u8], n: 
                 format!("range {}+{} lies outside the file ({data_len} bytes)", e.offset, e.len),
             ));
         }
-        if e.values != h.chunk_values(i as u64) || e.values > e.len.saturating_mul(MAX_VALUES_PER_BYTE) {
+        if e.values > MAX_CHUNK_VALUES || e.values > e.len.saturating_mul(MAX_VALUES_PER_BYTE) {
             return Err(err(
                 &format!("chunk {i}"),
-                format!(
-                    "claims {} values in {} bytes; the header implies {}",
-                    e.values,
-                    e.len,
-                    h.chunk_values(i as u64)
-                ),
+                format!("claims {} values in {} bytes", e.values, e.len),
             ));
         }
+        sum += e.values;
         out.push(e);
+    }
+    if sum != h.values {
+        return Err(err("index", format!("chunks hold {sum} values, the header says {}", h.values)));
     }
     Ok(out)
 }

@@ -179,11 +179,20 @@ impl Store {
         }
         let ib = format::block(&self.name, &self.map, &e.index, &what("index"), self.map.len() as u64)?;
         let index = format::check_table(&self.name, self.map.len() as u64, &header, ib, e.chunks)?;
+        let starts = index
+            .iter()
+            .scan(0u64, |acc, e| {
+                let s = *acc;
+                *acc += e.values;
+                Some(s)
+            })
+            .collect();
         let t = StoredTable {
             file: self.name.clone(),
             map: self.map.clone(),
             header,
             index,
+            starts,
             cache: self.cache.clone(),
             id: i,
         };
@@ -213,6 +222,7 @@ pub struct StoredTable {
     map: Arc<memmap2::Mmap>,
     header: TableHeader,
     index: Vec<ChunkEntry>,
+    starts: Vec<u64>,
     cache: Arc<ChunkCache>,
     id: usize,
 }
@@ -266,13 +276,25 @@ impl StoredTable {
         self.index.get(i).map_or(0, |e| e.values as usize)
     }
 
+    /// The chunk holding flat value offset `flat`, and the offset inside it.
+    pub fn locate(&self, flat: u64) -> Result<(usize, usize)> {
+        let i = self.starts.partition_point(|&s| s <= flat).saturating_sub(1);
+        match self.index.get(i) {
+            Some(e) if flat < self.starts[i] + e.values => Ok((i, (flat - self.starts[i]) as usize)),
+            _ => Err(Error::arg(
+                "offset",
+                format!("value {flat} is outside table `{}` ({} values)", self.header.name, self.header.values),
+            )),
+        }
+    }
+
     /// Decodes chunk `i` (bypassing the cache).
     pub fn decode_chunk(&self, i: usize) -> Result<Vec<f32>> {
         let b = self.raw_chunk(i)?;
-        codec::decode(b, self.index[i].values as usize).map_err(|e| self.locate(e, i))
+        codec::decode(b, self.index[i].values as usize).map_err(|e| self.in_chunk(e, i))
     }
 
-    fn locate(&self, e: Error, i: usize) -> Error {
+    fn in_chunk(&self, e: Error, i: usize) -> Error {
         match e {
             Error::Format { field, offset, msg, .. } => Error::Format {
                 file: self.file.clone(),
@@ -311,7 +333,7 @@ impl StoredTable {
         }
         parts.into_par_iter().enumerate().try_for_each(|(i, dst)| {
             let b = self.raw_chunk(i)?;
-            codec::decode_into(b, dst).map_err(|e| self.locate(e, i))
+            codec::decode_into(b, dst).map_err(|e| self.in_chunk(e, i))
         })?;
         Ok(out)
     }

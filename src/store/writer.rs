@@ -104,12 +104,12 @@ impl Writer {
         if self.names().any(|n| n == header.name) {
             return Err(Error::arg("--name", format!("duplicate table name `{}`", header.name)));
         }
-        let total = header
-            .total_values()
-            .filter(|&t| t <= format::MAX_VALUES)
-            .ok_or_else(|| Error::arg("shape", format!("{:?} is too large", header.shape)))?;
-        if header.chunk_len == 0 && total > 0 || header.chunk_len > format::MAX_CHUNK_VALUES {
-            return Err(Error::arg("chunk_len", format!("{}", header.chunk_len)));
+        let dense = header.dense_values().unwrap_or(u64::MAX);
+        if header.shape.is_empty() || header.values > dense || header.values > format::MAX_VALUES {
+            return Err(Error::arg(
+                "shape",
+                format!("{:?} / {} values: empty, inconsistent or too large", header.shape, header.values),
+            ));
         }
         self.table = Some(Open {
             header,
@@ -124,10 +124,17 @@ impl Writer {
         self.table.as_ref().map(|t| &t.header)
     }
 
-    /// Encodes and appends the next chunk of the open table.
+    /// Encodes and appends the next chunk of the open table (with the header's layout).
     pub fn chunk(&mut self, values: &[f32]) -> Result<()> {
+        let layout = self.header().map(|h| h.layout).unwrap_or(codec::Layout::FLAT);
+        self.chunk_with(values, layout)
+    }
+
+    /// Encodes and appends the next chunk with its own predictor layout (e.g. packed tables whose
+    /// chunks have different row counts).
+    pub fn chunk_with(&mut self, values: &[f32], layout: codec::Layout) -> Result<()> {
         let t = self.table.as_ref().ok_or_else(|| Error::arg("table", "no table begun"))?;
-        let bytes = codec::encode(values, t.header.layout, &t.header.codec).map_err(|e| {
+        let bytes = codec::encode(values, layout, &t.header.codec).map_err(|e| {
             match e {
                 Error::Encode { msg } => Error::Encode {
                     msg: format!("table `{}` chunk {}: {msg}", t.header.name, t.index.len()),
@@ -141,14 +148,15 @@ impl Writer {
     /// Appends an already encoded chunk (e.g. copied from another file) holding `values` values.
     pub fn encoded_chunk(&mut self, bytes: &[u8], values: u64) -> Result<()> {
         let t = self.table.as_ref().ok_or_else(|| Error::arg("table", "no table begun"))?;
-        let i = t.index.len() as u64;
-        let expect = t.header.chunk_values(i);
-        if values != expect || i >= t.header.chunk_count().unwrap_or(0) {
+        let done: u64 = t.index.iter().map(|e| e.values).sum();
+        if done + values > t.header.values || values > format::MAX_CHUNK_VALUES {
             return Err(Error::arg(
                 "chunk",
                 format!(
-                    "table `{}` chunk {i} has {values} values; the shape needs {expect}",
-                    t.header.name
+                    "table `{}` chunk {} of {values} values overflows the header's {} values (or the chunk limit)",
+                    t.header.name,
+                    t.index.len(),
+                    t.header.values
                 ),
             ));
         }
@@ -164,20 +172,17 @@ impl Writer {
         Ok(())
     }
 
-    /// Encodes a whole in-memory table (`data` = all values, outermost axis first) in parallel
-    /// and appends its chunks.
-    pub fn chunks_par(&mut self, data: &[f32]) -> Result<()> {
+    /// Encodes chunks held in memory in parallel (each with its layout) and appends them in
+    /// order.
+    pub fn chunks_par(&mut self, chunks: &[(&[f32], codec::Layout)]) -> Result<()> {
         let t = self.table.as_ref().ok_or_else(|| Error::arg("table", "no table begun"))?;
-        let (n, start) = (t.header.chunk_len.max(1) as usize, t.index.len() * t.header.chunk_len as usize);
-        let (layout, c) = (t.header.layout, t.header.codec);
-        let rest = data.get(start..).unwrap_or(&[]);
-        let encoded: Vec<Result<(Vec<u8>, u64)>> = rest
-            .par_chunks(n)
-            .map(|c_| Ok((codec::encode(c_, layout, &c)?, c_.len() as u64)))
+        let c = t.header.codec;
+        let encoded: Vec<Result<Vec<u8>>> = chunks
+            .par_iter()
+            .map(|(v, l)| codec::encode(v, *l, &c))
             .collect();
-        for e in encoded {
-            let (b, v) = e?;
-            self.encoded_chunk(&b, v)?;
+        for (e, (v, _)) in encoded.into_iter().zip(chunks) {
+            self.encoded_chunk(&e?, v.len() as u64)?;
         }
         Ok(())
     }
@@ -185,14 +190,15 @@ impl Writer {
     /// Ends the open table: writes its header and chunk index.
     pub fn end_table(&mut self) -> Result<()> {
         let t = self.table.take().ok_or_else(|| Error::arg("table", "no table begun"))?;
-        let need = t.header.chunk_count().unwrap_or(0);
-        if t.index.len() as u64 != need {
+        let got: u64 = t.index.iter().map(|e| e.values).sum();
+        if got != t.header.values {
             return Err(Error::arg(
                 "table",
                 format!(
-                    "table `{}` got {} chunks, its shape needs {need}",
+                    "table `{}` got {got} values in {} chunks, its header says {}",
                     t.header.name,
-                    t.index.len()
+                    t.index.len(),
+                    t.header.values
                 ),
             ));
         }
