@@ -56,7 +56,7 @@ impl Default for OpenOptions {
 pub struct Store {
     path: PathBuf,
     name: String,
-    map: Arc<memmap2::Mmap>,
+    map: Arc<Backing>,
     toc: Toc,
     cache: Arc<ChunkCache>,
     opts: OpenOptions,
@@ -95,10 +95,15 @@ impl Store {
         // the mapped bytes do not change under us. A foreign process truncating the file could
         // still fault; that is the usual caveat of memory maps.
         let map = unsafe { memmap2::Mmap::map(&f) }.map_err(|e| Error::io(&path, e))?;
-        Self::from_map(path, name, map, opts)
+        Self::from_backing(path, name, Backing::Map(map), opts)
     }
 
-    fn from_map(path: PathBuf, name: String, map: memmap2::Mmap, opts: OpenOptions) -> Result<Store> {
+    /// Opens a file held in memory (`name` is used in error messages). Used by the fuzz target.
+    pub fn from_bytes(name: &str, bytes: Vec<u8>, opts: OpenOptions) -> Result<Store> {
+        Self::from_backing(PathBuf::from(name), name.to_owned(), Backing::Bytes(bytes), opts)
+    }
+
+    fn from_backing(path: PathBuf, name: String, map: Backing, opts: OpenOptions) -> Result<Store> {
         let sb = Superblock::parse(&name, &map)?;
         let toc_bytes = format::block(&name, &map, &sb.toc, "table of contents", format::MAX_JSON_LEN)?;
         let toc: Toc = format::json(&name, "table of contents", toc_bytes)?;
@@ -215,11 +220,29 @@ impl Store {
     }
 }
 
+/// The bytes of an open file: a read-only memory map, or bytes in memory.
+pub enum Backing {
+    /// A memory-mapped file.
+    Map(memmap2::Mmap),
+    /// Bytes in memory.
+    Bytes(Vec<u8>),
+}
+
+impl std::ops::Deref for Backing {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        match self {
+            Backing::Map(m) => m,
+            Backing::Bytes(b) => b,
+        }
+    }
+}
+
 /// One stored table: its header, chunk index, and decoded chunks on demand.
 #[derive(Clone)]
 pub struct StoredTable {
     file: String,
-    map: Arc<memmap2::Mmap>,
+    map: Arc<Backing>,
     header: TableHeader,
     index: Vec<ChunkEntry>,
     starts: Vec<u64>,
