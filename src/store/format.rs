@@ -347,7 +347,8 @@ pub fn check_table(file: &str, data_len: u64, h: &TableHeader, index: &[u8], n: 
     let what = |f: &str| format!("table `{}` {f}", h.name);
     let err = |f: &str, msg: String| Error::format(file, Some(&what(f)), None, msg);
     let dense = h.dense_values().unwrap_or(u64::MAX);
-    if h.shape.is_empty() || h.values > MAX_VALUES || h.values > dense {
+    // Packed layouts store at least half of the dense shape; chunks are slabs of axis 0.
+    if h.shape.is_empty() || h.values > MAX_VALUES || h.values > dense || dense / 2 > h.values || h.shape[0] != n {
         return Err(err(
             "shape",
             format!("{:?} / {} values: empty, inconsistent or more than {MAX_VALUES}", h.shape, h.values),

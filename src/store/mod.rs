@@ -18,6 +18,7 @@
 pub mod db;
 pub mod export;
 pub mod format;
+pub mod tables;
 mod writer;
 
 use std::collections::HashMap;
@@ -261,6 +262,11 @@ impl std::fmt::Debug for StoredTable {
 }
 
 impl StoredTable {
+    /// The file name (for messages).
+    pub fn file(&self) -> &str {
+        &self.file
+    }
+
     /// The table's header.
     pub fn header(&self) -> &TableHeader {
         &self.header
