@@ -155,38 +155,17 @@ pub fn slice(a: SliceArgs) -> Result<()> {
             slice::incident(a.theta_in.to_radians(), a.phi_in.to_radians()),
         ),
     };
-    let lower = a.output.to_ascii_lowercase();
     let what = match a.kind {
         SliceKind::Halfdiff => format!(
             "f_r, x = θh 0..90°, y = θd 0..90° (top to bottom), φd = {}°",
             a.phi_d
         ),
         SliceKind::Polar => format!(
-            "f_r·cos θo over the outgoing hemisphere (radius ∝ θo, +x right), θi = {}°, φi = {}°",
+            "f_r·cos θo over the outgoing hemisphere (radius ∝ θo, +x right, +y up), θi = {}°, φi = {}°",
             a.theta_in, a.phi_in
         ),
     };
-    if lower.ends_with(".exr") {
-        slice::write_exr(&img, channel, &a.output)?;
-        println!("{}: {what}; linear f32", a.output);
-    } else if lower.ends_with(".png") {
-        let l = slice::write_png(&img, channel, &a.output)?;
-        let ch = channel.map_or_else(
-            || {
-                if names.len() == 3 && names[0] == "R" {
-                    "luminance".to_string()
-                } else {
-                    "channel mean".to_string()
-                }
-            },
-            |c| names[c].clone(),
-        );
-        println!(
-            "{}: {what}; {ch}, log10 scale, viridis: colorbar bottom {:.4e} .. top {:.4e} (1/sr)",
-            a.output, l.min, l.max
-        );
-    } else {
-        return Err(Error::arg("--output", "must end in .exr or .png"));
-    }
+    let legend = slice::write(&img, channel, &a.output)?;
+    println!("{}: {what}; {legend}", a.output);
     Ok(())
 }
