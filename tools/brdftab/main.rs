@@ -26,6 +26,8 @@ enum Command {
     Info(measured::InfoArgs),
     /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
     Slice(measured::SliceArgs),
+    /// Convert between formats (MERL .binary, RGL .bsdf read only, tables).
+    Convert(measured::ConvertArgs),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
         Command::Models(a) => models::models(a),
         Command::Info(a) => measured::info(a),
         Command::Slice(a) => measured::slice(a),
+        Command::Convert(a) => measured::convert(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -169,3 +169,43 @@ pub fn slice(a: SliceArgs) -> Result<()> {
     println!("{}: {what}; {legend}", a.output);
     Ok(())
 }
+
+/// Arguments of `brdftab convert`.
+#[derive(Args)]
+pub struct ConvertArgs {
+    /// Any SOURCE: a MERL `.binary`, an RGL `.bsdf` (read only), a spec, a table.
+    input: String,
+    /// The output: a MERL `.binary` (the source resampled at the MERL cell centres).
+    output: String,
+    /// Evaluate spec sources at these wavelengths (nm); MERL output uses the RGB wavelengths.
+    #[arg(long)]
+    wavelengths: Option<String>,
+}
+
+/// Converts between formats.
+pub fn convert(a: ConvertArgs) -> Result<()> {
+    let channels = source::channels(a.wavelengths.as_deref())?;
+    match source::kind(&a.output) {
+        Kind::Merl => {
+            let brdf = source::open(&a.input, &channels)?;
+            let t = std::time::Instant::now();
+            let m = MerlBrdf::from_brdf(&*brdf);
+            m.write(&a.output)?;
+            println!(
+                "{}: {} resampled on the MERL grid (90 × 90 × 180 cell centres) in {:.2} s",
+                a.output,
+                brdf.describe(),
+                t.elapsed().as_secs_f64()
+            );
+            Ok(())
+        }
+        Kind::Rgl => Err(Error::Unsupported(
+            "writing RGL .bsdf files (they are read only)".into(),
+        )),
+        _ => Err(Error::Unsupported(format!(
+            "{}: converting to tables needs the table bake (not in this build yet); \
+             outputs supported here: .binary",
+            a.output
+        ))),
+    }
+}
