@@ -216,7 +216,7 @@ fn lobe_centre(
         }
     }
     let scale = sum.max(1e-3 * g_mirror.max(0.0)).max(f64::MIN_POSITIVE);
-    if !(best > 2.0 * g_mirror) {
+    if g_mirror.is_nan() || best <= 2.0 * g_mirror {
         return (mirror, scale);
     }
     // Pattern search from the best grid node, halving the step.
@@ -341,7 +341,7 @@ fn adaptive<F: FnMut(f64, &mut [f64], &mut usize)>(
             }
         }
         let mag = out[..c].iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        if err <= abs.max(rel * mag) || segs.len() >= max_segs || !err.is_finite() && err.is_nan() {
+        if err <= abs.max(rel * mag) || segs.len() >= max_segs || err.is_nan() {
             return err;
         }
         // Bisect the worst segment.

@@ -15,7 +15,8 @@ pub struct AlbedoArgs {
     #[arg(
         long,
         default_value = "0,15,30,45,60,75,85,89",
-        value_name = "DEG[,DEG..]"
+        value_name = "DEG[,DEG..]",
+        allow_hyphen_values = true
     )]
     theta: String,
     /// Compute at these wavelengths in nm (comma separated) instead of RGB.
