@@ -79,8 +79,8 @@ pub const LECTURE_MODELS: &[(&str, &str)] = &[
 pub fn demo(_a: DemoArgs) -> Result<()> {
     println!("Physical plausibility of the lecture's BRDF models (RGB; albedo at θ′ = 0..89°)\n");
     println!(
-        "{:<26} {:<9} {:<22} {}",
-        "model", "positive", "reciprocal (max err)", "energy conserving (max albedo @ θ′)"
+        "{:<26} {:<9} {:<22} energy conserving (max albedo @ θ′)",
+        "model", "positive", "reciprocal (max err)"
     );
     let mut skipped = Vec::new();
     for (label, spec) in LECTURE_MODELS {
