@@ -44,11 +44,12 @@ pub fn albedo(a: AlbedoArgs) -> Result<()> {
     let brdf = source::open(&a.source, &channels)?;
     let radians: Vec<f64> = thetas.iter().map(|t| t.to_radians()).collect();
     let curve = albedo::albedo_curve(&*brdf, &radians);
+    let mut text = String::new();
     for (t, row) in thetas.iter().zip(curve) {
         let vals: Vec<String> = row.iter().map(|&x| sig7(x)).collect();
-        println!("{t} {}", vals.join(" "));
+        text += &format!("{t} {}\n", vals.join(" "));
     }
-    Ok(())
+    emit(&text)
 }
 
 /// Prints the plausibility report (text or JSON).
@@ -59,11 +60,19 @@ pub fn check(a: CheckArgs) -> Result<()> {
     if a.json {
         let json = serde_json::to_string(&report)
             .map_err(|e| Error::Unsupported(format!("cannot serialize the report: {e}")))?;
-        println!("{json}");
+        emit(&format!("{json}\n"))
     } else {
-        print!("{report}");
+        emit(&report.to_string())
     }
-    Ok(())
+}
+
+/// Writes `text` to stdout; a failed write (e.g. a closed pipe) is an error, not a panic.
+pub fn emit(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| Error::io("stdout", e))
 }
 
 /// Parses `0,30,60` as degrees in [0, 90].

@@ -9,6 +9,8 @@ use brdftab::analysis::plausibility::{self, Report};
 use brdftab::{Channels, ModelSpec, Result};
 use clap::Args;
 
+use crate::analysis::emit;
+
 /// Arguments of `brdftab demo`.
 #[derive(Args)]
 pub struct DemoArgs {}
@@ -77,11 +79,10 @@ pub const LECTURE_MODELS: &[(&str, &str)] = &[
 
 /// Prints the plausibility table of [`LECTURE_MODELS`].
 pub fn demo(_a: DemoArgs) -> Result<()> {
-    println!("Physical plausibility of the lecture's BRDF models (RGB; albedo at θ′ = 0..89°)\n");
-    println!(
-        "{:<26} {:<9} {:<22} energy conserving (max albedo @ θ′)",
+    emit(&format!(
+        "Physical plausibility of the lecture's BRDF models (RGB; albedo at θ′ = 0..89°)\n\n{:<26} {:<9} {:<22} energy conserving (max albedo @ θ′)\n",
         "model", "positive", "reciprocal (max err)"
-    );
+    ))?;
     let mut skipped = Vec::new();
     for (label, spec) in LECTURE_MODELS {
         let brdf = match ModelSpec::parse(spec).and_then(|s| s.build(&Channels::Rgb)) {
@@ -92,13 +93,14 @@ pub fn demo(_a: DemoArgs) -> Result<()> {
             }
         };
         let r = plausibility::check(&*brdf, &plausibility::Options::default());
-        println!("{}", row(label, &r));
+        emit(&format!("{}\n", row(label, &r)))?;
     }
     if !skipped.is_empty() {
-        println!("\nskipped (not available in this build):");
+        let mut text = "\nskipped (not available in this build):\n".to_string();
         for s in skipped {
-            println!("  {s}");
+            text += &format!("  {s}\n");
         }
+        emit(&text)?;
     }
     Ok(())
 }
