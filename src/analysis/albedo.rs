@@ -571,6 +571,45 @@ mod tests {
         assert!(rel(a[0], expect) < 1e-5, "{} vs {expect}", a[0]);
     }
 
+    fn model(spec: &str) -> Box<dyn Brdf> {
+        crate::spec::ModelSpec::parse(spec)
+            .unwrap()
+            .build(&Channels::Rgb)
+            .unwrap()
+    }
+
+    #[test]
+    fn real_reciprocal_phong_at_normal_incidence() {
+        for n in [10.0, 100.0, 1000.0] {
+            let b = model(&format!(
+                r#"{{"model": "reciprocal_phong", "ks": [0.2, 0.5, 0.8], "n": {n}}}"#
+            ));
+            let mut a = [0.0; 3];
+            quadrature(&*b, DVec3::Z, &mut a);
+            for (k, ks) in [0.2f32, 0.5, 0.8].into_iter().enumerate() {
+                let expect = TAU * ks as f64 / (n + 2.0);
+                assert!(rel(a[k], expect) < 1e-4, "n {n}: {} vs {expect}", a[k]);
+            }
+        }
+    }
+
+    #[test]
+    fn real_cook_torrance_sharp_lobe_matches_a_tight_run() {
+        // m = 0.05 without Fresnel: at normal incidence G = 1 over the lobe and the albedo is
+        // ∫ D cos θh dωh = 1 up to f32 rounding of the values.
+        let b = model(r#"{"model": "cook_torrance", "m": 0.05}"#);
+        let est = integrate(&*b, DVec3::Z, &Options::default());
+        assert!(rel(est.value[0], 1.0) < 1e-4, "{:?}", est.value);
+        let wi = geometry::spherical(70f64.to_radians(), 0.3);
+        let a = integrate(&*b, wi, &Options::default()).value[0];
+        let tight = Options {
+            rel_tol: 1e-8,
+            ..Options::default()
+        };
+        let t = integrate(&*b, wi, &tight).value[0];
+        assert!(rel(a, t) < 1e-5, "{a} vs {t}");
+    }
+
     #[test]
     fn below_horizon_nan_and_zero_give_zero() {
         let l = Lambert::new(Value::Grey(0.3), &Channels::Rgb).unwrap();

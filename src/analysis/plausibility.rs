@@ -473,6 +473,52 @@ mod tests {
         assert_eq!(r.max_albedo_theta_deg, 89.0);
     }
 
+    fn model(spec: &str) -> Box<dyn Brdf> {
+        crate::spec::ModelSpec::parse(spec)
+            .unwrap()
+            .build(&Channels::Rgb)
+            .unwrap()
+    }
+
+    #[test]
+    fn real_lecture_models() {
+        let o = quick();
+        let r = check(&*model(r#"{"model": "phong", "ks": 0.5, "n": 20}"#), &o);
+        assert!(r.positive && !r.reciprocal && !r.declared.reciprocal, "{r}");
+        for spec in [
+            r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 20}"#,
+            r#"{"model": "max_phong", "ks": 0.5, "n": 20}"#,
+            r#"{"model": "pumped_phong", "ks": 0.5, "n": 20, "x": "product"}"#,
+        ] {
+            let r = check(&*model(spec), &o);
+            assert!(r.positive && r.reciprocal, "{spec}: {r}");
+        }
+        // Reciprocal Phong loses energy at grazing incidence, X = cos θ cos θ′ pumps it up
+        // without bound.
+        let r = check(
+            &*model(r#"{"model": "reciprocal_phong", "ks": 1, "n": 20}"#),
+            &o,
+        );
+        assert!(r.energy_conserving && r.max_albedo_theta_deg == 0.0, "{r}");
+        let r = check(
+            &*model(r#"{"model": "pumped_phong", "ks": 1, "n": 20, "x": "product"}"#),
+            &o,
+        );
+        assert!(
+            !r.energy_conserving && r.max_albedo_theta_deg == 89.0,
+            "{r}"
+        );
+        // Cook-Torrance with gold: the albedo climbs towards grazing incidence.
+        let r = check(
+            &*model(r#"{"model": "cook_torrance", "m": 0.6, "fresnel": {"conductor": "Au"}}"#),
+            &o,
+        );
+        assert!(r.positive && r.reciprocal, "{r}");
+        let a: Vec<f64> = r.albedo_curve.iter().map(|p| p.albedo[2]).collect();
+        assert!(a[4] > 1.2 * a[0], "{r}");
+        assert_eq!(r.max_albedo_theta_deg, 89.0);
+    }
+
     #[test]
     fn negative_values_are_found() {
         let r = check(&Negative, &quick());

@@ -29,9 +29,12 @@ pub fn build(spec: &ModelSpec, channels: &Channels) -> Result<Box<dyn Brdf>> {
         ModelSpec::PumpedPhong { ks, n, x } => {
             Box::new(phong::Phong::pumped(ks.clone(), *n, *x, channels)?)
         }
-        ModelSpec::CookTorrance { m, ks, fresnel } => Box::new(
-            cook_torrance::CookTorrance::new(*m, ks.clone(), fresnel, channels)?,
-        ),
+        ModelSpec::CookTorrance { m, ks, fresnel } => Box::new(cook_torrance::CookTorrance::new(
+            *m,
+            ks.clone(),
+            fresnel,
+            channels,
+        )?),
         other => {
             return Err(Error::Unsupported(format!(
                 "model `{}` is not implemented yet",
