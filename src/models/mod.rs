@@ -43,7 +43,13 @@ pub fn build(spec: &ModelSpec, channels: &Channels) -> Result<Box<dyn Brdf>> {
                     ));
                 }
             };
-            Box::new(ggx::Ggx::new(ax, ay, ks.clone(), fresnel.clone(), channels)?)
+            Box::new(ggx::Ggx::new(
+                ax,
+                ay,
+                ks.clone(),
+                fresnel.clone(),
+                channels,
+            )?)
         }
         ModelSpec::Ward {
             ks,

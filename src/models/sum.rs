@@ -3,7 +3,7 @@
 //! # Flags
 //!
 //! A sum has a symmetry only when every term has it: `reciprocal`, `isotropic` and `bilateral`
-//! are the AND of the terms' flags. `delta` is set only when *every* term is a delta (then the
+//! are the AND of the terms' flags (of every term, whatever its weight). `delta` is set only when *every* term is a delta (then the
 //! sum is a delta model); `transmission` is set when *any* term transmits.
 //!
 //! # Delta terms
@@ -305,19 +305,22 @@ impl Brdf for Sum {
         let target = u.x * total;
         let mut cum = 0.0;
         let mut chosen = None;
+        let mut last = None;
         for j in 0..self.terms.len() {
             let s = self.selection(j, wo.z);
             if s <= 0.0 {
                 continue;
             }
-            if target < cum + s || chosen.is_none() {
+            if target < cum + s {
                 chosen = Some((j, s, ((target - cum) / s).clamp(0.0, 1.0 - f64::EPSILON)));
-                if target < cum + s {
-                    break;
-                }
+                break;
             }
             cum += s;
+            last = Some(j);
         }
+        // Rounding can leave target ≥ the accumulated total: that is the end of the last term.
+        let chosen =
+            chosen.or_else(|| last.map(|j| (j, self.selection(j, wo.z), 1.0 - f64::EPSILON)));
         let (j, s, ux) = chosen?;
         let pj = s / total;
         let c = self.channels.len();
@@ -385,13 +388,24 @@ mod tests {
 
     fn ggx(ax: f64, ay: f64) -> Box<dyn Brdf> {
         Box::new(
-            Ggx::new(ax, ay, Value::Rgb([0.9, 0.7, 0.5]), FresnelSpec::None, &Channels::Rgb)
-                .unwrap(),
+            Ggx::new(
+                ax,
+                ay,
+                Value::Rgb([0.9, 0.7, 0.5]),
+                FresnelSpec::None,
+                &Channels::Rgb,
+            )
+            .unwrap(),
         )
     }
 
     fn plastic() -> Sum {
-        Sum::new(vec![lambert(0.2), ggx(0.1, 0.1)], Some(vec![1.0, 0.5]), &Channels::Rgb).unwrap()
+        Sum::new(
+            vec![lambert(0.2), ggx(0.1, 0.1)],
+            Some(vec![1.0, 0.5]),
+            &Channels::Rgb,
+        )
+        .unwrap()
     }
 
     fn three() -> Sum {
@@ -453,7 +467,11 @@ mod tests {
             b.eval(wi, wo, &mut fb);
             for c in 0..3 {
                 let expect = fa[c] as f64 + 0.5 * fb[c] as f64;
-                assert!((f[c] as f64 - expect).abs() <= 1e-7 * expect, "{} vs {expect}", f[c]);
+                assert!(
+                    (f[c] as f64 - expect).abs() <= 1e-7 * expect,
+                    "{} vs {expect}",
+                    f[c]
+                );
             }
             let expect = a.eval_wavelength(wi, wo, 500.0) + 0.5 * b.eval_wavelength(wi, wo, 500.0);
             assert!((s.eval_wavelength(wi, wo, 500.0) - expect).abs() <= 1e-12 * expect);
@@ -469,7 +487,11 @@ mod tests {
         .unwrap();
         let s = spec.build(&Channels::Rgb).unwrap();
         let mut f = [0.0f32; 3];
-        s.eval(DVec3::new(0.1, 0.2, 1.0), DVec3::new(-0.5, 0.0, 0.5), &mut f);
+        s.eval(
+            DVec3::new(0.1, 0.2, 1.0),
+            DVec3::new(-0.5, 0.0, 0.5),
+            &mut f,
+        );
         assert!((f[0] as f64 - 0.3).abs() < 1e-7);
     }
 
@@ -526,8 +548,12 @@ mod tests {
     #[test]
     fn selection_follows_albedo() {
         // A white Lambert (albedo 1) and a GGX with F = 1 weighted by 0 gets nothing.
-        let s = Sum::new(vec![lambert(1.0 / std::f64::consts::PI), ggx(0.2, 0.2)], Some(vec![1.0, 0.0]), &Channels::Rgb)
-            .unwrap();
+        let s = Sum::new(
+            vec![lambert(1.0 / std::f64::consts::PI), ggx(0.2, 0.2)],
+            Some(vec![1.0, 0.0]),
+            &Channels::Rgb,
+        )
+        .unwrap();
         assert_eq!(s.selection_probabilities(DVec3::Z), vec![1.0, 0.0]);
         // Equal albedo terms get (nearly) equal probability.
         let s = Sum::new(vec![lambert(0.1), lambert(0.3)], None, &Channels::Rgb).unwrap();
@@ -585,14 +611,13 @@ mod tests {
     }
 
     #[test]
-    fn mixture_sampler_passes_chi_square() {
-        let (a, b) = (plastic(), three());
-        let mut cases: Vec<(&dyn Brdf, DVec3)> = Vec::new();
-        for wo in test_wos() {
-            cases.push((&a, wo));
-            cases.push((&b, wo));
-        }
-        chi2_cases(&cases);
+    fn mixture_sampler_passes_chi_square_plastic() {
+        chi2_models(&[&plastic()]);
+    }
+
+    #[test]
+    fn mixture_sampler_passes_chi_square_three_terms() {
+        chi2_models(&[&*THREE]);
     }
 
     static THREE: std::sync::LazyLock<Sum> = std::sync::LazyLock::new(three);

@@ -43,16 +43,21 @@ pub fn integrate_hemisphere(f: impl Fn(DVec3) -> f64, width: f64, nphi: usize, n
 /// Outgoing directions used by the sampling tests: normal, moderate, steep and near-grazing,
 /// at azimuths off the axes so anisotropic lobes are exercised.
 pub fn test_wos() -> Vec<DVec3> {
-    [(0.0, 0.0), (30.0, 0.4), (60.0, 2.0), (80.0, -1.1), (88.0, 0.9)]
-        .iter()
-        .map(|&(t, p): &(f64, f64)| geometry::spherical(t.to_radians(), p))
-        .collect()
+    [
+        (0.0, 0.0),
+        (30.0, 0.4),
+        (60.0, 2.0),
+        (80.0, -1.1),
+        (88.0, 0.9),
+    ]
+    .iter()
+    .map(|&(t, p): &(f64, f64)| geometry::spherical(t.to_radians(), p))
+    .collect()
 }
 
 /// A proptest strategy for directions strictly above the horizon (unnormalized on purpose).
 pub fn dir_strategy() -> impl Strategy<Value = DVec3> {
-    (0.0f64..1.55, -PI..PI, 0.1f64..10.0)
-        .prop_map(|(t, p, len)| geometry::spherical(t, p) * len)
+    (0.0f64..1.55, -PI..PI, 0.1f64..10.0).prop_map(|(t, p, len)| geometry::spherical(t, p) * len)
 }
 
 /// f(a, b) == f(b, a) per channel to f32 accuracy.
@@ -136,7 +141,11 @@ pub fn check_sampling_consistency<B: Brdf + ?Sized>(brdf: &B, wos: &[DVec3], n: 
             };
             got += 1;
             assert!(!s.delta);
-            assert!((s.wi.length() - 1.0).abs() < 1e-12 && s.wi.z > 0.0, "{}", s.wi);
+            assert!(
+                (s.wi.length() - 1.0).abs() < 1e-12 && s.wi.z > 0.0,
+                "{}",
+                s.wi
+            );
             let pdf = brdf.pdf(s.wi, wo);
             assert!(
                 (s.pdf - pdf).abs() <= 1e-7 * pdf,
@@ -159,6 +168,17 @@ pub fn check_sampling_consistency<B: Brdf + ?Sized>(brdf: &B, wos: &[DVec3], n: 
     }
 }
 
+/// Chi-square tests of each model's sampler at every [`test_wos`] direction (see [`chi2_cases`]).
+pub fn chi2_models(models: &[&dyn Brdf]) {
+    let mut cases: Vec<(&dyn Brdf, DVec3)> = Vec::new();
+    for &m in models {
+        for wo in test_wos() {
+            cases.push((m, wo));
+        }
+    }
+    chi2_cases(&cases);
+}
+
 /// Runs the chi-square test (`crate::analysis::chi2`) for every `(sampler, wo)` case with a
 /// Šidák-corrected overall significance of 1 %, and fails listing the cases that do not pass.
 pub fn chi2_cases(cases: &[(&dyn Brdf, DVec3)]) {
@@ -175,7 +195,11 @@ pub fn chi2_cases(cases: &[(&dyn Brdf, DVec3)]) {
             failures.push(format!("{} at wo = {wo}: {r:?}", brdf.describe()));
         }
     }
-    assert!(failures.is_empty(), "chi-square failures:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "chi-square failures:\n{}",
+        failures.join("\n")
+    );
 }
 
 /// A sampler given by closures, seen as a `Brdf` so the chi-square harness can test it:
