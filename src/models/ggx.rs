@@ -388,6 +388,43 @@ mod tests {
     }
 
     #[test]
+    fn matches_the_trigonometric_formulas() {
+        // D and Λ as the papers write them, with θ and φ from atan2/acos.
+        let (ax, ay) = (0.15, 0.45);
+        let m = Ggx::new(ax, ay, Value::Grey(0.7), FresnelSpec::None, &Channels::Rgb).unwrap();
+        let mut rng = Pcg32::new(12);
+        for _ in 0..2000 {
+            let wi = geometry::uniform_hemisphere(rng.next_dvec2());
+            let wo = geometry::uniform_hemisphere(rng.next_dvec2());
+            let h = (wi + wo).normalize();
+            let (th, ph) = geometry::to_spherical(h);
+            let d = 1.0
+                / (PI
+                    * ax
+                    * ay
+                    * th.cos().powi(4)
+                    * (1.0
+                        + th.tan().powi(2)
+                            * (ph.cos().powi(2) / (ax * ax) + ph.sin().powi(2) / (ay * ay)))
+                        .powi(2));
+            let lambda = |w: DVec3| {
+                let (t, p) = geometry::to_spherical(w);
+                let a2 = p.cos().powi(2) * ax * ax + p.sin().powi(2) * ay * ay;
+                0.5 * (-1.0 + (1.0 + a2 * t.tan().powi(2)).sqrt())
+            };
+            let g2 = 1.0 / (1.0 + lambda(wi) + lambda(wo));
+            let expect = 0.7 * d * g2 / (4.0 * wi.z * wo.z);
+            let mut f = [0.0f32; 3];
+            m.eval(wi, wo, &mut f);
+            assert!(
+                (f[0] as f64 - expect).abs() <= 1e-6 * expect + 1e-12,
+                "{wi} {wo}: {} vs {expect}",
+                f[0]
+            );
+        }
+    }
+
+    #[test]
     fn anisotropic_with_equal_alphas_equals_isotropic() {
         let a = Ggx::isotropic(0.3, Value::Grey(0.8), conductor(), &Channels::Rgb).unwrap();
         // Through the spec, as a user would write it.
@@ -559,6 +596,24 @@ mod tests {
             .map(|s| (s as &dyn Brdf, DVec3::Z))
             .collect();
         chi2_cases(&cases);
+    }
+
+    #[test]
+    fn chi_square_detects_a_slightly_wrong_density() {
+        // The tests above can fail: half vectors of α = 0.3 against the density of α = 0.33.
+        use crate::analysis::chi2::{Chi2Options, test};
+        let (a, b) = (aniso(0.3, 0.3), aniso(0.33, 0.33));
+        let wrong = FnSampler {
+            sample: |u| Some(a.sample_half_vector(u)),
+            pdf: |h: DVec3| b.pdf_half_vector(h),
+            name: "mismatched".into(),
+        };
+        let o = Chi2Options {
+            samples: 200_000,
+            ..Default::default()
+        };
+        let r = test(&wrong, DVec3::Z, &o);
+        assert!(!r.passes(0.01), "{r:?}");
     }
 
     proptest! {

@@ -223,6 +223,28 @@ mod tests {
     }
 
     #[test]
+    fn matches_the_trigonometric_formula() {
+        let (ax, ay) = (0.12, 0.35);
+        let m = Ward::new(Value::Grey(0.6), ax, ay, &Channels::Rgb).unwrap();
+        let mut rng = Pcg32::new(13);
+        for _ in 0..2000 {
+            let wi = geometry::uniform_hemisphere(rng.next_dvec2());
+            let wo = geometry::uniform_hemisphere(rng.next_dvec2());
+            let (th, ph) = geometry::to_spherical((wi + wo).normalize());
+            let e =
+                th.tan().powi(2) * (ph.cos().powi(2) / (ax * ax) + ph.sin().powi(2) / (ay * ay));
+            let expect = 0.6 * (-e).exp() / (4.0 * PI * ax * ay * (wi.z * wo.z).sqrt());
+            let mut f = [0.0f32; 3];
+            m.eval(wi, wo, &mut f);
+            assert!(
+                (f[0] as f64 - expect).abs() <= 1e-6 * expect + 1e-30,
+                "{} vs {expect}",
+                f[0]
+            );
+        }
+    }
+
+    #[test]
     fn formula_at_known_points() {
         let m = Ward::new(Value::Grey(0.5), 0.2, 0.4, &Channels::Rgb).unwrap();
         let mut f = [0.0f32; 3];
