@@ -546,6 +546,37 @@ mod tests {
     }
 
     #[test]
+    fn lambert_plus_real_mirror_from_spec() {
+        // The mean sample weight is the reflectance towards wo: k_d π + F(cos θo).
+        let spec = ModelSpec::parse(
+            r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.1},
+                {"model": "mirror", "fresnel": {"n": 1.5, "k": 0.0}}]}"#,
+        )
+        .unwrap();
+        let s = spec.build(&Channels::Rgb).unwrap();
+        assert!(!s.flags().delta);
+        let mut rng = Pcg32::new(21);
+        for deg in [10.0f64, 70.0] {
+            let wo = geometry::spherical(deg.to_radians(), 1.0);
+            let expect = 0.1 * std::f64::consts::PI + crate::fresnel::dielectric(wo.z, 1.5);
+            let n = 50_000;
+            let mut sum = 0.0;
+            for _ in 0..n {
+                let mut w = [0.0f32; 3];
+                if s.sample(wo, rng.next_dvec2(), &mut w).is_some() {
+                    sum += w[0] as f64;
+                }
+            }
+            let mean = sum / n as f64;
+            // Each branch's weight is its reflectance / p_j; only the branch choice varies.
+            assert!(
+                (mean - expect).abs() < 0.02 * expect,
+                "{deg}°: {mean} vs {expect}"
+            );
+        }
+    }
+
+    #[test]
     fn selection_follows_albedo() {
         // A white Lambert (albedo 1) and a GGX with F = 1 weighted by 0 gets nothing.
         let s = Sum::new(
