@@ -2,4 +2,5 @@
 
 pub mod albedo;
 pub mod chi2;
+pub mod plausibility;
 pub mod slice;

@@ -1,6 +1,8 @@
 //! `brdftab`: the command-line tool. Thin over the library: parse arguments, call the library,
 //! print. Errors print as `error: ...` on stderr with exit code 1.
 
+mod analysis;
+mod demo;
 mod measured;
 mod models;
 mod source;
@@ -28,21 +30,63 @@ enum Command {
     Slice(measured::SliceArgs),
     /// Convert between formats (MERL .binary, RGL .bsdf read only, tables).
     Convert(measured::ConvertArgs),
+    /// Directional albedo a(θ′) per channel: one line `theta a_1 a_2 ...` per angle.
+    Albedo(analysis::AlbedoArgs),
+    /// Physical plausibility: positivity, reciprocity, energy conservation.
+    Check(analysis::CheckArgs),
+    /// The lecture's models side by side (plausibility table).
+    Demo(demo::DemoArgs),
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(e),
+    };
     let result = match cli.command {
         Command::Eval(a) => models::eval(a),
         Command::Models(a) => models::models(a),
         Command::Info(a) => measured::info(a),
         Command::Slice(a) => measured::slice(a),
         Command::Convert(a) => measured::convert(a),
+        Command::Albedo(a) => analysis::albedo(a),
+        Command::Check(a) => analysis::check(a),
+        Command::Demo(a) => demo::demo(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader went away (`brdftab ... | head`): stop quietly.
+        Err(brdftab::Error::Io { source, .. })
+            if source.kind() == std::io::ErrorKind::BrokenPipe =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// `--help` and `--version` print to stdout and succeed; every usage error prints
+/// `error: ...` on stderr and exits 1, like every other error.
+fn clap_exit(e: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            print!("{e}");
+            ExitCode::SUCCESS
+        }
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            eprint!("error: a subcommand is required\n\n{e}");
+            ExitCode::from(1)
+        }
+        _ => {
+            let msg = e.to_string();
+            match msg.strip_prefix("error: ") {
+                Some(rest) => eprint!("error: {rest}"),
+                None => eprint!("error: {msg}"),
+            }
             ExitCode::from(1)
         }
     }
