@@ -1,7 +1,9 @@
 //! `brdftab`: the command-line tool. Thin over the library: parse arguments, call the library,
 //! print. Errors print as `error: ...` on stderr with exit code 1.
 
+mod fit;
 mod models;
+mod sample;
 mod source;
 
 use clap::{Parser, Subcommand};
@@ -21,6 +23,12 @@ enum Command {
     Eval(models::EvalArgs),
     /// List every model with its parameters.
     Models(models::ModelsArgs),
+    /// Fit a model's parameters to SOURCE by least squares; prints the fitted spec.
+    Fit(fit::FitArgs),
+    /// Draw incident directions from SOURCE's sampler: `wix wiy wiz pdf w_1 .. w_c` per line.
+    Sample(sample::SampleArgs),
+    /// Print pdf(wi | wo) for `wix wiy wiz wox woy woz` lines read from stdin.
+    Pdf(sample::PdfArgs),
 }
 
 fn main() -> ExitCode {
@@ -28,6 +36,9 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Eval(a) => models::eval(a),
         Command::Models(a) => models::models(a),
+        Command::Fit(a) => fit::fit(a),
+        Command::Sample(a) => sample::sample(a),
+        Command::Pdf(a) => sample::pdf(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
