@@ -503,10 +503,39 @@ impl Problem<'_> {
     /// Transformed model values f̂ cos θi at `t`, or `None` if the model cannot be built.
     fn model_values(&self, t: &DVector<f64>) -> Option<Vec<f64>> {
         self.evaluations.set(self.evaluations.get() + 1);
-        let model = self.spec_at(t).ok()?.build(self.channels).ok()?;
-        let v = eval_cos(model.as_ref(), self.pairs);
+        let spec = self.spec_at(t).ok()?;
+        spec.validate().ok()?;
+        let mut terms = Vec::new();
+        flatten(&spec, 1.0, self.channels, &mut terms).ok()?;
+        let mut v = vec![0.0; self.target.len()];
+        for (w, term) in &terms {
+            for (a, b) in v.iter_mut().zip(eval_cos(term.as_ref(), self.pairs)) {
+                *a += w * b;
+            }
+        }
         Some(v.into_iter().map(|y| transform(y, self.log)).collect())
     }
+}
+
+/// The terms of a (nested) sum with their combined weights, each built on its own: a `Sum`
+/// precomputes albedo tables for its sampler when built, which a fit that only evaluates would pay
+/// for at every step.
+fn flatten(
+    spec: &ModelSpec,
+    weight: f64,
+    channels: &Channels,
+    out: &mut Vec<(f64, Box<dyn Brdf>)>,
+) -> Result<()> {
+    match spec {
+        ModelSpec::Sum { terms, weights } => {
+            for (i, t) in terms.iter().enumerate() {
+                let w = weights.as_ref().map_or(1.0, |w| w[i]);
+                flatten(t, weight * w, channels, out)?;
+            }
+        }
+        other => out.push((weight, crate::models::build(other, channels)?)),
+    }
+    Ok(())
 }
 
 impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
