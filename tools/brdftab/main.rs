@@ -3,8 +3,10 @@
 
 mod analysis;
 mod demo;
+mod fit;
 mod measured;
 mod models;
+mod sample;
 mod source;
 
 use clap::{Parser, Subcommand};
@@ -34,6 +36,12 @@ enum Command {
     Check(analysis::CheckArgs),
     /// The lecture's models side by side (plausibility table).
     Demo(demo::DemoArgs),
+    /// Fit a model's parameters to SOURCE by least squares; prints the fitted spec.
+    Fit(fit::FitArgs),
+    /// Draw incident directions from SOURCE's sampler: `wix wiy wiz pdf w_1 .. w_c` per line.
+    Sample(sample::SampleArgs),
+    /// Print pdf(wi | wo) for `wix wiy wiz wox woy woz` lines read from stdin.
+    Pdf(sample::PdfArgs),
 }
 
 fn main() -> ExitCode {
@@ -49,6 +57,9 @@ fn main() -> ExitCode {
         Command::Albedo(a) => analysis::albedo(a),
         Command::Check(a) => analysis::check(a),
         Command::Demo(a) => demo::demo(a),
+        Command::Fit(a) => fit::fit(a),
+        Command::Sample(a) => sample::sample(a),
+        Command::Pdf(a) => sample::pdf(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
