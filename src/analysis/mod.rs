@@ -1,3 +1,4 @@
 //! Analysis of any `&dyn Brdf`: albedo, physical plausibility, accuracy metrics.
 
 pub mod albedo;
+pub mod accuracy;
