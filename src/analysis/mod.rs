@@ -1,4 +1,5 @@
 //! Analysis of any `&dyn Brdf`: albedo, physical plausibility, accuracy metrics.
 
-pub mod albedo;
 pub mod accuracy;
+pub mod albedo;
+pub mod chi2;

@@ -4,7 +4,11 @@
 //! against the equation. Models are built from a [`ModelSpec`] with [`build`]; parameters are
 //! resolved per channel at construction so `eval` never allocates.
 
+pub mod beckmann;
+pub mod cook_torrance;
 pub mod lambert;
+pub mod mirror;
+pub mod phong;
 
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
@@ -15,6 +19,19 @@ use crate::spectrum::Channels;
 pub fn build(spec: &ModelSpec, channels: &Channels) -> Result<Box<dyn Brdf>> {
     Ok(match spec {
         ModelSpec::Lambert { kd } => Box::new(lambert::Lambert::new(kd.clone(), channels)?),
+        ModelSpec::Mirror { fresnel } => Box::new(mirror::Mirror::new(fresnel, channels)?),
+        ModelSpec::Refractor { eta } => Box::new(mirror::Refractor::new(eta.clone(), channels)?),
+        ModelSpec::Phong { ks, n } => Box::new(phong::Phong::original(ks.clone(), *n, channels)?),
+        ModelSpec::ReciprocalPhong { ks, n } => {
+            Box::new(phong::Phong::reciprocal(ks.clone(), *n, channels)?)
+        }
+        ModelSpec::MaxPhong { ks, n } => Box::new(phong::Phong::max(ks.clone(), *n, channels)?),
+        ModelSpec::PumpedPhong { ks, n, x } => {
+            Box::new(phong::Phong::pumped(ks.clone(), *n, *x, channels)?)
+        }
+        ModelSpec::CookTorrance { m, ks, fresnel } => Box::new(
+            cook_torrance::CookTorrance::new(*m, ks.clone(), fresnel, channels)?,
+        ),
         other => {
             return Err(Error::Unsupported(format!(
                 "model `{}` is not implemented yet",
