@@ -236,7 +236,7 @@ impl StoredAxis {
     }
 
     /// The fractional node index s of coordinate `x` (not clamped or wrapped).
-    #[inline]
+    #[inline(always)]
     pub fn continuous(&self, x: f64) -> f64 {
         if self.size <= 1 {
             return 0.0;
@@ -328,7 +328,7 @@ impl StoredAxis {
 
     /// The two nodes and the weight of the second for linear interpolation at `x`:
     /// value = (1 − t)·v[i0] + t·v[i1].
-    #[inline]
+    #[inline(always)]
     pub fn linear(&self, x: f64) -> (usize, usize, f32) {
         let n = self.size;
         if n <= 1 {
@@ -336,19 +336,29 @@ impl StoredAxis {
         }
         let s = self.continuous(x);
         if self.periodic {
-            let s = if s.is_finite() { s } else { 0.0 };
-            let f = s.floor();
-            let t = (s - f) as f32;
-            let i0 = (f as i64).rem_euclid(n as i64) as usize;
+            if !s.is_finite() {
+                return (0, 1, 0.0);
+            }
+            // floor without a libm call (s is usually in [0, n]).
+            let mut i = s as i64;
+            if (i as f64) > s {
+                i -= 1;
+            }
+            let t = (s - i as f64) as f32;
+            let ni = n as i64;
+            let i0 = if (0..ni).contains(&i) {
+                i
+            } else if (ni..2 * ni).contains(&i) {
+                i - ni
+            } else {
+                i.rem_euclid(ni)
+            } as usize;
             let i1 = if i0 + 1 == n { 0 } else { i0 + 1 };
             (i0, i1, t)
         } else {
-            let s = if s.is_nan() {
-                0.0
-            } else {
-                s.clamp(0.0, (n - 1) as f64)
-            };
-            let i0 = (s.floor() as usize).min(n - 2);
+            // NaN → 0; clamp to [0, n − 1]; `as usize` truncates (= floor for s ≥ 0).
+            let s = if s > 0.0 { s.min((n - 1) as f64) } else { 0.0 };
+            let i0 = (s as usize).min(n - 2);
             (i0, i0 + 1, (s - i0 as f64) as f32)
         }
     }

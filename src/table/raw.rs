@@ -28,34 +28,78 @@ struct Header {
     values: u64,
 }
 
-impl Table {
-    /// Writes the table as a raw file (see [`crate::table::raw`]).
-    pub fn save_raw(&self, path: impl AsRef<Path>) -> Result<()> {
-        let path = path.as_ref();
+/// Writes a raw table file chunk by chunk (bounded memory): feed it from
+/// [`bake_chunks`](crate::table::bake_chunks). The file appears under its name only after
+/// [`RawWriter::finish`] (written to a temporary name, then renamed).
+pub struct RawWriter {
+    tmp: std::path::PathBuf,
+    path: std::path::PathBuf,
+    w: std::io::BufWriter<std::fs::File>,
+    remaining: u64,
+    bytes: Vec<u8>,
+}
+
+impl RawWriter {
+    /// Starts a raw file for a table on `grid`.
+    pub fn create(path: impl AsRef<Path>, grid: &Grid, description: &str) -> Result<RawWriter> {
+        let path = path.as_ref().to_path_buf();
         let header = serde_json::to_vec(&Header {
             format: 1,
-            grid: self.grid().clone(),
-            description: self.description().to_owned(),
-            values: self.values().len() as u64,
+            grid: grid.clone(),
+            description: description.to_owned(),
+            values: grid.stored_values() as u64,
         })
         .map_err(|e| Error::Json {
             context: path.display().to_string(),
             source: e,
         })?;
         let tmp = path.with_extension("tmp-raw");
-        let io = |e| Error::io(&tmp, e);
-        let f = std::fs::File::create(&tmp).map_err(io)?;
-        let mut w = std::io::BufWriter::new(f);
-        w.write_all(MAGIC).map_err(io)?;
-        w.write_all(&(header.len() as u64).to_le_bytes()).map_err(io)?;
-        w.write_all(&header).map_err(io)?;
-        for chunk in self.values().chunks(1 << 16) {
-            let bytes: Vec<u8> = chunk.iter().flat_map(|v| v.to_le_bytes()).collect();
-            w.write_all(&bytes).map_err(io)?;
+        let f = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
+        let mut head = MAGIC.to_vec();
+        head.extend_from_slice(&(header.len() as u64).to_le_bytes());
+        head.extend_from_slice(&header);
+        w.write_all(&head).map_err(|e| Error::io(&tmp, e))?;
+        Ok(RawWriter {
+            tmp,
+            path,
+            w,
+            remaining: grid.stored_values() as u64,
+            bytes: Vec::new(),
+        })
+    }
+
+    /// Appends values (the next chunk, in order).
+    pub fn write_chunk(&mut self, values: &[f32]) -> Result<()> {
+        if values.len() as u64 > self.remaining {
+            return Err(Error::arg("values", "more values than the grid stores"));
         }
-        w.flush().map_err(io)?;
-        drop(w);
-        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+        self.remaining -= values.len() as u64;
+        for part in values.chunks(1 << 18) {
+            self.bytes.clear();
+            self.bytes.extend(part.iter().flat_map(|v| v.to_le_bytes()));
+            self.w.write_all(&self.bytes).map_err(|e| Error::io(&self.tmp, e))?;
+        }
+        Ok(())
+    }
+
+    /// Flushes and moves the file into place; fails if values are missing.
+    pub fn finish(mut self) -> Result<()> {
+        if self.remaining != 0 {
+            let _ = std::fs::remove_file(&self.tmp);
+            return Err(Error::arg("values", format!("{} values missing", self.remaining)));
+        }
+        self.w.flush().map_err(|e| Error::io(&self.tmp, e))?;
+        std::fs::rename(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))
+    }
+}
+
+impl Table {
+    /// Writes the table as a raw file (see [`crate::table::raw`]).
+    pub fn save_raw(&self, path: impl AsRef<Path>) -> Result<()> {
+        let mut w = RawWriter::create(path, self.grid(), self.description())?;
+        w.write_chunk(self.values())?;
+        w.finish()
     }
 
     /// True when the file starts with the raw table magic.

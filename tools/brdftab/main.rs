@@ -3,6 +3,7 @@
 
 mod models;
 mod source;
+mod table;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -21,6 +22,12 @@ enum Command {
     Eval(models::EvalArgs),
     /// List every model with its parameters.
     Models(models::ModelsArgs),
+    /// Bake SOURCE into a dense (symmetry-reduced) table file.
+    Bake(table::BakeArgs),
+    /// Describe a table file: grid, symmetry, channels, sizes.
+    Info(table::InfoArgs),
+    /// Time lookups of SOURCE on random pairs (single thread and batch on all cores).
+    Bench(table::BenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -28,6 +35,9 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Eval(a) => models::eval(a),
         Command::Models(a) => models::models(a),
+        Command::Bake(a) => table::bake(a),
+        Command::Info(a) => table::info(a),
+        Command::Bench(a) => table::bench(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
