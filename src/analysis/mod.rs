@@ -3,3 +3,4 @@
 pub mod accuracy;
 pub mod albedo;
 pub mod chi2;
+pub mod slice;

@@ -464,7 +464,9 @@ impl Grid {
             if n % m != 0 {
                 Err(Error::arg(
                     "grid",
-                    format!("{what} of size {n} must be a multiple of {m} to be folded by symmetry"),
+                    format!(
+                        "{what} of size {n} must be a multiple of {m} to be folded by symmetry"
+                    ),
                 ))
             } else {
                 Ok(())
@@ -532,7 +534,12 @@ impl Grid {
         };
         let packed = param == Param::InOut && s.reciprocal;
         let layout = Layout::new(
-            [stored[0].size, stored[1].size, stored[2].size, stored[3].size],
+            [
+                stored[0].size,
+                stored[1].size,
+                stored[2].size,
+                stored[3].size,
+            ],
             packed,
             channels.len(),
         );
@@ -845,7 +852,10 @@ mod tests {
                 let ax = StoredAxis::theta(&Axis::theta(17, m, nodes));
                 for i in 0..17 {
                     let x = ax.node(i);
-                    assert!((ax.continuous(x) - i as f64).abs() < 1e-9, "{m:?} {nodes:?} {i}");
+                    assert!(
+                        (ax.continuous(x) - i as f64).abs() < 1e-9,
+                        "{m:?} {nodes:?} {i}"
+                    );
                     assert_eq!(ax.nearest(x + 1e-12), i);
                 }
             }

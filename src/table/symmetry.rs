@@ -312,10 +312,7 @@ fn transformed(which: usize, wi: DVec3, wo: DVec3, angle: f64) -> (DVec3, DVec3)
             (r(wi), r(wo))
         }
         1 => (wo, wi),
-        _ => (
-            DVec3::new(wi.x, -wi.y, wi.z),
-            DVec3::new(wo.x, -wo.y, wo.z),
-        ),
+        _ => (DVec3::new(wi.x, -wi.y, wi.z), DVec3::new(wo.x, -wo.y, wo.z)),
     }
 }
 

@@ -1,6 +1,7 @@
 //! `brdftab`: the command-line tool. Thin over the library: parse arguments, call the library,
 //! print. Errors print as `error: ...` on stderr with exit code 1.
 
+mod measured;
 mod models;
 mod source;
 mod table;
@@ -24,10 +25,12 @@ enum Command {
     Models(models::ModelsArgs),
     /// Bake SOURCE into a dense (symmetry-reduced) table file.
     Bake(table::BakeArgs),
-    /// Describe a table file: grid, symmetry, channels, sizes.
+    /// Describe a table file (grid, symmetry, channels, sizes) or a measured file (MERL, RGL).
     Info(table::InfoArgs),
     /// Time lookups of SOURCE on random pairs (single thread and batch on all cores).
     Bench(table::BenchArgs),
+    /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
+    Slice(measured::SliceArgs),
 }
 
 fn main() -> ExitCode {
@@ -38,6 +41,7 @@ fn main() -> ExitCode {
         Command::Bake(a) => table::bake(a),
         Command::Info(a) => table::info(a),
         Command::Bench(a) => table::bench(a),
+        Command::Slice(a) => measured::slice(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -72,12 +72,13 @@ pub fn open(source: &str, channels: &Channels) -> Result<Box<dyn Brdf>> {
 pub fn open_with(source: &str, channels: &Channels, interp: Interp) -> Result<Box<dyn Brdf>> {
     match kind(source) {
         Kind::Spec => spec(source)?.build(channels),
-        Kind::Merl => Err(Error::Unsupported(format!(
-            "{source}: MERL files are not supported yet"
-        ))),
-        Kind::Rgl => Err(Error::Unsupported(format!(
-            "{source}: RGL files are not supported yet"
-        ))),
+        Kind::Merl => Ok(Box::new(brdftab::measured::MerlBrdf::open(source)?)),
+        // An RGL file answers in its own channels (RGB, or its wavelengths) unless wavelengths
+        // are asked for explicitly.
+        Kind::Rgl if *channels != Channels::Rgb => Ok(Box::new(
+            brdftab::measured::RglBrdf::open_with_channels(source, channels)?,
+        )),
+        Kind::Rgl => Ok(Box::new(brdftab::measured::RglBrdf::open(source)?)),
         Kind::Table => {
             if Table::is_raw(source) {
                 Ok(Box::new(
