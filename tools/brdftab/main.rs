@@ -8,6 +8,7 @@ mod measured;
 mod models;
 mod sample;
 mod source;
+mod table;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -26,8 +27,12 @@ enum Command {
     Eval(models::EvalArgs),
     /// List every model with its parameters.
     Models(models::ModelsArgs),
-    /// Describe a measured file (MERL .binary, RGL .bsdf): description, dims, channels, sha256.
-    Info(measured::InfoArgs),
+    /// Bake SOURCE into a dense (symmetry-reduced) table file.
+    Bake(table::BakeArgs),
+    /// Describe a table file (grid, symmetry, channels, sizes) or a measured file (MERL, RGL).
+    Info(table::InfoArgs),
+    /// Time lookups of SOURCE on random pairs (single thread and batch on all cores).
+    Bench(table::BenchArgs),
     /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
     Slice(measured::SliceArgs),
     /// Directional albedo a(θ′) per channel: one line `theta a_1 a_2 ...` per angle.
@@ -52,7 +57,9 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Eval(a) => models::eval(a),
         Command::Models(a) => models::models(a),
-        Command::Info(a) => measured::info(a),
+        Command::Bake(a) => table::bake(a),
+        Command::Info(a) => table::info(a),
+        Command::Bench(a) => table::bench(a),
         Command::Slice(a) => measured::slice(a),
         Command::Albedo(a) => analysis::albedo(a),
         Command::Check(a) => analysis::check(a),
