@@ -3,9 +3,12 @@
 
 mod analysis;
 mod demo;
+mod fit;
 mod measured;
 mod models;
+mod sample;
 mod source;
+mod table;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -24,8 +27,12 @@ enum Command {
     Eval(models::EvalArgs),
     /// List every model with its parameters.
     Models(models::ModelsArgs),
-    /// Describe a measured file (MERL .binary, RGL .bsdf): description, dims, channels, sha256.
-    Info(measured::InfoArgs),
+    /// Bake SOURCE into a dense (symmetry-reduced) table file.
+    Bake(table::BakeArgs),
+    /// Describe a table file (grid, symmetry, channels, sizes) or a measured file (MERL, RGL).
+    Info(table::InfoArgs),
+    /// Time lookups of SOURCE on random pairs (single thread and batch on all cores).
+    Bench(table::BenchArgs),
     /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
     Slice(measured::SliceArgs),
     /// Convert between formats (MERL .binary, RGL .bsdf read only, tables).
@@ -36,6 +43,12 @@ enum Command {
     Check(analysis::CheckArgs),
     /// The lecture's models side by side (plausibility table).
     Demo(demo::DemoArgs),
+    /// Fit a model's parameters to SOURCE by least squares; prints the fitted spec.
+    Fit(fit::FitArgs),
+    /// Draw incident directions from SOURCE's sampler: `wix wiy wiz pdf w_1 .. w_c` per line.
+    Sample(sample::SampleArgs),
+    /// Print pdf(wi | wo) for `wix wiy wiz wox woy woz` lines read from stdin.
+    Pdf(sample::PdfArgs),
 }
 
 fn main() -> ExitCode {
@@ -46,12 +59,17 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Eval(a) => models::eval(a),
         Command::Models(a) => models::models(a),
-        Command::Info(a) => measured::info(a),
+        Command::Bake(a) => table::bake(a),
+        Command::Info(a) => table::info(a),
+        Command::Bench(a) => table::bench(a),
         Command::Slice(a) => measured::slice(a),
         Command::Convert(a) => measured::convert(a),
         Command::Albedo(a) => analysis::albedo(a),
         Command::Check(a) => analysis::check(a),
         Command::Demo(a) => demo::demo(a),
+        Command::Fit(a) => fit::fit(a),
+        Command::Sample(a) => sample::sample(a),
+        Command::Pdf(a) => sample::pdf(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
