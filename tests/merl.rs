@@ -287,3 +287,33 @@ fn table_on_the_merl_grid_holds_the_cells_and_indexes_like_the_reader() {
         assert_eq!(ax[3].nearest(pd_folded), ref_phi_diff_index(pd), "φd {pd}");
     }
 }
+
+#[test]
+fn nearest_table_reproduces_the_reader_value_for_value() {
+    use brdftab::table::{Interp, TabulatedBrdf};
+    let data = random_data(11);
+    let m = MerlBrdf::from_raw("random", data.clone()).unwrap();
+    let t = TabulatedBrdf::from_table(m.to_table()).with_interp(Interp::Nearest);
+    let lin = TabulatedBrdf::from_table(m.to_table()).with_interp(Interp::Linear);
+    let mut rng = Pcg32::new(12);
+    let (mut a, mut b, mut l) = ([0f32; 3], [0f32; 3], [0f32; 3]);
+    for k in 0..100_000 {
+        let wi = brdftab::geometry::uniform_hemisphere(rng.next_dvec2());
+        let wo = if k % 2 == 0 {
+            // Near specular, where θh indices are dense.
+            let r = brdftab::geometry::reflect_z(wi)
+                + 0.05 * brdftab::geometry::uniform_sphere(rng.next_dvec2());
+            if r.z <= 0.0 {
+                continue;
+            }
+            r.normalize()
+        } else {
+            brdftab::geometry::uniform_hemisphere(rng.next_dvec2())
+        };
+        m.eval(wi, wo, &mut a);
+        t.eval(wi, wo, &mut b);
+        assert_eq!(a, b, "pair {k}: {wi} {wo}");
+        lin.eval(wi, wo, &mut l);
+        assert!(l.iter().all(|x| x.is_finite() && *x >= 0.0));
+    }
+}
