@@ -87,7 +87,7 @@ impl Brdf for Lambert {
         }
         let wi = geometry::cosine_hemisphere(u);
         let pdf = wi.z * std::f64::consts::FRAC_1_PI;
-        if !(pdf > 0.0) {
+        if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         for (w, &k) in weight[..self.kd.len()].iter_mut().zip(&self.kd) {
