@@ -44,8 +44,7 @@ pub struct CookTorrance {
     cos_prob: f64,
 }
 
-/// The geometric part D·G / (4 (N·V)(N·L)) and the Fresnel cosine L·H of a pair, or `None` when
-/// the pair is invalid or below the horizon.
+/// The geometric part D·G / (4 (N·V)(N·L)) and the Fresnel cosine L·H of a pair.
 struct Geometry {
     dg: f64,
     l_dot_h: f64,
@@ -108,8 +107,8 @@ impl CookTorrance {
     ///
     /// Written for speed with the half vector left unnormalized: with l, v unit and h = l + v,
     /// cos² α = h_z² / |h|², L·H = V·H = |h| / 2, and the V-cavity factor
-    /// 2 (N·H) / (V·H) = 4 h_z / |h|². Two square roots and one division for the input lengths, one root for L·H, one division
-    /// each for D, G and the final quotient; every expression is
+    /// 2 (N·H) / (V·H) = 4 h_z / |h|². Two square roots and one division normalize the inputs,
+    /// one root gives L·H, one division each D, G and the final quotient; every expression is
     /// symmetric in (l, v), so reciprocity holds bit for bit.
     #[inline]
     fn geometry(&self, wi: DVec3, wo: DVec3) -> Option<Geometry> {
