@@ -1,6 +1,7 @@
 //! `brdftab`: the command-line tool. Thin over the library: parse arguments, call the library,
 //! print. Errors print as `error: ...` on stderr with exit code 1.
 
+mod measured;
 mod models;
 mod source;
 
@@ -21,6 +22,10 @@ enum Command {
     Eval(models::EvalArgs),
     /// List every model with its parameters.
     Models(models::ModelsArgs),
+    /// Describe a measured file (MERL .binary, RGL .bsdf): description, dims, channels, sha256.
+    Info(measured::InfoArgs),
+    /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
+    Slice(measured::SliceArgs),
 }
 
 fn main() -> ExitCode {
@@ -28,6 +33,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Eval(a) => models::eval(a),
         Command::Models(a) => models::models(a),
+        Command::Info(a) => measured::info(a),
+        Command::Slice(a) => measured::slice(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
