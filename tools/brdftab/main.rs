@@ -2,6 +2,7 @@
 //! print. Errors print as `error: ...` on stderr with exit code 1.
 
 mod models;
+mod render;
 mod source;
 
 use clap::{Parser, Subcommand};
@@ -21,6 +22,8 @@ enum Command {
     Eval(models::EvalArgs),
     /// List every model with its parameters.
     Models(models::ModelsArgs),
+    /// Render SOURCE on a sphere (path tracer or lit sphere); --compare renders two side by side.
+    Render(render::RenderArgs),
 }
 
 fn main() -> ExitCode {
@@ -28,6 +31,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Eval(a) => models::eval(a),
         Command::Models(a) => models::models(a),
+        Command::Render(a) => render::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
