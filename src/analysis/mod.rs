@@ -1,3 +1,5 @@
 //! Analysis of any `&dyn Brdf`: albedo, physical plausibility, accuracy metrics.
 
 pub mod albedo;
+pub mod chi2;
+pub mod slice;

@@ -4,9 +4,9 @@
 //! direction; BRDF is constant". The albedo has the closed form
 //! a = ∫ k_d cos θ dω = k_d π, so energy is conserved only for k_d ≤ 1/π.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
-use crate::brdf::{Brdf, Flags};
+use crate::brdf::{Brdf, BrdfSample, Flags};
 use crate::error::Result;
 use crate::geometry;
 use crate::spectrum::{Channels, Value};
@@ -76,6 +76,35 @@ impl Brdf for Lambert {
             } else {
                 0.0
             };
+        }
+    }
+
+    /// Cosine-weighted sampling, pdf cos θi / π: the weight f·cos θi / pdf = k_d π is constant.
+    fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+        let wo = geometry::normalize(wo)?;
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = geometry::cosine_hemisphere(u);
+        let pdf = wi.z * std::f64::consts::FRAC_1_PI;
+        if !(pdf > 0.0) {
+            return None;
+        }
+        for (w, &k) in weight[..self.kd.len()].iter_mut().zip(&self.kd) {
+            *w = (k as f64 * std::f64::consts::PI) as f32;
+        }
+        Some(BrdfSample {
+            wi,
+            pdf,
+            delta: false,
+        })
+    }
+
+    /// The cosine density cos θi / π (0 below the horizon or for invalid directions).
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        match geometry::upper_pair(wi, wo) {
+            Some((wi, _)) => wi.z * std::f64::consts::FRAC_1_PI,
+            None => 0.0,
         }
     }
 }

@@ -1,1 +1,152 @@
 //! Dense 5D tables: grids, symmetry reduction, baking, interpolated lookup.
+//!
+//! - [`grid`]: the axes ([`Axis`], [`Mapping`], [`Nodes`]), the parameterization ([`Param`]),
+//!   the stored layout and its chunks ([`Layout`]);
+//! - [`symmetry`]: [`Symmetry`], the canonical maps, [`symmetry::verify`] and
+//!   [`symmetry::detect`];
+//! - [`Table`]: a grid plus its stored values, in memory;
+//! - `bake`: any `Brdf` → values, chunk by chunk or into a [`Table`];
+//! - `tabulated`: `TabulatedBrdf`, the `Brdf` over a table (eager or lazily loaded chunks).
+//!
+//! Values are stored λ innermost: the values of one node for every channel are contiguous, so
+//! one set of angular interpolation weights serves all channels.
+
+pub mod grid;
+pub mod symmetry;
+
+pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, StoredAxis};
+pub use symmetry::Symmetry;
+
+use glam::DVec3;
+
+use crate::error::{Error, Result};
+
+/// A grid and its stored values, in memory (the layout is [`Grid::layout`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    grid: Grid,
+    values: Vec<f32>,
+    description: String,
+}
+
+impl Table {
+    /// A table from values in the grid's stored layout; checks the length.
+    pub fn new(grid: Grid, values: Vec<f32>, description: impl Into<String>) -> Result<Table> {
+        if values.len() != grid.stored_values() {
+            return Err(Error::arg(
+                "values",
+                format!(
+                    "{} values given, the grid stores {}",
+                    values.len(),
+                    grid.stored_values()
+                ),
+            ));
+        }
+        Ok(Table {
+            grid,
+            values,
+            description: description.into(),
+        })
+    }
+
+    /// A table filled by `f(node index, node angles, out)` for every stored node, in layout order
+    /// (single-threaded; for sources that are not a `Brdf`, e.g. a measurement array).
+    pub fn from_fn(
+        grid: Grid,
+        description: impl Into<String>,
+        mut f: impl FnMut([usize; 4], [f64; 4], &mut [f32]),
+    ) -> Table {
+        let l = grid.layout().clone();
+        let c = l.channels;
+        let mut values = vec![0.0f32; l.len()];
+        for a in 0..l.chunk_count() {
+            let base = l.chunk_range(a).start;
+            for r in 0..l.rows_in_chunk(a) {
+                let (p, b) = l.row_node(a, r);
+                for q in 0..l.shape[3] {
+                    let idx = [a, p, b, q];
+                    let off = base + (r * l.shape[3] + q) * c;
+                    f(idx, grid.node_angles(idx), &mut values[off..off + c]);
+                }
+            }
+        }
+        Table {
+            grid,
+            values,
+            description: description.into(),
+        }
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// All stored values (layout order, λ innermost).
+    pub fn values(&self) -> &[f32] {
+        &self.values
+    }
+
+    /// Mutable stored values.
+    pub fn values_mut(&mut self) -> &mut [f32] {
+        &mut self.values
+    }
+
+    /// The values of chunk `i` (a slab of stored axis 0).
+    pub fn chunk(&self, i: usize) -> &[f32] {
+        &self.values[self.grid.layout().chunk_range(i)]
+    }
+
+    /// What the table was made from (the source's `describe()`).
+    pub fn description(&self) -> &str {
+        &self.description
+    }
+
+    /// The grid, values and description.
+    pub fn into_parts(self) -> (Grid, Vec<f32>, String) {
+        (self.grid, self.values, self.description)
+    }
+
+    /// The values of the stored node `idx` (all channels), if stored.
+    pub fn node(&self, idx: [usize; 4]) -> Option<&[f32]> {
+        let o = self.grid.layout().offset(idx)?;
+        Some(&self.values[o..o + self.grid.channels().len()])
+    }
+}
+
+/// The representative direction pair of stored coordinates `c` (in the stored domains):
+/// `inout` → spherical(θ1, φ1), spherical(θ2, φ2); `halfdiff` → the inverse Rusinkiewicz
+/// transform. Directions at or below the horizon are lifted to z = [`HORIZON_Z`] so that nodes
+/// outside the physical domain carry the nearby boundary value (this keeps interpolation next to
+/// the horizon accurate, and constant sources exact).
+pub fn pair_of(param: Param, c: [f64; 4]) -> (DVec3, DVec3) {
+    let (wi, wo) = match param {
+        Param::InOut => (
+            crate::geometry::spherical(c[0], c[1]),
+            crate::geometry::spherical(c[2], c[3]),
+        ),
+        Param::HalfDiff => crate::geometry::from_half_diff(crate::geometry::HalfDiff {
+            theta_h: c[0],
+            phi_h: c[1],
+            theta_d: c[2],
+            phi_d: c[3],
+        }),
+    };
+    (lift(wi), lift(wo))
+}
+
+/// Minimum z of a baked direction (see [`pair_of`]).
+pub const HORIZON_Z: f64 = 1e-3;
+
+fn lift(w: DVec3) -> DVec3 {
+    if w.z >= HORIZON_Z {
+        return w;
+    }
+    let r = (w.x * w.x + w.y * w.y).sqrt();
+    let s = (1.0 - HORIZON_Z * HORIZON_Z).sqrt();
+    if r > 0.0 {
+        DVec3::new(w.x / r * s, w.y / r * s, HORIZON_Z)
+    } else {
+        DVec3::new(s, 0.0, HORIZON_Z)
+    }
+}

@@ -1,6 +1,7 @@
 //! `brdftab`: the command-line tool. Thin over the library: parse arguments, call the library,
 //! print. Errors print as `error: ...` on stderr with exit code 1.
 
+mod measured;
 mod models;
 mod render;
 mod source;
@@ -24,6 +25,10 @@ enum Command {
     Models(models::ModelsArgs),
     /// Render SOURCE on a sphere (path tracer or lit sphere); --compare renders two side by side.
     Render(render::RenderArgs),
+    /// Describe a measured file (MERL .binary, RGL .bsdf): description, dims, channels, sha256.
+    Info(measured::InfoArgs),
+    /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
+    Slice(measured::SliceArgs),
 }
 
 fn main() -> ExitCode {
@@ -32,6 +37,8 @@ fn main() -> ExitCode {
         Command::Eval(a) => models::eval(a),
         Command::Models(a) => models::models(a),
         Command::Render(a) => render::run(a),
+        Command::Info(a) => measured::info(a),
+        Command::Slice(a) => measured::slice(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,420 @@
+//! Chi-square goodness-of-fit tests for BRDF samplers — the definition of a correct sampler.
+//!
+//! A sampler is correct when the directions [`Brdf::sample`] draws are distributed with the density
+//! [`Brdf::pdf`] reports. The test (after Mitsuba 3's `ChiSquareTest`) draws many samples for a fixed
+//! `wo`, histograms `wi` into equal-area bins over the sphere (uniform in cos θ and φ), integrates
+//! the pdf over each bin for the expected counts, pools bins whose expected count is below 5, and
+//! computes the p-value of Pearson's statistic from the regularized incomplete gamma function.
+//! Samples the sampler refuses (`None`) are a bin of their own whose expectation is the pdf mass
+//! missing from the sphere, so a pdf that does not integrate to the sampling probability fails too.
+//!
+//! Use [`sidak`] to correct the significance level when many cases are tested together.
+
+use glam::DVec3;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+use crate::brdf::Brdf;
+use crate::rng::Pcg32;
+use crate::spectrum::MAX_CHANNELS;
+
+/// Settings of a chi-square test.
+#[derive(Debug, Clone, Copy)]
+pub struct Chi2Options {
+    /// Number of samples drawn.
+    pub samples: usize,
+    /// Bins in cos θ over [−1, 1].
+    pub cos_bins: usize,
+    /// Bins in φ over [0, 2π).
+    pub phi_bins: usize,
+    /// Seed of the sample stream.
+    pub seed: u64,
+    /// Minimum expected count per pooled bin.
+    pub min_expected: f64,
+}
+
+impl Default for Chi2Options {
+    fn default() -> Self {
+        Chi2Options {
+            samples: 1_000_000,
+            cos_bins: 40,
+            phi_bins: 80,
+            seed: 1,
+            min_expected: 5.0,
+        }
+    }
+}
+
+/// The outcome of a chi-square test.
+#[derive(Debug, Clone)]
+pub struct Chi2Result {
+    /// Pearson's statistic Σ (observed − expected)² / expected over the pooled bins.
+    pub chi2: f64,
+    /// Degrees of freedom (pooled bins − 1).
+    pub dof: usize,
+    /// Probability of a statistic at least this large if the sampler is correct.
+    pub p_value: f64,
+    /// Samples the sampler refused (`None`).
+    pub refused: usize,
+    /// Integral of the pdf over the sphere (should be the fraction of accepted samples).
+    pub pdf_integral: f64,
+    /// Samples whose reported pdf was not positive and finite, or whose direction was not unit.
+    pub invalid: usize,
+}
+
+impl Chi2Result {
+    /// True when the test passes at significance `alpha` and no sample was invalid.
+    pub fn passes(&self, alpha: f64) -> bool {
+        self.invalid == 0 && self.p_value > alpha
+    }
+}
+
+/// Šidák-corrected significance for each of `m` independent tests with overall level `alpha`:
+/// 1 − (1 − alpha)^(1/m).
+pub fn sidak(alpha: f64, m: usize) -> f64 {
+    1.0 - (1.0 - alpha).powf(1.0 / m.max(1) as f64)
+}
+
+fn bin_of(w: DVec3, o: &Chi2Options) -> usize {
+    let c = ((w.z + 1.0) * 0.5 * o.cos_bins as f64) as isize;
+    let c = c.clamp(0, o.cos_bins as isize - 1) as usize;
+    let mut phi = w.y.atan2(w.x);
+    if phi < 0.0 {
+        phi += 2.0 * PI;
+    }
+    let p = ((phi / (2.0 * PI)) * o.phi_bins as f64) as isize;
+    let p = p.clamp(0, o.phi_bins as isize - 1) as usize;
+    c * o.phi_bins + p
+}
+
+/// Histogram of sampled directions: `(counts per bin, refused, invalid)`.
+pub fn histogram<B: Brdf + ?Sized>(
+    brdf: &B,
+    wo: DVec3,
+    o: &Chi2Options,
+) -> (Vec<u64>, usize, usize) {
+    let nbins = o.cos_bins * o.phi_bins;
+    let chunks = 64usize;
+    let per = o.samples.div_ceil(chunks);
+    let c = brdf.channels().len().min(MAX_CHANNELS);
+    let parts: Vec<(Vec<u64>, usize, usize)> = (0..chunks)
+        .into_par_iter()
+        .map(|k| {
+            let mut rng = Pcg32::with_stream(o.seed, k as u64 + 1);
+            let mut counts = vec![0u64; nbins];
+            let (mut refused, mut invalid) = (0, 0);
+            let mut weight = [0.0f32; MAX_CHANNELS];
+            let n = per.min(o.samples.saturating_sub(k * per));
+            for _ in 0..n {
+                let u = rng.next_dvec2();
+                match brdf.sample(wo, u, &mut weight[..c]) {
+                    None => refused += 1,
+                    Some(s) => {
+                        let ok = s.pdf.is_finite()
+                            && s.pdf > 0.0
+                            && (s.wi.length() - 1.0).abs() < 1e-6
+                            && !s.delta;
+                        if ok {
+                            counts[bin_of(s.wi, o)] += 1;
+                        } else {
+                            invalid += 1;
+                        }
+                    }
+                }
+            }
+            (counts, refused, invalid)
+        })
+        .collect();
+    let mut counts = vec![0u64; nbins];
+    let (mut refused, mut invalid) = (0, 0);
+    for (c, r, i) in parts {
+        for (a, b) in counts.iter_mut().zip(c) {
+            *a += b;
+        }
+        refused += r;
+        invalid += i;
+    }
+    (counts, refused, invalid)
+}
+
+/// Integral of `pdf(·, wo)` over each bin (solid angle), by adaptive Simpson quadrature nested in
+/// cos θ and φ.
+pub fn expected_mass<B: Brdf + ?Sized>(brdf: &B, wo: DVec3, o: &Chi2Options) -> Vec<f64> {
+    let nbins = o.cos_bins * o.phi_bins;
+    (0..nbins)
+        .into_par_iter()
+        .map(|b| {
+            let (ci, pi) = (b / o.phi_bins, b % o.phi_bins);
+            let z0 = -1.0 + 2.0 * ci as f64 / o.cos_bins as f64;
+            let z1 = -1.0 + 2.0 * (ci + 1) as f64 / o.cos_bins as f64;
+            let p0 = 2.0 * PI * pi as f64 / o.phi_bins as f64;
+            let p1 = 2.0 * PI * (pi + 1) as f64 / o.phi_bins as f64;
+            // dω = dz dφ on the sphere.
+            let f = |z: f64, phi: f64| {
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let wi = DVec3::new(r * phi.cos(), r * phi.sin(), z);
+                let p = brdf.pdf(wi, wo);
+                if p.is_finite() { p } else { 0.0 }
+            };
+            let inner = |z: f64| adaptive_simpson(&|phi| f(z, phi), p0, p1, 1e-7, 8);
+            adaptive_simpson(&inner, z0, z1, 1e-7, 8)
+        })
+        .collect()
+}
+
+/// Adaptive Simpson quadrature of `f` over [a, b] with absolute tolerance `eps` and at most
+/// `depth` levels of bisection (after an initial 4-panel split).
+pub fn adaptive_simpson(f: &dyn Fn(f64) -> f64, a: f64, b: f64, eps: f64, depth: u32) -> f64 {
+    #[allow(clippy::too_many_arguments)]
+    fn rec(
+        f: &dyn Fn(f64) -> f64,
+        a: f64,
+        b: f64,
+        fa: f64,
+        fm: f64,
+        fb: f64,
+        whole: f64,
+        eps: f64,
+        depth: u32,
+    ) -> f64 {
+        let m = 0.5 * (a + b);
+        let (lm, rm) = (0.5 * (a + m), 0.5 * (m + b));
+        let (flm, frm) = (f(lm), f(rm));
+        let left = (m - a) / 6.0 * (fa + 4.0 * flm + fm);
+        let right = (b - m) / 6.0 * (fm + 4.0 * frm + fb);
+        let delta = left + right - whole;
+        if depth == 0 || delta.abs() <= 15.0 * eps {
+            left + right + delta / 15.0
+        } else {
+            rec(f, a, m, fa, flm, fm, left, eps * 0.5, depth - 1)
+                + rec(f, m, b, fm, frm, fb, right, eps * 0.5, depth - 1)
+        }
+    }
+    let n = 4;
+    let h = (b - a) / n as f64;
+    (0..n)
+        .map(|i| {
+            let (x0, x1) = (a + i as f64 * h, a + (i + 1) as f64 * h);
+            let (f0, fm, f1) = (f(x0), f(0.5 * (x0 + x1)), f(x1));
+            let whole = (x1 - x0) / 6.0 * (f0 + 4.0 * fm + f1);
+            rec(f, x0, x1, f0, fm, f1, whole, eps / n as f64, depth)
+        })
+        .sum()
+}
+
+/// Runs the chi-square test of `brdf`'s sampler for outgoing direction `wo`.
+pub fn test<B: Brdf + ?Sized>(brdf: &B, wo: DVec3, o: &Chi2Options) -> Chi2Result {
+    let (counts, refused, invalid) = histogram(brdf, wo, o);
+    let mass = expected_mass(brdf, wo, o);
+    let n = o.samples as f64;
+    let pdf_integral: f64 = mass.iter().sum();
+    // Pairs (observed, expected), the refused samples as their own bin.
+    let mut cells: Vec<(f64, f64)> = counts
+        .iter()
+        .zip(&mass)
+        .map(|(&c, &m)| (c as f64, m * n))
+        .collect();
+    cells.push((refused as f64, (1.0 - pdf_integral).max(0.0) * n));
+    // Pool small expected counts: sort by expectation, merge the smallest until ≥ min_expected.
+    cells.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let mut chi2 = 0.0;
+    let mut dof: isize = -1;
+    let (mut po, mut pe) = (0.0, 0.0);
+    for (obs, exp) in cells {
+        if exp < o.min_expected {
+            po += obs;
+            pe += exp;
+            continue;
+        }
+        chi2 += (obs - exp) * (obs - exp) / exp;
+        dof += 1;
+    }
+    if pe > 0.0 || po > 0.0 {
+        if pe < o.min_expected {
+            // Not enough mass to form a bin: any observations there are evidence against.
+            if po > 0.0 && pe <= 1e-12 {
+                chi2 = f64::INFINITY;
+            } else {
+                chi2 += (po - pe) * (po - pe) / pe.max(1e-12);
+                dof += 1;
+            }
+        } else {
+            chi2 += (po - pe) * (po - pe) / pe;
+            dof += 1;
+        }
+    }
+    let dof = dof.max(1) as usize;
+    let p_value = if chi2.is_finite() {
+        gamma_q(dof as f64 / 2.0, chi2 / 2.0)
+    } else {
+        0.0
+    };
+    Chi2Result {
+        chi2,
+        dof,
+        p_value,
+        refused,
+        pdf_integral,
+        invalid,
+    }
+}
+
+/// ln Γ(x) for x > 0 (Lanczos approximation, g = 7, n = 9; relative error < 1e-13).
+pub fn ln_gamma(x: f64) -> f64 {
+    const G: f64 = 7.0;
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    if x < 0.5 {
+        // Reflection formula.
+        return (PI / (PI * x).sin()).ln() - ln_gamma(1.0 - x);
+    }
+    let x = x - 1.0;
+    let mut a = C[0];
+    let t = x + G + 0.5;
+    for (i, &c) in C.iter().enumerate().skip(1) {
+        a += c / (x + i as f64);
+    }
+    0.5 * (2.0 * PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+}
+
+/// Regularized upper incomplete gamma function Q(a, x) = Γ(a, x) / Γ(a): the chi-square survival
+/// function is Q(dof/2, χ²/2). Series for x < a + 1, Lentz continued fraction otherwise.
+pub fn gamma_q(a: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 1.0;
+    }
+    let gln = ln_gamma(a);
+    if x < a + 1.0 {
+        // P(a, x) by its series.
+        let mut ap = a;
+        let mut sum = 1.0 / a;
+        let mut del = sum;
+        for _ in 0..10_000 {
+            ap += 1.0;
+            del *= x / ap;
+            sum += del;
+            if del.abs() < sum.abs() * 1e-16 {
+                break;
+            }
+        }
+        let p = sum * (-x + a * x.ln() - gln).exp();
+        (1.0 - p).clamp(0.0, 1.0)
+    } else {
+        let tiny = 1e-300;
+        let mut b = x + 1.0 - a;
+        let mut c = 1.0 / tiny;
+        let mut d = 1.0 / b;
+        let mut h = d;
+        for i in 1..10_000 {
+            let an = -(i as f64) * (i as f64 - a);
+            b += 2.0;
+            d = an * d + b;
+            if d.abs() < tiny {
+                d = tiny;
+            }
+            c = b + an / c;
+            if c.abs() < tiny {
+                c = tiny;
+            }
+            d = 1.0 / d;
+            let del = d * c;
+            h *= del;
+            if (del - 1.0).abs() < 1e-16 {
+                break;
+            }
+        }
+        ((-x + a * x.ln() - gln).exp() * h).clamp(0.0, 1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brdf::{BrdfSample, Flags};
+    use crate::spectrum::Channels;
+    use glam::DVec2;
+
+    #[test]
+    fn gamma_q_known_values() {
+        // Q(1, x) = e^{-x}; Q(1/2, x) = erfc(sqrt(x)).
+        for &x in &[0.1, 1.0, 3.0, 10.0, 40.0] {
+            assert!((gamma_q(1.0, x) - (-x).exp()).abs() < 1e-12);
+        }
+        // erfc(1) = 0.157299207050285
+        assert!((gamma_q(0.5, 1.0) - 0.157_299_207_050_285).abs() < 1e-12);
+        // Chi-square with 10 dof at 18.307 has p = 0.05.
+        assert!((gamma_q(5.0, 18.307 / 2.0) - 0.05).abs() < 1e-4);
+        assert!((ln_gamma(10.0) - 362_880f64.ln()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn sidak_correction() {
+        assert!((sidak(0.01, 1) - 0.01).abs() < 1e-15);
+        assert!(sidak(0.01, 10) < 0.01 / 9.9 && sidak(0.01, 10) > 0.01 / 10.1);
+    }
+
+    /// Cosine sampler whose pdf is correct (the trait's defaults).
+    struct Cosine(Channels);
+    impl Brdf for Cosine {
+        fn channels(&self) -> &Channels {
+            &self.0
+        }
+        fn eval(&self, _: DVec3, _: DVec3, out: &mut [f32]) {
+            out.fill(0.1);
+        }
+        fn flags(&self) -> Flags {
+            Flags::SMOOTH_SYMMETRIC
+        }
+        fn describe(&self) -> String {
+            "cosine".into()
+        }
+    }
+
+    /// Cosine sampler that reports a uniform pdf: wrong.
+    struct Lying(Channels);
+    impl Brdf for Lying {
+        fn channels(&self) -> &Channels {
+            &self.0
+        }
+        fn eval(&self, _: DVec3, _: DVec3, out: &mut [f32]) {
+            out.fill(0.1);
+        }
+        fn flags(&self) -> Flags {
+            Flags::SMOOTH_SYMMETRIC
+        }
+        fn describe(&self) -> String {
+            "lying".into()
+        }
+        fn sample(&self, wo: DVec3, u: DVec2, w: &mut [f32]) -> Option<BrdfSample> {
+            Cosine(Channels::Rgb)
+                .sample(wo, u, w)
+                .map(|s| BrdfSample { pdf: 0.5 / PI, ..s })
+        }
+        fn pdf(&self, wi: DVec3, _: DVec3) -> f64 {
+            if wi.z > 0.0 { 0.5 / PI } else { 0.0 }
+        }
+    }
+
+    #[test]
+    fn correct_sampler_passes_and_wrong_one_fails() {
+        let o = Chi2Options {
+            samples: 200_000,
+            ..Default::default()
+        };
+        let wo = DVec3::new(0.3, 0.2, 0.9).normalize();
+        let good = test(&Cosine(Channels::Rgb), wo, &o);
+        assert!(good.passes(0.01), "{good:?}");
+        assert!((good.pdf_integral - 1.0).abs() < 1e-4, "{good:?}");
+        let bad = test(&Lying(Channels::Rgb), wo, &o);
+        assert!(!bad.passes(0.01), "{bad:?}");
+    }
+}

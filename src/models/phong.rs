@@ -1,0 +1,331 @@
+//! The Phong family of the lecture: one lobe k_s cos^n ψ, four ways to divide it.
+//!
+//! ψ is the angle between the viewer direction ω (`wo`) and the ideal reflection of the light
+//! direction ω′ (`wi`); cos ψ is clamped at 0. Because cos ψ = wo · reflect(wi) = wi · reflect(wo),
+//! the lobe itself is symmetric in its two directions; whether a model is reciprocal depends only
+//! on the divisor X:
+//!
+//! | variant | f_r | reciprocal |
+//! |---|---|---|
+//! | [`PhongVariant::Original`] | k_s cos^n ψ / cos θ′ (L^ref = L^ir k_s cos^n ψ) | no |
+//! | [`PhongVariant::Reciprocal`] | k_s cos^n ψ | yes |
+//! | [`PhongVariant::Max`] | k_s cos^n ψ / max(cos θ′, cos θ) | yes |
+//! | [`PhongVariant::Pumped`] | k_s cos^n ψ / X, X = mean, product or sqrt of cos θ′, cos θ | yes |
+//!
+//! The lecture's albedo of the reciprocal model at perpendicular illumination is
+//! a_max = 2π k_s / (n + 2); the pumped-up versions do not lose energy at grazing angles like the
+//! reciprocal one does (the product and sqrt versions gain without bound there).
+//!
+//! Importance sampling draws the lobe cos^n ψ around the reflection of `wo`, mixed with cosine
+//! sampling for robustness (directions the lobe sends below the horizon are rejected, so the
+//! sampled density is exactly the mixture density restricted to the upper hemisphere).
+
+use glam::{DVec2, DVec3};
+use std::f64::consts::{FRAC_1_PI, PI};
+
+use crate::brdf::{Brdf, BrdfSample, Flags};
+use crate::error::Result;
+use crate::geometry::{self, Frame};
+use crate::spec::PumpX;
+use crate::spectrum::{Channels, Value};
+
+/// Which divisor X the Phong lobe k_s cos^n ψ is divided by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PhongVariant {
+    /// The original Phong model: X = cos θ′ (not reciprocal).
+    Original,
+    /// The reciprocal Phong model: X = 1.
+    Reciprocal,
+    /// The max Phong model: X = max(cos θ′, cos θ).
+    Max,
+    /// The pumped-up reciprocal Phong model with a symmetric X.
+    Pumped(PumpX),
+}
+
+/// Probability of drawing from the cos^n ψ lobe (the rest is cosine-weighted).
+///
+/// The lobe dominates f·cos for every variant, so most samples go there; the cosine part bounds
+/// the weight f·cos θi / pdf by f·π/(1 − LOBE_PROB) where the lobe density is small (the
+/// original and pumped variants have their 1/X growth near the horizon, which the lobe alone does
+/// not follow).
+pub const LOBE_PROB: f64 = 0.85;
+
+/// A member of the Phong family (see the module docs): k_s cos^n ψ / X.
+#[derive(Debug, Clone)]
+pub struct Phong {
+    channels: Channels,
+    variant: PhongVariant,
+    ks_spec: Value,
+    ks: Vec<f64>,
+    n: f64,
+    /// (n + 1) / 2π: normalization of cos^n ψ over the hemisphere around the reflection direction.
+    lobe_norm: f64,
+}
+
+impl Phong {
+    /// A Phong-family model with specular coefficient `ks` (≥ 0) and exponent `n` (≥ 0).
+    pub fn new(variant: PhongVariant, ks: Value, n: f64, channels: &Channels) -> Result<Self> {
+        ks.validate("ks", 0.0)?;
+        if !n.is_finite() || n < 0.0 {
+            return Err(crate::Error::spec(
+                "n",
+                format!("{n} must be a finite number ≥ 0"),
+            ));
+        }
+        Ok(Phong {
+            channels: channels.clone(),
+            variant,
+            ks: ks.resolve(channels),
+            ks_spec: ks,
+            n,
+            lobe_norm: (n + 1.0) / (2.0 * PI),
+        })
+    }
+
+    /// The original (non-reciprocal) Phong model, k_s cos^n ψ / cos θ′.
+    pub fn original(ks: Value, n: f64, channels: &Channels) -> Result<Self> {
+        Self::new(PhongVariant::Original, ks, n, channels)
+    }
+
+    /// The reciprocal Phong model, k_s cos^n ψ.
+    pub fn reciprocal(ks: Value, n: f64, channels: &Channels) -> Result<Self> {
+        Self::new(PhongVariant::Reciprocal, ks, n, channels)
+    }
+
+    /// The max Phong model, k_s cos^n ψ / max(cos θ′, cos θ).
+    pub fn max(ks: Value, n: f64, channels: &Channels) -> Result<Self> {
+        Self::new(PhongVariant::Max, ks, n, channels)
+    }
+
+    /// The pumped-up reciprocal Phong model, k_s cos^n ψ / X.
+    pub fn pumped(ks: Value, n: f64, x: PumpX, channels: &Channels) -> Result<Self> {
+        Self::new(PhongVariant::Pumped(x), ks, n, channels)
+    }
+
+    /// The variant.
+    pub fn variant(&self) -> PhongVariant {
+        self.variant
+    }
+
+    /// The shared core: cos^n ψ / X for unit directions above the horizon (0 when cos ψ ≤ 0).
+    /// `wi` is ω′ (θ′), `wo` is ω (θ).
+    #[inline]
+    fn lobe_over_x(&self, wi: DVec3, wo: DVec3) -> f64 {
+        // cos ψ = ω · (2 (N·ω′) N − ω′) = reflect_z(ω′) · ω.
+        let cos_psi = geometry::reflect_z(wi).dot(wo);
+        if !(cos_psi > 0.0) {
+            return 0.0;
+        }
+        let lobe = cos_psi.powf(self.n);
+        let (ci, co) = (wi.z, wo.z);
+        let x = match self.variant {
+            PhongVariant::Original => ci,
+            PhongVariant::Reciprocal => 1.0,
+            PhongVariant::Max => ci.max(co),
+            PhongVariant::Pumped(PumpX::Mean) => 0.5 * (ci + co),
+            PhongVariant::Pumped(PumpX::Product) => ci * co,
+            PhongVariant::Pumped(PumpX::Sqrt) => (ci * co).sqrt(),
+        };
+        lobe / x
+    }
+
+    /// Density of the cos^n ψ lobe around the reflection of `wo` (hemisphere-normalized).
+    #[inline]
+    fn lobe_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        let cos_psi = geometry::reflect_z(wo).dot(wi);
+        if cos_psi > 0.0 {
+            self.lobe_norm * cos_psi.powf(self.n)
+        } else {
+            0.0
+        }
+    }
+}
+
+impl Brdf for Phong {
+    fn channels(&self) -> &Channels {
+        &self.channels
+    }
+
+    #[inline]
+    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+        let out = &mut out[..self.ks.len()];
+        let Some((wi, wo)) = geometry::upper_pair(wi, wo) else {
+            out.fill(0.0);
+            return;
+        };
+        let v = self.lobe_over_x(wi, wo);
+        for (o, &k) in out.iter_mut().zip(&self.ks) {
+            *o = (k * v) as f32;
+        }
+    }
+
+    fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        match geometry::upper_pair(wi, wo) {
+            Some((wi, wo)) => self.ks_spec.at(nm) * self.lobe_over_x(wi, wo),
+            None => 0.0,
+        }
+    }
+
+    fn flags(&self) -> Flags {
+        Flags {
+            reciprocal: self.variant != PhongVariant::Original,
+            ..Flags::SMOOTH_SYMMETRIC
+        }
+    }
+
+    fn describe(&self) -> String {
+        let name = match self.variant {
+            PhongVariant::Original => "phong".to_string(),
+            PhongVariant::Reciprocal => "reciprocal_phong".to_string(),
+            PhongVariant::Max => "max_phong".to_string(),
+            PhongVariant::Pumped(x) => format!(
+                "pumped_phong x={}",
+                serde_json::to_string(&x).unwrap_or_default()
+            ),
+        };
+        format!(
+            "{name} ks={} n={}",
+            serde_json::to_string(&self.ks_spec).unwrap_or_default(),
+            self.n
+        )
+    }
+
+    /// Mixture of the cos^n ψ lobe around reflect(wo) (probability [`LOBE_PROB`]) and cosine
+    /// sampling; weight f_r cos θi / pdf with pdf the exact mixture density.
+    fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+        let wo = geometry::normalize(wo)?;
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = if u.x < LOBE_PROB {
+            let u0 = u.x / LOBE_PROB;
+            // cos ψ = u^(1/(n+1)) has density ∝ cos^n ψ per solid angle.
+            let cos_psi = u0.powf(1.0 / (self.n + 1.0));
+            let sin_psi = (1.0 - cos_psi * cos_psi).max(0.0).sqrt();
+            let (s, c) = (2.0 * PI * u.y).sin_cos();
+            let r = geometry::reflect_z(wo);
+            Frame::from_normal(r).to_world(DVec3::new(sin_psi * c, sin_psi * s, cos_psi))
+        } else {
+            let u0 = ((u.x - LOBE_PROB) / (1.0 - LOBE_PROB)).min(1.0 - f64::EPSILON);
+            geometry::cosine_hemisphere(DVec2::new(u0, u.y))
+        };
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.pdf(wi, wo);
+        if !(pdf > 0.0) {
+            return None;
+        }
+        let c = self.ks.len();
+        self.eval(wi, wo, &mut weight[..c]);
+        let s = wi.z / pdf;
+        for w in &mut weight[..c] {
+            *w = (*w as f64 * s) as f32;
+        }
+        Some(BrdfSample {
+            wi,
+            pdf,
+            delta: false,
+        })
+    }
+
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        let Some((wi, wo)) = geometry::upper_pair(wi, wo) else {
+            return 0.0;
+        };
+        LOBE_PROB * self.lobe_pdf(wi, wo) + (1.0 - LOBE_PROB) * wi.z * FRAC_1_PI
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::albedo::quadrature;
+
+    #[test]
+    fn reciprocal_albedo_at_normal_incidence_is_2pi_ks_over_n_plus_2() {
+        for n in [10.0, 50.0] {
+            let p = Phong::reciprocal(Value::Rgb([0.2, 0.5, 0.9]), n, &Channels::Rgb).unwrap();
+            let mut a = [0.0; 3];
+            quadrature(&p, DVec3::Z, &mut a);
+            for (c, ks) in [0.2, 0.5, 0.9].into_iter().enumerate() {
+                let expect = 2.0 * PI * ks / (n + 2.0);
+                // Gauss-Legendre in cos θ is exact for cos^(n+1) θ; the rest is f32 rounding.
+                assert!(
+                    (a[c] - expect).abs() < 1e-6 * expect,
+                    "n={n}: {} vs {expect}",
+                    a[c]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn lobe_peaks_at_the_mirror_direction() {
+        let p = Phong::reciprocal(Value::Grey(0.5), 20.0, &Channels::Rgb).unwrap();
+        let wi = geometry::spherical(0.5, 0.3);
+        let mut f = [0.0f32; 3];
+        p.eval(wi, geometry::reflect_z(wi), &mut f);
+        assert!((f[0] - 0.5).abs() < 1e-6);
+        // cos ψ < 0: zero.
+        p.eval(wi, geometry::spherical(1.2, 0.3), &mut f);
+        assert_eq!(f, [0.0; 3]);
+    }
+
+    #[test]
+    fn variants_divide_as_the_lecture_says() {
+        let (wi, wo) = (geometry::spherical(0.4, 0.0), geometry::spherical(0.6, 3.0));
+        let base = Phong::reciprocal(Value::Grey(1.0), 5.0, &Channels::Rgb).unwrap();
+        let mut f0 = [0.0f32; 3];
+        base.eval(wi, wo, &mut f0);
+        assert!(f0[0] > 0.0);
+        let (ci, co) = (wi.z, wo.z);
+        let cases = [
+            (PhongVariant::Original, ci),
+            (PhongVariant::Max, ci.max(co)),
+            (PhongVariant::Pumped(PumpX::Mean), 0.5 * (ci + co)),
+            (PhongVariant::Pumped(PumpX::Product), ci * co),
+            (PhongVariant::Pumped(PumpX::Sqrt), (ci * co).sqrt()),
+        ];
+        for (v, x) in cases {
+            let p = Phong::new(v, Value::Grey(1.0), 5.0, &Channels::Rgb).unwrap();
+            let mut f = [0.0f32; 3];
+            p.eval(wi, wo, &mut f);
+            let expect = f0[0] as f64 / x;
+            assert!((f[0] as f64 - expect).abs() < 1e-6 * expect, "{v:?}");
+        }
+    }
+
+    #[test]
+    fn original_phong_is_not_reciprocal() {
+        let p = Phong::original(Value::Grey(1.0), 10.0, &Channels::Rgb).unwrap();
+        assert!(!p.flags().reciprocal);
+        let (wi, wo) = (geometry::spherical(0.2, 0.0), geometry::spherical(0.3, 3.1));
+        let (mut a, mut b) = ([0.0f32; 3], [0.0f32; 3]);
+        p.eval(wi, wo, &mut a);
+        p.eval(wo, wi, &mut b);
+        // The ratio is cos θ / cos θ′ ≠ 1.
+        assert!((a[0] / b[0] - (wo.z / wi.z) as f32).abs() < 1e-5);
+        assert!((a[0] - b[0]).abs() > 1e-3 * a[0]);
+    }
+
+    #[test]
+    fn invalid_inputs_give_zero() {
+        let p = Phong::max(Value::Grey(1.0), 10.0, &Channels::Rgb).unwrap();
+        for (wi, wo) in [
+            (DVec3::new(0.0, 0.0, -1.0), DVec3::Z),
+            (DVec3::Z, DVec3::new(1.0, 0.0, 0.0)),
+            (DVec3::ZERO, DVec3::Z),
+            (DVec3::new(f64::NAN, 0.0, 1.0), DVec3::Z),
+            (DVec3::Z, DVec3::splat(f64::INFINITY)),
+        ] {
+            let mut f = [1.0f32; 3];
+            p.eval(wi, wo, &mut f);
+            assert_eq!(f, [0.0; 3]);
+            assert_eq!(p.pdf(wi, wo), 0.0);
+            assert_eq!(p.eval_wavelength(wi, wo, 550.0), 0.0);
+        }
+        assert!(Phong::reciprocal(Value::Grey(1.0), -1.0, &Channels::Rgb).is_err());
+        assert!(Phong::reciprocal(Value::Grey(-1.0), 1.0, &Channels::Rgb).is_err());
+    }
+}

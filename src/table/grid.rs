@@ -1,0 +1,894 @@
+//! Grids: the five axes of a dense table, their mappings and node placement, and the stored
+//! (symmetry-reduced) layout with its chunks.
+//!
+//! # Parameterizations
+//!
+//! A table has four angular axes and the channel (λ) axis:
+//!
+//! | [`Param`]    | axis 0 (`theta1`) | axis 1 (`phi1`) | axis 2 (`theta2`) | axis 3 (`phi2`) |
+//! |--------------|-------------------|-----------------|-------------------|-----------------|
+//! | `inout`      | θi                | φi              | θo                | φo (Δφ = φo − φi when isotropic) |
+//! | `halfdiff`   | θh                | φh              | θd                | φd              |
+//!
+//! `inout` is the lecture's table; `halfdiff` is Rusinkiewicz's (MERL's) parameterization, see
+//! [`crate::geometry::half_diff_vectors`].
+//!
+//! # Full axes and stored axes
+//!
+//! A [`Grid`] is described by its four *full* axes — the unreduced grid over the whole domain:
+//! θ axes over [0, π/2], φ axes periodic over [0, 2π) — plus a [`Symmetry`]. The symmetry
+//! determines the *stored* axes ([`Grid::stored_axes`]), which are what a table holds:
+//!
+//! - isotropy: φ1 is stored with size 1; in `inout` axis 3 holds Δφ = φo − φi;
+//! - bilateral symmetry folds a φ axis onto [0, π] (or [0, π/2] together with reciprocity in
+//!   `halfdiff`), stored with [`Nodes::Edges`] so that the folded nodes are exactly full nodes;
+//! - reciprocity: `halfdiff` stores φd over the period [0, π); `inout` *packs* θ1 ≤ θ2 (only the
+//!   upper triangle of the (θ1, θ2) plane is stored, see [`Layout`]).
+//!
+//! Full φ axes always use [`Mapping::Uniform`] and [`Nodes::CellStart`] (node i at i·2π/N), so
+//! every symmetry maps full nodes onto full nodes and interpolation commutes with the reduction.
+//!
+//! # Node placement
+//!
+//! An axis maps a coordinate x in its domain [lo, hi] to u ∈ [0, 1] ([`Mapping`]), then u to a
+//! fractional node index s ([`Nodes`]):
+//!
+//! - [`Nodes::Centers`]: node i at u = (i + ½)/n, s = u·n − ½. No node on the domain ends; lookups
+//!   beyond the first/last node clamp. The default for θ axes: the horizon (where many models
+//!   are singular) is never evaluated.
+//! - [`Nodes::Edges`]: node i at u = i/(n − 1), s = u·(n − 1); both ends are nodes.
+//! - [`Nodes::CellStart`]: node i at u = i/n, s = u·n; node i stands for the cell [i, i+1) and a
+//!   *nearest* lookup takes ⌊s⌋ (not the rounded index). This is MERL's convention:
+//!   `int(sqrt(θh/(π/2))·90)`, `int(θd/(π/2)·90)`, `int(φd/π·180)`. The arithmetic is done in the
+//!   same order as the MERL reader so a nearest lookup on [`Grid::merl`] reproduces its indices
+//!   value for value (`sqrt(((θh/(π/2))·90)·90)`, `(θd/(π/2))·90`, `(φd/π)·180`, with φd + π when
+//!   negative). One documented difference: φd = π exactly wraps to index 0 (it *is* φd = 0 by
+//!   reciprocity) where the MERL reader clamps to 179; this is a measure-zero event.
+//!
+//! Linear interpolation is between neighbouring nodes in s on every node placement; on a
+//! non-periodic axis s is clamped to [0, n − 1], on a periodic axis it wraps.
+//!
+//! # Chunks
+//!
+//! The stored values are a dense row-major array over (axis 0, axis 1, axis 2, axis 3, λ), λ
+//! innermost. A *chunk* is the slab of one index of axis 0 (θi or θh): `chunk_count = n0`.
+//! Chunks are the unit of baking, compression and lazy loading; [`Layout::chunk_range`] gives
+//! each chunk's place in the value array. With packed `inout` reciprocity chunks differ in size
+//! (chunk a holds θ2 indices a..n).
+
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::ops::Range;
+
+use crate::error::{Error, Result};
+use crate::spectrum::Channels;
+use crate::table::symmetry::Symmetry;
+
+/// The angular parameterization of a table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
+pub enum Param {
+    /// (θi, φi, θo, φo): incident and outgoing spherical angles (the lecture's table).
+    #[serde(rename = "inout")]
+    InOut,
+    /// (θh, φh, θd, φd): Rusinkiewicz half/difference angles (MERL).
+    #[default]
+    #[serde(rename = "halfdiff")]
+    HalfDiff,
+}
+
+impl Param {
+    /// Names of the four angular axes.
+    pub fn axis_names(self) -> [&'static str; 4] {
+        match self {
+            Param::InOut => ["theta_i", "phi_i", "theta_o", "phi_o"],
+            Param::HalfDiff => ["theta_h", "phi_h", "theta_d", "phi_d"],
+        }
+    }
+
+    /// Parses `inout` or `halfdiff`.
+    pub fn parse(s: &str) -> Result<Self> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "inout" | "in_out" => Ok(Param::InOut),
+            "halfdiff" | "half_diff" => Ok(Param::HalfDiff),
+            other => Err(Error::arg(
+                "--param",
+                format!("`{other}`: expected inout or halfdiff"),
+            )),
+        }
+    }
+}
+
+/// How an axis's coordinate x ∈ [lo, hi] maps to u ∈ [0, 1] before node placement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
+#[serde(rename_all = "snake_case")]
+pub enum Mapping {
+    /// u = (x − lo)/(hi − lo).
+    #[default]
+    Uniform,
+    /// u = sqrt((x − lo)/(hi − lo)): MERL's θh mapping, dense near the specular peak θh = 0.
+    Sqrt,
+    /// Uniform in cos θ: u = (cos lo − cos x)/(cos lo − cos hi) (θ axes; dense near the horizon
+    /// in θ, uniform in projected solid angle for the polar part).
+    Cos,
+}
+
+/// Where the nodes of an axis sit (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
+#[serde(rename_all = "snake_case")]
+pub enum Nodes {
+    /// Node i at u = (i + ½)/n (cell centres); the domain ends are not nodes.
+    #[default]
+    Centers,
+    /// Node i at u = i/(n − 1); both domain ends are nodes.
+    Edges,
+    /// Node i at u = i/n and stands for the cell [i/n, (i+1)/n): nearest = floor (MERL).
+    CellStart,
+}
+
+/// One full (unreduced) angular axis: its size, mapping and node placement. The domain follows
+/// from the axis's role: θ axes [0, π/2], φ axes periodic [0, 2π).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Hash)]
+pub struct Axis {
+    /// Number of nodes (≥ 1).
+    pub size: usize,
+    /// Coordinate → [0, 1] mapping (θ axes only; φ axes are uniform).
+    #[serde(default)]
+    pub mapping: Mapping,
+    /// Node placement (θ axes; φ axes are always `cell_start`).
+    #[serde(default)]
+    pub nodes: Nodes,
+}
+
+impl Axis {
+    /// A θ axis with `size` nodes.
+    pub fn theta(size: usize, mapping: Mapping, nodes: Nodes) -> Self {
+        Axis {
+            size,
+            mapping,
+            nodes,
+        }
+    }
+
+    /// A periodic φ axis over [0, 2π) with node i at i·2π/size.
+    pub fn phi(size: usize) -> Self {
+        Axis {
+            size,
+            mapping: Mapping::Uniform,
+            nodes: Nodes::CellStart,
+        }
+    }
+}
+
+/// A stored axis: domain, size, mapping, node placement and periodicity — everything lookups
+/// need. Derived from a [`Grid`] by [`Grid::stored_axes`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StoredAxis {
+    /// Number of stored nodes.
+    pub size: usize,
+    /// Lower end of the domain (radians).
+    pub lo: f64,
+    /// Upper end of the domain (for a periodic axis, lo + period).
+    pub hi: f64,
+    /// Coordinate mapping.
+    pub mapping: Mapping,
+    /// Node placement.
+    pub nodes: Nodes,
+    /// Whether the axis wraps around (φ axes that are not folded).
+    pub periodic: bool,
+}
+
+impl StoredAxis {
+    fn theta(a: &Axis) -> Self {
+        StoredAxis {
+            size: a.size,
+            lo: 0.0,
+            hi: FRAC_PI_2,
+            mapping: a.mapping,
+            nodes: a.nodes,
+            periodic: false,
+        }
+    }
+
+    fn periodic(size: usize, period: f64) -> Self {
+        StoredAxis {
+            size,
+            lo: 0.0,
+            hi: period,
+            mapping: Mapping::Uniform,
+            nodes: Nodes::CellStart,
+            periodic: true,
+        }
+    }
+
+    fn folded(size: usize, hi: f64) -> Self {
+        StoredAxis {
+            size,
+            lo: 0.0,
+            hi,
+            mapping: Mapping::Uniform,
+            nodes: Nodes::Edges,
+            periodic: false,
+        }
+    }
+
+    fn single() -> Self {
+        StoredAxis {
+            size: 1,
+            lo: 0.0,
+            hi: 0.0,
+            mapping: Mapping::Uniform,
+            nodes: Nodes::Edges,
+            periodic: false,
+        }
+    }
+
+    /// The fractional node index s of coordinate `x` (not clamped or wrapped).
+    #[inline]
+    pub fn continuous(&self, x: f64) -> f64 {
+        if self.size <= 1 {
+            return 0.0;
+        }
+        let n = self.size as f64;
+        let r = (x - self.lo) / (self.hi - self.lo);
+        match (self.mapping, self.nodes) {
+            // MERL arithmetic order: sqrt(((θ/(π/2))·n)·n).
+            (Mapping::Sqrt, Nodes::CellStart) => (r * n * n).max(0.0).sqrt(),
+            (Mapping::Uniform, Nodes::CellStart) => r * n,
+            (m, nodes) => {
+                let u = match m {
+                    Mapping::Uniform => r,
+                    Mapping::Sqrt => r.max(0.0).sqrt(),
+                    Mapping::Cos => {
+                        let (cl, ch) = (self.lo.cos(), self.hi.cos());
+                        (cl - x.cos()) / (cl - ch)
+                    }
+                };
+                match nodes {
+                    Nodes::Centers => u * n - 0.5,
+                    Nodes::Edges => u * (n - 1.0),
+                    Nodes::CellStart => u * n,
+                }
+            }
+        }
+    }
+
+    /// The coordinate at fractional node index `s` (inverse of [`StoredAxis::continuous`]).
+    pub fn coord(&self, s: f64) -> f64 {
+        if self.size <= 1 {
+            return self.lo;
+        }
+        let n = self.size as f64;
+        let u = match self.nodes {
+            Nodes::Centers => (s + 0.5) / n,
+            Nodes::Edges => s / (n - 1.0),
+            Nodes::CellStart => s / n,
+        };
+        let r = match self.mapping {
+            Mapping::Uniform => u,
+            Mapping::Sqrt => u * u,
+            Mapping::Cos => {
+                let (cl, ch) = (self.lo.cos(), self.hi.cos());
+                let c = (cl - u * (cl - ch)).clamp(-1.0, 1.0);
+                return c.acos();
+            }
+        };
+        self.lo + r * (self.hi - self.lo)
+    }
+
+    /// The coordinate of node `i`.
+    pub fn node(&self, i: usize) -> f64 {
+        self.coord(i as f64)
+    }
+
+    /// The node a *nearest* lookup of `x` uses: ⌊s⌋ for [`Nodes::CellStart`], the rounded s
+    /// otherwise; clamped (or wrapped when periodic) into 0..size.
+    #[inline]
+    pub fn nearest(&self, x: f64) -> usize {
+        let s = self.continuous(x);
+        let i = if self.nodes == Nodes::CellStart {
+            s.floor()
+        } else {
+            (s + 0.5).floor()
+        };
+        self.index(i)
+    }
+
+    #[inline]
+    fn index(&self, i: f64) -> usize {
+        let n = self.size;
+        if self.periodic {
+            let k = if i.is_finite() { i as i64 } else { 0 };
+            k.rem_euclid(n as i64) as usize
+        } else if i.is_nan() || i <= 0.0 {
+            0
+        } else {
+            (i as usize).min(n - 1)
+        }
+    }
+
+    /// The two nodes and the weight of the second for linear interpolation at `x`:
+    /// value = (1 − t)·v[i0] + t·v[i1].
+    #[inline]
+    pub fn linear(&self, x: f64) -> (usize, usize, f32) {
+        let n = self.size;
+        if n <= 1 {
+            return (0, 0, 0.0);
+        }
+        let s = self.continuous(x);
+        if self.periodic {
+            let s = if s.is_finite() { s } else { 0.0 };
+            let f = s.floor();
+            let t = (s - f) as f32;
+            let i0 = (f as i64).rem_euclid(n as i64) as usize;
+            let i1 = if i0 + 1 == n { 0 } else { i0 + 1 };
+            (i0, i1, t)
+        } else {
+            let s = if s.is_nan() {
+                0.0
+            } else {
+                s.clamp(0.0, (n - 1) as f64)
+            };
+            let i0 = (s.floor() as usize).min(n - 2);
+            (i0, i0 + 1, (s - i0 as f64) as f32)
+        }
+    }
+}
+
+/// A dense table's grid: parameterization, four full angular axes, channels and the symmetry
+/// reduction that decides what is stored. Serializable (it goes into file headers); built with
+/// [`Grid::new`], which checks consistency.
+///
+/// ```
+/// use brdftab::table::{Grid, Symmetry};
+/// use brdftab::Channels;
+/// let g = Grid::merl(Channels::Rgb);
+/// assert_eq!(g.stored_shape(), [90, 1, 90, 180]);
+/// assert_eq!(g.stored_values(), 90 * 90 * 180 * 3);
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "GridRepr", into = "GridRepr")]
+pub struct Grid {
+    param: Param,
+    axes: [Axis; 4],
+    channels: Channels,
+    symmetry: Symmetry,
+    stored: [StoredAxis; 4],
+    layout: Layout,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GridRepr {
+    param: Param,
+    theta1: Axis,
+    phi1: Axis,
+    theta2: Axis,
+    phi2: Axis,
+    channels: Channels,
+    symmetry: Symmetry,
+}
+
+impl TryFrom<GridRepr> for Grid {
+    type Error = Error;
+    fn try_from(r: GridRepr) -> Result<Grid> {
+        Grid::new(
+            r.param,
+            [r.theta1, r.phi1, r.theta2, r.phi2],
+            r.channels,
+            r.symmetry,
+        )
+    }
+}
+
+impl From<Grid> for GridRepr {
+    fn from(g: Grid) -> GridRepr {
+        GridRepr {
+            param: g.param,
+            theta1: g.axes[0],
+            phi1: g.axes[1],
+            theta2: g.axes[2],
+            phi2: g.axes[3],
+            channels: g.channels,
+            symmetry: g.symmetry,
+        }
+    }
+}
+
+impl Grid {
+    /// A grid from its full axes `[θ1, φ1, θ2, φ2]` (see the table in the module docs).
+    ///
+    /// Requirements (checked): every size ≥ 1 and the grid at most 2^40 values; φ axes uniform
+    /// with `cell_start` nodes; φ1 of size 1 only when isotropic (it then counts as φ2's size in
+    /// [`Grid::full_values`]); folded φ axes need an even size (a multiple of 4 when
+    /// `halfdiff` φd is folded by both reciprocity and bilateral symmetry); `inout` reciprocity
+    /// needs identical θ axes (and equal φ sizes when anisotropic).
+    pub fn new(
+        param: Param,
+        axes: [Axis; 4],
+        channels: Channels,
+        symmetry: Symmetry,
+    ) -> Result<Grid> {
+        let name = param.axis_names();
+        for (k, a) in axes.iter().enumerate() {
+            if a.size == 0 {
+                return Err(Error::arg("grid", format!("axis {} has size 0", name[k])));
+            }
+            if k % 2 == 1 && (a.mapping != Mapping::Uniform || a.nodes != Nodes::CellStart) {
+                return Err(Error::arg(
+                    "grid",
+                    format!(
+                        "φ axis {} must be uniform with cell_start nodes (periodic)",
+                        name[k]
+                    ),
+                ));
+            }
+        }
+        let [t1, p1, t2, p2] = axes;
+        if p1.size == 1 && !symmetry.isotropic && p2.size > 1 {
+            return Err(Error::arg(
+                "grid",
+                format!("{} of size 1 needs an isotropic table", name[1]),
+            ));
+        }
+        let even = |n: usize, what: &str, m: usize| -> Result<()> {
+            if n % m != 0 {
+                Err(Error::arg(
+                    "grid",
+                    format!(
+                        "{what} of size {n} must be a multiple of {m} to be folded by symmetry"
+                    ),
+                ))
+            } else {
+                Ok(())
+            }
+        };
+        let (s, iso) = (symmetry, symmetry.isotropic);
+        let stored = match param {
+            Param::InOut => {
+                let sp1 = if iso {
+                    StoredAxis::single()
+                } else if s.bilateral {
+                    even(p1.size, name[1], 2)?;
+                    StoredAxis::folded(p1.size / 2 + 1, PI)
+                } else {
+                    StoredAxis::periodic(p1.size, TAU)
+                };
+                let sp2 = if iso && s.bilateral {
+                    even(p2.size, name[3], 2)?;
+                    StoredAxis::folded(p2.size / 2 + 1, PI)
+                } else {
+                    StoredAxis::periodic(p2.size, TAU)
+                };
+                if s.reciprocal {
+                    if t1 != t2 {
+                        return Err(Error::arg(
+                            "grid",
+                            "inout reciprocity needs identical θi and θo axes",
+                        ));
+                    }
+                    if !iso && p1.size != p2.size {
+                        return Err(Error::arg(
+                            "grid",
+                            "anisotropic inout reciprocity needs equal φi and φo sizes",
+                        ));
+                    }
+                }
+                [StoredAxis::theta(&t1), sp1, StoredAxis::theta(&t2), sp2]
+            }
+            Param::HalfDiff => {
+                let sp1 = if iso {
+                    StoredAxis::single()
+                } else if s.bilateral {
+                    even(p1.size, name[1], 2)?;
+                    StoredAxis::folded(p1.size / 2 + 1, PI)
+                } else {
+                    StoredAxis::periodic(p1.size, TAU)
+                };
+                let sp2 = match (s.reciprocal, s.bilateral && iso) {
+                    (true, true) => {
+                        even(p2.size, name[3], 4)?;
+                        StoredAxis::folded(p2.size / 4 + 1, FRAC_PI_2)
+                    }
+                    (true, false) => {
+                        even(p2.size, name[3], 2)?;
+                        StoredAxis::periodic(p2.size / 2, PI)
+                    }
+                    (false, true) => {
+                        even(p2.size, name[3], 2)?;
+                        StoredAxis::folded(p2.size / 2 + 1, PI)
+                    }
+                    (false, false) => StoredAxis::periodic(p2.size, TAU),
+                };
+                [StoredAxis::theta(&t1), sp1, StoredAxis::theta(&t2), sp2]
+            }
+        };
+        let packed = param == Param::InOut && s.reciprocal;
+        let layout = Layout::new(
+            [
+                stored[0].size,
+                stored[1].size,
+                stored[2].size,
+                stored[3].size,
+            ],
+            packed,
+            channels.len(),
+        );
+        let g = Grid {
+            param,
+            axes,
+            channels,
+            symmetry,
+            stored,
+            layout,
+        };
+        if g.full_values() > 1 << 40 {
+            return Err(Error::arg("grid", "more than 2^40 values"));
+        }
+        Ok(g)
+    }
+
+    /// Convenience: θ axes of sizes `n_theta1`, `n_theta2` with the given mappings and
+    /// [`Nodes::Centers`], φ axes of sizes `n_phi1`, `n_phi2`.
+    pub fn with_sizes(
+        param: Param,
+        sizes: [usize; 4],
+        mappings: [Mapping; 2],
+        channels: Channels,
+        symmetry: Symmetry,
+    ) -> Result<Grid> {
+        Grid::new(
+            param,
+            [
+                Axis::theta(sizes[0], mappings[0], Nodes::Centers),
+                Axis::phi(sizes[1]),
+                Axis::theta(sizes[2], mappings[1], Nodes::Centers),
+                Axis::phi(sizes[3]),
+            ],
+            channels,
+            symmetry,
+        )
+    }
+
+    /// The MERL grid: `halfdiff`, θh 90 nodes with the square-root mapping, θd 90, φd 180 over
+    /// [0, π) (full φd 360), all [`Nodes::CellStart`]; isotropic and reciprocal. Stored shape
+    /// 90 × 1 × 90 × 180. A *nearest* lookup reproduces the MERL reader's indices.
+    pub fn merl(channels: Channels) -> Grid {
+        let sym = Symmetry {
+            isotropic: true,
+            reciprocal: true,
+            bilateral: false,
+        };
+        Grid::new(
+            Param::HalfDiff,
+            [
+                Axis::theta(90, Mapping::Sqrt, Nodes::CellStart),
+                Axis::phi(360),
+                Axis::theta(90, Mapping::Uniform, Nodes::CellStart),
+                Axis::phi(360),
+            ],
+            channels,
+            sym,
+        )
+        .expect("the MERL grid is valid")
+    }
+
+    /// The parameterization.
+    pub fn param(&self) -> Param {
+        self.param
+    }
+    /// The full axes `[θ1, φ1, θ2, φ2]`.
+    pub fn axes(&self) -> &[Axis; 4] {
+        &self.axes
+    }
+    /// The channels (λ axis).
+    pub fn channels(&self) -> &Channels {
+        &self.channels
+    }
+    /// The symmetry reduction in force.
+    pub fn symmetry(&self) -> Symmetry {
+        self.symmetry
+    }
+    /// The stored (reduced) axes.
+    pub fn stored_axes(&self) -> &[StoredAxis; 4] {
+        &self.stored
+    }
+    /// Sizes of the stored axes.
+    pub fn stored_shape(&self) -> [usize; 4] {
+        self.layout.shape
+    }
+    /// The stored layout and chunks.
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+    /// Number of stored values (stored nodes × channels).
+    pub fn stored_values(&self) -> usize {
+        self.layout.len()
+    }
+    /// Number of values of the unreduced grid (full axes × channels).
+    pub fn full_values(&self) -> u64 {
+        let a = &self.axes;
+        let p1 = if a[1].size == 1 { a[3].size } else { a[1].size };
+        (a[0].size * p1) as u64 * (a[2].size * a[3].size) as u64 * self.channels.len() as u64
+    }
+
+    /// The same grid with another symmetry reduction.
+    pub fn with_symmetry(&self, symmetry: Symmetry) -> Result<Grid> {
+        Grid::new(self.param, self.axes, self.channels.clone(), symmetry)
+    }
+
+    /// The same grid with other channels.
+    pub fn with_channels(&self, channels: Channels) -> Result<Grid> {
+        Grid::new(self.param, self.axes, channels, self.symmetry)
+    }
+
+    /// The angles of stored node `idx` (in the stored domains; for isotropic `inout`, axis 3 is
+    /// Δφ and axis 1 is 0).
+    pub fn node_angles(&self, idx: [usize; 4]) -> [f64; 4] {
+        [
+            self.stored[0].node(idx[0]),
+            self.stored[1].node(idx[1]),
+            self.stored[2].node(idx[2]),
+            self.stored[3].node(idx[3]),
+        ]
+    }
+
+    /// A one-line human description, e.g. `halfdiff 90x1x90x180 (sqrt θh) rgb isotropic+reciprocal`.
+    pub fn summary(&self) -> String {
+        let s = self.stored_shape();
+        format!(
+            "{} full {}x{}x{}x{} stored {}x{}x{}x{} x{} ch, θ1 {:?}/{:?}, θ2 {:?}/{:?}, symmetry {}",
+            match self.param {
+                Param::InOut => "inout",
+                Param::HalfDiff => "halfdiff",
+            },
+            self.axes[0].size,
+            self.axes[1].size,
+            self.axes[2].size,
+            self.axes[3].size,
+            s[0],
+            s[1],
+            s[2],
+            s[3],
+            self.channels.len(),
+            self.axes[0].mapping,
+            self.axes[0].nodes,
+            self.axes[2].mapping,
+            self.axes[2].nodes,
+            self.symmetry,
+        )
+    }
+}
+
+/// The stored layout: a row-major array over the four stored axes and λ (innermost), split into
+/// chunks = slabs of axis 0. With `packed` (inout reciprocity) only θ2 ≥ θ1 is stored: chunk a
+/// holds axis-2 indices a..n, so its size is (n − a)·s1·s3·c.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Layout {
+    /// Stored axis sizes.
+    pub shape: [usize; 4],
+    /// Upper-triangle packing of (axis 0, axis 2).
+    pub packed: bool,
+    /// Number of channels (values per node).
+    pub channels: usize,
+    /// Start offset (in values) of each chunk, plus the total at the end.
+    chunk_starts: Vec<usize>,
+}
+
+impl Layout {
+    fn new(shape: [usize; 4], packed: bool, channels: usize) -> Layout {
+        let [n0, s1, n2, s3] = shape;
+        let mut starts = Vec::with_capacity(n0 + 1);
+        let mut acc = 0usize;
+        for a in 0..n0 {
+            starts.push(acc);
+            let rows = if packed { n2.saturating_sub(a) } else { n2 };
+            acc += s1 * rows * s3 * channels;
+        }
+        starts.push(acc);
+        Layout {
+            shape,
+            packed,
+            channels,
+            chunk_starts: starts,
+        }
+    }
+
+    /// Total number of stored values.
+    pub fn len(&self) -> usize {
+        *self.chunk_starts.last().unwrap_or(&0)
+    }
+
+    /// True when nothing is stored (never for a valid grid).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Number of chunks (= size of stored axis 0).
+    pub fn chunk_count(&self) -> usize {
+        self.shape[0]
+    }
+
+    /// The value range of chunk `i` in the whole array.
+    pub fn chunk_range(&self, i: usize) -> Range<usize> {
+        self.chunk_starts[i]..self.chunk_starts[i + 1]
+    }
+
+    /// Number of values in chunk `i`.
+    pub fn chunk_len(&self, i: usize) -> usize {
+        self.chunk_starts[i + 1] - self.chunk_starts[i]
+    }
+
+    /// Number of axis-2 indices stored in chunk `a` and the first one.
+    #[inline]
+    pub fn rows2(&self, a: usize) -> (usize, usize) {
+        if self.packed {
+            (a, self.shape[2] - a)
+        } else {
+            (0, self.shape[2])
+        }
+    }
+
+    /// Offset of node `[a, p, b, q]` (its channel 0) inside chunk `a`, or `None` when the node
+    /// is not stored (out of range, or b < a when packed).
+    #[inline]
+    pub fn offset_in_chunk(&self, idx: [usize; 4]) -> Option<usize> {
+        let [a, p, b, q] = idx;
+        let [n0, s1, _, s3] = self.shape;
+        let (b0, nb) = self.rows2(a.min(n0.saturating_sub(1)));
+        if a >= n0 || p >= s1 || b < b0 || b - b0 >= nb || q >= s3 {
+            return None;
+        }
+        Some(((p * nb + (b - b0)) * s3 + q) * self.channels)
+    }
+
+    /// Offset of node `[a, p, b, q]` (its channel 0) in the whole array.
+    pub fn offset(&self, idx: [usize; 4]) -> Option<usize> {
+        Some(self.chunk_starts[idx[0].min(self.shape[0])] + self.offset_in_chunk(idx)?)
+    }
+
+    /// The node of row `r` of chunk `a` (a row = all axis-3 nodes × channels for one (p, b)).
+    pub fn row_node(&self, a: usize, r: usize) -> (usize, usize) {
+        let (b0, nb) = self.rows2(a);
+        (r / nb, b0 + r % nb)
+    }
+
+    /// Number of rows in chunk `a`.
+    pub fn rows_in_chunk(&self, a: usize) -> usize {
+        self.shape[1] * self.rows2(a).1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sym(i: bool, r: bool, b: bool) -> Symmetry {
+        Symmetry {
+            isotropic: i,
+            reciprocal: r,
+            bilateral: b,
+        }
+    }
+
+    #[test]
+    fn lecture_counts_on_one_degree_inout_grid() {
+        // 90 x 360 x 90 x 360, 1 channel: the brief's counts.
+        let ch = Channels::wavelengths(vec![550.0]).unwrap();
+        let g = |s| {
+            Grid::with_sizes(
+                Param::InOut,
+                [90, 360, 90, 360],
+                [Mapping::Uniform; 2],
+                ch.clone(),
+                s,
+            )
+            .unwrap()
+        };
+        let full = g(sym(false, false, false));
+        assert_eq!(full.stored_values(), 1_049_760_000);
+        assert_eq!(full.full_values(), 1_049_760_000);
+        let iso = g(sym(true, false, false)).stored_values();
+        assert_eq!(iso, 2_916_000); // 2.9e6
+        let rec = g(sym(true, true, false)).stored_values();
+        assert_eq!(rec, 4095 * 360); // 1.47e6
+        let bil = g(sym(true, true, true)).stored_values();
+        assert_eq!(bil, 4095 * 181); // 0.74e6
+        let ratio = full.stored_values() as f64 / bil as f64;
+        assert!((1400.0..1450.0).contains(&ratio), "{ratio}");
+    }
+
+    #[test]
+    fn merl_indices_match_the_reader_formulas() {
+        let g = Grid::merl(Channels::Rgb);
+        let [th, _, td, pd] = *g.stored_axes();
+        let mut rng = crate::rng::Pcg32::new(5);
+        for _ in 0..100_000 {
+            let a = rng.next_f64() * FRAC_PI_2;
+            let b = rng.next_f64() * FRAC_PI_2;
+            let c = rng.next_f64() * PI;
+            let merl_h = ((((a / (PI / 2.0)) * 90.0) * 90.0).sqrt() as i64).clamp(0, 89) as usize;
+            let merl_d = (((b / (PI / 2.0)) * 90.0) as i64).clamp(0, 89) as usize;
+            let merl_p = (((c / PI) * 180.0) as i64).clamp(0, 179) as usize;
+            assert_eq!(th.nearest(a), merl_h);
+            assert_eq!(td.nearest(b), merl_d);
+            assert_eq!(pd.nearest(c), merl_p);
+        }
+    }
+
+    #[test]
+    fn continuous_and_coord_are_inverse() {
+        for nodes in [Nodes::Centers, Nodes::Edges, Nodes::CellStart] {
+            for m in [Mapping::Uniform, Mapping::Sqrt, Mapping::Cos] {
+                let ax = StoredAxis::theta(&Axis::theta(17, m, nodes));
+                for i in 0..17 {
+                    let x = ax.node(i);
+                    assert!(
+                        (ax.continuous(x) - i as f64).abs() < 1e-9,
+                        "{m:?} {nodes:?} {i}"
+                    );
+                    assert_eq!(ax.nearest(x + 1e-12), i);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn packed_layout_offsets_are_dense_and_unique() {
+        let g = Grid::with_sizes(
+            Param::InOut,
+            [5, 4, 5, 4],
+            [Mapping::Uniform; 2],
+            Channels::Rgb,
+            sym(false, true, true),
+        )
+        .unwrap();
+        let l = g.layout();
+        let [n0, s1, n2, s3] = l.shape;
+        let mut seen = vec![false; l.len() / 3];
+        for a in 0..n0 {
+            for p in 0..s1 {
+                for b in 0..n2 {
+                    for q in 0..s3 {
+                        let o = l.offset([a, p, b, q]);
+                        assert_eq!(o.is_some(), b >= a);
+                        if let Some(o) = o {
+                            assert!(l.chunk_range(a).contains(&o));
+                            assert!(!seen[o / 3]);
+                            seen[o / 3] = true;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&s| s));
+    }
+
+    #[test]
+    fn grid_json_round_trips() {
+        let g = Grid::merl(Channels::Rgb);
+        let j = serde_json::to_string(&g).unwrap();
+        let h: Grid = serde_json::from_str(&j).unwrap();
+        assert_eq!(g, h);
+        assert!(j.contains("\"halfdiff\""), "{j}");
+    }
+
+    #[test]
+    fn inconsistent_grids_are_rejected() {
+        let bad = Grid::with_sizes(
+            Param::HalfDiff,
+            [8, 1, 8, 10],
+            [Mapping::Sqrt, Mapping::Uniform],
+            Channels::Rgb,
+            sym(true, true, true),
+        );
+        assert!(bad.is_err());
+        let bad = Grid::with_sizes(
+            Param::InOut,
+            [8, 1, 8, 8],
+            [Mapping::Uniform; 2],
+            Channels::Rgb,
+            sym(false, false, false),
+        );
+        assert!(bad.is_err());
+    }
+}

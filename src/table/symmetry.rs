@@ -1,0 +1,325 @@
+//! Symmetry reduction: isotropy, bilateral symmetry and Helmholtz reciprocity.
+//!
+//! Each symmetry is a map from any direction pair (wi, wo) to *canonical* coordinates in the
+//! stored domains of a [`Grid`](super::Grid) ([`canonical_coords`]); a reduced table stores only
+//! canonical nodes. The maps:
+//!
+//! | symmetry    | `inout`                                          | `halfdiff`                        |
+//! |-------------|--------------------------------------------------|-----------------------------------|
+//! | isotropic   | (θi, θo, Δφ = φo − φi), φi dropped               | φh dropped                        |
+//! | bilateral   | Δφ → \|Δφ\| ∈ [0, π] (anisotropic: φi, φo → −φi, −φo when φi > π) | φd → −φd (anisotropic: (φh, φd) → (−φh, −φd) when φh < 0) |
+//! | reciprocal  | swap so θ1 ≤ θ2 (Δφ → −Δφ), upper-triangle packing | φd ≡ φd + π: φd ∈ [0, π)         |
+//!
+//! Because full φ nodes sit at i·2π/N and folded axes keep exactly those nodes, every map sends
+//! nodes to nodes and cells to cells, so interpolating a reduced table gives the same value as
+//! interpolating the full table of a symmetric source. The one place where a cell crosses the
+//! stored region is the diagonal θ1 = θ2 of packed `inout` reciprocity; lookups canonicalize
+//! those corners individually ([`canonical_corner_inout`]).
+//!
+//! A symmetry is *declared* (from [`Flags`](crate::Flags) or by the user) or *detected*
+//! ([`detect`]) and always *verified* ([`verify`]) before a reduced table is baked: a source
+//! breaking a declared symmetry beyond tolerance gives [`Error::Symmetry`] unless forced.
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{PI, TAU};
+use std::fmt;
+
+use crate::brdf::Brdf;
+use crate::error::{Error, Result};
+use crate::geometry;
+use crate::rng::Pcg32;
+use crate::spectrum::MAX_CHANNELS;
+use crate::table::grid::Param;
+
+/// Which symmetries a table exploits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, Hash)]
+#[serde(default, deny_unknown_fields)]
+pub struct Symmetry {
+    /// Invariance under a common rotation about the normal.
+    pub isotropic: bool,
+    /// Helmholtz reciprocity f(wi, wo) = f(wo, wi).
+    pub reciprocal: bool,
+    /// Mirror symmetry through the x–z plane (for isotropic sources: Δφ → −Δφ).
+    pub bilateral: bool,
+}
+
+impl Symmetry {
+    /// No reduction.
+    pub const NONE: Symmetry = Symmetry {
+        isotropic: false,
+        reciprocal: false,
+        bilateral: false,
+    };
+    /// All three.
+    pub const ALL: Symmetry = Symmetry {
+        isotropic: true,
+        reciprocal: true,
+        bilateral: true,
+    };
+
+    /// The symmetries a model declares in its flags.
+    pub fn from_flags(f: crate::Flags) -> Symmetry {
+        Symmetry {
+            isotropic: f.isotropic,
+            reciprocal: f.reciprocal,
+            bilateral: f.bilateral,
+        }
+    }
+
+    /// Parses a comma-separated list: `isotropic,reciprocal,bilateral` (also `iso`, `recip`,
+    /// `bilat`), `none` or `all`.
+    pub fn parse(s: &str) -> Result<Symmetry> {
+        let mut out = Symmetry::NONE;
+        for w in s.split(',').map(|w| w.trim().to_ascii_lowercase()) {
+            match w.as_str() {
+                "" | "none" => {}
+                "all" => out = Symmetry::ALL,
+                "isotropic" | "iso" | "isotropy" => out.isotropic = true,
+                "reciprocal" | "recip" | "reciprocity" => out.reciprocal = true,
+                "bilateral" | "bilat" => out.bilateral = true,
+                other => {
+                    return Err(Error::arg(
+                        "--symmetry",
+                        format!(
+                            "`{other}`: expected auto, none, all or a list of isotropic, reciprocal, bilateral"
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The symmetries present in both.
+    pub fn intersect(self, o: Symmetry) -> Symmetry {
+        Symmetry {
+            isotropic: self.isotropic && o.isotropic,
+            reciprocal: self.reciprocal && o.reciprocal,
+            bilateral: self.bilateral && o.bilateral,
+        }
+    }
+}
+
+impl fmt::Display for Symmetry {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut v = Vec::new();
+        if self.isotropic {
+            v.push("isotropic");
+        }
+        if self.reciprocal {
+            v.push("reciprocal");
+        }
+        if self.bilateral {
+            v.push("bilateral");
+        }
+        if v.is_empty() {
+            f.write_str("none")
+        } else {
+            f.write_str(&v.join("+"))
+        }
+    }
+}
+
+/// Canonical coordinates of a pair in the stored domains of a grid with parameterization
+/// `param` and symmetry `sym`: `[θ1, φ1, θ2, φ2]` (`inout` isotropic: `[θi, 0, θo, Δφ]`;
+/// `halfdiff` isotropic: `[θh, 0, θd, φd]`). `None` below the horizon or for invalid input.
+///
+/// Angles come from vector algebra where possible (one `atan2` for Δφ instead of two).
+#[inline]
+pub fn canonical_coords(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -> Option<[f64; 4]> {
+    let (wi, wo) = geometry::upper_pair(wi, wo)?;
+    match param {
+        Param::InOut => {
+            let ti = wi.z.min(1.0).acos();
+            let to = wo.z.min(1.0).acos();
+            if sym.isotropic {
+                let dot = wi.x * wo.x + wi.y * wo.y;
+                let cross = wi.x * wo.y - wi.y * wo.x;
+                let mut d = cross.atan2(dot);
+                let (mut t1, mut t2) = (ti, to);
+                if sym.reciprocal && t1 > t2 {
+                    std::mem::swap(&mut t1, &mut t2);
+                    d = -d;
+                }
+                if sym.bilateral {
+                    d = d.abs();
+                } else if d < 0.0 {
+                    d += TAU;
+                }
+                Some([t1, 0.0, t2, d])
+            } else {
+                let mut a = [ti, wi.y.atan2(wi.x), to, wo.y.atan2(wo.x)];
+                if sym.reciprocal && a[0] > a[2] {
+                    a.swap(0, 2);
+                    a.swap(1, 3);
+                }
+                if sym.bilateral && a[1] < 0.0 {
+                    a[1] = -a[1];
+                    a[3] = -a[3];
+                }
+                if a[1] < 0.0 {
+                    a[1] += TAU;
+                }
+                if a[3] < 0.0 {
+                    a[3] += TAU;
+                }
+                Some(a)
+            }
+        }
+        Param::HalfDiff => {
+            let (h, d) = geometry::half_diff_vectors(wi, wo)?;
+            let th = h.z.clamp(-1.0, 1.0).acos();
+            let td = d.z.clamp(-1.0, 1.0).acos();
+            let mut pd = d.y.atan2(d.x);
+            let mut ph = 0.0;
+            if !sym.isotropic {
+                ph = h.y.atan2(h.x);
+                if sym.bilateral && ph < 0.0 {
+                    ph = -ph;
+                    pd = -pd;
+                }
+                if ph < 0.0 {
+                    ph += TAU;
+                }
+            }
+            let iso_bilat = sym.isotropic && sym.bilateral;
+            if sym.reciprocal && iso_bilat {
+                let a = pd.abs();
+                pd = a.min(PI - a);
+            } else if sym.reciprocal {
+                // As the MERL reader: φd + π when negative.
+                if pd < 0.0 {
+                    pd += PI;
+                }
+            } else if iso_bilat {
+                pd = pd.abs();
+            } else if pd < 0.0 {
+                pd += TAU;
+            }
+            Some([th, ph, td, pd])
+        }
+    }
+}
+
+/// Canonicalizes a corner `[a, p, b, q]` of packed `inout` reciprocity (stored θ1 ≤ θ2): when
+/// a > b, the reciprocal node is returned. `n1`, `n3` are the full φ sizes (φi, φo);
+/// the stored axis-1/axis-3 conventions follow the grid (see the module table).
+#[inline]
+pub fn canonical_corner_inout(sym: Symmetry, idx: [usize; 4], n3: usize) -> [usize; 4] {
+    let [a, p, b, q] = idx;
+    if a <= b {
+        return idx;
+    }
+    if sym.isotropic {
+        // (θi, θo, Δφ) → (θo, θi, −Δφ); with bilateral symmetry the stored |Δφ| is unchanged.
+        let q2 = if sym.bilateral || q == 0 { q } else { n3 - q };
+        [b, 0, a, q2]
+    } else if sym.bilateral && q > n3 / 2 {
+        // Swap, then reflect both φ through the x–z plane to bring φ1 into [0, π].
+        let p2 = if p == 0 { 0 } else { n3 - p };
+        [b, n3 - q, a, p2]
+    } else {
+        [b, q, a, p]
+    }
+}
+
+/// The three symmetry tests on one pair: which transformed pair to compare with.
+fn transformed(which: usize, wi: DVec3, wo: DVec3, angle: f64) -> (DVec3, DVec3) {
+    match which {
+        0 => {
+            let (s, c) = angle.sin_cos();
+            let r = |v: DVec3| DVec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
+            (r(wi), r(wo))
+        }
+        1 => (wo, wi),
+        _ => (DVec3::new(wi.x, -wi.y, wi.z), DVec3::new(wo.x, -wo.y, wo.z)),
+    }
+}
+
+const NAMES: [&str; 3] = ["isotropic", "reciprocal", "bilateral"];
+
+/// The worst relative difference between f(wi, wo) and f at the transformed pair, for
+/// `which` = 0 (isotropy: common rotation), 1 (reciprocity: swap), 2 (bilateral: y → −y), over
+/// `pairs` random pairs uniform on the hemisphere (seeded). Relative to max(|a|, |b|) floored at
+/// 1e-6 × the largest value seen, so values that are 0 up to rounding do not count.
+/// Returns (error, a description of the worst pair).
+pub fn violation(brdf: &dyn Brdf, which: usize, pairs: usize, seed: u64) -> (f64, String) {
+    let c = brdf.channels().len().min(MAX_CHANNELS);
+    let mut rng = Pcg32::with_stream(seed, which as u64 + 11);
+    let mut fa = [0.0f32; MAX_CHANNELS];
+    let mut fb = [0.0f32; MAX_CHANNELS];
+    let mut samples = Vec::with_capacity(pairs);
+    let mut scale = 0.0f64;
+    for _ in 0..pairs {
+        // Keep away from the horizon: grazing values are numerically fragile in many models.
+        let wi = geometry::uniform_hemisphere(rng.next_dvec2());
+        let wo = geometry::uniform_hemisphere(rng.next_dvec2());
+        if wi.z < 0.02 || wo.z < 0.02 {
+            continue;
+        }
+        let angle = rng.next_f64() * TAU;
+        let (ti, to) = transformed(which, wi, wo, angle);
+        brdf.eval(wi, wo, &mut fa[..c]);
+        brdf.eval(ti, to, &mut fb[..c]);
+        for k in 0..c {
+            let (a, b) = (fa[k] as f64, fb[k] as f64);
+            if a.is_finite() && b.is_finite() {
+                scale = scale.max(a.abs()).max(b.abs());
+                samples.push((a, b, wi, wo));
+            }
+        }
+    }
+    let floor = (scale * 1e-6).max(1e-30);
+    let mut worst = (0.0, String::new());
+    for (a, b, wi, wo) in samples {
+        let e = (a - b).abs() / a.abs().max(b.abs()).max(floor);
+        if e > worst.0 {
+            worst = (
+                e,
+                format!(
+                    "wi=({:.4},{:.4},{:.4}) wo=({:.4},{:.4},{:.4}): {a:.6e} vs {b:.6e}",
+                    wi.x, wi.y, wi.z, wo.x, wo.y, wo.z
+                ),
+            );
+        }
+    }
+    worst
+}
+
+/// Default tolerance of [`verify`] and [`detect`] (relative).
+pub const DEFAULT_TOLERANCE: f64 = 1e-3;
+/// Number of random pairs [`verify`] and [`detect`] evaluate.
+pub const CHECK_PAIRS: usize = 20_000;
+
+/// Checks that `brdf` has every symmetry in `sym` within relative tolerance `tol`; the first
+/// violated one gives [`Error::Symmetry`].
+pub fn verify(brdf: &dyn Brdf, sym: Symmetry, tol: f64) -> Result<()> {
+    let wanted = [sym.isotropic, sym.reciprocal, sym.bilateral];
+    for (k, &w) in wanted.iter().enumerate() {
+        if !w {
+            continue;
+        }
+        let (e, at) = violation(brdf, k, CHECK_PAIRS, 0x5EED);
+        if e > tol || e.is_nan() {
+            return Err(Error::Symmetry {
+                symmetry: NAMES[k].into(),
+                error: e,
+                tolerance: tol,
+                at,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Detects which symmetries `brdf` has within relative tolerance `tol` by evaluating it on
+/// [`CHECK_PAIRS`] random pairs per symmetry.
+pub fn detect(brdf: &dyn Brdf, tol: f64) -> Symmetry {
+    let ok = |k| violation(brdf, k, CHECK_PAIRS, 0x5EED).0 <= tol;
+    Symmetry {
+        isotropic: ok(0),
+        reciprocal: ok(1),
+        bilateral: ok(2),
+    }
+}
