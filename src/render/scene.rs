@@ -618,3 +618,21 @@ mod tests {
         assert_eq!(scene.intersect(scene.eye, d, f64::INFINITY), Hit::Miss);
     }
 }
+
+#[cfg(test)]
+mod exr_env_tests {
+    use super::*;
+
+    #[test]
+    fn exr_lat_long_map_loads_with_orientation() {
+        // Bright top half (sky), dark bottom half: the zenith is bright, the nadir dark.
+        let img = Image::from_fn(16, 8, 3, |_, y, o| o.fill(if y < 4 { 2.0 } else { 0.5 }));
+        let p = std::env::temp_dir().join(format!("brdftab-env-{}.exr", std::process::id()));
+        crate::render::image::write_exr(&img, &p, crate::render::image::ExrPrecision::F16).unwrap();
+        let env = Environment::from_exr(&p).unwrap();
+        assert_eq!(env.eval(DVec3::Z), DVec3::splat(2.0));
+        assert_eq!(env.eval(-DVec3::Z), DVec3::splat(0.5));
+        assert!(env.pdf(DVec3::new(0.0, 0.6, 0.8)) > env.pdf(DVec3::new(0.0, 0.6, -0.8)));
+        assert!(Environment::from_exr("/nonexistent/env.exr").is_err());
+    }
+}
