@@ -315,12 +315,12 @@ fn corrupted_headers_never_panic() {
             let at = rng.below(420) as usize;
             b[at] = rng.below(256) as u8;
         }
-        if let Ok(t) = TensorFile::from_bytes("fuzz", b) {
-            if let Ok(brdf) = RglBrdf::from_tensor(&t, None) {
-                let mut f = [0f32; 3];
-                brdf.eval(dir(40.0, 10.0), dir(30.0, 200.0), &mut f);
-                assert!(f.iter().all(|x| x.is_finite() && *x >= 0.0));
-            }
+        if let Ok(t) = TensorFile::from_bytes("fuzz", b)
+            && let Ok(brdf) = RglBrdf::from_tensor(&t, None)
+        {
+            let mut f = [0f32; 3];
+            brdf.eval(dir(40.0, 10.0), dir(30.0, 200.0), &mut f);
+            assert!(f.iter().all(|x| x.is_finite() && *x >= 0.0));
         }
     }
 }
