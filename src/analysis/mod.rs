@@ -2,3 +2,4 @@
 
 pub mod albedo;
 pub mod chi2;
+pub mod slice;

@@ -1,1 +1,449 @@
 //! The brdftab file format and database of named tables.
+//!
+//! One format serves a single table and a database of many (suggested extension `.btdb`); see
+//! [`format`] for the byte layout. A table is stored as independently decodable, checksummed
+//! chunks (slabs of its outermost axis, λ innermost), so a lookup decodes only the chunks it
+//! touches and whole-table reads decode in parallel.
+//!
+//! - [`Store::open`] maps the file and checks its superblock and table of contents; nothing else
+//!   is read. [`Store::table`] reads and checks one table's header and chunk index.
+//! - [`StoredTable::chunk`] decodes a chunk on first touch into a thread-safe cache bounded in
+//!   memory ([`OpenOptions::cache_bytes`]), or every chunk up front with [`OpenOptions::eager`].
+//! - [`Writer`] streams chunks into a new file and replaces the destination atomically;
+//!   [`db`] builds add / replace / remove / verify on it.
+//!
+//! Files are never modified in place — every write produces a new file and renames it — so a
+//! reader that has a file open keeps seeing the version it opened (it maps the old inode).
+
+pub mod db;
+pub mod export;
+pub mod format;
+pub mod tables;
+mod writer;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use rayon::prelude::*;
+
+pub use format::{Source, TableHeader, TocEntry};
+use format::{ChunkEntry, Superblock, Toc};
+pub use writer::Writer;
+
+use crate::codec;
+use crate::error::{Error, Result};
+
+/// Options for [`Store::open_with`].
+#[derive(Debug, Clone, Copy)]
+pub struct OpenOptions {
+    /// Memory bound of the decoded-chunk cache, in bytes (default 512 MiB). The least recently
+    /// used chunks are dropped beyond it (chunks still referenced by a caller stay alive).
+    pub cache_bytes: usize,
+    /// Decode every chunk of a table when it is opened (in parallel), instead of on first touch.
+    pub eager: bool,
+}
+
+impl Default for OpenOptions {
+    fn default() -> Self {
+        OpenOptions {
+            cache_bytes: 512 << 20,
+            eager: false,
+        }
+    }
+}
+
+/// An open brdftab file (one table or a database).
+pub struct Store {
+    path: PathBuf,
+    name: String,
+    map: Arc<Backing>,
+    toc: Toc,
+    cache: Arc<ChunkCache>,
+    opts: OpenOptions,
+}
+
+impl std::fmt::Debug for Store {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Store")
+            .field("path", &self.path)
+            .field("tables", &self.toc.tables.len())
+            .finish()
+    }
+}
+
+impl Store {
+    /// Opens a file with default options.
+    pub fn open(path: impl AsRef<Path>) -> Result<Store> {
+        Self::open_with(path, OpenOptions::default())
+    }
+
+    /// Opens a file: maps it and checks the superblock and table of contents.
+    pub fn open_with(path: impl AsRef<Path>, opts: OpenOptions) -> Result<Store> {
+        let path = path.as_ref().to_path_buf();
+        let name = path.display().to_string();
+        let f = std::fs::File::open(&path).map_err(|e| Error::io(&path, e))?;
+        let len = f.metadata().map_err(|e| Error::io(&path, e))?.len();
+        if len < format::SUPERBLOCK_LEN as u64 {
+            let mut head = Vec::new();
+            std::io::Read::read_to_end(&mut &f, &mut head).map_err(|e| Error::io(&path, e))?;
+            return Err(match Superblock::parse(&name, &head) {
+                Err(e) => e,
+                Ok(_) => Error::format(&name, Some("superblock"), None, "truncated"),
+            });
+        }
+        // SAFETY: brdftab never modifies a file in place (writers rename a new file over it), so
+        // the mapped bytes do not change under us. A foreign process truncating the file could
+        // still fault; that is the usual caveat of memory maps.
+        let map = unsafe { memmap2::Mmap::map(&f) }.map_err(|e| Error::io(&path, e))?;
+        Self::from_backing(path, name, Backing::Map(map), opts)
+    }
+
+    /// Opens a file held in memory (`name` is used in error messages). Used by the fuzz target.
+    pub fn from_bytes(name: &str, bytes: Vec<u8>, opts: OpenOptions) -> Result<Store> {
+        Self::from_backing(PathBuf::from(name), name.to_owned(), Backing::Bytes(bytes), opts)
+    }
+
+    fn from_backing(path: PathBuf, name: String, map: Backing, opts: OpenOptions) -> Result<Store> {
+        let sb = Superblock::parse(&name, &map)?;
+        let toc_bytes = format::block(&name, &map, &sb.toc, "table of contents", format::MAX_JSON_LEN)?;
+        let toc: Toc = format::json(&name, "table of contents", toc_bytes)?;
+        let mut seen = std::collections::HashSet::new();
+        for t in &toc.tables {
+            if !seen.insert(t.name.as_str()) {
+                return Err(Error::format(&name, Some("table of contents"), None, format!("duplicate table `{}`", t.name)));
+            }
+        }
+        Ok(Store {
+            path,
+            name,
+            map: Arc::new(map),
+            toc,
+            cache: Arc::new(ChunkCache::new(opts.cache_bytes)),
+            opts,
+        })
+    }
+
+    /// The file's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The size of the file in bytes.
+    pub fn file_len(&self) -> u64 {
+        self.map.len() as u64
+    }
+
+    /// The tables, in file order.
+    pub fn tables(&self) -> &[TocEntry] {
+        &self.toc.tables
+    }
+
+    /// Opens the table `name` (reads and checks its header and chunk index).
+    pub fn table(&self, name: &str) -> Result<StoredTable> {
+        let (i, e) = self
+            .toc
+            .tables
+            .iter()
+            .enumerate()
+            .find(|(_, t)| t.name == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = self.toc.tables.iter().map(|t| t.name.as_str()).collect();
+                Error::NotFound(format!("table `{name}` in {} (has: {})", self.name, names.join(", ")))
+            })?;
+        self.table_at(i, e)
+    }
+
+    /// Opens the only table of a single-table file (error if there are several or none).
+    pub fn single(&self) -> Result<StoredTable> {
+        match self.toc.tables.as_slice() {
+            [e] => self.table_at(0, e),
+            [] => Err(Error::NotFound(format!("{}: the file holds no table", self.name))),
+            ts => Err(Error::arg(
+                "SOURCE",
+                format!(
+                    "{} is a database of {} tables; name one as {}#NAME",
+                    self.name,
+                    ts.len(),
+                    self.name
+                ),
+            )),
+        }
+    }
+
+    fn table_at(&self, i: usize, e: &TocEntry) -> Result<StoredTable> {
+        let what = |s: &str| format!("table `{}` {s}", e.name);
+        let hb = format::block(&self.name, &self.map, &e.header, &what("header"), format::MAX_JSON_LEN)?;
+        let header: TableHeader = format::json(&self.name, &what("header"), hb)?;
+        if header.name != e.name {
+            return Err(Error::format(
+                &self.name,
+                Some(&what("header")),
+                Some(e.header.offset),
+                format!("header names the table `{}`", header.name),
+            ));
+        }
+        let ib = format::block(&self.name, &self.map, &e.index, &what("index"), self.map.len() as u64)?;
+        let index = format::check_table(&self.name, self.map.len() as u64, &header, ib, e.chunks)?;
+        let starts = index
+            .iter()
+            .scan(0u64, |acc, e| {
+                let s = *acc;
+                *acc += e.values;
+                Some(s)
+            })
+            .collect();
+        let t = StoredTable {
+            file: self.name.clone(),
+            map: self.map.clone(),
+            header,
+            index,
+            starts,
+            cache: self.cache.clone(),
+            id: i,
+        };
+        if self.opts.eager {
+            (0..t.index.len()).into_par_iter().try_for_each(|c| t.chunk(c).map(drop))?;
+        }
+        Ok(t)
+    }
+
+    /// Checks every checksum and decodes every chunk of every table (in parallel). Returns the
+    /// number of chunks checked.
+    pub fn verify(&self) -> Result<usize> {
+        let mut n = 0;
+        for e in &self.toc.tables {
+            let t = self.table(&e.name)?;
+            t.verify()?;
+            n += t.chunk_count();
+        }
+        Ok(n)
+    }
+}
+
+/// The bytes of an open file: a read-only memory map, or bytes in memory.
+pub enum Backing {
+    /// A memory-mapped file.
+    Map(memmap2::Mmap),
+    /// Bytes in memory.
+    Bytes(Vec<u8>),
+}
+
+impl std::ops::Deref for Backing {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        match self {
+            Backing::Map(m) => m,
+            Backing::Bytes(b) => b,
+        }
+    }
+}
+
+/// One stored table: its header, chunk index, and decoded chunks on demand.
+#[derive(Clone)]
+pub struct StoredTable {
+    file: String,
+    map: Arc<Backing>,
+    header: TableHeader,
+    index: Vec<ChunkEntry>,
+    starts: Vec<u64>,
+    cache: Arc<ChunkCache>,
+    id: usize,
+}
+
+impl std::fmt::Debug for StoredTable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StoredTable")
+            .field("file", &self.file)
+            .field("name", &self.header.name)
+            .field("chunks", &self.index.len())
+            .finish()
+    }
+}
+
+impl StoredTable {
+    /// The file name (for messages).
+    pub fn file(&self) -> &str {
+        &self.file
+    }
+
+    /// The table's header.
+    pub fn header(&self) -> &TableHeader {
+        &self.header
+    }
+
+    /// Number of chunks.
+    pub fn chunk_count(&self) -> usize {
+        self.index.len()
+    }
+
+    /// Total compressed bytes of the chunks.
+    pub fn compressed_bytes(&self) -> u64 {
+        self.index.iter().map(|e| e.len).sum()
+    }
+
+    /// The checksummed bytes of chunk `i` as stored (encoded).
+    pub fn raw_chunk(&self, i: usize) -> Result<&[u8]> {
+        let e = self.index.get(i).ok_or_else(|| {
+            Error::arg("chunk", format!("chunk {i} of {} in table `{}`", self.index.len(), self.header.name))
+        })?;
+        let b = &self.map[e.offset as usize..(e.offset + e.len) as usize];
+        let computed = format::xxh3(b);
+        if computed != e.xxh3 {
+            return Err(Error::Checksum {
+                file: self.file.clone(),
+                what: format!("table `{}` chunk {i}", self.header.name),
+                stored: e.xxh3,
+                computed,
+            });
+        }
+        Ok(b)
+    }
+
+    /// Number of values in chunk `i`.
+    pub fn chunk_values(&self, i: usize) -> usize {
+        self.index.get(i).map_or(0, |e| e.values as usize)
+    }
+
+    /// The chunk holding flat value offset `flat`, and the offset inside it.
+    pub fn locate(&self, flat: u64) -> Result<(usize, usize)> {
+        let i = self.starts.partition_point(|&s| s <= flat).saturating_sub(1);
+        match self.index.get(i) {
+            Some(e) if flat < self.starts[i] + e.values => Ok((i, (flat - self.starts[i]) as usize)),
+            _ => Err(Error::arg(
+                "offset",
+                format!("value {flat} is outside table `{}` ({} values)", self.header.name, self.header.values),
+            )),
+        }
+    }
+
+    /// Decodes chunk `i` (bypassing the cache).
+    pub fn decode_chunk(&self, i: usize) -> Result<Vec<f32>> {
+        let b = self.raw_chunk(i)?;
+        codec::decode(b, self.index[i].values as usize).map_err(|e| self.in_chunk(e, i))
+    }
+
+    fn in_chunk(&self, e: Error, i: usize) -> Error {
+        match e {
+            Error::Format { field, offset, msg, .. } => Error::Format {
+                file: self.file.clone(),
+                field: Some(format!(
+                    "table `{}` chunk {i}{}",
+                    self.header.name,
+                    field.map(|f| format!(" {f}")).unwrap_or_default()
+                )),
+                offset: offset.map(|o| o + self.index[i].offset),
+                msg,
+            },
+            e => e,
+        }
+    }
+
+    /// Chunk `i`, decoded on first touch and kept in the cache.
+    pub fn chunk(&self, i: usize) -> Result<Arc<[f32]>> {
+        if let Some(c) = self.cache.get(self.id, i) {
+            return Ok(c);
+        }
+        let v: Arc<[f32]> = self.decode_chunk(i)?.into();
+        self.cache.put(self.id, i, v.clone());
+        Ok(v)
+    }
+
+    /// Decodes the whole table (all chunks in parallel), outermost axis first.
+    pub fn read_all(&self) -> Result<Vec<f32>> {
+        let total = self.index.iter().map(|e| e.values as usize).sum();
+        let mut out = vec![0.0f32; total];
+        let mut parts = Vec::with_capacity(self.index.len());
+        let mut rest = out.as_mut_slice();
+        for e in &self.index {
+            let (a, b) = rest.split_at_mut(e.values as usize);
+            parts.push(a);
+            rest = b;
+        }
+        parts.into_par_iter().enumerate().try_for_each(|(i, dst)| {
+            let b = self.raw_chunk(i)?;
+            codec::decode_into(b, dst).map_err(|e| self.in_chunk(e, i))
+        })?;
+        Ok(out)
+    }
+
+    /// Checks every chunk's checksum and decodes it (in parallel).
+    pub fn verify(&self) -> Result<()> {
+        (0..self.index.len())
+            .into_par_iter()
+            .try_for_each(|i| self.decode_chunk(i).map(drop))
+    }
+
+    /// A loader of this table's chunks, for `TabulatedBrdf`.
+    pub fn loader(&self) -> Arc<StoredTable> {
+        Arc::new(self.clone())
+    }
+}
+
+/// A thread-safe cache of decoded chunks with a memory bound (least recently used out).
+pub struct ChunkCache {
+    budget: usize,
+    inner: Mutex<CacheInner>,
+}
+
+#[derive(Default)]
+struct CacheInner {
+    map: HashMap<(usize, usize), (Arc<[f32]>, u64)>,
+    bytes: usize,
+    tick: u64,
+}
+
+impl ChunkCache {
+    /// A cache holding at most `budget` bytes of decoded values.
+    pub fn new(budget: usize) -> ChunkCache {
+        ChunkCache {
+            budget,
+            inner: Mutex::new(CacheInner::default()),
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, CacheInner> {
+        self.inner.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn get(&self, t: usize, i: usize) -> Option<Arc<[f32]>> {
+        let mut g = self.lock();
+        g.tick += 1;
+        let tick = g.tick;
+        g.map.get_mut(&(t, i)).map(|(v, last)| {
+            *last = tick;
+            v.clone()
+        })
+    }
+
+    fn put(&self, t: usize, i: usize, v: Arc<[f32]>) {
+        let size = v.len() * 4;
+        let mut g = self.lock();
+        g.tick += 1;
+        let tick = g.tick;
+        if let Some((old, _)) = g.map.insert((t, i), (v, tick)) {
+            g.bytes -= old.len() * 4;
+        }
+        g.bytes += size;
+        while g.bytes > self.budget && g.map.len() > 1 {
+            let oldest = g
+                .map
+                .iter()
+                .filter(|(k, _)| **k != (t, i))
+                .min_by_key(|(_, (_, last))| *last)
+                .map(|(k, _)| *k);
+            match oldest {
+                Some(k) => {
+                    let (old, _) = g.map.remove(&k).expect("present");
+                    g.bytes -= old.len() * 4;
+                }
+                None => break,
+            }
+        }
+    }
+
+    /// Bytes of decoded values currently cached.
+    pub fn bytes(&self) -> usize {
+        self.lock().bytes
+    }
+}

@@ -2,6 +2,7 @@
 //! print. Errors print as `error: ...` on stderr with exit code 1.
 
 mod fit;
+mod measured;
 mod models;
 mod sample;
 mod source;
@@ -29,6 +30,10 @@ enum Command {
     Sample(sample::SampleArgs),
     /// Print pdf(wi | wo) for `wix wiy wiz wox woy woz` lines read from stdin.
     Pdf(sample::PdfArgs),
+    /// Describe a measured file (MERL .binary, RGL .bsdf): description, dims, channels, sha256.
+    Info(measured::InfoArgs),
+    /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
+    Slice(measured::SliceArgs),
 }
 
 fn main() -> ExitCode {
@@ -39,6 +44,8 @@ fn main() -> ExitCode {
         Command::Fit(a) => fit::fit(a),
         Command::Sample(a) => sample::sample(a),
         Command::Pdf(a) => sample::pdf(a),
+        Command::Info(a) => measured::info(a),
+        Command::Slice(a) => measured::slice(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -66,12 +66,13 @@ pub fn spec(source: &str) -> Result<ModelSpec> {
 pub fn open(source: &str, channels: &Channels) -> Result<Box<dyn Brdf>> {
     match kind(source) {
         Kind::Spec => spec(source)?.build(channels),
-        Kind::Merl => Err(Error::Unsupported(format!(
-            "{source}: MERL files are not supported yet"
-        ))),
-        Kind::Rgl => Err(Error::Unsupported(format!(
-            "{source}: RGL files are not supported yet"
-        ))),
+        Kind::Merl => Ok(Box::new(brdftab::measured::MerlBrdf::open(source)?)),
+        // An RGL file answers in its own channels (RGB, or its wavelengths) unless wavelengths
+        // are asked for explicitly.
+        Kind::Rgl if *channels != Channels::Rgb => Ok(Box::new(
+            brdftab::measured::RglBrdf::open_with_channels(source, channels)?,
+        )),
+        Kind::Rgl => Ok(Box::new(brdftab::measured::RglBrdf::open(source)?)),
         Kind::Table => Err(Error::Unsupported(format!(
             "{source}: table files are not supported yet"
         ))),

@@ -1,0 +1,160 @@
+//! Database operations on a brdftab file: add, replace, remove, list, get, verify.
+//!
+//! Every change writes a complete new file next to the old one (copying the other tables' chunks
+//! byte for byte, checksums checked, without decoding them), fsyncs it, renames it over the old
+//! file and fsyncs the directory. A process killed at any moment therefore leaves the old
+//! database or the new one, and an entry already stored is never lost. Writers serialize on an
+//! advisory lock file (`.NAME.lock` beside the database) so two concurrent `add`s cannot drop
+//! each other's table; readers take no lock and keep the version they opened.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use super::{Store, TableHeader, TocEntry, Writer};
+use crate::error::{Error, Result};
+
+/// Holds the database's writer lock while alive.
+pub struct Lock {
+    _file: File,
+}
+
+/// Takes the exclusive writer lock of the database at `path` (blocks until free).
+pub fn lock(path: &Path) -> Result<Lock> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| Error::arg("DB", format!("{} has no file name", path.display())))?
+        .to_string_lossy();
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let lp = dir.join(format!(".{name}.lock"));
+    let f = File::options()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&lp)
+        .map_err(|e| Error::io(&lp, e))?;
+    f.lock().map_err(|e| Error::io(&lp, e))?;
+    Ok(Lock { _file: f })
+}
+
+/// Opens an existing database, or `None` when the file does not exist.
+fn existing(path: &Path) -> Result<Option<Store>> {
+    match std::fs::metadata(path) {
+        Ok(_) => Store::open(path).map(Some),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(Error::io(path, e)),
+    }
+}
+
+/// Copies table `e` of `from` into `w` without decoding (checksums are checked on the way).
+fn copy_table(from: &Store, e: &TocEntry, w: &mut Writer) -> Result<()> {
+    let t = from.table(&e.name)?;
+    w.begin_table(t.header().clone())?;
+    for i in 0..t.chunk_count() {
+        w.encoded_chunk(t.raw_chunk(i)?, t.chunk_values(i) as u64)?;
+    }
+    w.end_table()
+}
+
+/// Adds a table to the database at `path` (created if absent). `write` receives the writer with
+/// the table begun and must supply all its chunks ([`Writer::chunk`] one at a time, or
+/// [`Writer::chunks_par`]). With `replace`, an existing table of that name is replaced in place;
+/// without it, an existing name is an error.
+pub fn put(
+    path: impl AsRef<Path>,
+    header: TableHeader,
+    replace: bool,
+    write: impl FnOnce(&mut Writer) -> Result<()>,
+) -> Result<()> {
+    let path = path.as_ref();
+    let _lock = lock(path)?;
+    let old = existing(path)?;
+    let name = header.name.clone();
+    if let Some(s) = &old
+        && !replace
+        && s.tables().iter().any(|t| t.name == name)
+    {
+        return Err(Error::arg(
+            "--name",
+            format!("{} already holds a table `{name}` (use --replace)", path.display()),
+        ));
+    }
+    let mut w = Writer::create(path)?;
+    let mut new: Option<(TableHeader, Box<dyn FnOnce(&mut Writer) -> Result<()> + '_>)> =
+        Some((header, Box::new(write)));
+    fn emit(
+        w: &mut Writer,
+        new: &mut Option<(TableHeader, Box<dyn FnOnce(&mut Writer) -> Result<()> + '_>)>,
+    ) -> Result<()> {
+        if let Some((h, f)) = new.take() {
+            w.begin_table(h)?;
+            f(w)?;
+            w.end_table()?;
+        }
+        Ok(())
+    }
+    if let Some(s) = &old {
+        for e in s.tables() {
+            if e.name == name {
+                emit(&mut w, &mut new)?;
+            } else {
+                copy_table(s, e, &mut w)?;
+            }
+        }
+    }
+    emit(&mut w, &mut new)?;
+    w.finish()
+}
+
+/// Writes a single-table file from chunks in memory (each with its predictor layout),
+/// replacing `path`.
+pub fn write_table(
+    path: impl AsRef<Path>,
+    header: TableHeader,
+    chunks: &[(&[f32], crate::codec::Layout)],
+) -> Result<()> {
+    let mut w = Writer::create(path)?;
+    w.begin_table(header)?;
+    w.chunks_par(chunks)?;
+    w.end_table()?;
+    w.finish()
+}
+
+/// Removes table `name`. Errors with [`Error::NotFound`] if absent.
+pub fn remove(path: impl AsRef<Path>, name: &str) -> Result<()> {
+    let path = path.as_ref();
+    let _lock = lock(path)?;
+    let s = Store::open(path)?;
+    if !s.tables().iter().any(|t| t.name == name) {
+        return Err(Error::NotFound(format!("table `{name}` in {}", path.display())));
+    }
+    let mut w = Writer::create(path)?;
+    for e in s.tables().iter().filter(|e| e.name != name) {
+        copy_table(&s, e, &mut w)?;
+    }
+    w.finish()
+}
+
+/// The tables of the database with their headers.
+pub fn list(path: impl AsRef<Path>) -> Result<Vec<(TocEntry, TableHeader)>> {
+    let s = Store::open(path)?;
+    s.tables()
+        .iter()
+        .map(|e| Ok((e.clone(), s.table(&e.name)?.header().clone())))
+        .collect()
+}
+
+/// Checks every checksum and decodes every chunk; returns the number of chunks checked.
+pub fn verify(path: impl AsRef<Path>) -> Result<usize> {
+    Store::open(path)?.verify()
+}
+
+/// Splits `DB#NAME` into the path and the optional table name.
+pub fn split_source(source: &str) -> (&str, Option<&str>) {
+    match source.rsplit_once('#') {
+        Some((p, n)) if !n.is_empty() && !n.contains('/') => (p, Some(n)),
+        _ => (source, None),
+    }
+}

@@ -1,0 +1,225 @@
+//! Exports of stored tables: the dense table as NumPy `.npy`, 2D slices as OpenEXR.
+//!
+//! Both stream from the chunks: `.npy` writes chunk after chunk (the table is never whole in
+//! memory), EXR slices decode only the chunks the slice touches.
+
+use std::io::Write;
+use std::path::Path;
+
+use super::StoredTable;
+use crate::error::{Error, Result};
+use crate::spectrum::Channels;
+
+/// The `.npy` v1.0 header for a little-endian f32 C-order array of `shape`.
+pub fn npy_header(shape: &[u64]) -> Vec<u8> {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    let shape = if dims.len() == 1 {
+        format!("({},)", dims[0])
+    } else {
+        format!("({})", dims.join(", "))
+    };
+    let mut dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {shape}, }}");
+    // magic(6) + version(2) + len(2) + dict + '\n' must be a multiple of 64.
+    let unpadded = 10 + dict.len() + 1;
+    dict.push_str(&" ".repeat(unpadded.next_multiple_of(64) - unpadded));
+    dict.push('\n');
+    let mut out = Vec::with_capacity(10 + dict.len());
+    out.extend_from_slice(b"\x93NUMPY\x01\x00");
+    out.extend_from_slice(&(dict.len() as u16).to_le_bytes());
+    out.extend_from_slice(dict.as_bytes());
+    out
+}
+
+/// Maps the index of a node (one per angular axis of the stored shape) to the flat offset of its
+/// channel 0, or `None` when the node is not stored (packed layouts). `None` as a whole means the
+/// plain row-major layout of the stored shape.
+pub type NodeOffset<'a> = Option<&'a (dyn Fn(&[usize]) -> Option<usize> + Sync)>;
+
+/// Writes the table as `.npy`: shape = stored grid dims + channels, dtype `<f4`, C order. Dense
+/// tables stream chunk by chunk; packed tables (fewer values than the shape) are expanded with
+/// `offset`, unstored nodes written as NaN.
+pub fn npy(table: &StoredTable, out: impl AsRef<Path>, offset: NodeOffset<'_>) -> Result<()> {
+    let path = out.as_ref();
+    let h = table.header();
+    let f = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
+    let io = |e| Error::io(path, e);
+    w.write_all(&npy_header(&h.shape)).map_err(io)?;
+    let mut buf = Vec::new();
+    if offset.is_none() || Some(h.values) == h.dense_values() {
+        if Some(h.values) != h.dense_values() {
+            return Err(Error::Unsupported(format!(
+                "table `{}` is packed ({} of {:?} values) and no layout was given",
+                h.name, h.values, h.shape
+            )));
+        }
+        for i in 0..table.chunk_count() {
+            let c = table.decode_chunk(i)?;
+            buf.clear();
+            for v in c.iter() {
+                buf.extend_from_slice(&v.to_le_bytes());
+            }
+            w.write_all(&buf).map_err(io)?;
+        }
+        return w.flush().map_err(io);
+    }
+    let offset = offset.expect("checked");
+    let axes: Vec<usize> = h.shape[..h.shape.len() - 1].iter().map(|&d| d as usize).collect();
+    let nc = *h.shape.last().expect("non-empty") as usize;
+    let nodes: usize = axes.iter().product();
+    let mut idx = vec![0usize; axes.len()];
+    for _ in 0..nodes {
+        match offset(&idx) {
+            Some(o) => {
+                let (ci, off) = table.locate(o as u64)?;
+                let c = table.chunk(ci)?;
+                for v in &c[off..off + nc] {
+                    buf.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+            None => (0..nc).for_each(|_| buf.extend_from_slice(&f32::NAN.to_le_bytes())),
+        }
+        if buf.len() > 1 << 20 {
+            w.write_all(&buf).map_err(io)?;
+            buf.clear();
+        }
+        for a in (0..axes.len()).rev() {
+            idx[a] += 1;
+            if idx[a] < axes[a] {
+                break;
+            }
+            idx[a] = 0;
+        }
+    }
+    w.write_all(&buf).map_err(io)?;
+    w.flush().map_err(io)
+}
+
+/// Which 2D slice of a table to export: the axes along x and y (indices into the stored shape,
+/// channels excluded) and a fixed index for every other axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Slice {
+    /// The axis along image x.
+    pub x: usize,
+    /// The axis along image y.
+    pub y: usize,
+    /// One index per angular axis (those of `x` and `y` are ignored).
+    pub fixed: Vec<u64>,
+}
+
+impl Slice {
+    /// Parses `X,Y[:i0,i1,...]`, e.g. `3,2:45,0,0,0` (x along axis 3, y along axis 2, the other
+    /// axes at the given indices; missing indices are 0).
+    pub fn parse(s: &str, axes: usize) -> Result<Slice> {
+        let err = |m: String| Error::arg("--slice", m);
+        let (xy, fixed) = s.split_once(':').unwrap_or((s, ""));
+        let num = |t: &str| t.trim().parse::<u64>().map_err(|_| err(format!("`{t}` is not an index")));
+        let xy: Vec<u64> = xy.split(',').map(num).collect::<Result<_>>()?;
+        let [x, y] = xy[..] else {
+            return Err(err("expected two axes `X,Y`".into()));
+        };
+        let mut fixed: Vec<u64> = if fixed.trim().is_empty() {
+            vec![]
+        } else {
+            fixed.split(',').map(num).collect::<Result<_>>()?
+        };
+        if fixed.len() > axes {
+            return Err(err(format!("{} fixed indices for {axes} axes", fixed.len())));
+        }
+        fixed.resize(axes, 0);
+        let (x, y) = (x as usize, y as usize);
+        if x >= axes || y >= axes || x == y {
+            return Err(err(format!("axes {x},{y} must be two different axes below {axes}")));
+        }
+        Ok(Slice { x, y, fixed })
+    }
+}
+
+/// Extracts a slice: returns (width, height, values as `[y][x][channel]`). Unstored nodes of
+/// packed layouts are NaN.
+pub fn slice(table: &StoredTable, s: &Slice, offset: NodeOffset<'_>) -> Result<(usize, usize, Vec<f32>)> {
+    let h = table.header();
+    let (axes, nc) = (&h.shape[..h.shape.len() - 1], *h.shape.last().unwrap_or(&1) as usize);
+    if s.x >= axes.len() || s.y >= axes.len() || s.fixed.len() != axes.len() {
+        return Err(Error::arg("--slice", format!("the table has {} angular axes", axes.len())));
+    }
+    for (a, (&i, &d)) in s.fixed.iter().zip(axes).enumerate() {
+        if a != s.x && a != s.y && i >= d {
+            return Err(Error::arg("--slice", format!("index {i} of axis {a} is not below its length {d}")));
+        }
+    }
+    let (w, ht) = (axes[s.x] as usize, axes[s.y] as usize);
+    // Strides of the flat array (values).
+    let mut stride = vec![0u64; axes.len()];
+    let mut acc = nc as u64;
+    for a in (0..axes.len()).rev() {
+        stride[a] = acc;
+        acc *= axes[a];
+    }
+    let mut out = vec![f32::NAN; w * ht * nc];
+    let mut idx: Vec<usize> = s.fixed.iter().map(|&i| i as usize).collect();
+    for yy in 0..ht {
+        for xx in 0..w {
+            idx[s.x] = xx;
+            idx[s.y] = yy;
+            let flat = match offset {
+                Some(f) => f(&idx),
+                None => Some(idx.iter().zip(&stride).map(|(&i, &st)| i as u64 * st).sum::<u64>() as usize),
+            };
+            let Some(flat) = flat else { continue };
+            let (ci, off) = table.locate(flat as u64)?;
+            let c = table.chunk(ci)?;
+            let o = (yy * w + xx) * nc;
+            out[o..o + nc].copy_from_slice(&c[off..off + nc]);
+        }
+    }
+    Ok((w, ht, out))
+}
+
+/// Channel names for EXR: `R`, `G`, `B` or `<nm>nm`.
+fn channel_names(c: &Channels, n: usize) -> Vec<String> {
+    match c {
+        Channels::Rgb if n == 3 => vec!["R".into(), "G".into(), "B".into()],
+        Channels::Wavelengths(w) if w.len() == n => w.iter().map(|x| format!("{x}nm")).collect(),
+        _ => (0..n).map(|i| format!("c{i}")).collect(),
+    }
+}
+
+/// Writes a 2D slice as OpenEXR, channels as EXR channels, f32 or f16 (`half`), ZIP-compressed.
+pub fn exr(
+    table: &StoredTable,
+    s: &Slice,
+    offset: NodeOffset<'_>,
+    out: impl AsRef<Path>,
+    half: bool,
+) -> Result<()> {
+    use exr::prelude::*;
+    let (w, ht, v) = slice(table, s, offset)?;
+    let nc = *table.header().shape.last().unwrap_or(&1) as usize;
+    if w == 0 || ht == 0 {
+        return Err(crate::Error::arg("--slice", "empty slice"));
+    }
+    let names = channel_names(&table.header().channels, nc);
+    let list: Vec<AnyChannel<FlatSamples>> = (0..nc)
+        .map(|c| {
+            let plane = v.iter().skip(c).step_by(nc).copied();
+            let samples = if half {
+                FlatSamples::F16(plane.map(f16::from_f32).collect())
+            } else {
+                FlatSamples::F32(plane.collect())
+            };
+            AnyChannel::new(names[c].as_str(), samples)
+        })
+        .collect();
+    let layer = Layer::new(
+        (w, ht),
+        LayerAttributes::named(table.header().name.as_str()),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list.into()),
+    );
+    let path = out.as_ref();
+    Image::from_layer(layer)
+        .write()
+        .to_file(path)
+        .map_err(|e| crate::Error::io(path, std::io::Error::other(e.to_string())))
+}

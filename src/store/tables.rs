@@ -1,0 +1,140 @@
+//! Storing [`Table`]s and [`Grid`]s: headers from grids, per-chunk predictor layouts, saving a
+//! table (in memory or chunk by chunk), and getting a table's grid back from a file.
+
+use std::path::Path;
+
+use super::format::Source;
+use super::{StoredTable, TableHeader, Writer, db};
+use crate::codec::{self, Codec};
+use crate::error::{Error, Result};
+use crate::spec::ModelSpec;
+use crate::table::{Grid, Table};
+
+impl Source {
+    /// The source of a table baked from a model spec.
+    pub fn model(spec: &ModelSpec) -> Source {
+        Source::Model {
+            spec: serde_json::to_value(spec).unwrap_or(serde_json::Value::Null),
+        }
+    }
+
+    /// The source of a table read from a measured file: its name and SHA-256.
+    pub fn measured(path: impl AsRef<Path>) -> Result<Source> {
+        use sha2::Digest;
+        let path = path.as_ref();
+        let mut f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+        let mut h = sha2::Sha256::new();
+        std::io::copy(&mut f, &mut h).map_err(|e| Error::io(path, e))?;
+        let sha: String = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
+        Ok(Source::Measured {
+            file: path
+                .file_name()
+                .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned()),
+            sha256: sha,
+        })
+    }
+}
+
+impl TableHeader {
+    /// The header of a table on `grid`.
+    pub fn for_grid(name: impl Into<String>, source: Source, grid: &Grid, codec: Codec) -> TableHeader {
+        let s = grid.stored_shape();
+        let shape = vec![s[0] as u64, s[1] as u64, s[2] as u64, s[3] as u64, grid.channels().len() as u64];
+        let mut h = TableHeader::new(name, source, shape, grid.channels().clone(), codec);
+        h.grid = serde_json::to_value(grid).unwrap_or(serde_json::Value::Null);
+        h.parameterization = match grid.param() {
+            crate::table::Param::InOut => "inout".into(),
+            crate::table::Param::HalfDiff => "halfdiff".into(),
+        };
+        h.symmetry = grid.symmetry().to_string();
+        h.values = grid.stored_values() as u64;
+        h.layout = chunk_layout(grid, 0);
+        h
+    }
+}
+
+/// The predictor layout of chunk `a` of `grid`: rows of stored axis 3 (× channels) in planes of
+/// the stored axis-2 rows of that chunk.
+pub fn chunk_layout(grid: &Grid, a: usize) -> codec::Layout {
+    let l = grid.layout();
+    codec::Layout::new(l.channels, l.shape[3], l.rows2(a.min(l.shape[0].saturating_sub(1))).1)
+}
+
+/// Saves an in-memory table as `name` in the database (or single-table file) at `path`, encoding
+/// its chunks in parallel. With `replace`, an existing table of that name is replaced.
+pub fn save(path: impl AsRef<Path>, name: &str, source: Source, table: &Table, codec: Codec, replace: bool) -> Result<()> {
+    let grid = table.grid();
+    let header = TableHeader::for_grid(name, source, grid, codec);
+    db::put(path, header, replace, |w| write_table_chunks(w, table))
+}
+
+/// Appends all chunks of `table` to a writer whose table is begun (encoded in parallel).
+pub fn write_table_chunks(w: &mut Writer, table: &Table) -> Result<()> {
+    let grid = table.grid();
+    let chunks: Vec<(&[f32], codec::Layout)> = (0..grid.layout().chunk_count())
+        .map(|a| (table.chunk(a), chunk_layout(grid, a)))
+        .collect();
+    w.chunks_par(&chunks)
+}
+
+impl StoredTable {
+    /// The table's grid, checked against the stored shape and chunk lengths.
+    pub fn grid(&self) -> Result<Grid> {
+        let h = self.header();
+        let bad = |msg: String| Error::format(self.file(), Some(&format!("table `{}` grid", h.name)), None, msg);
+        // Bound every size in the grid JSON by the (already validated) stored shape before the
+        // grid allocates anything from them.
+        let max = h.shape.iter().copied().max().unwrap_or(0).saturating_mul(4).saturating_add(4);
+        let mut sizes = Vec::new();
+        collect_sizes(&h.grid, &mut sizes);
+        if let Some(s) = sizes.iter().find(|&&s| s > max) {
+            return Err(bad(format!("axis size {s} does not fit the stored shape {:?}", h.shape)));
+        }
+        let grid: Grid = serde_json::from_value(h.grid.clone())
+            .map_err(|e| bad(format!("{e}")))?;
+        let s = grid.stored_shape();
+        let want = [s[0] as u64, s[1] as u64, s[2] as u64, s[3] as u64, grid.channels().len() as u64];
+        if h.shape != want || grid.layout().chunk_count() != self.chunk_count() {
+            return Err(bad(format!("grid stores {want:?}, the header says {:?}", h.shape)));
+        }
+        for a in 0..self.chunk_count() {
+            if grid.layout().chunk_len(a) != self.chunk_values(a) {
+                return Err(bad(format!(
+                    "chunk {a} holds {} values, the grid needs {}",
+                    self.chunk_values(a),
+                    grid.layout().chunk_len(a)
+                )));
+            }
+        }
+        Ok(grid)
+    }
+
+    /// Decodes the whole table into memory.
+    pub fn to_table(&self) -> Result<Table> {
+        let grid = self.grid()?;
+        Table::new(grid, self.read_all()?, self.header().name.clone())
+    }
+}
+
+fn collect_sizes(v: &serde_json::Value, out: &mut Vec<u64>) {
+    match v {
+        serde_json::Value::Object(m) => {
+            for (k, x) in m {
+                if k == "size" {
+                    out.push(x.as_u64().unwrap_or(u64::MAX));
+                }
+                collect_sizes(x, out);
+            }
+        }
+        serde_json::Value::Array(a) => a.iter().for_each(|x| collect_sizes(x, out)),
+        _ => {}
+    }
+}
+
+/// The node-offset function of a grid's stored layout, for the exports.
+pub fn node_offset(grid: &Grid) -> impl Fn(&[usize]) -> Option<usize> + Sync + '_ {
+    move |i: &[usize]| match i {
+        [a, b, c, d] => grid.layout().offset([*a, *b, *c, *d]),
+        _ => None,
+    }
+}

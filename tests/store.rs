@@ -1,0 +1,431 @@
+//! The brdftab file format and database, as a specification: round trips, database operations,
+//! and refusal of every kind of bad input with a typed error (never a panic or a huge allocation).
+
+use std::path::{Path, PathBuf};
+
+use brdftab::codec::{Codec, Layout, Quant};
+use brdftab::store::format::{self, Superblock, Toc};
+use brdftab::store::{OpenOptions, Source, Store, TableHeader, Writer, db, export};
+use brdftab::{Channels, Error};
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("brdftab-store-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A smooth specular-lobe-like table of shape [a, b, c, 3], chunks = slabs of axis 0.
+fn lobe(shape: [usize; 3], seed: f32) -> Vec<f32> {
+    let [a, b, c] = shape;
+    let mut v = Vec::with_capacity(a * b * c * 3);
+    for i in 0..a {
+        for j in 0..b {
+            for k in 0..c {
+                let x = i as f32 / a as f32;
+                let y = j as f32 / b as f32;
+                let z = k as f32 / c as f32;
+                let s = (-(x * x) * 40.0 - (y - 0.3).powi(2) * 5.0).exp() * 50.0 + 0.05 * (z * 3.0 + seed).cos().abs();
+                v.extend_from_slice(&[s * 0.9, s, s * 1.1]);
+            }
+        }
+    }
+    v
+}
+
+fn header(name: &str, shape: [usize; 3], quant: Quant) -> TableHeader {
+    TableHeader::new(
+        name,
+        Source::Other {
+            description: "synthetic lobe".into(),
+        },
+        vec![shape[0] as u64, shape[1] as u64, shape[2] as u64, 3],
+        Channels::Rgb,
+        Codec {
+            quant,
+            level: 3,
+            ..Codec::default()
+        },
+    )
+}
+
+const SHAPE: [usize; 3] = [6, 10, 20];
+
+fn add(path: &Path, name: &str, quant: Quant, seed: f32) {
+    let data = lobe(SHAPE, seed);
+    let h = header(name, SHAPE, quant);
+    let n = data.len() / SHAPE[0];
+    db::put(path, h, true, |w| {
+        for c in data.chunks(n) {
+            w.chunk(c)?;
+        }
+        Ok(())
+    })
+    .unwrap();
+}
+
+#[test]
+fn every_codec_round_trips_through_a_file() {
+    let d = tmpdir("roundtrip");
+    let data = lobe(SHAPE, 0.0);
+    for (k, q) in [
+        Quant::F32,
+        Quant::F16,
+        Quant::Log16 {
+            tolerance: 1e-3,
+            floor: None,
+        },
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let p = d.join(format!("t{k}.btdb"));
+        let n = data.len() / SHAPE[0];
+        let chunks: Vec<(&[f32], Layout)> = data.chunks(n).map(|c| (c, Layout::new(3, 20, 10))).collect();
+        db::write_table(&p, header("lobe", SHAPE, q), &chunks).unwrap();
+        let s = Store::open(&p).unwrap();
+        let t = s.single().unwrap();
+        assert_eq!(t.chunk_count(), SHAPE[0]);
+        let back = t.read_all().unwrap();
+        for (a, b) in data.iter().zip(&back) {
+            match q {
+                Quant::F32 => assert_eq!(a.to_bits(), b.to_bits()),
+                Quant::F16 => assert!((a - b).abs() <= a.abs() * 1e-3 + 1e-7),
+                Quant::Log16 { tolerance, .. } => assert!(((a - b).abs() as f64) <= tolerance * *a as f64 + 1e-20),
+            }
+        }
+        // Lazy chunks equal the eager read and are cached.
+        let c2 = t.chunk(2).unwrap();
+        assert_eq!(&c2[..], &back[2 * n..3 * n]);
+        assert_eq!(t.locate((2 * n + 5) as u64).unwrap(), (2, 5));
+        assert_eq!(s.verify().unwrap(), SHAPE[0]);
+        assert!(t.compressed_bytes() < (data.len() * 4) as u64);
+    }
+}
+
+#[test]
+fn database_add_replace_remove_list_verify() {
+    let d = tmpdir("db");
+    let p = d.join("db.btdb");
+    add(&p, "a", Quant::F16, 0.0);
+    add(&p, "b", Quant::F32, 1.0);
+    add(&p, "c", Quant::F16, 2.0);
+    let names = |p: &Path| db::list(p).unwrap().into_iter().map(|(e, _)| e.name).collect::<Vec<_>>();
+    assert_eq!(names(&p), ["a", "b", "c"]);
+
+    // A reader opened now keeps seeing this version.
+    let old = Store::open(&p).unwrap();
+    let old_b = old.table("b").unwrap().read_all().unwrap();
+
+    // Replace keeps the position; the other tables are copied byte for byte.
+    add(&p, "b", Quant::F16, 5.0);
+    assert_eq!(names(&p), ["a", "b", "c"]);
+    let s = Store::open(&p).unwrap();
+    assert_eq!(s.table("b").unwrap().header().codec.quant, Quant::F16);
+    assert_eq!(s.table("a").unwrap().read_all().unwrap(), Store::open(&p).unwrap().table("a").unwrap().read_all().unwrap());
+    assert_eq!(old.table("b").unwrap().read_all().unwrap(), old_b);
+
+    // Adding an existing name without replace is refused.
+    let e = db::put(&p, header("a", SHAPE, Quant::F16), false, |_| Ok(())).unwrap_err();
+    assert!(e.to_string().contains("already holds"), "{e}");
+
+    db::remove(&p, "a").unwrap();
+    assert_eq!(names(&p), ["b", "c"]);
+    assert!(matches!(db::remove(&p, "zzz"), Err(Error::NotFound(_))));
+    assert!(matches!(Store::open(&p).unwrap().table("a"), Err(Error::NotFound(_))));
+    assert_eq!(db::verify(&p).unwrap(), 2 * SHAPE[0]);
+
+    // A failed write leaves the database as it was and no temporary file behind.
+    let e = db::put(&p, header("d", SHAPE, Quant::F16), false, |w| w.chunk(&[f32::NAN; 600])).unwrap_err();
+    assert!(e.to_string().contains("index 0"), "{e}");
+    assert_eq!(names(&p), ["b", "c"]);
+    let stray: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp."))
+        .collect();
+    assert!(stray.is_empty(), "{stray:?}");
+}
+
+#[test]
+fn cache_respects_its_memory_bound_and_eager_decodes_everything() {
+    let d = tmpdir("cache");
+    let p = d.join("t.btdb");
+    add(&p, "a", Quant::F16, 0.0);
+    let chunk_bytes = 10 * 20 * 3 * 4;
+    let s = Store::open_with(&p, OpenOptions { cache_bytes: 2 * chunk_bytes, eager: false }).unwrap();
+    let t = s.table("a").unwrap();
+    for i in 0..t.chunk_count() {
+        t.chunk(i).unwrap();
+    }
+    assert!(format!("{s:?}").contains("tables"));
+    let s = Store::open_with(&p, OpenOptions { cache_bytes: 1 << 30, eager: true }).unwrap();
+    s.table("a").unwrap();
+}
+
+#[test]
+fn nan_in_data_names_the_chunk_and_index() {
+    let d = tmpdir("nan");
+    let mut w = Writer::create(d.join("x.btdb")).unwrap();
+    w.begin_table(header("x", SHAPE, Quant::F32)).unwrap();
+    let mut v = lobe(SHAPE, 0.0)[..600].to_vec();
+    v[17] = f32::NAN;
+    let e = w.chunk(&v).unwrap_err().to_string();
+    assert!(e.contains("chunk 0") && e.contains("index 17") && e.contains("NaN"), "{e}");
+}
+
+#[test]
+fn npy_and_exr_exports() {
+    let d = tmpdir("export");
+    let p = d.join("t.btdb");
+    add(&p, "a", Quant::F32, 0.0);
+    let s = Store::open(&p).unwrap();
+    let t = s.table("a").unwrap();
+    let out = d.join("a.npy");
+    export::npy(&t, &out, None).unwrap();
+    let b = std::fs::read(&out).unwrap();
+    assert_eq!(&b[..8], b"\x93NUMPY\x01\x00");
+    let hl = u16::from_le_bytes([b[8], b[9]]) as usize;
+    assert_eq!((10 + hl) % 64, 0);
+    let hdr = std::str::from_utf8(&b[10..10 + hl]).unwrap();
+    assert!(hdr.contains("'shape': (6, 10, 20, 3)") && hdr.contains("'<f4'"), "{hdr}");
+    let data = lobe(SHAPE, 0.0);
+    assert_eq!(b.len(), 10 + hl + data.len() * 4);
+    let v: Vec<f32> = b[10 + hl..].chunks(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    assert_eq!(v, data);
+
+    let sl = export::Slice::parse("2,0:0,4", 3).unwrap();
+    let (w, h, px) = export::slice(&t, &sl, None).unwrap();
+    assert_eq!((w, h), (20, 6));
+    // pixel (x=7, y=3) = node [3, 4, 7]
+    let o = ((3 * 10 + 4) * 20 + 7) * 3;
+    assert_eq!(&px[(3 * 20 + 7) * 3..][..3], &data[o..o + 3]);
+    export::exr(&t, &sl, None, d.join("a.exr"), true).unwrap();
+    export::exr(&t, &sl, None, d.join("a32.exr"), false).unwrap();
+    assert!(std::fs::metadata(d.join("a.exr")).unwrap().len() > 100);
+    assert!(export::Slice::parse("1,1", 3).is_err());
+    assert!(export::slice(&t, &export::Slice::parse("0,1:0,0,99", 3).unwrap(), None).is_err());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input.
+
+fn sample_file(d: &Path) -> (PathBuf, Vec<u8>) {
+    let p = d.join("sample.btdb");
+    add(&p, "a", Quant::F16, 0.0);
+    add(&p, "b", Quant::Log16 { tolerance: 1e-3, floor: None }, 1.0);
+    let b = std::fs::read(&p).unwrap();
+    (p, b)
+}
+
+/// Opens bytes as a file and verifies everything; returns the error (panics if it succeeds).
+fn open_err(d: &Path, bytes: &[u8]) -> Error {
+    let _ = d;
+    match Store::from_bytes("bad.btdb", bytes.to_vec(), OpenOptions::default()).and_then(|s| s.verify()) {
+        Ok(_) => panic!("damaged file accepted"),
+        Err(e) => e,
+    }
+}
+
+/// Replaces the TOC (and optionally appends `extra` bytes before it), resealing the superblock,
+/// so a test can plant a specific lie past all checksums.
+fn reseal(bytes: &[u8], extra: &[u8], edit: impl FnOnce(&mut Toc, u64)) -> Vec<u8> {
+    let sb = Superblock::parse("x", bytes).unwrap();
+    let mut toc: Toc = serde_json::from_slice(&bytes[sb.toc.offset as usize..][..sb.toc.len as usize]).unwrap();
+    let mut out = bytes[..sb.toc.offset as usize].to_vec();
+    let extra_at = out.len() as u64;
+    out.extend_from_slice(extra);
+    edit(&mut toc, extra_at);
+    let tj = serde_json::to_vec(&toc).unwrap();
+    let toc_block = format::Block {
+        offset: out.len() as u64,
+        len: tj.len() as u64,
+        xxh3: format::xxh3(&tj),
+    };
+    out.extend_from_slice(&tj);
+    let sb = Superblock {
+        version: sb.version,
+        toc: toc_block,
+        file_len: out.len() as u64,
+    };
+    out[..64].copy_from_slice(&sb.to_bytes());
+    out
+}
+
+#[test]
+fn truncation_anywhere_is_a_typed_error() {
+    let d = tmpdir("trunc");
+    let (_, b) = sample_file(&d);
+    // Through real files for a few lengths (the path goes through the mmap), in memory for all.
+    for len in [0, 5, 63, 64, 100, b.len() - 1] {
+        let p = d.join("trunc.btdb");
+        std::fs::write(&p, &b[..len]).unwrap();
+        let e = Store::open(&p).and_then(|s| s.verify()).unwrap_err();
+        assert!(matches!(e, Error::Format { .. } | Error::Checksum { .. }), "{len}: {e}");
+    }
+    for len in 0..b.len() {
+        let e = open_err(&d, &b[..len]);
+        assert!(matches!(e, Error::Format { .. } | Error::Checksum { .. }), "{len}: {e}");
+    }
+}
+
+#[test]
+fn wrong_magic_and_newer_version() {
+    let d = tmpdir("magic");
+    let (_, b) = sample_file(&d);
+    let mut m = b.clone();
+    m[1] = b'X';
+    assert!(open_err(&d, &m).to_string().contains("wrong magic"));
+    let mut v = b.clone();
+    let mut sb = Superblock::parse("x", &b).unwrap();
+    sb.version = format::VERSION + 1;
+    v[..64].copy_from_slice(&sb.to_bytes());
+    let e = open_err(&d, &v).to_string();
+    assert!(e.contains("newer"), "{e}");
+}
+
+#[test]
+fn every_flipped_byte_is_caught() {
+    let d = tmpdir("flip");
+    let (_, b) = sample_file(&d);
+    for i in 0..b.len() {
+        let mut m = b.clone();
+        m[i] ^= 0x10;
+        let e = open_err(&d, &m);
+        assert!(matches!(e, Error::Format { .. } | Error::Checksum { .. } | Error::Json { .. }), "byte {i}: {e}");
+    }
+}
+
+#[test]
+fn overflowing_chunk_ranges_are_refused() {
+    let d = tmpdir("overflow");
+    let (_, b) = sample_file(&d);
+    let sb = Superblock::parse("x", &b).unwrap();
+    let toc: Toc = serde_json::from_slice(&b[sb.toc.offset as usize..][..sb.toc.len as usize]).unwrap();
+    let idx = toc.tables[0].index;
+    for (field, val) in [(0usize, u64::MAX - 3), (1, u64::MAX), (1, 1 << 40), (2, u64::MAX), (2, 1 << 40)] {
+        let mut ib = b[idx.offset as usize..][..idx.len as usize].to_vec();
+        ib[8 * field..8 * field + 8].copy_from_slice(&val.to_le_bytes());
+        let m = reseal(&b, &ib, |t, at| {
+            t.tables[0].index = format::Block { offset: at, len: ib.len() as u64, xxh3: format::xxh3(&ib) };
+        });
+        let e = open_err(&d, &m);
+        assert!(matches!(e, Error::Format { .. }), "field {field} = {val}: {e}");
+    }
+}
+
+#[test]
+fn absurd_dimensions_and_invalid_json_are_refused_before_allocating() {
+    let d = tmpdir("bomb");
+    let (_, b) = sample_file(&d);
+    let mut h = header("a", SHAPE, Quant::F16);
+    for (shape, values) in [
+        (vec![1u64 << 20, 1 << 20, 1 << 20, 3], 1u64 << 62),
+        (vec![u64::MAX, u64::MAX], 1 << 30),
+        (vec![], 0),
+        (vec![6, 10, 20, 3], 1 << 33), // more values than the shape holds
+    ] {
+        h.shape = shape;
+        h.values = values;
+        let j = serde_json::to_vec(&h).unwrap();
+        let m = reseal(&b, &j, |t, at| {
+            t.tables[0].header = format::Block { offset: at, len: j.len() as u64, xxh3: format::xxh3(&j) };
+        });
+        let e = open_err(&d, &m);
+        assert!(matches!(e, Error::Format { .. }), "{e}");
+    }
+    // Invalid JSON in a header and in the TOC itself.
+    let j = b"{\"name\": \"a\", nope".to_vec();
+    let m = reseal(&b, &j, |t, at| {
+        t.tables[0].header = format::Block { offset: at, len: j.len() as u64, xxh3: format::xxh3(&j) };
+    });
+    assert!(matches!(open_err(&d, &m), Error::Json { .. }));
+    // A TOC claiming a huge index count.
+    let m = reseal(&b, &[], |t, _| t.tables[0].chunks = u64::MAX / 2);
+    assert!(matches!(open_err(&d, &m), Error::Format { .. }));
+}
+
+/// The in-repo substitute for a fuzzer (nightly is not available for `cargo fuzz`): thousands of
+/// random mutations — byte flips, overwrites, truncations, splices — of a real database must
+/// each give an error, never a panic or an accepted file.
+#[test]
+fn random_mutations_never_panic_or_pass() {
+    let d = tmpdir("mutate");
+    let (_, b) = sample_file(&d);
+    let iters: usize = std::env::var("BRDFTAB_MUTATIONS").ok().and_then(|s| s.parse().ok()).unwrap_or(3000);
+    let mut rng = 0x9E3779B97F4A7C15u64;
+    let mut next = move || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        rng
+    };
+    for it in 0..iters {
+        let mut m = b.clone();
+        for _ in 0..1 + next() % 4 {
+            let at = (next() % m.len() as u64) as usize;
+            match next() % 5 {
+                0 => m[at] ^= 1 << (next() % 8),
+                1 => m[at] = next() as u8,
+                2 => m.truncate(at.max(1)),
+                3 => {
+                    let src = (next() % m.len() as u64) as usize;
+                    let n = (next() % 64) as usize;
+                    let chunk: Vec<u8> = m[src..(src + n).min(m.len())].to_vec();
+                    let end = (at + chunk.len()).min(m.len());
+                    m[at..end].copy_from_slice(&chunk[..end - at]);
+                }
+                _ => m.insert(at, next() as u8),
+            }
+        }
+        if m == b {
+            continue;
+        }
+        let r = std::panic::catch_unwind(|| Store::from_bytes("m", m.clone(), OpenOptions::default()).and_then(|s| s.verify()));
+        match r {
+            Err(_) => panic!("mutation {it} panicked"),
+            Ok(Ok(_)) => panic!("mutation {it} accepted"),
+            Ok(Err(_)) => {}
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tables on grids (packed reciprocal layouts have chunks of different lengths).
+
+#[test]
+fn grid_tables_round_trip_including_packed_layouts() {
+    use brdftab::store::tables;
+    use brdftab::table::{Grid, Mapping, Param, Symmetry, Table};
+    let d = tmpdir("grid");
+    let p = d.join("g.btdb");
+    for (k, (param, sizes, sym)) in [
+        (Param::HalfDiff, [9, 1, 9, 18], Symmetry { isotropic: true, reciprocal: true, bilateral: false }),
+        (Param::InOut, [8, 1, 8, 16], Symmetry { isotropic: true, reciprocal: true, bilateral: false }),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let g = Grid::with_sizes(param, sizes, [Mapping::Uniform; 2], Channels::Rgb, sym).unwrap();
+        let t = Table::from_fn(g, "test", |i, a, out| {
+            for (c, o) in out.iter_mut().enumerate() {
+                *o = (a[0].cos() * a[2].cos()).abs() as f32 * (1.0 + c as f32) + i[3] as f32 * 1e-3;
+            }
+        });
+        let name = format!("t{k}");
+        tables::save(&p, &name, Source::Other { description: "fn".into() }, &t, Codec { quant: Quant::F32, level: 3, ..Codec::default() }, false).unwrap();
+        let s = Store::open(&p).unwrap();
+        let st = s.table(&name).unwrap();
+        let back = st.to_table().unwrap();
+        assert_eq!(back.values(), t.values());
+        assert_eq!(back.grid(), t.grid());
+        // npy with the grid's node offsets (unstored nodes of packed layouts are NaN).
+        let g = st.grid().unwrap();
+        let off = tables::node_offset(&g);
+        let out = d.join(format!("{name}.npy"));
+        export::npy(&st, &out, Some(&off)).unwrap();
+        let n: u64 = st.header().shape.iter().product();
+        let hl = 128; // header is padded to 64; small shapes fit in 128
+        assert_eq!(std::fs::metadata(&out).unwrap().len(), hl + 4 * n);
+    }
+}
