@@ -204,6 +204,35 @@ pub fn preset(name: &str) -> Result<ModelSpec> {
     spec_from_json(json)
 }
 
+/// `spec` with the Fresnel term of every microfacet lobe (`cook_torrance`, `ggx`) replaced by
+/// `fresnel` — e.g. `{"schlick": 0.04}` so that a fit also finds F0, or `{"eta": 1.5}` for a
+/// dielectric index. Presets use `"none"` (k_s absorbs the reflectance).
+pub fn with_fresnel(spec: &ModelSpec, fresnel: &crate::fresnel::FresnelSpec) -> Result<ModelSpec> {
+    fn walk(v: &mut Json, f: &Json) {
+        let Some(obj) = v.as_object_mut() else { return };
+        if matches!(
+            obj.get("model").and_then(Json::as_str),
+            Some("cook_torrance" | "ggx")
+        ) {
+            obj.insert("fresnel".into(), f.clone());
+        }
+        if let Some(Json::Array(terms)) = obj.get_mut("terms") {
+            for t in terms {
+                walk(t, f);
+            }
+        }
+    }
+    let to_json = |x: serde_json::Result<Json>| {
+        x.map_err(|e| Error::Json {
+            context: "spec".into(),
+            source: e,
+        })
+    };
+    let mut json = to_json(serde_json::to_value(spec))?;
+    walk(&mut json, &to_json(serde_json::to_value(fresnel))?);
+    spec_from_json(json)
+}
+
 fn spec_from_json(json: Json) -> Result<ModelSpec> {
     ModelSpec::parse(&json.to_string())
 }

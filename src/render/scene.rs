@@ -61,7 +61,11 @@ impl Distribution1D {
     fn sample(&self, u: f64) -> (f64, f64, usize) {
         let n = self.func.len();
         // Largest i with cdf[i] <= u.
-        let i = self.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(n - 1);
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .saturating_sub(1)
+            .min(n - 1);
         let width = self.cdf[i + 1] - self.cdf[i];
         let du = if width > 0.0 {
             ((u - self.cdf[i]) / width).clamp(0.0, 1.0)
@@ -595,7 +599,10 @@ mod tests {
         for _ in 0..1000 {
             let (d, pdf, _) = scene.sample_sphere_light(p, rng.next_dvec2()).unwrap();
             assert!((scene.sphere_light_pdf(p, d) - pdf).abs() < 1e-9 * pdf);
-            assert!(matches!(scene.intersect(p, d, f64::INFINITY), Hit::Light { .. }));
+            assert!(matches!(
+                scene.intersect(p, d, f64::INFINITY),
+                Hit::Light { .. }
+            ));
         }
     }
 
@@ -603,7 +610,10 @@ mod tests {
     fn camera_sees_the_sphere_in_the_centre_and_sky_in_the_corner() {
         let scene = Scene::new(Environment::sky(), None, false);
         let d = scene.camera_ray(0.5, 0.5, 1.0);
-        assert!(matches!(scene.intersect(scene.eye, d, f64::INFINITY), Hit::Sphere { .. }));
+        assert!(matches!(
+            scene.intersect(scene.eye, d, f64::INFINITY),
+            Hit::Sphere { .. }
+        ));
         let d = scene.camera_ray(0.0, 0.0, 1.0);
         assert_eq!(scene.intersect(scene.eye, d, f64::INFINITY), Hit::Miss);
     }
