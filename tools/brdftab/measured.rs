@@ -14,6 +14,13 @@ pub struct InfoArgs {
     source: String,
 }
 
+/// `info` for a measured file named by path (used by the table `info` command's dispatch).
+pub fn info_source(source: &str) -> Result<()> {
+    info(InfoArgs {
+        source: source.to_owned(),
+    })
+}
+
 /// Prints what a measured file holds: description, dimensions, channels, sha256.
 pub fn info(a: InfoArgs) -> Result<()> {
     match source::kind(&a.source) {
