@@ -19,8 +19,8 @@ pub mod raw;
 pub mod symmetry;
 pub mod tabulated;
 
-pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, StoredAxis};
 pub use bake::{BakeOptions, BakeReport, bake, bake_chunks};
+pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, StoredAxis};
 pub use lookup::Interp;
 pub use symmetry::Symmetry;
 pub use tabulated::{ChunkLoader, TabulatedBrdf};

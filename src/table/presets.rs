@@ -42,7 +42,10 @@ impl Preset {
             "small" => Ok(Preset::Small),
             "medium" => Ok(Preset::Medium),
             "large" => Ok(Preset::Large),
-            o => Err(Error::arg("--preset", format!("`{o}`: expected small, medium or large"))),
+            o => Err(Error::arg(
+                "--preset",
+                format!("`{o}`: expected small, medium or large"),
+            )),
         }
     }
 
@@ -66,12 +69,23 @@ impl Preset {
     }
 
     /// The preset grid for `param` (default `halfdiff`), symmetry and channels.
-    pub fn grid(self, param: Option<Param>, symmetry: Symmetry, channels: Channels) -> Result<Grid> {
+    pub fn grid(
+        self,
+        param: Option<Param>,
+        symmetry: Symmetry,
+        channels: Channels,
+    ) -> Result<Grid> {
         let param = param.unwrap_or(Param::HalfDiff);
         let mappings = match param {
             Param::HalfDiff => [Mapping::Sqrt, Mapping::Uniform],
             Param::InOut => [Mapping::Uniform, Mapping::Uniform],
         };
-        Grid::with_sizes(param, self.sizes(param, symmetry.isotropic), mappings, channels, symmetry)
+        Grid::with_sizes(
+            param,
+            self.sizes(param, symmetry.isotropic),
+            mappings,
+            channels,
+            symmetry,
+        )
     }
 }

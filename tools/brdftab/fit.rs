@@ -32,6 +32,9 @@ pub struct FitArgs {
     /// Number of direction pairs.
     #[arg(long, default_value_t = 4000)]
     pairs: usize,
+    /// Largest polar angle of the fitting pairs' directions, in degrees (grazing data excluded).
+    #[arg(long, default_value_t = 80.0)]
+    max_theta_deg: f64,
     /// Seed of the pairs and starts.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -78,6 +81,7 @@ pub fn fit(a: FitArgs) -> Result<()> {
         log: a.log,
         starts: a.starts,
         seed: a.seed,
+        max_theta: a.max_theta_deg.to_radians(),
         color: if a.grey {
             ColorMode::Grey
         } else {
