@@ -24,12 +24,13 @@
 //!   forward differences with tiny steps would see only rounding. The channels of a per-channel
 //!   value are differenced together (each affects only its own channel), so an RGB `kd` costs
 //!   one pair of model evaluations per iteration, not three.
-//! - **Error**: `rmse` is [`analysis::accuracy`](crate::analysis::accuracy)'s cosine-weighted
-//!   relative RMSE sqrt(Σ ((f̂ − f) cos θi)² / Σ (f cos θi)²) over every channel, on
-//!   [`ACCURACY_PAIRS`] pairs uniform on the hemisphere — the crate's common yardstick, the same as
-//!   for a table against its source. `rmse_held_out` is that expression on a held-out set drawn
-//!   like the fitting pairs (seed changed), `rmse_fit` on the fitting pairs themselves; the
-//!   fitting distribution stresses the specular cone, so those are usually larger.
+//! - **Error**: `rmse` is the cosine-weighted relative RMSE of
+//!   [`analysis::accuracy`](crate::analysis::accuracy), sqrt(Σ ((f̂ − f) cos θi)² / Σ (f cos θi)²)
+//!   over every channel, on a *held-out* set of pairs drawn like the fitting pairs (another seed),
+//!   so within `max_theta`; `rmse_fit` is the same on the fitting pairs. `rmse_uniform` /
+//!   `max_rel_uniform` are `analysis::accuracy::compare` itself ([`ACCURACY_PAIRS`] pairs uniform
+//!   on the whole hemisphere, grazing included) — the crate's yardstick for tables, but for
+//!   measured data a handful of extreme-grazing values can dominate it.
 //!
 //! ```
 //! use brdftab::{fit::{self, FitOptions}, spec::ModelSpec, spectrum::Channels};
@@ -141,13 +142,13 @@ pub struct StartResult {
 pub struct FitResult {
     /// The fitted spec (valid, builds, usable as a SOURCE).
     pub spec: ModelSpec,
-    /// Cosine-weighted relative RMSE of the fitted spec against the source on uniform pairs
-    /// ([`analysis::accuracy`](crate::analysis::accuracy)).
+    /// Cosine-weighted relative RMSE of the fitted spec against the source on held-out pairs
+    /// drawn like the fitting pairs (see the module docs).
     pub rmse: f64,
-    /// Maximum relative error on those pairs (see `analysis::accuracy`).
-    pub max_rel: f64,
-    /// The same RMSE on held-out pairs drawn like the fitting pairs.
-    pub rmse_held_out: f64,
+    /// `analysis::accuracy::compare` on uniform pairs over the whole hemisphere: relative RMSE.
+    pub rmse_uniform: f64,
+    /// `analysis::accuracy::compare`: maximum relative error.
+    pub max_rel_uniform: f64,
     /// Relative RMSE on the fitting pairs.
     pub rmse_fit: f64,
     /// The objective of the best start.
@@ -451,7 +452,7 @@ pub fn fit_with_progress(
         opts.max_theta,
         opts.seed ^ 0x9e37_79b9_7f4a_7c15,
     );
-    let rmse_held_out = relative_rmse(source, model.as_ref(), &held_out)?;
+    let rmse = relative_rmse(source, model.as_ref(), &held_out)?;
     let acc =
         crate::analysis::accuracy::compare(model.as_ref(), source, ACCURACY_PAIRS, opts.seed)?;
     let x = from_free(&params, t_best.as_slice());
@@ -476,9 +477,9 @@ pub fn fit_with_progress(
     let b = &starts[best_start];
     Ok(FitResult {
         spec,
-        rmse: acc.rel_rmse,
-        max_rel: acc.max_rel,
-        rmse_held_out,
+        rmse,
+        rmse_uniform: acc.rel_rmse,
+        max_rel_uniform: acc.max_rel,
         rmse_fit: b.rmse,
         objective: b.objective,
         iterations: b.iterations,
