@@ -593,7 +593,8 @@ pub fn false_color(img: &Image, opts: &FalseColor) -> (Image, String) {
             }
         }
     };
-    // Degenerate ranges (empty, constant, all-zero on a log scale) map to mid-colour.
+    // Degenerate ranges (empty, all-zero on a log scale) get a nominal range and say so.
+    let degenerate = !(lo.is_finite() && hi.is_finite()) || (opts.log && hi <= 0.0);
     let (lo, hi) = if !(lo.is_finite() && hi.is_finite()) || (opts.log && hi <= 0.0) {
         if opts.log { (1.0, 10.0) } else { (0.0, 1.0) }
     } else if opts.log && lo <= 0.0 {
@@ -603,7 +604,7 @@ pub fn false_color(img: &Image, opts: &FalseColor) -> (Image, String) {
     };
     let t_of = |v: f32| -> f32 {
         if opts.log {
-            if !(v > 0.0) {
+            if v.is_nan() || v <= 0.0 {
                 return 0.0;
             }
             let (a, b) = (lo.log10(), hi.log10());
@@ -637,6 +638,14 @@ pub fn false_color(img: &Image, opts: &FalseColor) -> (Image, String) {
     } else {
         mapped
     };
+    if degenerate {
+        let legend = format!(
+            "{} scale (viridis): no {} values — all pixels at the low end",
+            if opts.log { "log10" } else { "linear" },
+            if opts.log { "positive" } else { "finite" }
+        );
+        return (out, legend);
+    }
     let legend = format!(
         "{} scale (viridis): dark purple = {lo:.3e} … yellow = {hi:.3e}{}",
         if opts.log { "log10" } else { "linear" },
@@ -786,7 +795,8 @@ mod tests {
             Image::new(0, 0, 3),
             Image::new(1, 1, 1),
         ] {
-            let _ = false_color(&img, &FalseColor::default());
+            let (_, legend) = false_color(&img, &FalseColor::default());
+            assert!(legend.contains("no positive values"), "{legend}");
             let _ = false_color(
                 &img,
                 &FalseColor {

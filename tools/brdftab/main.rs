@@ -6,6 +6,7 @@ mod demo;
 mod fit;
 mod measured;
 mod models;
+mod render;
 mod sample;
 mod source;
 mod table;
@@ -33,6 +34,8 @@ enum Command {
     Info(table::InfoArgs),
     /// Time lookups of SOURCE on random pairs (single thread and batch on all cores).
     Bench(table::BenchArgs),
+    /// Render SOURCE on a sphere (path tracer or lit sphere); --compare renders two side by side.
+    Render(render::RenderArgs),
     /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
     Slice(measured::SliceArgs),
     /// Directional albedo a(θ′) per channel: one line `theta a_1 a_2 ...` per angle.
@@ -60,6 +63,7 @@ fn main() -> ExitCode {
         Command::Bake(a) => table::bake(a),
         Command::Info(a) => table::info(a),
         Command::Bench(a) => table::bench(a),
+        Command::Render(a) => render::run(a),
         Command::Slice(a) => measured::slice(a),
         Command::Albedo(a) => analysis::albedo(a),
         Command::Check(a) => analysis::check(a),
