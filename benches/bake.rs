@@ -13,11 +13,10 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 
 fn bench(c: &mut Criterion) {
     let ch = Channels::linspace(400.0, 700.0, 10).expect("valid wavelengths");
-    let model = ModelSpec::parse(
-        r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"n": 0.2, "k": 3}}"#,
-    )
-    .and_then(|s| s.build(&ch))
-    .expect("cook_torrance builds");
+    let model =
+        ModelSpec::parse(r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"n": 0.2, "k": 3}}"#)
+            .and_then(|s| s.build(&ch))
+            .expect("cook_torrance builds");
     let grid = Preset::Medium
         .grid(None, Symmetry::ALL, ch)
         .expect("medium grid");

@@ -13,12 +13,27 @@ use brdftab::{Channels, ModelSpec};
 
 const MODELS: &[(&str, &str)] = &[
     ("lambert", r#"{"model": "lambert", "kd": [0.1, 0.2, 0.3]}"#),
-    ("cook_torrance m=0.3 n=0.2 k=3", r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"n": 0.2, "k": 3}}"#),
-    ("reciprocal_phong n=50", r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 50}"#),
+    (
+        "cook_torrance m=0.3 n=0.2 k=3",
+        r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"n": 0.2, "k": 3}}"#,
+    ),
+    (
+        "reciprocal_phong n=50",
+        r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 50}"#,
+    ),
     ("ggx alpha=0.1", r#"{"model": "ggx", "alpha": 0.1}"#),
-    ("reciprocal_phong n=1000", r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 1000}"#),
-    ("phong n=1000 (original)", r#"{"model": "phong", "ks": 0.5, "n": 1000}"#),
-    ("ward ax=0.1 ay=0.3", r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}"#),
+    (
+        "reciprocal_phong n=1000",
+        r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 1000}"#,
+    ),
+    (
+        "phong n=1000 (original)",
+        r#"{"model": "phong", "ks": 0.5, "n": 1000}"#,
+    ),
+    (
+        "ward ax=0.1 ay=0.3",
+        r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}"#,
+    ),
 ];
 
 fn main() -> brdftab::Result<()> {
@@ -39,7 +54,10 @@ fn main() -> brdftab::Result<()> {
     if presets.is_empty() {
         presets.push(Preset::Medium);
     }
-    println!("{:<32} {:<7} {:<46} {:>10} {:>11} {:>11} {:>8}", "model", "preset", "grid (stored)", "values", "rmse lin", "rmse near", "max lin");
+    println!(
+        "{:<32} {:<7} {:<46} {:>10} {:>11} {:>11} {:>8}",
+        "model", "preset", "grid (stored)", "values", "rmse lin", "rmse near", "max lin"
+    );
     for (name, spec) in MODELS {
         if only.as_deref().is_some_and(|o| !name.contains(o)) {
             continue;
@@ -63,7 +81,10 @@ fn main() -> brdftab::Result<()> {
             let b = accuracy::compare(&near, model.as_ref(), pairs, 12345)?;
             let lin = near.with_interp(Interp::Linear);
             let mut spread: Vec<f64> = (1..seeds)
-                .map(|s| accuracy::compare(&lin, model.as_ref(), pairs, 12345 + s).map(|a| a.rel_rmse * 100.0))
+                .map(|s| {
+                    accuracy::compare(&lin, model.as_ref(), pairs, 12345 + s)
+                        .map(|a| a.rel_rmse * 100.0)
+                })
                 .collect::<brdftab::Result<_>>()?;
             spread.push(a.rel_rmse * 100.0);
             spread.sort_by(f64::total_cmp);

@@ -9,14 +9,23 @@ use brdftab::{Brdf, Channels, ModelSpec, geometry, rng::Pcg32};
 fn main() -> brdftab::Result<()> {
     let spec = std::env::args().nth(1).unwrap();
     let mode = std::env::args().nth(2).unwrap_or("u".into());
-    let ntd: usize = std::env::args().nth(3).and_then(|s| s.parse().ok()).unwrap_or(90);
+    let ntd: usize = std::env::args()
+        .nth(3)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(90);
     let model = ModelSpec::parse(&spec)?.build(&Channels::Rgb)?;
     let sym = symmetry::detect(model.as_ref(), 1e-3);
     let m = match mode.as_str() {
         "c" => Mapping::Cos,
         _ => Mapping::Uniform,
     };
-    let grid = Grid::with_sizes(Param::HalfDiff, [90, 360, ntd, 360], [Mapping::Sqrt, m], Channels::Rgb, sym)?;
+    let grid = Grid::with_sizes(
+        Param::HalfDiff,
+        [90, 360, ntd, 360],
+        [Mapping::Sqrt, m],
+        Channels::Rgb,
+        sym,
+    )?;
     let (t, _) = bake(model.as_ref(), &grid, &BakeOptions::default())?;
     let tb = TabulatedBrdf::from_table(t);
     let nb = 9;
@@ -37,13 +46,29 @@ fn main() -> brdftab::Result<()> {
             tot += (b[k] as f64 * wi.z).powi(2);
         }
     }
-    println!("{}\nshare of squared error (%), rows θh, columns θd (10° bins)", grid.summary());
+    println!(
+        "{}\nshare of squared error (%), rows θh, columns θd (10° bins)",
+        grid.summary()
+    );
     for i in 0..nb {
-        let row: Vec<String> = (0..nb).map(|o| format!("{:6.2}", 100.0 * e[i * nb + o] / e.iter().sum::<f64>())).collect();
+        let row: Vec<String> = (0..nb)
+            .map(|o| format!("{:6.2}", 100.0 * e[i * nb + o] / e.iter().sum::<f64>()))
+            .collect();
         println!("{}", row.join(" "));
     }
-    let mut r: Vec<f64> = (0..7).map(|s| accuracy::compare(&tb, model.as_ref(), 100_000, 12345 + s).unwrap().rel_rmse * 100.0).collect();
+    let mut r: Vec<f64> = (0..7)
+        .map(|s| {
+            accuracy::compare(&tb, model.as_ref(), 100_000, 12345 + s)
+                .unwrap()
+                .rel_rmse
+                * 100.0
+        })
+        .collect();
     r.sort_by(f64::total_cmp);
-    println!("rel rmse {:.4}% (200k, seed 1); 7 seeds x 1e5: {:?}", 100.0 * (e.iter().sum::<f64>() / tot).sqrt(), r.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>());
+    println!(
+        "rel rmse {:.4}% (200k, seed 1); 7 seeds x 1e5: {:?}",
+        100.0 * (e.iter().sum::<f64>() / tot).sqrt(),
+        r.iter().map(|x| format!("{x:.3}")).collect::<Vec<_>>()
+    );
     Ok(())
 }

@@ -95,7 +95,10 @@ struct Multilinear(Grid);
 impl Multilinear {
     fn g(s: [f64; 4]) -> f64 {
         // φ terms vanish where the φ angle is undefined (θ = 0 nodes).
-        1.0 + 0.3 * s[0] + 0.2 * s[2] + 0.01 * s[0] * s[2] + 0.05 * s[0] * s[2] * s[3]
+        1.0 + 0.3 * s[0]
+            + 0.2 * s[2]
+            + 0.01 * s[0] * s[2]
+            + 0.05 * s[0] * s[2] * s[3]
             + 0.1 * s[0] * s[1]
             + 0.003 * s[0] * s[1] * s[2]
     }
@@ -115,7 +118,11 @@ impl Brdf for Multilinear {
         let s = [0, 1, 2, 3].map(|k| {
             let s = ax[k].continuous(x[k]);
             let n = ax[k].size as f64;
-            if ax[k].periodic && s > n - 1e-6 { s - n } else { s }
+            if ax[k].periodic && s > n - 1e-6 {
+                s - n
+            } else {
+                s
+            }
         });
         let f = Self::g(s);
         for k in 0..3 {
@@ -186,7 +193,11 @@ fn reciprocity_and_bilateral_reduction_are_exact_for_any_pair() {
     for (param, sizes, iso, src) in cases {
         for interp in [Interp::Linear, Interp::Nearest] {
             let base = tab(src, &grid(param, sizes, sym(iso, false, false)), interp);
-            for s in [sym(iso, true, false), sym(iso, false, true), sym(iso, true, true)] {
+            for s in [
+                sym(iso, true, false),
+                sym(iso, false, true),
+                sym(iso, true, true),
+            ] {
                 let red = tab(src, &grid(param, sizes, s), interp);
                 assert!(red.grid().stored_values() < base.grid().stored_values());
                 let mut rng = Pcg32::new(9);
@@ -283,7 +294,11 @@ fn nearest_lookup_at_nodes_returns_the_baked_values() {
         grid(Param::InOut, [6, 8, 5, 8], Symmetry::NONE),
     ];
     for g in grids {
-        let src: &dyn Brdf = if g.symmetry().isotropic { &Symmetric } else { &Aniso };
+        let src: &dyn Brdf = if g.symmetry().isotropic {
+            &Symmetric
+        } else {
+            &Aniso
+        };
         let (t, _) = bake(src, &g, &BakeOptions::default()).unwrap();
         let tb = TabulatedBrdf::from_table(t.clone()).with_interp(Interp::Nearest);
         let [n0, s1, n2, s3] = g.stored_shape();
@@ -328,12 +343,37 @@ fn linear_interpolation_reproduces_multilinear_functions() {
     };
     let grids = [
         // Every stored axis non-periodic: exact everywhere.
-        edges(Param::HalfDiff, [9, 16, 7, 16], Symmetry::ALL, [Mapping::Sqrt, Mapping::Uniform]),
-        edges(Param::HalfDiff, [9, 16, 7, 16], Symmetry::ALL, [Mapping::Cos, Mapping::Sqrt]),
-        edges(Param::InOut, [7, 16, 9, 24], sym(true, false, true), [Mapping::Uniform, Mapping::Cos]),
+        edges(
+            Param::HalfDiff,
+            [9, 16, 7, 16],
+            Symmetry::ALL,
+            [Mapping::Sqrt, Mapping::Uniform],
+        ),
+        edges(
+            Param::HalfDiff,
+            [9, 16, 7, 16],
+            Symmetry::ALL,
+            [Mapping::Cos, Mapping::Sqrt],
+        ),
+        edges(
+            Param::InOut,
+            [7, 16, 9, 24],
+            sym(true, false, true),
+            [Mapping::Uniform, Mapping::Cos],
+        ),
         // Periodic axes: exact away from the wrap-around cell.
-        edges(Param::InOut, [5, 8, 6, 8], Symmetry::NONE, [Mapping::Uniform, Mapping::Uniform]),
-        edges(Param::HalfDiff, [5, 8, 6, 12], sym(false, true, false), [Mapping::Sqrt, Mapping::Uniform]),
+        edges(
+            Param::InOut,
+            [5, 8, 6, 8],
+            Symmetry::NONE,
+            [Mapping::Uniform, Mapping::Uniform],
+        ),
+        edges(
+            Param::HalfDiff,
+            [5, 8, 6, 12],
+            sym(false, true, false),
+            [Mapping::Sqrt, Mapping::Uniform],
+        ),
     ];
     for g in grids {
         let src = Multilinear(g.clone());
@@ -351,13 +391,12 @@ fn linear_interpolation_reproduces_multilinear_functions() {
             let cell_ok = {
                 let (lo, hi) = (ax[0].linear(x[0]), ax[2].linear(x[2]));
                 let s = |k: usize, i: usize| ax[k].node(i);
-                let corners_ok = [lo.0, lo.1].iter().all(|&i| {
+                [lo.0, lo.1].iter().all(|&i| {
                     [hi.0, hi.1].iter().all(|&j| match g.param() {
                         Param::HalfDiff => s(0, i) + s(2, j) < FRAC_PI_2 - 1e-3,
                         Param::InOut => i + 1 < ax[0].size && j + 1 < ax[2].size,
                     })
-                });
-                corners_ok
+                })
             };
             if !cell_ok {
                 continue;
@@ -365,7 +404,11 @@ fn linear_interpolation_reproduces_multilinear_functions() {
             n += 1;
             let got = eval3(&tb, wi, wo);
             let want = eval3(&src, wi, wo);
-            assert!(close(got, want, 2e-5), "{} wi={wi} wo={wo}: {got:?} vs {want:?}", g.summary());
+            assert!(
+                close(got, want, 2e-5),
+                "{} wi={wi} wo={wo}: {got:?} vs {want:?}",
+                g.summary()
+            );
         }
     }
 }
@@ -460,7 +503,10 @@ fn symmetry_violation_is_an_error_unless_forced() {
     );
     let g = grid(Param::HalfDiff, [8, 16, 8, 16], sym(true, false, false));
     let e = bake(&Aniso, &g, &BakeOptions::default()).unwrap_err();
-    assert!(matches!(&e, Error::Symmetry { symmetry, .. } if symmetry == "isotropic"), "{e}");
+    assert!(
+        matches!(&e, Error::Symmetry { symmetry, .. } if symmetry == "isotropic"),
+        "{e}"
+    );
     let forced = BakeOptions {
         force: true,
         ..Default::default()

@@ -34,14 +34,22 @@ pub struct Accuracy {
     pub per_channel: Vec<f64>,
 }
 
-fn ser_pair<S: serde::Serializer>(p: &(DVec3, DVec3), s: S) -> std::result::Result<S::Ok, S::Error> {
+fn ser_pair<S: serde::Serializer>(
+    p: &(DVec3, DVec3),
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
     [p.0.to_array(), p.1.to_array()].serialize(s)
 }
 
 const BLOCK: usize = 4096;
 
 /// Compares `approx` against `reference` over `pairs` random pairs with seed `seed`.
-pub fn compare(approx: &dyn Brdf, reference: &dyn Brdf, pairs: usize, seed: u64) -> Result<Accuracy> {
+pub fn compare(
+    approx: &dyn Brdf,
+    reference: &dyn Brdf,
+    pairs: usize,
+    seed: u64,
+) -> Result<Accuracy> {
     let c = reference.channels().len();
     if approx.channels().len() != c || c > MAX_CHANNELS {
         return Err(Error::arg(
@@ -102,7 +110,15 @@ pub fn compare(approx: &dyn Brdf, reference: &dyn Brdf, pairs: usize, seed: u64)
             }
         }
     }
-    let ratio = |e: f64, r: f64| if r > 0.0 { (e / r).sqrt() } else if e > 0.0 { f64::INFINITY } else { 0.0 };
+    let ratio = |e: f64, r: f64| {
+        if r > 0.0 {
+            (e / r).sqrt()
+        } else if e > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        }
+    };
     Ok(Accuracy {
         pairs,
         rel_rmse: ratio(e2.iter().sum(), r2.iter().sum()),

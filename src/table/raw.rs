@@ -78,7 +78,9 @@ impl RawWriter {
         for part in values.chunks(1 << 18) {
             self.bytes.clear();
             self.bytes.extend(part.iter().flat_map(|v| v.to_le_bytes()));
-            self.w.write_all(&self.bytes).map_err(|e| Error::io(&self.tmp, e))?;
+            self.w
+                .write_all(&self.bytes)
+                .map_err(|e| Error::io(&self.tmp, e))?;
         }
         Ok(())
     }
@@ -87,7 +89,10 @@ impl RawWriter {
     pub fn finish(mut self) -> Result<()> {
         if self.remaining != 0 {
             let _ = std::fs::remove_file(&self.tmp);
-            return Err(Error::arg("values", format!("{} values missing", self.remaining)));
+            return Err(Error::arg(
+                "values",
+                format!("{} values missing", self.remaining),
+            ));
         }
         self.w.flush().map_err(|e| Error::io(&self.tmp, e))?;
         std::fs::rename(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))
@@ -117,18 +122,36 @@ impl Table {
         let name = path.display().to_string();
         let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
         if bytes.len() < 20 || &bytes[..12] != MAGIC {
-            return Err(Error::format(&name, Some("magic"), Some(0), "not a brdftab raw table"));
+            return Err(Error::format(
+                &name,
+                Some("magic"),
+                Some(0),
+                "not a brdftab raw table",
+            ));
         }
         let hl = u64::from_le_bytes(bytes[12..20].try_into().unwrap_or_default());
-        let end = 20u64.checked_add(hl).filter(|&e| e <= bytes.len() as u64).ok_or_else(|| {
-            Error::format(&name, Some("header length"), Some(12), format!("{hl} exceeds the file"))
-        })? as usize;
+        let end = 20u64
+            .checked_add(hl)
+            .filter(|&e| e <= bytes.len() as u64)
+            .ok_or_else(|| {
+                Error::format(
+                    &name,
+                    Some("header length"),
+                    Some(12),
+                    format!("{hl} exceeds the file"),
+                )
+            })? as usize;
         let h: Header = serde_json::from_slice(&bytes[20..end]).map_err(|e| Error::Json {
             context: name.clone(),
             source: e,
         })?;
         if h.format != 1 {
-            return Err(Error::format(&name, Some("format"), None, format!("version {} unknown", h.format)));
+            return Err(Error::format(
+                &name,
+                Some("format"),
+                None,
+                format!("version {} unknown", h.format),
+            ));
         }
         let n = h.grid.stored_values();
         if h.values != n as u64 || bytes.len() - end != n * 4 {
@@ -136,7 +159,11 @@ impl Table {
                 &name,
                 Some("values"),
                 Some(end as u64),
-                format!("{} bytes of values, the grid needs {}", bytes.len() - end, n * 4),
+                format!(
+                    "{} bytes of values, the grid needs {}",
+                    bytes.len() - end,
+                    n * 4
+                ),
             ));
         }
         let values = bytes[end..]

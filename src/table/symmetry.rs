@@ -147,7 +147,11 @@ pub fn canonical_coords_fast(
 
 #[inline(always)]
 fn acos<const FAST: bool>(x: f64) -> f64 {
-    if FAST { fast_acos(x) } else { x.clamp(-1.0, 1.0).acos() }
+    if FAST {
+        fast_acos(x)
+    } else {
+        x.clamp(-1.0, 1.0).acos()
+    }
 }
 
 #[inline(always)]
@@ -176,7 +180,11 @@ pub fn fast_acos(x: f64) -> f64 {
 #[inline(always)]
 pub fn fast_atan2(y: f64, x: f64) -> f64 {
     let (ax, ay) = (x.abs(), y.abs());
-    let (num, den, swap) = if ay > ax { (ax, ay, true) } else { (ay, ax, false) };
+    let (num, den, swap) = if ay > ax {
+        (ax, ay, true)
+    } else {
+        (ay, ax, false)
+    };
     // z = min/max in [0, 1]; reduce to [0, tan(π/8)].
     let z = if den > 0.0 { num / den } else { 0.0 };
     let (base, t) = if z > 0.414_213_562_373_095 {
@@ -201,12 +209,7 @@ pub fn fast_atan2(y: f64, x: f64) -> f64 {
 }
 
 #[inline(always)]
-fn coords<const FAST: bool>(
-    param: Param,
-    sym: Symmetry,
-    wi: DVec3,
-    wo: DVec3,
-) -> Option<[f64; 4]> {
+fn coords<const FAST: bool>(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -> Option<[f64; 4]> {
     let (wi, wo) = geometry::upper_pair(wi, wo)?;
     match param {
         Param::InOut => {
@@ -424,7 +427,14 @@ mod tests {
             let (y, x) = (rng.next_f64() * 2.0 - 1.0, rng.next_f64() * 2.0 - 1.0);
             worst = worst.max((fast_atan2(y, x) - y.atan2(x)).abs());
         }
-        for (y, x) in [(0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0), (0.0, 0.0), (1e-300, 1.0)] {
+        for (y, x) in [
+            (0.0, 1.0),
+            (1.0, 0.0),
+            (0.0, -1.0),
+            (-1.0, 0.0),
+            (0.0, 0.0),
+            (1e-300, 1.0),
+        ] {
             worst = worst.max((fast_atan2(y, x) - f64::atan2(y, x)).abs());
         }
         assert!(worst < 2e-7, "atan2 {worst}");

@@ -174,7 +174,10 @@ pub fn bake(a: BakeArgs) -> Result<()> {
 
 /// `brdftab info`.
 pub fn info(a: InfoArgs) -> Result<()> {
-    if matches!(source::kind(&a.file), source::Kind::Merl | source::Kind::Rgl) {
+    if matches!(
+        source::kind(&a.file),
+        source::Kind::Merl | source::Kind::Rgl
+    ) {
         return crate::measured::info_source(&a.file);
     }
     let t = Table::open_raw(&a.file)?;
