@@ -98,8 +98,26 @@ pub fn conductor(cos_i: f64, n: f64, k: f64) -> f64 {
     if cos_i.is_nan() || cos_i <= 0.0 {
         return 1.0;
     }
-    let (a, b) = conductor_polarized(cos_i, n, k);
-    0.5 * (a + b)
+    // The same quantity as `conductor_polarized` in real arithmetic (exact, not an
+    // approximation; e.g. Lagarde, "Memo on Fresnel equations", 2013): with
+    // a² + b² = |η² − sin² θ′| and a = Re sqrt(η² − sin² θ′),
+    // F⊥ = (a² + b² − 2a cos θ′ + cos² θ′) / (a² + b² + 2a cos θ′ + cos² θ′),
+    // F∥ = F⊥ (cos² θ′ (a² + b²) − 2a cos θ′ sin² θ′ + sin⁴ θ′) / (… + …).
+    // Two square roots and two divisions instead of complex division and square roots; this is
+    // on the hot path of every microfacet model with a metal.
+    let c = cos_i.min(1.0);
+    let cos2 = c * c;
+    let sin2 = 1.0 - cos2;
+    let (n2, k2) = (n * n, k * k);
+    let t0 = n2 - k2 - sin2;
+    let a2b2 = (t0 * t0 + 4.0 * n2 * k2).sqrt();
+    let a = (0.5 * (a2b2 + t0)).max(0.0).sqrt();
+    let t1 = a2b2 + cos2;
+    let t2 = 2.0 * a * c;
+    let t3 = cos2 * a2b2 + sin2 * sin2;
+    let t4 = t2 * sin2;
+    // ½ (F⊥ + F∥) = ½ F⊥ (1 + (t3 − t4)/(t3 + t4)) = F⊥ t3 / (t3 + t4): one division.
+    (t1 - t2) * t3 / ((t1 + t2) * (t3 + t4))
 }
 
 /// Unpolarized dielectric reflectance for incidence cosine `cos_i` and relative index
@@ -346,6 +364,35 @@ impl Fresnel {
         }
     }
 
+    /// Writes `scale[c] · s · F_c(cos_i)` as `f32` into `out[c]` for every channel: the last step
+    /// of a microfacet model's `eval`. The variant is matched once, outside the channel loop, so
+    /// the loop is straight-line arithmetic the compiler can vectorize.
+    #[inline]
+    pub fn eval_scaled(&self, cos_i: f64, scale: &[f64], s: f64, out: &mut [f32]) {
+        match self {
+            Fresnel::None => {
+                for (o, &k) in out.iter_mut().zip(scale) {
+                    *o = (k * s) as f32;
+                }
+            }
+            Fresnel::Conductor { n, k, .. } => {
+                for (((o, &ks), &n), &k) in out.iter_mut().zip(scale).zip(n).zip(k) {
+                    *o = (ks * s * conductor(cos_i, n, k)) as f32;
+                }
+            }
+            Fresnel::Dielectric { eta, .. } => {
+                for ((o, &ks), &e) in out.iter_mut().zip(scale).zip(eta) {
+                    *o = (ks * s * dielectric(cos_i, e)) as f32;
+                }
+            }
+            Fresnel::Schlick { f0, .. } => {
+                for ((o, &ks), &f) in out.iter_mut().zip(scale).zip(f0) {
+                    *o = (ks * s * schlick(cos_i, f)) as f32;
+                }
+            }
+        }
+    }
+
     /// F at wavelength `nm` from the spectral data.
     pub fn eval_at(&self, cos_i: f64, nm: f64) -> f64 {
         match self {
@@ -380,6 +427,29 @@ mod tests {
         }
         let expect = (0.5f64 / 2.5).powi(2);
         assert!((dielectric(1.0, 1.5) - expect).abs() < 1e-14);
+    }
+
+    #[test]
+    fn real_closed_form_equals_complex_form() {
+        for &(n, k) in &[
+            (1.5, 0.0),
+            (0.2, 3.0),
+            (0.14, 3.697),
+            (1.1, 7.0),
+            (2.5, 0.3),
+            (0.65, 0.0),
+        ] {
+            for i in 1..=200 {
+                let c = i as f64 / 200.0;
+                let (a, b) = conductor_polarized(c, n, k);
+                let complex = 0.5 * (a + b);
+                let real = conductor(c, n, k);
+                assert!(
+                    (real - complex).abs() < 1e-12,
+                    "n={n} k={k} cos={c}: {real} vs {complex}"
+                );
+            }
+        }
     }
 
     #[test]

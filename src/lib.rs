@@ -45,3 +45,8 @@ pub use brdf::{Brdf, BrdfSample, Flags};
 pub use error::{Error, Result};
 pub use spec::ModelSpec;
 pub use spectrum::{Channels, Value};
+
+/// The README's code examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -3,4 +3,5 @@
 pub mod accuracy;
 pub mod albedo;
 pub mod chi2;
+pub mod plausibility;
 pub mod slice;

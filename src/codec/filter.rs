@@ -143,7 +143,15 @@ word!(u32, i32);
 
 /// The prediction for `w[s + j]` in a row starting at `s`, given earlier words.
 #[inline(always)]
-fn predict<W: Word>(w: &[W], s: usize, j: usize, ch: usize, row: usize, up: bool, plane: bool) -> W {
+fn predict<W: Word>(
+    w: &[W],
+    s: usize,
+    j: usize,
+    ch: usize,
+    row: usize,
+    up: bool,
+    plane: bool,
+) -> W {
     let i = s + j;
     if j >= ch {
         if plane && up {
@@ -176,7 +184,11 @@ pub fn forward<W: Word>(words: &[W], layout: Layout, filter: Filter) -> Vec<W> {
         let mut prev_d = W::default();
         for j in 0..len {
             let d = words[s + j].wsub(predict(words, s, j, ch, row, up, plane));
-            let e = if chan && j % ch != 0 { d.wsub(prev_d) } else { d };
+            let e = if chan && j % ch != 0 {
+                d.wsub(prev_d)
+            } else {
+                d
+            };
             prev_d = d;
             out[s + j] = e.zigzag();
         }
@@ -205,7 +217,11 @@ pub fn inverse<W: Word>(words: &mut [W], layout: Layout, filter: Filter) {
         let mut prev_d = W::default();
         for j in 0..len {
             let e = words[s + j].unzigzag();
-            let d = if chan && j % ch != 0 { e.wadd(prev_d) } else { e };
+            let d = if chan && j % ch != 0 {
+                e.wadd(prev_d)
+            } else {
+                e
+            };
             prev_d = d;
             words[s + j] = d.wadd(predict(words, s, j, ch, row, up, plane));
         }

@@ -46,7 +46,9 @@ pub fn to_f16(data: &[f32]) -> Result<Vec<u16>> {
 pub fn from_f16(words: &[u16], out: &mut [f32]) {
     use half::slice::HalfBitsSliceExt;
     use half::slice::HalfFloatSliceExt;
-    words.reinterpret_cast::<half::f16>().convert_to_f32_slice(out);
+    words
+        .reinterpret_cast::<half::f16>()
+        .convert_to_f32_slice(out);
 }
 
 /// Largest 16-bit code used by log16.
@@ -248,7 +250,9 @@ mod tests {
 
     #[test]
     fn log16_too_tight_fails_clearly() {
-        let e = to_log16(&[0.0, 1e6], 1e-6, Some(1e-3)).unwrap_err().to_string();
+        let e = to_log16(&[0.0, 1e6], 1e-6, Some(1e-3))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("too tight"), "{e}");
     }
 

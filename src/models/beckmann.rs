@@ -35,10 +35,22 @@ impl Beckmann {
         }
     }
 
+    /// 1 / m².
+    #[inline]
+    pub fn inv_m2(&self) -> f64 {
+        self.inv_m2
+    }
+
+    /// 1 / (π m²).
+    #[inline]
+    pub fn inv_pi_m2(&self) -> f64 {
+        self.inv_pi_m2
+    }
+
     /// D for a facet normal with cos α = `cos_a` (N·H); 0 for cos α ≤ 0.
     #[inline]
     pub fn d(&self, cos_a: f64) -> f64 {
-        if !(cos_a > 0.0) {
+        if cos_a.is_nan() || cos_a <= 0.0 {
             return 0.0;
         }
         let c2 = cos_a * cos_a;

@@ -41,7 +41,12 @@ impl Brdf for Lambert {
         // Only the horizon test needs the directions; no normalization is needed for the sign.
         let above = wi.z > 0.0 && wo.z > 0.0 && wi.is_finite() && wo.is_finite();
         let out = &mut out[..self.kd.len()];
-        if above {
+        // RGB fast path: three stores instead of a `memcpy`/`memset` call for a 12-byte copy
+        // (a third of the whole evaluation time).
+        if let ([o0, o1, o2], [k0, k1, k2]) = (&mut *out, self.kd.as_slice()) {
+            let m = if above { 1.0 } else { 0.0 };
+            (*o0, *o1, *o2) = (k0 * m, k1 * m, k2 * m);
+        } else if above {
             out.copy_from_slice(&self.kd);
         } else {
             out.fill(0.0);
@@ -87,7 +92,7 @@ impl Brdf for Lambert {
         }
         let wi = geometry::cosine_hemisphere(u);
         let pdf = wi.z * std::f64::consts::FRAC_1_PI;
-        if !(pdf > 0.0) {
+        if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         for (w, &k) in weight[..self.kd.len()].iter_mut().zip(&self.kd) {

@@ -33,7 +33,7 @@ pub fn refract(w: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
         if c < 0.0 { (-n, -c) } else { (n, c) }
     };
     let disc = 1.0 - (1.0 - cos_a * cos_a) / (eta * eta);
-    if !(disc >= 0.0) || !(eta > 0.0) {
+    if disc.is_nan() || disc < 0.0 || eta.is_nan() || eta <= 0.0 {
         return None;
     }
     Some(n * (cos_a / eta - disc.sqrt()) - w / eta)

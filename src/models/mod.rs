@@ -23,6 +23,26 @@ use crate::error::{Error, Result};
 use crate::spec::ModelSpec;
 use crate::spectrum::Channels;
 
+/// [`geometry::upper_pair`](crate::geometry::upper_pair) for the hot path: normalizes both
+/// directions with one division (1 / (|wi| |wo|)) instead of six, and checks both are strictly
+/// above the horizon and finite. Symmetric: swapping the arguments swaps the results bit for bit.
+#[inline]
+pub(crate) fn unit_upper_pair(
+    wi: glam::DVec3,
+    wo: glam::DVec3,
+) -> Option<(glam::DVec3, glam::DVec3)> {
+    let (l2, v2) = (wi.length_squared(), wo.length_squared());
+    if !(wi.z > 0.0 && wo.z > 0.0 && l2.is_finite() && v2.is_finite()) {
+        return None;
+    }
+    let (sl, sv) = (l2.sqrt(), v2.sqrt());
+    let r = 1.0 / (sl * sv);
+    if !r.is_finite() {
+        return None;
+    }
+    Some((wi * (sv * r), wo * (sl * r)))
+}
+
 /// Builds the model a (validated) spec describes for a channel set.
 pub fn build(spec: &ModelSpec, channels: &Channels) -> Result<Box<dyn Brdf>> {
     Ok(match spec {

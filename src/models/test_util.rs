@@ -168,6 +168,17 @@ pub fn check_sampling_consistency<B: Brdf + ?Sized>(brdf: &B, wos: &[DVec3], n: 
     }
 }
 
+/// Chi-square tests of each model's sampler at every [`test_wos`] direction (see [`chi2_cases`]).
+pub fn chi2_models(models: &[&dyn Brdf]) {
+    let mut cases: Vec<(&dyn Brdf, DVec3)> = Vec::new();
+    for &m in models {
+        for wo in test_wos() {
+            cases.push((m, wo));
+        }
+    }
+    chi2_cases(&cases);
+}
+
 /// Runs the chi-square test (`crate::analysis::chi2`) for every `(sampler, wo)` case with a
 /// Šidák-corrected overall significance of 1 %, and fails listing the cases that do not pass.
 pub fn chi2_cases(cases: &[(&dyn Brdf, DVec3)]) {

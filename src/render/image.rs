@@ -562,7 +562,11 @@ impl Default for FalseColor {
 /// `colorbar`, a strip of height max(4, height/12) separated by a 1-pixel black gap is added
 /// below the image.
 pub fn false_color(img: &Image, opts: &FalseColor) -> (Image, String) {
-    let values: Vec<f32> = img.data.chunks_exact(img.channels.max(1)).map(luminance_of).collect();
+    let values: Vec<f32> = img
+        .data
+        .chunks_exact(img.channels.max(1))
+        .map(luminance_of)
+        .collect();
     let (lo, hi) = match opts.range {
         Some(r) => r,
         None => {
@@ -589,7 +593,8 @@ pub fn false_color(img: &Image, opts: &FalseColor) -> (Image, String) {
             }
         }
     };
-    // Degenerate ranges (empty, constant, all-zero on a log scale) map to mid-colour.
+    // Degenerate ranges (empty, all-zero on a log scale) get a nominal range and say so.
+    let degenerate = !(lo.is_finite() && hi.is_finite()) || (opts.log && hi <= 0.0);
     let (lo, hi) = if !(lo.is_finite() && hi.is_finite()) || (opts.log && hi <= 0.0) {
         if opts.log { (1.0, 10.0) } else { (0.0, 1.0) }
     } else if opts.log && lo <= 0.0 {
@@ -599,11 +604,15 @@ pub fn false_color(img: &Image, opts: &FalseColor) -> (Image, String) {
     };
     let t_of = |v: f32| -> f32 {
         if opts.log {
-            if !(v > 0.0) {
+            if v.is_nan() || v <= 0.0 {
                 return 0.0;
             }
             let (a, b) = (lo.log10(), hi.log10());
-            if b > a { (v.log10() - a) / (b - a) } else { 0.5 }
+            if b > a {
+                (v.log10() - a) / (b - a)
+            } else {
+                0.5
+            }
         } else if hi > lo {
             (v - lo) / (hi - lo)
         } else {
@@ -618,17 +627,33 @@ pub fn false_color(img: &Image, opts: &FalseColor) -> (Image, String) {
         let h = (img.height / 12).max(4);
         let w = img.width;
         let bar = Image::from_fn(w, h, 3, |x, _, o| {
-            let t = if w > 1 { x as f32 / (w - 1) as f32 } else { 0.5 };
+            let t = if w > 1 {
+                x as f32 / (w - 1) as f32
+            } else {
+                0.5
+            };
             o.copy_from_slice(&lin(t))
         });
         Image::vstack(&[&mapped, &bar], 1, 0.0).unwrap_or(mapped)
     } else {
         mapped
     };
+    if degenerate {
+        let legend = format!(
+            "{} scale (viridis): no {} values — all pixels at the low end",
+            if opts.log { "log10" } else { "linear" },
+            if opts.log { "positive" } else { "finite" }
+        );
+        return (out, legend);
+    }
     let legend = format!(
         "{} scale (viridis): dark purple = {lo:.3e} … yellow = {hi:.3e}{}",
         if opts.log { "log10" } else { "linear" },
-        if opts.colorbar { " (colorbar left → right)" } else { "" }
+        if opts.colorbar {
+            " (colorbar left → right)"
+        } else {
+            ""
+        }
     );
     (out, legend)
 }
@@ -720,7 +745,9 @@ mod tests {
         assert_eq!(&buf[0..6], &[0, 188, 255, 255, 0, 0]);
         // exposure +1 stop doubles: 0.25 → 0.5 → 188.
         write_png(&img, &p, 1.0).unwrap();
-        let mut reader = png::Decoder::new(File::open(&p).unwrap()).read_info().unwrap();
+        let mut reader = png::Decoder::new(File::open(&p).unwrap())
+            .read_info()
+            .unwrap();
         reader.next_frame(&mut buf).unwrap();
         assert_eq!(buf[6], 188);
     }
@@ -741,7 +768,10 @@ mod tests {
         assert_eq!(fc.width, 10);
         assert_eq!(fc.height, 12 + 1 + 4);
         // Default: at most six decades below the maximum, so the low end is 1e0, not 1e-3.
-        assert!(legend.contains("1.000e0") && legend.contains("1.000e6"), "{legend}");
+        assert!(
+            legend.contains("1.000e0") && legend.contains("1.000e6"),
+            "{legend}"
+        );
         // Left end → first viridis stop, right end → last, exactly after sRGB encoding.
         let (bytes, _) = to_srgb8_bytes(&fc, 0.0).unwrap();
         assert_eq!(&bytes[0..3], &[0x44, 0x01, 0x54]);
@@ -760,8 +790,13 @@ mod tests {
 
     #[test]
     fn false_color_degenerate_inputs_do_not_panic() {
-        for img in [Image::new(3, 3, 3), Image::new(0, 0, 3), Image::new(1, 1, 1)] {
-            let _ = false_color(&img, &FalseColor::default());
+        for img in [
+            Image::new(3, 3, 3),
+            Image::new(0, 0, 3),
+            Image::new(1, 1, 1),
+        ] {
+            let (_, legend) = false_color(&img, &FalseColor::default());
+            assert!(legend.contains("no positive values"), "{legend}");
             let _ = false_color(
                 &img,
                 &FalseColor {
@@ -778,7 +813,10 @@ mod tests {
         let b = Image::from_fn(3, 1, 1, |_, _, o| o[0] = 2.0);
         let s = Image::hstack(&[&a, &b], 1, -1.0).unwrap();
         assert_eq!((s.width, s.height), (6, 2));
-        assert_eq!(s.data, [1., 1., -1., 2., 2., 2., 1., 1., -1., -1., -1., -1.]);
+        assert_eq!(
+            s.data,
+            [1., 1., -1., 2., 2., 2., 1., 1., -1., -1., -1., -1.]
+        );
         assert!(Image::hstack(&[&a, &Image::new(1, 1, 3)], 0, 0.0).is_err());
         assert!(Image::hstack(&[], 0, 0.0).is_err());
     }

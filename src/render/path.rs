@@ -216,7 +216,8 @@ impl<'a> RgbMaterial<'a> {
         match &self.map {
             None => DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64),
             Some(m) => {
-                let c = |(i0, i1, t): (usize, usize, f64)| (1.0 - t) * v[i0] as f64 + t * v[i1] as f64;
+                let c =
+                    |(i0, i1, t): (usize, usize, f64)| (1.0 - t) * v[i0] as f64 + t * v[i1] as f64;
                 DVec3::new(c(m[0]), c(m[1]), c(m[2]))
             }
         }
@@ -305,8 +306,7 @@ impl Tracer<'_> {
                 }
                 Hit::Light { .. } => {
                     let le = scene.light_radiance();
-                    let w = self
-                        .emitter_weight(prev_pdf, || scene.sphere_light_pdf(prev_point, d));
+                    let w = self.emitter_weight(prev_pdf, || scene.sphere_light_pdf(prev_point, d));
                     l += beta * le * w;
                     break;
                 }
@@ -489,7 +489,11 @@ fn shading_frame(n: DVec3) -> Frame {
         return Frame::from_normal(n);
     }
     let s = s / l;
-    Frame { s, t: n.cross(s), n }
+    Frame {
+        s,
+        t: n.cross(s),
+        n,
+    }
 }
 
 /// Side of the square tiles the image is split into for parallel rendering.
@@ -579,8 +583,8 @@ mod tests {
     use super::*;
     use crate::brdf::{BrdfSample, Flags};
     use crate::models::lambert::Lambert;
-    use crate::spectrum::Value;
     use crate::render::compare::compare;
+    use crate::spectrum::Value;
 
     fn lambert(kd: f64) -> Lambert {
         Lambert::new(Value::Grey(kd), &Channels::Rgb).unwrap()
@@ -716,7 +720,10 @@ mod tests {
                             (y as f64 + dy) / opts.height as f64,
                             opts.width as f64 / opts.height as f64,
                         );
-                        matches!(scene.intersect(scene.eye, d, f64::INFINITY), Hit::Sphere { .. })
+                        matches!(
+                            scene.intersect(scene.eye, d, f64::INFINITY),
+                            Hit::Sphere { .. }
+                        )
                     })
                     .count();
                 cov.push(match hits {
@@ -741,7 +748,12 @@ mod tests {
     fn white_furnace() {
         let brdf = lambert(FRAC_1_PI);
         for mode in [Mode::Path, Mode::Lit] {
-            for sampling in [Sampling::Mis, Sampling::BrdfOnly, Sampling::LightOnly, Sampling::Fixed] {
+            for sampling in [
+                Sampling::Mis,
+                Sampling::BrdfOnly,
+                Sampling::LightOnly,
+                Sampling::Fixed,
+            ] {
                 let opts = RenderOptions {
                     env: EnvChoice::Constant([1.0; 3]),
                     mode,
@@ -750,7 +762,15 @@ mod tests {
                 };
                 let cov = coverage(&opts);
                 let a = render(&brdf, &opts, None).unwrap();
-                let b = render(&brdf, &RenderOptions { seed: 9, ..opts.clone() }, None).unwrap();
+                let b = render(
+                    &brdf,
+                    &RenderOptions {
+                        seed: 9,
+                        ..opts.clone()
+                    },
+                    None,
+                )
+                .unwrap();
                 let interior: Vec<usize> = (0..cov.len()).filter(|&i| cov[i] == 2).collect();
                 assert!(interior.len() > 150);
                 let s2 = interior
@@ -774,11 +794,17 @@ mod tests {
                     }
                 }
                 let (m, se) = mean_and_se(&brdf, &opts, 6);
-                assert!((m - 1.0).abs() <= 5.0 * se + 1e-6, "{mode:?} {sampling:?}: mean {m} ± {se}");
+                assert!(
+                    (m - 1.0).abs() <= 5.0 * se + 1e-6,
+                    "{mode:?} {sampling:?}: mean {m} ± {se}"
+                );
                 // BRDF sampling of a Lambertian under a constant environment is a zero-variance
                 // estimator: weight 1 · radiance 1.
                 if sampling == Sampling::BrdfOnly {
-                    assert!(sigma < 1e-6, "BRDF-only furnace should be exact, σ = {sigma}");
+                    assert!(
+                        sigma < 1e-6,
+                        "BRDF-only furnace should be exact, σ = {sigma}"
+                    );
                 }
             }
         }
@@ -789,7 +815,11 @@ mod tests {
     #[test]
     fn black_material_shows_only_background() {
         let brdf = lambert(0.0);
-        for (light, ground) in [(LightChoice::None, false), (LightChoice::Area, true), (LightChoice::Point, true)] {
+        for (light, ground) in [
+            (LightChoice::None, false),
+            (LightChoice::Area, true),
+            (LightChoice::Point, true),
+        ] {
             let opts = RenderOptions {
                 light,
                 ground,
@@ -820,9 +850,30 @@ mod tests {
             spp: 4,
             ..tiny()
         };
-        let a = render(&brdf, &RenderOptions { threads: Some(1), ..opts.clone() }, None).unwrap();
-        let b = render(&brdf, &RenderOptions { threads: Some(3), ..opts.clone() }, None).unwrap();
-        assert!(a.data.iter().zip(&b.data).all(|(x, y)| x.to_bits() == y.to_bits()));
+        let a = render(
+            &brdf,
+            &RenderOptions {
+                threads: Some(1),
+                ..opts.clone()
+            },
+            None,
+        )
+        .unwrap();
+        let b = render(
+            &brdf,
+            &RenderOptions {
+                threads: Some(3),
+                ..opts.clone()
+            },
+            None,
+        )
+        .unwrap();
+        assert!(
+            a.data
+                .iter()
+                .zip(&b.data)
+                .all(|(x, y)| x.to_bits() == y.to_bits())
+        );
         let c = render(&brdf, &RenderOptions { seed: 1, ..opts }, None).unwrap();
         assert_ne!(a.data, c.data);
         assert_eq!(compare(&a, &a).unwrap().rel_rmse, 0.0);
@@ -845,9 +896,19 @@ mod tests {
         };
         let (m_mis, se_mis) = mean_and_se(&brdf, &base, 6);
         for sampling in [Sampling::BrdfOnly, Sampling::LightOnly, Sampling::Fixed] {
-            let (m, se) = mean_and_se(&brdf, &RenderOptions { sampling, ..base.clone() }, 6);
+            let (m, se) = mean_and_se(
+                &brdf,
+                &RenderOptions {
+                    sampling,
+                    ..base.clone()
+                },
+                6,
+            );
             let z = (m - m_mis) / (se * se + se_mis * se_mis).sqrt();
-            assert!(z.abs() < 4.5, "{sampling:?}: {m} vs MIS {m_mis} (z = {z:.2})");
+            assert!(
+                z.abs() < 4.5,
+                "{sampling:?}: {m} vs MIS {m_mis} (z = {z:.2})"
+            );
         }
     }
 
@@ -875,8 +936,14 @@ mod tests {
         for o in [
             RenderOptions { width: 0, ..tiny() },
             RenderOptions { spp: 0, ..tiny() },
-            RenderOptions { max_depth: 0, ..tiny() },
-            RenderOptions { threads: Some(0), ..tiny() },
+            RenderOptions {
+                max_depth: 0,
+                ..tiny()
+            },
+            RenderOptions {
+                threads: Some(0),
+                ..tiny()
+            },
         ] {
             assert!(render(&brdf, &o, None).is_err());
         }
@@ -900,7 +967,17 @@ mod tests {
         let cb = |k: u64| {
             n.fetch_add(k, std::sync::atomic::Ordering::Relaxed);
         };
-        render(&lambert(0.1), &RenderOptions { spp: 1, width: 37, height: 19, ..tiny() }, Some(&cb)).unwrap();
+        render(
+            &lambert(0.1),
+            &RenderOptions {
+                spp: 1,
+                width: 37,
+                height: 19,
+                ..tiny()
+            },
+            Some(&cb),
+        )
+        .unwrap();
         assert_eq!(n.into_inner(), 37 * 19);
     }
 }

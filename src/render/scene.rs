@@ -61,7 +61,11 @@ impl Distribution1D {
     fn sample(&self, u: f64) -> (f64, f64, usize) {
         let n = self.func.len();
         // Largest i with cdf[i] <= u.
-        let i = self.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(n - 1);
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .saturating_sub(1)
+            .min(n - 1);
         let width = self.cdf[i + 1] - self.cdf[i];
         let du = if width > 0.0 {
             ((u - self.cdf[i]) / width).clamp(0.0, 1.0)
@@ -284,9 +288,9 @@ fn sky_radiance(d: DVec3, sun: DVec3) -> [f32; 3] {
     let t = ((-d.z) / 0.08).clamp(0.0, 1.0);
     let t = t * t * (3.0 - 2.0 * t);
     let base = sky.lerp(ground, t);
-    // A broad sun lobe exp(k (cos γ − 1)), k = 60 → σ ≈ 7.4°, peak 12 × warm white.
+    // A broad sun lobe exp(k (cos γ − 1)), k = 30 → σ ≈ 10.5°, peak 6 × warm white.
     let cos_g = d.dot(sun);
-    let sun_l = 12.0 * (60.0 * (cos_g - 1.0)).exp() * DVec3::new(1.0, 0.92, 0.80);
+    let sun_l = 6.0 * (30.0 * (cos_g - 1.0)).exp() * DVec3::new(1.0, 0.92, 0.80);
     let l = base + sun_l * (1.0 - t);
     [l.x as f32, l.y as f32, l.z as f32]
 }
@@ -595,7 +599,10 @@ mod tests {
         for _ in 0..1000 {
             let (d, pdf, _) = scene.sample_sphere_light(p, rng.next_dvec2()).unwrap();
             assert!((scene.sphere_light_pdf(p, d) - pdf).abs() < 1e-9 * pdf);
-            assert!(matches!(scene.intersect(p, d, f64::INFINITY), Hit::Light { .. }));
+            assert!(matches!(
+                scene.intersect(p, d, f64::INFINITY),
+                Hit::Light { .. }
+            ));
         }
     }
 
@@ -603,8 +610,29 @@ mod tests {
     fn camera_sees_the_sphere_in_the_centre_and_sky_in_the_corner() {
         let scene = Scene::new(Environment::sky(), None, false);
         let d = scene.camera_ray(0.5, 0.5, 1.0);
-        assert!(matches!(scene.intersect(scene.eye, d, f64::INFINITY), Hit::Sphere { .. }));
+        assert!(matches!(
+            scene.intersect(scene.eye, d, f64::INFINITY),
+            Hit::Sphere { .. }
+        ));
         let d = scene.camera_ray(0.0, 0.0, 1.0);
         assert_eq!(scene.intersect(scene.eye, d, f64::INFINITY), Hit::Miss);
+    }
+}
+
+#[cfg(test)]
+mod exr_env_tests {
+    use super::*;
+
+    #[test]
+    fn exr_lat_long_map_loads_with_orientation() {
+        // Bright top half (sky), dark bottom half: the zenith is bright, the nadir dark.
+        let img = Image::from_fn(16, 8, 3, |_, y, o| o.fill(if y < 4 { 2.0 } else { 0.5 }));
+        let p = std::env::temp_dir().join(format!("brdftab-env-{}.exr", std::process::id()));
+        crate::render::image::write_exr(&img, &p, crate::render::image::ExrPrecision::F16).unwrap();
+        let env = Environment::from_exr(&p).unwrap();
+        assert_eq!(env.eval(DVec3::Z), DVec3::splat(2.0));
+        assert_eq!(env.eval(-DVec3::Z), DVec3::splat(0.5));
+        assert!(env.pdf(DVec3::new(0.0, 0.6, 0.8)) > env.pdf(DVec3::new(0.0, 0.6, -0.8)));
+        assert!(Environment::from_exr("/nonexistent/env.exr").is_err());
     }
 }

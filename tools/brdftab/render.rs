@@ -1,0 +1,239 @@
+//! `render`: preview images of a SOURCE on a sphere, and comparisons of two sources.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use brdftab::render::{
+    self, EnvChoice, Environment, Image, LightChoice, Mode, RenderOptions, Sampling,
+};
+use brdftab::{Error, Result};
+use clap::Args;
+
+use crate::source;
+
+/// Arguments of `brdftab render`.
+#[derive(Args)]
+pub struct RenderArgs {
+    /// The material: a model spec (inline JSON or .json), a table, a MERL or RGL file.
+    source: String,
+    /// Output image, .png (8-bit sRGB) or .exr (linear f32).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 64)]
+    spp: usize,
+    /// Image size, WxH.
+    #[arg(long, default_value = "256x256")]
+    size: String,
+    /// Random seed (same seed → identical image).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// `path` (full path tracing) or `lit` (direct lighting only, fast).
+    #[arg(long, default_value = "path")]
+    mode: String,
+    /// Maximum path length in bounces (path mode).
+    #[arg(long, default_value_t = 8)]
+    max_depth: usize,
+    /// Environment: `sky` (smooth procedural), `white` (constant 1, the furnace), `none`, or a
+    /// lat-long FILE.exr (z up: row 0 = zenith).
+    #[arg(long, default_value = "sky")]
+    env: String,
+    /// Extra light: none, point or area (a small spherical light).
+    #[arg(long, default_value = "none")]
+    light: String,
+    /// Put the sphere on a diffuse grey ground plane.
+    #[arg(long)]
+    ground: bool,
+    /// Sampling: mis (light + BRDF sampling), brdf, light, or fixed (light + cosine sampling:
+    /// material-independent directions). Default: mis, but fixed with --compare, so that both
+    /// sources see the same directions and the difference shows the materials, not the noise.
+    #[arg(long)]
+    sampling: Option<String>,
+    /// Exposure in stops for PNG output.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    exposure: f32,
+    /// Render a second SOURCE with the same seed; write OUT as the side-by-side pair
+    /// (SOURCE left, OTHER right), OUT-diff.png as the false-colour difference, and print the
+    /// relative RMSE of SOURCE against OTHER.
+    #[arg(long)]
+    compare: Option<String>,
+    /// Seed for the --compare render (default: the same seed). Comparing a SOURCE with itself
+    /// under another seed measures the noise floor.
+    #[arg(long)]
+    compare_seed: Option<u64>,
+    /// Evaluate spectral sources at these wavelengths in nm (comma separated).
+    #[arg(long)]
+    wavelengths: Option<String>,
+    /// Number of threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+fn parse_size(s: &str) -> Result<(usize, usize)> {
+    let bad = || Error::arg("--size", format!("`{s}` is not WxH (e.g. 256x256)"));
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let w = w.trim().parse().map_err(|_| bad())?;
+    let h = h.trim().parse().map_err(|_| bad())?;
+    Ok((w, h))
+}
+
+fn options(a: &RenderArgs) -> Result<RenderOptions> {
+    let (width, height) = parse_size(&a.size)?;
+    let mode = match a.mode.as_str() {
+        "path" => Mode::Path,
+        "lit" => Mode::Lit,
+        m => return Err(Error::arg("--mode", format!("`{m}`: expected path or lit"))),
+    };
+    let env = match a.env.as_str() {
+        "sky" => EnvChoice::Sky,
+        "white" => EnvChoice::Constant([1.0; 3]),
+        "none" => EnvChoice::Black,
+        f if f.to_ascii_lowercase().ends_with(".exr") => {
+            EnvChoice::Map(Arc::new(Environment::from_exr(f)?))
+        }
+        e => {
+            return Err(Error::arg(
+                "--env",
+                format!("`{e}`: expected sky, white, none or a .exr file"),
+            ));
+        }
+    };
+    let light = match a.light.as_str() {
+        "none" => LightChoice::None,
+        "point" => LightChoice::Point,
+        "area" => LightChoice::Area,
+        l => {
+            return Err(Error::arg(
+                "--light",
+                format!("`{l}`: expected none, point or area"),
+            ));
+        }
+    };
+    let default_sampling = if a.compare.is_some() { "fixed" } else { "mis" };
+    let sampling = match a.sampling.as_deref().unwrap_or(default_sampling) {
+        "mis" => Sampling::Mis,
+        "brdf" => Sampling::BrdfOnly,
+        "light" => Sampling::LightOnly,
+        "fixed" => Sampling::Fixed,
+        s => {
+            return Err(Error::arg(
+                "--sampling",
+                format!("`{s}`: expected mis, brdf, light or fixed"),
+            ));
+        }
+    };
+    Ok(RenderOptions {
+        width,
+        height,
+        spp: a.spp,
+        seed: a.seed,
+        max_depth: a.max_depth,
+        mode,
+        sampling,
+        env,
+        light,
+        ground: a.ground,
+        exposure: a.exposure,
+        threads: a.threads,
+    })
+}
+
+/// Renders with a progress bar on a terminal, silently otherwise; reports the time on stderr.
+fn render_one(brdf: &dyn brdftab::Brdf, opts: &RenderOptions, label: &str) -> Result<Image> {
+    let start = Instant::now();
+    let img = if std::io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new((opts.width * opts.height) as u64);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {percent}% eta {eta}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+        bar.set_message(label.to_string());
+        let cb = |k: u64| bar.inc(k);
+        let r = render::render(brdf, opts, Some(&cb));
+        bar.finish_and_clear();
+        r?
+    } else {
+        render::render(brdf, opts, None)?
+    };
+    eprintln!(
+        "{label}: {}×{} at {} spp in {:.2} s",
+        opts.width,
+        opts.height,
+        opts.spp,
+        start.elapsed().as_secs_f64()
+    );
+    Ok(img)
+}
+
+/// `OUT.png` → `OUT-diff.png` (always PNG: it is a false-colour picture).
+fn diff_path(out: &Path) -> PathBuf {
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "render".into());
+    out.with_file_name(format!("{stem}-diff.png"))
+}
+
+/// Runs `brdftab render`.
+pub fn run(a: RenderArgs) -> Result<()> {
+    let opts = options(&a)?;
+    let channels = source::channels(a.wavelengths.as_deref())?;
+    let brdf = source::open(&a.source, &channels)?;
+    let img = render_one(brdf.as_ref(), &opts, &a.source)?;
+    let Some(other) = &a.compare else {
+        return render::write_auto(&img, &a.output, opts.exposure);
+    };
+    let brdf_b = source::open(other, &channels)?;
+    let opts_b = RenderOptions {
+        seed: a.compare_seed.unwrap_or(opts.seed),
+        ..opts.clone()
+    };
+    let img_b = render_one(brdf_b.as_ref(), &opts_b, other)?;
+    let r = render::compare(&img, &img_b)?;
+    let pair = Image::hstack(&[&img, &img_b], 4, 0.0)?;
+    render::write_auto(&pair, &a.output, opts.exposure)?;
+    let (diff, legend) = render::difference_image(&img, &img_b)?;
+    let dp = diff_path(&a.output);
+    render::write_png(&diff, &dp, 0.0)?;
+    println!(
+        "relative RMSE: {:.6} ({:.4}%)",
+        r.rel_rmse,
+        100.0 * r.rel_rmse
+    );
+    println!("RMSE: {:.6e}  max |a-b|: {:.6e}", r.rmse, r.max_abs);
+    println!(
+        "mean {}: {:.6}  mean {}: {:.6}",
+        a.source, r.mean_a, other, r.mean_b
+    );
+    println!(
+        "side by side: {} ({} left, {} right)",
+        a.output.display(),
+        a.source,
+        other
+    );
+    println!("difference: {} — {legend}", dp.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_size("256x128").unwrap(), (256, 128));
+        assert!(parse_size("256").is_err());
+        assert!(parse_size("axb").is_err());
+    }
+
+    #[test]
+    fn diff_path_is_beside_the_output() {
+        assert_eq!(
+            diff_path(Path::new("out/a.exr")),
+            PathBuf::from("out/a-diff.png")
+        );
+    }
+}
