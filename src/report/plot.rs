@@ -99,17 +99,23 @@ fn panel(
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
+        // The ranges are padded by 0.1 % so that plotters' log key points (which round
+        // log10(start) up) include the lower decade and its intermediate labels.
+        .build_cartesian_2d(
+            (xr.0 * 0.999..xr.1 * 1.001).log_scale(),
+            (yr.0 * 0.999..yr.1 * 1.001).log_scale(),
+        )
         .map_err(perr(path))?;
     chart
         .configure_mesh()
         .x_desc("bytes stored (compressed)")
         .y_desc(y_desc)
-        .x_labels(12)
-        .y_labels(12)
+        .x_labels(10)
+        .y_labels(10)
         .x_label_formatter(&|x| format!("{x:.0e}"))
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .label_style(("sans-serif", 13))
+        .light_line_style(RGBColor(238, 238, 238))
         .axis_desc_style(("sans-serif", 15))
         .draw()
         .map_err(perr(path))?;
