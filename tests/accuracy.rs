@@ -2,10 +2,10 @@
 
 use std::process::Command;
 
+use brdftab::render::{LightChoice, Mode, RenderOptions, Sampling};
 use brdftab::report::suite::{
     self, CSV_HEADER, CodecDef, NOT_MEASURED, SourceDef, SuiteConfig, default_codecs,
 };
-use brdftab::render::{LightChoice, Mode, RenderOptions, Sampling};
 use brdftab::table::Param;
 use brdftab::table::presets::Preset;
 
@@ -25,10 +25,12 @@ fn codecs(names: &[&str]) -> Vec<CodecDef> {
 fn tiny() -> SuiteConfig {
     SuiteConfig {
         sources: vec![
-            SourceDef::model("lambert", r#"{"model": "lambert", "kd": [0.2, 0.15, 0.1]}"#)
-                .unwrap(),
-            SourceDef::model("rphong", r#"{"model": "reciprocal_phong", "ks": 1, "n": 10}"#)
-                .unwrap(),
+            SourceDef::model("lambert", r#"{"model": "lambert", "kd": [0.2, 0.15, 0.1]}"#).unwrap(),
+            SourceDef::model(
+                "rphong",
+                r#"{"model": "reciprocal_phong", "ks": 1, "n": 10}"#,
+            )
+            .unwrap(),
         ],
         presets: vec![Preset::Small],
         params: vec![Param::HalfDiff],
@@ -53,7 +55,12 @@ fn tiny() -> SuiteConfig {
 /// Parses the CSV into (header, rows of fields); no field of these names contains a comma.
 fn parse_csv(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
     let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(str::to_owned).collect();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_owned)
+        .collect();
     let rows = lines
         .map(|l| l.split(',').map(str::to_owned).collect())
         .collect();
@@ -137,7 +144,14 @@ fn unmeasured_render_is_minus_one_and_said_so() {
     let r = &report.rows[0];
     assert_eq!(r.render, "skipped");
     assert_eq!(r.render_rel_rmse, NOT_MEASURED);
-    assert!(report.csv().lines().nth(1).unwrap().contains(",skipped,ok,"));
+    assert!(
+        report
+            .csv()
+            .lines()
+            .nth(1)
+            .unwrap()
+            .contains(",skipped,ok,")
+    );
 }
 
 #[test]
@@ -157,7 +171,7 @@ fn write_all_writes_csv_markdown_and_valid_pngs() {
         let info = reader.next_frame(&mut buf).unwrap();
         assert_eq!((info.width, info.height), (1400, 560));
         // Not blank: the figure has dark pixels (text, axes) and white background.
-        assert!(buf.iter().any(|&b| b < 64) && buf.iter().any(|&b| b == 255));
+        assert!(buf.iter().any(|&b| b < 64) && buf.contains(&255));
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -182,7 +196,11 @@ fn cli_writes_the_files() {
         .env_remove("BRDFTAB_RGL_DIR")
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let csv = std::fs::read_to_string(dir.join("accuracy.csv")).unwrap();
     let (header, rows) = parse_csv(&csv);
     assert_eq!(header.join(","), CSV_HEADER);

@@ -6,7 +6,8 @@
 //! One figure per source, two panels: the cosine-weighted relative RMSE and the relative RMSE of
 //! the preview render, each against the compressed size, log scale on both axes. One line per
 //! parameterization × codec through the grid presets (small → large, i.e. growing bytes); with a
-//! single preset each line is a single marker. Zero errors (e.g. a Lambert table) are drawn at
+//! single preset each line is a single marker (markers shrink with the codec index, so equal
+//! points nest). Zero errors (e.g. a Lambert table) are drawn at
 //! the panel's floor [`FLOOR`]; unmeasured values (−1) are left out.
 
 use std::path::Path;
@@ -129,8 +130,22 @@ fn panel(
             .map_err(perr(path))?;
         return Ok(());
     }
+    let codecs: Vec<&str> = {
+        let mut v: Vec<&str> = Vec::new();
+        for (l, _) in data {
+            let c = l.split_once(' ').map_or(l.as_str(), |x| x.1);
+            if !v.contains(&c) {
+                v.push(c);
+            }
+        }
+        v
+    };
     for (i, (label, pts)) in data.iter().enumerate() {
         let color = COLORS[i % COLORS.len()];
+        // Markers shrink with the codec's index, so codecs with equal errors and sizes nest
+        // instead of hiding each other.
+        let k = codecs.iter().position(|c| label.ends_with(c)).unwrap_or(0) as i32;
+        let size = (9 - 2 * k).max(3);
         // halfdiff: filled circles and solid lines; inout: hollow triangles.
         let inout = label.starts_with("inout");
         chart
@@ -144,12 +159,12 @@ fn panel(
             chart
                 .draw_series(
                     pts.iter()
-                        .map(|&p| TriangleMarker::new(p, 6, color.stroke_width(2))),
+                        .map(|&p| TriangleMarker::new(p, size + 2, color.stroke_width(2))),
                 )
                 .map_err(perr(path))?;
         } else {
             chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                .draw_series(pts.iter().map(|&p| Circle::new(p, size, color.filled())))
                 .map_err(perr(path))?;
         }
     }

@@ -156,7 +156,10 @@ pub fn rgl_sources(dir: impl AsRef<Path>) -> Result<Vec<SourceDef>> {
     let mut v: Vec<SourceDef> = std::fs::read_dir(dir)
         .map_err(|e| Error::io(dir, e))?
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("bsdf")))
+        .filter(|p| {
+            p.extension()
+                .is_some_and(|x| x.eq_ignore_ascii_case("bsdf"))
+        })
         .map(|p| SourceDef {
             name: p
                 .file_stem()
@@ -261,7 +264,9 @@ impl SuiteConfig {
             params: vec![Param::HalfDiff, Param::InOut],
             codecs: default_codecs(),
             pairs: 200_000,
-            albedo_thetas: (0..8).map(|i| (5.0 + 10.0 * i as f64).to_radians()).collect(),
+            albedo_thetas: (0..8)
+                .map(|i| (5.0 + 10.0 * i as f64).to_radians())
+                .collect(),
             render: Some(preview(64, 16)),
             render_measured: true,
             seed: 1,
@@ -292,7 +297,10 @@ impl SuiteConfig {
             params: vec![Param::HalfDiff, Param::InOut],
             codecs: default_codecs(),
             pairs: 20_000,
-            albedo_thetas: [10.0f64, 45.0, 75.0].iter().map(|d| d.to_radians()).collect(),
+            albedo_thetas: [10.0f64, 45.0, 75.0]
+                .iter()
+                .map(|d| d.to_radians())
+                .collect(),
             render: Some(preview(24, 4)),
             render_measured: true,
             seed: 1,

@@ -4,8 +4,8 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use brdftab::report::suite::{self, SuiteConfig};
-use brdftab::table::presets::Preset;
 use brdftab::table::Param;
+use brdftab::table::presets::Preset;
 use brdftab::{Error, Result};
 use clap::Args;
 
@@ -50,7 +50,10 @@ pub fn accuracy(a: AccuracyArgs) -> Result<()> {
         .or_else(|| std::env::var_os("BRDFTAB_RGL_DIR").map(PathBuf::from));
     if let Some(d) = &rgl {
         if !d.is_dir() {
-            return Err(Error::NotFound(format!("--rgl {}: not a directory", d.display())));
+            return Err(Error::NotFound(format!(
+                "--rgl {}: not a directory",
+                d.display()
+            )));
         }
     } else {
         eprintln!("note: no --rgl DIR (or $BRDFTAB_RGL_DIR): analytic models only");
@@ -68,7 +71,8 @@ pub fn accuracy(a: AccuracyArgs) -> Result<()> {
     }
     if let Some(o) = &a.only {
         let keys: Vec<&str> = list(o).collect();
-        cfg.sources.retain(|s| keys.iter().any(|k| s.name.contains(k)));
+        cfg.sources
+            .retain(|s| keys.iter().any(|k| s.name.contains(k)));
     }
     if let Some(n) = a.pairs {
         cfg.pairs = n;
@@ -77,14 +81,19 @@ pub fn accuracy(a: AccuracyArgs) -> Result<()> {
         cfg.render = None;
     }
     if cfg.sources.is_empty() || cfg.presets.is_empty() || cfg.params.is_empty() {
-        return Err(Error::arg("accuracy", "nothing to run (no sources, presets or params)"));
+        return Err(Error::arg(
+            "accuracy",
+            "nothing to run (no sources, presets or params)",
+        ));
     }
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new(cfg.row_count() as u64);
         b.set_style(
-            indicatif::ProgressStyle::with_template("accuracy [{bar:30}] {pos}/{len} rows {elapsed} {msg}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-                .progress_chars("=> "),
+            indicatif::ProgressStyle::with_template(
+                "accuracy [{bar:30}] {pos}/{len} rows {elapsed} {msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
         );
         b
     });
