@@ -1,6 +1,7 @@
 //! `brdftab`: the command-line tool. Thin over the library: parse arguments, call the library,
 //! print. Errors print as `error: ...` on stderr with exit code 1.
 
+mod accuracy;
 mod analysis;
 mod demo;
 mod fit;
@@ -48,6 +49,8 @@ enum Command {
     Check(analysis::CheckArgs),
     /// The lecture's models side by side (plausibility table).
     Demo(demo::DemoArgs),
+    /// Accuracy suite: tables of every source per grid and codec vs the source; CSV, Markdown, plots.
+    Accuracy(accuracy::AccuracyArgs),
     /// Fit a model's parameters to SOURCE by least squares; prints the fitted spec.
     Fit(fit::FitArgs),
     /// Draw incident directions from SOURCE's sampler: `wix wiy wiz pdf w_1 .. w_c` per line.
@@ -74,6 +77,7 @@ fn main() -> ExitCode {
         Command::Albedo(a) => analysis::albedo(a),
         Command::Check(a) => analysis::check(a),
         Command::Demo(a) => demo::demo(a),
+        Command::Accuracy(a) => accuracy::accuracy(a),
         Command::Fit(a) => fit::fit(a),
         Command::Sample(a) => sample::sample(a),
         Command::Pdf(a) => sample::pdf(a),
