@@ -43,10 +43,30 @@ fn cook_torrance_table(sizes: [usize; 4]) -> Table {
     })
 }
 
-fn row(name: &str, raw: usize, bytes: usize, c: Duration, d: Duration) {
+/// CPU time of the calling thread (Linux: /proc/thread-self/schedstat), for throughput figures
+/// that do not depend on how busy the shared machine is.
+fn thread_cpu() -> Option<Duration> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(Duration::from_nanos(s.split_whitespace().next()?.parse().ok()?))
+}
+
+/// Best-of-N single-threaded CPU time of `f`.
+fn cpu_time<T>(mut f: impl FnMut() -> T) -> Duration {
+    let mut best = Duration::MAX;
+    for _ in 0..reps() {
+        let (Some(a), _, Some(b)) = (thread_cpu(), f(), thread_cpu()) else { return Duration::ZERO };
+        best = best.min(b - a);
+    }
+    best
+}
+
+fn row(name: &str, raw: usize, bytes: usize, c: Duration, d: Duration, cpu: Option<(Duration, Duration)>) {
     let mb = raw as f64 / 1e6;
+    let per_core = cpu.map_or(String::new(), |(c1, d1)| {
+        format!("   | 1 core CPU: {:>5.0} / {:>5.0} MB/s", mb / c1.as_secs_f64(), mb / d1.as_secs_f64())
+    });
     println!(
-        "{name:<28} {bytes:>10} B {:>7.1}x {:>9.0} MB/s {:>9.0} MB/s",
+        "{name:<24} {bytes:>9} B {:>6.1}x {:>6.0} MB/s {:>6.0} MB/s{per_core}",
         raw as f64 / bytes as f64,
         mb / c.as_secs_f64(),
         mb / d.as_secs_f64()
@@ -80,7 +100,8 @@ fn main() {
         "Cook-Torrance (m 0.3, Au) halfdiff medium: stored {:?} x {} ch = {} values ({:.1} MB f32), {} chunks; baked in {:.2?}; {} threads",
         l.shape, l.channels, table.values().len(), raw as f64 / 1e6, l.chunk_count(), t0.elapsed(), rayon::current_num_threads()
     );
-    println!("{:<28} {:>12} {:>8} {:>14} {:>14}", "codec", "size", "ratio", "compress", "decompress");
+    println!("wall time on all threads of the (shared) machine, then single-thread CPU time");
+    println!("{:<24} {:>11} {:>7} {:>11} {:>11}", "codec", "size", "ratio", "compress", "decompress");
 
     let chunks: Vec<(&[f32], codec::Layout)> =
         (0..l.chunk_count()).map(|a| (table.chunk(a), tables::chunk_layout(&grid, a))).collect();
@@ -90,7 +111,9 @@ fn main() {
         chunks.par_iter().map(|(v, _)| zstd::bulk::compress(bytemuck(v), 3).unwrap()).collect()
     });
     let (d, _) = time(|| z.par_iter().zip(&chunks).map(|(b, (v, _))| zstd::bulk::decompress(b, v.len() * 4).unwrap().len()).sum::<usize>());
-    row("zstd-3 raw f32", raw, z.iter().map(Vec::len).sum(), c, d);
+    let c1 = cpu_time(|| chunks.iter().map(|(v, _)| zstd::bulk::compress(bytemuck(v), 3).unwrap().len()).sum::<usize>());
+    let d1 = cpu_time(|| z.iter().zip(&chunks).map(|(b, (v, _))| zstd::bulk::decompress(b, v.len() * 4).unwrap().len()).sum::<usize>());
+    row("zstd-3 raw f32", raw, z.iter().map(Vec::len).sum(), c, d, Some((c1, d1)));
 
     for (name, quant, level) in [
         ("f32 + filters, zstd-3", Quant::F32, 3),
@@ -107,12 +130,14 @@ fn main() {
         let (d, _) = time(|| {
             enc.par_iter().zip(&chunks).map(|(b, (v, _))| codec::decode(b, v.len()).unwrap().len()).sum::<usize>()
         });
-        row(name, raw, enc.iter().map(Vec::len).sum(), c, d);
+        let c1 = cpu_time(|| chunks.iter().map(|(v, lay)| codec::encode(v, *lay, &codec).unwrap().len()).sum::<usize>());
+        let d1 = cpu_time(|| enc.iter().zip(&chunks).map(|(b, (v, _))| codec::decode(b, v.len()).unwrap().len()).sum::<usize>());
+        row(name, raw, enc.iter().map(Vec::len).sum(), c, d, Some((c1, d1)));
         let mut filters = std::collections::BTreeMap::new();
         for b in &enc {
             *filters.entry(format!("{:?}", codec::chunk_info(b).unwrap().filter)).or_insert(0) += 1;
         }
-        println!("{:<28} filters chosen: {filters:?}", "");
+        println!("{:<24}   filters chosen: {filters:?}", "");
     }
 
     // OpenEXR: the table as an image of width = stored φd × rows = θh·θd, RGB channels.
@@ -120,7 +145,7 @@ fn main() {
     for (name, comp) in [("exr ZIP (f32)", exr::prelude::Compression::ZIP16), ("exr PIZ (f32)", exr::prelude::Compression::PIZ)] {
         let (c, b) = time(|| exr_bytes(table.values(), w, h, comp));
         let (d, _) = time(|| exr_read(&b));
-        row(name, raw, b.len(), c, d);
+        row(name, raw, b.len(), c, d, None);
     }
 
     // Open a 100-table database and do a first lookup.

@@ -61,11 +61,14 @@ pub const LOG16_MAX_AUTO_FLOOR_RATIO: f64 = 1e-3;
 
 /// The per-chunk parameters of log16, stored in the chunk header.
 ///
-/// A value `v` is coded as `q = round((ln(|v| + floor) − lo) / step)` and decoded as
-/// `v̂ = max(0, exp(lo + q·step) − floor)`. With `step = 2·ln(1 + tol/2)·0.98`, the decoded value
-/// satisfies `|v̂ − v| ≤ (|v| + floor)(e^{step/2} − 1) ≤ tol·max(|v|, floor)` with a 2% margin.
-/// The encoder nevertheless decodes every value and checks the bound; values that fail it
-/// (negatives, anything f32 rounding pushes over) go to an exact escape list.
+/// A value `v ≥ 0` is coded as `q = round((ln(v + floor) − lo) / step)` and decoded as
+/// `v̂ = max(0, exp(lo + q·step) − floor)`, so `|v̂ − v| ≤ (v + floor)(e^{step/2} − 1)`. With
+/// `step = 2·ln(1 + tol)·0.98` that is at most `0.98·tol·(v + floor)`, within the bound
+/// `tol·max(v, floor)` wherever `v ≥ 50·floor` — which, with the automatically chosen floor
+/// (around 1e-28 of the chunk's maximum), is every value but exact zeros and the near-zero
+/// crumbs next to them. The encoder therefore decodes every value and checks the bound; values
+/// that fail it (negatives, magnitudes close to the floor, anything f32 rounding pushes over) go
+/// to an exact escape list. The guarantee holds for every value by construction.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Log16Params {
     /// ln of the smallest coded magnitude plus floor.
@@ -108,7 +111,7 @@ pub struct Log16 {
 
 /// The log16 step for tolerance `tol`.
 pub fn log16_step(tol: f64) -> f64 {
-    2.0 * (tol / 2.0).ln_1p() * 0.98
+    2.0 * tol.ln_1p() * 0.98
 }
 
 /// Quantizes `data` with relative tolerance `tol`; `floor` pins the absolute floor, `None` lets
