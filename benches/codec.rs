@@ -134,6 +134,10 @@ fn main() {
         let d1 = cpu_time(|| enc.iter().zip(&chunks).map(|(b, (v, _))| codec::decode(b, v.len()).unwrap().len()).sum::<usize>());
         row(name, raw, enc.iter().map(Vec::len).sum(), c, d, Some((c1, d1)));
         let mut filters = std::collections::BTreeMap::new();
+        let esc: usize = enc.iter().map(|b| codec::chunk_info(b).unwrap().escapes).sum();
+        if esc > 0 {
+            println!("{:<24}   exactly stored (escapes): {esc}", "");
+        }
         for b in &enc {
             *filters.entry(format!("{:?}", codec::chunk_info(b).unwrap().filter)).or_insert(0) += 1;
         }

@@ -74,10 +74,10 @@ impl Filter {
         Filter::ALL.get(b as usize).copied()
     }
 
-    fn plane(self) -> bool {
+    pub(crate) fn plane(self) -> bool {
         matches!(self, Filter::Plane | Filter::PlaneChannel)
     }
-    fn channel(self) -> bool {
+    pub(crate) fn channel(self) -> bool {
         matches!(self, Filter::DeltaChannel | Filter::PlaneChannel)
     }
 }
@@ -142,7 +142,7 @@ word!(u16, i16);
 word!(u32, i32);
 
 /// Rows of the array: (start, length, whether the row above is in the same plane).
-fn rows(n: usize, layout: Layout) -> impl Iterator<Item = (usize, usize, bool)> {
+pub(crate) fn rows(n: usize, layout: Layout) -> impl Iterator<Item = (usize, usize, bool)> {
     let row = layout.row().max(1);
     let next = layout.next.max(1);
     (0..n.div_ceil(row)).map(move |r| {
