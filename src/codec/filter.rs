@@ -282,6 +282,48 @@ pub fn shuffle<W: Word>(words: &[W], out: &mut Vec<u8>) {
     }
 }
 
+/// Splits words into bit planes (bit 0 of every word, then bit 1, ...), appending to `out`.
+pub fn bitshuffle<W: Word>(words: &[W], out: &mut Vec<u8>) {
+    let n = words.len();
+    let pb = n.div_ceil(8);
+    let base = out.len();
+    out.resize(base + pb * W::BYTES * 8, 0);
+    let dst = &mut out[base..];
+    for (g, ws) in words.chunks(8).enumerate() {
+        for k in 0..W::BYTES {
+            let bytes: [u8; 8] = std::array::from_fn(|t| ws.get(t).map_or(0, |w| w.byte(k)));
+            for bit in 0..8 {
+                let mut b = 0u8;
+                for (t, &x) in bytes.iter().enumerate() {
+                    b |= ((x >> bit) & 1) << t;
+                }
+                dst[(k * 8 + bit) * pb + g] = b;
+            }
+        }
+    }
+}
+
+/// Inverse of [`bitshuffle`]: `bytes` must hold exactly `out.len().div_ceil(8) * W::BYTES * 8`.
+pub fn unbitshuffle<W: Word>(bytes: &[u8], out: &mut [W]) {
+    let n = out.len();
+    let pb = n.div_ceil(8);
+    out.fill(W::default());
+    for k in 0..W::BYTES {
+        for (g, ws) in out.chunks_mut(8).enumerate() {
+            let mut acc = [0u8; 8];
+            for bit in 0..8 {
+                let b = bytes[(k * 8 + bit) * pb + g];
+                for (t, a) in acc.iter_mut().enumerate() {
+                    *a |= ((b >> t) & 1) << bit;
+                }
+            }
+            for (t, w) in ws.iter_mut().enumerate() {
+                *w = w.with_byte(k, acc[t]);
+            }
+        }
+    }
+}
+
 /// Inverse of [`shuffle`]: `bytes` must hold exactly `out.len() * W::BYTES` bytes.
 pub fn unshuffle<W: Word>(bytes: &[u8], out: &mut [W]) {
     let n = out.len();
@@ -321,6 +363,15 @@ mod tests {
                 inverse(&mut r, layout, f);
                 prop_assert_eq!(&r, &words);
             }
+        }
+
+        #[test]
+        fn bitshuffle_inverts(words in proptest::collection::vec(any::<u16>(), 0..100)) {
+            let mut b = vec![];
+            bitshuffle(&words, &mut b);
+            let mut back = vec![0u16; words.len()];
+            unbitshuffle(&b, &mut back);
+            prop_assert_eq!(back, words);
         }
 
         #[test]
