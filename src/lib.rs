@@ -20,6 +20,10 @@
 //! # Ok::<(), brdftab::Error>(())
 //! ```
 
+// `!(x > 0.0)` is the idiom this crate uses to reject NaN together with non-positive values
+// (DESIGN.md: NaN input gives 0, never a panic); rewriting it with `partial_cmp` obscures that.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod analysis;
 pub mod brdf;
 pub mod codec;
@@ -41,3 +45,8 @@ pub use brdf::{Brdf, BrdfSample, Flags};
 pub use error::{Error, Result};
 pub use spec::ModelSpec;
 pub use spectrum::{Channels, Value};
+
+/// The README's code examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

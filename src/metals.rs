@@ -182,7 +182,10 @@ mod tests {
     fn tables_are_valid_and_cover_the_visible_range() {
         for name in NAMES {
             let t = table(name).unwrap();
-            assert!(t.first().unwrap().0 < 380.0 && t.last().unwrap().0 > 780.0, "{name}");
+            assert!(
+                t.first().unwrap().0 < 380.0 && t.last().unwrap().0 > 780.0,
+                "{name}"
+            );
             let (n, k) = metal(name).unwrap();
             n.validate("n", 0.0).unwrap();
             k.validate("k", 0.0).unwrap();

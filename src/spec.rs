@@ -226,25 +226,25 @@ pub const MODELS: &[ModelInfo] = &[
     ModelInfo {
         name: "ggx",
         params: "alpha | alpha_x + alpha_y: number, ks: Value = 1, fresnel: Fresnel = \"none\"",
-        description: "GGX / Trowbridge-Reitz microfacet model, Smith height-correlated G, isotropic or anisotropic",
+        description: "GGX / Trowbridge-Reitz microfacet model, k_s D G2 F(wi·h) / (4 cos θi cos θo), Smith height-correlated G2, isotropic or anisotropic; visible-normal sampling",
         example: r#"{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}"#,
     },
     ModelInfo {
         name: "ward",
         params: "ks: Value, alpha_x: number, alpha_y: number",
-        description: "Ward (1992) anisotropic Gaussian lobe",
+        description: "Ward (1992) anisotropic Gaussian lobe, k_s exp(−tan²θh (cos²φh/α_x² + sin²φh/α_y²)) / (4π α_x α_y √(cos θi cos θo)); not energy conserving at grazing angles",
         example: r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}"#,
     },
     ModelInfo {
         name: "oren_nayar",
         params: "kd: Value, sigma: radians",
-        description: "Oren-Nayar rough diffuse (qualitative model); sigma = 0 is Lambert",
+        description: "Oren-Nayar rough diffuse (qualitative model), k_d (A + B max(0, cos Δφ) sin α tan β); sigma = 0 is Lambert",
         example: r#"{"model": "oren_nayar", "kd": 0.25, "sigma": 0.3}"#,
     },
     ModelInfo {
         name: "sum",
         params: "terms: [spec, ...], weights: [number, ...] = all 1",
-        description: "weighted sum of models, e.g. diffuse + specular",
+        description: "weighted sum of models, e.g. diffuse + specular; sampling picks a term with probability ∝ weight × albedo",
         example: r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.2}, {"model": "cook_torrance", "m": 0.2}]}"#,
     },
 ];

@@ -14,15 +14,23 @@ use brdftab::store::{Source, Store, TableHeader, db};
 fn header(name: &str) -> TableHeader {
     TableHeader::new(
         name,
-        Source::Other { description: "crash test".into() },
+        Source::Other {
+            description: "crash test".into(),
+        },
         vec![8, 16, 32, 3],
         Channels::Rgb,
-        Codec { quant: Quant::F16, level: 1, ..Codec::default() },
+        Codec {
+            quant: Quant::F16,
+            level: 1,
+            ..Codec::default()
+        },
     )
 }
 
 fn add(path: &Path, name: &str, slow: bool) {
-    let data: Vec<f32> = (0..8 * 16 * 32 * 3).map(|i| ((i % 97) as f32 * 0.37).sin().abs()).collect();
+    let data: Vec<f32> = (0..8 * 16 * 32 * 3)
+        .map(|i| ((i % 97) as f32 * 0.37).sin().abs())
+        .collect();
     db::put(path, header(name), false, |w| {
         for c in data.chunks(16 * 32 * 3) {
             if slow {
@@ -44,7 +52,9 @@ fn names(path: &Path) -> Vec<String> {
 /// The child: adds tables `t<N>` until killed.
 #[test]
 fn crash_child() {
-    let Some(p) = std::env::var_os("BRDFTAB_CRASH_CHILD") else { return };
+    let Some(p) = std::env::var_os("BRDFTAB_CRASH_CHILD") else {
+        return;
+    };
     let p = std::path::PathBuf::from(p);
     loop {
         let n = names(&p).len();
@@ -75,7 +85,10 @@ fn killed_writer_leaves_old_or_new_database() {
         child.wait().unwrap();
         kills += 1;
         let after = names(&p);
-        assert!(after.len() >= before.len(), "lost entries: {before:?} -> {after:?}");
+        assert!(
+            after.len() >= before.len(),
+            "lost entries: {before:?} -> {after:?}"
+        );
         assert_eq!(&after[..before.len()], &before[..], "entries changed");
     }
     assert_eq!(kills, 10);

@@ -58,7 +58,11 @@ fn chi_square_every_sampler_at_every_angle() {
             }
         }
     }
-    assert!(failures.is_empty(), "chi-square failures:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "chi-square failures:\n{}",
+        failures.join("\n")
+    );
 }
 
 /// The chi-square test has power: a Phong sampler with a lying pdf (claims n+1 when it samples n)
@@ -132,14 +136,20 @@ fn sample_weight_is_f_cos_over_pdf_and_pdf_agrees() {
                     );
                 }
             }
-            assert!(accepted > 1000, "{json} {deg}°: only {accepted} of 2000 accepted");
+            assert!(
+                accepted > 1000,
+                "{json} {deg}°: only {accepted} of 2000 accepted"
+            );
         }
     }
 }
 
 #[test]
 fn white_furnace_lambert_one_over_pi() {
-    let brdf = build(&format!(r#"{{"model": "lambert", "kd": {}}}"#, 1.0 / std::f64::consts::PI));
+    let brdf = build(&format!(
+        r#"{{"model": "lambert", "kd": {}}}"#,
+        1.0 / std::f64::consts::PI
+    ));
     let mut rng = Pcg32::new(3);
     for &deg in THETAS {
         let wo = geometry::spherical(deg.to_radians(), 0.3);
@@ -147,12 +157,18 @@ fn white_furnace_lambert_one_over_pi() {
         let mut sum = 0.0;
         for _ in 0..n {
             let mut w = [0.0f32; 3];
-            let s = brdf.sample(wo, rng.next_dvec2(), &mut w).expect("lambert always samples");
+            let s = brdf
+                .sample(wo, rng.next_dvec2(), &mut w)
+                .expect("lambert always samples");
             assert!(s.pdf > 0.0);
             sum += w[1] as f64;
         }
         // Every weight is exactly k_d π = 1 (up to f32 rounding of k_d).
-        assert!((sum / n as f64 - 1.0).abs() < 1e-6, "{deg}°: {}", sum / n as f64);
+        assert!(
+            (sum / n as f64 - 1.0).abs() < 1e-6,
+            "{deg}°: {}",
+            sum / n as f64
+        );
     }
 }
 
@@ -245,11 +261,17 @@ fn eval_wavelength_agrees_with_channels_at_rgb_wavelengths() {
         brdf.eval(wi, wo, &mut f);
         for (c, &nm) in brdftab::spectrum::RGB_WAVELENGTHS.iter().enumerate() {
             let v = brdf.eval_wavelength(wi, wo, nm);
-            assert!((v - f[c] as f64).abs() <= 1e-6 * v.abs() + 1e-12, "{json} {nm}: {v} vs {}", f[c]);
+            assert!(
+                (v - f[c] as f64).abs() <= 1e-6 * v.abs() + 1e-12,
+                "{json} {nm}: {v} vs {}",
+                f[c]
+            );
         }
     }
     // A spectral channel set uses the metal's own data.
-    let spec = ModelSpec::parse(r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#).unwrap();
+    let spec =
+        ModelSpec::parse(r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#)
+            .unwrap();
     let ch = Channels::linspace(400.0, 700.0, 7).unwrap();
     let b = spec.build(&ch).unwrap();
     let mut f = [0.0f32; 7];
@@ -258,7 +280,10 @@ fn eval_wavelength_agrees_with_channels_at_rgb_wavelengths() {
         let nm = 400.0 + 50.0 * i as f64;
         assert!((b.eval_wavelength(wi, wo, nm) - x as f64).abs() < 1e-6 * x as f64);
     }
-    assert!(f[6] > f[0] * 1.5, "gold reflects red much more than violet: {f:?}");
+    assert!(
+        f[6] > f[0] * 1.5,
+        "gold reflects red much more than violet: {f:?}"
+    );
 }
 
 #[test]
@@ -269,7 +294,10 @@ fn original_phong_is_not_reciprocal_and_says_so() {
     let (mut a, mut c) = ([0.0f32; 3], [0.0f32; 3]);
     b.eval(wi, wo, &mut a);
     b.eval(wo, wi, &mut c);
-    assert!(a[0] > 0.0 && (a[0] - c[0]).abs() > 0.05 * a[0], "{a:?} {c:?}");
+    assert!(
+        a[0] > 0.0 && (a[0] - c[0]).abs() > 0.05 * a[0],
+        "{a:?} {c:?}"
+    );
 }
 
 fn upper() -> impl Strategy<Value = DVec3> {

@@ -25,7 +25,8 @@ fn lobe(shape: [usize; 3], seed: f32) -> Vec<f32> {
                 let x = i as f32 / a as f32;
                 let y = j as f32 / b as f32;
                 let z = k as f32 / c as f32;
-                let s = (-(x * x) * 40.0 - (y - 0.3).powi(2) * 5.0).exp() * 50.0 + 0.05 * (z * 3.0 + seed).cos().abs();
+                let s = (-(x * x) * 40.0 - (y - 0.3).powi(2) * 5.0).exp() * 50.0
+                    + 0.05 * (z * 3.0 + seed).cos().abs();
                 v.extend_from_slice(&[s * 0.9, s, s * 1.1]);
             }
         }
@@ -81,7 +82,10 @@ fn every_codec_round_trips_through_a_file() {
     {
         let p = d.join(format!("t{k}.btdb"));
         let n = data.len() / SHAPE[0];
-        let chunks: Vec<(&[f32], Layout)> = data.chunks(n).map(|c| (c, Layout::new(3, 20, 10))).collect();
+        let chunks: Vec<(&[f32], Layout)> = data
+            .chunks(n)
+            .map(|c| (c, Layout::new(3, 20, 10)))
+            .collect();
         db::write_table(&p, header("lobe", SHAPE, q), &chunks).unwrap();
         let s = Store::open(&p).unwrap();
         let t = s.single().unwrap();
@@ -91,7 +95,9 @@ fn every_codec_round_trips_through_a_file() {
             match q {
                 Quant::F32 => assert_eq!(a.to_bits(), b.to_bits()),
                 Quant::F16 => assert!((a - b).abs() <= a.abs() * 1e-3 + 1e-7),
-                Quant::Log16 { tolerance, .. } => assert!(((a - b).abs() as f64) <= tolerance * *a as f64 + 1e-20),
+                Quant::Log16 { tolerance, .. } => {
+                    assert!(((a - b).abs() as f64) <= tolerance * *a as f64 + 1e-20)
+                }
             }
         }
         // Lazy chunks equal the eager read and are cached.
@@ -110,7 +116,13 @@ fn database_add_replace_remove_list_verify() {
     add(&p, "a", Quant::F16, 0.0);
     add(&p, "b", Quant::F32, 1.0);
     add(&p, "c", Quant::F16, 2.0);
-    let names = |p: &Path| db::list(p).unwrap().into_iter().map(|(e, _)| e.name).collect::<Vec<_>>();
+    let names = |p: &Path| {
+        db::list(p)
+            .unwrap()
+            .into_iter()
+            .map(|(e, _)| e.name)
+            .collect::<Vec<_>>()
+    };
     assert_eq!(names(&p), ["a", "b", "c"]);
 
     // A reader opened now keeps seeing this version.
@@ -122,7 +134,15 @@ fn database_add_replace_remove_list_verify() {
     assert_eq!(names(&p), ["a", "b", "c"]);
     let s = Store::open(&p).unwrap();
     assert_eq!(s.table("b").unwrap().header().codec.quant, Quant::F16);
-    assert_eq!(s.table("a").unwrap().read_all().unwrap(), Store::open(&p).unwrap().table("a").unwrap().read_all().unwrap());
+    assert_eq!(
+        s.table("a").unwrap().read_all().unwrap(),
+        Store::open(&p)
+            .unwrap()
+            .table("a")
+            .unwrap()
+            .read_all()
+            .unwrap()
+    );
     assert_eq!(old.table("b").unwrap().read_all().unwrap(), old_b);
 
     // Adding an existing name without replace is refused.
@@ -132,11 +152,17 @@ fn database_add_replace_remove_list_verify() {
     db::remove(&p, "a").unwrap();
     assert_eq!(names(&p), ["b", "c"]);
     assert!(matches!(db::remove(&p, "zzz"), Err(Error::NotFound(_))));
-    assert!(matches!(Store::open(&p).unwrap().table("a"), Err(Error::NotFound(_))));
+    assert!(matches!(
+        Store::open(&p).unwrap().table("a"),
+        Err(Error::NotFound(_))
+    ));
     assert_eq!(db::verify(&p).unwrap(), 2 * SHAPE[0]);
 
     // A failed write leaves the database as it was and no temporary file behind.
-    let e = db::put(&p, header("d", SHAPE, Quant::F16), false, |w| w.chunk(&[f32::NAN; 600])).unwrap_err();
+    let e = db::put(&p, header("d", SHAPE, Quant::F16), false, |w| {
+        w.chunk(&[f32::NAN; 600])
+    })
+    .unwrap_err();
     assert!(e.to_string().contains("index 0"), "{e}");
     assert_eq!(names(&p), ["b", "c"]);
     let stray: Vec<_> = std::fs::read_dir(&d)
@@ -153,13 +179,27 @@ fn cache_respects_its_memory_bound_and_eager_decodes_everything() {
     let p = d.join("t.btdb");
     add(&p, "a", Quant::F16, 0.0);
     let chunk_bytes = 10 * 20 * 3 * 4;
-    let s = Store::open_with(&p, OpenOptions { cache_bytes: 2 * chunk_bytes, eager: false }).unwrap();
+    let s = Store::open_with(
+        &p,
+        OpenOptions {
+            cache_bytes: 2 * chunk_bytes,
+            eager: false,
+        },
+    )
+    .unwrap();
     let t = s.table("a").unwrap();
     for i in 0..t.chunk_count() {
         t.chunk(i).unwrap();
     }
     assert!(format!("{s:?}").contains("tables"));
-    let s = Store::open_with(&p, OpenOptions { cache_bytes: 1 << 30, eager: true }).unwrap();
+    let s = Store::open_with(
+        &p,
+        OpenOptions {
+            cache_bytes: 1 << 30,
+            eager: true,
+        },
+    )
+    .unwrap();
     s.table("a").unwrap();
 }
 
@@ -171,7 +211,10 @@ fn nan_in_data_names_the_chunk_and_index() {
     let mut v = lobe(SHAPE, 0.0)[..600].to_vec();
     v[17] = f32::NAN;
     let e = w.chunk(&v).unwrap_err().to_string();
-    assert!(e.contains("chunk 0") && e.contains("index 17") && e.contains("NaN"), "{e}");
+    assert!(
+        e.contains("chunk 0") && e.contains("index 17") && e.contains("NaN"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -188,10 +231,16 @@ fn npy_and_exr_exports() {
     let hl = u16::from_le_bytes([b[8], b[9]]) as usize;
     assert_eq!((10 + hl) % 64, 0);
     let hdr = std::str::from_utf8(&b[10..10 + hl]).unwrap();
-    assert!(hdr.contains("'shape': (6, 10, 20, 3)") && hdr.contains("'<f4'"), "{hdr}");
+    assert!(
+        hdr.contains("'shape': (6, 10, 20, 3)") && hdr.contains("'<f4'"),
+        "{hdr}"
+    );
     let data = lobe(SHAPE, 0.0);
     assert_eq!(b.len(), 10 + hl + data.len() * 4);
-    let v: Vec<f32> = b[10 + hl..].chunks(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    let v: Vec<f32> = b[10 + hl..]
+        .chunks(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
     assert_eq!(v, data);
 
     let sl = export::Slice::parse("2,0:0,4", 3).unwrap();
@@ -213,7 +262,15 @@ fn npy_and_exr_exports() {
 fn sample_file(d: &Path) -> (PathBuf, Vec<u8>) {
     let p = d.join("sample.btdb");
     add(&p, "a", Quant::F16, 0.0);
-    add(&p, "b", Quant::Log16 { tolerance: 1e-3, floor: None }, 1.0);
+    add(
+        &p,
+        "b",
+        Quant::Log16 {
+            tolerance: 1e-3,
+            floor: None,
+        },
+        1.0,
+    );
     let b = std::fs::read(&p).unwrap();
     (p, b)
 }
@@ -221,7 +278,9 @@ fn sample_file(d: &Path) -> (PathBuf, Vec<u8>) {
 /// Opens bytes as a file and verifies everything; returns the error (panics if it succeeds).
 fn open_err(d: &Path, bytes: &[u8]) -> Error {
     let _ = d;
-    match Store::from_bytes("bad.btdb", bytes.to_vec(), OpenOptions::default()).and_then(|s| s.verify()) {
+    match Store::from_bytes("bad.btdb", bytes.to_vec(), OpenOptions::default())
+        .and_then(|s| s.verify())
+    {
         Ok(_) => panic!("damaged file accepted"),
         Err(e) => e,
     }
@@ -231,7 +290,8 @@ fn open_err(d: &Path, bytes: &[u8]) -> Error {
 /// so a test can plant a specific lie past all checksums.
 fn reseal(bytes: &[u8], extra: &[u8], edit: impl FnOnce(&mut Toc, u64)) -> Vec<u8> {
     let sb = Superblock::parse("x", bytes).unwrap();
-    let mut toc: Toc = serde_json::from_slice(&bytes[sb.toc.offset as usize..][..sb.toc.len as usize]).unwrap();
+    let mut toc: Toc =
+        serde_json::from_slice(&bytes[sb.toc.offset as usize..][..sb.toc.len as usize]).unwrap();
     let mut out = bytes[..sb.toc.offset as usize].to_vec();
     let extra_at = out.len() as u64;
     out.extend_from_slice(extra);
@@ -261,11 +321,17 @@ fn truncation_anywhere_is_a_typed_error() {
         let p = d.join("trunc.btdb");
         std::fs::write(&p, &b[..len]).unwrap();
         let e = Store::open(&p).and_then(|s| s.verify()).unwrap_err();
-        assert!(matches!(e, Error::Format { .. } | Error::Checksum { .. }), "{len}: {e}");
+        assert!(
+            matches!(e, Error::Format { .. } | Error::Checksum { .. }),
+            "{len}: {e}"
+        );
     }
     for len in 0..b.len() {
         let e = open_err(&d, &b[..len]);
-        assert!(matches!(e, Error::Format { .. } | Error::Checksum { .. }), "{len}: {e}");
+        assert!(
+            matches!(e, Error::Format { .. } | Error::Checksum { .. }),
+            "{len}: {e}"
+        );
     }
 }
 
@@ -292,7 +358,13 @@ fn every_flipped_byte_is_caught() {
         let mut m = b.clone();
         m[i] ^= 0x10;
         let e = open_err(&d, &m);
-        assert!(matches!(e, Error::Format { .. } | Error::Checksum { .. } | Error::Json { .. }), "byte {i}: {e}");
+        assert!(
+            matches!(
+                e,
+                Error::Format { .. } | Error::Checksum { .. } | Error::Json { .. }
+            ),
+            "byte {i}: {e}"
+        );
     }
 }
 
@@ -301,16 +373,30 @@ fn overflowing_chunk_ranges_are_refused() {
     let d = tmpdir("overflow");
     let (_, b) = sample_file(&d);
     let sb = Superblock::parse("x", &b).unwrap();
-    let toc: Toc = serde_json::from_slice(&b[sb.toc.offset as usize..][..sb.toc.len as usize]).unwrap();
+    let toc: Toc =
+        serde_json::from_slice(&b[sb.toc.offset as usize..][..sb.toc.len as usize]).unwrap();
     let idx = toc.tables[0].index;
-    for (field, val) in [(0usize, u64::MAX - 3), (1, u64::MAX), (1, 1 << 40), (2, u64::MAX), (2, 1 << 40)] {
+    for (field, val) in [
+        (0usize, u64::MAX - 3),
+        (1, u64::MAX),
+        (1, 1 << 40),
+        (2, u64::MAX),
+        (2, 1 << 40),
+    ] {
         let mut ib = b[idx.offset as usize..][..idx.len as usize].to_vec();
         ib[8 * field..8 * field + 8].copy_from_slice(&val.to_le_bytes());
         let m = reseal(&b, &ib, |t, at| {
-            t.tables[0].index = format::Block { offset: at, len: ib.len() as u64, xxh3: format::xxh3(&ib) };
+            t.tables[0].index = format::Block {
+                offset: at,
+                len: ib.len() as u64,
+                xxh3: format::xxh3(&ib),
+            };
         });
         let e = open_err(&d, &m);
-        assert!(matches!(e, Error::Format { .. }), "field {field} = {val}: {e}");
+        assert!(
+            matches!(e, Error::Format { .. }),
+            "field {field} = {val}: {e}"
+        );
     }
 }
 
@@ -329,7 +415,11 @@ fn absurd_dimensions_and_invalid_json_are_refused_before_allocating() {
         h.values = values;
         let j = serde_json::to_vec(&h).unwrap();
         let m = reseal(&b, &j, |t, at| {
-            t.tables[0].header = format::Block { offset: at, len: j.len() as u64, xxh3: format::xxh3(&j) };
+            t.tables[0].header = format::Block {
+                offset: at,
+                len: j.len() as u64,
+                xxh3: format::xxh3(&j),
+            };
         });
         let e = open_err(&d, &m);
         assert!(matches!(e, Error::Format { .. }), "{e}");
@@ -337,7 +427,11 @@ fn absurd_dimensions_and_invalid_json_are_refused_before_allocating() {
     // Invalid JSON in a header and in the TOC itself.
     let j = b"{\"name\": \"a\", nope".to_vec();
     let m = reseal(&b, &j, |t, at| {
-        t.tables[0].header = format::Block { offset: at, len: j.len() as u64, xxh3: format::xxh3(&j) };
+        t.tables[0].header = format::Block {
+            offset: at,
+            len: j.len() as u64,
+            xxh3: format::xxh3(&j),
+        };
     });
     assert!(matches!(open_err(&d, &m), Error::Json { .. }));
     // A TOC claiming a huge index count.
@@ -352,7 +446,10 @@ fn absurd_dimensions_and_invalid_json_are_refused_before_allocating() {
 fn random_mutations_never_panic_or_pass() {
     let d = tmpdir("mutate");
     let (_, b) = sample_file(&d);
-    let iters: usize = std::env::var("BRDFTAB_MUTATIONS").ok().and_then(|s| s.parse().ok()).unwrap_or(3000);
+    let iters: usize = std::env::var("BRDFTAB_MUTATIONS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3000);
     let mut rng = 0x9E3779B97F4A7C15u64;
     let mut next = move || {
         rng ^= rng << 13;
@@ -381,7 +478,9 @@ fn random_mutations_never_panic_or_pass() {
         if m == b {
             continue;
         }
-        let r = std::panic::catch_unwind(|| Store::from_bytes("m", m.clone(), OpenOptions::default()).and_then(|s| s.verify()));
+        let r = std::panic::catch_unwind(|| {
+            Store::from_bytes("m", m.clone(), OpenOptions::default()).and_then(|s| s.verify())
+        });
         match r {
             Err(_) => panic!("mutation {it} panicked"),
             Ok(Ok(_)) => panic!("mutation {it} accepted"),
@@ -400,8 +499,24 @@ fn grid_tables_round_trip_including_packed_layouts() {
     let d = tmpdir("grid");
     let p = d.join("g.btdb");
     for (k, (param, sizes, sym)) in [
-        (Param::HalfDiff, [9, 1, 9, 18], Symmetry { isotropic: true, reciprocal: true, bilateral: false }),
-        (Param::InOut, [8, 1, 8, 16], Symmetry { isotropic: true, reciprocal: true, bilateral: false }),
+        (
+            Param::HalfDiff,
+            [9, 1, 9, 18],
+            Symmetry {
+                isotropic: true,
+                reciprocal: true,
+                bilateral: false,
+            },
+        ),
+        (
+            Param::InOut,
+            [8, 1, 8, 16],
+            Symmetry {
+                isotropic: true,
+                reciprocal: true,
+                bilateral: false,
+            },
+        ),
     ]
     .into_iter()
     .enumerate()
@@ -413,7 +528,21 @@ fn grid_tables_round_trip_including_packed_layouts() {
             }
         });
         let name = format!("t{k}");
-        tables::save(&p, &name, Source::Other { description: "fn".into() }, &t, Codec { quant: Quant::F32, level: 3, ..Codec::default() }, false).unwrap();
+        tables::save(
+            &p,
+            &name,
+            Source::Other {
+                description: "fn".into(),
+            },
+            &t,
+            Codec {
+                quant: Quant::F32,
+                level: 3,
+                ..Codec::default()
+            },
+            false,
+        )
+        .unwrap();
         let s = Store::open(&p).unwrap();
         let st = s.table(&name).unwrap();
         let back = st.to_table().unwrap();

@@ -1,4 +1,7 @@
 //! Analysis of any `&dyn Brdf`: albedo, physical plausibility, accuracy metrics.
 
+pub mod accuracy;
 pub mod albedo;
 pub mod chi2;
+pub mod plausibility;
+pub mod slice;

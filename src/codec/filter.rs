@@ -153,13 +153,25 @@ pub(crate) fn rows(n: usize, layout: Layout) -> impl Iterator<Item = (usize, usi
 
 /// Filters one row `words[s..s + len]` into `out` (zigzagged residuals).
 #[inline]
-fn forward_row<W: Word>(words: &[W], s: usize, len: usize, up: bool, layout: Layout, filter: Filter, out: &mut [W]) {
+fn forward_row<W: Word>(
+    words: &[W],
+    s: usize,
+    len: usize,
+    up: bool,
+    layout: Layout,
+    filter: Filter,
+    out: &mut [W],
+) {
     let ch = layout.channels.min(len);
     let row = layout.row();
     let cur = &words[s..s + len];
     // First point of the row: predicted by the row above (any plane), else stored as is.
     for j in 0..ch {
-        out[j] = if s >= row { cur[j].wsub(words[s - row + j]) } else { cur[j] };
+        out[j] = if s >= row {
+            cur[j].wsub(words[s - row + j])
+        } else {
+            cur[j]
+        };
     }
     if filter.plane() && up {
         let prev = &words[s - row..s - row + len];

@@ -88,7 +88,14 @@ pub struct Encoded {
 /// The prediction loop shared by encoder and decoder. `step_fn(i, p)` returns the reconstructed
 /// value of point `i` given its prediction `p`.
 #[inline(always)]
-fn run(n: usize, layout: Layout, filter: Filter, lo: f64, r: &mut [f64], mut step_fn: impl FnMut(usize, f64) -> f64) {
+fn run(
+    n: usize,
+    layout: Layout,
+    filter: Filter,
+    lo: f64,
+    r: &mut [f64],
+    mut step_fn: impl FnMut(usize, f64) -> f64,
+) {
     let ch = layout.channels;
     let row = layout.channels * layout.inner;
     let (plane, chan) = (filter.plane(), filter.channel() && ch > 1);
@@ -101,13 +108,21 @@ fn run(n: usize, layout: Layout, filter: Filter, lo: f64, r: &mut [f64], mut ste
             let base = if none {
                 lo
             } else if j >= ch {
-                if plane && up { r[i - ch] + r[i - row] - r[i - row - ch] } else { r[i - ch] }
+                if plane && up {
+                    r[i - ch] + r[i - row] - r[i - row - ch]
+                } else {
+                    r[i - ch]
+                }
             } else if s >= row {
                 r[i - row]
             } else {
                 lo
             };
-            let p = if chan && c != 0 { base + (r[i - 1] - base_prev) } else { base };
+            let p = if chan && c != 0 {
+                base + (r[i - 1] - base_prev)
+            } else {
+                base
+            };
             base_prev = base;
             r[i] = step_fn(i, p);
             c += 1;
@@ -129,24 +144,40 @@ fn from_code(c: u16) -> f64 {
 /// Encodes `data` with relative tolerance `tol` (see the module docs for the guarantee).
 /// `floor`: absolute floor, or `None` for `1e-7 ×` the chunk's largest magnitude. `filter`: force
 /// a predictor, or `None` to pick the one with the cheapest residuals.
-pub fn encode(data: &[f32], layout: Layout, tol: f64, floor: Option<f64>, filter: Option<Filter>) -> Result<Encoded> {
+pub fn encode(
+    data: &[f32],
+    layout: Layout,
+    tol: f64,
+    floor: Option<f64>,
+    filter: Option<Filter>,
+) -> Result<Encoded> {
     super::quantize::check_finite(data)?;
     if !(tol.is_finite() && (MIN_TOL..=0.5).contains(&tol)) {
         return Err(Error::Encode {
-            msg: format!("log16 tolerance {tol} is outside [{MIN_TOL}, 0.5]; use codec f32 for lossless storage"),
+            msg: format!(
+                "log16 tolerance {tol} is outside [{MIN_TOL}, 0.5]; use codec f32 for lossless storage"
+            ),
         });
     }
     if let Some(f) = floor
         && !(f.is_finite() && f > 0.0)
     {
-        return Err(Error::Encode { msg: format!("log16 floor {f} must be a positive number") });
+        return Err(Error::Encode {
+            msg: format!("log16 floor {f} must be a positive number"),
+        });
     }
     if data.len() > u32::MAX as usize {
-        return Err(Error::Encode { msg: "log16 chunks hold at most 2^32 - 1 values".into() });
+        return Err(Error::Encode {
+            msg: "log16 chunks hold at most 2^32 - 1 values".into(),
+        });
     }
     let amax = data.iter().fold(0.0f64, |m, v| m.max(v.abs() as f64));
     let floor = floor.unwrap_or((amax * FLOOR_RATIO).max(MIN_FLOOR));
-    let params = Log16Params { lo: 0.0, step: step(tol), floor };
+    let params = Log16Params {
+        lo: 0.0,
+        step: step(tol),
+        floor,
+    };
     let n = data.len();
     let l: Vec<f64> = data.iter().map(|&v| to_log(v as f64, floor)).collect();
     let inv = 1.0 / params.step;
@@ -207,25 +238,45 @@ pub fn encode(data: &[f32], layout: Layout, tol: f64, floor: Option<f64>, filter
             ),
         });
     }
-    Ok(Encoded { filter, codes, params, escapes })
+    Ok(Encoded {
+        filter,
+        codes,
+        params,
+        escapes,
+    })
 }
 
 /// `g(v)` (see the module docs).
 #[inline]
 pub fn to_log(v: f64, floor: f64) -> f64 {
     let a = v.abs();
-    if a <= floor { v / floor } else { (1.0 + (a / floor).ln()).copysign(v) }
+    if a <= floor {
+        v / floor
+    } else {
+        (1.0 + (a / floor).ln()).copysign(v)
+    }
 }
 
 /// `g⁻¹(y)` as f32.
 #[inline]
 pub fn from_log(y: f64, floor: f64) -> f32 {
     let a = y.abs();
-    (if a <= 1.0 { y * floor } else { (floor * (a - 1.0).exp()).copysign(y) }) as f32
+    (if a <= 1.0 {
+        y * floor
+    } else {
+        (floor * (a - 1.0).exp()).copysign(y)
+    }) as f32
 }
 
 /// Decodes codes into `out` (same length), given the chunk's escapes (sorted, in range).
-pub fn decode(codes: &[u16], params: &Log16Params, layout: Layout, filter: Filter, escapes: &[(u32, f32)], out: &mut [f32]) {
+pub fn decode(
+    codes: &[u16],
+    params: &Log16Params,
+    layout: Layout,
+    filter: Filter,
+    escapes: &[(u32, f32)],
+    out: &mut [f32],
+) {
     let n = codes.len();
     let mut r = vec![0.0f64; n];
     let mut e = escapes.iter().peekable();
@@ -251,7 +302,9 @@ mod tests {
 
     #[test]
     fn nan_is_refused_naming_the_index() {
-        let e = encode(&[0.0, 0.0, f32::NAN], Layout::FLAT, 1e-3, None, None).unwrap_err().to_string();
+        let e = encode(&[0.0, 0.0, f32::NAN], Layout::FLAT, 1e-3, None, None)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("index 2") && e.contains("NaN"), "{e}");
     }
 
@@ -260,9 +313,19 @@ mod tests {
         let v = [1.0, -0.5, 2.0, -1e-9, -3e5];
         let q = encode(&v, Layout::FLAT, 1e-3, None, None).unwrap();
         let mut out = [0.0; 5];
-        decode(&q.codes, &q.params, Layout::FLAT, q.filter, &q.escapes, &mut out);
+        decode(
+            &q.codes,
+            &q.params,
+            Layout::FLAT,
+            q.filter,
+            &q.escapes,
+            &mut out,
+        );
         for (a, b) in v.iter().zip(&out) {
-            assert!(((a - b).abs() as f64) <= 1e-3 * (a.abs() as f64).max(q.params.floor), "{a} {b}");
+            assert!(
+                ((a - b).abs() as f64) <= 1e-3 * (a.abs() as f64).max(q.params.floor),
+                "{a} {b}"
+            );
         }
     }
 
@@ -282,19 +345,32 @@ mod tests {
     #[test]
     fn rough_data_fails_clearly() {
         // Alternating ±1e30 / tiny at a tight tolerance: residuals overflow 16 bits.
-        let v: Vec<f32> = (0..100).map(|i| if i % 2 == 0 { 1e30 } else { -1e30 }).collect();
-        let e = encode(&v, Layout::FLAT, 1e-6, Some(1e-30), Some(Filter::Delta)).unwrap_err().to_string();
+        let v: Vec<f32> = (0..100)
+            .map(|i| if i % 2 == 0 { 1e30 } else { -1e30 })
+            .collect();
+        let e = encode(&v, Layout::FLAT, 1e-6, Some(1e-30), Some(Filter::Delta))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("exactly"), "{e}");
     }
 
     #[test]
     fn smooth_data_gives_small_residuals() {
-        let v: Vec<f32> = (0..1000).map(|i| (-(i as f32 - 500.0).powi(2) / 5e4).exp()).collect();
+        let v: Vec<f32> = (0..1000)
+            .map(|i| (-(i as f32 - 500.0).powi(2) / 5e4).exp())
+            .collect();
         let q = encode(&v, Layout::new(1, 100, 10), 1e-3, None, None).unwrap();
         let small = q.codes.iter().filter(|&&c| c <= 8).count();
         assert!(small > 850, "{small}");
         let mut out = vec![0.0; v.len()];
-        decode(&q.codes, &q.params, Layout::new(1, 100, 10), q.filter, &q.escapes, &mut out);
+        decode(
+            &q.codes,
+            &q.params,
+            Layout::new(1, 100, 10),
+            q.filter,
+            &q.escapes,
+            &mut out,
+        );
         for (a, b) in v.iter().zip(&out) {
             assert!((a - b).abs() as f64 <= 1e-3 * (*a as f64).max(q.params.floor));
         }

@@ -35,8 +35,8 @@ pub mod quantize;
 
 use serde::{Deserialize, Serialize};
 
-pub use filter::{Filter, Layout};
 use filter::Word;
+pub use filter::{Filter, Layout};
 pub use log16::Log16Params;
 
 use crate::error::{Error, Result};
@@ -255,7 +255,11 @@ fn pack<W: Word>(words: &[W], tail: &[u8], codec: &Codec) -> Result<(Shuffle, Ve
 }
 
 /// Filters, shuffles and compresses words; returns the filter, shuffle and the zstd frame.
-fn filtered<W: Word>(words: &[W], layout: Layout, codec: &Codec) -> Result<(Filter, Shuffle, Vec<u8>)> {
+fn filtered<W: Word>(
+    words: &[W],
+    layout: Layout,
+    codec: &Codec,
+) -> Result<(Filter, Shuffle, Vec<u8>)> {
     if codec.exhaustive && codec.filter.is_none() {
         let mut best: Option<(Filter, Shuffle, Vec<u8>)> = None;
         for f in Filter::ALL {
@@ -266,7 +270,9 @@ fn filtered<W: Word>(words: &[W], layout: Layout, codec: &Codec) -> Result<(Filt
         }
         return Ok(best.expect("at least one filter"));
     }
-    let f = codec.filter.unwrap_or_else(|| filter::choose(words, layout));
+    let f = codec
+        .filter
+        .unwrap_or_else(|| filter::choose(words, layout));
     let (m, c) = pack(&filter::forward(words, layout, f), &[], codec)?;
     Ok((f, m, c))
 }
@@ -335,14 +341,15 @@ pub fn chunk_info(bytes: &[u8]) -> Result<ChunkInfo> {
         2 => "log16",
         q => return Err(bad("quant", 3, format!("unknown quantizer {q}"))),
     };
-    let filter =
-        Filter::from_u8(bytes[4]).ok_or_else(|| bad("filter", 4, format!("unknown filter {}", bytes[4])))?;
+    let filter = Filter::from_u8(bytes[4])
+        .ok_or_else(|| bad("filter", 4, format!("unknown filter {}", bytes[4])))?;
     let shuffle = match bytes[5] {
         1 => Shuffle::Byte,
         2 => Shuffle::Bit,
         m => return Err(bad("shuffle", 5, format!("unknown shuffle mode {m}"))),
     };
-    let len = usize::try_from(le_u64(bytes, 8)).map_err(|_| bad("len", 8, "value count too large"))?;
+    let len =
+        usize::try_from(le_u64(bytes, 8)).map_err(|_| bad("len", 8, "value count too large"))?;
     let layout = Layout {
         channels: le_u32(bytes, 16) as usize,
         inner: le_u32(bytes, 20) as usize,
@@ -369,7 +376,11 @@ pub fn chunk_info(bytes: &[u8]) -> Result<ChunkInfo> {
         None
     };
     if escapes > len {
-        return Err(bad("escapes", 28, format!("{escapes} escapes for {len} values")));
+        return Err(bad(
+            "escapes",
+            28,
+            format!("{escapes} escapes for {len} values"),
+        ));
     }
     Ok(ChunkInfo {
         quant,
@@ -420,13 +431,8 @@ pub fn decode_into(bytes: &[u8], out: &mut [f32]) -> Result<()> {
         .and_then(|x| x.checked_add(info.escapes.checked_mul(8)?))
         .ok_or_else(|| bad("len", 8, "size overflows"))?;
     let frame = &bytes[CHUNK_HEADER_LEN..];
-    let raw = zstd::bulk::decompress(frame, raw_len).map_err(|e| {
-        bad(
-            "payload",
-            CHUNK_HEADER_LEN as u64,
-            format!("zstd: {e}"),
-        )
-    })?;
+    let raw = zstd::bulk::decompress(frame, raw_len)
+        .map_err(|e| bad("payload", CHUNK_HEADER_LEN as u64, format!("zstd: {e}")))?;
     if raw.len() != raw_len {
         return Err(bad(
             "payload",
@@ -464,7 +470,9 @@ pub fn decode_into(bytes: &[u8], out: &mut [f32]) -> Result<()> {
                         return Err(bad(
                             "escapes",
                             CHUNK_HEADER_LEN as u64,
-                            format!("escape {k} at index {pos} is out of order or range, or not finite"),
+                            format!(
+                                "escape {k} at index {pos} is out of order or range, or not finite"
+                            ),
                         ));
                     }
                     esc.push((pos as u32, v));
@@ -512,10 +520,15 @@ mod tests {
         ];
         prop_oneof![
             proptest::collection::vec(value, 0..300),
-            (any::<f32>().prop_filter("finite", |v| v.is_finite()), 0usize..300)
+            (
+                any::<f32>().prop_filter("finite", |v| v.is_finite()),
+                0usize..300
+            )
                 .prop_map(|(v, n)| vec![v; n]),
             (0usize..300, 0usize..300, 1e-3f32..1e6).prop_map(|(n, at, s)| {
-                let mut v: Vec<f32> = (0..n).map(|i| 0.1 + (i as f32 * 0.05).sin().abs()).collect();
+                let mut v: Vec<f32> = (0..n)
+                    .map(|i| 0.1 + (i as f32 * 0.05).sin().abs())
+                    .collect();
                 if at < n {
                     v[at] = s;
                 }

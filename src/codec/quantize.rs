@@ -45,7 +45,9 @@ pub fn to_f16(data: &[f32]) -> Result<Vec<u16>> {
 pub fn from_f16(words: &[u16], out: &mut [f32]) {
     use half::slice::HalfBitsSliceExt;
     use half::slice::HalfFloatSliceExt;
-    words.reinterpret_cast::<half::f16>().convert_to_f32_slice(out);
+    words
+        .reinterpret_cast::<half::f16>()
+        .convert_to_f32_slice(out);
 }
 
 #[cfg(test)]

@@ -1,1 +1,731 @@
 //! Least-squares fitting of model parameters to any source.
+//!
+//! The lecture's recipe ("Fitting to measurement data"): measurements F_k = f_r(ω′_k, ω_k) cos θ′_k
+//! at direction pairs, a model w(ω′, ω, p_1..p_m) = f̂_r cos θ′, and the least-squares estimate
+//! that minimizes E(p) = Σ_k (w(ω′_k, ω_k, p) − F_k)². Here the "measurements" come from any
+//! `&dyn Brdf` — an analytic model, a baked table, MERL or RGL data — and the model is any
+//! [`ModelSpec`], so a fitted result is again a spec usable as a SOURCE.
+//!
+//! - **Parameters** are paths into the spec (`kd`, `terms[1].m`; see [`params`]), by default every
+//!   numeric parameter outside Fresnel terms and sum weights. `kd`/`ks` are fit per channel of the
+//!   source ([`ColorMode::PerChannel`], an RGB triple or a spectrum on the source's wavelengths)
+//!   or as one grey value ([`ColorMode::Grey`]); shape parameters (m, n, α, σ) are shared by all
+//!   channels. Bounds are enforced by a logistic reparameterization (in log space for exponents
+//!   and roughness), so Levenberg-Marquardt runs unconstrained.
+//! - **Pairs** are deterministic: cosine-distributed plus a fraction near the mirror direction
+//!   (see [`pairs`]).
+//! - **Residuals** are r_kc = f̂_c cos θi − f_c cos θi per pair k and channel c, or with
+//!   [`FitOptions::log`] r_kc = ln(1 + f̂_c cos θi) − ln(1 + f_c cos θi) (Ngan et al. 2005 style:
+//!   compresses specular peaks so the diffuse part and lobe shape count).
+//! - **Multi-start**: start 0 is the given spec's values; starts 1.. are a Latin hypercube over the
+//!   bounds (positions 5%–95%, the channels of one field sharing a start). The start with the
+//!   smallest objective wins.
+//! - **Jacobian** by central differences (step 10⁻³ in the free variable): models return f32, so
+//!   forward differences with tiny steps would see only rounding. The channels of a per-channel
+//!   value are differenced together (each affects only its own channel), so an RGB `kd` costs
+//!   one pair of model evaluations per iteration, not three.
+//! - **Error**: the reported `rmse` is the cosine-weighted relative RMSE
+//!   sqrt(Σ (f̂ − f)² cos² θi / Σ f² cos² θi) over all channels, on a *held-out* set of pairs drawn
+//!   like the fitting pairs with another seed; `rmse_fit` is the same on the fitting pairs.
+//!   (`analysis::accuracy` was not in main when this was written; [`relative_rmse`] is the
+//!   metric.)
+//!
+//! ```
+//! use brdftab::{fit::{self, FitOptions}, spec::ModelSpec, spectrum::Channels};
+//! let source = ModelSpec::parse(r#"{"model": "lambert", "kd": [0.1, 0.2, 0.05]}"#)?
+//!     .build(&Channels::Rgb)?;
+//! let start = fit::preset("lambert")?;
+//! let r = fit::fit(source.as_ref(), &start, &FitOptions { pairs: 200, starts: 2, ..Default::default() })?;
+//! assert!(r.rmse < 1e-4);
+//! # Ok::<(), brdftab::Error>(())
+//! ```
+
+pub mod pairs;
+pub mod params;
+
+use std::cell::Cell;
+use std::time::Instant;
+
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use serde::Serialize;
+use serde_json::Value as Json;
+
+use crate::brdf::Brdf;
+use crate::error::{Error, Result};
+use crate::rng::Pcg32;
+use crate::spec::ModelSpec;
+use crate::spectrum::Channels;
+
+pub use pairs::Pairs;
+pub use params::{Bounds, ColorMode, Param, ParamRequest, Scale};
+
+/// Options of a fit. `Default` gives 4000 pairs (30% specular), linear residuals, 8 starts,
+/// every parameter with default bounds, per-channel colours.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitOptions {
+    /// Parameters to fit; empty = every numeric parameter with default bounds.
+    pub params: Vec<ParamRequest>,
+    /// Number of direction pairs.
+    pub pairs: usize,
+    /// Fraction of pairs drawn near the mirror direction.
+    pub specular_fraction: f64,
+    /// Residuals in log space: ln(1 + f cos θi).
+    pub log: bool,
+    /// Number of starts (≥ 1).
+    pub starts: usize,
+    /// Seed of the pairs and the starts.
+    pub seed: u64,
+    /// Per-channel or grey `kd`/`ks`.
+    pub color: ColorMode,
+    /// At most this many LM iterations (Jacobians) per start.
+    pub max_iterations: usize,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        FitOptions {
+            params: Vec::new(),
+            pairs: 4000,
+            specular_fraction: 0.3,
+            log: false,
+            starts: 8,
+            seed: 1,
+            color: ColorMode::PerChannel,
+            max_iterations: 100,
+        }
+    }
+}
+
+/// A fitted parameter's final value(s).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FittedParam {
+    /// Path into the spec.
+    pub path: String,
+    /// One value per channel, or one.
+    pub value: Vec<f64>,
+    /// The bounds in force.
+    pub bounds: Bounds,
+    /// True when a value ended within 0.1% (of the range, in its scale) of a bound.
+    pub at_bound: bool,
+}
+
+/// The outcome of one start.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StartResult {
+    /// Parameter values at the start (flattened, in parameter order).
+    pub initial: Vec<f64>,
+    /// Parameter values at the end.
+    pub fitted: Vec<f64>,
+    /// The least-squares objective ½ Σ r² / (pairs · channels) at the end.
+    pub objective: f64,
+    /// Relative RMSE on the fitting pairs.
+    pub rmse: f64,
+    /// LM iterations (Jacobian evaluations).
+    pub iterations: usize,
+    /// Model evaluations over all pairs (residual vectors, including those of the Jacobians).
+    pub evaluations: usize,
+    /// Why LM stopped.
+    pub termination: String,
+}
+
+/// The result of [`fit`].
+#[derive(Debug, Clone, Serialize)]
+pub struct FitResult {
+    /// The fitted spec (valid, builds, usable as a SOURCE).
+    pub spec: ModelSpec,
+    /// Relative RMSE of the fitted spec on held-out pairs (see the module docs).
+    pub rmse: f64,
+    /// Relative RMSE on the fitting pairs.
+    pub rmse_fit: f64,
+    /// The objective of the best start.
+    pub objective: f64,
+    /// LM iterations of the best start.
+    pub iterations: usize,
+    /// Model evaluations over all starts.
+    pub evaluations: usize,
+    /// Index of the best start.
+    pub best_start: usize,
+    /// The fitted parameters.
+    pub params: Vec<FittedParam>,
+    /// Every start.
+    pub starts: Vec<StartResult>,
+    /// Number of pairs.
+    pub pairs: usize,
+    /// Log-space residuals were used.
+    pub log: bool,
+    /// Wall-clock time of the fit in seconds.
+    pub seconds: f64,
+}
+
+/// Default starting spec for a model name, or a sum of them joined with `+`
+/// (`lambert+cook_torrance`, `lambert+ggx`, `lambert+blinn_phong`, `lambert+ward`, `ggx`, ...).
+/// An inline JSON spec (starting with `{`) is parsed and used as given. Fresnel terms are
+/// `"none"`: a fitted `ks` then absorbs the average reflectance.
+pub fn preset(name: &str) -> Result<ModelSpec> {
+    let name = name.trim();
+    if name.starts_with('{') {
+        return ModelSpec::parse(name);
+    }
+    let one = |n: &str| -> Result<Json> {
+        Ok(match n.trim() {
+            "lambert" => serde_json::json!({"model": "lambert", "kd": 0.1}),
+            "oren_nayar" => serde_json::json!({"model": "oren_nayar", "kd": 0.1, "sigma": 0.3}),
+            m @ ("phong" | "reciprocal_phong" | "max_phong") => {
+                serde_json::json!({"model": m, "ks": 1.0, "n": 20.0})
+            }
+            "pumped_phong" => {
+                serde_json::json!({"model": "pumped_phong", "ks": 1.0, "n": 20.0, "x": "mean"})
+            }
+            "blinn_phong" => serde_json::json!({"model": "blinn_phong", "ks": 0.5, "n": 50.0}),
+            "cook_torrance" => serde_json::json!({"model": "cook_torrance", "m": 0.3, "ks": 0.5}),
+            "ggx" => serde_json::json!({"model": "ggx", "alpha": 0.3, "ks": 0.5}),
+            "ward" => {
+                serde_json::json!({"model": "ward", "ks": 0.2, "alpha_x": 0.2, "alpha_y": 0.2})
+            }
+            other => {
+                return Err(Error::arg(
+                    "--model",
+                    format!(
+                        "`{other}` cannot be fit; use lambert, oren_nayar, phong, reciprocal_phong, \
+                         max_phong, pumped_phong, blinn_phong, cook_torrance, ggx, ward, sums of \
+                         them with `+`, or a JSON spec"
+                    ),
+                ));
+            }
+        })
+    };
+    let terms = name.split('+').map(one).collect::<Result<Vec<_>>>()?;
+    let json = if terms.len() == 1 {
+        terms.into_iter().next().unwrap_or_default()
+    } else {
+        serde_json::json!({"model": "sum", "terms": terms})
+    };
+    spec_from_json(json)
+}
+
+fn spec_from_json(json: Json) -> Result<ModelSpec> {
+    ModelSpec::parse(&json.to_string())
+}
+
+/// Cosine-weighted relative RMSE of `model` against `source` over `pairs`:
+/// sqrt(Σ (f̂ − f)² cos² θi / Σ f² cos² θi), summed over every channel. Both must have the same
+/// channel count.
+pub fn relative_rmse(source: &dyn Brdf, model: &dyn Brdf, pairs: &Pairs) -> Result<f64> {
+    let c = source.channels().len();
+    if model.channels().len() != c {
+        return Err(Error::arg(
+            "model",
+            format!("{} channels, the source has {c}", model.channels().len()),
+        ));
+    }
+    let f = eval_cos(source, pairs);
+    let g = eval_cos(model, pairs);
+    Ok(rel_rmse(&g, &f))
+}
+
+fn rel_rmse(model: &[f64], target: &[f64]) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (a, b) in model.iter().zip(target) {
+        num += (a - b) * (a - b);
+        den += b * b;
+    }
+    if den > 0.0 {
+        (num / den).sqrt()
+    } else if num == 0.0 {
+        0.0
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// f·cos θi for every pair and channel (pair-major), NaN/inf mapped to 0.
+fn eval_cos(b: &dyn Brdf, pairs: &Pairs) -> Vec<f64> {
+    let c = b.channels().len();
+    let mut buf = vec![0.0f32; pairs.len() * c];
+    b.eval_batch(&pairs.wi, &pairs.wo, &mut buf);
+    buf.iter()
+        .enumerate()
+        .map(|(k, &v)| {
+            let x = v as f64 * pairs.wi[k / c].z;
+            if x.is_finite() { x } else { 0.0 }
+        })
+        .collect()
+}
+
+/// Fits the parameters of `init` to `source`; see the module docs.
+pub fn fit(source: &dyn Brdf, init: &ModelSpec, opts: &FitOptions) -> Result<FitResult> {
+    fit_with_progress(source, init, opts, &mut |_, _| {})
+}
+
+/// [`fit`], calling `progress(done, total)` after each start.
+pub fn fit_with_progress(
+    source: &dyn Brdf,
+    init: &ModelSpec,
+    opts: &FitOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<FitResult> {
+    let clock = Instant::now();
+    if opts.pairs == 0 {
+        return Err(Error::arg("--pairs", "at least one pair is needed"));
+    }
+    if opts.starts == 0 {
+        return Err(Error::arg("--starts", "at least one start is needed"));
+    }
+    if !(0.0..=1.0).contains(&opts.specular_fraction) {
+        return Err(Error::arg("specular_fraction", "must be in [0, 1]"));
+    }
+    if source.flags().delta {
+        return Err(Error::Unsupported(
+            "fitting a delta (mirror/refractor) source: eval is 0 everywhere".into(),
+        ));
+    }
+    let channels = source.channels().clone();
+    let mut base = serde_json::to_value(init).map_err(|e| Error::Json {
+        context: "spec".into(),
+        source: e,
+    })?;
+    let params = params::resolve(&mut base, &opts.params, &channels, opts.color)?;
+    // The starting spec must build for the source's channels (catches unimplemented models early).
+    init.build(&channels)?;
+
+    let pairs = Pairs::sample(opts.pairs, opts.specular_fraction, opts.seed);
+    let target_lin = eval_cos(source, &pairs);
+    let problem = Problem {
+        base: base.clone(),
+        params: &params,
+        channels: &channels,
+        pairs: &pairs,
+        target: target_lin.iter().map(|&y| transform(y, opts.log)).collect(),
+        log: opts.log,
+        scale: 1.0 / (target_lin.len() as f64).sqrt(),
+        t: DVector::zeros(0),
+        iterations: Cell::new(0),
+        evaluations: Cell::new(0),
+    };
+
+    // Start positions.
+    let n_free: usize = params.iter().map(|p| p.width).sum();
+    let mut first = Vec::with_capacity(n_free);
+    for p in &params {
+        first.extend(params::read(&mut base, p, &channels)?);
+    }
+    let mut rng = Pcg32::with_stream(opts.seed, 0x5354_4152);
+    let lhs: Vec<Vec<usize>> = params
+        .iter()
+        .map(|_| {
+            let k = opts.starts.saturating_sub(1);
+            let mut perm: Vec<usize> = (0..k).collect();
+            for i in (1..k).rev() {
+                perm.swap(i, rng.below(i as u32 + 1) as usize);
+            }
+            perm
+        })
+        .collect();
+    let start_values = |s: usize| -> Vec<f64> {
+        if s == 0 {
+            // The spec's own values, pulled inside the bounds.
+            return from_free(&params, &to_free(&params, &first));
+        }
+        let k = (opts.starts - 1) as f64;
+        let mut v = Vec::with_capacity(n_free);
+        for (pi, p) in params.iter().enumerate() {
+            let u = 0.05 + 0.9 * (lhs[pi][s - 1] as f64 + 0.5) / k;
+            v.extend(std::iter::repeat_n(p.bounds.from_unit(u), p.width));
+        }
+        v
+    };
+
+    let lm = LevenbergMarquardt::new()
+        .with_ftol(1e-10)
+        .with_xtol(1e-9)
+        .with_gtol(1e-10)
+        .with_patience(opts.max_iterations.max(1));
+    let mut starts = Vec::with_capacity(opts.starts);
+    let mut best: Option<(usize, DVector<f64>)> = None;
+    let mut problem = problem;
+    let mut evaluations = 0;
+    for s in 0..opts.starts {
+        let x0 = start_values(s);
+        let t0 = DVector::from_vec(to_free(&params, &x0));
+        problem.t = t0;
+        problem.iterations.set(0);
+        problem.evaluations.set(0);
+        let (p, report) = lm.minimize(problem);
+        problem = p;
+        // The objective as LM reports it may belong to a rejected step; recompute at the end point.
+        let end = problem.model_values(&problem.t);
+        let (objective, rmse) = match &end {
+            Some(m) => {
+                let obj = 0.5
+                    * m.iter()
+                        .zip(&problem.target)
+                        .map(|(a, b)| (a - b) * (a - b))
+                        .sum::<f64>()
+                    * problem.scale
+                    * problem.scale;
+                let lin: Vec<f64> = if opts.log {
+                    m.iter().map(|&y| y.exp_m1()).collect()
+                } else {
+                    m.clone()
+                };
+                (obj, rel_rmse(&lin, &target_lin))
+            }
+            None => (f64::INFINITY, f64::INFINITY),
+        };
+        evaluations += problem.evaluations.get();
+        starts.push(StartResult {
+            initial: x0,
+            fitted: from_free(&params, problem.t.as_slice()),
+            objective,
+            rmse,
+            iterations: problem.iterations.get(),
+            evaluations: problem.evaluations.get(),
+            termination: format!("{:?}", report.termination),
+        });
+        if objective.is_finite()
+            && best
+                .as_ref()
+                .is_none_or(|(b, _)| objective < starts[*b].objective)
+        {
+            best = Some((s, problem.t.clone()));
+        }
+        progress(s + 1, opts.starts);
+    }
+    let Some((best_start, t_best)) = best else {
+        return Err(Error::Unsupported(
+            "every start of the fit failed (the model could not be evaluated)".into(),
+        ));
+    };
+    let spec = problem.spec_at(&t_best)?;
+    let model = spec.build(&channels)?;
+    let held_out = Pairs::sample(
+        opts.pairs,
+        opts.specular_fraction,
+        opts.seed ^ 0x9e37_79b9_7f4a_7c15,
+    );
+    let rmse = relative_rmse(source, model.as_ref(), &held_out)?;
+    let x = from_free(&params, t_best.as_slice());
+    let mut off = 0;
+    let fitted = params
+        .iter()
+        .map(|p| {
+            let value = x[off..off + p.width].to_vec();
+            let t = &t_best.as_slice()[off..off + p.width];
+            off += p.width;
+            FittedParam {
+                path: p.path.clone(),
+                at_bound: value.iter().zip(t).any(|(&v, _)| {
+                    let u = p.bounds.to_unit(v);
+                    !(1e-3..=1.0 - 1e-3).contains(&u)
+                }),
+                value,
+                bounds: p.bounds,
+            }
+        })
+        .collect();
+    let b = &starts[best_start];
+    Ok(FitResult {
+        spec,
+        rmse,
+        rmse_fit: b.rmse,
+        objective: b.objective,
+        iterations: b.iterations,
+        evaluations,
+        best_start,
+        params: fitted,
+        pairs: pairs.len(),
+        log: opts.log,
+        seconds: clock.elapsed().as_secs_f64(),
+        starts,
+    })
+}
+
+fn transform(y: f64, log: bool) -> f64 {
+    if log { y.max(0.0).ln_1p() } else { y }
+}
+
+fn to_free(params: &[Param], x: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(x.len());
+    let mut off = 0;
+    for p in params {
+        for &v in &x[off..off + p.width] {
+            out.push(p.bounds.to_free(v));
+        }
+        off += p.width;
+    }
+    out
+}
+
+fn from_free(params: &[Param], t: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(t.len());
+    let mut off = 0;
+    for p in params {
+        for &v in &t[off..off + p.width] {
+            out.push(p.bounds.from_free(v));
+        }
+        off += p.width;
+    }
+    out
+}
+
+/// The least-squares problem LM sees: free variables `t`, residuals per pair and channel.
+struct Problem<'a> {
+    base: Json,
+    params: &'a [Param],
+    channels: &'a Channels,
+    pairs: &'a Pairs,
+    /// Transformed targets (f cos θi, or its log), pair-major.
+    target: Vec<f64>,
+    log: bool,
+    /// 1/sqrt(number of residuals), so the objective is a mean.
+    scale: f64,
+    t: DVector<f64>,
+    iterations: Cell<usize>,
+    evaluations: Cell<usize>,
+}
+
+/// Central-difference step in the free variables.
+const FD_STEP: f64 = 1e-3;
+
+impl Problem<'_> {
+    fn spec_at(&self, t: &DVector<f64>) -> Result<ModelSpec> {
+        let mut json = self.base.clone();
+        let x = from_free(self.params, t.as_slice());
+        let mut off = 0;
+        for p in self.params {
+            params::write(&mut json, p, &x[off..off + p.width], self.channels)?;
+            off += p.width;
+        }
+        spec_from_json(json)
+    }
+
+    /// Transformed model values f̂ cos θi at `t`, or `None` if the model cannot be built.
+    fn model_values(&self, t: &DVector<f64>) -> Option<Vec<f64>> {
+        self.evaluations.set(self.evaluations.get() + 1);
+        let spec = self.spec_at(t).ok()?;
+        spec.validate().ok()?;
+        let mut terms = Vec::new();
+        flatten(&spec, 1.0, self.channels, &mut terms).ok()?;
+        let mut v = vec![0.0; self.target.len()];
+        for (w, term) in &terms {
+            for (a, b) in v.iter_mut().zip(eval_cos(term.as_ref(), self.pairs)) {
+                *a += w * b;
+            }
+        }
+        Some(v.into_iter().map(|y| transform(y, self.log)).collect())
+    }
+}
+
+/// The terms of a (nested) sum with their combined weights, each built on its own: a `Sum`
+/// precomputes albedo tables for its sampler when built, which a fit that only evaluates would pay
+/// for at every step.
+fn flatten(
+    spec: &ModelSpec,
+    weight: f64,
+    channels: &Channels,
+    out: &mut Vec<(f64, Box<dyn Brdf>)>,
+) -> Result<()> {
+    match spec {
+        ModelSpec::Sum { terms, weights } => {
+            for (i, t) in terms.iter().enumerate() {
+                let w = weights.as_ref().map_or(1.0, |w| w[i]);
+                flatten(t, weight * w, channels, out)?;
+            }
+        }
+        other => out.push((weight, crate::models::build(other, channels)?)),
+    }
+    Ok(())
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.t.copy_from(x);
+    }
+
+    fn params(&self) -> DVector<f64> {
+        self.t.clone()
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        let m = self.model_values(&self.t)?;
+        Some(DVector::from_iterator(
+            m.len(),
+            m.iter()
+                .zip(&self.target)
+                .map(|(a, b)| (a - b) * self.scale),
+        ))
+    }
+
+    /// Central differences. A per-channel value (width = channel count) is perturbed in all its
+    /// channels at once: channel k of f̂ depends only on channel k of the value (values are
+    /// resolved per channel), so one pair of evaluations gives all its columns — the classic
+    /// colouring of a sparse Jacobian — instead of one pair per channel.
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        self.iterations.set(self.iterations.get() + 1);
+        let n = self.t.len();
+        let m = self.target.len();
+        let c = self.channels.len();
+        let inv = self.scale / (2.0 * FD_STEP);
+        let mut j = DMatrix::zeros(m, n);
+        let mut off = 0;
+        for p in self.params {
+            let (mut tp, mut tm) = (self.t.clone(), self.t.clone());
+            for k in off..off + p.width {
+                tp[k] += FD_STEP;
+                tm[k] -= FD_STEP;
+            }
+            let fp = self.model_values(&tp)?;
+            let fm = self.model_values(&tm)?;
+            for (row, (a, b)) in fp.iter().zip(&fm).enumerate() {
+                let col = if p.width == 1 { off } else { off + row % c };
+                j[(row, col)] = (a - b) * inv;
+            }
+            off += p.width;
+        }
+        Some(j)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn build(json: &str) -> Box<dyn Brdf> {
+        ModelSpec::parse(json)
+            .unwrap()
+            .build(&Channels::Rgb)
+            .unwrap()
+    }
+
+    fn quick() -> FitOptions {
+        FitOptions {
+            pairs: 400,
+            starts: 3,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn lambert_recovers_kd_per_channel() {
+        let src = build(r#"{"model": "lambert", "kd": [0.1, 0.2, 0.05]}"#);
+        let r = fit(src.as_ref(), &preset("lambert").unwrap(), &quick()).unwrap();
+        let ModelSpec::Lambert { kd } = &r.spec else {
+            panic!("{:?}", r.spec)
+        };
+        let v = kd.resolve(&Channels::Rgb);
+        for (a, b) in v.iter().zip([0.1, 0.2, 0.05]) {
+            assert!((a - b).abs() < 1e-4 * b, "{v:?}");
+        }
+        assert!(r.rmse < 1e-4, "{}", r.rmse);
+        assert_eq!(r.starts.len(), 3);
+        // The fitted spec is valid JSON that parses back and builds.
+        let back = ModelSpec::parse(&r.spec.to_json()).unwrap();
+        back.build(&Channels::Rgb).unwrap();
+    }
+
+    #[test]
+    fn grey_mode_fits_the_mean() {
+        let src = build(r#"{"model": "lambert", "kd": [0.1, 0.2, 0.3]}"#);
+        let opts = FitOptions {
+            color: ColorMode::Grey,
+            ..quick()
+        };
+        let r = fit(src.as_ref(), &preset("lambert").unwrap(), &opts).unwrap();
+        assert!(
+            matches!(r.spec, ModelSpec::Lambert { kd: crate::Value::Grey(k) } if (k - 0.2).abs() < 1e-4)
+        );
+    }
+
+    #[test]
+    fn bounds_are_respected() {
+        let src = build(r#"{"model": "lambert", "kd": 0.25}"#);
+        let opts = FitOptions {
+            params: vec![ParamRequest::parse("kd=0.01:0.05").unwrap()],
+            ..quick()
+        };
+        let r = fit(src.as_ref(), &preset("lambert").unwrap(), &opts).unwrap();
+        let v = &r.params[0].value;
+        assert!(v.iter().all(|&k| (0.01..=0.05).contains(&k)), "{v:?}");
+        assert!(v.iter().all(|&k| k > 0.049), "{v:?}");
+        assert!(r.params[0].at_bound);
+        for s in &r.starts {
+            assert!(s.fitted.iter().all(|&k| (0.01..=0.05).contains(&k)));
+            assert!(s.initial.iter().all(|&k| (0.01..=0.05).contains(&k)));
+        }
+    }
+
+    #[test]
+    fn log_space_fit_recovers_kd() {
+        let src = build(r#"{"model": "lambert", "kd": 0.3}"#);
+        let opts = FitOptions {
+            log: true,
+            ..quick()
+        };
+        let r = fit(src.as_ref(), &preset("lambert").unwrap(), &opts).unwrap();
+        assert!(r.log);
+        assert!(
+            r.params[0].value.iter().all(|k| (k - 0.3).abs() < 1e-4),
+            "{:?}",
+            r.params
+        );
+    }
+
+    #[test]
+    fn presets_parse_and_unknown_names_fail() {
+        for name in [
+            "lambert+cook_torrance",
+            "lambert+ggx",
+            "lambert+blinn_phong",
+            "lambert+ward",
+            "ggx",
+            "reciprocal_phong",
+        ] {
+            let s = preset(name).unwrap();
+            assert_eq!(s.name(), if name.contains('+') { "sum" } else { name });
+        }
+        assert!(preset("mirror").is_err());
+        assert!(preset("lambert+bogus").is_err());
+        assert_eq!(
+            preset(r#"{"model": "lambert", "kd": 0.2}"#).unwrap().name(),
+            "lambert"
+        );
+    }
+
+    #[test]
+    fn bad_options_are_errors() {
+        let src = build(r#"{"model": "lambert", "kd": 0.25}"#);
+        let l = preset("lambert").unwrap();
+        assert!(
+            fit(
+                src.as_ref(),
+                &l,
+                &FitOptions {
+                    pairs: 0,
+                    ..quick()
+                }
+            )
+            .is_err()
+        );
+        assert!(
+            fit(
+                src.as_ref(),
+                &l,
+                &FitOptions {
+                    starts: 0,
+                    ..quick()
+                }
+            )
+            .is_err()
+        );
+        let o = FitOptions {
+            params: vec![ParamRequest::new("terms[1].m")],
+            ..quick()
+        };
+        assert!(fit(src.as_ref(), &l, &o).is_err());
+    }
+}

@@ -55,7 +55,10 @@ impl CookTorrance {
     /// A Cook-Torrance model with Beckmann roughness `m` (> 0), scale `ks` (≥ 0) and Fresnel term.
     pub fn new(m: f64, ks: Value, fresnel: &FresnelSpec, channels: &Channels) -> Result<Self> {
         if !m.is_finite() || m <= 0.0 {
-            return Err(crate::Error::spec("m", format!("{m} must be a finite number > 0")));
+            return Err(crate::Error::spec(
+                "m",
+                format!("{m} must be a finite number > 0"),
+            ));
         }
         ks.validate("ks", 0.0)?;
         Ok(CookTorrance {
@@ -212,7 +215,8 @@ mod tests {
     #[test]
     fn matches_the_formula_at_a_hand_computed_pair() {
         let m = 0.3;
-        let ct = CookTorrance::new(m, Value::Grey(0.8), &FresnelSpec::None, &Channels::Rgb).unwrap();
+        let ct =
+            CookTorrance::new(m, Value::Grey(0.8), &FresnelSpec::None, &Channels::Rgb).unwrap();
         let l = geometry::spherical(0.5, 0.2);
         let v = geometry::spherical(0.3, 2.9);
         let h = (l + v).normalize();
@@ -224,15 +228,19 @@ mod tests {
         let expect = 0.8 * d * g / (4.0 * v.z * l.z);
         let mut f = [0.0f32; 3];
         ct.eval(l, v, &mut f);
-        assert!((f[0] as f64 - expect).abs() < 1e-6 * expect, "{} vs {expect}", f[0]);
+        assert!(
+            (f[0] as f64 - expect).abs() < 1e-6 * expect,
+            "{} vs {expect}",
+            f[0]
+        );
     }
 
     #[test]
     fn fresnel_is_taken_at_l_dot_h_per_channel() {
         let spec = FresnelSpec::Conductor("Au".into());
         let ct = CookTorrance::new(0.2, Value::Grey(1.0), &spec, &Channels::Rgb).unwrap();
-        let plain = CookTorrance::new(0.2, Value::Grey(1.0), &FresnelSpec::None, &Channels::Rgb)
-            .unwrap();
+        let plain =
+            CookTorrance::new(0.2, Value::Grey(1.0), &FresnelSpec::None, &Channels::Rgb).unwrap();
         let l = geometry::spherical(0.7, 0.0);
         let v = geometry::spherical(0.5, 2.5);
         let lh = l.dot((l + v).normalize());
@@ -265,8 +273,8 @@ mod tests {
 
     #[test]
     fn invalid_inputs_give_zero() {
-        let ct = CookTorrance::new(0.3, Value::Grey(1.0), &FresnelSpec::None, &Channels::Rgb)
-            .unwrap();
+        let ct =
+            CookTorrance::new(0.3, Value::Grey(1.0), &FresnelSpec::None, &Channels::Rgb).unwrap();
         for (wi, wo) in [
             (DVec3::new(0.0, 0.0, -1.0), DVec3::Z),
             (DVec3::Z, DVec3::new(1.0, 0.0, 0.0)),
@@ -278,6 +286,8 @@ mod tests {
             assert_eq!(f, [0.0; 3]);
             assert_eq!(ct.pdf(wi, wo), 0.0);
         }
-        assert!(CookTorrance::new(0.0, Value::Grey(1.0), &FresnelSpec::None, &Channels::Rgb).is_err());
+        assert!(
+            CookTorrance::new(0.0, Value::Grey(1.0), &FresnelSpec::None, &Channels::Rgb).is_err()
+        );
     }
 }

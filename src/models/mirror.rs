@@ -294,7 +294,9 @@ mod tests {
         // k_r = 1 without Fresnel.
         let plain = Mirror::new(&FresnelSpec::None, &Channels::Rgb).unwrap();
         let mut w = [0.0f32; 3];
-        plain.sample(DVec3::new(0.3, 0.0, 1.0), DVec2::ZERO, &mut w).unwrap();
+        plain
+            .sample(DVec3::new(0.3, 0.0, 1.0), DVec2::ZERO, &mut w)
+            .unwrap();
         assert_eq!(w, [1.0; 3]);
     }
 
@@ -302,9 +304,15 @@ mod tests {
     fn mirror_rejects_bad_wo() {
         let m = ag();
         let mut w = [0.0f32; 3];
-        assert!(m.sample(DVec3::new(0.0, 0.0, -1.0), DVec2::ZERO, &mut w).is_none());
+        assert!(
+            m.sample(DVec3::new(0.0, 0.0, -1.0), DVec2::ZERO, &mut w)
+                .is_none()
+        );
         assert!(m.sample(DVec3::ZERO, DVec2::ZERO, &mut w).is_none());
-        assert!(m.sample(DVec3::new(f64::NAN, 0.0, 1.0), DVec2::ZERO, &mut w).is_none());
+        assert!(
+            m.sample(DVec3::new(f64::NAN, 0.0, 1.0), DVec2::ZERO, &mut w)
+                .is_none()
+        );
     }
 
     #[test]
@@ -346,7 +354,14 @@ mod tests {
         assert!(w.iter().all(|&x| (0.0..1.0).contains(&x)));
         // Outside never has TIR.
         for deg in [0.0f64, 45.0, 89.9] {
-            assert!(r.sample(geometry::spherical(deg.to_radians(), 0.0), DVec2::ZERO, &mut w).is_some());
+            assert!(
+                r.sample(
+                    geometry::spherical(deg.to_radians(), 0.0),
+                    DVec2::ZERO,
+                    &mut w
+                )
+                .is_some()
+            );
         }
     }
 

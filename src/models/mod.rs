@@ -5,10 +5,18 @@
 //! resolved per channel at construction so `eval` never allocates.
 
 pub mod beckmann;
+pub mod blinn_phong;
 pub mod cook_torrance;
+pub mod ggx;
 pub mod lambert;
 pub mod mirror;
+pub mod oren_nayar;
 pub mod phong;
+pub mod sum;
+pub mod ward;
+
+#[cfg(test)]
+pub(crate) mod test_util;
 
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
@@ -29,14 +37,63 @@ pub fn build(spec: &ModelSpec, channels: &Channels) -> Result<Box<dyn Brdf>> {
         ModelSpec::PumpedPhong { ks, n, x } => {
             Box::new(phong::Phong::pumped(ks.clone(), *n, *x, channels)?)
         }
-        ModelSpec::CookTorrance { m, ks, fresnel } => Box::new(
-            cook_torrance::CookTorrance::new(*m, ks.clone(), fresnel, channels)?,
-        ),
-        other => {
-            return Err(Error::Unsupported(format!(
-                "model `{}` is not implemented yet",
-                other.name()
-            )));
+        ModelSpec::CookTorrance { m, ks, fresnel } => Box::new(cook_torrance::CookTorrance::new(
+            *m,
+            ks.clone(),
+            fresnel,
+            channels,
+        )?),
+        ModelSpec::BlinnPhong { ks, n } => {
+            Box::new(blinn_phong::BlinnPhong::new(ks.clone(), *n, channels)?)
+        }
+        ModelSpec::Ggx {
+            alpha,
+            alpha_x,
+            alpha_y,
+            ks,
+            fresnel,
+        } => {
+            let (ax, ay) = match (alpha, alpha_x, alpha_y) {
+                (Some(a), None, None) => (*a, *a),
+                (None, Some(ax), Some(ay)) => (*ax, *ay),
+                _ => {
+                    return Err(Error::spec(
+                        "alpha",
+                        "give either `alpha` or both `alpha_x` and `alpha_y`",
+                    ));
+                }
+            };
+            Box::new(ggx::Ggx::new(
+                ax,
+                ay,
+                ks.clone(),
+                fresnel.clone(),
+                channels,
+            )?)
+        }
+        ModelSpec::Ward {
+            ks,
+            alpha_x,
+            alpha_y,
+        } => Box::new(ward::Ward::new(ks.clone(), *alpha_x, *alpha_y, channels)?),
+        ModelSpec::OrenNayar { kd, sigma } => {
+            Box::new(oren_nayar::OrenNayar::new(kd.clone(), *sigma, channels)?)
+        }
+        ModelSpec::Sum { terms, weights } => {
+            let built = terms
+                .iter()
+                .enumerate()
+                .map(|(i, t)| build(t, channels).map_err(|e| prefix_field(e, i)))
+                .collect::<Result<Vec<_>>>()?;
+            Box::new(sum::Sum::new(built, weights.clone(), channels)?)
         }
     })
+}
+
+/// Prefixes the field of a spec error from term `i` of a sum with `terms[i].`.
+fn prefix_field(e: Error, i: usize) -> Error {
+    match e {
+        Error::Spec { field, msg } => Error::spec(format!("terms[{i}].{field}"), msg),
+        other => other,
+    }
 }

@@ -67,7 +67,10 @@ impl Phong {
     pub fn new(variant: PhongVariant, ks: Value, n: f64, channels: &Channels) -> Result<Self> {
         ks.validate("ks", 0.0)?;
         if !n.is_finite() || n < 0.0 {
-            return Err(crate::Error::spec("n", format!("{n} must be a finite number ≥ 0")));
+            return Err(crate::Error::spec(
+                "n",
+                format!("{n} must be a finite number ≥ 0"),
+            ));
         }
         Ok(Phong {
             channels: channels.clone(),
@@ -248,7 +251,11 @@ mod tests {
             for (c, ks) in [0.2, 0.5, 0.9].into_iter().enumerate() {
                 let expect = 2.0 * PI * ks / (n + 2.0);
                 // Gauss-Legendre in cos θ is exact for cos^(n+1) θ; the rest is f32 rounding.
-                assert!((a[c] - expect).abs() < 1e-6 * expect, "n={n}: {} vs {expect}", a[c]);
+                assert!(
+                    (a[c] - expect).abs() < 1e-6 * expect,
+                    "n={n}: {} vs {expect}",
+                    a[c]
+                );
             }
         }
     }

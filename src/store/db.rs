@@ -78,7 +78,10 @@ pub fn put(
     {
         return Err(Error::arg(
             "--name",
-            format!("{} already holds a table `{name}` (use --replace)", path.display()),
+            format!(
+                "{} already holds a table `{name}` (use --replace)",
+                path.display()
+            ),
         ));
     }
     let mut w = Writer::create(path)?;
@@ -128,7 +131,10 @@ pub fn remove(path: impl AsRef<Path>, name: &str) -> Result<()> {
     let _lock = lock(path)?;
     let s = Store::open(path)?;
     if !s.tables().iter().any(|t| t.name == name) {
-        return Err(Error::NotFound(format!("table `{name}` in {}", path.display())));
+        return Err(Error::NotFound(format!(
+            "table `{name}` in {}",
+            path.display()
+        )));
     }
     let mut w = Writer::create(path)?;
     for e in s.tables().iter().filter(|e| e.name != name) {

@@ -64,7 +64,10 @@ pub fn npy(table: &StoredTable, out: impl AsRef<Path>, offset: NodeOffset<'_>) -
         return w.flush().map_err(io);
     }
     let offset = offset.expect("checked");
-    let axes: Vec<usize> = h.shape[..h.shape.len() - 1].iter().map(|&d| d as usize).collect();
+    let axes: Vec<usize> = h.shape[..h.shape.len() - 1]
+        .iter()
+        .map(|&d| d as usize)
+        .collect();
     let nc = *h.shape.last().expect("non-empty") as usize;
     let nodes: usize = axes.iter().product();
     let mut idx = vec![0usize; axes.len()];
@@ -113,7 +116,11 @@ impl Slice {
     pub fn parse(s: &str, axes: usize) -> Result<Slice> {
         let err = |m: String| Error::arg("--slice", m);
         let (xy, fixed) = s.split_once(':').unwrap_or((s, ""));
-        let num = |t: &str| t.trim().parse::<u64>().map_err(|_| err(format!("`{t}` is not an index")));
+        let num = |t: &str| {
+            t.trim()
+                .parse::<u64>()
+                .map_err(|_| err(format!("`{t}` is not an index")))
+        };
         let xy: Vec<u64> = xy.split(',').map(num).collect::<Result<_>>()?;
         let [x, y] = xy[..] else {
             return Err(err("expected two axes `X,Y`".into()));
@@ -124,12 +131,17 @@ impl Slice {
             fixed.split(',').map(num).collect::<Result<_>>()?
         };
         if fixed.len() > axes {
-            return Err(err(format!("{} fixed indices for {axes} axes", fixed.len())));
+            return Err(err(format!(
+                "{} fixed indices for {axes} axes",
+                fixed.len()
+            )));
         }
         fixed.resize(axes, 0);
         let (x, y) = (x as usize, y as usize);
         if x >= axes || y >= axes || x == y {
-            return Err(err(format!("axes {x},{y} must be two different axes below {axes}")));
+            return Err(err(format!(
+                "axes {x},{y} must be two different axes below {axes}"
+            )));
         }
         Ok(Slice { x, y, fixed })
     }
@@ -137,15 +149,28 @@ impl Slice {
 
 /// Extracts a slice: returns (width, height, values as `[y][x][channel]`). Unstored nodes of
 /// packed layouts are NaN.
-pub fn slice(table: &StoredTable, s: &Slice, offset: NodeOffset<'_>) -> Result<(usize, usize, Vec<f32>)> {
+pub fn slice(
+    table: &StoredTable,
+    s: &Slice,
+    offset: NodeOffset<'_>,
+) -> Result<(usize, usize, Vec<f32>)> {
     let h = table.header();
-    let (axes, nc) = (&h.shape[..h.shape.len() - 1], *h.shape.last().unwrap_or(&1) as usize);
+    let (axes, nc) = (
+        &h.shape[..h.shape.len() - 1],
+        *h.shape.last().unwrap_or(&1) as usize,
+    );
     if s.x >= axes.len() || s.y >= axes.len() || s.fixed.len() != axes.len() {
-        return Err(Error::arg("--slice", format!("the table has {} angular axes", axes.len())));
+        return Err(Error::arg(
+            "--slice",
+            format!("the table has {} angular axes", axes.len()),
+        ));
     }
     for (a, (&i, &d)) in s.fixed.iter().zip(axes).enumerate() {
         if a != s.x && a != s.y && i >= d {
-            return Err(Error::arg("--slice", format!("index {i} of axis {a} is not below its length {d}")));
+            return Err(Error::arg(
+                "--slice",
+                format!("index {i} of axis {a} is not below its length {d}"),
+            ));
         }
     }
     let (w, ht) = (axes[s.x] as usize, axes[s.y] as usize);
@@ -164,7 +189,12 @@ pub fn slice(table: &StoredTable, s: &Slice, offset: NodeOffset<'_>) -> Result<(
             idx[s.y] = yy;
             let flat = match offset {
                 Some(f) => f(&idx),
-                None => Some(idx.iter().zip(&stride).map(|(&i, &st)| i as u64 * st).sum::<u64>() as usize),
+                None => Some(
+                    idx.iter()
+                        .zip(&stride)
+                        .map(|(&i, &st)| i as u64 * st)
+                        .sum::<u64>() as usize,
+                ),
             };
             let Some(flat) = flat else { continue };
             let (ci, off) = table.locate(flat as u64)?;

@@ -105,9 +105,18 @@ impl TableHeader {
     /// A header for a dense table of `shape` (angular axes outermost first, channels last) with
     /// the predictor layout taken from the shape; grid, parameterization and symmetry are left
     /// empty for the caller to fill in.
-    pub fn new(name: impl Into<String>, source: Source, shape: Vec<u64>, channels: Channels, codec: Codec) -> TableHeader {
+    pub fn new(
+        name: impl Into<String>,
+        source: Source,
+        shape: Vec<u64>,
+        channels: Channels,
+        codec: Codec,
+    ) -> TableHeader {
         let dim = |k: usize| shape.len().checked_sub(k).map_or(1, |i| shape[i] as usize);
-        let values = shape.iter().try_fold(1u64, |a, &d| a.checked_mul(d)).unwrap_or(u64::MAX);
+        let values = shape
+            .iter()
+            .try_fold(1u64, |a, &d| a.checked_mul(d))
+            .unwrap_or(u64::MAX);
         TableHeader {
             name: name.into(),
             source,
@@ -237,7 +246,10 @@ impl Superblock {
                 file,
                 Some("superblock"),
                 Some(data.len() as u64),
-                format!("truncated: {} bytes, the superblock alone is {SUPERBLOCK_LEN}", data.len()),
+                format!(
+                    "truncated: {} bytes, the superblock alone is {SUPERBLOCK_LEN}",
+                    data.len()
+                ),
             ));
         }
         let u64_at = |o: usize| u64::from_le_bytes(data[o..o + 8].try_into().expect("8 bytes"));
@@ -257,11 +269,18 @@ impl Superblock {
                 file,
                 Some("version"),
                 Some(8),
-                format!("format version {version} is newer than this build reads ({VERSION}); upgrade brdftab"),
+                format!(
+                    "format version {version} is newer than this build reads ({VERSION}); upgrade brdftab"
+                ),
             ));
         }
         if version == 0 {
-            return Err(Error::format(file, Some("version"), Some(8), "format version 0"));
+            return Err(Error::format(
+                file,
+                Some("version"),
+                Some(8),
+                "format version 0",
+            ));
         }
         let sb = Superblock {
             version,
@@ -295,7 +314,13 @@ pub fn xxh3(b: &[u8]) -> u64 {
 
 /// Returns the bytes of `block`, checking it lies inside `data` (after the superblock) and its
 /// checksum matches.
-pub fn block<'a>(file: &str, data: &'a [u8], block: &Block, what: &str, max: u64) -> Result<&'a [u8]> {
+pub fn block<'a>(
+    file: &str,
+    data: &'a [u8],
+    block: &Block,
+    what: &str,
+    max: u64,
+) -> Result<&'a [u8]> {
     let end = block.offset.checked_add(block.len);
     match end {
         Some(end) if block.offset >= SUPERBLOCK_LEN as u64 && end <= data.len() as u64 => {}
@@ -343,21 +368,39 @@ pub fn json<T: serde::de::DeserializeOwned>(file: &str, what: &str, b: &[u8]) ->
 }
 
 /// Checks a table header and its chunk index against each other and the file; returns the index.
-pub fn check_table(file: &str, data_len: u64, h: &TableHeader, index: &[u8], n: u64) -> Result<Vec<ChunkEntry>> {
+pub fn check_table(
+    file: &str,
+    data_len: u64,
+    h: &TableHeader,
+    index: &[u8],
+    n: u64,
+) -> Result<Vec<ChunkEntry>> {
     let what = |f: &str| format!("table `{}` {f}", h.name);
     let err = |f: &str, msg: String| Error::format(file, Some(&what(f)), None, msg);
     let dense = h.dense_values().unwrap_or(u64::MAX);
     // Packed layouts store at least half of the dense shape; chunks are slabs of axis 0.
-    if h.shape.is_empty() || h.values > MAX_VALUES || h.values > dense || dense / 2 > h.values || h.shape[0] != n {
+    if h.shape.is_empty()
+        || h.values > MAX_VALUES
+        || h.values > dense
+        || dense / 2 > h.values
+        || h.shape[0] != n
+    {
         return Err(err(
             "shape",
-            format!("{:?} / {} values: empty, inconsistent or more than {MAX_VALUES}", h.shape, h.values),
+            format!(
+                "{:?} / {} values: empty, inconsistent or more than {MAX_VALUES}",
+                h.shape, h.values
+            ),
         ));
     }
     if index.len() as u64 != n.saturating_mul(INDEX_ENTRY_LEN as u64) || n > h.values.max(1) {
         return Err(err(
             "index",
-            format!("{n} chunks in an index of {} bytes for {} values", index.len(), h.values),
+            format!(
+                "{n} chunks in an index of {} bytes for {} values",
+                index.len(),
+                h.values
+            ),
         ));
     }
     let mut out = Vec::with_capacity(n as usize);
@@ -371,7 +414,10 @@ pub fn check_table(file: &str, data_len: u64, h: &TableHeader, index: &[u8], n: 
         if !ok_range {
             return Err(err(
                 &format!("chunk {i}"),
-                format!("range {}+{} lies outside the file ({data_len} bytes)", e.offset, e.len),
+                format!(
+                    "range {}+{} lies outside the file ({data_len} bytes)",
+                    e.offset, e.len
+                ),
             ));
         }
         if e.values > MAX_CHUNK_VALUES || e.values > e.len.saturating_mul(MAX_VALUES_PER_BYTE) {
@@ -384,7 +430,10 @@ pub fn check_table(file: &str, data_len: u64, h: &TableHeader, index: &[u8], n: 
         out.push(e);
     }
     if sum != h.values {
-        return Err(err("index", format!("chunks hold {sum} values, the header says {}", h.values)));
+        return Err(err(
+            "index",
+            format!("chunks hold {sum} values, the header says {}", h.values),
+        ));
     }
     Ok(out)
 }

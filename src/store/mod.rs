@@ -27,8 +27,8 @@ use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
-pub use format::{Source, TableHeader, TocEntry};
 use format::{ChunkEntry, Superblock, Toc};
+pub use format::{Source, TableHeader, TocEntry};
 pub use writer::Writer;
 
 use crate::codec;
@@ -101,17 +101,33 @@ impl Store {
 
     /// Opens a file held in memory (`name` is used in error messages). Used by the fuzz target.
     pub fn from_bytes(name: &str, bytes: Vec<u8>, opts: OpenOptions) -> Result<Store> {
-        Self::from_backing(PathBuf::from(name), name.to_owned(), Backing::Bytes(bytes), opts)
+        Self::from_backing(
+            PathBuf::from(name),
+            name.to_owned(),
+            Backing::Bytes(bytes),
+            opts,
+        )
     }
 
     fn from_backing(path: PathBuf, name: String, map: Backing, opts: OpenOptions) -> Result<Store> {
         let sb = Superblock::parse(&name, &map)?;
-        let toc_bytes = format::block(&name, &map, &sb.toc, "table of contents", format::MAX_JSON_LEN)?;
+        let toc_bytes = format::block(
+            &name,
+            &map,
+            &sb.toc,
+            "table of contents",
+            format::MAX_JSON_LEN,
+        )?;
         let toc: Toc = format::json(&name, "table of contents", toc_bytes)?;
         let mut seen = std::collections::HashSet::new();
         for t in &toc.tables {
             if !seen.insert(t.name.as_str()) {
-                return Err(Error::format(&name, Some("table of contents"), None, format!("duplicate table `{}`", t.name)));
+                return Err(Error::format(
+                    &name,
+                    Some("table of contents"),
+                    None,
+                    format!("duplicate table `{}`", t.name),
+                ));
             }
         }
         Ok(Store {
@@ -149,7 +165,11 @@ impl Store {
             .find(|(_, t)| t.name == name)
             .ok_or_else(|| {
                 let names: Vec<&str> = self.toc.tables.iter().map(|t| t.name.as_str()).collect();
-                Error::NotFound(format!("table `{name}` in {} (has: {})", self.name, names.join(", ")))
+                Error::NotFound(format!(
+                    "table `{name}` in {} (has: {})",
+                    self.name,
+                    names.join(", ")
+                ))
             })?;
         self.table_at(i, e)
     }
@@ -158,7 +178,10 @@ impl Store {
     pub fn single(&self) -> Result<StoredTable> {
         match self.toc.tables.as_slice() {
             [e] => self.table_at(0, e),
-            [] => Err(Error::NotFound(format!("{}: the file holds no table", self.name))),
+            [] => Err(Error::NotFound(format!(
+                "{}: the file holds no table",
+                self.name
+            ))),
             ts => Err(Error::arg(
                 "SOURCE",
                 format!(
@@ -173,7 +196,13 @@ impl Store {
 
     fn table_at(&self, i: usize, e: &TocEntry) -> Result<StoredTable> {
         let what = |s: &str| format!("table `{}` {s}", e.name);
-        let hb = format::block(&self.name, &self.map, &e.header, &what("header"), format::MAX_JSON_LEN)?;
+        let hb = format::block(
+            &self.name,
+            &self.map,
+            &e.header,
+            &what("header"),
+            format::MAX_JSON_LEN,
+        )?;
         let header: TableHeader = format::json(&self.name, &what("header"), hb)?;
         if header.name != e.name {
             return Err(Error::format(
@@ -183,7 +212,13 @@ impl Store {
                 format!("header names the table `{}`", header.name),
             ));
         }
-        let ib = format::block(&self.name, &self.map, &e.index, &what("index"), self.map.len() as u64)?;
+        let ib = format::block(
+            &self.name,
+            &self.map,
+            &e.index,
+            &what("index"),
+            self.map.len() as u64,
+        )?;
         let index = format::check_table(&self.name, self.map.len() as u64, &header, ib, e.chunks)?;
         let starts = index
             .iter()
@@ -203,7 +238,9 @@ impl Store {
             id: i,
         };
         if self.opts.eager {
-            (0..t.index.len()).into_par_iter().try_for_each(|c| t.chunk(c).map(drop))?;
+            (0..t.index.len())
+                .into_par_iter()
+                .try_for_each(|c| t.chunk(c).map(drop))?;
         }
         Ok(t)
     }
@@ -285,7 +322,14 @@ impl StoredTable {
     /// The checksummed bytes of chunk `i` as stored (encoded).
     pub fn raw_chunk(&self, i: usize) -> Result<&[u8]> {
         let e = self.index.get(i).ok_or_else(|| {
-            Error::arg("chunk", format!("chunk {i} of {} in table `{}`", self.index.len(), self.header.name))
+            Error::arg(
+                "chunk",
+                format!(
+                    "chunk {i} of {} in table `{}`",
+                    self.index.len(),
+                    self.header.name
+                ),
+            )
         })?;
         let b = &self.map[e.offset as usize..(e.offset + e.len) as usize];
         let computed = format::xxh3(b);
@@ -307,12 +351,20 @@ impl StoredTable {
 
     /// The chunk holding flat value offset `flat`, and the offset inside it.
     pub fn locate(&self, flat: u64) -> Result<(usize, usize)> {
-        let i = self.starts.partition_point(|&s| s <= flat).saturating_sub(1);
+        let i = self
+            .starts
+            .partition_point(|&s| s <= flat)
+            .saturating_sub(1);
         match self.index.get(i) {
-            Some(e) if flat < self.starts[i] + e.values => Ok((i, (flat - self.starts[i]) as usize)),
+            Some(e) if flat < self.starts[i] + e.values => {
+                Ok((i, (flat - self.starts[i]) as usize))
+            }
             _ => Err(Error::arg(
                 "offset",
-                format!("value {flat} is outside table `{}` ({} values)", self.header.name, self.header.values),
+                format!(
+                    "value {flat} is outside table `{}` ({} values)",
+                    self.header.name, self.header.values
+                ),
             )),
         }
     }
@@ -325,7 +377,9 @@ impl StoredTable {
 
     fn in_chunk(&self, e: Error, i: usize) -> Error {
         match e {
-            Error::Format { field, offset, msg, .. } => Error::Format {
+            Error::Format {
+                field, offset, msg, ..
+            } => Error::Format {
                 file: self.file.clone(),
                 field: Some(format!(
                     "table `{}` chunk {i}{}",

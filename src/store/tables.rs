@@ -27,9 +27,10 @@ impl Source {
         std::io::copy(&mut f, &mut h).map_err(|e| Error::io(path, e))?;
         let sha: String = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
         Ok(Source::Measured {
-            file: path
-                .file_name()
-                .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned()),
+            file: path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            ),
             sha256: sha,
         })
     }
@@ -37,9 +38,20 @@ impl Source {
 
 impl TableHeader {
     /// The header of a table on `grid`.
-    pub fn for_grid(name: impl Into<String>, source: Source, grid: &Grid, codec: Codec) -> TableHeader {
+    pub fn for_grid(
+        name: impl Into<String>,
+        source: Source,
+        grid: &Grid,
+        codec: Codec,
+    ) -> TableHeader {
         let s = grid.stored_shape();
-        let shape = vec![s[0] as u64, s[1] as u64, s[2] as u64, s[3] as u64, grid.channels().len() as u64];
+        let shape = vec![
+            s[0] as u64,
+            s[1] as u64,
+            s[2] as u64,
+            s[3] as u64,
+            grid.channels().len() as u64,
+        ];
         let mut h = TableHeader::new(name, source, shape, grid.channels().clone(), codec);
         h.grid = serde_json::to_value(grid).unwrap_or(serde_json::Value::Null);
         h.parameterization = match grid.param() {
@@ -57,12 +69,23 @@ impl TableHeader {
 /// the stored axis-2 rows of that chunk.
 pub fn chunk_layout(grid: &Grid, a: usize) -> codec::Layout {
     let l = grid.layout();
-    codec::Layout::new(l.channels, l.shape[3], l.rows2(a.min(l.shape[0].saturating_sub(1))).1)
+    codec::Layout::new(
+        l.channels,
+        l.shape[3],
+        l.rows2(a.min(l.shape[0].saturating_sub(1))).1,
+    )
 }
 
 /// Saves an in-memory table as `name` in the database (or single-table file) at `path`, encoding
 /// its chunks in parallel. With `replace`, an existing table of that name is replaced.
-pub fn save(path: impl AsRef<Path>, name: &str, source: Source, table: &Table, codec: Codec, replace: bool) -> Result<()> {
+pub fn save(
+    path: impl AsRef<Path>,
+    name: &str,
+    source: Source,
+    table: &Table,
+    codec: Codec,
+    replace: bool,
+) -> Result<()> {
     let grid = table.grid();
     let header = TableHeader::for_grid(name, source, grid, codec);
     db::put(path, header, replace, |w| write_table_chunks(w, table))
@@ -81,21 +104,46 @@ impl StoredTable {
     /// The table's grid, checked against the stored shape and chunk lengths.
     pub fn grid(&self) -> Result<Grid> {
         let h = self.header();
-        let bad = |msg: String| Error::format(self.file(), Some(&format!("table `{}` grid", h.name)), None, msg);
+        let bad = |msg: String| {
+            Error::format(
+                self.file(),
+                Some(&format!("table `{}` grid", h.name)),
+                None,
+                msg,
+            )
+        };
         // Bound every size in the grid JSON by the (already validated) stored shape before the
         // grid allocates anything from them.
-        let max = h.shape.iter().copied().max().unwrap_or(0).saturating_mul(4).saturating_add(4);
+        let max = h
+            .shape
+            .iter()
+            .copied()
+            .max()
+            .unwrap_or(0)
+            .saturating_mul(4)
+            .saturating_add(4);
         let mut sizes = Vec::new();
         collect_sizes(&h.grid, &mut sizes);
         if let Some(s) = sizes.iter().find(|&&s| s > max) {
-            return Err(bad(format!("axis size {s} does not fit the stored shape {:?}", h.shape)));
+            return Err(bad(format!(
+                "axis size {s} does not fit the stored shape {:?}",
+                h.shape
+            )));
         }
-        let grid: Grid = serde_json::from_value(h.grid.clone())
-            .map_err(|e| bad(format!("{e}")))?;
+        let grid: Grid = serde_json::from_value(h.grid.clone()).map_err(|e| bad(format!("{e}")))?;
         let s = grid.stored_shape();
-        let want = [s[0] as u64, s[1] as u64, s[2] as u64, s[3] as u64, grid.channels().len() as u64];
+        let want = [
+            s[0] as u64,
+            s[1] as u64,
+            s[2] as u64,
+            s[3] as u64,
+            grid.channels().len() as u64,
+        ];
         if h.shape != want || grid.layout().chunk_count() != self.chunk_count() {
-            return Err(bad(format!("grid stores {want:?}, the header says {:?}", h.shape)));
+            return Err(bad(format!(
+                "grid stores {want:?}, the header says {:?}",
+                h.shape
+            )));
         }
         for a in 0..self.chunk_count() {
             if grid.layout().chunk_len(a) != self.chunk_values(a) {

@@ -98,17 +98,26 @@ impl Writer {
         if header.name.is_empty() || header.name.contains('#') {
             return Err(Error::arg(
                 "--name",
-                format!("table name `{}` must be non-empty and contain no `#`", header.name),
+                format!(
+                    "table name `{}` must be non-empty and contain no `#`",
+                    header.name
+                ),
             ));
         }
         if self.names().any(|n| n == header.name) {
-            return Err(Error::arg("--name", format!("duplicate table name `{}`", header.name)));
+            return Err(Error::arg(
+                "--name",
+                format!("duplicate table name `{}`", header.name),
+            ));
         }
         let dense = header.dense_values().unwrap_or(u64::MAX);
         if header.shape.is_empty() || header.values > dense || header.values > format::MAX_VALUES {
             return Err(Error::arg(
                 "shape",
-                format!("{:?} / {} values: empty, inconsistent or too large", header.shape, header.values),
+                format!(
+                    "{:?} / {} values: empty, inconsistent or too large",
+                    header.shape, header.values
+                ),
             ));
         }
         self.table = Some(Open {
@@ -126,28 +135,35 @@ impl Writer {
 
     /// Encodes and appends the next chunk of the open table (with the header's layout).
     pub fn chunk(&mut self, values: &[f32]) -> Result<()> {
-        let layout = self.header().map(|h| h.layout).unwrap_or(codec::Layout::FLAT);
+        let layout = self
+            .header()
+            .map(|h| h.layout)
+            .unwrap_or(codec::Layout::FLAT);
         self.chunk_with(values, layout)
     }
 
     /// Encodes and appends the next chunk with its own predictor layout (e.g. packed tables whose
     /// chunks have different row counts).
     pub fn chunk_with(&mut self, values: &[f32], layout: codec::Layout) -> Result<()> {
-        let t = self.table.as_ref().ok_or_else(|| Error::arg("table", "no table begun"))?;
-        let bytes = codec::encode(values, layout, &t.header.codec).map_err(|e| {
-            match e {
-                Error::Encode { msg } => Error::Encode {
-                    msg: format!("table `{}` chunk {}: {msg}", t.header.name, t.index.len()),
-                },
-                e => e,
-            }
+        let t = self
+            .table
+            .as_ref()
+            .ok_or_else(|| Error::arg("table", "no table begun"))?;
+        let bytes = codec::encode(values, layout, &t.header.codec).map_err(|e| match e {
+            Error::Encode { msg } => Error::Encode {
+                msg: format!("table `{}` chunk {}: {msg}", t.header.name, t.index.len()),
+            },
+            e => e,
         })?;
         self.encoded_chunk(&bytes, values.len() as u64)
     }
 
     /// Appends an already encoded chunk (e.g. copied from another file) holding `values` values.
     pub fn encoded_chunk(&mut self, bytes: &[u8], values: u64) -> Result<()> {
-        let t = self.table.as_ref().ok_or_else(|| Error::arg("table", "no table begun"))?;
+        let t = self
+            .table
+            .as_ref()
+            .ok_or_else(|| Error::arg("table", "no table begun"))?;
         let done: u64 = t.index.iter().map(|e| e.values).sum();
         if done + values > t.header.values || values > format::MAX_CHUNK_VALUES {
             return Err(Error::arg(
@@ -175,7 +191,10 @@ impl Writer {
     /// Encodes chunks held in memory in parallel (each with its layout) and appends them in
     /// order.
     pub fn chunks_par(&mut self, chunks: &[(&[f32], codec::Layout)]) -> Result<()> {
-        let t = self.table.as_ref().ok_or_else(|| Error::arg("table", "no table begun"))?;
+        let t = self
+            .table
+            .as_ref()
+            .ok_or_else(|| Error::arg("table", "no table begun"))?;
         let c = t.header.codec;
         let encoded: Vec<Result<Vec<u8>>> = chunks
             .par_iter()
@@ -189,7 +208,10 @@ impl Writer {
 
     /// Ends the open table: writes its header and chunk index.
     pub fn end_table(&mut self) -> Result<()> {
-        let t = self.table.take().ok_or_else(|| Error::arg("table", "no table begun"))?;
+        let t = self
+            .table
+            .take()
+            .ok_or_else(|| Error::arg("table", "no table begun"))?;
         let got: u64 = t.index.iter().map(|e| e.values).sum();
         if got != t.header.values {
             return Err(Error::arg(

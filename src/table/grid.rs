@@ -25,8 +25,12 @@
 //! - reciprocity: `halfdiff` stores φd over the period [0, π); `inout` *packs* θ1 ≤ θ2 (only the
 //!   upper triangle of the (θ1, θ2) plane is stored, see [`Layout`]).
 //!
-//! Full φ axes always use [`Mapping::Uniform`] and [`Nodes::CellStart`] (node i at i·2π/N), so
-//! every symmetry maps full nodes onto full nodes and interpolation commutes with the reduction.
+//! Full φ axes are periodic with node i at i·2π/N ([`Mapping::Uniform`]); their `nodes` field only
+//! selects the *nearest* rule: [`Nodes::Edges`] (the default, [`Axis::phi`]) rounds,
+//! [`Nodes::CellStart`] ([`Axis::phi_cells`], MERL) takes ⌊s⌋. Every symmetry maps full nodes onto
+//! full nodes, so linear interpolation commutes with the reduction, and so does nearest lookup
+//! with rounding (⌊s⌋ is not mirror-symmetric: bilateral folds of `cell_start` φ axes are
+//! consistent for linear lookups only).
 //!
 //! # Node placement
 //!
@@ -149,8 +153,17 @@ impl Axis {
         }
     }
 
-    /// A periodic φ axis over [0, 2π) with node i at i·2π/size.
+    /// A periodic φ axis over [0, 2π) with node i at i·2π/size; nearest lookups round.
     pub fn phi(size: usize) -> Self {
+        Axis {
+            size,
+            mapping: Mapping::Uniform,
+            nodes: Nodes::Edges,
+        }
+    }
+
+    /// A periodic φ axis like [`Axis::phi`] whose nearest lookups take ⌊s⌋ (MERL's φd).
+    pub fn phi_cells(size: usize) -> Self {
         Axis {
             size,
             mapping: Mapping::Uniform,
@@ -189,13 +202,13 @@ impl StoredAxis {
         }
     }
 
-    fn periodic(size: usize, period: f64) -> Self {
+    fn periodic(size: usize, period: f64, nodes: Nodes) -> Self {
         StoredAxis {
             size,
             lo: 0.0,
             hi: period,
             mapping: Mapping::Uniform,
-            nodes: Nodes::CellStart,
+            nodes,
             periodic: true,
         }
     }
@@ -223,13 +236,17 @@ impl StoredAxis {
     }
 
     /// The fractional node index s of coordinate `x` (not clamped or wrapped).
-    #[inline]
+    #[inline(always)]
     pub fn continuous(&self, x: f64) -> f64 {
         if self.size <= 1 {
             return 0.0;
         }
         let n = self.size as f64;
         let r = (x - self.lo) / (self.hi - self.lo);
+        if self.periodic {
+            // Node i at i/n of the period on every periodic axis.
+            return r * n;
+        }
         match (self.mapping, self.nodes) {
             // MERL arithmetic order: sqrt(((θ/(π/2))·n)·n).
             (Mapping::Sqrt, Nodes::CellStart) => (r * n * n).max(0.0).sqrt(),
@@ -258,6 +275,9 @@ impl StoredAxis {
             return self.lo;
         }
         let n = self.size as f64;
+        if self.periodic {
+            return self.lo + s / n * (self.hi - self.lo);
+        }
         let u = match self.nodes {
             Nodes::Centers => (s + 0.5) / n,
             Nodes::Edges => s / (n - 1.0),
@@ -308,7 +328,7 @@ impl StoredAxis {
 
     /// The two nodes and the weight of the second for linear interpolation at `x`:
     /// value = (1 − t)·v[i0] + t·v[i1].
-    #[inline]
+    #[inline(always)]
     pub fn linear(&self, x: f64) -> (usize, usize, f32) {
         let n = self.size;
         if n <= 1 {
@@ -316,19 +336,29 @@ impl StoredAxis {
         }
         let s = self.continuous(x);
         if self.periodic {
-            let s = if s.is_finite() { s } else { 0.0 };
-            let f = s.floor();
-            let t = (s - f) as f32;
-            let i0 = (f as i64).rem_euclid(n as i64) as usize;
+            if !s.is_finite() {
+                return (0, 1, 0.0);
+            }
+            // floor without a libm call (s is usually in [0, n]).
+            let mut i = s as i64;
+            if (i as f64) > s {
+                i -= 1;
+            }
+            let t = (s - i as f64) as f32;
+            let ni = n as i64;
+            let i0 = if (0..ni).contains(&i) {
+                i
+            } else if (ni..2 * ni).contains(&i) {
+                i - ni
+            } else {
+                i.rem_euclid(ni)
+            } as usize;
             let i1 = if i0 + 1 == n { 0 } else { i0 + 1 };
             (i0, i1, t)
         } else {
-            let s = if s.is_nan() {
-                0.0
-            } else {
-                s.clamp(0.0, (n - 1) as f64)
-            };
-            let i0 = (s.floor() as usize).min(n - 2);
+            // NaN → 0; clamp to [0, n − 1]; `as usize` truncates (= floor for s ≥ 0).
+            let s = if s > 0.0 { s.min((n - 1) as f64) } else { 0.0 };
+            let i0 = (s as usize).min(n - 2);
             (i0, i0 + 1, (s - i0 as f64) as f32)
         }
     }
@@ -413,11 +443,11 @@ impl Grid {
             if a.size == 0 {
                 return Err(Error::arg("grid", format!("axis {} has size 0", name[k])));
             }
-            if k % 2 == 1 && (a.mapping != Mapping::Uniform || a.nodes != Nodes::CellStart) {
+            if k % 2 == 1 && (a.mapping != Mapping::Uniform || a.nodes == Nodes::Centers) {
                 return Err(Error::arg(
                     "grid",
                     format!(
-                        "φ axis {} must be uniform with cell_start nodes (periodic)",
+                        "φ axis {} must be uniform with edges or cell_start nodes (periodic)",
                         name[k]
                     ),
                 ));
@@ -434,7 +464,9 @@ impl Grid {
             if n % m != 0 {
                 Err(Error::arg(
                     "grid",
-                    format!("{what} of size {n} must be a multiple of {m} to be folded by symmetry"),
+                    format!(
+                        "{what} of size {n} must be a multiple of {m} to be folded by symmetry"
+                    ),
                 ))
             } else {
                 Ok(())
@@ -449,13 +481,13 @@ impl Grid {
                     even(p1.size, name[1], 2)?;
                     StoredAxis::folded(p1.size / 2 + 1, PI)
                 } else {
-                    StoredAxis::periodic(p1.size, TAU)
+                    StoredAxis::periodic(p1.size, TAU, p1.nodes)
                 };
                 let sp2 = if iso && s.bilateral {
                     even(p2.size, name[3], 2)?;
                     StoredAxis::folded(p2.size / 2 + 1, PI)
                 } else {
-                    StoredAxis::periodic(p2.size, TAU)
+                    StoredAxis::periodic(p2.size, TAU, p2.nodes)
                 };
                 if s.reciprocal {
                     if t1 != t2 {
@@ -480,7 +512,7 @@ impl Grid {
                     even(p1.size, name[1], 2)?;
                     StoredAxis::folded(p1.size / 2 + 1, PI)
                 } else {
-                    StoredAxis::periodic(p1.size, TAU)
+                    StoredAxis::periodic(p1.size, TAU, p1.nodes)
                 };
                 let sp2 = match (s.reciprocal, s.bilateral && iso) {
                     (true, true) => {
@@ -489,20 +521,25 @@ impl Grid {
                     }
                     (true, false) => {
                         even(p2.size, name[3], 2)?;
-                        StoredAxis::periodic(p2.size / 2, PI)
+                        StoredAxis::periodic(p2.size / 2, PI, p2.nodes)
                     }
                     (false, true) => {
                         even(p2.size, name[3], 2)?;
                         StoredAxis::folded(p2.size / 2 + 1, PI)
                     }
-                    (false, false) => StoredAxis::periodic(p2.size, TAU),
+                    (false, false) => StoredAxis::periodic(p2.size, TAU, p2.nodes),
                 };
                 [StoredAxis::theta(&t1), sp1, StoredAxis::theta(&t2), sp2]
             }
         };
         let packed = param == Param::InOut && s.reciprocal;
         let layout = Layout::new(
-            [stored[0].size, stored[1].size, stored[2].size, stored[3].size],
+            [
+                stored[0].size,
+                stored[1].size,
+                stored[2].size,
+                stored[3].size,
+            ],
             packed,
             channels.len(),
         );
@@ -555,9 +592,9 @@ impl Grid {
             Param::HalfDiff,
             [
                 Axis::theta(90, Mapping::Sqrt, Nodes::CellStart),
-                Axis::phi(360),
+                Axis::phi_cells(360),
                 Axis::theta(90, Mapping::Uniform, Nodes::CellStart),
-                Axis::phi(360),
+                Axis::phi_cells(360),
             ],
             channels,
             sym,
@@ -815,7 +852,10 @@ mod tests {
                 let ax = StoredAxis::theta(&Axis::theta(17, m, nodes));
                 for i in 0..17 {
                     let x = ax.node(i);
-                    assert!((ax.continuous(x) - i as f64).abs() < 1e-9, "{m:?} {nodes:?} {i}");
+                    assert!(
+                        (ax.continuous(x) - i as f64).abs() < 1e-9,
+                        "{m:?} {nodes:?} {i}"
+                    );
                     assert_eq!(ax.nearest(x + 1e-12), i);
                 }
             }

@@ -11,11 +11,19 @@
 //! Values are stored λ innermost: the values of one node for every channel are contiguous, so
 //! one set of angular interpolation weights serves all channels.
 
+pub mod bake;
 pub mod grid;
+pub mod lookup;
+pub mod presets;
+pub mod raw;
 pub mod symmetry;
+pub mod tabulated;
 
+pub use bake::{BakeOptions, BakeReport, bake, bake_chunks};
 pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, StoredAxis};
+pub use lookup::Interp;
 pub use symmetry::Symmetry;
+pub use tabulated::{ChunkLoader, TabulatedBrdf};
 
 use glam::DVec3;
 

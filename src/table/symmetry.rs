@@ -125,18 +125,100 @@ impl fmt::Display for Symmetry {
 /// `param` and symmetry `sym`: `[θ1, φ1, θ2, φ2]` (`inout` isotropic: `[θi, 0, θo, Δφ]`;
 /// `halfdiff` isotropic: `[θh, 0, θd, φd]`). `None` below the horizon or for invalid input.
 ///
-/// Angles come from vector algebra where possible (one `atan2` for Δφ instead of two).
+/// Angles come from vector algebra where possible (one `atan2` for Δφ instead of two) and from
+/// the exact `libm` functions; [`canonical_coords_fast`] uses polynomial approximations.
 #[inline]
 pub fn canonical_coords(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -> Option<[f64; 4]> {
+    coords::<false>(param, sym, wi, wo)
+}
+
+/// [`canonical_coords`] with polynomial `acos`/`atan2` (absolute error below 2e-7 rad): for
+/// linear interpolation, where that is far below a node spacing. Nearest lookups use the exact
+/// version so that cell boundaries (MERL's `int(...)`) are reproduced exactly.
+#[inline]
+pub fn canonical_coords_fast(
+    param: Param,
+    sym: Symmetry,
+    wi: DVec3,
+    wo: DVec3,
+) -> Option<[f64; 4]> {
+    coords::<true>(param, sym, wi, wo)
+}
+
+#[inline(always)]
+fn acos<const FAST: bool>(x: f64) -> f64 {
+    if FAST {
+        fast_acos(x)
+    } else {
+        x.clamp(-1.0, 1.0).acos()
+    }
+}
+
+#[inline(always)]
+fn atan2<const FAST: bool>(y: f64, x: f64) -> f64 {
+    if FAST { fast_atan2(y, x) } else { y.atan2(x) }
+}
+
+/// acos with absolute error ≤ 2e-8 (Abramowitz & Stegun 4.4.46); input clamped to [−1, 1].
+#[inline(always)]
+pub fn fast_acos(x: f64) -> f64 {
+    let a = x.abs().min(1.0);
+    let p = -0.0012624911;
+    let p = p * a + 0.0066700901;
+    let p = p * a - 0.0170881256;
+    let p = p * a + 0.0308918810;
+    let p = p * a - 0.0501743046;
+    let p = p * a + 0.0889789874;
+    let p = p * a - 0.2145988016;
+    let p = p * a + 1.5707963050;
+    let r = (1.0 - a).sqrt() * p;
+    if x < 0.0 { PI - r } else { r }
+}
+
+/// atan2 with absolute error ≤ 2e-7 (Cephes `atanf` range reduction and polynomial), same
+/// quadrant conventions as `f64::atan2` for finite input: result in [−π, π].
+#[inline(always)]
+pub fn fast_atan2(y: f64, x: f64) -> f64 {
+    let (ax, ay) = (x.abs(), y.abs());
+    let (num, den, swap) = if ay > ax {
+        (ax, ay, true)
+    } else {
+        (ay, ax, false)
+    };
+    // z = min/max in [0, 1]; reduce to [0, tan(π/8)].
+    let z = if den > 0.0 { num / den } else { 0.0 };
+    let (base, t) = if z > 0.414_213_562_373_095 {
+        (std::f64::consts::FRAC_PI_4, (z - 1.0) / (z + 1.0))
+    } else {
+        (0.0, z)
+    };
+    let t2 = t * t;
+    let mut r = base
+        + (((8.053_744_495_38e-2 * t2 - 1.387_768_560_32e-1) * t2 + 1.997_771_064_78e-1) * t2
+            - 3.333_294_915_39e-1)
+            * t2
+            * t
+        + t;
+    if swap {
+        r = std::f64::consts::FRAC_PI_2 - r;
+    }
+    if x < 0.0 {
+        r = PI - r;
+    }
+    if y < 0.0 { -r } else { r }
+}
+
+#[inline(always)]
+fn coords<const FAST: bool>(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -> Option<[f64; 4]> {
     let (wi, wo) = geometry::upper_pair(wi, wo)?;
     match param {
         Param::InOut => {
-            let ti = wi.z.min(1.0).acos();
-            let to = wo.z.min(1.0).acos();
+            let ti = acos::<FAST>(wi.z);
+            let to = acos::<FAST>(wo.z);
             if sym.isotropic {
                 let dot = wi.x * wo.x + wi.y * wo.y;
                 let cross = wi.x * wo.y - wi.y * wo.x;
-                let mut d = cross.atan2(dot);
+                let mut d = atan2::<FAST>(cross, dot);
                 let (mut t1, mut t2) = (ti, to);
                 if sym.reciprocal && t1 > t2 {
                     std::mem::swap(&mut t1, &mut t2);
@@ -149,7 +231,7 @@ pub fn canonical_coords(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -> Op
                 }
                 Some([t1, 0.0, t2, d])
             } else {
-                let mut a = [ti, wi.y.atan2(wi.x), to, wo.y.atan2(wo.x)];
+                let mut a = [ti, atan2::<FAST>(wi.y, wi.x), to, atan2::<FAST>(wo.y, wo.x)];
                 if sym.reciprocal && a[0] > a[2] {
                     a.swap(0, 2);
                     a.swap(1, 3);
@@ -169,12 +251,12 @@ pub fn canonical_coords(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -> Op
         }
         Param::HalfDiff => {
             let (h, d) = geometry::half_diff_vectors(wi, wo)?;
-            let th = h.z.clamp(-1.0, 1.0).acos();
-            let td = d.z.clamp(-1.0, 1.0).acos();
-            let mut pd = d.y.atan2(d.x);
+            let th = acos::<FAST>(h.z);
+            let td = acos::<FAST>(d.z);
+            let mut pd = atan2::<FAST>(d.y, d.x);
             let mut ph = 0.0;
             if !sym.isotropic {
-                ph = h.y.atan2(h.x);
+                ph = atan2::<FAST>(h.y, h.x);
                 if sym.bilateral && ph < 0.0 {
                     ph = -ph;
                     pd = -pd;
@@ -233,10 +315,7 @@ fn transformed(which: usize, wi: DVec3, wo: DVec3, angle: f64) -> (DVec3, DVec3)
             (r(wi), r(wo))
         }
         1 => (wo, wi),
-        _ => (
-            DVec3::new(wi.x, -wi.y, wi.z),
-            DVec3::new(wo.x, -wo.y, wo.z),
-        ),
+        _ => (DVec3::new(wi.x, -wi.y, wi.z), DVec3::new(wo.x, -wo.y, wo.z)),
     }
 }
 
@@ -324,5 +403,40 @@ pub fn detect(brdf: &dyn Brdf, tol: f64) -> Symmetry {
         isotropic: ok(0),
         reciprocal: ok(1),
         bilateral: ok(2),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_trig_is_accurate() {
+        let mut rng = Pcg32::new(1);
+        let mut worst: f64 = 0.0;
+        for _ in 0..200_000 {
+            let x = rng.next_f64() * 2.0 - 1.0;
+            worst = worst.max((fast_acos(x) - x.acos()).abs());
+        }
+        for x in [-1.0, 0.0, 1.0, 1.0 - 1e-12, -1.0 + 1e-12] {
+            worst = worst.max((fast_acos(x) - x.acos()).abs());
+        }
+        assert!(worst < 5e-8, "acos {worst}");
+        let mut worst: f64 = 0.0;
+        for _ in 0..200_000 {
+            let (y, x) = (rng.next_f64() * 2.0 - 1.0, rng.next_f64() * 2.0 - 1.0);
+            worst = worst.max((fast_atan2(y, x) - y.atan2(x)).abs());
+        }
+        for (y, x) in [
+            (0.0, 1.0),
+            (1.0, 0.0),
+            (0.0, -1.0),
+            (-1.0, 0.0),
+            (0.0, 0.0),
+            (1e-300, 1.0),
+        ] {
+            worst = worst.max((fast_atan2(y, x) - f64::atan2(y, x)).abs());
+        }
+        assert!(worst < 2e-7, "atan2 {worst}");
     }
 }

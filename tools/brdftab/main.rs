@@ -1,8 +1,14 @@
 //! `brdftab`: the command-line tool. Thin over the library: parse arguments, call the library,
 //! print. Errors print as `error: ...` on stderr with exit code 1.
 
+mod analysis;
+mod demo;
+mod fit;
+mod measured;
 mod models;
+mod sample;
 mod source;
+mod table;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -21,18 +27,81 @@ enum Command {
     Eval(models::EvalArgs),
     /// List every model with its parameters.
     Models(models::ModelsArgs),
+    /// Bake SOURCE into a dense (symmetry-reduced) table file.
+    Bake(table::BakeArgs),
+    /// Describe a table file (grid, symmetry, channels, sizes) or a measured file (MERL, RGL).
+    Info(table::InfoArgs),
+    /// Time lookups of SOURCE on random pairs (single thread and batch on all cores).
+    Bench(table::BenchArgs),
+    /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
+    Slice(measured::SliceArgs),
+    /// Directional albedo a(θ′) per channel: one line `theta a_1 a_2 ...` per angle.
+    Albedo(analysis::AlbedoArgs),
+    /// Physical plausibility: positivity, reciprocity, energy conservation.
+    Check(analysis::CheckArgs),
+    /// The lecture's models side by side (plausibility table).
+    Demo(demo::DemoArgs),
+    /// Fit a model's parameters to SOURCE by least squares; prints the fitted spec.
+    Fit(fit::FitArgs),
+    /// Draw incident directions from SOURCE's sampler: `wix wiy wiz pdf w_1 .. w_c` per line.
+    Sample(sample::SampleArgs),
+    /// Print pdf(wi | wo) for `wix wiy wiz wox woy woz` lines read from stdin.
+    Pdf(sample::PdfArgs),
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(e),
+    };
     let result = match cli.command {
         Command::Eval(a) => models::eval(a),
         Command::Models(a) => models::models(a),
+        Command::Bake(a) => table::bake(a),
+        Command::Info(a) => table::info(a),
+        Command::Bench(a) => table::bench(a),
+        Command::Slice(a) => measured::slice(a),
+        Command::Albedo(a) => analysis::albedo(a),
+        Command::Check(a) => analysis::check(a),
+        Command::Demo(a) => demo::demo(a),
+        Command::Fit(a) => fit::fit(a),
+        Command::Sample(a) => sample::sample(a),
+        Command::Pdf(a) => sample::pdf(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader went away (`brdftab ... | head`): stop quietly.
+        Err(brdftab::Error::Io { source, .. })
+            if source.kind() == std::io::ErrorKind::BrokenPipe =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// `--help` and `--version` print to stdout and succeed; every usage error prints
+/// `error: ...` on stderr and exits 1, like every other error.
+fn clap_exit(e: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            print!("{e}");
+            ExitCode::SUCCESS
+        }
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            eprint!("error: a subcommand is required\n\n{e}");
+            ExitCode::from(1)
+        }
+        _ => {
+            let msg = e.to_string();
+            match msg.strip_prefix("error: ") {
+                Some(rest) => eprint!("error: {rest}"),
+                None => eprint!("error: {msg}"),
+            }
             ExitCode::from(1)
         }
     }

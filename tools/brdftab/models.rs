@@ -12,11 +12,14 @@ use crate::source;
 /// Arguments of `brdftab eval`.
 #[derive(Args)]
 pub struct EvalArgs {
-    /// A model spec (inline JSON starting with `{`, or a .json file).
+    /// A model spec (inline JSON starting with `{`, or a .json file), or a table file.
     source: String,
     /// Evaluate at these wavelengths in nm (comma separated) instead of RGB.
     #[arg(long)]
     wavelengths: Option<String>,
+    /// Interpolation for table sources: nearest or linear.
+    #[arg(long, default_value = "linear")]
+    interp: String,
 }
 
 /// Arguments of `brdftab models`.
@@ -30,7 +33,8 @@ pub struct ModelsArgs {
 /// Reads `wix wiy wiz wox woy woz` lines from stdin, prints f_r per channel.
 pub fn eval(a: EvalArgs) -> Result<()> {
     let channels = source::channels(a.wavelengths.as_deref())?;
-    let brdf = source::open(&a.source, &channels)?;
+    let interp = brdftab::table::Interp::parse(&a.interp)?;
+    let brdf = source::open_with(&a.source, &channels, interp)?;
     let c = brdf.channels().len();
     let mut f = vec![0.0f32; c];
     let stdin = std::io::stdin().lock();

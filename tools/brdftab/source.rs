@@ -4,6 +4,7 @@
 //! brdftab table file or database entry (`FILE` / `DB#NAME`), a MERL `.binary` file, or an RGL
 //! `.bsdf` file. Each kind is handled by the library; this module only dispatches.
 
+use brdftab::table::{Interp, Table, TabulatedBrdf};
 use brdftab::{Brdf, Channels, Error, ModelSpec, Result};
 
 /// What a SOURCE argument names.
@@ -62,18 +63,34 @@ pub fn spec(source: &str) -> Result<ModelSpec> {
 }
 
 /// Opens SOURCE as a `Brdf`. `channels` applies to model specs (tables and measurements have
-/// their own channel sets).
+/// their own channel sets). Tables use linear interpolation.
 pub fn open(source: &str, channels: &Channels) -> Result<Box<dyn Brdf>> {
+    open_with(source, channels, Interp::Linear)
+}
+
+/// Opens SOURCE as a `Brdf`, tables with interpolation `interp`.
+pub fn open_with(source: &str, channels: &Channels, interp: Interp) -> Result<Box<dyn Brdf>> {
     match kind(source) {
         Kind::Spec => spec(source)?.build(channels),
-        Kind::Merl => Err(Error::Unsupported(format!(
-            "{source}: MERL files are not supported yet"
-        ))),
-        Kind::Rgl => Err(Error::Unsupported(format!(
-            "{source}: RGL files are not supported yet"
-        ))),
-        Kind::Table => Err(Error::Unsupported(format!(
-            "{source}: table files are not supported yet"
-        ))),
+        Kind::Merl => Ok(Box::new(brdftab::measured::MerlBrdf::open(source)?)),
+        // An RGL file answers in its own channels (RGB, or its wavelengths) unless wavelengths
+        // are asked for explicitly.
+        Kind::Rgl if *channels != Channels::Rgb => Ok(Box::new(
+            brdftab::measured::RglBrdf::open_with_channels(source, channels)?,
+        )),
+        Kind::Rgl => Ok(Box::new(brdftab::measured::RglBrdf::open(source)?)),
+        Kind::Table => {
+            if Table::is_raw(source) {
+                Ok(Box::new(
+                    TabulatedBrdf::from_table(Table::open_raw(source)?).with_interp(interp),
+                ))
+            } else if !std::path::Path::new(source).exists() {
+                Err(Error::NotFound(format!("{source}: no such table file")))
+            } else {
+                Err(Error::Unsupported(format!(
+                    "{source}: not a table file this build can read"
+                )))
+            }
+        }
     }
 }

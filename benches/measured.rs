@@ -1,0 +1,134 @@
+//! Measured-data benchmarks (plain timing harness, short runs for a shared machine):
+//!
+//! - native RGL evaluation, ns per `eval`;
+//! - MERL: load time of a (synthetic) 35 MB `.binary` file, ns per nearest lookup;
+//! - the RGL material resampled to the MERL grid: ns per lookup and its error against native.
+//!
+//! Run: `cargo bench --bench measured`.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use brdftab::Brdf;
+use brdftab::geometry::uniform_hemisphere;
+use brdftab::measured::{MerlBrdf, RglBrdf, merl};
+use brdftab::rng::Pcg32;
+use glam::DVec3;
+
+const RGL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/measured/rgl/");
+
+fn pairs(n: usize) -> Vec<(DVec3, DVec3)> {
+    let mut rng = Pcg32::new(42);
+    (0..n)
+        .map(|_| {
+            (
+                uniform_hemisphere(rng.next_dvec2()),
+                uniform_hemisphere(rng.next_dvec2()),
+            )
+        })
+        .collect()
+}
+
+/// Best-of-3 ns per evaluation over `pairs`.
+fn ns_per_eval(b: &dyn Brdf, pairs: &[(DVec3, DVec3)]) -> f64 {
+    let mut f = [0f32; 64];
+    let c = b.channels().len();
+    let mut best = f64::INFINITY;
+    for _ in 0..3 {
+        let t = Instant::now();
+        for &(wi, wo) in pairs {
+            b.eval(black_box(wi), black_box(wo), &mut f[..c]);
+            black_box(&f);
+        }
+        best = best.min(t.elapsed().as_nanos() as f64 / pairs.len() as f64);
+    }
+    best
+}
+
+/// Cosine-weighted relative RMSE of `b` against `reference` over `pairs` (all channels):
+/// sqrt(Σ cos θi cos θo (b − r)²) / sqrt(Σ cos θi cos θo r²).
+fn rel_rmse(b: &dyn Brdf, reference: &dyn Brdf, pairs: &[(DVec3, DVec3)]) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    let (mut fa, mut fb) = ([0f32; 3], [0f32; 3]);
+    for &(wi, wo) in pairs {
+        b.eval(wi, wo, &mut fa);
+        reference.eval(wi, wo, &mut fb);
+        let w = wi.z * wo.z;
+        for k in 0..3 {
+            num += w * (fa[k] as f64 - fb[k] as f64).powi(2);
+            den += w * (fb[k] as f64).powi(2);
+        }
+    }
+    (num / den).sqrt()
+}
+
+fn main() {
+    let p = pairs(200_000);
+    println!(
+        "measured benchmarks ({} random direction pairs, best of 3)",
+        p.len()
+    );
+
+    for file in [
+        "paper_white_rgb.bsdf",
+        "cc_ibiza_sunset_rgb.bsdf",
+        "cg_sunflower_rgb.bsdf",
+    ] {
+        let t = Instant::now();
+        let b = RglBrdf::open(format!("{RGL}{file}")).unwrap();
+        let load = t.elapsed().as_secs_f64() * 1e3;
+        println!(
+            "rgl native eval   {file:<28} {:7.1} ns/eval   (open {load:.1} ms)",
+            ns_per_eval(&b, &p)
+        );
+    }
+
+    // MERL: a synthetic file of random values.
+    let dir = std::env::temp_dir().join(format!("brdftab-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("synthetic.binary");
+    let mut rng = Pcg32::new(7);
+    let data: Vec<f64> = (0..3 * merl::SAMPLES)
+        .map(|_| rng.next_f64() * 2000.0)
+        .collect();
+    MerlBrdf::from_raw("synthetic", data)
+        .unwrap()
+        .write(&path)
+        .unwrap();
+    let mut best = f64::INFINITY;
+    let mut m = None;
+    for _ in 0..3 {
+        let t = Instant::now();
+        m = Some(MerlBrdf::open(&path).unwrap());
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    let m = m.unwrap();
+    println!(
+        "merl load         synthetic 34,992,012 bytes    {:7.3} s (target ≤ 0.3 s)",
+        best
+    );
+    let t = Instant::now();
+    let sha = merl::sha256_file(&path).unwrap();
+    println!(
+        "merl sha256       (info only, not on load)      {:7.3} s  {}…",
+        t.elapsed().as_secs_f64(),
+        &sha[..12]
+    );
+    println!(
+        "merl nearest eval                               {:7.1} ns/eval",
+        ns_per_eval(&m, &p)
+    );
+    std::fs::remove_dir_all(&dir).ok();
+
+    // The RGL material resampled to the MERL grid (a dense nearest-lookup table).
+    let b = RglBrdf::open(format!("{RGL}cc_ibiza_sunset_rgb.bsdf")).unwrap();
+    let t = Instant::now();
+    let resampled = MerlBrdf::from_brdf(&b);
+    let secs = t.elapsed().as_secs_f64();
+    let q = &p[..50_000];
+    println!(
+        "rgl → merl grid   cc_ibiza_sunset (resample {secs:.2} s) {:7.1} ns/lookup, cos-weighted rel RMSE {:.3}",
+        ns_per_eval(&resampled, &p),
+        rel_rmse(&resampled, &b, q)
+    );
+}

@@ -1,0 +1,129 @@
+//! Accuracy of one BRDF against another (a table against its source, a fit against data).
+//!
+//! Over N direction pairs drawn uniformly on the hemisphere (independently for wi and wo,
+//! deterministic seed):
+//!
+//! - cosine-weighted relative RMSE: sqrt(Σ((f̂ − f) cos θi)² / Σ(f cos θi)²), summed over pairs
+//!   and channels;
+//! - max relative error: max |f̂ − f| / max(|f|, 1% of the RMS of f) — the floor keeps pairs
+//!   where f is (nearly) 0 from dominating.
+
+use glam::DVec3;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::brdf::Brdf;
+use crate::error::{Error, Result};
+use crate::geometry;
+use crate::rng::Pcg32;
+use crate::spectrum::MAX_CHANNELS;
+
+/// Result of [`compare`].
+#[derive(Debug, Clone, Serialize)]
+pub struct Accuracy {
+    /// Number of pairs evaluated.
+    pub pairs: usize,
+    /// Cosine-weighted relative RMSE (see the module docs).
+    pub rel_rmse: f64,
+    /// Maximum relative error.
+    pub max_rel: f64,
+    /// The pair of the maximum relative error.
+    #[serde(serialize_with = "ser_pair")]
+    pub max_rel_at: (DVec3, DVec3),
+    /// Cosine-weighted relative RMSE per channel.
+    pub per_channel: Vec<f64>,
+}
+
+fn ser_pair<S: serde::Serializer>(
+    p: &(DVec3, DVec3),
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    [p.0.to_array(), p.1.to_array()].serialize(s)
+}
+
+const BLOCK: usize = 4096;
+
+/// Compares `approx` against `reference` over `pairs` random pairs with seed `seed`.
+pub fn compare(
+    approx: &dyn Brdf,
+    reference: &dyn Brdf,
+    pairs: usize,
+    seed: u64,
+) -> Result<Accuracy> {
+    let c = reference.channels().len();
+    if approx.channels().len() != c || c > MAX_CHANNELS {
+        return Err(Error::arg(
+            "channels",
+            format!("{} vs {} channels", approx.channels().len(), c),
+        ));
+    }
+    let blocks = pairs.div_ceil(BLOCK);
+    // Per block: (Σ err² per channel, Σ ref² per channel, Σ f² unweighted, samples (|err|, |f|, wi, wo)).
+    type Block = (Vec<f64>, Vec<f64>, f64, Vec<(f64, f64, DVec3, DVec3)>);
+    let parts: Vec<Block> = (0..blocks)
+        .into_par_iter()
+        .map(|b| {
+            let mut rng = Pcg32::with_stream(seed, b as u64);
+            let n = BLOCK.min(pairs - b * BLOCK);
+            let mut e2 = vec![0.0; c];
+            let mut r2 = vec![0.0; c];
+            let mut f2 = 0.0;
+            let mut worst = Vec::with_capacity(n * c);
+            let mut fa = [0.0f32; MAX_CHANNELS];
+            let mut fr = [0.0f32; MAX_CHANNELS];
+            for _ in 0..n {
+                let wi = geometry::uniform_hemisphere(rng.next_dvec2());
+                let wo = geometry::uniform_hemisphere(rng.next_dvec2());
+                approx.eval(wi, wo, &mut fa[..c]);
+                reference.eval(wi, wo, &mut fr[..c]);
+                for k in 0..c {
+                    let (a, r) = (fa[k] as f64, fr[k] as f64);
+                    let err = a - r;
+                    e2[k] += (err * wi.z).powi(2);
+                    r2[k] += (r * wi.z).powi(2);
+                    f2 += r * r;
+                    worst.push((err.abs(), r.abs(), wi, wo));
+                }
+            }
+            (e2, r2, f2, worst)
+        })
+        .collect();
+    let mut e2 = vec![0.0; c];
+    let mut r2 = vec![0.0; c];
+    let mut f2 = 0.0;
+    for p in &parts {
+        for k in 0..c {
+            e2[k] += p.0[k];
+            r2[k] += p.1[k];
+        }
+        f2 += p.2;
+    }
+    let floor = 0.01 * (f2 / (pairs * c).max(1) as f64).sqrt();
+    let mut max_rel = 0.0;
+    let mut at = (DVec3::ZERO, DVec3::ZERO);
+    for p in &parts {
+        for &(e, r, wi, wo) in &p.3 {
+            let rel = e / r.max(floor).max(1e-300);
+            if rel > max_rel || rel.is_nan() {
+                max_rel = rel;
+                at = (wi, wo);
+            }
+        }
+    }
+    let ratio = |e: f64, r: f64| {
+        if r > 0.0 {
+            (e / r).sqrt()
+        } else if e > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        }
+    };
+    Ok(Accuracy {
+        pairs,
+        rel_rmse: ratio(e2.iter().sum(), r2.iter().sum()),
+        max_rel,
+        max_rel_at: at,
+        per_channel: (0..c).map(|k| ratio(e2[k], r2[k])).collect(),
+    })
+}

@@ -1,0 +1,548 @@
+//! Physical plausibility of any BRDF: positivity, reciprocity and energy conservation.
+//!
+//! The lecture calls a BRDF *physically plausible* when it is positive, symmetric (Helmholtz
+//! reciprocity) and energy conserving (albedo < 1 for every incident direction) — exactly the
+//! conditions under which the light-transport operator is a contraction and a global illumination
+//! solver converges. [`check`] measures all three on any `&dyn Brdf` — an analytic model, a baked
+//! table, a measurement — and reports them next to what the source *declares* about itself
+//! ([`Flags`]), so a model that claims reciprocity but is not (or a table whose interpolation
+//! breaks it) shows up at once.
+//!
+//! - **Positivity**: the smallest value over many direction pairs and channels (non-finite values
+//!   are counted separately and make the source non-positive).
+//! - **Reciprocity**: the largest relative difference |f(a, b) − f(b, a)| / max(|f(a, b)|,
+//!   |f(b, a)|, floor) over the same pairs. The pairs are random but deterministic (PCG32 with a
+//!   fixed seed): half uniform on the hemisphere, a quarter near the mirror configuration (where
+//!   sharp lobes live) and a quarter near grazing.
+//! - **Energy conservation**: the directional albedo ([`Brdf::albedo`], i.e. the model's closed
+//!   form or the adaptive quadrature of [`super::albedo`]) for incidence angles 0..89°; for
+//!   sources not declared isotropic at several azimuths.
+//!
+//! ```
+//! use brdftab::{analysis::plausibility, spec::ModelSpec, spectrum::Channels};
+//! let brdf = ModelSpec::parse(r#"{"model": "lambert", "kd": 0.5}"#)?.build(&Channels::Rgb)?;
+//! let report = plausibility::check(&*brdf, &plausibility::Options::default());
+//! assert!(report.positive && report.reciprocal);
+//! assert!(!report.energy_conserving); // k_d > 1/π
+//! assert!((report.max_albedo - 0.5 * std::f64::consts::PI).abs() < 1e-6);
+//! # Ok::<(), brdftab::Error>(())
+//! ```
+
+use std::fmt;
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::brdf::{Brdf, Flags};
+use crate::geometry;
+use crate::rng::Pcg32;
+use crate::spectrum::MAX_CHANNELS;
+
+/// Settings of [`check`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    /// Number of random direction pairs for positivity and reciprocity.
+    pub pairs: usize,
+    /// Seed of the pair generator (the report is deterministic for a given seed).
+    pub seed: u64,
+    /// Incidence angles in degrees at which the albedo is computed.
+    pub thetas_deg: Vec<f64>,
+    /// Largest relative reciprocity error still called reciprocal.
+    pub reciprocity_tolerance: f64,
+    /// Absolute floor (1/sr) of the denominator of the relative reciprocity error, so values
+    /// that are both essentially zero do not count.
+    pub reciprocity_floor: f64,
+    /// Largest albedo excess over 1 still called energy conserving (quadrature slack).
+    pub albedo_tolerance: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            pairs: 20_000,
+            seed: 0x5eed_b7df,
+            thetas_deg: (0..90).map(f64::from).collect(),
+            reciprocity_tolerance: 1e-3,
+            reciprocity_floor: 1e-6,
+            albedo_tolerance: 1e-3,
+        }
+    }
+}
+
+/// A direction given by its spherical angles in degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AnglesDeg {
+    /// Polar angle from the normal.
+    pub theta: f64,
+    /// Azimuth from +x.
+    pub phi: f64,
+}
+
+impl AnglesDeg {
+    fn of(w: DVec3) -> Self {
+        let (t, p) = geometry::to_spherical(w);
+        AnglesDeg {
+            theta: t.to_degrees(),
+            phi: p.to_degrees(),
+        }
+    }
+}
+
+/// One point of the albedo curve.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AlbedoPoint {
+    /// Incidence angle θ′ in degrees (azimuth 0).
+    pub theta_deg: f64,
+    /// The albedo per channel.
+    pub albedo: Vec<f64>,
+}
+
+/// The plausibility of a BRDF, measured, next to what it declares. Serializes to one JSON object.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Report {
+    /// The source's own description.
+    pub source: String,
+    /// Channel names (`R`, `G`, `B` or wavelengths).
+    pub channels: Vec<String>,
+    /// What the source declares about itself.
+    pub declared: Flags,
+    /// Number of direction pairs evaluated (each in both orders).
+    pub pairs: usize,
+    /// No negative or non-finite value was seen.
+    pub positive: bool,
+    /// The smallest finite value seen (1/sr).
+    pub min_value: f64,
+    /// The number of non-finite (NaN, ±∞) values seen.
+    pub non_finite: usize,
+    /// `max_reciprocity_error` ≤ the tolerance.
+    pub reciprocal: bool,
+    /// The largest relative |f(a, b) − f(b, a)| seen.
+    pub max_reciprocity_error: f64,
+    /// Where the largest reciprocity error was seen (`[wi, wo]`), if any was nonzero.
+    pub max_reciprocity_at: Option<[AnglesDeg; 2]>,
+    /// The tolerance applied to `max_reciprocity_error`.
+    pub reciprocity_tolerance: f64,
+    /// `max_albedo` ≤ 1 + the tolerance.
+    pub energy_conserving: bool,
+    /// The largest albedo over every angle and channel.
+    pub max_albedo: f64,
+    /// The incidence angle at which it occurs (degrees).
+    pub max_albedo_theta_deg: f64,
+    /// The incidence azimuth at which it occurs (degrees; 0 for isotropic sources).
+    pub max_albedo_phi_deg: f64,
+    /// The channel in which it occurs.
+    pub max_albedo_channel: String,
+    /// The tolerance applied to `max_albedo − 1`.
+    pub albedo_tolerance: f64,
+    /// The albedo at every checked incidence angle (azimuth 0).
+    pub albedo_curve: Vec<AlbedoPoint>,
+}
+
+impl Report {
+    /// The three lecture properties at once: positive, reciprocal and energy conserving.
+    pub fn plausible(&self) -> bool {
+        self.positive && self.reciprocal && self.energy_conserving
+    }
+}
+
+/// Measures positivity, reciprocity and energy conservation of `brdf`.
+pub fn check(brdf: &dyn Brdf, opts: &Options) -> Report {
+    let channels = brdf.channels();
+    let c = channels.len().min(MAX_CHANNELS);
+    let declared = brdf.flags();
+
+    // Positivity and reciprocity over deterministic random pairs.
+    let mut rng = Pcg32::new(opts.seed);
+    let (mut fab, mut fba) = ([0.0f32; MAX_CHANNELS], [0.0f32; MAX_CHANNELS]);
+    let mut min_value = f64::INFINITY;
+    let mut non_finite = 0usize;
+    let mut max_err = 0.0f64;
+    let mut max_at = None;
+    for k in 0..opts.pairs {
+        let (a, b) = random_pair(&mut rng, k);
+        brdf.eval(a, b, &mut fab[..c]);
+        brdf.eval(b, a, &mut fba[..c]);
+        for ch in 0..c {
+            let (x, y) = (fab[ch] as f64, fba[ch] as f64);
+            for v in [x, y] {
+                if v.is_finite() {
+                    min_value = min_value.min(v);
+                } else {
+                    non_finite += 1;
+                }
+            }
+            if x.is_finite() && y.is_finite() {
+                let err = (x - y).abs() / x.abs().max(y.abs()).max(opts.reciprocity_floor);
+                if err > max_err {
+                    max_err = err;
+                    max_at = Some([AnglesDeg::of(a), AnglesDeg::of(b)]);
+                }
+            }
+        }
+    }
+    if !min_value.is_finite() {
+        min_value = 0.0;
+    }
+
+    // Energy: the albedo at every angle (and a few azimuths for anisotropic sources).
+    let azimuths: &[f64] = if declared.isotropic {
+        &[0.0]
+    } else {
+        &[0.0, 45.0, 90.0, 135.0]
+    };
+    let jobs: Vec<(f64, f64)> = opts
+        .thetas_deg
+        .iter()
+        .flat_map(|&t| azimuths.iter().map(move |&p| (t, p)))
+        .collect();
+    let albedos: Vec<Vec<f64>> = jobs
+        .par_iter()
+        .map(|&(t, p)| {
+            let mut a = vec![0.0; c];
+            brdf.albedo(geometry::spherical(t.to_radians(), p.to_radians()), &mut a);
+            a
+        })
+        .collect();
+    let (mut max_albedo, mut max_t, mut max_p, mut max_ch) = (0.0f64, 0.0, 0.0, 0usize);
+    let mut curve = Vec::with_capacity(opts.thetas_deg.len());
+    for (&(t, p), a) in jobs.iter().zip(&albedos) {
+        for (ch, &v) in a.iter().enumerate() {
+            if v > max_albedo || v.is_nan() && !max_albedo.is_nan() {
+                (max_albedo, max_t, max_p, max_ch) = (v, t, p, ch);
+            }
+        }
+        if p == 0.0 {
+            curve.push(AlbedoPoint {
+                theta_deg: t,
+                albedo: a.clone(),
+            });
+        }
+    }
+    let names = channels.names();
+    Report {
+        source: brdf.describe(),
+        channels: names.clone(),
+        declared,
+        pairs: opts.pairs,
+        positive: min_value >= 0.0 && non_finite == 0,
+        min_value,
+        non_finite,
+        reciprocal: max_err <= opts.reciprocity_tolerance,
+        max_reciprocity_error: max_err,
+        max_reciprocity_at: max_at,
+        reciprocity_tolerance: opts.reciprocity_tolerance,
+        energy_conserving: max_albedo <= 1.0 + opts.albedo_tolerance,
+        max_albedo,
+        max_albedo_theta_deg: max_t,
+        max_albedo_phi_deg: max_p,
+        max_albedo_channel: names.get(max_ch).cloned().unwrap_or_default(),
+        albedo_tolerance: opts.albedo_tolerance,
+        albedo_curve: curve,
+    }
+}
+
+/// The k-th random pair: uniform, near-mirror or near-grazing, in turn.
+fn random_pair(rng: &mut Pcg32, k: usize) -> (DVec3, DVec3) {
+    let a = geometry::uniform_hemisphere(rng.next_dvec2());
+    match k % 4 {
+        // Near the mirror configuration: the mirror direction of `a` tilted by a log-uniform
+        // angle between 1e-4 and 0.3 rad, so sharp lobes are probed at every scale.
+        1 => {
+            let r = geometry::reflect_z(a);
+            let frame = geometry::Frame::from_normal(r);
+            let tilt = 1e-4 * (0.3f64 / 1e-4).powf(rng.next_f64());
+            let phi = std::f64::consts::TAU * rng.next_f64();
+            let local = geometry::spherical(tilt, phi);
+            let b = frame.to_world(local);
+            if b.z > 0.0 { (a, b) } else { (a, r) }
+        }
+        // Near grazing: one direction between 80° and 89.9°.
+        2 => {
+            let u = rng.next_dvec2();
+            let t = (80.0 + 9.9 * u.x).to_radians();
+            let g = geometry::spherical(t, std::f64::consts::TAU * u.y);
+            (g, a)
+        }
+        _ => (
+            a,
+            geometry::uniform_hemisphere(DVec2::new(rng.next_f64(), rng.next_f64())),
+        ),
+    }
+}
+
+fn yes_no(b: bool) -> &'static str {
+    if b { "yes" } else { "NO" }
+}
+
+impl fmt::Display for Report {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "source:             {}", self.source)?;
+        writeln!(f, "channels:           {}", self.channels.join(" "))?;
+        writeln!(
+            f,
+            "positive:           {}   (min value {:.4e} over {} pairs, {} non-finite)",
+            yes_no(self.positive),
+            self.min_value,
+            self.pairs,
+            self.non_finite
+        )?;
+        write!(
+            f,
+            "reciprocal:         {}   (max relative error {:.3e}, tolerance {:.0e}; declared {})",
+            yes_no(self.reciprocal),
+            self.max_reciprocity_error,
+            self.reciprocity_tolerance,
+            if self.declared.reciprocal {
+                "yes"
+            } else {
+                "no"
+            }
+        )?;
+        if let (false, Some([a, b])) = (self.reciprocal, self.max_reciprocity_at) {
+            write!(
+                f,
+                "\n                    worst at wi (θ {:.1}°, φ {:.1}°), wo (θ {:.1}°, φ {:.1}°)",
+                a.theta, a.phi, b.theta, b.phi
+            )?;
+        }
+        writeln!(f)?;
+        writeln!(
+            f,
+            "energy conserving:  {}   (max albedo {:.6} at θ′ = {}°{}, channel {})",
+            yes_no(self.energy_conserving),
+            self.max_albedo,
+            self.max_albedo_theta_deg,
+            if self.max_albedo_phi_deg != 0.0 {
+                format!(", φ′ = {}°", self.max_albedo_phi_deg)
+            } else {
+                String::new()
+            },
+            self.max_albedo_channel
+        )?;
+        writeln!(
+            f,
+            "declared flags:     reciprocal {}, isotropic {}, bilateral {}, delta {}, transmission {}",
+            self.declared.reciprocal,
+            self.declared.isotropic,
+            self.declared.bilateral,
+            self.declared.delta,
+            self.declared.transmission
+        )?;
+        writeln!(
+            f,
+            "albedo curve (θ′ in degrees every 5° and the last; one column per channel):"
+        )?;
+        let last = self.albedo_curve.len().saturating_sub(1);
+        for (i, p) in self.albedo_curve.iter().enumerate() {
+            if p.theta_deg % 5.0 != 0.0 && i != last {
+                continue;
+            }
+            let vals: Vec<String> = p.albedo.iter().map(|a| format!("{a:.6}")).collect();
+            writeln!(f, "  {:>5} {}", p.theta_deg, vals.join(" "))?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::lambert::Lambert;
+    use crate::spectrum::{Channels, Value};
+
+    /// Test-only original Phong: k_s cos^n ψ / cos θ′ (θ′ = angle of wi).
+    struct OriginalPhong;
+
+    impl Brdf for OriginalPhong {
+        fn channels(&self) -> &Channels {
+            &Channels::Rgb
+        }
+        fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+            let v = match geometry::upper_pair(wi, wo) {
+                Some((wi, wo)) => 0.5 * geometry::reflect_z(wi).dot(wo).max(0.0).powi(20) / wi.z,
+                None => 0.0,
+            };
+            out[..3].fill(v as f32);
+        }
+        fn flags(&self) -> Flags {
+            Flags {
+                reciprocal: false,
+                ..Flags::SMOOTH_SYMMETRIC
+            }
+        }
+        fn describe(&self) -> String {
+            "test original phong".into()
+        }
+    }
+
+    /// Test-only Cook-Torrance with F = 1: normalized Beckmann D, V-cavity G, D G / (4 cos θ cos θ′).
+    struct CookTorrance {
+        m: f64,
+    }
+
+    impl Brdf for CookTorrance {
+        fn channels(&self) -> &Channels {
+            &Channels::Rgb
+        }
+        fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+            let v = match geometry::upper_pair(wi, wo) {
+                Some((l, v)) => {
+                    let h = (l + v).normalize();
+                    let (nh, nl, nv, vh) = (h.z, l.z, v.z, v.dot(h));
+                    let tan2 = (1.0 - nh * nh) / (nh * nh);
+                    let m2 = self.m * self.m;
+                    let d = (-tan2 / m2).exp() / (std::f64::consts::PI * m2 * nh.powi(4));
+                    let g = (2.0 * nh * nv / vh).min(2.0 * nh * nl / vh).min(1.0);
+                    d * g / (4.0 * nl * nv)
+                }
+                None => 0.0,
+            };
+            out[..3].fill(v as f32);
+        }
+        fn flags(&self) -> Flags {
+            Flags::SMOOTH_SYMMETRIC
+        }
+        fn describe(&self) -> String {
+            "test cook-torrance".into()
+        }
+    }
+
+    /// Test-only BRDF with a negative value somewhere.
+    struct Negative;
+
+    impl Brdf for Negative {
+        fn channels(&self) -> &Channels {
+            &Channels::Rgb
+        }
+        fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+            let v = if wi.z > 0.0 && wo.z > 0.0 {
+                0.1 - wi.x * wo.x
+            } else {
+                0.0
+            };
+            out[..3].fill(v as f32);
+        }
+        fn flags(&self) -> Flags {
+            Flags::SMOOTH_SYMMETRIC
+        }
+        fn describe(&self) -> String {
+            "test negative".into()
+        }
+    }
+
+    fn quick() -> Options {
+        Options {
+            pairs: 4000,
+            thetas_deg: vec![0.0, 30.0, 60.0, 80.0, 89.0],
+            ..Options::default()
+        }
+    }
+
+    #[test]
+    fn lambert_is_plausible_below_one_over_pi_and_not_above() {
+        let ok = Lambert::new(Value::Grey(0.3), &Channels::Rgb).unwrap();
+        let r = check(&ok, &quick());
+        assert!(r.plausible(), "{r}");
+        assert_eq!(r.min_value, 0.3f32 as f64);
+        assert_eq!(r.max_reciprocity_error, 0.0);
+        let bright = Lambert::new(Value::Grey(0.5), &Channels::Rgb).unwrap();
+        let r = check(&bright, &quick());
+        assert!(r.positive && r.reciprocal && !r.energy_conserving, "{r}");
+        assert!((r.max_albedo - 0.5 * std::f64::consts::PI).abs() < 1e-6);
+    }
+
+    #[test]
+    fn original_phong_is_not_reciprocal() {
+        let r = check(&OriginalPhong, &quick());
+        assert!(r.positive, "{r}");
+        assert!(!r.reciprocal && r.max_reciprocity_error > 0.5, "{r}");
+        assert!(r.max_reciprocity_at.is_some());
+        assert!(!r.declared.reciprocal);
+    }
+
+    #[test]
+    fn cook_torrance_albedo_grows_at_grazing_angles() {
+        // The lecture's "cheat": 1/(N·L) lets the albedo climb towards grazing incidence (with
+        // the V-cavity G and F = 1 it tends to 1 instead of falling off like a real rough surface).
+        let r = check(&CookTorrance { m: 0.6 }, &quick());
+        assert!(r.positive && r.reciprocal, "{r}");
+        let a: Vec<f64> = r.albedo_curve.iter().map(|p| p.albedo[0]).collect();
+        assert!(a.windows(2).all(|w| w[1] > w[0]), "{a:?}");
+        assert!(a[4] > 1.2 * a[0], "{r}");
+        assert_eq!(r.max_albedo_theta_deg, 89.0);
+    }
+
+    fn model(spec: &str) -> Box<dyn Brdf> {
+        crate::spec::ModelSpec::parse(spec)
+            .unwrap()
+            .build(&Channels::Rgb)
+            .unwrap()
+    }
+
+    #[test]
+    fn real_lecture_models() {
+        let o = quick();
+        let r = check(&*model(r#"{"model": "phong", "ks": 0.5, "n": 20}"#), &o);
+        assert!(r.positive && !r.reciprocal && !r.declared.reciprocal, "{r}");
+        for spec in [
+            r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 20}"#,
+            r#"{"model": "max_phong", "ks": 0.5, "n": 20}"#,
+            r#"{"model": "pumped_phong", "ks": 0.5, "n": 20, "x": "product"}"#,
+        ] {
+            let r = check(&*model(spec), &o);
+            assert!(r.positive && r.reciprocal, "{spec}: {r}");
+        }
+        // Reciprocal Phong loses energy at grazing incidence, X = cos θ cos θ′ pumps it up
+        // without bound.
+        let r = check(
+            &*model(r#"{"model": "reciprocal_phong", "ks": 1, "n": 20}"#),
+            &o,
+        );
+        assert!(r.energy_conserving && r.max_albedo_theta_deg == 0.0, "{r}");
+        let r = check(
+            &*model(r#"{"model": "pumped_phong", "ks": 1, "n": 20, "x": "product"}"#),
+            &o,
+        );
+        assert!(
+            !r.energy_conserving && r.max_albedo_theta_deg == 89.0,
+            "{r}"
+        );
+        // Cook-Torrance with gold: the albedo climbs towards grazing incidence.
+        let r = check(
+            &*model(r#"{"model": "cook_torrance", "m": 0.6, "fresnel": {"conductor": "Au"}}"#),
+            &o,
+        );
+        assert!(r.positive && r.reciprocal, "{r}");
+        let a: Vec<f64> = r.albedo_curve.iter().map(|p| p.albedo[2]).collect();
+        assert!(a[4] > 1.2 * a[0], "{r}");
+        assert_eq!(r.max_albedo_theta_deg, 89.0);
+    }
+
+    #[test]
+    fn negative_values_are_found() {
+        let r = check(&Negative, &quick());
+        assert!(!r.positive && r.min_value < -0.5, "{r}");
+    }
+
+    #[test]
+    fn report_is_deterministic_and_serializes() {
+        let a = check(&OriginalPhong, &quick());
+        let b = check(&OriginalPhong, &quick());
+        assert_eq!(a, b);
+        let json = serde_json::to_value(&a).unwrap();
+        for key in [
+            "positive",
+            "min_value",
+            "reciprocal",
+            "max_reciprocity_error",
+            "energy_conserving",
+            "max_albedo",
+            "max_albedo_theta_deg",
+            "declared",
+            "albedo_curve",
+        ] {
+            assert!(json.get(key).is_some(), "{key} missing in {json}");
+        }
+    }
+}

@@ -1,0 +1,416 @@
+//! MERL BRDF database files (`.binary`, Matusik et al., "A Data-Driven Reflectance Model",
+//! SIGGRAPH 2003): read, evaluate exactly as the reference reader, and write.
+//!
+//! # Format
+//!
+//! ```text
+//! i32[3]  dims = (90, 90, 180)            θh, θd, φd resolutions (product 1,458,000)
+//! f64[3 × 1,458,000]                      channel-planar R, then G, then B; little-endian
+//! ```
+//!
+//! 34,992,012 bytes in all. Sample (θh, θd, φd) of channel c is at `c·N + φd + 180·θd + 180·90·θh`
+//! and scales to f_r by R 1/1500, G 1.15/1500, B 1.66/1500. The angles are the Rusinkiewicz
+//! half/difference angles of ([`geometry::to_half_diff`](crate::geometry::to_half_diff), with the
+//! MERL reader's "in" direction = our `wi`), indexed as the reference reader `BRDFRead.cpp` does:
+//!
+//! - θh: `int(sqrt(θh / (π/2)) · 90)`, 0 when θh ≤ 0 — a square-root axis, dense near the
+//!   specular peak;
+//! - θd: `int(θd / (π/2) · 90)`;
+//! - φd: plus π when negative (reciprocity, φd ≡ φd + π), then `int(φd / π · 180)`;
+//!
+//! each clamped to its range. Index `i` therefore covers a cell whose centre — in index space
+//! `i + ½` — is where [`MerlBrdf::from_brdf`] samples a model and where a table's nodes must sit
+//! for nearest-node lookup to reproduce this truncating lookup.
+//!
+//! # Missing measurements
+//!
+//! Negative stored values (the database uses −1) mark cells that were never measured (mostly at
+//! grazing θd). [`MerlBrdf`] keeps them as stored — writing a file back is bit-exact — exposes
+//! them through [`MerlBrdf::is_valid`], and evaluates them as 0, as the reference reader's clamp
+//! does. Consequence for interpolating consumers (a table with `--interp linear`): a valid cell
+//! next to an invalid one is blended towards 0 over the half cell between them, so the measured
+//! data near the unmeasured region are darkened slightly. Nearest lookup is unaffected.
+//!
+//! # Identification
+//!
+//! [`material_of`] names a file from its SHA-256 using [`MERL_FILES`](super::merl_manifest::MERL_FILES),
+//! the checksums of the 100 published files.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+use std::path::Path;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::brdf::{Brdf, Flags};
+use crate::error::{Error, Result};
+use crate::geometry::{self, HalfDiff};
+use crate::spectrum::{Channels, RGB_WAVELENGTHS};
+
+/// θh resolution.
+pub const RES_THETA_H: usize = 90;
+/// θd resolution.
+pub const RES_THETA_D: usize = 90;
+/// φd resolution (over [0, π): the other half follows by reciprocity).
+pub const RES_PHI_D: usize = 180;
+/// Samples per channel.
+pub const SAMPLES: usize = RES_THETA_H * RES_THETA_D * RES_PHI_D;
+/// Size of every MERL file in bytes.
+pub const FILE_SIZE: u64 = 12 + 3 * SAMPLES as u64 * 8;
+/// Scale from stored values to f_r, per channel R, G, B.
+pub const SCALE: [f64; 3] = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
+
+/// θh index: `int(sqrt(θh / (π/2)) · 90)`, 0 for θh ≤ 0, clamped to [0, 89].
+#[inline]
+pub fn theta_h_index(theta_h: f64) -> usize {
+    if theta_h.is_nan() || theta_h <= 0.0 {
+        return 0;
+    }
+    let x = (theta_h / FRAC_PI_2).sqrt() * RES_THETA_H as f64;
+    (x as usize).min(RES_THETA_H - 1)
+}
+
+/// θd index: `int(θd / (π/2) · 90)`, clamped to [0, 89].
+#[inline]
+pub fn theta_d_index(theta_d: f64) -> usize {
+    let x = theta_d / FRAC_PI_2 * RES_THETA_D as f64;
+    if x.is_nan() || x <= 0.0 {
+        return 0;
+    }
+    (x as usize).min(RES_THETA_D - 1)
+}
+
+/// φd index: φd + π when negative, then `int(φd / π · 180)`, clamped to [0, 179].
+#[inline]
+pub fn phi_d_index(phi_d: f64) -> usize {
+    let p = if phi_d < 0.0 { phi_d + PI } else { phi_d };
+    let x = p / PI * RES_PHI_D as f64;
+    if x.is_nan() || x <= 0.0 {
+        return 0;
+    }
+    (x as usize).min(RES_PHI_D - 1)
+}
+
+/// Linear sample index of (θh, θd, φd) indices within a channel plane.
+#[inline]
+pub fn sample_index(ith: usize, itd: usize, ipd: usize) -> usize {
+    ipd + RES_PHI_D * itd + RES_PHI_D * RES_THETA_D * ith
+}
+
+/// The half/difference angles at the centre of cell (ith, itd, ipd) (φh = 0).
+pub fn cell_center(ith: usize, itd: usize, ipd: usize) -> HalfDiff {
+    let u = (ith as f64 + 0.5) / RES_THETA_H as f64;
+    HalfDiff {
+        theta_h: u * u * FRAC_PI_2,
+        phi_h: 0.0,
+        theta_d: (itd as f64 + 0.5) / RES_THETA_D as f64 * FRAC_PI_2,
+        phi_d: (ipd as f64 + 0.5) / RES_PHI_D as f64 * PI,
+    }
+}
+
+/// The material whose published file has this SHA-256 (lower-case hex), if any.
+pub fn material_of(sha256: &str) -> Option<&'static str> {
+    super::merl_manifest::MERL_FILES
+        .iter()
+        .find(|(_, h)| h.eq_ignore_ascii_case(sha256))
+        .map(|(m, _)| *m)
+}
+
+/// SHA-256 of a file, lower-case hex.
+pub fn sha256_file(path: impl AsRef<Path>) -> Result<String> {
+    use sha2::Digest;
+    use std::io::Read;
+    let path = path.as_ref();
+    let mut f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut h = sha2::Sha256::new();
+    let mut buf = vec![0u8; 1 << 20];
+    loop {
+        let n = f.read(&mut buf).map_err(|e| Error::io(path, e))?;
+        if n == 0 {
+            break;
+        }
+        h.update(&buf[..n]);
+    }
+    Ok(format!("{:x}", h.finalize()))
+}
+
+/// A MERL measurement: the stored samples (raw, unscaled, invalid cells negative) and the
+/// reference reader's nearest lookup.
+#[derive(Clone)]
+pub struct MerlBrdf {
+    name: String,
+    /// Raw stored values, channel-planar R, G, B (3 × [`SAMPLES`]).
+    data: Vec<f64>,
+    channels: Channels,
+}
+
+impl std::fmt::Debug for MerlBrdf {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MerlBrdf")
+            .field("name", &self.name)
+            .field("invalid_cells", &self.invalid_cells())
+            .finish_non_exhaustive()
+    }
+}
+
+impl MerlBrdf {
+    /// Reads a `.binary` file; checks its size and header before reading the samples.
+    pub fn open(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+        if meta.len() != FILE_SIZE {
+            // Read the header anyway (if present) for a more helpful message.
+            let hint = std::fs::File::open(path)
+                .ok()
+                .and_then(|mut f| {
+                    use std::io::Read;
+                    let mut h = [0u8; 12];
+                    f.read_exact(&mut h).ok().map(|_| h)
+                })
+                .map(|h| {
+                    let d = dims(&h);
+                    format!(" (header says {} × {} × {})", d[0], d[1], d[2])
+                })
+                .unwrap_or_default();
+            return Err(Error::format(
+                &file,
+                None,
+                None,
+                format!(
+                    "a MERL file has {FILE_SIZE} bytes, this one has {}{hint}",
+                    meta.len()
+                ),
+            ));
+        }
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        Self::from_bytes(file, &bytes)
+    }
+
+    /// Parses a MERL file held in memory; `name` names it in errors.
+    pub fn from_bytes(name: impl Into<String>, bytes: &[u8]) -> Result<Self> {
+        let name = name.into();
+        if bytes.len() < 12 {
+            return Err(Error::format(
+                &name,
+                Some("header"),
+                Some(0),
+                format!("truncated: {} bytes, the header alone has 12", bytes.len()),
+            ));
+        }
+        let d = dims(&bytes[..12]);
+        if d != [RES_THETA_H as i32, RES_THETA_D as i32, RES_PHI_D as i32] {
+            let product = d.iter().map(|&x| x as i64).product::<i64>();
+            return Err(Error::format(
+                &name,
+                Some("header"),
+                Some(0),
+                format!(
+                    "dimensions {} × {} × {} (product {product}); MERL files are 90 × 90 × 180 = {SAMPLES}",
+                    d[0], d[1], d[2]
+                ),
+            ));
+        }
+        if bytes.len() as u64 != FILE_SIZE {
+            return Err(Error::format(
+                &name,
+                None,
+                Some(bytes.len().min(FILE_SIZE as usize) as u64),
+                format!(
+                    "a MERL file has {FILE_SIZE} bytes, this one has {}",
+                    bytes.len()
+                ),
+            ));
+        }
+        let data: Vec<f64> = bytes[12..]
+            .chunks_exact(8)
+            .map(|b| f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]))
+            .collect();
+        if let Some(k) = data.iter().position(|v| v.is_nan()) {
+            return Err(Error::format(
+                &name,
+                Some(["R", "G", "B"][k / SAMPLES]),
+                Some(12 + 8 * k as u64),
+                format!("sample {} is NaN", k % SAMPLES),
+            ));
+        }
+        Ok(MerlBrdf {
+            name,
+            data,
+            channels: Channels::Rgb,
+        })
+    }
+
+    /// Builds from raw stored values (3 × [`SAMPLES`], channel-planar, unscaled).
+    pub fn from_raw(name: impl Into<String>, data: Vec<f64>) -> Result<Self> {
+        if data.len() != 3 * SAMPLES {
+            return Err(Error::arg(
+                "data",
+                format!("{} values, expected 3 × {SAMPLES}", data.len()),
+            ));
+        }
+        Ok(MerlBrdf {
+            name: name.into(),
+            data,
+            channels: Channels::Rgb,
+        })
+    }
+
+    /// Resamples any BRDF at the cell centres of the MERL grid (RGB channels: `eval`; other
+    /// channel sets: [`Brdf::eval_wavelength`] at the representative RGB wavelengths) and stores
+    /// f_r / scale. Runs in parallel.
+    pub fn from_brdf(brdf: &dyn Brdf) -> Self {
+        let rgb = *brdf.channels() == Channels::Rgb;
+        let plane = RES_THETA_D * RES_PHI_D;
+        let mut cells = vec![[0.0f64; 3]; SAMPLES];
+        cells
+            .par_chunks_mut(plane)
+            .enumerate()
+            .for_each(|(ith, chunk)| {
+                for itd in 0..RES_THETA_D {
+                    for ipd in 0..RES_PHI_D {
+                        let (wi, wo) = geometry::from_half_diff(cell_center(ith, itd, ipd));
+                        let mut f = [0.0f32; 3];
+                        if rgb {
+                            brdf.eval(wi, wo, &mut f);
+                        } else {
+                            for (c, nm) in RGB_WAVELENGTHS.iter().enumerate() {
+                                f[c] = brdf.eval_wavelength(wi, wo, *nm) as f32;
+                            }
+                        }
+                        let cell = &mut chunk[ipd + RES_PHI_D * itd];
+                        for c in 0..3 {
+                            cell[c] = f[c] as f64 / SCALE[c];
+                        }
+                    }
+                }
+            });
+        let mut data = vec![0.0f64; 3 * SAMPLES];
+        for (k, cell) in cells.iter().enumerate() {
+            for c in 0..3 {
+                data[c * SAMPLES + k] = cell[c];
+            }
+        }
+        MerlBrdf {
+            name: format!("resampled {}", brdf.describe()),
+            data,
+            channels: Channels::Rgb,
+        }
+    }
+
+    /// The file's bytes: header and the raw samples, little-endian.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(FILE_SIZE as usize);
+        for d in [RES_THETA_H, RES_THETA_D, RES_PHI_D] {
+            out.extend_from_slice(&(d as i32).to_le_bytes());
+        }
+        for v in &self.data {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        out
+    }
+
+    /// Writes the file (through a temporary file renamed into place).
+    pub fn write(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
+        let tmp = path.with_extension("binary.tmp");
+        std::fs::write(&tmp, self.to_bytes()).map_err(|e| Error::io(&tmp, e))?;
+        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+    }
+
+    /// Name (file name or what it was resampled from).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The raw stored values, channel-planar R, G, B.
+    pub fn raw(&self) -> &[f64] {
+        &self.data
+    }
+
+    /// Whether cell (ith, itd, ipd) was measured (every channel ≥ 0).
+    pub fn is_valid(&self, ith: usize, itd: usize, ipd: usize) -> bool {
+        let k = sample_index(ith, itd, ipd);
+        (0..3).all(|c| self.data[c * SAMPLES + k] >= 0.0)
+    }
+
+    /// Number of unmeasured cells (any channel negative).
+    pub fn invalid_cells(&self) -> usize {
+        (0..SAMPLES)
+            .filter(|&k| (0..3).any(|c| self.data[c * SAMPLES + k] < 0.0))
+            .count()
+    }
+
+    /// f_r of cell (ith, itd, ipd): scaled, invalid (negative) clamped to 0.
+    #[inline]
+    pub fn cell(&self, ith: usize, itd: usize, ipd: usize) -> [f32; 3] {
+        self.cell_at(sample_index(ith, itd, ipd))
+    }
+
+    #[inline]
+    fn cell_at(&self, k: usize) -> [f32; 3] {
+        let mut f = [0.0f32; 3];
+        for (c, v) in f.iter_mut().enumerate() {
+            *v = (self.data[c * SAMPLES + k].max(0.0) * SCALE[c]) as f32;
+        }
+        f
+    }
+}
+
+impl MerlBrdf {
+    /// The measurement as a dense table on [`Grid::merl`](crate::table::Grid::merl): stored
+    /// node (θh i, φh 0, θd j, φd k) holds cell (i, j, k) scaled to f_r, unmeasured cells as 0.
+    ///
+    /// The grid's nodes use [`Nodes::CellStart`](crate::table::Nodes::CellStart), so a *nearest*
+    /// lookup takes the same indices as [`MerlBrdf::eval`] (value for value); a *linear* lookup
+    /// interpolates between cells and, next to an unmeasured cell, towards 0 (see the module
+    /// docs).
+    pub fn to_table(&self) -> crate::table::Table {
+        let grid = crate::table::Grid::merl(Channels::Rgb);
+        crate::table::Table::from_fn(grid, self.describe(), |idx, _, out| {
+            out.copy_from_slice(&self.cell(idx[0], idx[2], idx[3]));
+        })
+    }
+}
+
+fn dims(h: &[u8]) -> [i32; 3] {
+    let r = |i: usize| i32::from_le_bytes([h[i], h[i + 1], h[i + 2], h[i + 3]]);
+    [r(0), r(4), r(8)]
+}
+
+impl Brdf for MerlBrdf {
+    fn channels(&self) -> &Channels {
+        &self.channels
+    }
+
+    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+        let out = &mut out[..3];
+        out.fill(0.0);
+        let Some((wi, wo)) = geometry::upper_pair(wi, wo) else {
+            return;
+        };
+        let Some(hd) = geometry::to_half_diff(wi, wo) else {
+            return;
+        };
+        let k = sample_index(
+            theta_h_index(hd.theta_h),
+            theta_d_index(hd.theta_d),
+            phi_d_index(hd.phi_d),
+        );
+        out.copy_from_slice(&self.cell_at(k));
+    }
+
+    fn flags(&self) -> Flags {
+        // The φd ≡ φd + π fold makes every lookup reciprocal; only φd ∈ [0, π) is stored, and
+        // the data are isotropic by construction (no φh).
+        Flags {
+            reciprocal: true,
+            isotropic: true,
+            ..Flags::default()
+        }
+    }
+
+    fn describe(&self) -> String {
+        format!("MERL measured BRDF ({})", self.name)
+    }
+}

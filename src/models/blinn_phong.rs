@@ -1,0 +1,269 @@
+//! Normalized Blinn-Phong: a cosine-power lobe around the normal, in the half vector.
+//!
+//! ```text
+//! f_r(wi, wo) = k_s (n + 8) / (8π) · cos^n θh,     h = normalize(wi + wo)
+//! ```
+//!
+//! The factor (n + 8)/(8π) is the usual approximate energy normalization (Akenine-Möller et al.,
+//! *Real-Time Rendering*): at normal incidence the albedo is close to k_s for every exponent, so
+//! k_s reads as "how much is reflected" rather than "how bright the peak is". It is an
+//! approximation — the exact normal-incidence albedo drifts a few per cent with n — and the model
+//! is not energy conserving at grazing angles for k_s near 1.
+//!
+//! The model depends on the directions only through h, so it is reciprocal, isotropic and
+//! bilaterally symmetric.
+//!
+//! # Sampling
+//!
+//! The half vector is drawn from the normalized distribution D(h) cos θh with
+//! D(h) = (n + 2)/(2π) cos^n θh, i.e. density (n + 2)/(2π) cos^{n+1} θh (cos θh = u₁^{1/(n+2)},
+//! φh = 2π u₂), and reflected: wi = 2 (wo·h) h − wo. The change of variables h → wi has
+//! Jacobian 1/(4 |wo·h|), so
+//!
+//! ```text
+//! pdf(wi | wo) = (n + 2)/(2π) cos^{n+1} θh / (4 (wo·h)).
+//! ```
+//!
+//! Half vectors whose reflection falls below the horizon are rejected (`None`); the sampled
+//! density then integrates to less than 1 over the hemisphere, which is the honest density of
+//! what is returned. The weight f cos θi / pdf = k_s (n+8)/(n+2) · cos θi (wo·h) / cos θh is
+//! bounded (by 2 k_s (n+8)/(n+2)), so no cosine mixture is needed.
+
+use glam::{DVec2, DVec3};
+use std::f64::consts::PI;
+
+use crate::brdf::{Brdf, BrdfSample, Flags};
+use crate::error::{Error, Result};
+use crate::geometry;
+use crate::spectrum::{Channels, Value};
+
+/// Normalized Blinn-Phong, f_r = k_s (n + 8)/(8π) cos^n θh.
+#[derive(Debug, Clone)]
+pub struct BlinnPhong {
+    channels: Channels,
+    ks_spec: Value,
+    ks: Vec<f64>,
+    n: f64,
+    /// (n + 8) / (8π), the normalization of f_r.
+    norm: f64,
+}
+
+impl BlinnPhong {
+    /// A Blinn-Phong lobe with specular coefficient `ks` and exponent `n` ≥ 0.
+    pub fn new(ks: Value, n: f64, channels: &Channels) -> Result<Self> {
+        ks.validate("ks", 0.0)?;
+        if !(n.is_finite() && n >= 0.0) {
+            return Err(Error::spec("n", format!("{n} must be a finite number ≥ 0")));
+        }
+        Ok(BlinnPhong {
+            channels: channels.clone(),
+            ks: ks.resolve(channels),
+            ks_spec: ks,
+            n,
+            norm: (n + 8.0) / (8.0 * PI),
+        })
+    }
+
+    /// The exponent n.
+    pub fn exponent(&self) -> f64 {
+        self.n
+    }
+
+    /// The lobe without k_s, (n + 8)/(8π) cos^n θh, for unit directions above the horizon.
+    #[inline]
+    fn lobe(&self, wi: DVec3, wo: DVec3) -> f64 {
+        match geometry::normalize(wi + wo) {
+            Some(h) => self.norm * h.z.max(0.0).powf(self.n),
+            None => 0.0,
+        }
+    }
+
+    /// The normalized microfacet distribution D(h) = (n + 2)/(2π) cos^n θh, with
+    /// ∫ D(h) cos θh dω_h = 1 over the hemisphere.
+    #[inline]
+    pub fn ndf(&self, h: DVec3) -> f64 {
+        if h.z <= 0.0 {
+            return 0.0;
+        }
+        (self.n + 2.0) / (2.0 * PI) * h.z.powf(self.n)
+    }
+
+    /// Draws a half vector with density D(h) cos θh (see [`BlinnPhong::ndf`]).
+    #[inline]
+    pub fn sample_half_vector(&self, u: DVec2) -> DVec3 {
+        // The CDF of cos θh is cos^{n+2} θh; 1 − u avoids u = 0 mapping to the horizon.
+        let cos_t = (1.0 - u.x).powf(1.0 / (self.n + 2.0));
+        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+        let (sp, cp) = (2.0 * PI * u.y).sin_cos();
+        DVec3::new(sin_t * cp, sin_t * sp, cos_t)
+    }
+}
+
+impl Brdf for BlinnPhong {
+    fn channels(&self) -> &Channels {
+        &self.channels
+    }
+
+    #[inline]
+    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+        let out = &mut out[..self.ks.len()];
+        let Some((wi, wo)) = geometry::upper_pair(wi, wo) else {
+            out.fill(0.0);
+            return;
+        };
+        let lobe = self.lobe(wi, wo);
+        for (o, &k) in out.iter_mut().zip(&self.ks) {
+            *o = (k * lobe) as f32;
+        }
+    }
+
+    fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        match geometry::upper_pair(wi, wo) {
+            Some((wi, wo)) => self.ks_spec.at(nm) * self.lobe(wi, wo),
+            None => 0.0,
+        }
+    }
+
+    fn flags(&self) -> Flags {
+        Flags::SMOOTH_SYMMETRIC
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "blinn_phong ks={} n={}",
+            serde_json::to_string(&self.ks_spec).unwrap_or_default(),
+            self.n
+        )
+    }
+
+    fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+        let wo = geometry::normalize(wo)?;
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let h = self.sample_half_vector(u);
+        let wo_h = wo.dot(h);
+        let wi = geometry::normalize(2.0 * wo_h * h - wo)?;
+        if wi.z <= 0.0 || wo_h <= 0.0 {
+            return None;
+        }
+        let pdf = self.ndf(h) * h.z / (4.0 * wo_h);
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        // f cos θi / pdf with the lobe evaluated at the exact sampled h.
+        let ratio = self.norm * h.z.powf(self.n) * wi.z / pdf;
+        for (w, &k) in weight[..self.ks.len()].iter_mut().zip(&self.ks) {
+            *w = (k * ratio) as f32;
+        }
+        Some(BrdfSample {
+            wi,
+            pdf,
+            delta: false,
+        })
+    }
+
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        let Some((wi, wo)) = geometry::upper_pair(wi, wo) else {
+            return 0.0;
+        };
+        let Some(h) = geometry::normalize(wi + wo) else {
+            return 0.0;
+        };
+        let wo_h = wo.dot(h);
+        if wo_h <= 0.0 {
+            return 0.0;
+        }
+        self.ndf(h) * h.z / (4.0 * wo_h)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::test_util::*;
+    use proptest::prelude::*;
+
+    fn model(ks: f64, n: f64) -> BlinnPhong {
+        BlinnPhong::new(Value::Grey(ks), n, &Channels::Rgb).unwrap()
+    }
+
+    #[test]
+    fn ndf_is_normalized() {
+        for n in [0.0, 1.0, 10.0, 100.0, 1000.0] {
+            let m = model(1.0, n);
+            // The lobe has angular width ~ sqrt(2/n); break the θ range around it.
+            let width = (2.0 / (n + 2.0)).sqrt();
+            let integral = integrate_hemisphere(|h| m.ndf(h) * h.z, width, 1, 32);
+            assert!(
+                (integral - 1.0).abs() < 1e-9,
+                "n = {n}: ∫ D cos = {integral}"
+            );
+        }
+    }
+
+    #[test]
+    fn value_at_the_peak() {
+        let m = model(0.5, 20.0);
+        let mut f = [0.0f32; 3];
+        m.eval(DVec3::Z, DVec3::Z, &mut f);
+        let expect = 0.5 * 28.0 / (8.0 * PI);
+        assert!((f[0] as f64 - expect).abs() < 1e-6 * expect);
+        // 60° apart in the plane of incidence: θh = 30°.
+        let wi = geometry::spherical(60f64.to_radians(), 0.0);
+        m.eval(wi, DVec3::Z, &mut f);
+        let expect = expect * 30f64.to_radians().cos().powi(20);
+        assert!((f[1] as f64 - expect).abs() < 1e-6 * expect);
+    }
+
+    #[test]
+    fn normal_incidence_albedo_is_close_to_ks() {
+        // The (n+8)/(8π) normalization is approximate: within 10 % of k_s for moderate n.
+        for n in [10.0, 50.0, 200.0] {
+            let m = model(1.0, n);
+            let mut a = [0.0; 3];
+            m.albedo(DVec3::Z, &mut a);
+            assert!((a[0] - 1.0).abs() < 0.1, "n = {n}: albedo {}", a[0]);
+        }
+    }
+
+    #[test]
+    fn below_horizon_and_nan_give_zero() {
+        check_invalid_inputs_give_zero(&model(0.5, 20.0));
+    }
+
+    #[test]
+    fn spectral_parameters_follow_eval_wavelength() {
+        let ch = Channels::linspace(400.0, 700.0, 4).unwrap();
+        let ks = Value::Spectral {
+            wavelengths: vec![400.0, 700.0],
+            values: vec![0.2, 0.8],
+        };
+        let m = BlinnPhong::new(ks, 30.0, &ch).unwrap();
+        check_eval_wavelength_matches_channels(&m);
+    }
+
+    #[test]
+    fn sample_weight_and_pdf_are_consistent() {
+        for n in [0.0, 5.0, 80.0, 2000.0] {
+            check_sampling_consistency(&model(0.7, n), &test_wos(), 2000);
+        }
+    }
+
+    #[test]
+    fn sampler_passes_chi_square_broad() {
+        chi2_models(&[&model(0.7, 1.0), &model(0.7, 20.0)]);
+    }
+
+    #[test]
+    fn sampler_passes_chi_square_sharp() {
+        chi2_models(&[&model(0.7, 300.0)]);
+    }
+
+    proptest! {
+        #[test]
+        fn reciprocal(a in dir_strategy(), b in dir_strategy(), n in 0.0f64..500.0) {
+            check_reciprocity(&model(0.6, n), a, b)?;
+        }
+    }
+}

@@ -1,0 +1,250 @@
+//! Baking: evaluating any [`Brdf`] on a [`Grid`], chunk by chunk.
+//!
+//! [`bake_chunks`] produces the stored values one chunk (slab of stored axis 0, see
+//! [`Layout`](super::Layout)) at a time, in order, and hands each to a sink — a streaming writer
+//! never needs the whole table in memory. Consecutive chunks are grouped up to
+//! [`BakeOptions::memory_budget`] bytes and the group is evaluated in parallel (rayon) row by row
+//! (a row = one (axis 1, axis 2) node with every axis-3 node and channel, λ innermost), so peak
+//! memory is about one group. [`bake`] collects everything into an in-memory [`Table`].
+//!
+//! Before a reduced grid is baked its symmetries are verified on the source
+//! ([`symmetry::verify`]); a violation is an error unless [`BakeOptions::force`] is set.
+//!
+//! A node's value is f at the node's representative pair ([`pair_of`](super::pair_of)); with
+//! `supersample = k > 1` it is the mean of k^d stratified, jittered samples over the node's cell
+//! (d = stored angular axes of size > 1, cell = ±½ node spacing, [i, i+1) for
+//! [`Nodes::CellStart`](super::Nodes)) — a box prefilter for lobes narrower than a cell.
+
+use rayon::prelude::*;
+use std::time::Instant;
+
+use crate::brdf::Brdf;
+use crate::error::{Error, Result};
+use crate::rng::Pcg32;
+use crate::spectrum::MAX_CHANNELS;
+use crate::table::grid::{Grid, Nodes, StoredAxis};
+use crate::table::symmetry::{self, Symmetry};
+use crate::table::{Table, pair_of};
+
+/// Progress callback: (values done, values total).
+pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
+
+/// Options of [`bake_chunks`] and [`bake`].
+#[derive(Clone, Copy)]
+pub struct BakeOptions<'a> {
+    /// Samples per stored axis and cell (1 = the node value only).
+    pub supersample: usize,
+    /// Bake even when the source breaks the grid's declared symmetry.
+    pub force: bool,
+    /// Relative tolerance of the symmetry verification.
+    pub tolerance: f64,
+    /// Bytes of values evaluated together in parallel (at least one chunk).
+    pub memory_budget: usize,
+    /// Called after every chunk.
+    pub progress: Option<Progress<'a>>,
+}
+
+impl Default for BakeOptions<'_> {
+    fn default() -> Self {
+        BakeOptions {
+            supersample: 1,
+            force: false,
+            tolerance: symmetry::DEFAULT_TOLERANCE,
+            memory_budget: 64 << 20,
+            progress: None,
+        }
+    }
+}
+
+/// What a bake did.
+#[derive(Debug, Clone, Default)]
+pub struct BakeReport {
+    /// Stored values produced.
+    pub values: u64,
+    /// Wall-clock seconds (excluding the symmetry check).
+    pub seconds: f64,
+    /// The symmetry violation that `force` overrode, if any.
+    pub forced: Option<String>,
+}
+
+/// Checks the source against the grid: channel count and declared symmetry.
+fn check(brdf: &dyn Brdf, grid: &Grid, opts: &BakeOptions) -> Result<Option<String>> {
+    if brdf.channels().len() != grid.channels().len() {
+        return Err(Error::arg(
+            "grid",
+            format!(
+                "the source has {} channels, the grid {}",
+                brdf.channels().len(),
+                grid.channels().len()
+            ),
+        ));
+    }
+    if brdf.flags().delta {
+        return Err(Error::Unsupported(
+            "a delta (mirror/refractor) BRDF cannot be tabulated".into(),
+        ));
+    }
+    if opts.supersample == 0 || opts.supersample > 64 {
+        return Err(Error::arg("--supersample", "must be in 1..=64"));
+    }
+    if grid.symmetry() == Symmetry::NONE {
+        return Ok(None);
+    }
+    match symmetry::verify(brdf, grid.symmetry(), opts.tolerance) {
+        Ok(()) => Ok(None),
+        Err(e) if opts.force => Ok(Some(e.to_string())),
+        Err(e) => Err(e),
+    }
+}
+
+/// Bakes `brdf` on `grid`, calling `sink(chunk_index, values)` for every chunk in order
+/// (`values.len() == grid.layout().chunk_len(chunk_index)`). An error from the sink stops the
+/// bake and is returned.
+pub fn bake_chunks(
+    brdf: &dyn Brdf,
+    grid: &Grid,
+    opts: &BakeOptions,
+    mut sink: impl FnMut(usize, &[f32]) -> Result<()>,
+) -> Result<BakeReport> {
+    let forced = check(brdf, grid, opts)?;
+    let start = Instant::now();
+    let layout = grid.layout();
+    let total = layout.len() as u64;
+    let c = layout.channels;
+    let s3 = layout.shape[3];
+    let row_len = s3 * c;
+    let axes = *grid.stored_axes();
+    let budget = (opts.memory_budget / 4).max(1);
+    let mut buf: Vec<f32> = Vec::new();
+    let mut a = 0;
+    let n0 = layout.chunk_count();
+    while a < n0 {
+        // Group chunks a..e up to the budget.
+        let mut e = a + 1;
+        let mut len = layout.chunk_len(a);
+        while e < n0 && len + layout.chunk_len(e) <= budget {
+            len += layout.chunk_len(e);
+            e += 1;
+        }
+        buf.clear();
+        buf.resize(len, 0.0);
+        // Row r of the group → (chunk, row within chunk).
+        let mut row_starts = Vec::with_capacity(e - a + 1);
+        let mut acc = 0;
+        for k in a..e {
+            row_starts.push(acc);
+            acc += layout.rows_in_chunk(k);
+        }
+        row_starts.push(acc);
+        if row_len > 0 {
+            buf.par_chunks_mut(row_len)
+                .with_min_len(8)
+                .enumerate()
+                .for_each(|(gr, row)| {
+                    let k = row_starts.partition_point(|&s| s <= gr) - 1;
+                    let chunk = a + k;
+                    let (p, b) = layout.row_node(chunk, gr - row_starts[k]);
+                    for q in 0..s3 {
+                        let out = &mut row[q * c..(q + 1) * c];
+                        eval_node(brdf, grid, &axes, [chunk, p, b, q], opts.supersample, out);
+                    }
+                });
+        }
+        let mut off = 0;
+        let mut done = layout.chunk_range(a).start as u64;
+        for k in a..e {
+            let l = layout.chunk_len(k);
+            sink(k, &buf[off..off + l])?;
+            off += l;
+            done += l as u64;
+            if let Some(p) = opts.progress {
+                p(done, total);
+            }
+        }
+        a = e;
+    }
+    Ok(BakeReport {
+        values: total,
+        seconds: start.elapsed().as_secs_f64(),
+        forced,
+    })
+}
+
+/// Bakes `brdf` on `grid` into an in-memory [`Table`].
+pub fn bake(brdf: &dyn Brdf, grid: &Grid, opts: &BakeOptions) -> Result<(Table, BakeReport)> {
+    let mut values = Vec::with_capacity(grid.stored_values());
+    let report = bake_chunks(brdf, grid, opts, |_, v| {
+        values.extend_from_slice(v);
+        Ok(())
+    })?;
+    Ok((Table::new(grid.clone(), values, brdf.describe())?, report))
+}
+
+/// The value of one stored node (all channels) into `out`.
+fn eval_node(
+    brdf: &dyn Brdf,
+    grid: &Grid,
+    axes: &[StoredAxis; 4],
+    idx: [usize; 4],
+    k: usize,
+    out: &mut [f32],
+) {
+    let param = grid.param();
+    if k <= 1 {
+        let (wi, wo) = pair_of(param, grid.node_angles(idx));
+        brdf.eval(wi, wo, out);
+        for v in out.iter_mut() {
+            if !v.is_finite() {
+                *v = 0.0;
+            }
+        }
+        return;
+    }
+    // Stratified jittered samples over the node's cell on every axis of size > 1.
+    let active: Vec<usize> = (0..4).filter(|&d| axes[d].size > 1).collect();
+    let cell = |d: usize| -> (f64, f64) {
+        let i = idx[d] as f64;
+        if axes[d].nodes == Nodes::CellStart {
+            (i, i + 1.0)
+        } else {
+            (i - 0.5, i + 0.5)
+        }
+    };
+    let c = out.len().min(MAX_CHANNELS);
+    let mut acc = [0.0f64; MAX_CHANNELS];
+    let mut f = [0.0f32; MAX_CHANNELS];
+    let seed = idx.iter().fold(0x9E37_79B9_7F4A_7C15u64, |h, &i| {
+        (h ^ i as u64).wrapping_mul(0x1000_0000_01b3)
+    });
+    let mut rng = Pcg32::new(seed);
+    let total = k.pow(active.len() as u32);
+    for s in 0..total {
+        let mut coords = grid.node_angles(idx);
+        let mut rest = s;
+        for &d in &active {
+            let j = rest % k;
+            rest /= k;
+            let (lo, hi) = cell(d);
+            let t = lo + (hi - lo) * ((j as f64 + rng.next_f64()) / k as f64);
+            let ax = &axes[d];
+            let n = ax.size as f64;
+            let t = match (ax.periodic, ax.nodes) {
+                (true, _) => t,
+                (false, Nodes::Centers) => t.clamp(-0.5, n - 0.5),
+                (false, Nodes::Edges) => t.clamp(0.0, n - 1.0),
+                (false, Nodes::CellStart) => t.clamp(0.0, n),
+            };
+            coords[d] = ax.coord(t);
+        }
+        let (wi, wo) = pair_of(param, coords);
+        brdf.eval(wi, wo, &mut f[..c]);
+        for ch in 0..c {
+            if f[ch].is_finite() {
+                acc[ch] += f[ch] as f64;
+            }
+        }
+    }
+    for ch in 0..c {
+        out[ch] = (acc[ch] / total as f64) as f32;
+    }
+}

@@ -1,0 +1,240 @@
+//! [`TabulatedBrdf`]: a table behind the [`Brdf`] trait.
+//!
+//! Values live in chunks (slabs of stored axis 0, see [`Layout`](super::Layout)), each in a
+//! `OnceLock<Arc<[f32]>>`. A table built from an in-memory [`Table`] has every chunk set; one
+//! built with [`TabulatedBrdf::lazy`] asks a [`ChunkLoader`] (e.g. the file store's decoder) for
+//! a chunk the first time a lookup touches it. After that first touch a read is one atomic load
+//! — no lock, no allocation.
+//!
+//! **Load failures.** `eval` cannot return an error. When a chunk fails to load (I/O error,
+//! checksum, wrong length) the chunk is marked empty, its corners contribute 0 to every lookup
+//! (so a lookup whose corners all lie in a failed chunk writes 0), and the first error is kept:
+//! check [`TabulatedBrdf::load_error`] after a batch, or call [`TabulatedBrdf::load_all`]
+//! up front to get a proper `Result`. Failed chunks are not retried.
+
+use glam::DVec3;
+use rayon::prelude::*;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use crate::brdf::{Brdf, Flags};
+use crate::error::{Error, Result};
+use crate::spectrum::Channels;
+use crate::table::Table;
+use crate::table::grid::Grid;
+use crate::table::lookup::{Interp, Lookup};
+
+/// Supplies the values of a chunk on demand (decoding, reading from disk, ...).
+pub trait ChunkLoader: Send + Sync {
+    /// The values of chunk `chunk`: exactly `grid.layout().chunk_len(chunk)` of them.
+    fn load(&self, chunk: usize) -> Result<Vec<f32>>;
+}
+
+/// A dense table as a [`Brdf`]: nearest or multilinear lookup, chunks loaded lazily.
+pub struct TabulatedBrdf {
+    grid: Grid,
+    lookup: Lookup,
+    chunks: Box<[OnceLock<Arc<[f32]>>]>,
+    loader: Option<Box<dyn ChunkLoader>>,
+    interp: Interp,
+    description: String,
+    error: Mutex<Option<String>>,
+}
+
+impl std::fmt::Debug for TabulatedBrdf {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TabulatedBrdf")
+            .field("grid", &self.grid.summary())
+            .field("interp", &self.interp)
+            .field("description", &self.description)
+            .finish()
+    }
+}
+
+impl TabulatedBrdf {
+    /// A tabulated BRDF over an in-memory table (every chunk present), linear interpolation.
+    pub fn from_table(table: Table) -> TabulatedBrdf {
+        let (grid, values, description) = table.into_parts();
+        let l = grid.layout();
+        let chunks: Box<[OnceLock<Arc<[f32]>>]> = (0..l.chunk_count())
+            .map(|i| OnceLock::from(Arc::<[f32]>::from(&values[l.chunk_range(i)])))
+            .collect();
+        TabulatedBrdf {
+            lookup: Lookup::new(&grid),
+            grid,
+            chunks,
+            loader: None,
+            interp: Interp::Linear,
+            description,
+            error: Mutex::new(None),
+        }
+    }
+
+    /// A tabulated BRDF whose chunks `loader` supplies on first use, linear interpolation.
+    pub fn lazy(
+        grid: Grid,
+        loader: Box<dyn ChunkLoader>,
+        description: impl Into<String>,
+    ) -> TabulatedBrdf {
+        let chunks = (0..grid.layout().chunk_count())
+            .map(|_| OnceLock::new())
+            .collect();
+        TabulatedBrdf {
+            lookup: Lookup::new(&grid),
+            grid,
+            chunks,
+            loader: Some(loader),
+            interp: Interp::Linear,
+            description: description.into(),
+            error: Mutex::new(None),
+        }
+    }
+
+    /// The same with interpolation `interp`.
+    pub fn with_interp(mut self, interp: Interp) -> Self {
+        self.interp = interp;
+        self
+    }
+
+    /// Sets the interpolation.
+    pub fn set_interp(&mut self, interp: Interp) {
+        self.interp = interp;
+    }
+
+    /// The interpolation in use.
+    pub fn interp(&self) -> Interp {
+        self.interp
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The first chunk-load error, if any (see the module docs).
+    pub fn load_error(&self) -> Option<String> {
+        self.error.lock().ok().and_then(|e| e.clone())
+    }
+
+    /// Loads every chunk now; returns the first error.
+    pub fn load_all(&self) -> Result<()> {
+        for i in 0..self.chunks.len() {
+            self.chunk(i);
+        }
+        match self.load_error() {
+            None => Ok(()),
+            Some(e) => Err(Error::format("<table>", None, None, e)),
+        }
+    }
+
+    /// Number of chunks currently loaded.
+    pub fn loaded_chunks(&self) -> usize {
+        self.chunks.iter().filter(|c| c.get().is_some()).count()
+    }
+
+    /// The whole table in memory (loads every chunk).
+    pub fn to_table(&self) -> Result<Table> {
+        self.load_all()?;
+        let mut v = Vec::with_capacity(self.grid.stored_values());
+        for i in 0..self.chunks.len() {
+            v.extend_from_slice(self.chunk(i));
+        }
+        Table::new(self.grid.clone(), v, self.description.clone())
+    }
+
+    #[inline(always)]
+    fn chunk(&self, a: usize) -> &[f32] {
+        match self.chunks.get(a) {
+            Some(c) => match c.get() {
+                Some(v) => v,
+                None => self.load_chunk(a),
+            },
+            None => &[],
+        }
+    }
+
+    #[cold]
+    fn load_chunk(&self, a: usize) -> &[f32] {
+        self.chunks[a].get_or_init(|| {
+            let want = self.grid.layout().chunk_len(a);
+            let r = match &self.loader {
+                Some(l) => l.load(a),
+                None => Err(Error::NotFound(format!("chunk {a}: no loader"))),
+            };
+            match r {
+                Ok(v) if v.len() == want => v.into(),
+                Ok(v) => {
+                    self.record(format!(
+                        "chunk {a}: {} values loaded, {want} expected",
+                        v.len()
+                    ));
+                    Arc::from([])
+                }
+                Err(e) => {
+                    self.record(format!("chunk {a}: {e}"));
+                    Arc::from([])
+                }
+            }
+        })
+    }
+
+    fn record(&self, msg: String) {
+        if let Ok(mut e) = self.error.lock() {
+            e.get_or_insert(msg);
+        }
+    }
+}
+
+impl Brdf for TabulatedBrdf {
+    fn channels(&self) -> &Channels {
+        self.grid.channels()
+    }
+
+    #[inline]
+    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+        self.lookup
+            .eval(self.interp, wi, wo, out, |a| self.chunk(a))
+    }
+
+    /// Only the symmetries the table stores are declared (a reduced table has them exactly).
+    fn flags(&self) -> Flags {
+        let s = self.grid.symmetry();
+        Flags {
+            delta: false,
+            reciprocal: s.reciprocal,
+            isotropic: s.isotropic,
+            bilateral: s.bilateral,
+            transmission: false,
+        }
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "table [{}] {:?} of: {}",
+            self.grid.summary(),
+            self.interp,
+            self.description
+        )
+    }
+
+    /// Parallel (rayon) above 16384 pairs, sequential below.
+    fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
+        let c = self.lookup.channels();
+        let n = wi.len().min(wo.len()).min(out.len() / c.max(1));
+        const BLOCK: usize = 4096;
+        if n >= 4 * BLOCK {
+            out[..n * c]
+                .par_chunks_mut(BLOCK * c)
+                .enumerate()
+                .for_each(|(b, o)| {
+                    let s = b * BLOCK;
+                    for (k, oc) in o.chunks_exact_mut(c).enumerate() {
+                        self.eval(wi[s + k], wo[s + k], oc);
+                    }
+                });
+        } else {
+            for (k, oc) in out[..n * c].chunks_exact_mut(c).enumerate() {
+                self.eval(wi[k], wo[k], oc);
+            }
+        }
+    }
+}

@@ -1,0 +1,229 @@
+//! The `brdftab` command line as a user sees it: output contracts and error behaviour.
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+struct Out {
+    code: i32,
+    stdout: String,
+    stderr: String,
+}
+
+fn run(args: &[&str], stdin: &str) -> Out {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_brdftab"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    // A failing command may exit before reading stdin: ignore a broken pipe.
+    let _ = child.stdin.take().unwrap().write_all(stdin.as_bytes());
+    let out = child.wait_with_output().unwrap();
+    Out {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8(out.stdout).unwrap(),
+        stderr: String::from_utf8(out.stderr).unwrap(),
+    }
+}
+
+/// Asserts the error contract: exit 1, stderr starts with `error:`, no panic, nothing on stdout.
+fn assert_error(o: &Out, needle: &str) {
+    assert_eq!(o.code, 1, "stderr: {}", o.stderr);
+    assert!(o.stderr.starts_with("error:"), "stderr: {}", o.stderr);
+    assert!(!o.stderr.contains("panicked"), "stderr: {}", o.stderr);
+    assert!(
+        o.stderr.to_lowercase().contains(&needle.to_lowercase()),
+        "`{needle}` not in: {}",
+        o.stderr
+    );
+}
+
+fn numbers(line: &str) -> Vec<f64> {
+    line.split_whitespace()
+        .map(|t| t.parse().unwrap())
+        .collect()
+}
+
+const LAMBERT: &str = r#"{"model": "lambert", "kd": [0.1, 0.123456789, 0.3]}"#;
+
+#[test]
+fn eval_skips_blank_and_comment_lines_and_prints_one_line_per_pair() {
+    let input = "# wi then wo\n0 0 1 0 0 1\n\n   \n0.3 0.1 1  -0.2 0.4 0.9\n# below the horizon:\n0 0 -1 0 0 1\n";
+    let o = run(&["eval", LAMBERT], input);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let lines: Vec<&str> = o.stdout.lines().collect();
+    assert_eq!(lines.len(), 3, "{}", o.stdout);
+    for l in &lines[..2] {
+        let v: Vec<f32> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+        // Full f32 precision: the printed value parses back to the same f32.
+        assert_eq!(v, [0.1f32, 0.123_456_789_f64 as f32, 0.3f32], "{l}");
+    }
+    assert_eq!(numbers(lines[2]), [0.0; 3]);
+}
+
+#[test]
+fn eval_wavelengths_gives_one_column_per_wavelength() {
+    let o = run(
+        &[
+            "eval",
+            r#"{"model": "lambert", "kd": 0.25}"#,
+            "--wavelengths",
+            "400,500,600,700",
+        ],
+        "0 0 1 0 0.6 0.8\n0 0 1 0 0 1\n",
+    );
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let lines: Vec<&str> = o.stdout.lines().collect();
+    assert_eq!(lines.len(), 2);
+    for l in lines {
+        assert_eq!(numbers(l), [0.25; 4]);
+    }
+}
+
+#[test]
+fn eval_reads_a_spec_file() {
+    let dir = std::env::temp_dir().join(format!("brdftab-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("lambert.json");
+    std::fs::write(&path, r#"{"model": "lambert", "kd": 0.2}"#).unwrap();
+    let o = run(&["eval", path.to_str().unwrap()], "0 0 1 0 0 1\n");
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let v: Vec<f32> = o
+        .stdout
+        .split_whitespace()
+        .map(|t| t.parse().unwrap())
+        .collect();
+    assert_eq!(v, [0.2f32; 3]);
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, "{\"model\": ").unwrap();
+    assert_error(&run(&["eval", bad.to_str().unwrap()], ""), "bad.json");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn malformed_stdin_line_names_the_line() {
+    let o = run(&["eval", LAMBERT], "0 0 1 0 0 1\n\n0 0 1 0 zero 1\n");
+    assert_error(&o, "line 3");
+    let o = run(&["eval", LAMBERT], "0 0 1 0 0\n");
+    assert_error(&o, "line 1");
+    let o = run(&["eval", LAMBERT], "0 0 1 0 0 1 7\n");
+    assert_error(&o, "line 1");
+}
+
+#[test]
+fn bad_specs_are_errors_naming_the_problem() {
+    assert_error(&run(&["eval", r#"{"model": "bogus"}"#], ""), "bogus");
+    assert_error(
+        &run(&["eval", r#"{"model": "lambert", "kd": 0.3, "kx": 1}"#], ""),
+        "kx",
+    );
+    assert_error(
+        &run(&["eval", r#"{"model": "lambert", "kd": -0.3}"#], ""),
+        "kd",
+    );
+    assert_error(
+        &run(&["eval", r#"{"model": "lambert", "kd": "#], ""),
+        "json",
+    );
+    assert_error(&run(&["check", r#"{"model": "lambert"}"#], ""), "kd");
+    assert_error(
+        &run(&["albedo", "/no/such/file.json"], ""),
+        "/no/such/file.json",
+    );
+}
+
+#[test]
+fn bad_arguments_are_errors() {
+    assert_error(&run(&["eval", LAMBERT, "--bogus"], ""), "--bogus");
+    assert_error(&run(&["frobnicate"], ""), "frobnicate");
+    assert_error(&run(&[], ""), "subcommand");
+    assert_error(&run(&["check"], ""), "SOURCE");
+    assert_error(
+        &run(&["eval", LAMBERT, "--wavelengths", "400,blue"], ""),
+        "--wavelengths",
+    );
+    assert_error(&run(&["albedo", LAMBERT, "--theta", "10,x"], ""), "--theta");
+    assert_error(&run(&["albedo", LAMBERT, "--theta", "-5"], ""), "--theta");
+    assert_error(&run(&["albedo", LAMBERT, "--theta", "95"], ""), "--theta");
+}
+
+#[test]
+fn help_and_version_succeed() {
+    let o = run(&["--help"], "");
+    assert_eq!(o.code, 0);
+    assert!(o.stdout.contains("albedo") && o.stdout.contains("check"));
+    let o = run(&["--version"], "");
+    assert_eq!(o.code, 0);
+    assert!(o.stdout.starts_with("brdftab "));
+}
+
+#[test]
+fn albedo_prints_theta_and_one_column_per_channel() {
+    let o = run(&["albedo", LAMBERT, "--theta", "0,45,89"], "");
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let rows: Vec<Vec<f64>> = o.stdout.lines().map(numbers).collect();
+    assert_eq!(rows.len(), 3);
+    for (row, theta) in rows.iter().zip([0.0, 45.0, 89.0]) {
+        assert_eq!(row.len(), 4);
+        assert_eq!(row[0], theta);
+        for (a, kd) in row[1..].iter().zip([0.1f32, 0.123_456_789_f64 as f32, 0.3]) {
+            let expect = kd as f64 * std::f64::consts::PI;
+            assert!((a - expect).abs() < 1e-6 * expect, "{a} vs {expect}");
+        }
+    }
+    let o = run(
+        &[
+            "albedo",
+            r#"{"model": "lambert", "kd": 0.1}"#,
+            "--theta",
+            "30",
+            "--wavelengths",
+            "450,550",
+        ],
+        "",
+    );
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert_eq!(numbers(o.stdout.trim()).len(), 3);
+}
+
+#[test]
+fn check_json_has_the_documented_fields() {
+    let o = run(
+        &["check", r#"{"model": "lambert", "kd": 0.5}"#, "--json"],
+        "",
+    );
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert_eq!(o.stdout.lines().count(), 1, "one JSON object on one line");
+    let v: serde_json::Value = serde_json::from_str(&o.stdout).unwrap();
+    assert_eq!(v["positive"], true);
+    assert_eq!(v["min_value"], 0.5);
+    assert_eq!(v["reciprocal"], true);
+    assert_eq!(v["max_reciprocity_error"], 0.0);
+    assert_eq!(v["energy_conserving"], false);
+    let a = v["max_albedo"].as_f64().unwrap();
+    assert!((a - 0.5 * std::f64::consts::PI).abs() < 1e-6);
+    assert!(v["max_albedo_theta_deg"].is_number());
+    assert_eq!(v["albedo_curve"].as_array().unwrap().len(), 90);
+}
+
+#[test]
+fn check_text_and_models_and_demo_run() {
+    let o = run(&["check", r#"{"model": "lambert", "kd": 0.3}"#], "");
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(o.stdout.contains("energy conserving:  yes"), "{}", o.stdout);
+    let o = run(&["models"], "");
+    assert_eq!(o.code, 0);
+    assert!(o.stdout.contains("reciprocal_phong"));
+    let o = run(&["models", "--json"], "");
+    let v: serde_json::Value = serde_json::from_str(&o.stdout).unwrap();
+    assert!(v.as_array().unwrap().len() >= 10);
+    let o = run(&["demo"], "");
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(o.stdout.contains("lambert kd=0.3"), "{}", o.stdout);
+    assert!(
+        o.stdout
+            .lines()
+            .any(|l| l.starts_with("lambert kd=0.5") && l.contains("NO"))
+    );
+}

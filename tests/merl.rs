@@ -1,0 +1,276 @@
+//! MERL `.binary` reader and writer. No real MERL file ships with the project, so these tests
+//! write files with known contents and check the lookups against an independent implementation
+//! of the reference reader (`BRDFRead.cpp`), written here with trigonometry.
+
+use brdftab::measured::MerlBrdf;
+use brdftab::measured::merl::{self, FILE_SIZE, SAMPLES};
+use brdftab::rng::Pcg32;
+use brdftab::{Brdf, Error};
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+fn tmpdir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("brdftab-merl-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Writes a MERL file by hand: header then planes.
+fn write_file(path: &std::path::Path, dims: [i32; 3], data: &[f64]) {
+    let mut b = Vec::new();
+    for d in dims {
+        b.extend_from_slice(&d.to_le_bytes());
+    }
+    for v in data {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(path, b).unwrap();
+}
+
+/// Random raw values, with about 3% negative "no measurement" sentinels.
+fn random_data(seed: u64) -> Vec<f64> {
+    let mut rng = Pcg32::new(seed);
+    (0..3 * SAMPLES)
+        .map(|_| {
+            if rng.next_f64() < 0.03 {
+                -1.0
+            } else {
+                rng.next_f64() * 3000.0
+            }
+        })
+        .collect()
+}
+
+// ---- independent reference: BRDFRead.cpp, with Rodrigues rotations and acos/atan2 ----
+
+fn rotate(v: [f64; 3], axis: [f64; 3], angle: f64) -> [f64; 3] {
+    let (s, c) = angle.sin_cos();
+    let dot = v[0] * axis[0] + v[1] * axis[1] + v[2] * axis[2];
+    let cross = [
+        axis[1] * v[2] - axis[2] * v[1],
+        axis[2] * v[0] - axis[0] * v[2],
+        axis[0] * v[1] - axis[1] * v[0],
+    ];
+    [0, 1, 2].map(|i| v[i] * c + axis[i] * dot * (1.0 - c) + cross[i] * s)
+}
+
+fn std_to_half_diff(ti: f64, pi: f64, to: f64, po: f64) -> (f64, f64, f64, f64) {
+    let inv = [ti.sin() * pi.cos(), ti.sin() * pi.sin(), ti.cos()];
+    let out = [to.sin() * po.cos(), to.sin() * po.sin(), to.cos()];
+    let h = [inv[0] + out[0], inv[1] + out[1], inv[2] + out[2]];
+    let n = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+    let h = h.map(|x| x / n);
+    let theta_half = h[2].acos();
+    let phi_half = h[1].atan2(h[0]);
+    let temp = rotate(inv, [0.0, 0.0, 1.0], -phi_half);
+    let diff = rotate(temp, [0.0, 1.0, 0.0], -theta_half);
+    (theta_half, phi_half, diff[2].acos(), diff[1].atan2(diff[0]))
+}
+
+fn ref_theta_half_index(th: f64) -> usize {
+    if th <= 0.0 {
+        return 0;
+    }
+    let deg = th / (PI / 2.0) * 90.0;
+    let t = (deg * 90.0).sqrt() as i64;
+    t.clamp(0, 89) as usize
+}
+fn ref_theta_diff_index(td: f64) -> usize {
+    ((td / (PI * 0.5) * 90.0) as i64).clamp(0, 89) as usize
+}
+fn ref_phi_diff_index(mut pd: f64) -> usize {
+    if pd < 0.0 {
+        pd += PI;
+    }
+    ((pd / PI * 180.0) as i64).clamp(0, 179) as usize
+}
+
+fn ref_lookup(data: &[f64], ti: f64, pi: f64, to: f64, po: f64) -> [f64; 3] {
+    let (th, _, td, pd) = std_to_half_diff(ti, pi, to, po);
+    let ind = ref_phi_diff_index(pd)
+        + ref_theta_diff_index(td) * 180
+        + ref_theta_half_index(th) * 180 * 90;
+    let scale = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
+    [0, 1, 2].map(|c| data[ind + c * SAMPLES] * scale[c])
+}
+
+#[test]
+fn nearest_lookup_matches_reference_reader() {
+    let dir = tmpdir("lookup");
+    let path = dir.join("random.binary");
+    let data = random_data(1);
+    write_file(&path, [90, 90, 180], &data);
+    let m = MerlBrdf::open(&path).unwrap();
+    let mut rng = Pcg32::new(2);
+    let mut f = [0f32; 3];
+    let mut invalid_seen = 0;
+    for k in 0..60_000 {
+        // Half the pairs near the specular direction, where the sqrt θh axis is dense.
+        let ti = rng.next_f64() * PI / 2.0 * 0.999;
+        let pi = (rng.next_f64() * 2.0 - 1.0) * PI;
+        let (to, po) = if k % 2 == 0 {
+            (
+                ti + (rng.next_f64() - 0.5) * 0.05,
+                pi + PI + (rng.next_f64() - 0.5) * 0.05,
+            )
+        } else {
+            (
+                rng.next_f64() * PI / 2.0 * 0.999,
+                (rng.next_f64() * 2.0 - 1.0) * PI,
+            )
+        };
+        if !(to > 0.0 && to < PI / 2.0) {
+            continue;
+        }
+        let want = ref_lookup(&data, ti, pi, to, po);
+        let wi = brdftab::geometry::spherical(ti, pi);
+        let wo = brdftab::geometry::spherical(to, po);
+        m.eval(wi, wo, &mut f);
+        for c in 0..3 {
+            if want[c] < 0.0 {
+                invalid_seen += 1;
+                assert_eq!(f[c], 0.0, "invalid cell must evaluate to 0");
+            } else {
+                assert_eq!(
+                    f[c], want[c] as f32,
+                    "pair {k} channel {c}: ({ti}, {pi}) ({to}, {po})"
+                );
+            }
+        }
+    }
+    assert!(invalid_seen > 30);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn write_read_is_bit_exact() {
+    let dir = tmpdir("rw");
+    let (a, b) = (dir.join("a.binary"), dir.join("b.binary"));
+    let data = random_data(3);
+    write_file(&a, [90, 90, 180], &data);
+    let m = MerlBrdf::open(&a).unwrap();
+    assert_eq!(m.raw(), &data[..]);
+    m.write(&b).unwrap();
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    assert_eq!(std::fs::metadata(&b).unwrap().len(), FILE_SIZE);
+    let invalid = (0..SAMPLES)
+        .filter(|&k| (0..3).any(|c| data[c * SAMPLES + k] < 0.0))
+        .count();
+    assert_eq!(m.invalid_cells(), invalid);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn resampled_lambert_round_trips() {
+    let kd = [0.2, 0.5, 0.8];
+    let brdf = brdftab::ModelSpec::parse(r#"{"model": "lambert", "kd": [0.2, 0.5, 0.8]}"#)
+        .unwrap()
+        .build(&brdftab::Channels::Rgb)
+        .unwrap();
+    let m = MerlBrdf::from_brdf(&*brdf);
+    let dir = tmpdir("lambert");
+    let p = dir.join("lambert.binary");
+    m.write(&p).unwrap();
+    let back = MerlBrdf::open(&p).unwrap();
+    let mut f = [0f32; 3];
+    back.eval(
+        brdftab::geometry::spherical(0.3, 0.2),
+        brdftab::geometry::spherical(1.1, 2.0),
+        &mut f,
+    );
+    for c in 0..3 {
+        // The foundation's Lambert takes kd as f_r itself.
+        assert!((f[c] as f64 - kd[c]).abs() < 1e-6, "{f:?}");
+    }
+    assert_eq!(back.invalid_cells(), 0);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn wrong_size_and_dims_are_typed_errors() {
+    let dir = tmpdir("bad");
+    let p = dir.join("bad.binary");
+    // Right size, wrong dimensions.
+    let data = vec![0.0; 3 * SAMPLES];
+    write_file(&p, [90, 90, 181], &data);
+    let e = MerlBrdf::open(&p).unwrap_err();
+    assert!(matches!(e, Error::Format { .. }));
+    assert!(e.to_string().contains("90 × 90 × 181"), "{e}");
+    // Truncated.
+    write_file(&p, [90, 90, 180], &data[..1000]);
+    let e = MerlBrdf::open(&p).unwrap_err().to_string();
+    assert!(e.contains("34992012") && e.contains("bad.binary"), "{e}");
+    // Empty.
+    std::fs::write(&p, b"").unwrap();
+    assert!(MerlBrdf::open(&p).is_err());
+    // NaN sample.
+    let mut d = data.clone();
+    d[SAMPLES + 5] = f64::NAN;
+    write_file(&p, [90, 90, 180], &d);
+    let e = MerlBrdf::open(&p).unwrap_err().to_string();
+    assert!(e.contains("field `G`"), "{e}");
+    // Missing file.
+    assert!(matches!(
+        MerlBrdf::open(dir.join("none.binary")),
+        Err(Error::Io { .. })
+    ));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn embedded_manifest_matches_tsv() {
+    let tsv = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/data/measured/merl/merl_expected_files.tsv"
+    ))
+    .unwrap();
+    let rows: Vec<Vec<&str>> = tsv
+        .lines()
+        .skip(1)
+        .map(|l| l.split('\t').collect())
+        .collect();
+    assert_eq!(
+        rows.len(),
+        brdftab::measured::merl_manifest::MERL_FILES.len()
+    );
+    for (r, (m, h)) in rows
+        .iter()
+        .zip(brdftab::measured::merl_manifest::MERL_FILES)
+    {
+        assert_eq!((r[0], r[2]), (m, h));
+        assert_eq!(r[1].parse::<u64>().unwrap(), FILE_SIZE);
+        assert_eq!(merl::material_of(h), Some(m));
+    }
+    assert_eq!(merl::material_of("00"), None);
+}
+
+#[test]
+fn table_on_the_merl_grid_holds_the_cells_and_indexes_like_the_reader() {
+    let data = random_data(9);
+    let m = MerlBrdf::from_raw("random", data.clone()).unwrap();
+    let t = m.to_table();
+    let mut rng = Pcg32::new(10);
+    for _ in 0..10_000 {
+        let (i, j, k) = (
+            rng.below(90) as usize,
+            rng.below(90) as usize,
+            rng.below(180) as usize,
+        );
+        let node = t.node([i, 0, j, k]).unwrap();
+        assert_eq!(node, &m.cell(i, j, k)[..]);
+        if !m.is_valid(i, j, k) {
+            assert!(node.iter().any(|&v| v == 0.0));
+        }
+    }
+    // The grid's nearest lookup takes the reader's indices.
+    let ax = t.grid().stored_axes();
+    for _ in 0..100_000 {
+        let th = rng.next_f64() * PI / 2.0;
+        let td = rng.next_f64() * PI / 2.0;
+        let pd = (rng.next_f64() * 2.0 - 1.0) * PI;
+        assert_eq!(ax[0].nearest(th), ref_theta_half_index(th), "θh {th}");
+        assert_eq!(ax[2].nearest(td), ref_theta_diff_index(td), "θd {td}");
+        let pd_folded = if pd < 0.0 { pd + PI } else { pd };
+        assert_eq!(ax[3].nearest(pd_folded), ref_phi_diff_index(pd), "φd {pd}");
+    }
+}

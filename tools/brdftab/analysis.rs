@@ -1,0 +1,98 @@
+//! `albedo` and `check`: directional albedo and the plausibility report of a SOURCE.
+
+use brdftab::analysis::{albedo, plausibility};
+use brdftab::{Error, Result};
+use clap::Args;
+
+use crate::source;
+
+/// Arguments of `brdftab albedo`.
+#[derive(Args)]
+pub struct AlbedoArgs {
+    /// A model spec (inline JSON starting with `{`, or a .json file).
+    source: String,
+    /// Incidence angles θ′ in degrees, comma separated.
+    #[arg(
+        long,
+        default_value = "0,15,30,45,60,75,85,89",
+        value_name = "DEG[,DEG..]",
+        allow_hyphen_values = true
+    )]
+    theta: String,
+    /// Compute at these wavelengths in nm (comma separated) instead of RGB.
+    #[arg(long)]
+    wavelengths: Option<String>,
+}
+
+/// Arguments of `brdftab check`.
+#[derive(Args)]
+pub struct CheckArgs {
+    /// A model spec (inline JSON starting with `{`, or a .json file).
+    source: String,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    json: bool,
+    /// Check at these wavelengths in nm (comma separated) instead of RGB.
+    #[arg(long)]
+    wavelengths: Option<String>,
+}
+
+/// Prints `theta a_1 a_2 ...` per requested angle.
+pub fn albedo(a: AlbedoArgs) -> Result<()> {
+    let thetas = parse_degrees(&a.theta)?;
+    let channels = source::channels(a.wavelengths.as_deref())?;
+    let brdf = source::open(&a.source, &channels)?;
+    let radians: Vec<f64> = thetas.iter().map(|t| t.to_radians()).collect();
+    let curve = albedo::albedo_curve(&*brdf, &radians);
+    let mut text = String::new();
+    for (t, row) in thetas.iter().zip(curve) {
+        let vals: Vec<String> = row.iter().map(|&x| sig7(x)).collect();
+        text += &format!("{t} {}\n", vals.join(" "));
+    }
+    emit(&text)
+}
+
+/// Prints the plausibility report (text or JSON).
+pub fn check(a: CheckArgs) -> Result<()> {
+    let channels = source::channels(a.wavelengths.as_deref())?;
+    let brdf = source::open(&a.source, &channels)?;
+    let report = plausibility::check(&*brdf, &plausibility::Options::default());
+    if a.json {
+        let json = serde_json::to_string(&report)
+            .map_err(|e| Error::Unsupported(format!("cannot serialize the report: {e}")))?;
+        emit(&format!("{json}\n"))
+    } else {
+        emit(&report.to_string())
+    }
+}
+
+/// Writes `text` to stdout; a failed write (e.g. a closed pipe) is an error, not a panic.
+pub fn emit(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| Error::io("stdout", e))
+}
+
+/// Parses `0,30,60` as degrees in [0, 90].
+fn parse_degrees(s: &str) -> Result<Vec<f64>> {
+    s.split(',')
+        .map(|x| {
+            let t: f64 = x
+                .trim()
+                .parse()
+                .map_err(|_| Error::arg("--theta", format!("`{x}` is not a number")))?;
+            if !(0.0..=90.0).contains(&t) {
+                return Err(Error::arg("--theta", format!("{t}° is outside [0°, 90°]")));
+            }
+            Ok(t)
+        })
+        .collect()
+}
+
+/// `x` rounded to 7 significant digits, printed in its shortest form.
+pub fn sig7(x: f64) -> String {
+    let rounded: f64 = format!("{x:.6e}").parse().unwrap_or(x);
+    format!("{rounded}")
+}

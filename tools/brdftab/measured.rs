@@ -1,0 +1,199 @@
+//! `info` for measured files and `slice` (any SOURCE).
+
+use brdftab::analysis::slice;
+use brdftab::measured::{MerlBrdf, RglBrdf, merl, tensor::TensorFile};
+use brdftab::{Brdf, Error, Result};
+use clap::{Args, ValueEnum};
+
+use crate::source::{self, Kind};
+
+/// Arguments of `brdftab info`.
+#[derive(Args)]
+pub struct InfoArgs {
+    /// A MERL `.binary` or RGL `.bsdf` file.
+    source: String,
+}
+
+/// `info` for a measured file named by path (used by the table `info` command's dispatch).
+pub fn info_source(source: &str) -> Result<()> {
+    info(InfoArgs {
+        source: source.to_owned(),
+    })
+}
+
+/// Prints what a measured file holds: description, dimensions, channels, sha256.
+pub fn info(a: InfoArgs) -> Result<()> {
+    match source::kind(&a.source) {
+        Kind::Merl => info_merl(&a.source),
+        Kind::Rgl => info_rgl(&a.source),
+        _ => Err(Error::Unsupported(format!(
+            "{}: `info` handles measured files (.binary, .bsdf) here",
+            a.source
+        ))),
+    }
+}
+
+fn info_merl(path: &str) -> Result<()> {
+    let sha = merl::sha256_file(path)?;
+    let m = MerlBrdf::open(path)?;
+    println!("file:        {path}");
+    println!("format:      MERL BRDF database (.binary, Matusik et al. 2003)");
+    match merl::material_of(&sha) {
+        Some(name) => println!("material:    {name} (sha256 matches the published file)"),
+        None => println!("material:    unknown (sha256 matches none of the 100 published files)"),
+    }
+    println!(
+        "dims:        θh {} × θd {} × φd {} (sqrt θh axis), {} bytes",
+        merl::RES_THETA_H,
+        merl::RES_THETA_D,
+        merl::RES_PHI_D,
+        merl::FILE_SIZE
+    );
+    println!("channels:    R G B (scales 1/1500, 1.15/1500, 1.66/1500)");
+    println!(
+        "unmeasured:  {} of {} cells (negative, evaluated as 0)",
+        m.invalid_cells(),
+        merl::SAMPLES
+    );
+    println!("sha256:      {sha}");
+    Ok(())
+}
+
+fn info_rgl(path: &str) -> Result<()> {
+    let t = TensorFile::open(path)?;
+    let b = RglBrdf::from_tensor(&t, None)?;
+    let s = b.summary();
+    println!("file:        {path}");
+    println!(
+        "format:      RGL-EPFL tensor file (.bsdf, Dupuy & Jakob 2018), {} bytes",
+        t.size()
+    );
+    println!("description: {}", s.description);
+    println!("kind:        {}", s.kind);
+    println!(
+        "dims:        φi {} × θi {}, table {}×{}, vndf {}×{}, {}",
+        s.phi_i,
+        s.theta_i,
+        s.resolution.0,
+        s.resolution.1,
+        s.vndf_resolution.0,
+        s.vndf_resolution.1,
+        if s.isotropic {
+            "isotropic".to_string()
+        } else {
+            format!("anisotropic, reduction {}", s.reduction)
+        }
+    );
+    println!("channels:    {}", b.channels().names().join(" "));
+    println!("fields:");
+    for f in t.fields() {
+        println!("  {:<12} {:<22} @ {}", f.name, f.describe(), f.offset);
+    }
+    println!("sha256:      {}", b.sha256());
+    Ok(())
+}
+
+/// Which slice to draw.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum SliceKind {
+    /// θh (x) × θd (y) at a fixed φd, the MERL-style image.
+    Halfdiff,
+    /// f_r · cos θo over the outgoing hemisphere for one incident direction.
+    Polar,
+}
+
+/// Arguments of `brdftab slice`.
+#[derive(Args)]
+pub struct SliceArgs {
+    /// Any SOURCE (spec, table, .binary, .bsdf).
+    source: String,
+    /// Output image: `.exr` (linear f32) or `.png` (log scale, viridis, colorbar).
+    #[arg(short, long)]
+    output: String,
+    /// Which slice.
+    #[arg(long, value_enum, default_value = "halfdiff")]
+    kind: SliceKind,
+    /// Incident polar angle in degrees (polar slice).
+    #[arg(long, default_value_t = 45.0)]
+    theta_in: f64,
+    /// Incident azimuth in degrees (polar slice).
+    #[arg(long, default_value_t = 0.0)]
+    phi_in: f64,
+    /// Difference azimuth φd in degrees (halfdiff slice).
+    #[arg(long, default_value_t = 90.0)]
+    phi_d: f64,
+    /// Channel to show in PNGs (and grey EXRs): a name (R, G, B, 550nm) or index; default
+    /// luminance for RGB, the channel mean otherwise.
+    #[arg(long)]
+    channel: Option<String>,
+    /// Image size in pixels.
+    #[arg(long, default_value_t = 256)]
+    size: usize,
+    /// Evaluate at these wavelengths in nm (comma separated) instead of RGB.
+    #[arg(long)]
+    wavelengths: Option<String>,
+}
+
+/// Renders a slice image.
+pub fn slice(a: SliceArgs) -> Result<()> {
+    if a.size == 0 || a.size > 8192 {
+        return Err(Error::arg("--size", "must be 1..=8192"));
+    }
+    let channels = source::channels(a.wavelengths.as_deref())?;
+    let brdf = source::open(&a.source, &channels)?;
+    let names = brdf.channels().names();
+    let channel = match &a.channel {
+        None => None,
+        Some(c) => Some(
+            names
+                .iter()
+                .position(|n| n.eq_ignore_ascii_case(c))
+                .or_else(|| c.parse::<usize>().ok().filter(|&i| i < names.len()))
+                .ok_or_else(|| {
+                    Error::arg("--channel", format!("`{c}` is none of {}", names.join(" ")))
+                })?,
+        ),
+    };
+    let img = match a.kind {
+        SliceKind::Halfdiff => slice::halfdiff(&*brdf, a.size, a.phi_d.to_radians()),
+        SliceKind::Polar => slice::polar(
+            &*brdf,
+            a.size,
+            slice::incident(a.theta_in.to_radians(), a.phi_in.to_radians()),
+        ),
+    };
+    let lower = a.output.to_ascii_lowercase();
+    let what = match a.kind {
+        SliceKind::Halfdiff => format!(
+            "f_r, x = θh 0..90°, y = θd 0..90° (top to bottom), φd = {}°",
+            a.phi_d
+        ),
+        SliceKind::Polar => format!(
+            "f_r·cos θo over the outgoing hemisphere (radius ∝ θo, +x right), θi = {}°, φi = {}°",
+            a.theta_in, a.phi_in
+        ),
+    };
+    if lower.ends_with(".exr") {
+        slice::write_exr(&img, channel, &a.output)?;
+        println!("{}: {what}; linear f32", a.output);
+    } else if lower.ends_with(".png") {
+        let l = slice::write_png(&img, channel, &a.output)?;
+        let ch = channel.map_or_else(
+            || {
+                if names.len() == 3 && names[0] == "R" {
+                    "luminance".to_string()
+                } else {
+                    "channel mean".to_string()
+                }
+            },
+            |c| names[c].clone(),
+        );
+        println!(
+            "{}: {what}; {ch}, log10 scale, viridis: colorbar bottom {:.4e} .. top {:.4e} (1/sr)",
+            a.output, l.min, l.max
+        );
+    } else {
+        return Err(Error::arg("--output", "must end in .exr or .png"));
+    }
+    Ok(())
+}

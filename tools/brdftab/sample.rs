@@ -1,0 +1,106 @@
+//! `sample` and `pdf`: the importance sampler of any SOURCE, from the command line.
+//!
+//! `sample` prints one line per drawn direction: `wix wiy wiz pdf w_1 .. w_c` where `w` is the
+//! per-channel weight f_r cos θi / pdf. Numbers are printed in Rust's shortest round-trip form,
+//! so `wi` can be fed back to `pdf` or `eval` exactly. Delta samples (mirror, refractor) print
+//! pdf 1 (the library's convention) and the lobe's reflectance as weight; nothing else marks them.
+//! Draws for which the sampler returns no direction (e.g. `wo` below the horizon) print nothing, so
+//! fewer than `--count` lines may appear.
+
+use std::io::{BufRead, Write};
+
+use brdftab::rng::Pcg32;
+use brdftab::{Error, Result};
+use clap::Args;
+use glam::DVec3;
+
+use crate::models::parse_numbers;
+use crate::source;
+
+/// Arguments of `brdftab sample`.
+#[derive(Args)]
+pub struct SampleArgs {
+    /// A spec, table, MERL or RGL SOURCE.
+    source: String,
+    /// The outgoing direction (towards the viewer) `X,Y,Z`; need not be normalized.
+    #[arg(long, allow_hyphen_values = true)]
+    wo: String,
+    /// Number of draws.
+    #[arg(long, default_value_t = 16)]
+    count: usize,
+    /// Seed of the uniform numbers (PCG32).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Wavelengths in nm (comma separated) for a spec SOURCE instead of RGB.
+    #[arg(long)]
+    wavelengths: Option<String>,
+}
+
+/// Arguments of `brdftab pdf`.
+#[derive(Args)]
+pub struct PdfArgs {
+    /// A spec, table, MERL or RGL SOURCE.
+    source: String,
+    /// Wavelengths in nm (comma separated) for a spec SOURCE instead of RGB.
+    #[arg(long)]
+    wavelengths: Option<String>,
+}
+
+fn parse_wo(s: &str) -> Result<DVec3> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| Error::arg("--wo", format!("`{s}`: expected X,Y,Z")))?;
+    match v[..] {
+        [x, y, z] => Ok(DVec3::new(x, y, z)),
+        _ => Err(Error::arg(
+            "--wo",
+            format!("`{s}`: expected 3 numbers X,Y,Z"),
+        )),
+    }
+}
+
+fn out_err(e: std::io::Error) -> Error {
+    Error::io("stdout", e)
+}
+
+/// Draws `count` directions for `wo` and prints `wix wiy wiz pdf w_1 .. w_c`.
+pub fn sample(a: SampleArgs) -> Result<()> {
+    let channels = source::channels(a.wavelengths.as_deref())?;
+    let brdf = source::open(&a.source, &channels)?;
+    let wo = parse_wo(&a.wo)?;
+    let c = brdf.channels().len();
+    let mut w = vec![0.0f32; c];
+    let mut rng = Pcg32::new(a.seed);
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    for _ in 0..a.count {
+        let u = rng.next_dvec2();
+        let Some(s) = brdf.sample(wo, u, &mut w) else {
+            continue;
+        };
+        write!(out, "{} {} {} {}", s.wi.x, s.wi.y, s.wi.z, s.pdf).map_err(out_err)?;
+        for x in &w {
+            write!(out, " {x}").map_err(out_err)?;
+        }
+        writeln!(out).map_err(out_err)?;
+    }
+    out.flush().map_err(out_err)
+}
+
+/// Reads `wix wiy wiz wox woy woz` lines from stdin, prints pdf(wi | wo) per line.
+pub fn pdf(a: PdfArgs) -> Result<()> {
+    let channels = source::channels(a.wavelengths.as_deref())?;
+    let brdf = source::open(&a.source, &channels)?;
+    let stdin = std::io::stdin().lock();
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    for (i, line) in stdin.lines().enumerate() {
+        let line = line.map_err(|e| Error::io("stdin", e))?;
+        let Some(v) = parse_numbers::<6>(&line, i + 1)? else {
+            continue;
+        };
+        let p = brdf.pdf(DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]));
+        writeln!(out, "{p}").map_err(out_err)?;
+    }
+    out.flush().map_err(out_err)
+}

@@ -1,0 +1,318 @@
+//! `bake`, `info` and `bench`: dense tables from the command line.
+
+use std::io::IsTerminal;
+use std::time::Instant;
+
+use brdftab::rng::Pcg32;
+use brdftab::table::presets::Preset;
+use brdftab::table::raw::RawWriter;
+use brdftab::table::{
+    BakeOptions, Grid, Interp, Mapping, Param, Symmetry, Table, bake_chunks, symmetry,
+};
+use brdftab::{Brdf, Error, Result, geometry};
+use clap::Args;
+use glam::DVec3;
+use serde_json::json;
+
+use crate::source;
+
+/// Arguments of `brdftab bake`.
+#[derive(Args)]
+pub struct BakeArgs {
+    /// The source: a model spec (inline JSON or .json), a table, a MERL or RGL file.
+    source: String,
+    /// Output table file.
+    #[arg(short, long)]
+    output: String,
+    /// Grid size preset: small, medium (default) or large.
+    #[arg(long, default_value = "medium")]
+    preset: String,
+    /// Parameterization: halfdiff (default) or inout.
+    #[arg(long)]
+    param: Option<String>,
+    /// Full grid sizes θ1xφ1xθ2xφ2 (e.g. 90x360x90x360), or `merl`; overrides --preset.
+    #[arg(long)]
+    grid: Option<String>,
+    /// Wavelengths in nm (comma separated) instead of RGB (model specs only).
+    #[arg(long)]
+    wavelengths: Option<String>,
+    /// Symmetry reduction: auto (detect), none, or a list of isotropic,reciprocal,bilateral.
+    #[arg(long, default_value = "auto")]
+    symmetry: String,
+    /// Bake even if the source breaks a declared symmetry.
+    #[arg(long)]
+    force: bool,
+    /// Relative tolerance of symmetry detection and verification.
+    #[arg(long, default_value_t = symmetry::DEFAULT_TOLERANCE)]
+    tolerance: f64,
+    /// Samples per axis and cell (box prefilter for very sharp lobes).
+    #[arg(long, default_value_t = 1)]
+    supersample: usize,
+}
+
+/// Arguments of `brdftab info`.
+#[derive(Args)]
+pub struct InfoArgs {
+    /// A table file.
+    file: String,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Arguments of `brdftab bench`.
+#[derive(Args)]
+pub struct BenchArgs {
+    /// The source: a table file or a model spec.
+    source: String,
+    /// Number of random pairs.
+    #[arg(long, default_value_t = 1_000_000)]
+    pairs: usize,
+    /// Interpolation for tables: nearest or linear.
+    #[arg(long, default_value = "linear")]
+    interp: String,
+    /// Wavelengths (model specs only).
+    #[arg(long)]
+    wavelengths: Option<String>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+fn parse_grid(s: &str) -> Result<[usize; 4]> {
+    let v: Vec<usize> = s
+        .split(['x', 'X', '×'])
+        .map(|t| {
+            t.trim()
+                .parse::<usize>()
+                .map_err(|_| Error::arg("--grid", format!("`{t}` is not a size")))
+        })
+        .collect::<Result<_>>()?;
+    v.try_into()
+        .map_err(|_| Error::arg("--grid", "expected four sizes θ1xφ1xθ2xφ2"))
+}
+
+/// `brdftab bake`.
+pub fn bake(a: BakeArgs) -> Result<()> {
+    let channels = source::channels(a.wavelengths.as_deref())?;
+    let src = source::open(&a.source, &channels)?;
+    let channels = src.channels().clone();
+    let sym = match a.symmetry.trim() {
+        "auto" => {
+            let d = symmetry::detect(src.as_ref(), a.tolerance);
+            let declared = Symmetry::from_flags(src.flags());
+            if d != declared {
+                eprintln!("note: the source declares {declared}, detected {d}; using {d}");
+            }
+            d
+        }
+        s => Symmetry::parse(s)?,
+    };
+    let param = a.param.as_deref().map(Param::parse).transpose()?;
+    let grid = match a.grid.as_deref() {
+        Some("merl") => Grid::merl(channels.clone()).with_symmetry(sym)?,
+        Some(g) => {
+            let p = param.unwrap_or(Param::HalfDiff);
+            let m = match p {
+                Param::HalfDiff => [Mapping::Sqrt, Mapping::Uniform],
+                Param::InOut => [Mapping::Uniform, Mapping::Uniform],
+            };
+            Grid::with_sizes(p, parse_grid(g)?, m, channels.clone(), sym)?
+        }
+        None => Preset::parse(&a.preset)?.grid(param, sym, channels.clone())?,
+    };
+    eprintln!(
+        "baking {}\n  grid: {}\n  {} stored values ({} unreduced, {:.1}x reduction)",
+        src.describe(),
+        grid.summary(),
+        grid.stored_values(),
+        grid.full_values(),
+        grid.full_values() as f64 / grid.stored_values() as f64
+    );
+    let bar = if std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(grid.stored_values() as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {percent:>3}% {human_pos}/{human_len} values, eta {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        Some(b)
+    } else {
+        None
+    };
+    let progress = |done: u64, _total: u64| {
+        if let Some(b) = &bar {
+            b.set_position(done);
+        }
+    };
+    let opts = BakeOptions {
+        supersample: a.supersample,
+        force: a.force,
+        tolerance: a.tolerance,
+        progress: Some(&progress),
+        ..Default::default()
+    };
+    let mut w = RawWriter::create(&a.output, &grid, &src.describe())?;
+    let report = bake_chunks(src.as_ref(), &grid, &opts, |_, v| w.write_chunk(v))?;
+    w.finish()?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    if let Some(f) = &report.forced {
+        eprintln!("warning: forced past a symmetry violation: {f}");
+    }
+    eprintln!(
+        "wrote {} ({} values in {:.2} s, {:.1} M values/s)",
+        a.output,
+        report.values,
+        report.seconds,
+        report.values as f64 / report.seconds.max(1e-9) / 1e6
+    );
+    Ok(())
+}
+
+/// `brdftab info`.
+pub fn info(a: InfoArgs) -> Result<()> {
+    if matches!(
+        source::kind(&a.file),
+        source::Kind::Merl | source::Kind::Rgl
+    ) {
+        return crate::measured::info_source(&a.file);
+    }
+    let t = Table::open_raw(&a.file)?;
+    let g = t.grid();
+    let bytes = std::fs::metadata(&a.file)
+        .map_err(|e| Error::io(&a.file, e))?
+        .len();
+    let v = json!({
+        "file": a.file,
+        "format": "raw",
+        "description": t.description(),
+        "grid": g,
+        "parameterization": g.param(),
+        "symmetry": g.symmetry().to_string(),
+        "channels": g.channels().names(),
+        "stored_shape": g.stored_shape(),
+        "chunks": g.layout().chunk_count(),
+        "stored_values": g.stored_values(),
+        "full_values": g.full_values(),
+        "bytes": bytes,
+    });
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+    } else {
+        println!("file:          {}", a.file);
+        println!("source:        {}", t.description());
+        println!("grid:          {}", g.summary());
+        println!("symmetry:      {}", g.symmetry());
+        println!("channels:      {}", g.channels().names().join(" "));
+        println!("chunks:        {}", g.layout().chunk_count());
+        println!("stored_values: {}", g.stored_values());
+        println!("full_values:   {}", g.full_values());
+        println!("bytes:         {bytes}");
+    }
+    Ok(())
+}
+
+/// `brdftab bench`.
+pub fn bench(a: BenchArgs) -> Result<()> {
+    if a.pairs == 0 {
+        return Err(Error::arg("--pairs", "must be positive"));
+    }
+    let interp = Interp::parse(&a.interp)?;
+    let channels = source::channels(a.wavelengths.as_deref())?;
+    let src = source::open_with(&a.source, &channels, interp)?;
+    let c = src.channels().len();
+    let mut rng = Pcg32::new(2024);
+    let (wi, wo): (Vec<DVec3>, Vec<DVec3>) = (0..a.pairs)
+        .map(|_| {
+            (
+                geometry::uniform_hemisphere(rng.next_dvec2()),
+                geometry::uniform_hemisphere(rng.next_dvec2()),
+            )
+        })
+        .unzip();
+    let mut out = vec![0.0f32; a.pairs * c];
+    // Warm up (loads lazy chunks, faults pages).
+    src.eval_batch(&wi, &wo, &mut out);
+    let repeats = 5;
+    let n = a.pairs as f64;
+    let threads = rayon::current_num_threads();
+    let (mut single, mut single_cpu) = (Vec::new(), Vec::new());
+    for _ in 0..repeats {
+        let (t, cpu) = (Instant::now(), thread_cpu_ns());
+        for (k, o) in out.chunks_exact_mut(c).enumerate() {
+            src.eval(wi[k], wo[k], o);
+        }
+        single.push(t.elapsed().as_secs_f64() * 1e9 / n);
+        if let (Some(a0), Some(a1)) = (cpu, thread_cpu_ns()) {
+            single_cpu.push((a1 - a0) as f64 / n);
+        }
+        std::hint::black_box(&out);
+    }
+    let (mut batch, mut batch_cpu) = (Vec::new(), Vec::new());
+    for _ in 0..repeats {
+        let (t, cpu) = (Instant::now(), process_cpu_ns());
+        src.eval_batch(&wi, &wo, &mut out);
+        batch.push(n / t.elapsed().as_secs_f64());
+        if let (Some(a0), Some(a1)) = (cpu, process_cpu_ns()) {
+            // What all cores would do if the process had them to itself.
+            batch_cpu.push(n * threads as f64 / ((a1 - a0) as f64 * 1e-9));
+        }
+        std::hint::black_box(&out);
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(|x, y| x.total_cmp(y));
+        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+    };
+    let ns = median(&mut single);
+    let per_s = median(&mut batch);
+    let ns_cpu = median(&mut single_cpu);
+    let per_s_cpu = median(&mut batch_cpu);
+    if a.json {
+        let v = json!({
+            "source": src.describe(),
+            "pairs": a.pairs,
+            "channels": c,
+            "interp": interp,
+            "ns_per_lookup_single_thread": ns,
+            "cpu_ns_per_lookup_single_thread": ns_cpu,
+            "lookups_per_s_batch": per_s,
+            "lookups_per_s_batch_cpu_time": per_s_cpu,
+            "threads": threads,
+        });
+        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+    } else {
+        println!("source:  {}", src.describe());
+        println!("pairs:   {} ({c} channels, {interp:?})", a.pairs);
+        println!(
+            "single:  {ns:.1} ns per lookup wall, {ns_cpu:.1} ns CPU time (median of {repeats}, one thread)"
+        );
+        println!(
+            "batch:   {:.2} M lookups/s wall, {:.2} M/s from CPU time ({threads} threads, median of {repeats})",
+            per_s / 1e6,
+            per_s_cpu / 1e6
+        );
+    }
+    Ok(())
+}
+
+/// CPU time of the calling thread in ns (Linux `/proc/thread-self/schedstat`); the machine may be
+/// shared, so wall-clock figures alone mislead.
+pub fn thread_cpu_ns() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    s.split_whitespace().next()?.parse().ok()
+}
+
+/// CPU time of every thread of the process in ns.
+pub fn process_cpu_ns() -> Option<u64> {
+    let mut total = 0;
+    for e in std::fs::read_dir("/proc/self/task").ok()? {
+        let p = e.ok()?.path().join("schedstat");
+        if let Ok(s) = std::fs::read_to_string(p) {
+            total += s.split_whitespace().next()?.parse::<u64>().ok()?;
+        }
+    }
+    Some(total)
+}
