@@ -201,7 +201,11 @@ impl StoredTable {
     pub fn brdf(&self) -> Result<crate::table::TabulatedBrdf> {
         let grid = self.grid()?;
         let desc = format!("table `{}` from {}", self.header().name, self.file());
-        Ok(crate::table::TabulatedBrdf::lazy(grid, Box::new(self.clone()), desc))
+        Ok(crate::table::TabulatedBrdf::lazy(
+            grid,
+            Box::new(self.clone()),
+            desc,
+        ))
     }
 }
 
@@ -231,7 +235,11 @@ pub fn open_brdf(source: &str, eager: bool) -> Result<crate::table::TabulatedBrd
             .into_par_iter()
             .map(|i| t.decode_chunk(i))
             .collect::<Result<_>>()?;
-        let table = Table::new(t.grid()?, chunks.concat(), format!("table `{}` from {path}", t.header().name))?;
+        let table = Table::new(
+            t.grid()?,
+            chunks.concat(),
+            format!("table `{}` from {path}", t.header().name),
+        )?;
         return Ok(crate::table::TabulatedBrdf::from_table(table));
     }
     t.brdf()
