@@ -17,7 +17,11 @@ fn brdftab(args: &[&str], stdin: Option<&str>) -> (bool, String, String) {
     }
     drop(c.stdin.take());
     let o = c.wait_with_output().unwrap();
-    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into(),
+        String::from_utf8_lossy(&o.stderr).into(),
+    )
 }
 
 #[test]
@@ -28,7 +32,19 @@ fn bake_info_db_eval_export() {
     let p = |f: &str| d.join(f).display().to_string();
     let ct = r#"{"model": "cook_torrance", "m": 0.3}"#;
 
-    let (ok, _, e) = brdftab(&["bake", ct, "-o", &p("ct.btdb"), "--preset", "small", "--codec", "log16:1e-3"], None);
+    let (ok, _, e) = brdftab(
+        &[
+            "bake",
+            ct,
+            "-o",
+            &p("ct.btdb"),
+            "--preset",
+            "small",
+            "--codec",
+            "log16:1e-3",
+        ],
+        None,
+    );
     assert!(ok, "{e}");
     let (ok, out, e) = brdftab(&["info", &p("ct.btdb"), "--json"], None);
     assert!(ok, "{e}");
@@ -39,10 +55,16 @@ fn bake_info_db_eval_export() {
 
     let db = p("lib.btdb");
     for (name, spec) in [("white", r#"{"model": "lambert", "kd": 0.5}"#), ("ct", ct)] {
-        let (ok, _, e) = brdftab(&["db", "add", &db, spec, "--name", name, "--preset", "small"], None);
+        let (ok, _, e) = brdftab(
+            &["db", "add", &db, spec, "--name", name, "--preset", "small"],
+            None,
+        );
         assert!(ok, "{e}");
     }
-    let (ok, _, e) = brdftab(&["db", "add", &db, ct, "--name", "ct", "--preset", "small"], None);
+    let (ok, _, e) = brdftab(
+        &["db", "add", &db, ct, "--name", "ct", "--preset", "small"],
+        None,
+    );
     assert!(!ok && e.contains("--replace"), "{e}");
     let (ok, out, _) = brdftab(&["db", "list", &db, "--json"], None);
     assert!(ok);
@@ -58,9 +80,25 @@ fn bake_info_db_eval_export() {
     let (ok, _, e) = brdftab(&["eval", &db], Some(""));
     assert!(!ok && e.contains("#NAME"), "{e}");
 
-    let (ok, _, e) = brdftab(&["export", &format!("{db}#ct"), "--npy", &p("ct.npy"), "--exr", &p("ct.exr"), "--slice", "3,2"], None);
+    let (ok, _, e) = brdftab(
+        &[
+            "export",
+            &format!("{db}#ct"),
+            "--npy",
+            &p("ct.npy"),
+            "--exr",
+            &p("ct.exr"),
+            "--slice",
+            "3,2",
+        ],
+        None,
+    );
     assert!(ok, "{e}");
-    assert!(std::fs::read(p("ct.npy")).unwrap().starts_with(b"\x93NUMPY"));
+    assert!(
+        std::fs::read(p("ct.npy"))
+            .unwrap()
+            .starts_with(b"\x93NUMPY")
+    );
 
     let (ok, _, _) = brdftab(&["db", "rm", &db, "white"], None);
     assert!(ok);
@@ -73,6 +111,9 @@ fn bake_info_db_eval_export() {
     b[n / 2] ^= 0x40;
     std::fs::write(p("bad.btdb"), &b).unwrap();
     let (ok, _, e) = brdftab(&["db", "verify", &p("bad.btdb")], None);
-    assert!(!ok && e.starts_with("error:") && !e.contains("panicked"), "{e}");
+    assert!(
+        !ok && e.starts_with("error:") && !e.contains("panicked"),
+        "{e}"
+    );
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -394,9 +394,11 @@ pub fn chunk_info(bytes: &[u8]) -> Result<ChunkInfo> {
 }
 
 /// Decodes a chunk that must hold exactly `expected` values.
+///
+/// Memory follows what the data actually decompress to: the output is allocated only after the
+/// payload has decompressed to exactly the size the header implies, so a small hostile chunk
+/// cannot make the decoder allocate more than zstd's maximum expansion of its bytes.
 pub fn decode(bytes: &[u8], expected: usize) -> Result<Vec<f32>> {
-    let mut out = vec![0.0f32; 0];
-    // Validate before allocating `expected` values.
     let info = chunk_info(bytes)?;
     if info.len != expected {
         return Err(bad(
@@ -405,8 +407,9 @@ pub fn decode(bytes: &[u8], expected: usize) -> Result<Vec<f32>> {
             format!("chunk holds {} values, expected {expected}", info.len),
         ));
     }
-    out.resize(expected, 0.0);
-    decode_into(bytes, &mut out)?;
+    let raw = payload(bytes, &info)?;
+    let mut out = vec![0.0f32; expected];
+    finish(&info, &raw, &mut out)?;
     Ok(out)
 }
 
@@ -420,6 +423,14 @@ pub fn decode_into(bytes: &[u8], out: &mut [f32]) -> Result<()> {
             format!("chunk holds {} values, expected {}", info.len, out.len()),
         ));
     }
+    let raw = payload(bytes, &info)?;
+    finish(&info, &raw, out)
+}
+
+/// Decompresses the payload, checking it has exactly the size the header implies. Up to 16 MiB
+/// decompress in one call into a buffer of that size; beyond, the buffer grows with the actual
+/// output.
+fn payload(bytes: &[u8], info: &ChunkInfo) -> Result<Vec<u8>> {
     let n = info.len;
     let wbytes = if info.quant == "f32" { 4 } else { 2 };
     let words_len = match info.shuffle {
@@ -431,8 +442,19 @@ pub fn decode_into(bytes: &[u8], out: &mut [f32]) -> Result<()> {
         .and_then(|x| x.checked_add(info.escapes.checked_mul(8)?))
         .ok_or_else(|| bad("len", 8, "size overflows"))?;
     let frame = &bytes[CHUNK_HEADER_LEN..];
-    let raw = zstd::bulk::decompress(frame, raw_len)
-        .map_err(|e| bad("payload", CHUNK_HEADER_LEN as u64, format!("zstd: {e}")))?;
+    let zerr = |e: std::io::Error| bad("payload", CHUNK_HEADER_LEN as u64, format!("zstd: {e}"));
+    let raw = if raw_len <= 16 << 20 {
+        zstd::bulk::decompress(frame, raw_len).map_err(zerr)?
+    } else {
+        use std::io::Read;
+        let mut raw = Vec::new();
+        zstd::stream::read::Decoder::with_buffer(frame)
+            .map_err(zerr)?
+            .take(raw_len as u64 + 1)
+            .read_to_end(&mut raw)
+            .map_err(zerr)?;
+        raw
+    };
     if raw.len() != raw_len {
         return Err(bad(
             "payload",
@@ -440,6 +462,19 @@ pub fn decode_into(bytes: &[u8], out: &mut [f32]) -> Result<()> {
             format!("decompressed {} bytes, expected {raw_len}", raw.len()),
         ));
     }
+    Ok(raw)
+}
+
+/// Undoes shuffle, prediction and quantization of a decompressed payload.
+fn finish(info: &ChunkInfo, raw: &[u8], out: &mut [f32]) -> Result<()> {
+    let n = info.len;
+    let wbytes = if info.quant == "f32" { 4 } else { 2 };
+    let words_len = n * wbytes
+        + if info.shuffle == Shuffle::Bit {
+            n.div_ceil(8) * 8 * wbytes - n * wbytes
+        } else {
+            0
+        };
     match info.quant {
         "f32" => {
             let mut w = vec![0u32; n];
