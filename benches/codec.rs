@@ -341,7 +341,12 @@ fn main() {
     let (t, f) = time(|| {
         let b = tables::open_brdf(&src, false).unwrap();
         let mut f = [0.0f32; 3];
-        brdftab::Brdf::eval(&b, glam::DVec3::new(0.3, 0.1, 0.9), glam::DVec3::new(-0.2, 0.3, 0.9), &mut f);
+        brdftab::Brdf::eval(
+            &b,
+            glam::DVec3::new(0.3, 0.1, 0.9),
+            glam::DVec3::new(-0.2, 0.3, 0.9),
+            &mut f,
+        );
         f
     });
     println!("open 100-table db + lazy TabulatedBrdf + first eval: {t:.2?} (f = {f:?})");

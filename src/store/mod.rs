@@ -470,9 +470,12 @@ pub struct ChunkCache {
     inner: Mutex<CacheInner>,
 }
 
+/// A decoded chunk and its last use.
+type Entry = (Arc<[f32]>, u64);
+
 #[derive(Default)]
 struct CacheInner {
-    map: HashMap<(usize, usize), (Arc<[f32]>, u64)>,
+    map: HashMap<(usize, usize), Entry>,
     bytes: usize,
     tick: u64,
 }

@@ -35,7 +35,7 @@ struct AddArgs {
     #[arg(long)]
     replace: bool,
     #[command(flatten)]
-    bake: BakeArgs,
+    bake: Box<BakeArgs>,
 }
 
 #[derive(Args)]
@@ -77,7 +77,7 @@ pub fn run(a: DbArgs) -> Result<()> {
                 ));
             }
             crate::table::bake_to(
-                a.bake,
+                *a.bake,
                 Target::Db {
                     path: &a.db,
                     name: &name,
