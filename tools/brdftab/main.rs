@@ -3,7 +3,9 @@
 
 mod accuracy;
 mod analysis;
+mod db;
 mod demo;
+mod export;
 mod fit;
 mod measured;
 mod models;
@@ -31,6 +33,10 @@ enum Command {
     Models(models::ModelsArgs),
     /// Bake SOURCE into a dense (symmetry-reduced) table file.
     Bake(table::BakeArgs),
+    /// Databases of named tables: add, list, rm, verify.
+    Db(db::DbArgs),
+    /// Export a stored table as .npy, or a 2D slice of it as EXR.
+    Export(export::ExportArgs),
     /// Describe a table file (grid, symmetry, channels, sizes) or a measured file (MERL, RGL).
     Info(table::InfoArgs),
     /// Time lookups of SOURCE on random pairs (single thread and batch on all cores).
@@ -69,6 +75,8 @@ fn main() -> ExitCode {
         Command::Models(a) => models::models(a),
         Command::Bake(a) => table::bake(a),
         Command::Info(a) => table::info(a),
+        Command::Db(a) => db::run(a),
+        Command::Export(a) => export::run(a),
         Command::Bench(a) => table::bench(a),
         Command::Render(a) => render::run(a),
         Command::Slice(a) => measured::slice(a),
