@@ -6,7 +6,8 @@
 //!   [`symmetry::detect`];
 //! - [`Table`]: a grid plus its stored values, in memory;
 //! - `bake`: any `Brdf` → values, chunk by chunk or into a [`Table`];
-//! - `tabulated`: `TabulatedBrdf`, the `Brdf` over a table (eager or lazily loaded chunks).
+//! - `tabulated`: `TabulatedBrdf`, the `Brdf` over a table (eager or lazily loaded chunks);
+//! - [`sampling`]: importance sampling of tables (tabulated CDFs of f_r·cos θi).
 //!
 //! Values are stored λ innermost: the values of one node for every channel are contiguous, so
 //! one set of angular interpolation weights serves all channels.
@@ -16,12 +17,14 @@ pub mod grid;
 pub mod lookup;
 pub mod presets;
 pub mod raw;
+pub mod sampling;
 pub mod symmetry;
 pub mod tabulated;
 
 pub use bake::{BakeOptions, BakeReport, bake, bake_chunks};
 pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, StoredAxis};
 pub use lookup::Interp;
+pub use sampling::{SamplingResolution, TableSampler};
 pub use symmetry::Symmetry;
 pub use tabulated::{ChunkLoader, TabulatedBrdf};
 
