@@ -171,7 +171,7 @@ impl TableSampler {
         let nt = res.theta_o.max(1);
         let np = if isotropic { 1 } else { res.phi_o.max(1) };
         let ss = res.supersample.max(1);
-        let c = brdf.channels().len().min(MAX_CHANNELS).max(1);
+        let c = brdf.channels().len().clamp(1, MAX_CHANNELS);
         let mut f = [0.0f32; MAX_CHANNELS];
         let mut nodes = Vec::with_capacity(nt * np);
         let mut mass = vec![0.0f64; n * n];
