@@ -97,7 +97,12 @@ fn table_of(src: &dyn Brdf) -> TabulatedBrdf {
     t
 }
 
-fn run<M: Measurement>(g: &mut criterion::BenchmarkGroup<M>, name: &str, b: &dyn Brdf, wos: &[DVec3]) {
+fn run<M: Measurement>(
+    g: &mut criterion::BenchmarkGroup<M>,
+    name: &str,
+    b: &dyn Brdf,
+    wos: &[DVec3],
+) {
     g.bench_function(name, |bch| {
         let mut rng = Pcg32::new(7);
         let mut w = [0.0f32; 3];

@@ -27,9 +27,10 @@
 //!   are zero (a lobe narrower than the supersampling): pdf = α cos θi/π + (1 − α) Σ w_k p_k.
 //! - **Random numbers**: the two uniforms are reused by rescaling (u.x picks cosine-or-table,
 //!   then the node, then the column; u.y picks the row), so sampling needs no third number and
-//!   never allocates. A sample costs two binary searches (n + 1 entries), one `sin_cos`, one
-//!   `atan` (the inverse map for the pdf of the other nodes and the cosine part), one lookup of
-//!   the source for the weight.
+//!   never allocates. A table-branch sample costs two binary searches (n + 1 entries), one
+//!   `sin_cos` (the concentric map), a few `sqrt`, and one lookup of the source for the weight;
+//!   all nodes share the square's cells, so the mixture pdf needs no inverse map. The cosine
+//!   branch and [`TableSampler::pdf`] add the inverse map (one `atan`).
 //!
 //! # Resolution and memory
 //!
@@ -130,8 +131,8 @@ pub fn square_to_hemisphere(p: DVec2) -> DVec3 {
 pub fn hemisphere_to_square(w: DVec3) -> DVec2 {
     let z = w.z.clamp(0.0, 1.0);
     // Disk point: direction of w.xy, radius r = sqrt(1 − z); |w.xy| = r·sqrt(1 + z).
-    let dx = w.x / (1.0 + z).sqrt();
-    let dy = w.y / (1.0 + z).sqrt();
+    let inv = 1.0 / (1.0 + z).sqrt();
+    let (dx, dy) = (w.x * inv, w.y * inv);
     let r = (1.0 - z).sqrt();
     let (a, b) = if dx == 0.0 && dy == 0.0 {
         (0.0, 0.0)
@@ -283,14 +284,19 @@ impl TableSampler {
         let n = self.n;
         let i = ((p.y * n as f64) as usize).min(n - 1);
         let j = ((p.x * n as f64) as usize).min(n - 1);
-        let cell = i * n + j;
+        self.pdf_cell(i * n + j, wl.z, m)
+    }
+
+    /// Density of a local-frame direction with z = `z` in square cell `cell` under `m`.
+    #[inline]
+    fn pdf_cell(&self, cell: usize, z: f64, m: &Mix) -> f64 {
         let mut d = 0.0;
         for k in 0..m.len {
             if m.w[k] > 0.0 {
                 d += m.w[k] * self.nodes[m.idx[k]].density[cell] as f64;
             }
         }
-        self.alpha * wl.z * FRAC_1_PI + (1.0 - self.alpha) * d * (0.5 * FRAC_1_PI)
+        self.alpha * z * FRAC_1_PI + (1.0 - self.alpha) * d * (0.5 * FRAC_1_PI)
     }
 
     /// The density (solid angle) with which [`TableSampler::sample`] draws `wi` given `wo`;
@@ -321,8 +327,12 @@ impl TableSampler {
         }
         let (c, s) = self.frame(wo);
         let m = self.mix(wo);
-        let wl = if u.x < self.alpha {
-            geometry::cosine_hemisphere(DVec2::new(u.x / self.alpha, u.y))
+        // The table branch knows its cell: no inverse map needed for the pdf (the cell of a point
+        // within rounding of a cell edge may differ from `pdf()`'s by that rounding — a
+        // measure-zero event).
+        let (wl, pdf) = if u.x < self.alpha {
+            let wl = geometry::cosine_hemisphere(DVec2::new(u.x / self.alpha, u.y));
+            (wl, self.pdf_local(wl, &m))
         } else {
             let mut ux = ((u.x - self.alpha) / (1.0 - self.alpha)).min(1.0 - f64::EPSILON);
             // Choose node k with probability w_k, reusing ux.
@@ -348,16 +358,17 @@ impl TableSampler {
             let j = find_interval(cols, ux);
             let (c0, c1) = (cols[j] as f64, cols[j + 1] as f64);
             let uu = ((ux - c0) / (c1 - c0)).clamp(0.0, 1.0);
-            square_to_hemisphere(DVec2::new(
+            let wl = square_to_hemisphere(DVec2::new(
                 (j as f64 + uu) / n as f64,
                 (i as f64 + v) / n as f64,
-            ))
+            ));
+            (wl, self.pdf_cell(i * n + j, wl.z, &m))
         };
         if wl.z <= 0.0 {
             return None;
         }
-        let wi = geometry::normalize(DVec3::new(c * wl.x - s * wl.y, s * wl.x + c * wl.y, wl.z))?;
-        let pdf = self.pdf_local(wl, &m);
+        // A rotation about z keeps the (unit) length.
+        let wi = DVec3::new(c * wl.x - s * wl.y, s * wl.x + c * wl.y, wl.z);
         if !(pdf > 0.0) || !pdf.is_finite() {
             return None;
         }

@@ -21,7 +21,10 @@ const CASES: usize = 15;
 const SAMPLES: usize = 1_000_000;
 
 fn rgl_path(name: &str) -> String {
-    format!("{}/../shared/data/measured/rgl/{name}", env!("CARGO_MANIFEST_DIR"))
+    format!(
+        "{}/../shared/data/measured/rgl/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    )
 }
 
 /// A small isotropic `halfdiff` table (32 θh (sqrt) × 32 θd × 64 φd, folded by `sym`).
@@ -39,7 +42,10 @@ fn baked(src: &dyn Brdf, sym: Symmetry) -> TabulatedBrdf {
 }
 
 fn model_table(spec: &str) -> TabulatedBrdf {
-    let m = ModelSpec::parse(spec).unwrap().build(&Channels::Rgb).unwrap();
+    let m = ModelSpec::parse(spec)
+        .unwrap()
+        .build(&Channels::Rgb)
+        .unwrap();
     baked(m.as_ref(), Symmetry::ALL)
 }
 
@@ -113,7 +119,11 @@ fn chi2_all(b: &TabulatedBrdf, name: &str) {
             failures.push(format!("{name} at wo = {wo}: {r:?}"));
         }
     }
-    assert!(failures.is_empty(), "chi-square failures (α = {alpha:.2e}):\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "chi-square failures (α = {alpha:.2e}):\n{}",
+        failures.join("\n")
+    );
 }
 
 #[test]
@@ -233,7 +243,6 @@ fn sampler_memory_is_bounded() {
     assert!(phong().pdf(DVec3::new(0.1, 0.0, 1.0), wo) > 0.0);
 }
 
-
 /// A chi-square test in the sampler's own equal-area cells (coarsened 2 × 2), where the expected
 /// counts are exact: the tabulated part of the pdf is constant on each cell (its mass is
 /// Σ_k w_k density_k / n²) and the cosine part is a smooth integral (z(p) dA, 16² midpoint points
@@ -316,6 +325,10 @@ fn chi2_exact_cells(b: &TabulatedBrdf, wo: DVec3, samples: usize) -> (f64, f64, 
         chi2 = f64::INFINITY;
     }
     let dof = dof.max(1) as usize;
-    let p = if chi2.is_finite() { gamma_q(dof as f64 / 2.0, chi2 / 2.0) } else { 0.0 };
+    let p = if chi2.is_finite() {
+        gamma_q(dof as f64 / 2.0, chi2 / 2.0)
+    } else {
+        0.0
+    };
     (p, chi2, dof)
 }
