@@ -428,10 +428,10 @@ impl Serialize for ModelSpec {
             "model".into(),
             serde_json::Value::String(self.name().into()),
         );
-        if let serde_json::Value::Object(o) = ext {
-            if let Some(serde_json::Value::Object(fields)) = o.into_iter().next().map(|(_, v)| v) {
-                out.extend(fields);
-            }
+        if let serde_json::Value::Object(o) = ext
+            && let Some((_, serde_json::Value::Object(fields))) = o.into_iter().next()
+        {
+            out.extend(fields);
         }
         serde_json::Value::Object(out).serialize(s)
     }

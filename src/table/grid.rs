@@ -482,7 +482,7 @@ impl Grid {
             ));
         }
         let even = |n: usize, what: &str, m: usize| -> Result<()> {
-            if n % m != 0 {
+            if !n.is_multiple_of(m) {
                 Err(Error::arg(
                     "grid",
                     format!(

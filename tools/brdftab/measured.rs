@@ -253,45 +253,6 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
     }
 }
 
-/// Arguments of `brdftab db`.
-#[derive(Args)]
-pub struct DbArgs {
-    #[command(subcommand)]
-    command: DbCommand,
-}
-
-/// `brdftab db` subcommands.
-#[derive(clap::Subcommand)]
-pub enum DbCommand {
-    /// Add a measured file (or any SOURCE) to a database as a table, with its provenance
-    /// (file name and sha256).
-    Add(DbAddArgs),
-}
-
-/// Arguments of `brdftab db add`.
-#[derive(Args)]
-pub struct DbAddArgs {
-    /// The database file (created if absent).
-    db: String,
-    /// The file to add: MERL `.binary`, RGL `.bsdf`, or any SOURCE.
-    file: String,
-    /// Table name (default: the file name without extension).
-    #[arg(long)]
-    name: Option<String>,
-    #[command(flatten)]
-    tab: TabulateArgs,
-}
-
-/// `brdftab db ...`.
-pub fn db(a: DbArgs) -> Result<()> {
-    match a.command {
-        DbCommand::Add(a) => {
-            let name = a.name.unwrap_or_else(|| stem(&a.file));
-            tabulate_into(&a.file, &format!("{}#{name}", a.db), &Channels::Rgb, &a.tab)
-        }
-    }
-}
-
 fn stem(path: &str) -> String {
     std::path::Path::new(path)
         .file_stem()

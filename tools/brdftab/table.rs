@@ -35,8 +35,10 @@ pub struct BakeArgs {
     /// Output table file (`.btdb`).
     #[arg(short, long)]
     pub output: Option<String>,
-    /// Codec: f32 (lossless), f16, or log16 (relative error bound; `log16:1e-3` sets it).
-    #[arg(long, default_value = "f16")]
+    /// Codec: f32 (lossless), f16 (fails above ±65504), or log16 (relative error bound at any
+    /// magnitude, default 1e-3; `log16:1e-2` sets it). The default is log16: analytic lobes such as
+    /// Cook-Torrance reach 1e5 at grazing angles, beyond f16.
+    #[arg(long, default_value = "log16")]
     pub codec: String,
     /// log16 relative tolerance (default 1e-3). Named so as not to clash with the symmetry
     /// `--tolerance`.
