@@ -62,8 +62,26 @@ fn rel_rmse(b: &dyn Brdf, reference: &dyn Brdf, pairs: &[(DVec3, DVec3)]) -> f64
     (num / den).sqrt()
 }
 
+/// Coherent pairs, as a renderer or a slice produces them: 200 incident directions, each with a
+/// 32 × 32 sweep of outgoing directions in scan order.
+fn coherent_pairs() -> Vec<(DVec3, DVec3)> {
+    let mut rng = Pcg32::new(43);
+    let mut v = Vec::with_capacity(200 * 1024);
+    for _ in 0..200 {
+        let wi = uniform_hemisphere(rng.next_dvec2());
+        for a in 0..32 {
+            for b in 0..32 {
+                let u = glam::DVec2::new((a as f64 + 0.5) / 32.0, (b as f64 + 0.5) / 32.0);
+                v.push((wi, uniform_hemisphere(u)));
+            }
+        }
+    }
+    v
+}
+
 fn main() {
     let p = pairs(200_000);
+    let coherent = coherent_pairs();
     println!(
         "measured benchmarks ({} random direction pairs, best of 3)",
         p.len()
@@ -120,14 +138,46 @@ fn main() {
     );
     std::fs::remove_dir_all(&dir).ok();
 
-    // The RGL material resampled to the MERL grid (a dense nearest-lookup table).
+    // The RGL material baked into tables (halfdiff, sqrt θh, isotropic) and the MERL grid.
+    use brdftab::table::presets::Preset;
+    use brdftab::table::{BakeOptions, Interp, Symmetry, TabulatedBrdf, bake};
     let b = RglBrdf::open(format!("{RGL}cc_ibiza_sunset_rgb.bsdf")).unwrap();
+    let native = ns_per_eval(&b, &p);
+    let native_coh = ns_per_eval(&b, &coherent);
+    println!("rgl native eval   cc_ibiza_sunset, coherent pairs {native_coh:7.1} ns/eval");
+    let q = &p[..100_000];
+    let iso = Symmetry {
+        isotropic: true,
+        reciprocal: false,
+        bilateral: false,
+    };
+    for preset in [Preset::Medium, Preset::Large] {
+        let grid = preset.grid(None, iso, brdftab::Channels::Rgb).unwrap();
+        let t = Instant::now();
+        let (table, _) = bake(&b, &grid, &BakeOptions::default()).unwrap();
+        let secs = t.elapsed().as_secs_f64();
+        for interp in [Interp::Linear, Interp::Nearest] {
+            let tab = TabulatedBrdf::from_table(table.clone()).with_interp(interp);
+            let ns = ns_per_eval(&tab, &p);
+            let ns_coh = ns_per_eval(&tab, &coherent);
+            let acc = brdftab::analysis::accuracy::compare(&tab, &b, 100_000, 1).unwrap();
+            println!(
+                "rgl → table {preset:?} {interp:?} ({}; bake {secs:.1} s):\n    random {ns:6.1} ns/lookup ({:.1}× native), \
+                 coherent {ns_coh:6.1} ns/lookup ({:.1}× native); \
+                 error of f_r·cos θo (cos θi cos θo weights) {:.4}, accuracy::compare (cos θi weights) {:.4}",
+                grid.summary(),
+                native / ns,
+                native_coh / ns_coh,
+                rel_rmse(&tab, &b, q),
+                acc.rel_rmse
+            );
+        }
+    }
     let t = Instant::now();
     let resampled = MerlBrdf::from_brdf(&b);
     let secs = t.elapsed().as_secs_f64();
-    let q = &p[..50_000];
     println!(
-        "rgl → merl grid   cc_ibiza_sunset (resample {secs:.2} s) {:7.1} ns/lookup, cos-weighted rel RMSE {:.3}",
+        "rgl → merl grid   cc_ibiza_sunset (resample {secs:.2} s) {:7.1} ns/lookup, error of f_r·cos θo {:.4}",
         ns_per_eval(&resampled, &p),
         rel_rmse(&resampled, &b, q)
     );

@@ -154,3 +154,36 @@ fn sample_rejects_a_bad_wo() {
     assert_eq!(code, 0);
     assert!(out.is_empty());
 }
+
+#[test]
+fn fit_through_a_baked_table_file_recovers_cook_torrance() {
+    let dir = std::env::temp_dir().join(format!("brdftab-fit-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let table = dir.join("ct.brdftab");
+    let table = table.to_str().unwrap();
+    let ct = r#"{"model": "cook_torrance", "m": 0.25, "ks": 0.8, "fresnel": "none"}"#;
+    let (_, err, code) = brdftab(&["bake", ct, "-o", table, "--preset", "small"], "");
+    assert_eq!(code, 0, "{err}");
+    let (out, err, code) = brdftab(
+        &[
+            "fit",
+            table,
+            "--model",
+            "cook_torrance",
+            "--grey",
+            "--pairs",
+            "1500",
+            "--starts",
+            "3",
+        ],
+        "",
+    );
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    let (m, ks) = (j["m"].as_f64().unwrap(), j["ks"].as_f64().unwrap());
+    assert!(
+        (m - 0.25).abs() < 0.005 && (ks - 0.8).abs() < 0.016,
+        "{out}"
+    );
+}

@@ -315,12 +315,12 @@ fn corrupted_headers_never_panic() {
             let at = rng.below(420) as usize;
             b[at] = rng.below(256) as u8;
         }
-        if let Ok(t) = TensorFile::from_bytes("fuzz", b) {
-            if let Ok(brdf) = RglBrdf::from_tensor(&t, None) {
-                let mut f = [0f32; 3];
-                brdf.eval(dir(40.0, 10.0), dir(30.0, 200.0), &mut f);
-                assert!(f.iter().all(|x| x.is_finite() && *x >= 0.0));
-            }
+        if let Ok(t) = TensorFile::from_bytes("fuzz", b)
+            && let Ok(brdf) = RglBrdf::from_tensor(&t, None)
+        {
+            let mut f = [0f32; 3];
+            brdf.eval(dir(40.0, 10.0), dir(30.0, 200.0), &mut f);
+            assert!(f.iter().all(|x| x.is_finite() && *x >= 0.0));
         }
     }
 }
@@ -339,6 +339,28 @@ fn random_pairs_are_finite_and_non_negative() {
                 f.iter().all(|x| x.is_finite() && *x >= 0.0),
                 "{wi} {wo} {f:?}"
             );
+        }
+    }
+}
+
+#[test]
+fn sampler_passes_chi_square() {
+    use brdftab::analysis::chi2::{self, Chi2Options};
+    let files = ["paper_white_rgb.bsdf", "cc_ibiza_sunset_rgb.bsdf"];
+    let wos = [dir(30.0, 20.0), dir(70.0, -100.0)];
+    let alpha = chi2::sidak(0.01, files.len() * wos.len());
+    let opts = Chi2Options {
+        samples: 100_000,
+        cos_bins: 20,
+        phi_bins: 40,
+        ..Chi2Options::default()
+    };
+    for file in files {
+        let b = RglBrdf::open(format!("{DIR}{file}")).unwrap();
+        for wo in wos {
+            let r = chi2::test(&b, wo, &opts);
+            eprintln!("{file} wo={wo}: {r:?}");
+            assert!(r.passes(alpha), "{file} wo={wo}: p = {}", r.p_value);
         }
     }
 }

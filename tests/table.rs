@@ -391,13 +391,12 @@ fn linear_interpolation_reproduces_multilinear_functions() {
             let cell_ok = {
                 let (lo, hi) = (ax[0].linear(x[0]), ax[2].linear(x[2]));
                 let s = |k: usize, i: usize| ax[k].node(i);
-                let corners_ok = [lo.0, lo.1].iter().all(|&i| {
+                [lo.0, lo.1].iter().all(|&i| {
                     [hi.0, hi.1].iter().all(|&j| match g.param() {
                         Param::HalfDiff => s(0, i) + s(2, j) < FRAC_PI_2 - 1e-3,
                         Param::InOut => i + 1 < ax[0].size && j + 1 < ax[2].size,
                     })
-                });
-                corners_ok
+                })
             };
             if !cell_ok {
                 continue;

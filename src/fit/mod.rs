@@ -12,8 +12,8 @@
 //!   or as one grey value ([`ColorMode::Grey`]); shape parameters (m, n, α, σ) are shared by all
 //!   channels. Bounds are enforced by a logistic reparameterization (in log space for exponents
 //!   and roughness), so Levenberg-Marquardt runs unconstrained.
-//! - **Pairs** are deterministic: cosine-distributed plus a fraction near the mirror direction
-//!   (see [`pairs`]).
+//! - **Pairs** are deterministic: cosine-distributed plus a fraction near the mirror direction,
+//!   both directions within 80° of the normal by default (see [`pairs`]).
 //! - **Residuals** are r_kc = f̂_c cos θi − f_c cos θi per pair k and channel c, or with
 //!   [`FitOptions::log`] r_kc = ln(1 + f̂_c cos θi) − ln(1 + f_c cos θi) (Ngan et al. 2005 style:
 //!   compresses specular peaks so the diffuse part and lobe shape count).
@@ -24,11 +24,13 @@
 //!   forward differences with tiny steps would see only rounding. The channels of a per-channel
 //!   value are differenced together (each affects only its own channel), so an RGB `kd` costs
 //!   one pair of model evaluations per iteration, not three.
-//! - **Error**: the reported `rmse` is the cosine-weighted relative RMSE
-//!   sqrt(Σ (f̂ − f)² cos² θi / Σ f² cos² θi) over all channels, on a *held-out* set of pairs drawn
-//!   like the fitting pairs with another seed; `rmse_fit` is the same on the fitting pairs.
-//!   (`analysis::accuracy` was not in main when this was written; [`relative_rmse`] is the
-//!   metric.)
+//! - **Error**: `rmse` is the cosine-weighted relative RMSE of
+//!   [`analysis::accuracy`](crate::analysis::accuracy), sqrt(Σ ((f̂ − f) cos θi)² / Σ (f cos θi)²)
+//!   over every channel, on a *held-out* set of pairs drawn like the fitting pairs (another seed),
+//!   so within `max_theta`; `rmse_fit` is the same on the fitting pairs. `rmse_uniform` /
+//!   `max_rel_uniform` are `analysis::accuracy::compare` itself ([`ACCURACY_PAIRS`] pairs uniform
+//!   on the whole hemisphere, grazing included) — the crate's yardstick for tables, but for
+//!   measured data a handful of extreme-grazing values can dominate it.
 //!
 //! ```
 //! use brdftab::{fit::{self, FitOptions}, spec::ModelSpec, spectrum::Channels};
@@ -60,6 +62,9 @@ use crate::spectrum::Channels;
 pub use pairs::Pairs;
 pub use params::{Bounds, ColorMode, Param, ParamRequest, Scale};
 
+/// Number of uniform pairs on which the final `rmse` is measured.
+pub const ACCURACY_PAIRS: usize = 20_000;
+
 /// Options of a fit. `Default` gives 4000 pairs (30% specular), linear residuals, 8 starts,
 /// every parameter with default bounds, per-channel colours.
 #[derive(Debug, Clone, PartialEq)]
@@ -70,6 +75,8 @@ pub struct FitOptions {
     pub pairs: usize,
     /// Fraction of pairs drawn near the mirror direction.
     pub specular_fraction: f64,
+    /// Largest polar angle of either direction of a pair, radians (default 80°).
+    pub max_theta: f64,
     /// Residuals in log space: ln(1 + f cos θi).
     pub log: bool,
     /// Number of starts (≥ 1).
@@ -88,6 +95,7 @@ impl Default for FitOptions {
             params: Vec::new(),
             pairs: 4000,
             specular_fraction: 0.3,
+            max_theta: pairs::MAX_THETA,
             log: false,
             starts: 8,
             seed: 1,
@@ -134,8 +142,13 @@ pub struct StartResult {
 pub struct FitResult {
     /// The fitted spec (valid, builds, usable as a SOURCE).
     pub spec: ModelSpec,
-    /// Relative RMSE of the fitted spec on held-out pairs (see the module docs).
+    /// Cosine-weighted relative RMSE of the fitted spec against the source on held-out pairs
+    /// drawn like the fitting pairs (see the module docs).
     pub rmse: f64,
+    /// `analysis::accuracy::compare` on uniform pairs over the whole hemisphere: relative RMSE.
+    pub rmse_uniform: f64,
+    /// `analysis::accuracy::compare`: maximum relative error.
+    pub max_rel_uniform: f64,
     /// Relative RMSE on the fitting pairs.
     pub rmse_fit: f64,
     /// The objective of the best start.
@@ -201,6 +214,35 @@ pub fn preset(name: &str) -> Result<ModelSpec> {
     } else {
         serde_json::json!({"model": "sum", "terms": terms})
     };
+    spec_from_json(json)
+}
+
+/// `spec` with the Fresnel term of every microfacet lobe (`cook_torrance`, `ggx`) replaced by
+/// `fresnel` — e.g. `{"schlick": 0.04}` so that a fit also finds F0, or `{"eta": 1.5}` for a
+/// dielectric index. Presets use `"none"` (k_s absorbs the reflectance).
+pub fn with_fresnel(spec: &ModelSpec, fresnel: &crate::fresnel::FresnelSpec) -> Result<ModelSpec> {
+    fn walk(v: &mut Json, f: &Json) {
+        let Some(obj) = v.as_object_mut() else { return };
+        if matches!(
+            obj.get("model").and_then(Json::as_str),
+            Some("cook_torrance" | "ggx")
+        ) {
+            obj.insert("fresnel".into(), f.clone());
+        }
+        if let Some(Json::Array(terms)) = obj.get_mut("terms") {
+            for t in terms {
+                walk(t, f);
+            }
+        }
+    }
+    let to_json = |x: serde_json::Result<Json>| {
+        x.map_err(|e| Error::Json {
+            context: "spec".into(),
+            source: e,
+        })
+    };
+    let mut json = to_json(serde_json::to_value(spec))?;
+    walk(&mut json, &to_json(serde_json::to_value(fresnel))?);
     spec_from_json(json)
 }
 
@@ -289,7 +331,12 @@ pub fn fit_with_progress(
     // The starting spec must build for the source's channels (catches unimplemented models early).
     init.build(&channels)?;
 
-    let pairs = Pairs::sample(opts.pairs, opts.specular_fraction, opts.seed);
+    let pairs = Pairs::sample(
+        opts.pairs,
+        opts.specular_fraction,
+        opts.max_theta,
+        opts.seed,
+    );
     let target_lin = eval_cos(source, &pairs);
     let problem = Problem {
         base: base.clone(),
@@ -402,9 +449,12 @@ pub fn fit_with_progress(
     let held_out = Pairs::sample(
         opts.pairs,
         opts.specular_fraction,
+        opts.max_theta,
         opts.seed ^ 0x9e37_79b9_7f4a_7c15,
     );
     let rmse = relative_rmse(source, model.as_ref(), &held_out)?;
+    let acc =
+        crate::analysis::accuracy::compare(model.as_ref(), source, ACCURACY_PAIRS, opts.seed)?;
     let x = from_free(&params, t_best.as_slice());
     let mut off = 0;
     let fitted = params
@@ -428,6 +478,8 @@ pub fn fit_with_progress(
     Ok(FitResult {
         spec,
         rmse,
+        rmse_uniform: acc.rel_rmse,
+        max_rel_uniform: acc.max_rel,
         rmse_fit: b.rmse,
         objective: b.objective,
         iterations: b.iterations,

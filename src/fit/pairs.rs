@@ -9,6 +9,11 @@
 //!   lobes as sharp as Phong n = 10⁴ or roughness 0.01 are still seen by a few percent of all
 //!   pairs. Directions that fall below the horizon are redrawn.
 //!
+//! Both directions are kept within `max_theta` of the normal (default 80°, as Ngan et al. 2005
+//! discard grazing measurements): measured data is least reliable there, and the 1/(cos θi cos θo)
+//! of microfacet models (and tables interpolating them) would let a few grazing pairs dominate
+//! the sum of squares.
+//!
 //! Each pair appears once in the sum of squares (no density compensation): the fit minimizes
 //! Σ (f̂ cos θi − f cos θi)² over these pairs, which weights the specular cone more than a
 //! uniform integral would, on purpose.
@@ -21,7 +26,10 @@ use crate::rng::Pcg32;
 /// Largest angle of a specular-cone sample from the mirror direction (20°).
 pub const SPECULAR_CONE: f64 = 20.0 * std::f64::consts::PI / 180.0;
 
-/// Direction pairs: `wi[k]`, `wo[k]`, both unit and strictly above the horizon (z ≥ 1e-3).
+/// Default largest polar angle of either direction (80°).
+pub const MAX_THETA: f64 = 80.0 * std::f64::consts::PI / 180.0;
+
+/// Direction pairs: `wi[k]`, `wo[k]`, both unit, within `max_theta` of the normal.
 #[derive(Debug, Clone, Default)]
 pub struct Pairs {
     /// Directions towards the light.
@@ -31,16 +39,20 @@ pub struct Pairs {
 }
 
 impl Pairs {
-    /// `n` pairs, a fraction `specular_fraction` of them near the mirror direction.
-    pub fn sample(n: usize, specular_fraction: f64, seed: u64) -> Self {
+    /// `n` pairs, a fraction `specular_fraction` of them near the mirror direction, both
+    /// directions at most `max_theta` (radians, clamped to [1°, 90°)) from the normal.
+    pub fn sample(n: usize, specular_fraction: f64, max_theta: f64, seed: u64) -> Self {
         let mut rng = Pcg32::with_stream(seed, 0x6f69_7421);
         let mut wi = Vec::with_capacity(n);
         let mut wo = Vec::with_capacity(n);
-        const MIN_Z: f64 = 1e-3;
+        let min_z = max_theta
+            .clamp(1f64.to_radians(), 89.9f64.to_radians())
+            .cos()
+            .max(1e-3);
         while wi.len() < n {
             let o = geometry::cosine_hemisphere(rng.next_dvec2());
             let specular = rng.next_f64() < specular_fraction;
-            if o.z < MIN_Z {
+            if o.z < min_z {
                 continue;
             }
             let i = if specular {
@@ -55,7 +67,7 @@ impl Pairs {
             let Some(i) = geometry::normalize(i) else {
                 continue;
             };
-            if i.z < MIN_Z {
+            if i.z < min_z {
                 continue;
             }
             wi.push(i);
@@ -81,13 +93,13 @@ mod tests {
 
     #[test]
     fn deterministic_above_horizon_and_some_specular() {
-        let a = Pairs::sample(2000, 0.3, 7);
-        let b = Pairs::sample(2000, 0.3, 7);
+        let a = Pairs::sample(2000, 0.3, MAX_THETA, 7);
+        let b = Pairs::sample(2000, 0.3, MAX_THETA, 7);
         assert_eq!(a.wi, b.wi);
         assert_eq!(a.len(), 2000);
         let mut near = 0;
         for (i, o) in a.wi.iter().zip(&a.wo) {
-            assert!(i.z > 0.0 && o.z > 0.0);
+            assert!(i.z >= MAX_THETA.cos() - 1e-12 && o.z >= MAX_THETA.cos() - 1e-12);
             assert!((i.length() - 1.0).abs() < 1e-12);
             if i.dot(geometry::reflect_z(*o)) > 1.0f64.to_radians().cos() {
                 near += 1;
@@ -95,6 +107,9 @@ mod tests {
         }
         // About 0.3 · sqrt(1/20) ≈ 6.7% lie within 1° of the mirror direction.
         assert!(near > 80 && near < 200, "{near}");
-        assert_ne!(Pairs::sample(10, 0.3, 8).wi, Pairs::sample(10, 0.3, 7).wi);
+        assert_ne!(
+            Pairs::sample(10, 0.3, MAX_THETA, 8).wi,
+            Pairs::sample(10, 0.3, MAX_THETA, 7).wi
+        );
     }
 }

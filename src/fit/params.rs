@@ -130,7 +130,7 @@ fn logistic(t: f64) -> f64 {
 /// True when the field `key` of model `model` holds a [`Value`](crate::Value) (grey, RGB or
 /// spectral) rather than a plain number.
 pub fn is_value_field(key: &str) -> bool {
-    matches!(key, "kd" | "ks" | "eta")
+    matches!(key, "kd" | "ks" | "eta" | "schlick")
 }
 
 /// The default bounds of field `key` in model `model`, or `None` when the field has no default
@@ -144,6 +144,8 @@ pub fn is_value_field(key: &str) -> bool {
 /// | `m`, `alpha`, `alpha_x`, `alpha_y` | microfacet, ward | [0.01, 1.5] | log |
 /// | `n` | Phong family, blinn_phong | [1, 10000] | log |
 /// | `sigma` | oren_nayar | [0, 1.5] rad | linear |
+/// | `fresnel.schlick` (F0) | microfacet | [0, 1] | linear |
+/// | `fresnel.eta` (dielectric) | microfacet | [1.01, 3] | linear |
 ///
 /// `k_d ≤ 1.2/π` allows a little more than energy conservation (albedo 1.2) so that measured data
 /// with calibration error is not clipped; `k_s` of the Phong family is the lobe's peak value, which
@@ -159,6 +161,8 @@ pub fn default_bounds(model: &str, key: &str) -> Option<Bounds> {
         "m" | "alpha" | "alpha_x" | "alpha_y" => Bounds::log(0.01, 1.5),
         "n" => Bounds::log(1.0, 10000.0),
         "sigma" => Bounds::linear(0.0, 1.5),
+        "schlick" => Bounds::linear(0.0, 1.0),
+        "eta" if model != "refractor" => Bounds::linear(1.01, 3.0),
         _ => return None,
     })
 }
@@ -305,14 +309,23 @@ pub struct Param {
     pub width: usize,
 }
 
-/// Every numeric parameter of `spec` (outside `fresnel` and `weights`) that has default bounds,
+/// Every numeric parameter of `spec` that has default bounds (sum `weights` excluded; a Fresnel
+/// term's `schlick` F0 or dielectric `eta` included when the spec has one),
 /// terms in order, fields of a term in alphabetical order (the JSON form keeps keys sorted).
 pub fn default_paths(spec: &Json) -> Vec<String> {
     fn walk(v: &Json, prefix: &str, out: &mut Vec<String>) {
         let Some(obj) = v.as_object() else { return };
         let model = obj.get("model").and_then(Json::as_str).unwrap_or("");
         for (k, x) in obj {
-            if k == "terms" {
+            if k == "fresnel" {
+                if let Some(f) = x.as_object() {
+                    for (fk, fx) in f {
+                        if default_bounds(model, fk).is_some() && !fx.is_null() {
+                            out.push(format!("{prefix}fresnel.{fk}"));
+                        }
+                    }
+                }
+            } else if k == "terms" {
                 if let Some(arr) = x.as_array() {
                     for (i, t) in arr.iter().enumerate() {
                         walk(t, &format!("{prefix}terms[{i}]."), out);
@@ -443,11 +456,30 @@ mod tests {
     fn default_paths_walk_sums_and_skip_fresnel() {
         let j = serde_json::json!({"model": "sum", "terms": [
             {"model": "lambert", "kd": 0.1},
-            {"model": "cook_torrance", "m": 0.3, "ks": 1.0, "fresnel": {"dielectric": 1.5}}
+            {"model": "cook_torrance", "m": 0.3, "ks": 1.0, "fresnel": {"conductor": "Au"}}
         ]});
         assert_eq!(
             default_paths(&j),
             ["terms[0].kd", "terms[1].ks", "terms[1].m"]
+        );
+    }
+
+    #[test]
+    fn fresnel_f0_and_eta_are_found() {
+        let j = serde_json::json!({"model": "sum", "terms": [
+            {"model": "ggx", "alpha": 0.3, "ks": 1.0, "fresnel": {"schlick": 0.04}},
+            {"model": "cook_torrance", "m": 0.3, "ks": 1.0, "fresnel": {"eta": 1.5}}
+        ]});
+        assert_eq!(
+            default_paths(&j),
+            [
+                "terms[0].alpha",
+                "terms[0].fresnel.schlick",
+                "terms[0].ks",
+                "terms[1].fresnel.eta",
+                "terms[1].ks",
+                "terms[1].m"
+            ]
         );
     }
 

@@ -258,7 +258,8 @@ impl MerlBrdf {
 
     /// Resamples any BRDF at the cell centres of the MERL grid (RGB channels: `eval`; other
     /// channel sets: [`Brdf::eval_wavelength`] at the representative RGB wavelengths) and stores
-    /// f_r / scale. Runs in parallel.
+    /// f_r / scale. Cells whose centre puts a direction below the horizon are stored as −1
+    /// (unmeasured), as in the database. Runs in parallel.
     pub fn from_brdf(brdf: &dyn Brdf) -> Self {
         let rgb = *brdf.channels() == Channels::Rgb;
         let plane = RES_THETA_D * RES_PHI_D;
@@ -270,6 +271,12 @@ impl MerlBrdf {
                 for itd in 0..RES_THETA_D {
                     for ipd in 0..RES_PHI_D {
                         let (wi, wo) = geometry::from_half_diff(cell_center(ith, itd, ipd));
+                        let cell = &mut chunk[ipd + RES_PHI_D * itd];
+                        if wi.z <= 0.0 || wo.z <= 0.0 {
+                            // Below the horizon: no value, marked as the database does.
+                            *cell = [-1.0; 3];
+                            continue;
+                        }
                         let mut f = [0.0f32; 3];
                         if rgb {
                             brdf.eval(wi, wo, &mut f);
@@ -278,7 +285,6 @@ impl MerlBrdf {
                                 f[c] = brdf.eval_wavelength(wi, wo, *nm) as f32;
                             }
                         }
-                        let cell = &mut chunk[ipd + RES_PHI_D * itd];
                         for c in 0..3 {
                             cell[c] = f[c] as f64 / SCALE[c];
                         }

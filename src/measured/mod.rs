@@ -1,15 +1,24 @@
 //! Measured BRDF data: MERL and RGL-EPFL readers.
 //!
-//! - [`tensor`]: the RGL tensor-file container (bounds-checked reader, writer for tests);
-//! - [`rgl`]: RGL-EPFL `.bsdf` measurements evaluated natively ([`RglBrdf`]);
-//! - [`merl`]: MERL `.binary` files, read and write ([`MerlBrdf`]); [`merl_manifest`]: the
-//!   SHA-256 of the 100 published files.
+//! - [`tensor`]: the RGL tensor-file container (bounds-checked reader of every dtype, and a
+//!   writer used by tests to build small or deliberately broken files);
+//! - [`rgl`]: RGL-EPFL `.bsdf` measurements evaluated natively by the published algorithm
+//!   ([`RglBrdf`], RGB or spectral, isotropic or anisotropic), with importance sampling by the
+//!   measurement's own warps;
+//! - [`merl`]: MERL `.binary` files, read (the reference reader's nearest lookup, a validity
+//!   mask for unmeasured cells), written (bit-exact, or any `Brdf` resampled on the MERL grid)
+//!   and turned into a table on [`Grid::merl`](crate::table::Grid::merl) ([`MerlBrdf`]);
+//! - [`merl_manifest`]: the SHA-256 of the 100 published MERL files, to name a file a user
+//!   brings.
+//!
+//! Both readers load a file completely at open (MERL: 35 MB in ≈ 0.1 s; RGL: < 1 MB) and never
+//! allocate in `eval`. Slice images of any source live in
+//! [`analysis::slice`](crate::analysis::slice).
 
+pub mod merl;
+pub mod merl_manifest;
 pub mod rgl;
 pub mod tensor;
 
-pub use rgl::RglBrdf;
-pub mod merl;
-pub mod merl_manifest;
-
 pub use merl::MerlBrdf;
+pub use rgl::RglBrdf;

@@ -33,7 +33,7 @@
 //! arithmetic here is f64 over the file's f32 data, so values agree with the f32 reference to
 //! about 1e-6 relative away from discontinuities.
 
-use std::f64::consts::{FRAC_2_PI, PI};
+use std::f64::consts::{FRAC_2_PI, FRAC_PI_2, PI};
 use std::path::Path;
 
 use glam::DVec3;
@@ -163,6 +163,67 @@ impl Warp {
     /// The point of the unit square that the warp maps onto `u` (the inverse of sampling).
     #[inline]
     fn invert(&self, u: [f64; 2], k: &Corners) -> [f64; 2] {
+        self.invert_pdf(u, k).0
+    }
+
+    /// Density scale: the data are normalized to integrate to 1 over the patches.
+    #[inline]
+    fn inv_patch_area(&self) -> f64 {
+        ((self.pdf.nx - 1) * (self.pdf.ny - 1)) as f64
+    }
+
+    /// The density of the warp's output at `u` (bilinear, per unit area).
+    #[inline]
+    fn eval(&self, u: [f64; 2], k: &Corners) -> f64 {
+        bilinear(&self.pdf, k, self.pdf.plane_len(), 0, u) * self.inv_patch_area()
+    }
+
+    /// Maps a uniform point of the unit square through the warp: the marginal CDF picks the row,
+    /// the conditional CDF the column, each inverted exactly for the bilinear patch (a quadratic).
+    /// Returns the warped point and its density.
+    fn sample(&self, mut u: [f64; 2], k: &Corners) -> ([f64; 2], f64) {
+        const ONE_MINUS_EPS: f64 = 0.999_999_940_395_355_2;
+        let (nx, ny) = (self.pdf.nx, self.pdf.ny);
+        let stride = nx * ny;
+        for v in &mut u {
+            *v = v.clamp(1.0 - ONE_MINUS_EPS, ONE_MINUS_EPS);
+        }
+        let cd = &self.conditional;
+        let marginal = |i: usize| k.lookup(&self.marginal, ny, i);
+        let row = find_interval(ny, |i| marginal(i) < u[1]);
+        u[1] -= marginal(row);
+        let off = row * nx;
+        let r0 = k.lookup(cd, stride, off + nx - 1);
+        let r1 = k.lookup(cd, stride, off + 2 * nx - 1);
+        u[1] = solve_linear_cdf(r0, r1, u[1]);
+        u[0] *= (1.0 - u[1]) * r0 + u[1] * r1;
+        let cond = |i: usize| {
+            (1.0 - u[1]) * k.lookup(cd, stride, off + i) + u[1] * k.lookup(cd, stride, off + nx + i)
+        };
+        let col = find_interval(nx, |i| cond(i) < u[0]);
+        u[0] -= cond(col);
+        let o = off + col;
+        let d = &self.pdf.data;
+        let v00 = k.lookup(d, stride, o);
+        let v10 = k.lookup(d, stride, o + 1);
+        let v01 = k.lookup(d, stride, o + nx);
+        let v11 = k.lookup(d, stride, o + nx + 1);
+        let c0 = (1.0 - u[1]) * v00 + u[1] * v01;
+        let c1 = (1.0 - u[1]) * v10 + u[1] * v11;
+        u[0] = solve_linear_cdf(c0, c1, u[0]);
+        let pdf = ((1.0 - u[0]) * c0 + u[0] * c1) * self.inv_patch_area();
+        (
+            [
+                (col as f64 + u[0]) / (nx - 1) as f64,
+                (row as f64 + u[1]) / (ny - 1) as f64,
+            ],
+            pdf,
+        )
+    }
+
+    /// [`Warp::invert`] and the density there.
+    #[inline]
+    fn invert_pdf(&self, u: [f64; 2], k: &Corners) -> ([f64; 2], f64) {
         let (nx, ny) = (self.pdf.nx, self.pdf.ny);
         let stride = nx * ny;
         let (ix, fx) = Planes::locate(u[0], nx);
@@ -189,7 +250,39 @@ impl Warp {
         // Row: integral of the row totals up to fy, plus the marginal CDF at the row start.
         let mut sy = fy * (r0 + 0.5 * fy * (r1 - r0));
         sy += k.lookup(&self.marginal, ny, iy);
-        [sx, sy]
+        let pdf = ((1.0 - fx) * c0 + fx * c1) * self.inv_patch_area();
+        ([sx, sy], pdf)
+    }
+}
+
+/// Largest i in [0, n−2] with `pred(i)` true (0 if none), for a predicate that is true on a
+/// prefix (binary search, as the reference's `find_interval`).
+#[inline]
+fn find_interval(n: usize, pred: impl Fn(usize) -> bool) -> usize {
+    let (mut lo, mut hi) = (1usize, n.saturating_sub(1)); // search (0, n−1)
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if pred(mid) {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo.saturating_sub(1).min(n.saturating_sub(2))
+}
+
+/// t ∈ [0, 1] with ∫₀ᵗ (a (1 − s) + b s) ds = y, i.e. a t + (b − a) t²/2 = y.
+#[inline]
+fn solve_linear_cdf(a: f64, b: f64, y: f64) -> f64 {
+    let t = if (a - b).abs() < 1e-4 * (a + b) {
+        2.0 * y / (a + b)
+    } else {
+        (a - (a * a - 2.0 * y * (a - b)).max(0.0).sqrt()) / (a - b)
+    };
+    if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
     }
 }
 
@@ -251,6 +344,8 @@ pub struct RglBrdf {
     ndf: Planes,
     sigma: Planes,
     vndf: Warp,
+    /// Luminance in the unwarped square, for importance sampling (absent: uniform).
+    luminance: Option<Warp>,
     /// Reflectance: slices × file channels × ny × nx.
     table: Planes,
     /// File channels: 3 for RGB, else the wavelengths (nm) of `spectra`.
@@ -364,6 +459,33 @@ impl RglBrdf {
             vf,
         )?;
 
+        let luminance = match tf.get("luminance") {
+            Some(lf) => {
+                let ls = tf.expect_ndim(lf, 4)?.to_vec();
+                if ls[0] != np || ls[1] != nt || ls[2] < 2 || ls[3] < 2 {
+                    return Err(tf.error(
+                        lf,
+                        format!(
+                            "shape {} does not match φi × θi = {np} × {nt}",
+                            lf.describe()
+                        ),
+                    ));
+                }
+                let mut d = f32s(lf)?;
+                d.iter_mut().for_each(|v| *v = v.max(0.0));
+                Some(Warp::new(
+                    Planes {
+                        nx: ls[3],
+                        ny: ls[2],
+                        data: d,
+                    },
+                    tf,
+                    lf,
+                )?)
+            }
+            None => None,
+        };
+
         let (tfield, wavelengths) = if let Some(f) = tf.get("rgb") {
             (f, None)
         } else if let Some(f) = tf.get("spectra") {
@@ -467,6 +589,7 @@ impl RglBrdf {
             ndf,
             sigma,
             vndf,
+            luminance,
             table,
             wavelengths,
             out_map,
@@ -567,6 +690,88 @@ impl RglBrdf {
         bilinear(&self.table, k, nch * plane, c * plane, sample).max(0.0)
     }
 
+    /// Signs for the φ reduction of anisotropic files, from the tensor-incident direction.
+    #[inline]
+    fn reduction_signs(&self, inc: DVec3) -> Option<(f64, f64)> {
+        (self.reduction >= 2).then(|| {
+            let sy = inc.y;
+            (if self.reduction == 4 { inc.x } else { sy }, sy)
+        })
+    }
+
+    #[inline]
+    fn flip(v: DVec3, signs: Option<(f64, f64)>) -> DVec3 {
+        match signs {
+            Some((sx, sy)) => DVec3::new(mulsign_neg(v.x, sx), mulsign_neg(v.y, sy), v.z),
+            None => v,
+        }
+    }
+
+    /// Solid-angle density with which the measurement's own sampler (luminance warp, then VNDF
+    /// warp, then reflection about the half vector) draws `out` for the tensor-incident
+    /// direction `inc`.
+    pub fn tensor_pdf(&self, inc: DVec3, out: DVec3) -> f64 {
+        let Some((inc, out)) = geometry::upper_pair(inc, out) else {
+            return 0.0;
+        };
+        let signs = self.reduction_signs(inc);
+        let (inc, out) = (Self::flip(inc, signs), Self::flip(out, signs));
+        let Some(wm) = geometry::normalize(inc + out) else {
+            return 0.0;
+        };
+        let theta_i = elevation(inc);
+        let phi_i = inc.y.atan2(inc.x);
+        let phi_m = wm.y.atan2(wm.x);
+        let mut u_wm = [
+            theta2u(elevation(wm)),
+            phi2u(if self.isotropic { phi_m - phi_i } else { phi_m }),
+        ];
+        u_wm[1] -= u_wm[1].floor();
+        let k = self.corners(phi_i, theta_i);
+        let (sample, vndf_pdf) = self.vndf.invert_pdf(u_wm, &k);
+        let lum = self.luminance.as_ref().map_or(1.0, |l| l.eval(sample, &k));
+        let sin_m = (wm.x * wm.x + wm.y * wm.y).sqrt();
+        let jac = (2.0 * PI * PI * u_wm[0] * sin_m).max(1e-6) * 4.0 * inc.dot(wm);
+        let pdf = vndf_pdf * lum / jac;
+        if pdf.is_finite() && pdf > 0.0 {
+            pdf
+        } else {
+            0.0
+        }
+    }
+
+    /// Draws an outgoing direction for the tensor-incident direction `inc` with the
+    /// measurement's sampler; returns it with its solid-angle density.
+    pub fn tensor_sample(&self, inc: DVec3, u: glam::DVec2) -> Option<(DVec3, f64)> {
+        let inc = geometry::normalize(inc)?;
+        if inc.z <= 0.0 {
+            return None;
+        }
+        let signs = self.reduction_signs(inc);
+        let inc = Self::flip(inc, signs);
+        let theta_i = elevation(inc);
+        let phi_i = inc.y.atan2(inc.x);
+        let k = self.corners(phi_i, theta_i);
+        let (sample, lum_pdf) = match &self.luminance {
+            Some(l) => l.sample([u.y, u.x], &k),
+            None => ([u.y, u.x], 1.0),
+        };
+        let (u_m, ndf_pdf) = self.vndf.sample(sample, &k);
+        let theta_m = u_m[0] * u_m[0] * FRAC_PI_2;
+        let mut phi_m = (2.0 * u_m[1] - 1.0) * PI;
+        if self.isotropic {
+            phi_m += phi_i;
+        }
+        let m = geometry::spherical(theta_m, phi_m);
+        let jac = (2.0 * PI * PI * u_m[0] * theta_m.sin()).max(1e-6) * 4.0 * inc.dot(m);
+        let out = geometry::reflect(inc, m);
+        let pdf = ndf_pdf * lum_pdf / jac;
+        if out.z <= 0.0 || !(pdf.is_finite() && pdf > 0.0) {
+            return None;
+        }
+        Some((Self::flip(out, signs), pdf))
+    }
+
     /// The reference reader's value, f_r · cos θo, per channel (for tests and comparisons).
     pub fn eval_cos(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
         self.eval(wi, wo, out);
@@ -625,6 +830,35 @@ impl Brdf for RglBrdf {
         let v = (1.0 - t) * self.channel(sample, &k, c0) + t * self.channel(sample, &k, c1);
         let f = v * scale / cos_o;
         if f.is_finite() && f > 0.0 { f } else { 0.0 }
+    }
+
+    /// Importance sampling by the measurement's own warps. The tensor is conditioned on the
+    /// incident direction `wi`, but `sample` must draw `wi` given `wo`; it therefore runs the
+    /// tensor's sampler with the roles swapped (tensor-incident = `wo`). That is exact — `pdf`
+    /// reports the density of this very procedure and the weight uses the true f_r(wi, wo) — and
+    /// efficient because measured reflectance is close to reciprocal.
+    fn sample(
+        &self,
+        wo: DVec3,
+        u: glam::DVec2,
+        weight: &mut [f32],
+    ) -> Option<crate::brdf::BrdfSample> {
+        let (wi, pdf) = self.tensor_sample(wo, u)?;
+        let c = self.channels.len();
+        self.eval(wi, wo, &mut weight[..c]);
+        let cos_i = wi.z;
+        for w in &mut weight[..c] {
+            *w = (*w as f64 * cos_i / pdf) as f32;
+        }
+        Some(crate::brdf::BrdfSample {
+            wi,
+            pdf,
+            delta: false,
+        })
+    }
+
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        self.tensor_pdf(wo, wi)
     }
 
     fn flags(&self) -> Flags {

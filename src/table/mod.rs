@@ -5,8 +5,13 @@
 //! - [`symmetry`]: [`Symmetry`], the canonical maps, [`symmetry::verify`] and
 //!   [`symmetry::detect`];
 //! - [`Table`]: a grid plus its stored values, in memory;
-//! - `bake`: any `Brdf` → values, chunk by chunk or into a [`Table`];
-//! - `tabulated`: `TabulatedBrdf`, the `Brdf` over a table (eager or lazily loaded chunks).
+//! - [`bake`](mod@bake): any `Brdf` → values, chunk by chunk ([`bake_chunks`], for streaming
+//!   writers) or into a [`Table`];
+//! - [`lookup`]: nearest and multilinear interpolation ([`Interp`]);
+//! - [`tabulated`]: [`TabulatedBrdf`], the `Brdf` over a table — every chunk in memory, or loaded
+//!   on first touch through a [`ChunkLoader`];
+//! - [`presets`]: `small`, `medium`, `large` grids with measured accuracy;
+//! - [`raw`]: a minimal JSON-header + f32 file (stop-gap until the store's format is wired in).
 //!
 //! Values are stored λ innermost: the values of one node for every channel are contiguous, so
 //! one set of angular interpolation weights serves all channels.

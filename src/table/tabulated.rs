@@ -29,6 +29,18 @@ pub trait ChunkLoader: Send + Sync {
     fn load(&self, chunk: usize) -> Result<Vec<f32>>;
 }
 
+impl<T: ChunkLoader + ?Sized> ChunkLoader for Arc<T> {
+    fn load(&self, chunk: usize) -> Result<Vec<f32>> {
+        (**self).load(chunk)
+    }
+}
+
+impl<T: ChunkLoader + ?Sized> ChunkLoader for Box<T> {
+    fn load(&self, chunk: usize) -> Result<Vec<f32>> {
+        (**self).load(chunk)
+    }
+}
+
 /// A dense table as a [`Brdf`]: nearest or multilinear lookup, chunks loaded lazily.
 pub struct TabulatedBrdf {
     grid: Grid,

@@ -3,7 +3,8 @@
 use std::io::IsTerminal;
 
 use brdftab::fit::{self, ColorMode, FitOptions, ParamRequest};
-use brdftab::{Error, Result};
+use brdftab::fresnel::FresnelSpec;
+use brdftab::{Error, Result, Value};
 use clap::Args;
 
 use crate::source;
@@ -31,9 +32,16 @@ pub struct FitArgs {
     /// Number of direction pairs.
     #[arg(long, default_value_t = 4000)]
     pairs: usize,
+    /// Largest polar angle of the fitting pairs' directions, in degrees (grazing data excluded).
+    #[arg(long, default_value_t = 80.0)]
+    max_theta_deg: f64,
     /// Seed of the pairs and starts.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Give every microfacet lobe (cook_torrance, ggx) a Fresnel term whose parameter is fit too:
+    /// `schlick` (F0, start 0.04), `dielectric` (eta, start 1.5) or `none` (default: ks absorbs it).
+    #[arg(long, value_parser = ["none", "schlick", "dielectric"])]
+    fresnel: Option<String>,
     /// Fit kd/ks as one grey value instead of one per channel.
     #[arg(long)]
     grey: bool,
@@ -49,7 +57,16 @@ pub struct FitArgs {
 pub fn fit(a: FitArgs) -> Result<()> {
     let channels = source::channels(a.wavelengths.as_deref())?;
     let brdf = source::open(&a.source, &channels)?;
-    let init = fit::preset(&a.model)?;
+    let mut init = fit::preset(&a.model)?;
+    let fresnel = match a.fresnel.as_deref() {
+        Some("schlick") => Some(FresnelSpec::Schlick(Value::Grey(0.04))),
+        Some("dielectric") => Some(FresnelSpec::Dielectric(Value::Grey(1.5))),
+        Some("none") => Some(FresnelSpec::None),
+        _ => None,
+    };
+    if let Some(f) = fresnel {
+        init = fit::with_fresnel(&init, &f)?;
+    }
     let params = match &a.params {
         None => Vec::new(),
         Some(s) => s
@@ -64,6 +81,7 @@ pub fn fit(a: FitArgs) -> Result<()> {
         log: a.log,
         starts: a.starts,
         seed: a.seed,
+        max_theta: a.max_theta_deg.to_radians(),
         color: if a.grey {
             ColorMode::Grey
         } else {

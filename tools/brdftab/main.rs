@@ -38,6 +38,10 @@ enum Command {
     Render(render::RenderArgs),
     /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
     Slice(measured::SliceArgs),
+    /// Convert between formats (MERL .binary, RGL .bsdf read only, tables).
+    Convert(measured::ConvertArgs),
+    /// Table databases: `db add DB FILE` (measured files with provenance).
+    Db(measured::DbArgs),
     /// Directional albedo a(θ′) per channel: one line `theta a_1 a_2 ...` per angle.
     Albedo(analysis::AlbedoArgs),
     /// Physical plausibility: positivity, reciprocity, energy conservation.
@@ -65,6 +69,8 @@ fn main() -> ExitCode {
         Command::Bench(a) => table::bench(a),
         Command::Render(a) => render::run(a),
         Command::Slice(a) => measured::slice(a),
+        Command::Convert(a) => measured::convert(a),
+        Command::Db(a) => measured::db(a),
         Command::Albedo(a) => analysis::albedo(a),
         Command::Check(a) => analysis::check(a),
         Command::Demo(a) => demo::demo(a),

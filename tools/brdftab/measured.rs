@@ -2,7 +2,7 @@
 
 use brdftab::analysis::slice;
 use brdftab::measured::{MerlBrdf, RglBrdf, merl, tensor::TensorFile};
-use brdftab::{Brdf, Error, Result};
+use brdftab::{Brdf, Channels, Error, Result};
 use clap::{Args, ValueEnum};
 
 use crate::source::{self, Kind};
@@ -162,38 +162,232 @@ pub fn slice(a: SliceArgs) -> Result<()> {
             slice::incident(a.theta_in.to_radians(), a.phi_in.to_radians()),
         ),
     };
-    let lower = a.output.to_ascii_lowercase();
     let what = match a.kind {
         SliceKind::Halfdiff => format!(
             "f_r, x = θh 0..90°, y = θd 0..90° (top to bottom), φd = {}°",
             a.phi_d
         ),
         SliceKind::Polar => format!(
-            "f_r·cos θo over the outgoing hemisphere (radius ∝ θo, +x right), θi = {}°, φi = {}°",
+            "f_r·cos θo over the outgoing hemisphere (radius ∝ θo, +x right, +y up), θi = {}°, φi = {}°",
             a.theta_in, a.phi_in
         ),
     };
-    if lower.ends_with(".exr") {
-        slice::write_exr(&img, channel, &a.output)?;
-        println!("{}: {what}; linear f32", a.output);
-    } else if lower.ends_with(".png") {
-        let l = slice::write_png(&img, channel, &a.output)?;
-        let ch = channel.map_or_else(
-            || {
-                if names.len() == 3 && names[0] == "R" {
-                    "luminance".to_string()
-                } else {
-                    "channel mean".to_string()
-                }
-            },
-            |c| names[c].clone(),
-        );
-        println!(
-            "{}: {what}; {ch}, log10 scale, viridis: colorbar bottom {:.4e} .. top {:.4e} (1/sr)",
-            a.output, l.min, l.max
-        );
+    let legend = slice::write(&img, channel, &a.output)?;
+    println!("{}: {what}; {legend}", a.output);
+    Ok(())
+}
+
+/// Grid and accuracy options shared by `convert` and `db add`.
+#[derive(Args, Clone)]
+pub struct TabulateArgs {
+    /// Grid size preset for the table: small, medium or large (default: the native MERL grid
+    /// for MERL files, medium otherwise).
+    #[arg(long)]
+    preset: Option<String>,
+    /// Full grid sizes θ1xφ1xθ2xφ2 (e.g. 90x360x90x360), or `merl`; overrides --preset.
+    #[arg(long)]
+    grid: Option<String>,
+    /// Parameterization: halfdiff (default) or inout.
+    #[arg(long)]
+    param: Option<String>,
+    /// Symmetry reduction: auto (detect), none, or a list of isotropic,reciprocal,bilateral.
+    #[arg(long, default_value = "auto")]
+    symmetry: String,
+    /// Bake even if the source breaks the symmetry.
+    #[arg(long)]
+    force: bool,
+    /// Interpolation for the reported accuracy: nearest or linear.
+    #[arg(long, default_value = "linear")]
+    interp: String,
+    /// Random pairs for the reported accuracy (0 = skip).
+    #[arg(long, default_value_t = 200_000)]
+    pairs: usize,
+    /// Store codec: f32, f16 or log16 (database outputs). Measured f_r can exceed the f16
+    /// range at grazing angles (RGL stores f_r·cos θo), hence log16 (relative error bound).
+    #[arg(long, default_value = "log16")]
+    codec: String,
+    /// Codec tolerance (log16).
+    #[arg(long)]
+    tolerance: Option<f64>,
+    /// Replace an existing table of that name (database outputs).
+    #[arg(long)]
+    replace: bool,
+}
+
+/// Arguments of `brdftab convert`.
+#[derive(Args)]
+pub struct ConvertArgs {
+    /// Any SOURCE: a MERL `.binary`, an RGL `.bsdf` (read only), a spec, a table.
+    input: String,
+    /// The output: a MERL `.binary` (the source resampled at the MERL cell centres), a table
+    /// database entry `DB#NAME` (or a `.btdb` file, named after the input), or a raw table file.
+    output: String,
+    /// Evaluate spec sources at these wavelengths (nm); MERL output uses the RGB wavelengths.
+    #[arg(long)]
+    wavelengths: Option<String>,
+    #[command(flatten)]
+    tab: TabulateArgs,
+}
+
+/// Converts between formats.
+pub fn convert(a: ConvertArgs) -> Result<()> {
+    let channels = source::channels(a.wavelengths.as_deref())?;
+    match source::kind(&a.output) {
+        Kind::Merl => {
+            let brdf = source::open(&a.input, &channels)?;
+            let t = std::time::Instant::now();
+            let m = MerlBrdf::from_brdf(&*brdf);
+            m.write(&a.output)?;
+            println!(
+                "{}: {} resampled on the MERL grid (90 × 90 × 180 cell centres) in {:.2} s",
+                a.output,
+                brdf.describe(),
+                t.elapsed().as_secs_f64()
+            );
+            Ok(())
+        }
+        Kind::Rgl => Err(Error::Unsupported(
+            "writing RGL .bsdf files (they are read only)".into(),
+        )),
+        _ => tabulate_into(&a.input, &a.output, &channels, &a.tab),
+    }
+}
+
+/// Arguments of `brdftab db`.
+#[derive(Args)]
+pub struct DbArgs {
+    #[command(subcommand)]
+    command: DbCommand,
+}
+
+/// `brdftab db` subcommands.
+#[derive(clap::Subcommand)]
+pub enum DbCommand {
+    /// Add a measured file (or any SOURCE) to a database as a table, with its provenance
+    /// (file name and sha256).
+    Add(DbAddArgs),
+}
+
+/// Arguments of `brdftab db add`.
+#[derive(Args)]
+pub struct DbAddArgs {
+    /// The database file (created if absent).
+    db: String,
+    /// The file to add: MERL `.binary`, RGL `.bsdf`, or any SOURCE.
+    file: String,
+    /// Table name (default: the file name without extension).
+    #[arg(long)]
+    name: Option<String>,
+    #[command(flatten)]
+    tab: TabulateArgs,
+}
+
+/// `brdftab db ...`.
+pub fn db(a: DbArgs) -> Result<()> {
+    match a.command {
+        DbCommand::Add(a) => {
+            let name = a.name.unwrap_or_else(|| stem(&a.file));
+            tabulate_into(&a.file, &format!("{}#{name}", a.db), &Channels::Rgb, &a.tab)
+        }
+    }
+}
+
+fn stem(path: &str) -> String {
+    std::path::Path::new(path)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "table".into())
+}
+
+/// Tabulates `input` and writes it to `output` (`DB#NAME`, `.btdb`, or a raw table file);
+/// reports the tabulated-vs-native accuracy.
+fn tabulate_into(input: &str, output: &str, channels: &Channels, o: &TabulateArgs) -> Result<()> {
+    use brdftab::table::presets::Preset;
+    use brdftab::table::{BakeOptions, Grid, Interp, Mapping, Param, Symmetry, TabulatedBrdf};
+
+    let interp = Interp::parse(&o.interp)?;
+    let src = source::open(input, channels)?;
+    let t0 = std::time::Instant::now();
+    let native_merl = source::kind(input) == Kind::Merl && o.preset.is_none() && o.grid.is_none();
+    let table = if native_merl {
+        // Exact: the measurement's own cells on the MERL grid (nearest = the reader).
+        MerlBrdf::open(input)?.to_table()
     } else {
-        return Err(Error::arg("--output", "must end in .exr or .png"));
+        let sym = match o.symmetry.trim() {
+            "auto" => brdftab::table::symmetry::detect(src.as_ref(), 1e-3),
+            s => Symmetry::parse(s)?,
+        };
+        let param = o.param.as_deref().map(Param::parse).transpose()?;
+        let ch = src.channels().clone();
+        let grid = match o.grid.as_deref() {
+            Some("merl") => Grid::merl(ch).with_symmetry(sym)?,
+            Some(g) => {
+                let sizes: Vec<usize> = g
+                    .split(['x', 'X', '×'])
+                    .map(|t| {
+                        t.trim()
+                            .parse()
+                            .map_err(|_| Error::arg("--grid", format!("`{t}` is not a size")))
+                    })
+                    .collect::<Result<_>>()?;
+                let sizes: [usize; 4] = sizes
+                    .try_into()
+                    .map_err(|_| Error::arg("--grid", "expected four sizes θ1xφ1xθ2xφ2"))?;
+                let p = param.unwrap_or(Param::HalfDiff);
+                let m = match p {
+                    Param::HalfDiff => [Mapping::Sqrt, Mapping::Uniform],
+                    Param::InOut => [Mapping::Uniform, Mapping::Uniform],
+                };
+                Grid::with_sizes(p, sizes, m, ch, sym)?
+            }
+            None => Preset::parse(o.preset.as_deref().unwrap_or("medium"))?.grid(param, sym, ch)?,
+        };
+        let opts = BakeOptions {
+            force: o.force,
+            ..Default::default()
+        };
+        brdftab::table::bake(src.as_ref(), &grid, &opts)?.0
+    };
+    let secs = t0.elapsed().as_secs_f64();
+    let (path, name) = brdftab::store::db::split_source(output);
+    let is_db = name.is_some() || path.to_ascii_lowercase().ends_with(".btdb");
+    if is_db {
+        let name = name.map(str::to_owned).unwrap_or_else(|| stem(input));
+        let provenance = match source::kind(input) {
+            Kind::Merl | Kind::Rgl => brdftab::store::Source::measured(input)?,
+            Kind::Spec => brdftab::store::Source::model(&source::spec(input)?),
+            Kind::Table => brdftab::store::Source::Other {
+                description: src.describe(),
+            },
+        };
+        let codec = brdftab::codec::Codec {
+            quant: brdftab::codec::Quant::parse(&o.codec, o.tolerance, None)?,
+            ..Default::default()
+        };
+        brdftab::store::tables::save(path, &name, provenance, &table, codec, o.replace)?;
+        println!("{path}#{name}: {}", src.describe());
+    } else {
+        table.save_raw(path)?;
+        println!("{path}: {}", src.describe());
+    }
+    println!(
+        "  grid: {}{} ({} values, {:.2} s)",
+        table.grid().summary(),
+        if native_merl {
+            ", the file's own cells"
+        } else {
+            ""
+        },
+        table.values().len(),
+        secs
+    );
+    if o.pairs > 0 {
+        let tab = TabulatedBrdf::from_table(table).with_interp(interp);
+        let acc = brdftab::analysis::accuracy::compare(&tab, src.as_ref(), o.pairs, 1)?;
+        println!(
+            "  accuracy vs native ({:?}, {} pairs): cosine-weighted relative RMSE {:.3e}, max relative {:.3e}",
+            interp, acc.pairs, acc.rel_rmse, acc.max_rel
+        );
     }
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! `bake`, `info` and `bench`: dense tables from the command line.
 
+use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::time::Instant;
 
@@ -15,6 +16,15 @@ use glam::DVec3;
 use serde_json::json;
 
 use crate::source;
+
+/// Writes `text` to stdout; a closed pipe (`| head`) is not an error.
+fn print_out(text: &str) -> Result<()> {
+    use std::io::Write;
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::io("stdout", e)),
+        _ => Ok(()),
+    }
+}
 
 /// Arguments of `brdftab bake`.
 #[derive(Args)]
@@ -185,6 +195,7 @@ pub fn info(a: InfoArgs) -> Result<()> {
     let bytes = std::fs::metadata(&a.file)
         .map_err(|e| Error::io(&a.file, e))?
         .len();
+    let mut o = String::new();
     let v = json!({
         "file": a.file,
         "format": "raw",
@@ -200,19 +211,23 @@ pub fn info(a: InfoArgs) -> Result<()> {
         "bytes": bytes,
     });
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        let _ = writeln!(
+            o,
+            "{}",
+            serde_json::to_string_pretty(&v).unwrap_or_default()
+        );
     } else {
-        println!("file:          {}", a.file);
-        println!("source:        {}", t.description());
-        println!("grid:          {}", g.summary());
-        println!("symmetry:      {}", g.symmetry());
-        println!("channels:      {}", g.channels().names().join(" "));
-        println!("chunks:        {}", g.layout().chunk_count());
-        println!("stored_values: {}", g.stored_values());
-        println!("full_values:   {}", g.full_values());
-        println!("bytes:         {bytes}");
+        let _ = writeln!(o, "file:          {}", a.file);
+        let _ = writeln!(o, "source:        {}", t.description());
+        let _ = writeln!(o, "grid:          {}", g.summary());
+        let _ = writeln!(o, "symmetry:      {}", g.symmetry());
+        let _ = writeln!(o, "channels:      {}", g.channels().names().join(" "));
+        let _ = writeln!(o, "chunks:        {}", g.layout().chunk_count());
+        let _ = writeln!(o, "stored_values: {}", g.stored_values());
+        let _ = writeln!(o, "full_values:   {}", g.full_values());
+        let _ = writeln!(o, "bytes:         {bytes}");
     }
-    Ok(())
+    print_out(&o)
 }
 
 /// `brdftab bench`.
@@ -239,6 +254,7 @@ pub fn bench(a: BenchArgs) -> Result<()> {
     let repeats = 5;
     let n = a.pairs as f64;
     let threads = rayon::current_num_threads();
+    let mut o = String::new();
     let (mut single, mut single_cpu) = (Vec::new(), Vec::new());
     for _ in 0..repeats {
         let (t, cpu) = (Instant::now(), thread_cpu_ns());
@@ -282,20 +298,26 @@ pub fn bench(a: BenchArgs) -> Result<()> {
             "lookups_per_s_batch_cpu_time": per_s_cpu,
             "threads": threads,
         });
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        let _ = writeln!(
+            o,
+            "{}",
+            serde_json::to_string_pretty(&v).unwrap_or_default()
+        );
     } else {
-        println!("source:  {}", src.describe());
-        println!("pairs:   {} ({c} channels, {interp:?})", a.pairs);
-        println!(
+        let _ = writeln!(o, "source:  {}", src.describe());
+        let _ = writeln!(o, "pairs:   {} ({c} channels, {interp:?})", a.pairs);
+        let _ = writeln!(
+            o,
             "single:  {ns:.1} ns per lookup wall, {ns_cpu:.1} ns CPU time (median of {repeats}, one thread)"
         );
-        println!(
+        let _ = writeln!(
+            o,
             "batch:   {:.2} M lookups/s wall, {:.2} M/s from CPU time ({threads} threads, median of {repeats})",
             per_s / 1e6,
             per_s_cpu / 1e6
         );
     }
-    Ok(())
+    print_out(&o)
 }
 
 /// CPU time of the calling thread in ns (Linux `/proc/thread-self/schedstat`); the machine may be
