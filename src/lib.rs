@@ -35,6 +35,7 @@ pub mod measured;
 pub mod metals;
 pub mod models;
 pub mod render;
+pub mod report;
 pub mod rng;
 pub mod spec;
 pub mod spectrum;

@@ -317,3 +317,33 @@ fn nearest_table_reproduces_the_reader_value_for_value() {
         assert!(l.iter().all(|x| x.is_finite() && *x >= 0.0));
     }
 }
+
+/// The table nodes of the MERL grid are the MERL cell centres, so a MERL file resampled from a
+/// model (which samples cell centres) and a table baked on the MERL grid agree, and linear
+/// interpolation of MERL data is not shifted by half a cell.
+#[test]
+fn merl_grid_nodes_are_cell_centres() {
+    let grid = brdftab::table::Grid::merl(brdftab::Channels::Rgb);
+    for (ith, itd, ipd) in [(0, 0, 0), (3, 10, 17), (45, 45, 90), (89, 89, 179)] {
+        let a = grid.node_angles([ith, 0, itd, ipd]);
+        let c = merl::cell_center(ith, itd, ipd);
+        assert!(
+            (a[0] - c.theta_h).abs() < 1e-12,
+            "θh {ith}: {} vs {}",
+            a[0],
+            c.theta_h
+        );
+        assert!(
+            (a[2] - c.theta_d).abs() < 1e-12,
+            "θd {itd}: {} vs {}",
+            a[2],
+            c.theta_d
+        );
+        assert!(
+            (a[3] - c.phi_d).abs() < 1e-12,
+            "φd {ipd}: {} vs {}",
+            a[3],
+            c.phi_d
+        );
+    }
+}

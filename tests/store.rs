@@ -558,3 +558,78 @@ fn grid_tables_round_trip_including_packed_layouts() {
         assert_eq!(std::fs::metadata(&out).unwrap().len(), hl + 4 * n);
     }
 }
+
+#[test]
+fn stored_tables_evaluate_like_the_table_they_came_from() {
+    use brdftab::Brdf;
+    use brdftab::store::tables;
+    use brdftab::table::{Grid, Mapping, Param, Symmetry, Table, TabulatedBrdf};
+    use glam::DVec3;
+    let d = tmpdir("brdf");
+    let p = d.join("g.btdb");
+    let g = Grid::with_sizes(
+        Param::HalfDiff,
+        [16, 1, 16, 32],
+        [Mapping::Sqrt, Mapping::Uniform],
+        Channels::Rgb,
+        Symmetry {
+            isotropic: true,
+            reciprocal: true,
+            bilateral: true,
+        },
+    )
+    .unwrap();
+    let t = Table::from_fn(g, "test", |_, a, out| {
+        for (c, o) in out.iter_mut().enumerate() {
+            *o = (1.0 + a[0].cos() * 3.0 + a[2].sin()) as f32 * (1.0 + c as f32);
+        }
+    });
+    tables::save(
+        &p,
+        "x",
+        Source::Other {
+            description: "fn".into(),
+        },
+        &t,
+        Codec {
+            quant: Quant::F32,
+            level: 3,
+            ..Codec::default()
+        },
+        false,
+    )
+    .unwrap();
+    tables::save(
+        &p,
+        "y",
+        Source::Other {
+            description: "fn".into(),
+        },
+        &t,
+        Codec {
+            quant: Quant::F16,
+            level: 3,
+            ..Codec::default()
+        },
+        false,
+    )
+    .unwrap();
+    let reference = TabulatedBrdf::from_table(t);
+    let lazy = tables::open_brdf(&format!("{}#x", p.display()), false).unwrap();
+    let eager = tables::open_brdf(&format!("{}#x", p.display()), true).unwrap();
+    assert_eq!(lazy.loaded_chunks(), 0);
+    let (wi, wo) = (DVec3::new(0.3, 0.1, 0.9), DVec3::new(-0.2, 0.4, 0.8));
+    let (mut a, mut b, mut c) = ([0f32; 3], [0f32; 3], [0f32; 3]);
+    reference.eval(wi, wo, &mut a);
+    lazy.eval(wi, wo, &mut b);
+    eager.eval(wi, wo, &mut c);
+    assert_eq!(a, b);
+    assert_eq!(a, c);
+    assert!(lazy.loaded_chunks() >= 1 && lazy.loaded_chunks() <= 2);
+    // A database with several tables needs a name.
+    let e = tables::open_brdf(&p.display().to_string(), false)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("#NAME"), "{e}");
+    assert!(tables::is_store_file(&p));
+}

@@ -74,10 +74,10 @@ impl Filter {
         Filter::ALL.get(b as usize).copied()
     }
 
-    fn plane(self) -> bool {
+    pub(crate) fn plane(self) -> bool {
         matches!(self, Filter::Plane | Filter::PlaneChannel)
     }
-    fn channel(self) -> bool {
+    pub(crate) fn channel(self) -> bool {
         matches!(self, Filter::DeltaChannel | Filter::PlaneChannel)
     }
 }
@@ -141,28 +141,58 @@ macro_rules! word {
 word!(u16, i16);
 word!(u32, i32);
 
-/// The prediction for `w[s + j]` in a row starting at `s`, given earlier words.
-#[inline(always)]
-fn predict<W: Word>(
-    w: &[W],
+/// Rows of the array: (start, length, whether the row above is in the same plane).
+pub(crate) fn rows(n: usize, layout: Layout) -> impl Iterator<Item = (usize, usize, bool)> {
+    let row = layout.row().max(1);
+    let next = layout.next.max(1);
+    (0..n.div_ceil(row)).map(move |r| {
+        let s = r * row;
+        (s, row.min(n - s), r % next != 0)
+    })
+}
+
+/// Filters one row `words[s..s + len]` into `out` (zigzagged residuals).
+#[inline]
+fn forward_row<W: Word>(
+    words: &[W],
     s: usize,
-    j: usize,
-    ch: usize,
-    row: usize,
+    len: usize,
     up: bool,
-    plane: bool,
-) -> W {
-    let i = s + j;
-    if j >= ch {
-        if plane && up {
-            w[i - ch].wadd(w[i - row]).wsub(w[i - row - ch])
+    layout: Layout,
+    filter: Filter,
+    out: &mut [W],
+) {
+    let ch = layout.channels.min(len);
+    let row = layout.row();
+    let cur = &words[s..s + len];
+    // First point of the row: predicted by the row above (any plane), else stored as is.
+    for j in 0..ch {
+        out[j] = if s >= row {
+            cur[j].wsub(words[s - row + j])
         } else {
-            w[i - ch]
+            cur[j]
+        };
+    }
+    if filter.plane() && up {
+        let prev = &words[s - row..s - row + len];
+        for j in ch..len {
+            out[j] = cur[j].wsub(cur[j - ch]).wsub(prev[j].wsub(prev[j - ch]));
         }
-    } else if i >= row {
-        w[i - row]
     } else {
-        W::default()
+        for j in ch..len {
+            out[j] = cur[j].wsub(cur[j - ch]);
+        }
+    }
+    if filter.channel() && layout.channels > 1 {
+        let c = layout.channels;
+        for p in out[..len].chunks_mut(c) {
+            for k in (1..p.len()).rev() {
+                p[k] = p[k].wsub(p[k - 1]);
+            }
+        }
+    }
+    for o in &mut out[..len] {
+        *o = o.zigzag();
     }
 }
 
@@ -173,30 +203,8 @@ pub fn forward<W: Word>(words: &[W], layout: Layout, filter: Filter) -> Vec<W> {
         out.copy_from_slice(words);
         return out;
     }
-    let ch = layout.channels;
-    let row = layout.row();
-    let (plane, chan) = (filter.plane(), filter.channel());
-    let mut s = 0;
-    let mut r = 0usize; // row index within the plane
-    while s < words.len() {
-        let len = row.min(words.len() - s);
-        let up = r > 0;
-        let mut prev_d = W::default();
-        for j in 0..len {
-            let d = words[s + j].wsub(predict(words, s, j, ch, row, up, plane));
-            let e = if chan && j % ch != 0 {
-                d.wsub(prev_d)
-            } else {
-                d
-            };
-            prev_d = d;
-            out[s + j] = e.zigzag();
-        }
-        s += len;
-        r += 1;
-        if r == layout.next {
-            r = 0;
-        }
+    for (s, len, up) in rows(words.len(), layout) {
+        forward_row(words, s, len, up, layout, filter, &mut out[s..s + len]);
     }
     out
 }
@@ -206,41 +214,55 @@ pub fn inverse<W: Word>(words: &mut [W], layout: Layout, filter: Filter) {
     if filter == Filter::None {
         return;
     }
-    let ch = layout.channels;
     let row = layout.row();
-    let (plane, chan) = (filter.plane(), filter.channel());
-    let mut s = 0;
-    let mut r = 0usize;
-    while s < words.len() {
-        let len = row.min(words.len() - s);
-        let up = r > 0;
-        let mut prev_d = W::default();
-        for j in 0..len {
-            let e = words[s + j].unzigzag();
-            let d = if chan && j % ch != 0 {
-                e.wadd(prev_d)
-            } else {
-                e
-            };
-            prev_d = d;
-            words[s + j] = d.wadd(predict(words, s, j, ch, row, up, plane));
+    for (s, len, up) in rows(words.len(), layout) {
+        let ch = layout.channels.min(len);
+        let (done, rest) = words.split_at_mut(s);
+        let cur = &mut rest[..len];
+        for w in cur.iter_mut() {
+            *w = w.unzigzag();
         }
-        s += len;
-        r += 1;
-        if r == layout.next {
-            r = 0;
+        if filter.channel() && layout.channels > 1 {
+            for p in cur.chunks_mut(layout.channels) {
+                for k in 1..p.len() {
+                    p[k] = p[k].wadd(p[k - 1]);
+                }
+            }
+        }
+        if s >= row {
+            let prev = &done[s - row..s - row + len];
+            for j in 0..ch {
+                cur[j] = cur[j].wadd(prev[j]);
+            }
+            if filter.plane() && up {
+                for j in ch..len {
+                    cur[j] = cur[j].wadd(prev[j].wsub(prev[j - ch]));
+                }
+            }
+        }
+        for j in ch..len {
+            cur[j] = cur[j].wadd(cur[j - ch]);
         }
     }
 }
 
-/// A cheap estimate of what `filter` would cost: total significant bits of the residuals,
-/// computed on a sample of rows.
+/// A cheap estimate of what `filter` would cost: total significant bits of the residuals of a
+/// sample of rows (every 4th).
 pub fn cost<W: Word>(words: &[W], layout: Layout, filter: Filter) -> u64 {
-    // Filtering everything is a linear pass and cheap next to zstd; keep it exact.
-    forward(words, layout, filter)
-        .iter()
-        .map(|w| w.bits() as u64 + 1)
-        .sum()
+    let mut buf = vec![W::default(); layout.row().min(words.len())];
+    let mut total = 0u64;
+    for (k, (s, len, up)) in rows(words.len(), layout).enumerate() {
+        if k % 4 != 1 && words.len() > 4 * layout.row() {
+            continue;
+        }
+        if filter == Filter::None {
+            buf[..len].copy_from_slice(&words[s..s + len]);
+        } else {
+            forward_row(words, s, len, up, layout, filter, &mut buf);
+        }
+        total += buf[..len].iter().map(|w| w.bits() as u64 + 1).sum::<u64>();
+    }
+    total
 }
 
 /// Picks the filter with the smallest [`cost`].
@@ -268,6 +290,48 @@ pub fn shuffle<W: Word>(words: &[W], out: &mut Vec<u8>) {
         let plane = &mut dst[k * n..(k + 1) * n];
         for (d, w) in plane.iter_mut().zip(words) {
             *d = w.byte(k);
+        }
+    }
+}
+
+/// Splits words into bit planes (bit 0 of every word, then bit 1, ...), appending to `out`.
+pub fn bitshuffle<W: Word>(words: &[W], out: &mut Vec<u8>) {
+    let n = words.len();
+    let pb = n.div_ceil(8);
+    let base = out.len();
+    out.resize(base + pb * W::BYTES * 8, 0);
+    let dst = &mut out[base..];
+    for (g, ws) in words.chunks(8).enumerate() {
+        for k in 0..W::BYTES {
+            let bytes: [u8; 8] = std::array::from_fn(|t| ws.get(t).map_or(0, |w| w.byte(k)));
+            for bit in 0..8 {
+                let mut b = 0u8;
+                for (t, &x) in bytes.iter().enumerate() {
+                    b |= ((x >> bit) & 1) << t;
+                }
+                dst[(k * 8 + bit) * pb + g] = b;
+            }
+        }
+    }
+}
+
+/// Inverse of [`bitshuffle`]: `bytes` must hold exactly `out.len().div_ceil(8) * W::BYTES * 8`.
+pub fn unbitshuffle<W: Word>(bytes: &[u8], out: &mut [W]) {
+    let n = out.len();
+    let pb = n.div_ceil(8);
+    out.fill(W::default());
+    for k in 0..W::BYTES {
+        for (g, ws) in out.chunks_mut(8).enumerate() {
+            let mut acc = [0u8; 8];
+            for bit in 0..8 {
+                let b = bytes[(k * 8 + bit) * pb + g];
+                for (t, a) in acc.iter_mut().enumerate() {
+                    *a |= ((b >> t) & 1) << bit;
+                }
+            }
+            for (t, w) in ws.iter_mut().enumerate() {
+                *w = w.with_byte(k, acc[t]);
+            }
         }
     }
 }
@@ -311,6 +375,15 @@ mod tests {
                 inverse(&mut r, layout, f);
                 prop_assert_eq!(&r, &words);
             }
+        }
+
+        #[test]
+        fn bitshuffle_inverts(words in proptest::collection::vec(any::<u16>(), 0..100)) {
+            let mut b = vec![];
+            bitshuffle(&words, &mut b);
+            let mut back = vec![0u16; words.len()];
+            unbitshuffle(&b, &mut back);
+            prop_assert_eq!(back, words);
         }
 
         #[test]

@@ -85,12 +85,9 @@ pub fn put(
         ));
     }
     let mut w = Writer::create(path)?;
-    let mut new: Option<(TableHeader, Box<dyn FnOnce(&mut Writer) -> Result<()> + '_>)> =
-        Some((header, Box::new(write)));
-    fn emit(
-        w: &mut Writer,
-        new: &mut Option<(TableHeader, Box<dyn FnOnce(&mut Writer) -> Result<()> + '_>)>,
-    ) -> Result<()> {
+    type Fill<'a> = Box<dyn FnOnce(&mut Writer) -> Result<()> + 'a>;
+    let mut new: Option<(TableHeader, Fill<'_>)> = Some((header, Box::new(write)));
+    fn emit(w: &mut Writer, new: &mut Option<(TableHeader, Fill<'_>)>) -> Result<()> {
         if let Some((h, f)) = new.take() {
             w.begin_table(h)?;
             f(w)?;

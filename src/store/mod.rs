@@ -11,6 +11,36 @@
 //!   memory ([`OpenOptions::cache_bytes`]), or every chunk up front with [`OpenOptions::eager`].
 //! - [`Writer`] streams chunks into a new file and replaces the destination atomically;
 //!   [`db`] builds add / replace / remove / verify on it.
+//! - [`tables`] connects the store to [`crate::table`]: headers from a `Grid`, saving a `Table`,
+//!   streaming `bake_chunks` into a [`Writer`] (`chunk_with` + [`tables::chunk_layout`]), and
+//!   [`tables::open_brdf`] (`FILE` or `DB#NAME`) giving a `TabulatedBrdf` whose
+//!   `ChunkLoader` is the [`StoredTable`] (chunks decoded, checksum checked, on first touch; the
+//!   `TabulatedBrdf` keeps what it loaded, so the memory bound of [`OpenOptions::cache_bytes`]
+//!   applies to [`StoredTable::chunk`] users such as the exports, not to a `TabulatedBrdf`).
+//! - [`export`]: `.npy` of the dense table, EXR of 2D slices.
+//!
+//! ```
+//! use brdftab::codec::{Codec, Quant};
+//! use brdftab::store::{Source, Store, TableHeader, db};
+//! use brdftab::Channels;
+//! let dir = std::env::temp_dir().join(format!("brdftab-doc-{}", std::process::id()));
+//! std::fs::create_dir_all(&dir).unwrap();
+//! let path = dir.join("doc.btdb");
+//! let data: Vec<f32> = (0..2 * 4 * 8 * 3).map(|i| i as f32 * 0.01).collect();
+//! let codec = Codec { quant: Quant::F32, ..Codec::default() };
+//! let header = TableHeader::new("ramp", Source::Other { description: "doc".into() },
+//!                               vec![2, 4, 8, 3], Channels::Rgb, codec);
+//! db::put(&path, header, false, |w| {
+//!     for chunk in data.chunks(4 * 8 * 3) {
+//!         w.chunk(chunk)?; // one slab of the outermost axis at a time
+//!     }
+//!     Ok(())
+//! })?;
+//! let store = Store::open(&path)?;
+//! assert_eq!(store.table("ramp")?.read_all()?, data);
+//! # std::fs::remove_dir_all(&dir).ok();
+//! # Ok::<(), brdftab::Error>(())
+//! ```
 //!
 //! Files are never modified in place — every write produces a new file and renames it — so a
 //! reader that has a file open keeps seeing the version it opened (it maps the old inode).
@@ -440,9 +470,12 @@ pub struct ChunkCache {
     inner: Mutex<CacheInner>,
 }
 
+/// A decoded chunk and its last use.
+type Entry = (Arc<[f32]>, u64);
+
 #[derive(Default)]
 struct CacheInner {
-    map: HashMap<(usize, usize), (Arc<[f32]>, u64)>,
+    map: HashMap<(usize, usize), Entry>,
     bytes: usize,
     tick: u64,
 }

@@ -186,3 +186,61 @@ pub fn node_offset(grid: &Grid) -> impl Fn(&[usize]) -> Option<usize> + Sync + '
         _ => None,
     }
 }
+
+impl crate::table::ChunkLoader for StoredTable {
+    /// Decodes the chunk (checksum checked) without going through the store's cache: the
+    /// `TabulatedBrdf` keeps what it loads.
+    fn load(&self, chunk: usize) -> Result<Vec<f32>> {
+        self.decode_chunk(chunk)
+    }
+}
+
+impl StoredTable {
+    /// This table as a [`TabulatedBrdf`](crate::table::TabulatedBrdf) whose chunks are decoded
+    /// on first touch (linear interpolation).
+    pub fn brdf(&self) -> Result<crate::table::TabulatedBrdf> {
+        let grid = self.grid()?;
+        let desc = format!("table `{}` from {}", self.header().name, self.file());
+        Ok(crate::table::TabulatedBrdf::lazy(
+            grid,
+            Box::new(self.clone()),
+            desc,
+        ))
+    }
+}
+
+/// True when `path` starts with the brdftab file magic.
+pub fn is_store_file(path: impl AsRef<Path>) -> bool {
+    use std::io::Read;
+    let mut m = [0u8; 8];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut m))
+        .is_ok()
+        && m == super::format::MAGIC
+}
+
+/// Opens `FILE` (a single-table file) or `DB#NAME` (a table of a database) as a lazily decoded
+/// [`TabulatedBrdf`](crate::table::TabulatedBrdf). With `eager`, every chunk is decoded now (in
+/// parallel) and checked.
+pub fn open_brdf(source: &str, eager: bool) -> Result<crate::table::TabulatedBrdf> {
+    let (path, name) = db::split_source(source);
+    let store = super::Store::open(path)?;
+    let t = match name {
+        Some(n) => store.table(n)?,
+        None => store.single()?,
+    };
+    if eager {
+        use rayon::prelude::*;
+        let chunks: Vec<Vec<f32>> = (0..t.chunk_count())
+            .into_par_iter()
+            .map(|i| t.decode_chunk(i))
+            .collect::<Result<_>>()?;
+        let table = Table::new(
+            t.grid()?,
+            chunks.concat(),
+            format!("table `{}` from {path}", t.header().name),
+        )?;
+        return Ok(crate::table::TabulatedBrdf::from_table(table));
+    }
+    t.brdf()
+}

@@ -41,8 +41,10 @@
 //!   beyond the first/last node clamp. The default for θ axes: the horizon (where many models
 //!   are singular) is never evaluated.
 //! - [`Nodes::Edges`]: node i at u = i/(n − 1), s = u·(n − 1); both ends are nodes.
-//! - [`Nodes::CellStart`]: node i at u = i/n, s = u·n; node i stands for the cell [i, i+1) and a
-//!   *nearest* lookup takes ⌊s⌋ (not the rounded index). This is MERL's convention:
+//! - [`Nodes::CellStart`]: the axis is cut into n cells [i/n, (i+1)/n) of u; node i stands for
+//!   cell i and sits at its centre u = (i + ½)/n (baking samples there and linear interpolation
+//!   runs between centres, so binned data such as MERL's are not shifted by half a cell), while a
+//!   *nearest* lookup takes ⌊u·n⌋ (not the rounded index). This is MERL's convention:
 //!   `int(sqrt(θh/(π/2))·90)`, `int(θd/(π/2)·90)`, `int(φd/π·180)`. The arithmetic is done in the
 //!   same order as the MERL reader so a nearest lookup on [`Grid::merl`] reproduces its indices
 //!   value for value (`sqrt(((θh/(π/2))·90)·90)`, `(θd/(π/2))·90`, `(φd/π)·180`, with φd + π when
@@ -236,8 +238,24 @@ impl StoredAxis {
     }
 
     /// The fractional node index s of coordinate `x` (not clamped or wrapped).
+    ///
+    /// On [`Nodes::CellStart`] axes node i is the centre of cell [i, i+1) — a binned measurement
+    /// stands for its cell, and baking samples the centre — so s is the cell coordinate − ½;
+    /// [`StoredAxis::nearest`] still floors the unshifted cell coordinate, exactly as MERL.
     #[inline(always)]
     pub fn continuous(&self, x: f64) -> f64 {
+        let c = self.cell_coordinate(x);
+        if self.nodes == Nodes::CellStart && self.size > 1 {
+            c - 0.5
+        } else {
+            c
+        }
+    }
+
+    /// The position of `x` in units of cells (node spacing), before the half-cell shift of
+    /// [`Nodes::CellStart`] axes; for those it is the MERL index before truncation.
+    #[inline(always)]
+    fn cell_coordinate(&self, x: f64) -> f64 {
         if self.size <= 1 {
             return 0.0;
         }
@@ -276,12 +294,16 @@ impl StoredAxis {
         }
         let n = self.size as f64;
         if self.periodic {
+            let s = if self.nodes == Nodes::CellStart {
+                s + 0.5
+            } else {
+                s
+            };
             return self.lo + s / n * (self.hi - self.lo);
         }
         let u = match self.nodes {
-            Nodes::Centers => (s + 0.5) / n,
+            Nodes::Centers | Nodes::CellStart => (s + 0.5) / n,
             Nodes::Edges => s / (n - 1.0),
-            Nodes::CellStart => s / n,
         };
         let r = match self.mapping {
             Mapping::Uniform => u,
@@ -304,11 +326,10 @@ impl StoredAxis {
     /// otherwise; clamped (or wrapped when periodic) into 0..size.
     #[inline]
     pub fn nearest(&self, x: f64) -> usize {
-        let s = self.continuous(x);
         let i = if self.nodes == Nodes::CellStart {
-            s.floor()
+            self.cell_coordinate(x).floor()
         } else {
-            (s + 0.5).floor()
+            (self.continuous(x) + 0.5).floor()
         };
         self.index(i)
     }

@@ -11,7 +11,8 @@
 //! - [`tabulated`]: [`TabulatedBrdf`], the `Brdf` over a table — every chunk in memory, or loaded
 //!   on first touch through a [`ChunkLoader`];
 //! - [`presets`]: `small`, `medium`, `large` grids with measured accuracy;
-//! - [`raw`]: a minimal JSON-header + f32 file (stop-gap until the store's format is wired in).
+//! - [`raw`]: a minimal JSON-header + f32 file (stop-gap until the store's format is wired in);
+//! - [`sampling`]: importance sampling of tables (tabulated equal-area CDFs of f_r·cos θi).
 //!
 //! Values are stored λ innermost: the values of one node for every channel are contiguous, so
 //! one set of angular interpolation weights serves all channels.
@@ -21,12 +22,14 @@ pub mod grid;
 pub mod lookup;
 pub mod presets;
 pub mod raw;
+pub mod sampling;
 pub mod symmetry;
 pub mod tabulated;
 
 pub use bake::{BakeOptions, BakeReport, bake, bake_chunks};
 pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, StoredAxis};
 pub use lookup::Interp;
+pub use sampling::{SamplingResolution, TableSampler};
 pub use symmetry::Symmetry;
 pub use tabulated::{ChunkLoader, TabulatedBrdf};
 

@@ -12,16 +12,17 @@
 //! check [`TabulatedBrdf::load_error`] after a batch, or call [`TabulatedBrdf::load_all`]
 //! up front to get a proper `Result`. Failed chunks are not retried.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use crate::brdf::{Brdf, Flags};
+use crate::brdf::{Brdf, BrdfSample, Flags};
 use crate::error::{Error, Result};
 use crate::spectrum::Channels;
 use crate::table::Table;
 use crate::table::grid::Grid;
 use crate::table::lookup::{Interp, Lookup};
+use crate::table::sampling::{SamplingResolution, TableSampler};
 
 /// Supplies the values of a chunk on demand (decoding, reading from disk, ...).
 pub trait ChunkLoader: Send + Sync {
@@ -50,6 +51,8 @@ pub struct TabulatedBrdf {
     interp: Interp,
     description: String,
     error: Mutex<Option<String>>,
+    /// Importance sampling distributions, built on first `sample`/`pdf` (see [`super::sampling`]).
+    sampler: OnceLock<TableSampler>,
 }
 
 impl std::fmt::Debug for TabulatedBrdf {
@@ -78,6 +81,7 @@ impl TabulatedBrdf {
             interp: Interp::Linear,
             description,
             error: Mutex::new(None),
+            sampler: OnceLock::new(),
         }
     }
 
@@ -98,18 +102,40 @@ impl TabulatedBrdf {
             interp: Interp::Linear,
             description: description.into(),
             error: Mutex::new(None),
+            sampler: OnceLock::new(),
         }
     }
 
     /// The same with interpolation `interp`.
     pub fn with_interp(mut self, interp: Interp) -> Self {
-        self.interp = interp;
+        self.set_interp(interp);
         self
     }
 
     /// Sets the interpolation.
     pub fn set_interp(&mut self, interp: Interp) {
         self.interp = interp;
+        self.sampler = OnceLock::new();
+    }
+
+    /// The importance sampler of [`Brdf::sample`]/[`Brdf::pdf`], built on first use with
+    /// [`SamplingResolution::default`] (isotropic tables) or [`SamplingResolution::anisotropic`].
+    pub fn sampler(&self) -> &TableSampler {
+        self.sampler.get_or_init(|| {
+            let iso = self.grid.symmetry().isotropic;
+            let res = if iso {
+                SamplingResolution::default()
+            } else {
+                SamplingResolution::anisotropic()
+            };
+            TableSampler::build(self, iso, &res)
+        })
+    }
+
+    /// Builds the sampler now with resolution `res` (replacing any built one).
+    pub fn set_sampling_resolution(&mut self, res: &SamplingResolution) {
+        let s = TableSampler::build(self, self.grid.symmetry().isotropic, res);
+        self.sampler = OnceLock::from(s);
     }
 
     /// The interpolation in use.
@@ -226,6 +252,15 @@ impl Brdf for TabulatedBrdf {
             self.interp,
             self.description
         )
+    }
+
+    /// Tabulated importance sampling of f_r·cos θi ([`TableSampler`]).
+    fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+        self.sampler().sample(self, wo, u, weight)
+    }
+
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        self.sampler().pdf(wi, wo)
     }
 
     /// Parallel (rayon) above 16384 pairs, sequential below.

@@ -1,8 +1,11 @@
 //! `brdftab`: the command-line tool. Thin over the library: parse arguments, call the library,
 //! print. Errors print as `error: ...` on stderr with exit code 1.
 
+mod accuracy;
 mod analysis;
+mod db;
 mod demo;
+mod export;
 mod fit;
 mod measured;
 mod models;
@@ -30,6 +33,10 @@ enum Command {
     Models(models::ModelsArgs),
     /// Bake SOURCE into a dense (symmetry-reduced) table file.
     Bake(table::BakeArgs),
+    /// Databases of named tables: add, list, rm, verify.
+    Db(db::DbArgs),
+    /// Export a stored table as .npy, or a 2D slice of it as EXR.
+    Export(export::ExportArgs),
     /// Describe a table file (grid, symmetry, channels, sizes) or a measured file (MERL, RGL).
     Info(table::InfoArgs),
     /// Time lookups of SOURCE on random pairs (single thread and batch on all cores).
@@ -48,6 +55,8 @@ enum Command {
     Check(analysis::CheckArgs),
     /// The lecture's models side by side (plausibility table).
     Demo(demo::DemoArgs),
+    /// Accuracy suite: tables of every source per grid and codec vs the source; CSV, Markdown, plots.
+    Accuracy(accuracy::AccuracyArgs),
     /// Fit a model's parameters to SOURCE by least squares; prints the fitted spec.
     Fit(fit::FitArgs),
     /// Draw incident directions from SOURCE's sampler: `wix wiy wiz pdf w_1 .. w_c` per line.
@@ -66,6 +75,8 @@ fn main() -> ExitCode {
         Command::Models(a) => models::models(a),
         Command::Bake(a) => table::bake(a),
         Command::Info(a) => table::info(a),
+        Command::Db(a) => db::run(a),
+        Command::Export(a) => export::run(a),
         Command::Bench(a) => table::bench(a),
         Command::Render(a) => render::run(a),
         Command::Slice(a) => measured::slice(a),
@@ -74,6 +85,7 @@ fn main() -> ExitCode {
         Command::Albedo(a) => analysis::albedo(a),
         Command::Check(a) => analysis::check(a),
         Command::Demo(a) => demo::demo(a),
+        Command::Accuracy(a) => accuracy::accuracy(a),
         Command::Fit(a) => fit::fit(a),
         Command::Sample(a) => sample::sample(a),
         Command::Pdf(a) => sample::pdf(a),

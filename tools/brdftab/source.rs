@@ -80,7 +80,12 @@ pub fn open_with(source: &str, channels: &Channels, interp: Interp) -> Result<Bo
         )),
         Kind::Rgl => Ok(Box::new(brdftab::measured::RglBrdf::open(source)?)),
         Kind::Table => {
-            if Table::is_raw(source) {
+            let path = brdftab::store::db::split_source(source).0;
+            if brdftab::store::tables::is_store_file(path) {
+                Ok(Box::new(
+                    brdftab::store::tables::open_brdf(source, false)?.with_interp(interp),
+                ))
+            } else if Table::is_raw(source) {
                 Ok(Box::new(
                     TabulatedBrdf::from_table(Table::open_raw(source)?).with_interp(interp),
                 ))

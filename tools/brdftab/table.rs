@@ -4,9 +4,10 @@ use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::time::Instant;
 
+use brdftab::codec::Codec;
 use brdftab::rng::Pcg32;
+use brdftab::store::{Source, TableHeader, Writer, db, tables};
 use brdftab::table::presets::Preset;
-use brdftab::table::raw::RawWriter;
 use brdftab::table::{
     BakeOptions, Grid, Interp, Mapping, Param, Symmetry, Table, bake_chunks, symmetry,
 };
@@ -30,10 +31,29 @@ fn print_out(text: &str) -> Result<()> {
 #[derive(Args)]
 pub struct BakeArgs {
     /// The source: a model spec (inline JSON or .json), a table, a MERL or RGL file.
-    source: String,
-    /// Output table file.
+    pub source: String,
+    /// Output table file (`.btdb`).
     #[arg(short, long)]
-    output: String,
+    pub output: Option<String>,
+    /// Codec: f32 (lossless), f16, or log16 (relative error bound; `log16:1e-3` sets it).
+    #[arg(long, default_value = "f16")]
+    pub codec: String,
+    /// log16 relative tolerance (default 1e-3). Named so as not to clash with the symmetry
+    /// `--tolerance`.
+    #[arg(long)]
+    pub codec_tolerance: Option<f64>,
+    /// log16 absolute floor (default: 1e-7 of each chunk's largest value).
+    #[arg(long)]
+    pub floor: Option<f64>,
+    /// zstd level (1..=22).
+    #[arg(long, default_value_t = 3)]
+    pub level: i32,
+    /// Try every filter through zstd per chunk and keep the smallest (slower).
+    #[arg(long)]
+    pub exhaustive: bool,
+    /// Table name inside the file (default: the output file's stem).
+    #[arg(long)]
+    pub name: Option<String>,
     /// Grid size preset: small, medium (default) or large.
     #[arg(long, default_value = "medium")]
     preset: String,
@@ -102,8 +122,60 @@ fn parse_grid(s: &str) -> Result<[usize; 4]> {
         .map_err(|_| Error::arg("--grid", "expected four sizes θ1xφ1xθ2xφ2"))
 }
 
+/// The codec the bake options ask for.
+pub fn codec(a: &BakeArgs) -> Result<Codec> {
+    let (name, tol) = match a.codec.split_once(':') {
+        Some((n, t)) => (
+            n,
+            Some(
+                t.parse::<f64>()
+                    .map_err(|_| Error::arg("--codec", format!("`{t}` is not a tolerance")))?,
+            ),
+        ),
+        None => (a.codec.as_str(), None),
+    };
+    let quant = brdftab::codec::Quant::parse(name.trim(), a.codec_tolerance.or(tol), a.floor)?;
+    if !(1..=22).contains(&a.level) {
+        return Err(Error::arg(
+            "--level",
+            format!("{} is outside 1..=22", a.level),
+        ));
+    }
+    Ok(Codec {
+        quant,
+        level: a.level,
+        exhaustive: a.exhaustive,
+        ..Codec::default()
+    })
+}
+
+/// Where a bake goes.
+pub enum Target<'a> {
+    /// A single-table file (replaced atomically).
+    File(&'a str),
+    /// A table in a database.
+    Db {
+        /// The database file.
+        path: &'a str,
+        /// The table's name.
+        name: &'a str,
+        /// Replace an existing table of that name.
+        replace: bool,
+    },
+}
+
 /// `brdftab bake`.
 pub fn bake(a: BakeArgs) -> Result<()> {
+    let out = a
+        .output
+        .clone()
+        .ok_or_else(|| Error::arg("--output", "an output file is required"))?;
+    bake_to(a, Target::File(&out))
+}
+
+/// Bakes SOURCE as the options say and streams the chunks into `target`.
+pub fn bake_to(a: BakeArgs, target: Target<'_>) -> Result<()> {
+    let codec = codec(&a)?;
     let channels = source::channels(a.wavelengths.as_deref())?;
     let src = source::open(&a.source, &channels)?;
     let channels = src.channels().clone();
@@ -163,9 +235,42 @@ pub fn bake(a: BakeArgs) -> Result<()> {
         progress: Some(&progress),
         ..Default::default()
     };
-    let mut w = RawWriter::create(&a.output, &grid, &src.describe())?;
-    let report = bake_chunks(src.as_ref(), &grid, &opts, |_, v| w.write_chunk(v))?;
-    w.finish()?;
+    let src_info = match source::kind(&a.source) {
+        source::Kind::Spec => Source::model(&source::spec(&a.source)?),
+        source::Kind::Merl | source::Kind::Rgl => Source::measured(&a.source)?,
+        source::Kind::Table => Source::Other {
+            description: format!("{}: {}", a.source, src.describe()),
+        },
+    };
+    let (out, default_name) = match &target {
+        Target::File(p) => (
+            *p,
+            std::path::Path::new(p)
+                .file_stem()
+                .map_or("table".into(), |s| s.to_string_lossy().into_owned()),
+        ),
+        Target::Db { path, name, .. } => (*path, name.to_string()),
+    };
+    let name = a.name.clone().unwrap_or(default_name);
+    let header = TableHeader::for_grid(name, src_info, &grid, codec);
+    let mut report = None;
+    let mut stream = |w: &mut Writer| -> Result<()> {
+        report = Some(bake_chunks(src.as_ref(), &grid, &opts, |i, v| {
+            w.chunk_with(v, tables::chunk_layout(&grid, i))
+        })?);
+        Ok(())
+    };
+    match target {
+        Target::File(p) => {
+            let mut w = Writer::create(p)?;
+            w.begin_table(header)?;
+            stream(&mut w)?;
+            w.end_table()?;
+            w.finish()?;
+        }
+        Target::Db { path, replace, .. } => db::put(path, header, replace, stream)?,
+    }
+    let report = report.ok_or_else(|| Error::arg("bake", "nothing baked"))?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -173,11 +278,12 @@ pub fn bake(a: BakeArgs) -> Result<()> {
         eprintln!("warning: forced past a symmetry violation: {f}");
     }
     eprintln!(
-        "wrote {} ({} values in {:.2} s, {:.1} M values/s)",
-        a.output,
+        "wrote {} ({} values in {:.2} s, {:.1} M values/s, codec {})",
+        out,
         report.values,
         report.seconds,
-        report.values as f64 / report.seconds.max(1e-9) / 1e6
+        report.values as f64 / report.seconds.max(1e-9) / 1e6,
+        codec.quant.name()
     );
     Ok(())
 }
@@ -189,6 +295,9 @@ pub fn info(a: InfoArgs) -> Result<()> {
         source::Kind::Merl | source::Kind::Rgl
     ) {
         return crate::measured::info_source(&a.file);
+    }
+    if tables::is_store_file(db::split_source(&a.file).0) {
+        return crate::db::info(&a.file, a.json);
     }
     let t = Table::open_raw(&a.file)?;
     let g = t.grid();

@@ -1,0 +1,144 @@
+//! Samples per second per core of `Brdf::sample` (direction + pdf + weight f_r cos θi / pdf), RGB,
+//! single thread: the analytic models' importance samplers (target ≥ 20 M samples/s per core)
+//! and tables with tabulated importance sampling (target ≥ 5 M samples/s per core).
+//!
+//! Each iteration draws one sample for an outgoing direction from a pool of 1024 random `wo`
+//! above the horizon (cycled) with fresh uniforms from a PCG32 stream, so branch predictors and
+//! caches see realistic variety. Tables are `halfdiff` `small` grids (32 × 32 × 64, folded)
+//! baked from the same models; their sampler is built before timing.
+//!
+//! Time is the benchmark thread's **CPU time** (`CLOCK_THREAD_CPUTIME_ID`), as in `benches/eval.rs`:
+//! the machines this runs on are shared. samples/s per core = 1e9 / (reported ns per iteration).
+//!
+//! Run: `cargo bench --bench sampling -- --warm-up-time 1 --measurement-time 2`
+
+use std::hint::black_box;
+
+use brdftab::geometry;
+use brdftab::rng::Pcg32;
+use brdftab::spec::ModelSpec;
+use brdftab::table::{BakeOptions, Grid, Mapping, Param, Symmetry, TabulatedBrdf, bake};
+use brdftab::{Brdf, Channels};
+use criterion::measurement::{Measurement, ValueFormatter, WallTime};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::DVec3;
+
+/// Thread CPU time in nanoseconds, formatted like wall time.
+struct ThreadCpuTime(WallTime);
+
+fn thread_cpu_ns() -> u64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant Linux supports.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
+}
+
+impl Measurement for ThreadCpuTime {
+    type Intermediate = u64;
+    type Value = u64;
+    fn start(&self) -> u64 {
+        thread_cpu_ns()
+    }
+    fn end(&self, start: u64) -> u64 {
+        thread_cpu_ns().saturating_sub(start)
+    }
+    fn add(&self, a: &u64, b: &u64) -> u64 {
+        a + b
+    }
+    fn zero(&self) -> u64 {
+        0
+    }
+    fn to_f64(&self, v: &u64) -> f64 {
+        *v as f64
+    }
+    fn formatter(&self) -> &dyn ValueFormatter {
+        self.0.formatter()
+    }
+}
+
+const MODELS: &[(&str, &str)] = &[
+    ("lambert", r#"{"model": "lambert", "kd": 0.3}"#),
+    (
+        "reciprocal_phong",
+        r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 50}"#,
+    ),
+    (
+        "cook_torrance",
+        r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#,
+    ),
+    (
+        "ggx",
+        r#"{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}"#,
+    ),
+];
+
+fn wos() -> Vec<DVec3> {
+    let mut rng = Pcg32::new(2024);
+    (0..1024)
+        .map(|_| geometry::uniform_hemisphere(rng.next_dvec2()))
+        .collect()
+}
+
+fn table_of(src: &dyn Brdf) -> TabulatedBrdf {
+    let grid = Grid::with_sizes(
+        Param::HalfDiff,
+        [32, 64, 32, 64],
+        [Mapping::Sqrt, Mapping::Uniform],
+        Channels::Rgb,
+        Symmetry::ALL,
+    )
+    .expect("grid");
+    let (t, _) = bake(src, &grid, &BakeOptions::default()).expect("bake");
+    let t = TabulatedBrdf::from_table(t);
+    t.sampler(); // build the distributions before timing
+    t
+}
+
+fn run<M: Measurement>(
+    g: &mut criterion::BenchmarkGroup<M>,
+    name: &str,
+    b: &dyn Brdf,
+    wos: &[DVec3],
+) {
+    g.bench_function(name, |bch| {
+        let mut rng = Pcg32::new(7);
+        let mut w = [0.0f32; 3];
+        let mut i = 0usize;
+        bch.iter(|| {
+            let wo = wos[i & 1023];
+            i = i.wrapping_add(1);
+            let s = b.sample(black_box(wo), rng.next_dvec2(), &mut w);
+            black_box((s.map(|s| s.pdf), w[0]))
+        })
+    });
+}
+
+fn bench_sampling(c: &mut Criterion<ThreadCpuTime>) {
+    let wos = wos();
+    let mut g = c.benchmark_group("sample_rgb");
+    g.throughput(Throughput::Elements(1));
+    let mut tables = Vec::new();
+    for (name, spec) in MODELS {
+        let Ok(m) = ModelSpec::parse(spec).and_then(|s| s.build(&Channels::Rgb)) else {
+            continue;
+        };
+        run(&mut g, name, m.as_ref(), &wos);
+        if *name != "ggx" {
+            tables.push((format!("table_{name}"), table_of(m.as_ref())));
+        }
+    }
+    for (name, t) in &tables {
+        run(&mut g, name, t, &wos);
+    }
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().with_measurement(ThreadCpuTime(WallTime));
+    targets = bench_sampling
+}
+criterion_main!(benches);

@@ -1,0 +1,787 @@
+//! The accuracy suite: how much a stored table costs and how far it is from its source.
+//!
+//! For every source × grid preset × parameterization × codec the suite
+//!
+//! 1. bakes the source on the preset grid (symmetry reduced as the source's flags declare; the
+//!    bake verifies it, and a source that fails the check is baked without reduction);
+//! 2. encodes every chunk with the codec exactly as the store writer does (same per-chunk
+//!    predictor layout, [`store::tables::chunk_layout`](crate::store::tables::chunk_layout),
+//!    zstd level 3) and counts the bytes — the sum of the chunk sizes, which is what a `.btdb`
+//!    file holds for the table apart from its small JSON header and chunk index;
+//! 3. decodes those bytes back into a [`TabulatedBrdf`] (linear interpolation): every metric is
+//!    measured on the *decoded* table, quantization error included;
+//! 4. measures, against the source:
+//!    - `rel_rmse`, `max_rel`: [`analysis::accuracy::compare`] over `pairs` uniform random pairs
+//!      (cosine-weighted relative RMSE; max relative error with a 1 %-of-RMS floor);
+//!    - `albedo_err`: max over the incidence angles `albedo_thetas` and channels of
+//!      |a_table − a_source| / a_source (denominator floored at 1e-3 × the largest source
+//!      albedo), both albedos by the same adaptive quadrature ([`albedo::integrate`]) with
+//!      [`ALBEDO_OPTIONS`], so quadrature error cancels as far as possible;
+//!    - `render_rel_rmse`: [`render::compare`] of a small lit-sphere render of the table against
+//!      the same render of the source, both with [`Sampling::Fixed`] and the same seed, so the
+//!      sampled directions coincide and the difference is (nearly) free of Monte Carlo noise.
+//!
+//! **Undefined metrics.** Every number in a row is finite. A metric that was not measured is
+//! written as `-1` (all real metrics are ≥ 0) and the `status` / `render` columns say why:
+//! `render = skipped` when renders are off for that kind of source (e.g. measured data with
+//! `render_measured = false`), `status = encode failed: ...` when a codec refuses the data
+//! (f16 beyond 65504), `status = bake failed: ...` when the source cannot be baked.
+//!
+//! **Channels.** Every source is evaluated in RGB (the renderer works in RGB, and RGB keeps
+//! tables of every source the same size). The spectral gold conductor of Cook-Torrance is
+//! evaluated at the RGB channel wavelengths (645, 526, 444 nm), i.e. three samples of the
+//! measured n + ik of gold.
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crate::analysis::{accuracy, albedo};
+use crate::brdf::Brdf;
+use crate::codec::{self, Codec, Quant};
+use crate::error::{Error, Result};
+use crate::geometry;
+use crate::render::{self, LightChoice, Mode, RenderOptions, Sampling};
+use crate::spec::ModelSpec;
+use crate::spectrum::{Channels, MAX_CHANNELS};
+use crate::table::presets::Preset;
+use crate::table::{BakeOptions, Grid, Param, Symmetry, Table, TabulatedBrdf, bake};
+
+/// Quadrature settings of the albedo metric: a 1e-4 target with bounded interval counts, so a
+/// piecewise-linear table (whose kinks defeat a 1e-6 target) costs at most ~30 000 evaluations
+/// per angle.
+pub const ALBEDO_OPTIONS: albedo::Options = albedo::Options {
+    rel_tol: 1e-4,
+    max_outer: 32,
+    max_inner: 64,
+};
+
+/// Written where a metric was not measured (see the module docs).
+pub const NOT_MEASURED: f64 = -1.0;
+
+/// Where a source comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SourceKind {
+    /// An analytic model (evaluated in RGB).
+    Model(ModelSpec),
+    /// An RGL-EPFL `.bsdf` file.
+    Rgl(PathBuf),
+}
+
+/// One source of the suite: a short name (used in file names and the CSV) and what it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourceDef {
+    /// Short name, e.g. `reciprocal_phong_n100`.
+    pub name: String,
+    /// The model spec or measured file.
+    pub kind: SourceKind,
+}
+
+impl SourceDef {
+    /// A model source from its JSON spec.
+    pub fn model(name: &str, json: &str) -> Result<SourceDef> {
+        Ok(SourceDef {
+            name: name.to_owned(),
+            kind: SourceKind::Model(ModelSpec::parse(json)?),
+        })
+    }
+
+    /// `model` or `measured`.
+    pub fn kind_name(&self) -> &'static str {
+        match self.kind {
+            SourceKind::Model(_) => "model",
+            SourceKind::Rgl(_) => "measured",
+        }
+    }
+
+    /// Opens the source as a `Brdf` (RGB).
+    pub fn open(&self) -> Result<Box<dyn Brdf>> {
+        match &self.kind {
+            SourceKind::Model(spec) => spec.build(&Channels::Rgb),
+            SourceKind::Rgl(path) => Ok(Box::new(crate::measured::RglBrdf::open(path)?)),
+        }
+    }
+}
+
+/// The lecture's models and the extra microfacet models, in RGB:
+/// Lambert; original / reciprocal / max Phong at n = 10, 100, 1000 (k_s = ½(n+2)/2π, so the
+/// normal-incidence albedo of reciprocal Phong is about ½); Cook-Torrance m = 0.1, 0.3, 0.5 with
+/// a gold conductor; GGX α = 0.1, 0.3; Ward anisotropic (α_x = 0.1, α_y = 0.3).
+pub fn lecture_sources() -> Vec<SourceDef> {
+    let mut v = vec![(
+        "lambert".to_owned(),
+        r#"{"model": "lambert", "kd": [0.2, 0.15, 0.1]}"#.to_owned(),
+    )];
+    for (model, short) in [
+        ("phong", "phong"),
+        ("reciprocal_phong", "reciprocal_phong"),
+        ("max_phong", "max_phong"),
+    ] {
+        for n in [10, 100, 1000] {
+            let ks = 0.5 * (n as f64 + 2.0) / (2.0 * PI);
+            v.push((
+                format!("{short}_n{n}"),
+                format!(r#"{{"model": "{model}", "ks": {ks}, "n": {n}}}"#),
+            ));
+        }
+    }
+    for m in ["0.1", "0.3", "0.5"] {
+        v.push((
+            format!("cook_torrance_m{m}"),
+            format!(r#"{{"model": "cook_torrance", "m": {m}, "fresnel": {{"conductor": "Au"}}}}"#),
+        ));
+    }
+    for a in ["0.1", "0.3"] {
+        v.push((
+            format!("ggx_a{a}"),
+            format!(r#"{{"model": "ggx", "alpha": {a}}}"#),
+        ));
+    }
+    v.push((
+        "ward_aniso".to_owned(),
+        r#"{"model": "ward", "ks": 0.5, "alpha_x": 0.1, "alpha_y": 0.3}"#.to_owned(),
+    ));
+    v.into_iter()
+        .map(|(name, json)| {
+            SourceDef::model(&name, &json).expect("the built-in source specs are valid")
+        })
+        .collect()
+}
+
+/// The RGL `.bsdf` files in `dir`, sorted by name (source name = file stem).
+pub fn rgl_sources(dir: impl AsRef<Path>) -> Result<Vec<SourceDef>> {
+    let dir = dir.as_ref();
+    let mut v: Vec<SourceDef> = std::fs::read_dir(dir)
+        .map_err(|e| Error::io(dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .is_some_and(|x| x.eq_ignore_ascii_case("bsdf"))
+        })
+        .map(|p| SourceDef {
+            name: p
+                .file_stem()
+                .map_or_else(String::new, |s| s.to_string_lossy().into_owned()),
+            kind: SourceKind::Rgl(p),
+        })
+        .collect();
+    v.sort_by(|a, b| a.name.cmp(&b.name));
+    Ok(v)
+}
+
+/// A named codec configuration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CodecDef {
+    /// Name in the CSV, e.g. `log16@1e-3`.
+    pub name: &'static str,
+    /// The codec.
+    pub codec: Codec,
+}
+
+/// f32, f16, log16 at 1e-2 and at 1e-3 (zstd level 3, filter chosen per chunk).
+pub fn default_codecs() -> Vec<CodecDef> {
+    let with = |quant| Codec {
+        quant,
+        ..Codec::default()
+    };
+    vec![
+        CodecDef {
+            name: "f32",
+            codec: with(Quant::F32),
+        },
+        CodecDef {
+            name: "f16",
+            codec: with(Quant::F16),
+        },
+        CodecDef {
+            name: "log16@1e-2",
+            codec: with(Quant::Log16 {
+                tolerance: 1e-2,
+                floor: None,
+            }),
+        },
+        CodecDef {
+            name: "log16@1e-3",
+            codec: with(Quant::Log16 {
+                tolerance: 1e-3,
+                floor: None,
+            }),
+        },
+    ]
+}
+
+/// What the suite runs.
+#[derive(Debug, Clone)]
+pub struct SuiteConfig {
+    /// The sources.
+    pub sources: Vec<SourceDef>,
+    /// Grid presets.
+    pub presets: Vec<Preset>,
+    /// Parameterizations.
+    pub params: Vec<Param>,
+    /// Codecs.
+    pub codecs: Vec<CodecDef>,
+    /// Random direction pairs of the BRDF-space metrics.
+    pub pairs: usize,
+    /// Incidence angles (radians) of the albedo metric.
+    pub albedo_thetas: Vec<f64>,
+    /// The preview render (`None`: no render metric). Use `Sampling::Fixed`.
+    pub render: Option<RenderOptions>,
+    /// Whether measured sources are rendered too.
+    pub render_measured: bool,
+    /// Seed of the random pairs.
+    pub seed: u64,
+}
+
+fn preview(size: usize, spp: usize) -> RenderOptions {
+    RenderOptions {
+        width: size,
+        height: size,
+        spp,
+        seed: 7,
+        max_depth: 1,
+        mode: Mode::Lit,
+        sampling: Sampling::Fixed,
+        light: LightChoice::Area,
+        ..RenderOptions::default()
+    }
+}
+
+impl SuiteConfig {
+    /// The full suite: every lecture source and every RGL file in `rgl_dir` (if given), all three
+    /// presets, both parameterizations, the four codecs, 200 000 pairs, 8 albedo angles, 64×64
+    /// renders at 16 spp (measured sources included).
+    pub fn full(rgl_dir: Option<&Path>) -> Result<SuiteConfig> {
+        let mut sources = lecture_sources();
+        if let Some(d) = rgl_dir {
+            sources.extend(rgl_sources(d)?);
+        }
+        Ok(SuiteConfig {
+            sources,
+            presets: vec![Preset::Small, Preset::Medium, Preset::Large],
+            params: vec![Param::HalfDiff, Param::InOut],
+            codecs: default_codecs(),
+            pairs: 200_000,
+            albedo_thetas: (0..8)
+                .map(|i| (5.0 + 10.0 * i as f64).to_radians())
+                .collect(),
+            render: Some(preview(64, 16)),
+            render_measured: true,
+            seed: 1,
+        })
+    }
+
+    /// The quick suite (under a minute on 2 cores): Lambert, reciprocal Phong n = 100,
+    /// Cook-Torrance m = 0.3 (gold), GGX α = 0.3, Ward, and the first RGL file; the small preset;
+    /// 20 000 pairs; 3 albedo angles; 24×24 renders at 4 spp.
+    pub fn quick(rgl_dir: Option<&Path>) -> Result<SuiteConfig> {
+        let keep = [
+            "lambert",
+            "reciprocal_phong_n100",
+            "cook_torrance_m0.3",
+            "ggx_a0.3",
+            "ward_aniso",
+        ];
+        let mut sources: Vec<SourceDef> = lecture_sources()
+            .into_iter()
+            .filter(|s| keep.contains(&s.name.as_str()))
+            .collect();
+        if let Some(d) = rgl_dir {
+            sources.extend(rgl_sources(d)?.into_iter().take(1));
+        }
+        Ok(SuiteConfig {
+            sources,
+            presets: vec![Preset::Small],
+            params: vec![Param::HalfDiff, Param::InOut],
+            codecs: default_codecs(),
+            pairs: 20_000,
+            albedo_thetas: [10.0f64, 45.0, 75.0]
+                .iter()
+                .map(|d| d.to_radians())
+                .collect(),
+            render: Some(preview(24, 4)),
+            render_measured: true,
+            seed: 1,
+        })
+    }
+
+    /// Number of rows the suite will produce.
+    pub fn row_count(&self) -> usize {
+        self.sources.len() * self.presets.len() * self.params.len() * self.codecs.len()
+    }
+}
+
+/// One row: a source on one grid with one codec.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// Source name.
+    pub source: String,
+    /// `model` or `measured`.
+    pub kind: String,
+    /// `small`, `medium` or `large`.
+    pub preset: String,
+    /// `halfdiff` or `inout`.
+    pub param: String,
+    /// The grid's symmetry reduction.
+    pub symmetry: String,
+    /// Codec name.
+    pub codec: String,
+    /// Stored values (nodes × channels).
+    pub values: u64,
+    /// Compressed bytes (sum of chunk sizes).
+    pub bytes: u64,
+    /// bytes / bytes of the f32 codec on the same grid (−1 if that is unknown).
+    pub ratio_f32: f64,
+    /// Bits per stored value.
+    pub bits_per_value: f64,
+    /// Cosine-weighted relative RMSE.
+    pub rel_rmse: f64,
+    /// Max relative error.
+    pub max_rel: f64,
+    /// Max relative albedo error.
+    pub albedo_err: f64,
+    /// Relative RMSE of the preview render.
+    pub render_rel_rmse: f64,
+    /// `ok` or `skipped`.
+    pub render: String,
+    /// `ok` or what went wrong.
+    pub status: String,
+    /// Seconds spent on this row (encode, decode, metrics; the bake is shared by the codecs of
+    /// a grid and not included).
+    pub seconds: f64,
+}
+
+/// The CSV header (column names of [`Row`], in order).
+pub const CSV_HEADER: &str = "source,kind,preset,param,symmetry,codec,values,bytes,ratio_f32,bits_per_value,rel_rmse,max_rel,albedo_err,render_rel_rmse,render,status,seconds";
+
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_owned()
+    }
+}
+
+fn num(x: f64) -> String {
+    if !x.is_finite() {
+        // Never reached for measured metrics (they are made finite before); kept as a guard.
+        return "-1".into();
+    }
+    format!("{x:.6e}")
+}
+
+impl Row {
+    /// The row as a CSV line (no newline).
+    pub fn csv(&self) -> String {
+        [
+            csv_field(&self.source),
+            csv_field(&self.kind),
+            csv_field(&self.preset),
+            csv_field(&self.param),
+            csv_field(&self.symmetry),
+            csv_field(&self.codec),
+            self.values.to_string(),
+            self.bytes.to_string(),
+            num(self.ratio_f32),
+            num(self.bits_per_value),
+            num(self.rel_rmse),
+            num(self.max_rel),
+            num(self.albedo_err),
+            num(self.render_rel_rmse),
+            csv_field(&self.render),
+            csv_field(&self.status),
+            format!("{:.3}", self.seconds),
+        ]
+        .join(",")
+    }
+}
+
+/// The result of [`run`].
+#[derive(Debug, Clone)]
+pub struct Report {
+    /// One row per source × preset × parameterization × codec.
+    pub rows: Vec<Row>,
+    /// Wall-clock seconds of the whole run.
+    pub seconds: f64,
+    /// A one-line description of the configuration.
+    pub config: String,
+}
+
+impl Report {
+    /// The CSV text (header and rows).
+    pub fn csv(&self) -> String {
+        let mut s = String::from(CSV_HEADER);
+        s.push('\n');
+        for r in &self.rows {
+            s.push_str(&r.csv());
+            s.push('\n');
+        }
+        s
+    }
+
+    /// A Markdown report: configuration, run time and one table row per CSV row.
+    pub fn markdown(&self) -> String {
+        let mut s = String::from("# brdftab accuracy suite\n\n");
+        s.push_str(&format!(
+            "{}\n\nRun time: {:.1} s, {} rows. Metrics are measured on the decoded table \
+             (quantization included) against the source; `-1` = not measured (see the `render` \
+             and `status` columns). rel RMSE is cosine-weighted; albedo error is the max \
+             relative error over the incidence angles; render error is the relative RMSE of a \
+             lit-sphere preview (fixed sampling, same seed).\n\n",
+            self.config,
+            self.seconds,
+            self.rows.len()
+        ));
+        s.push_str(
+            "| source | preset | param | sym | codec | bytes | ×f32 | bits/value | rel RMSE | max rel | albedo err | render err | status |\n\
+             |---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|\n",
+        );
+        let md = |x: f64| {
+            if x == NOT_MEASURED {
+                "–".to_owned()
+            } else {
+                format!("{x:.2e}")
+            }
+        };
+        for r in &self.rows {
+            s.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {} | {:.3} | {:.2} | {} | {} | {} | {} | {} |\n",
+                r.source,
+                r.preset,
+                r.param,
+                r.symmetry,
+                r.codec,
+                r.bytes,
+                r.ratio_f32,
+                r.bits_per_value,
+                md(r.rel_rmse),
+                md(r.max_rel),
+                md(r.albedo_err),
+                if r.render == "ok" {
+                    md(r.render_rel_rmse)
+                } else {
+                    r.render.clone()
+                },
+                r.status.replace('|', "/"),
+            ));
+        }
+        s
+    }
+
+    /// Writes `accuracy.csv`, `accuracy.md` and one rate–distortion PNG per source
+    /// (`rd_<source>.png`) into `dir` (created if missing). Returns the files written.
+    pub fn write_all(&self, dir: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
+        let dir = dir.as_ref();
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        let mut out = Vec::new();
+        let csv = dir.join("accuracy.csv");
+        std::fs::write(&csv, self.csv()).map_err(|e| Error::io(&csv, e))?;
+        out.push(csv);
+        let md = dir.join("accuracy.md");
+        std::fs::write(&md, self.markdown()).map_err(|e| Error::io(&md, e))?;
+        out.push(md);
+        let mut sources: Vec<&str> = Vec::new();
+        for r in &self.rows {
+            if !sources.contains(&r.source.as_str()) {
+                sources.push(&r.source);
+            }
+        }
+        for s in sources {
+            let rows: Vec<&Row> = self.rows.iter().filter(|r| r.source == s).collect();
+            let p = dir.join(format!("rd_{}.png", file_safe(s)));
+            super::plot::rate_distortion(s, &rows, &p)?;
+            out.push(p);
+        }
+        Ok(out)
+    }
+}
+
+/// A name made safe for a file name (letters, digits, `-`, `_`, `.`).
+pub fn file_safe(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "-_.".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Progress callback: (rows done, rows total, what was just done).
+pub type Progress<'a> = &'a (dyn Fn(usize, usize, &str) + Sync);
+
+fn param_name(p: Param) -> &'static str {
+    match p {
+        Param::HalfDiff => "halfdiff",
+        Param::InOut => "inout",
+    }
+}
+
+fn preset_name(p: Preset) -> &'static str {
+    match p {
+        Preset::Small => "small",
+        Preset::Medium => "medium",
+        Preset::Large => "large",
+    }
+}
+
+/// Albedo per θ and channel by [`albedo::integrate`] with [`ALBEDO_OPTIONS`].
+fn albedos(brdf: &dyn Brdf, thetas: &[f64]) -> Vec<Vec<f64>> {
+    thetas
+        .par_iter()
+        .map(|&t| albedo::integrate(brdf, geometry::spherical(t, 0.0), &ALBEDO_OPTIONS).value)
+        .collect()
+}
+
+/// Max over θ and channels of |a − a_ref| / max(a_ref, 1e-3 · max a_ref).
+pub fn albedo_error(a: &[Vec<f64>], reference: &[Vec<f64>]) -> f64 {
+    let top = reference
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, &x| m.max(x.abs()));
+    let floor = (1e-3 * top).max(1e-12);
+    let mut worst = 0.0f64;
+    for (ra, rr) in a.iter().zip(reference) {
+        for (&x, &y) in ra.iter().zip(rr) {
+            let e = (x - y).abs() / y.abs().max(floor);
+            if e.is_finite() {
+                worst = worst.max(e);
+            }
+        }
+    }
+    worst
+}
+
+/// Encodes every chunk of `table` with `codec` (as the store writer does) and decodes it again:
+/// (compressed bytes, decoded table).
+pub fn round_trip(table: &Table, codec: &Codec) -> Result<(u64, Table)> {
+    let grid = table.grid();
+    let n = grid.layout().chunk_count();
+    let parts: Vec<(usize, Vec<f32>)> = (0..n)
+        .into_par_iter()
+        .map(|a| {
+            let bytes = codec::encode(
+                table.chunk(a),
+                crate::store::tables::chunk_layout(grid, a),
+                codec,
+            )?;
+            let back = codec::decode(&bytes, grid.layout().chunk_len(a))?;
+            Ok((bytes.len(), back))
+        })
+        .collect::<Result<_>>()?;
+    let bytes = parts.iter().map(|p| p.0 as u64).sum();
+    let mut values = Vec::with_capacity(grid.stored_values());
+    for (_, v) in parts {
+        values.extend_from_slice(&v);
+    }
+    Ok((
+        bytes,
+        Table::new(grid.clone(), values, table.description())?,
+    ))
+}
+
+fn bake_table(src: &dyn Brdf, preset: Preset, param: Param) -> Result<Table> {
+    let declared = Symmetry::from_flags(src.flags());
+    let grid = |sym: Symmetry| -> Result<Grid> { preset.grid(Some(param), sym, Channels::Rgb) };
+    match bake(src, &grid(declared)?, &BakeOptions::default()) {
+        Ok((t, _)) => Ok(t),
+        Err(Error::Symmetry { .. }) => {
+            // The source breaks what it declares (within tolerance): keep only isotropy if it
+            // holds, else no reduction.
+            let iso = Symmetry {
+                isotropic: declared.isotropic,
+                ..Symmetry::NONE
+            };
+            match bake(src, &grid(iso)?, &BakeOptions::default()) {
+                Ok((t, _)) => Ok(t),
+                Err(Error::Symmetry { .. }) => {
+                    Ok(bake(src, &grid(Symmetry::NONE)?, &BakeOptions::default())?.0)
+                }
+                Err(e) => Err(e),
+            }
+        }
+        Err(e) => Err(e),
+    }
+}
+
+fn finite_or(x: f64, alt: f64) -> f64 {
+    if x.is_finite() { x } else { alt }
+}
+
+/// Runs the suite. `progress` is called after each grid (with the rows done so far).
+pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
+    let start = Instant::now();
+    if cfg.pairs == 0 {
+        return Err(Error::arg("pairs", "must be at least 1"));
+    }
+    let total = cfg.row_count();
+    let mut rows = Vec::with_capacity(total);
+    for sd in &cfg.sources {
+        let src = sd.open()?;
+        let c = src.channels().len();
+        if c == 0 || c > MAX_CHANNELS {
+            return Err(Error::arg("source", format!("{}: {c} channels", sd.name)));
+        }
+        let measured = matches!(sd.kind, SourceKind::Rgl(_));
+        let render_opts = cfg
+            .render
+            .as_ref()
+            .filter(|_| !measured || cfg.render_measured);
+        let src_albedo = albedos(src.as_ref(), &cfg.albedo_thetas);
+        let src_image = match render_opts {
+            Some(o) => Some(render::render(src.as_ref(), o, None)?),
+            None => None,
+        };
+        for &preset in &cfg.presets {
+            for &param in &cfg.params {
+                let base = |codec: &str| Row {
+                    source: sd.name.clone(),
+                    kind: sd.kind_name().to_owned(),
+                    preset: preset_name(preset).to_owned(),
+                    param: param_name(param).to_owned(),
+                    symmetry: String::new(),
+                    codec: codec.to_owned(),
+                    values: 0,
+                    bytes: 0,
+                    ratio_f32: NOT_MEASURED,
+                    bits_per_value: NOT_MEASURED,
+                    rel_rmse: NOT_MEASURED,
+                    max_rel: NOT_MEASURED,
+                    albedo_err: NOT_MEASURED,
+                    render_rel_rmse: NOT_MEASURED,
+                    render: "skipped".to_owned(),
+                    status: "ok".to_owned(),
+                    seconds: 0.0,
+                };
+                let table = match bake_table(src.as_ref(), preset, param) {
+                    Ok(t) => t,
+                    Err(e) => {
+                        for cd in &cfg.codecs {
+                            rows.push(Row {
+                                status: format!("bake failed: {e}"),
+                                ..base(cd.name)
+                            });
+                        }
+                        continue;
+                    }
+                };
+                let sym = table.grid().symmetry().to_string();
+                let values = table.grid().stored_values() as u64;
+                let mut group: Vec<Row> = cfg
+                    .codecs
+                    .par_iter()
+                    .map(|cd| {
+                        let t0 = Instant::now();
+                        let mut row = Row {
+                            symmetry: sym.clone(),
+                            values,
+                            ..base(cd.name)
+                        };
+                        let (bytes, decoded) = match round_trip(&table, &cd.codec) {
+                            Ok(x) => x,
+                            Err(e) => {
+                                row.status = format!("encode failed: {e}");
+                                return row;
+                            }
+                        };
+                        row.bytes = bytes;
+                        row.bits_per_value = 8.0 * bytes as f64 / values.max(1) as f64;
+                        let tab = TabulatedBrdf::from_table(decoded);
+                        match accuracy::compare(&tab, src.as_ref(), cfg.pairs, cfg.seed) {
+                            Ok(a) => {
+                                row.rel_rmse = finite_or(a.rel_rmse, NOT_MEASURED);
+                                row.max_rel = finite_or(a.max_rel, NOT_MEASURED);
+                            }
+                            Err(e) => row.status = format!("accuracy failed: {e}"),
+                        }
+                        row.albedo_err =
+                            albedo_error(&albedos(&tab, &cfg.albedo_thetas), &src_albedo);
+                        if let (Some(o), Some(reference)) = (render_opts, &src_image) {
+                            match render::render(&tab, o, None)
+                                .and_then(|img| render::compare(&img, reference))
+                            {
+                                Ok(r) if r.rel_rmse.is_finite() => {
+                                    row.render_rel_rmse = r.rel_rmse;
+                                    row.render = "ok".to_owned();
+                                }
+                                Ok(_) => row.render = "undefined (black reference)".to_owned(),
+                                Err(e) => row.render = format!("failed: {e}"),
+                            }
+                        }
+                        row.seconds = t0.elapsed().as_secs_f64();
+                        row
+                    })
+                    .collect();
+                let f32_bytes = group
+                    .iter()
+                    .zip(&cfg.codecs)
+                    .find(|(r, cd)| cd.codec.quant == Quant::F32 && r.bytes > 0)
+                    .map(|(r, _)| r.bytes);
+                if let Some(fb) = f32_bytes {
+                    for r in &mut group {
+                        if r.bytes > 0 {
+                            r.ratio_f32 = r.bytes as f64 / fb as f64;
+                        }
+                    }
+                }
+                rows.extend(group);
+                if let Some(p) = progress {
+                    p(
+                        rows.len(),
+                        total,
+                        &format!("{} {} {}", sd.name, preset_name(preset), param_name(param)),
+                    );
+                }
+            }
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let config = format!(
+        "{} sources × presets [{}] × params [{}] × codecs [{}]; {} pairs; albedo at θ = [{}]°; {}",
+        cfg.sources.len(),
+        cfg.presets
+            .iter()
+            .map(|&p| preset_name(p))
+            .collect::<Vec<_>>()
+            .join(", "),
+        cfg.params
+            .iter()
+            .map(|&p| param_name(p))
+            .collect::<Vec<_>>()
+            .join(", "),
+        cfg.codecs
+            .iter()
+            .map(|c| c.name)
+            .collect::<Vec<_>>()
+            .join(", "),
+        cfg.pairs,
+        cfg.albedo_thetas
+            .iter()
+            .map(|t| format!("{:.0}", t.to_degrees()))
+            .collect::<Vec<_>>()
+            .join(", "),
+        match &cfg.render {
+            Some(o) => format!(
+                "renders {}×{} at {} spp (lit sphere, fixed sampling){}",
+                o.width,
+                o.height,
+                o.spp,
+                if cfg.render_measured {
+                    ""
+                } else {
+                    ", measured sources not rendered"
+                }
+            ),
+            None => "no renders".to_owned(),
+        }
+    );
+    Ok(Report {
+        rows,
+        seconds,
+        config,
+    })
+}

@@ -1,0 +1,216 @@
+//! The accuracy suite: a tiny configuration end to end (library and CLI).
+
+use std::process::Command;
+
+use brdftab::render::{LightChoice, Mode, RenderOptions, Sampling};
+use brdftab::report::suite::{
+    self, CSV_HEADER, CodecDef, NOT_MEASURED, SourceDef, SuiteConfig, default_codecs,
+};
+use brdftab::table::Param;
+use brdftab::table::presets::Preset;
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("brdftab-accuracy-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn codecs(names: &[&str]) -> Vec<CodecDef> {
+    default_codecs()
+        .into_iter()
+        .filter(|c| names.contains(&c.name))
+        .collect()
+}
+
+fn tiny() -> SuiteConfig {
+    SuiteConfig {
+        sources: vec![
+            SourceDef::model("lambert", r#"{"model": "lambert", "kd": [0.2, 0.15, 0.1]}"#).unwrap(),
+            SourceDef::model(
+                "rphong",
+                r#"{"model": "reciprocal_phong", "ks": 1, "n": 10}"#,
+            )
+            .unwrap(),
+        ],
+        presets: vec![Preset::Small],
+        params: vec![Param::HalfDiff],
+        codecs: codecs(&["f32", "log16@1e-2"]),
+        pairs: 2000,
+        albedo_thetas: vec![0.5],
+        render: Some(RenderOptions {
+            width: 8,
+            height: 8,
+            spp: 1,
+            max_depth: 1,
+            mode: Mode::Lit,
+            sampling: Sampling::Fixed,
+            light: LightChoice::Area,
+            ..RenderOptions::default()
+        }),
+        render_measured: false,
+        seed: 3,
+    }
+}
+
+/// Parses the CSV into (header, rows of fields); no field of these names contains a comma.
+fn parse_csv(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(str::to_owned).collect())
+        .collect();
+    (header, rows)
+}
+
+const METRICS: [&str; 8] = [
+    "values",
+    "bytes",
+    "ratio_f32",
+    "bits_per_value",
+    "rel_rmse",
+    "max_rel",
+    "albedo_err",
+    "render_rel_rmse",
+];
+
+#[test]
+fn tiny_suite_has_header_expected_rows_and_finite_metrics() {
+    let cfg = tiny();
+    let report = suite::run(&cfg, None).unwrap();
+    assert_eq!(report.rows.len(), 4);
+    let (header, rows) = parse_csv(&report.csv());
+    assert_eq!(header.join(","), CSV_HEADER);
+    assert_eq!(rows.len(), 4);
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let keys: Vec<(String, String)> = rows
+        .iter()
+        .map(|r| (r[col("source")].clone(), r[col("codec")].clone()))
+        .collect();
+    assert_eq!(
+        keys,
+        [
+            ("lambert", "f32"),
+            ("lambert", "log16@1e-2"),
+            ("rphong", "f32"),
+            ("rphong", "log16@1e-2"),
+        ]
+        .map(|(a, b)| (a.to_owned(), b.to_owned()))
+    );
+    for r in &rows {
+        assert_eq!(r.len(), header.len());
+        assert_eq!(r[col("status")], "ok");
+        assert_eq!(r[col("render")], "ok");
+        assert_eq!(r[col("param")], "halfdiff");
+        for m in METRICS {
+            let x: f64 = r[col(m)].parse().unwrap();
+            assert!(x.is_finite() && x >= 0.0, "{m} = {x}");
+        }
+    }
+    // f32 is the reference of the ratio; log16 at 1e-2 stores fewer bytes than f32 here.
+    let ratio = |i: usize| rows[i][col("ratio_f32")].parse::<f64>().unwrap();
+    assert_eq!(ratio(0), 1.0);
+    assert!(ratio(3) < 1.0);
+}
+
+#[test]
+fn lambert_table_has_no_error() {
+    let mut cfg = tiny();
+    cfg.sources.truncate(1);
+    cfg.codecs = codecs(&["f32", "log16@1e-3"]);
+    let report = suite::run(&cfg, None).unwrap();
+    let f32 = &report.rows[0];
+    assert!(f32.rel_rmse < 1e-6, "{f32:?}");
+    assert!(f32.max_rel < 1e-6, "{f32:?}");
+    assert!(f32.albedo_err < 1e-6, "{f32:?}");
+    assert!(f32.render_rel_rmse < 1e-5, "{f32:?}");
+    // log16 keeps its bound: every error within the tolerance.
+    let l = &report.rows[1];
+    assert!(l.max_rel <= 1.01e-3, "{l:?}");
+    assert!(l.rel_rmse <= 1.01e-3 && l.albedo_err <= 1.01e-3, "{l:?}");
+}
+
+#[test]
+fn unmeasured_render_is_minus_one_and_said_so() {
+    let mut cfg = tiny();
+    cfg.sources.truncate(1);
+    cfg.codecs.truncate(1);
+    cfg.render = None;
+    let report = suite::run(&cfg, None).unwrap();
+    let r = &report.rows[0];
+    assert_eq!(r.render, "skipped");
+    assert_eq!(r.render_rel_rmse, NOT_MEASURED);
+    assert!(
+        report
+            .csv()
+            .lines()
+            .nth(1)
+            .unwrap()
+            .contains(",skipped,ok,")
+    );
+}
+
+#[test]
+fn write_all_writes_csv_markdown_and_valid_pngs() {
+    let report = suite::run(&tiny(), None).unwrap();
+    let dir = tmp("lib");
+    let files = report.write_all(&dir).unwrap();
+    assert_eq!(files.len(), 4, "{files:?}");
+    let md = std::fs::read_to_string(dir.join("accuracy.md")).unwrap();
+    assert!(md.contains("| lambert | small | halfdiff |") && md.contains("Run time:"));
+    for name in ["rd_lambert.png", "rd_rphong.png"] {
+        let f = std::fs::File::open(dir.join(name)).unwrap();
+        let mut reader = png::Decoder::new(std::io::BufReader::new(f))
+            .read_info()
+            .unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!((info.width, info.height), (1400, 560));
+        // Not blank: the figure has dark pixels (text, axes) and white background.
+        assert!(buf.iter().any(|&b| b < 64) && buf.contains(&255));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn cli_writes_the_files() {
+    let dir = tmp("cli");
+    let out = Command::new(env!("CARGO_BIN_EXE_brdftab"))
+        .args([
+            "accuracy",
+            "--quick",
+            "--only",
+            "lambert",
+            "--params",
+            "inout",
+            "--pairs",
+            "1000",
+            "--no-render",
+            "--out",
+        ])
+        .arg(&dir)
+        .env_remove("BRDFTAB_RGL_DIR")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("accuracy.csv")).unwrap();
+    let (header, rows) = parse_csv(&csv);
+    assert_eq!(header.join(","), CSV_HEADER);
+    assert_eq!(rows.len(), 4); // lambert × small × inout × 4 codecs
+    assert!(dir.join("accuracy.md").is_file() && dir.join("rd_lambert.png").is_file());
+    let bad = Command::new(env!("CARGO_BIN_EXE_brdftab"))
+        .args(["accuracy", "--presets", "huge", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(1));
+    let _ = std::fs::remove_dir_all(&dir);
+}

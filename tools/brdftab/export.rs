@@ -1,0 +1,61 @@
+//! `brdftab export`: a stored table as NumPy `.npy` or a 2D slice as OpenEXR.
+
+use brdftab::store::{Store, db, export, tables};
+use brdftab::{Error, Result};
+use clap::Args;
+
+/// Arguments of `brdftab export`.
+#[derive(Args)]
+pub struct ExportArgs {
+    /// The table: a brdftab file, or `DB#NAME`.
+    file: String,
+    /// Write the dense table as .npy (shape = stored grid dims + channels, float32).
+    #[arg(long)]
+    npy: Option<String>,
+    /// Write a 2D slice as OpenEXR (channels as EXR channels).
+    #[arg(long, requires = "slice")]
+    exr: Option<String>,
+    /// The slice: `X,Y[:i0,i1,i2,i3]` — stored axes along x and y, fixed indices of the others.
+    #[arg(long)]
+    slice: Option<String>,
+    /// Write EXR channels as half floats instead of f32.
+    #[arg(long)]
+    half: bool,
+}
+
+/// `brdftab export`.
+pub fn run(a: ExportArgs) -> Result<()> {
+    if a.npy.is_none() && a.exr.is_none() {
+        return Err(Error::arg(
+            "--npy/--exr",
+            "give --npy OUT and/or --exr OUT --slice ...",
+        ));
+    }
+    let (path, name) = db::split_source(&a.file);
+    let s = Store::open(path)?;
+    let t = match name {
+        Some(n) => s.table(n)?,
+        None => s.single()?,
+    };
+    // Tables with a grid use its layout (packed reciprocal tables expand, unstored nodes NaN).
+    let grid = if t.header().grid.is_null() {
+        None
+    } else {
+        Some(t.grid()?)
+    };
+    let off = grid.as_ref().map(tables::node_offset);
+    let off_ref: export::NodeOffset<'_> = off
+        .as_ref()
+        .map(|f| f as &(dyn Fn(&[usize]) -> Option<usize> + Sync));
+    if let Some(out) = &a.npy {
+        export::npy(&t, out, off_ref)?;
+        eprintln!("wrote {out} (shape {:?}, float32)", t.header().shape);
+    }
+    if let Some(out) = &a.exr {
+        let axes = t.header().shape.len().saturating_sub(1);
+        let sl = export::Slice::parse(a.slice.as_deref().unwrap_or(""), axes)?;
+        export::exr(&t, &sl, off_ref, out, a.half)?;
+        eprintln!("wrote {out}");
+    }
+    Ok(())
+}
