@@ -47,8 +47,9 @@ enum Command {
     Slice(measured::SliceArgs),
     /// Convert between formats (MERL .binary, RGL .bsdf read only, tables).
     Convert(measured::ConvertArgs),
-    /// Table databases: `db add DB FILE` (measured files with provenance).
-    Db(measured::DbArgs),
+    /// Add measured files to a table database with provenance (`measured-db add DB FILE`).
+    /// (Renamed from a second `db` variant that clashed with the storage `db` in the merge.)
+    MeasuredDb(measured::DbArgs),
     /// Directional albedo a(θ′) per channel: one line `theta a_1 a_2 ...` per angle.
     Albedo(analysis::AlbedoArgs),
     /// Physical plausibility: positivity, reciprocity, energy conservation.
@@ -81,7 +82,7 @@ fn main() -> ExitCode {
         Command::Render(a) => render::run(a),
         Command::Slice(a) => measured::slice(a),
         Command::Convert(a) => measured::convert(a),
-        Command::Db(a) => measured::db(a),
+        Command::MeasuredDb(a) => measured::db(a),
         Command::Albedo(a) => analysis::albedo(a),
         Command::Check(a) => analysis::check(a),
         Command::Demo(a) => demo::demo(a),
