@@ -218,7 +218,7 @@ fn check_text_and_models_and_demo_run() {
     let o = run(&["models", "--json"], "");
     let v: serde_json::Value = serde_json::from_str(&o.stdout).unwrap();
     assert!(v.as_array().unwrap().len() >= 10);
-    let o = run(&["demo"], "");
+    let o = run(&["demo", "--plausibility"], "");
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(o.stdout.contains("lambert kd=0.3"), "{}", o.stdout);
     assert!(
@@ -226,4 +226,16 @@ fn check_text_and_models_and_demo_run() {
             .lines()
             .any(|l| l.starts_with("lambert kd=0.5") && l.contains("NO"))
     );
+}
+
+#[test]
+fn demo_bakes_into_a_database_and_prints_where() {
+    let dir = std::env::temp_dir().join(format!("brdftab-demo-test-{}", std::process::id()));
+    let out = dir.to_str().unwrap();
+    let o = run(&["demo", "--quick", "--preset", "small", "--out", out], "");
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(o.stdout.contains("cook_torrance_gold"), "{}", o.stdout);
+    assert!(o.stdout.contains("demo.btdb"), "{}", o.stdout);
+    assert!(dir.join("demo.btdb").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -7,6 +7,11 @@
 //!   and channels;
 //! - max relative error: max |f̂ − f| / max(|f|, 1% of the RMS of f) — the floor keeps pairs
 //!   where f is (nearly) 0 from dominating.
+//!
+//! [`compare_cap`] draws both directions uniformly within θ ≤ θmax instead. Measured data stored as
+//! f_r·cos θo (RGL) turn into f_r ∝ 1/cos θo near the horizon, where a few grazing pairs then
+//! dominate the whole-hemisphere figure; Ngan et al. (2005) drop data beyond 80° for that reason,
+//! and the conversion report quotes both.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -50,6 +55,29 @@ pub fn compare(
     pairs: usize,
     seed: u64,
 ) -> Result<Accuracy> {
+    compare_cap(approx, reference, pairs, seed, std::f64::consts::FRAC_PI_2)
+}
+
+/// Like [`compare`], with both directions drawn uniformly over the cap θ ≤ `max_theta`.
+pub fn compare_cap(
+    approx: &dyn Brdf,
+    reference: &dyn Brdf,
+    pairs: usize,
+    seed: u64,
+    max_theta: f64,
+) -> Result<Accuracy> {
+    if !(max_theta > 0.0 && max_theta <= std::f64::consts::FRAC_PI_2) {
+        return Err(Error::arg(
+            "max_theta",
+            format!("{max_theta} is not in (0, π/2]"),
+        ));
+    }
+    // Uniform on the cap: z uniform in [cos θmax, 1].
+    let span = 1.0 - max_theta.cos();
+    // (For θmax = π/2, span rounds to exactly 1 and z = u.x, the same pairs as before.)
+    let cap = |u: glam::DVec2| {
+        geometry::uniform_hemisphere(glam::DVec2::new((1.0 - span) + span * u.x, u.y))
+    };
     let c = reference.channels().len();
     if approx.channels().len() != c || c > MAX_CHANNELS {
         return Err(Error::arg(
@@ -72,8 +100,8 @@ pub fn compare(
             let mut fa = [0.0f32; MAX_CHANNELS];
             let mut fr = [0.0f32; MAX_CHANNELS];
             for _ in 0..n {
-                let wi = geometry::uniform_hemisphere(rng.next_dvec2());
-                let wo = geometry::uniform_hemisphere(rng.next_dvec2());
+                let wi = cap(rng.next_dvec2());
+                let wo = cap(rng.next_dvec2());
                 approx.eval(wi, wo, &mut fa[..c]);
                 reference.eval(wi, wo, &mut fr[..c]);
                 for k in 0..c {

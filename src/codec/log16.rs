@@ -13,8 +13,7 @@
 //! innermost axis, or the planar `left + up − up-left`, optionally plus the previous channel's
 //! prediction error — the same family as [`Filter`]) is computed from the *reconstructed*
 //! neighbours `R`, and the residual is quantized: `q = round((L − P) / step)`, `R = P + q·step`,
-//! stored as a zigzagged 16-bit code. Decoding repeats the prediction and gives
-//! `v̂ = max(0, exp(R) − floor)`. Because the quantizer sits inside the prediction loop (DPCM, as
+//! stored as a zigzagged 16-bit code. Decoding repeats the prediction and gives `v̂ = g⁻¹(R)`. Because the quantizer sits inside the prediction loop (DPCM, as
 //! in the SZ compressors), smooth data leaves residual codes that are mostly 0 — far fewer bits
 //! than quantizing first and predicting the noisy codes afterwards — and there is no limit on the
 //! dynamic range of a chunk: only the *residual* must fit 16 bits.
@@ -25,9 +24,10 @@
 //! `step = 2·ln(1 + tol)·0.98` that is at most `0.98·tol·(v + floor)`, inside the bound
 //! `tol·max(v, floor)` except for values within a factor ~50 of the floor. The encoder therefore
 //! decodes every value exactly as the decoder will and checks the bound; a value that misses it
-//! — or is negative, or whose residual does not fit 16 bits — is stored exactly in an escape list
-//! (the decoder then continues the prediction from its exact `L`). So **every** decoded value
-//! satisfies `|v̂ − v| ≤ tol·max(|v|, floor)`, and negatives come back exactly.
+//! — or would decode with the other sign, or whose residual does not fit 16 bits — is stored
+//! exactly in an escape list (the decoder then continues the prediction from its exact `L`). So
+//! **every** decoded value satisfies `|v̂ − v| ≤ tol·max(|v|, floor)` and has the sign of `v`
+//! (a non-negative table never decodes to a negative value, which a BRDF must not return).
 //!
 //! The floor is `1e-7 ×` the chunk's largest magnitude unless given explicitly (absolute), and is
 //! stored in the chunk header: below it the error bound is absolute (`tol·floor`).
@@ -220,7 +220,9 @@ pub fn encode(
             let rec = p + q * params.step;
             let back = from_log(rec, floor) as f64;
             let a = v as f64;
-            if (back - a).abs() <= tol * a.abs().max(floor) {
+            // Sign-preserving: a non-negative value (a BRDF) must never decode negative.
+            let same_sign = if a >= 0.0 { back >= 0.0 } else { back <= 0.0 };
+            if same_sign && (back - a).abs() <= tol * a.abs().max(floor) {
                 codes[i] = c;
                 return rec;
             }

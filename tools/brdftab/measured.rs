@@ -349,6 +349,17 @@ fn tabulate_into(input: &str, output: &str, channels: &Channels, o: &TabulateArg
             "  accuracy vs native ({:?}, {} pairs): cosine-weighted relative RMSE {:.3e}, max relative {:.3e}",
             interp, acc.pairs, acc.rel_rmse, acc.max_rel
         );
+        let cap = brdftab::analysis::accuracy::compare_cap(
+            &tab,
+            src.as_ref(),
+            o.pairs,
+            1,
+            80f64.to_radians(),
+        )?;
+        println!(
+            "  within 80° of the normal (Ngan et al.'s cut; grazing f_r of measured data ∝ 1/cos θo): relative RMSE {:.3e}, max relative {:.3e}",
+            cap.rel_rmse, cap.max_rel
+        );
     }
     Ok(())
 }
