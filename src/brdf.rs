@@ -159,62 +159,41 @@ pub trait Brdf: Send + Sync {
     }
 }
 
-impl<B: Brdf + ?Sized> Brdf for Box<B> {
-    fn channels(&self) -> &Channels {
-        (**self).channels()
-    }
-    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
-        (**self).eval(wi, wo, out)
-    }
-    fn flags(&self) -> Flags {
-        (**self).flags()
-    }
-    fn describe(&self) -> String {
-        (**self).describe()
-    }
-    fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
-        (**self).eval_wavelength(wi, wo, nm)
-    }
-    fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
-        (**self).eval_batch(wi, wo, out)
-    }
-    fn albedo(&self, wi: DVec3, out: &mut [f64]) {
-        (**self).albedo(wi, out)
-    }
-    fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        (**self).sample(wo, u, weight)
-    }
-    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        (**self).pdf(wi, wo)
-    }
+/// Smart pointers to a `Brdf` are `Brdf`s: every method forwards to the pointee (so overrides such
+/// as a table's `eval_batch` or a model's closed-form `albedo` are kept).
+macro_rules! forward_brdf {
+    ($($ptr:ident)::+) => {
+        impl<B: Brdf + ?Sized> Brdf for $($ptr)::+<B> {
+            fn channels(&self) -> &Channels {
+                (**self).channels()
+            }
+            fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+                (**self).eval(wi, wo, out)
+            }
+            fn flags(&self) -> Flags {
+                (**self).flags()
+            }
+            fn describe(&self) -> String {
+                (**self).describe()
+            }
+            fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+                (**self).eval_wavelength(wi, wo, nm)
+            }
+            fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
+                (**self).eval_batch(wi, wo, out)
+            }
+            fn albedo(&self, wi: DVec3, out: &mut [f64]) {
+                (**self).albedo(wi, out)
+            }
+            fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+                (**self).sample(wo, u, weight)
+            }
+            fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+                (**self).pdf(wi, wo)
+            }
+        }
+    };
 }
 
-impl<B: Brdf + ?Sized> Brdf for std::sync::Arc<B> {
-    fn channels(&self) -> &Channels {
-        (**self).channels()
-    }
-    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
-        (**self).eval(wi, wo, out)
-    }
-    fn flags(&self) -> Flags {
-        (**self).flags()
-    }
-    fn describe(&self) -> String {
-        (**self).describe()
-    }
-    fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
-        (**self).eval_wavelength(wi, wo, nm)
-    }
-    fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
-        (**self).eval_batch(wi, wo, out)
-    }
-    fn albedo(&self, wi: DVec3, out: &mut [f64]) {
-        (**self).albedo(wi, out)
-    }
-    fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        (**self).sample(wo, u, weight)
-    }
-    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        (**self).pdf(wi, wo)
-    }
-}
+forward_brdf!(Box);
+forward_brdf!(std::sync::Arc);
