@@ -18,7 +18,8 @@ pub struct AccuracyArgs {
     /// The quick suite: 6 sources, small preset, fewer pairs, tiny renders (< 1 min).
     #[arg(long)]
     quick: bool,
-    /// Directory of RGL `.bsdf` files (default: $BRDFTAB_RGL_DIR; none → models only).
+    /// Directory of RGL `.bsdf` files (default: $BRDFTAB_RGL_DIR, else
+    /// ../shared/data/measured/rgl if present; none → models only).
     #[arg(long)]
     rgl: Option<PathBuf>,
     /// Grid presets, comma separated (default: small for --quick, else small,medium,large).
@@ -44,10 +45,7 @@ fn list(s: &str) -> impl Iterator<Item = &str> {
 
 /// Runs the suite and writes its files.
 pub fn accuracy(a: AccuracyArgs) -> Result<()> {
-    let rgl = a
-        .rgl
-        .clone()
-        .or_else(|| std::env::var_os("BRDFTAB_RGL_DIR").map(PathBuf::from));
+    let rgl = crate::source::rgl_dir(a.rgl.as_deref());
     if let Some(d) = &rgl {
         if !d.is_dir() {
             return Err(Error::NotFound(format!(
@@ -56,7 +54,9 @@ pub fn accuracy(a: AccuracyArgs) -> Result<()> {
             )));
         }
     } else {
-        eprintln!("note: no --rgl DIR (or $BRDFTAB_RGL_DIR): analytic models only");
+        eprintln!(
+            "note: no RGL directory (--rgl DIR, $BRDFTAB_RGL_DIR or ../shared/data/measured/rgl): analytic models only"
+        );
     }
     let mut cfg = if a.quick {
         SuiteConfig::quick(rgl.as_deref())?

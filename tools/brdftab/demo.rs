@@ -38,7 +38,7 @@ pub struct DemoArgs {
     /// small for anisotropic models).
     #[arg(long)]
     preset: Option<String>,
-    /// Directory of RGL-EPFL `.bsdf` files (default: $BRDFTAB_RGL, else
+    /// Directory of RGL-EPFL `.bsdf` files (default: $BRDFTAB_RGL_DIR, else
     /// ../shared/data/measured/rgl next to the working directory or the crate).
     #[arg(long)]
     rgl: Option<PathBuf>,
@@ -168,7 +168,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         let b = s.build(&Channels::Rgb)?;
         sources.push((name.to_string(), b, Source::model(&s)));
     }
-    let rgl_dir = rgl_dir(a.rgl.as_deref());
+    let rgl_dir = crate::source::rgl_dir(a.rgl.as_deref());
     let mut rgl_files = Vec::new();
     match &rgl_dir {
         Some(d) => {
@@ -181,7 +181,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             rgl_files.sort();
         }
         None => eprintln!(
-            "note: no RGL directory found (--rgl DIR or $BRDFTAB_RGL); baking the models only"
+            "note: no RGL directory found (--rgl DIR or $BRDFTAB_RGL_DIR); baking the models only"
         ),
     }
     for p in &rgl_files {
@@ -322,24 +322,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     emit(&text)
 }
 
-/// The RGL directory: the argument, $BRDFTAB_RGL, or ../shared/data/measured/rgl next to the
-/// working directory or the crate.
-fn rgl_dir(arg: Option<&Path>) -> Option<PathBuf> {
-    if let Some(p) = arg {
-        return Some(p.to_path_buf());
-    }
-    if let Some(p) = std::env::var_os("BRDFTAB_RGL") {
-        return Some(PathBuf::from(p));
-    }
-    let rel = Path::new("../shared/data/measured/rgl");
-    [
-        PathBuf::from(rel),
-        Path::new(env!("CARGO_MANIFEST_DIR")).join(rel),
-    ]
-    .into_iter()
-    .find(|p| p.is_dir())
-}
-
+/// A progress bar over `total` values on a terminal; `None` (quiet) otherwise.
 fn progress_bar(total: u64) -> Option<indicatif::ProgressBar> {
     if !std::io::stderr().is_terminal() {
         return None;
