@@ -94,5 +94,9 @@ fn parse_degrees(s: &str) -> Result<Vec<f64>> {
 /// `x` rounded to 7 significant digits, printed in its shortest form.
 pub fn sig7(x: f64) -> String {
     let rounded: f64 = format!("{x:.6e}").parse().unwrap_or(x);
-    format!("{rounded}")
+    if rounded != 0.0 && rounded.abs() < 1e-4 {
+        format!("{rounded:e}")
+    } else {
+        format!("{rounded}")
+    }
 }
