@@ -7,7 +7,12 @@ use brdftab::table::{BakeOptions, Grid, Mapping, Param, TabulatedBrdf, bake, sym
 use brdftab::{Brdf, Channels, ModelSpec, geometry, rng::Pcg32};
 
 fn main() -> brdftab::Result<()> {
-    let spec = std::env::args().nth(1).unwrap();
+    let Some(spec) = std::env::args().nth(1) else {
+        return Err(brdftab::Error::arg(
+            "SPEC",
+            "usage: table_diag SPEC [u|c] [n_theta_d]",
+        ));
+    };
     let mode = std::env::args().nth(2).unwrap_or("u".into());
     let ntd: usize = std::env::args()
         .nth(3)
@@ -38,7 +43,9 @@ fn main() -> brdftab::Result<()> {
         let wo = geometry::uniform_hemisphere(rng.next_dvec2());
         tb.eval(wi, wo, &mut a);
         model.eval(wi, wo, &mut b);
-        let hd = geometry::to_half_diff(wi, wo).unwrap();
+        let Some(hd) = geometry::to_half_diff(wi, wo) else {
+            continue;
+        };
         let i = ((hd.theta_h / std::f64::consts::FRAC_PI_2 * nb as f64) as usize).min(nb - 1);
         let o = ((hd.theta_d / std::f64::consts::FRAC_PI_2 * nb as f64) as usize).min(nb - 1);
         for k in 0..3 {
@@ -58,12 +65,9 @@ fn main() -> brdftab::Result<()> {
     }
     let mut r: Vec<f64> = (0..7)
         .map(|s| {
-            accuracy::compare(&tb, model.as_ref(), 100_000, 12345 + s)
-                .unwrap()
-                .rel_rmse
-                * 100.0
+            accuracy::compare(&tb, model.as_ref(), 100_000, 12345 + s).map(|a| a.rel_rmse * 100.0)
         })
-        .collect();
+        .collect::<brdftab::Result<_>>()?;
     r.sort_by(f64::total_cmp);
     println!(
         "rel rmse {:.4}% (200k, seed 1); 7 seeds x 1e5: {:?}",
