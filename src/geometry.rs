@@ -6,7 +6,7 @@
 //! (e.g. the half/diff rotation uses cos θh = h_z and sin θh = |h_xy|, not `acos` and `sin`).
 
 use glam::{DVec2, DVec3};
-use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+use std::f64::consts::FRAC_PI_4;
 
 /// Normalizes `v`, or returns `None` for zero, infinite or NaN vectors.
 #[inline]
@@ -16,6 +16,19 @@ pub fn normalize(v: DVec3) -> Option<DVec3> {
         Some(v / l2.sqrt())
     } else {
         None
+    }
+}
+
+/// Like [`normalize`], but returns `v` unchanged when it is already unit to within 2⁻⁴⁰ in
+/// squared length (the usual case: renderers pass unit directions), saving the square root and
+/// division that would otherwise head the dependency chain of every sampler.
+#[inline]
+pub fn unit(v: DVec3) -> Option<DVec3> {
+    let l2 = v.length_squared();
+    if (l2 - 1.0).abs() <= 1.0 / (1u64 << 40) as f64 {
+        Some(v)
+    } else {
+        normalize(v)
     }
 }
 
@@ -168,13 +181,15 @@ pub fn concentric_disk(u: DVec2) -> DVec2 {
     if a.x == 0.0 && a.y == 0.0 {
         return DVec2::ZERO;
     }
-    let (r, theta) = if a.x.abs() > a.y.abs() {
-        (a.x, FRAC_PI_4 * (a.y / a.x))
-    } else {
-        (a.y, FRAC_PI_2 - FRAC_PI_4 * (a.x / a.y))
-    };
-    let (s, c) = theta.sin_cos();
-    DVec2::new(r * c, r * s)
+    // θ = π/4 · t with |t| ≤ 1 in the first case, π/2 − π/4 · t in the second (where sine and
+    // cosine swap), so one bounded-range polynomial serves both. Written with selects rather
+    // than two branches: which case applies is a coin flip, and mispredictions cost more than
+    // the arithmetic.
+    let swap = a.x.abs() <= a.y.abs();
+    let (num, r) = if swap { (a.x, a.y) } else { (a.y, a.x) };
+    let (s, c) = crate::fastmath::sin_cos_quarter(FRAC_PI_4 * (num / r));
+    let (x, y) = if swap { (s, c) } else { (c, s) };
+    DVec2::new(r * x, r * y)
 }
 
 /// Cosine-weighted direction on the upper hemisphere (density cos θ / π).
@@ -190,7 +205,7 @@ pub fn cosine_hemisphere(u: DVec2) -> DVec3 {
 pub fn uniform_hemisphere(u: DVec2) -> DVec3 {
     let z = u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    let (s, c) = crate::fastmath::sin_cos_2pi(u.y);
     DVec3::new(r * c, r * s, z)
 }
 
@@ -199,7 +214,7 @@ pub fn uniform_hemisphere(u: DVec2) -> DVec3 {
 pub fn uniform_sphere(u: DVec2) -> DVec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    let (s, c) = crate::fastmath::sin_cos_2pi(u.y);
     DVec3::new(r * c, r * s, z)
 }
 
@@ -207,6 +222,7 @@ pub fn uniform_sphere(u: DVec2) -> DVec3 {
 mod tests {
     use super::*;
     use crate::rng::Pcg32;
+    use std::f64::consts::PI;
 
     #[test]
     fn half_diff_round_trip() {
@@ -256,6 +272,19 @@ mod tests {
             let v = uniform_sphere(rng.next_dvec2());
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-12);
         }
+    }
+
+    #[test]
+    fn unit_keeps_unit_vectors_and_normalizes_the_rest() {
+        let v = spherical(0.7, 2.0);
+        assert_eq!(unit(v), Some(v));
+        let w = unit(3.0 * v).unwrap();
+        assert!((w.length() - 1.0).abs() < 1e-15 && (w - v).length() < 1e-15);
+        let near = v * (1.0 + 1e-9);
+        assert!((unit(near).unwrap().length() - 1.0).abs() < 1e-15);
+        assert!(unit(DVec3::ZERO).is_none());
+        assert!(unit(DVec3::new(f64::NAN, 0.0, 1.0)).is_none());
+        assert!(unit(DVec3::new(f64::INFINITY, 0.0, 1.0)).is_none());
     }
 
     #[test]

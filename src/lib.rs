@@ -28,6 +28,7 @@ pub mod analysis;
 pub mod brdf;
 pub mod codec;
 pub mod error;
+pub mod fastmath;
 pub mod fit;
 pub mod fresnel;
 pub mod geometry;

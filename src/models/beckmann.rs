@@ -61,12 +61,23 @@ impl Beckmann {
     /// A facet normal drawn with density D(H) cos α (per solid angle of H) from `u` in [0,1)².
     #[inline]
     pub fn sample_h(&self, u: DVec2) -> DVec3 {
-        let tan2 = -self.m * self.m * (1.0 - u.x).ln();
-        let cos2 = 1.0 / (1.0 + tan2);
-        let cos_a = cos2.sqrt();
-        let sin_a = (1.0 - cos2).max(0.0).sqrt();
-        let (s, c) = (2.0 * PI * u.y).sin_cos();
-        DVec3::new(sin_a * c, sin_a * s, cos_a)
+        self.sample_h_d(u).0
+    }
+
+    /// [`Beckmann::sample_h`] together with D(H) at the drawn normal, for free: the inversion
+    /// sets exp(−tan² α / m²) = 1 − u₁, so D = (1 − u₁) / (π m² cos⁴ α) needs no `exp`.
+    #[inline]
+    pub fn sample_h_d(&self, u: DVec2) -> (DVec3, f64) {
+        let one_minus = 1.0 - u.x;
+        let tan2 = (-self.m * self.m * one_minus.ln()).max(0.0);
+        // 1/cos² α = 1 + tan² α; cos α = 1/√(1 + tan²), sin α = tan α · cos α (two independent
+        // roots, one division).
+        let inv_c2 = 1.0 + tan2;
+        let cos_a = 1.0 / inv_c2.sqrt();
+        let sin_a = tan2.sqrt() * cos_a;
+        let (s, c) = crate::fastmath::sin_cos_2pi(u.y);
+        let d = one_minus * self.inv_pi_m2 * (inv_c2 * inv_c2);
+        (DVec3::new(sin_a * c, sin_a * s, cos_a), d)
     }
 
     /// The density of [`Beckmann::sample_h`]: D(H) cos α.

@@ -48,6 +48,8 @@ pub struct CookTorrance {
 struct Geometry {
     dg: f64,
     l_dot_h: f64,
+    /// The half-vector strategy's density D cos α / (4 V·H).
+    d_cos_over_4vh: f64,
 }
 
 impl CookTorrance {
@@ -125,9 +127,12 @@ impl CookTorrance {
         }
         let d = (-x).exp() * self.d.inv_pi_m2() * inv_c2 * inv_c2;
         let g = (4.0 * h.z / hh * l.z.min(v.z)).min(1.0);
+        let len = hh.sqrt();
         Some(Geometry {
             dg: d * g / (4.0 * l.z * v.z),
-            l_dot_h: 0.5 * hh.sqrt(),
+            l_dot_h: 0.5 * len,
+            // D cos α / (4 V·H) with cos α = h_z/|h| and V·H = |h|/2.
+            d_cos_over_4vh: 0.5 * d * h.z / hh,
         })
     }
 }
@@ -169,36 +174,67 @@ impl Brdf for CookTorrance {
 
     /// Half-vector sampling of D(H) cos θh (L = 2(V·H)H − V, density D cos θh / (4 |V·H|)),
     /// mixed with cosine sampling with probability [`CookTorrance::cosine_prob`].
+    ///
+    /// The half-vector branch is fused: D comes with the sampled normal
+    /// ([`Beckmann::sample_h_d`]), so f, the mixture pdf and the weight cost no `exp` and no
+    /// renormalization; the cosine branch evaluates the model as `eval` and `pdf` do.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        let v = geometry::normalize(wo)?;
+        let v = geometry::unit(wo)?;
         if v.z <= 0.0 {
             return None;
         }
         let p = self.cos_prob;
-        let l = if u.x >= p {
+        let c = self.ks.len();
+        if u.x >= p {
             let u0 = ((u.x - p) / (1.0 - p)).min(1.0 - f64::EPSILON);
-            let h = self.d.sample_h(DVec2::new(u0, u.y));
+            let (h, d) = self.d.sample_h_d(DVec2::new(u0, u.y));
             let v_dot_h = v.dot(h);
             if v_dot_h.is_nan() || v_dot_h <= 0.0 {
                 return None;
             }
-            2.0 * v_dot_h * h - v
-        } else {
-            geometry::cosine_hemisphere(DVec2::new(u.x / p, u.y))
-        };
+            let l = 2.0 * v_dot_h * h - v;
+            if l.z.is_nan() || l.z <= 0.0 {
+                return None;
+            }
+            // One reciprocal of V·H serves the pdf's Jacobian and the V-cavity G.
+            let inv_vh = 1.0 / v_dot_h;
+            let pdf = (1.0 - p) * 0.25 * d * h.z * inv_vh + p * l.z * FRAC_1_PI;
+            if !(pdf > 0.0 && pdf.is_finite()) {
+                return None;
+            }
+            let g = (2.0 * h.z * inv_vh * v.z.min(l.z)).min(1.0);
+            // f cos θl / pdf = ks F · D G / (4 (N·V)(N·L)) · (N·L) / pdf.
+            let s = d * g / (4.0 * v.z * pdf);
+            self.fresnel
+                .eval_scaled(v_dot_h, &self.ks, s, &mut weight[..c]);
+            return Some(BrdfSample {
+                wi: l,
+                pdf,
+                delta: false,
+            });
+        }
+        let l = geometry::cosine_hemisphere(DVec2::new(u.x / p, u.y));
         if l.z.is_nan() || l.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(l, v);
+        // Cosine branch: one pass of `geometry` gives f's D·G and, since D cos α / (4 V·H) =
+        // D·(h_z/|h|)/(2|h|) with the unnormalized h = l + v, the half-vector density too.
+        let Some(gm) = self.geometry(l, v) else {
+            // D underflows: only the cosine density remains, and f = 0.
+            weight[..c].fill(0.0);
+            let pdf = p * l.z * FRAC_1_PI;
+            return (pdf > 0.0).then_some(BrdfSample {
+                wi: l,
+                pdf,
+                delta: false,
+            });
+        };
+        let pdf = (1.0 - p) * gm.d_cos_over_4vh + p * l.z * FRAC_1_PI;
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
-        let c = self.ks.len();
-        self.eval(l, v, &mut weight[..c]);
-        let s = l.z / pdf;
-        for w in &mut weight[..c] {
-            *w = (*w as f64 * s) as f32;
-        }
+        self.fresnel
+            .eval_scaled(gm.l_dot_h, &self.ks, gm.dg * l.z / pdf, &mut weight[..c]);
         Some(BrdfSample {
             wi: l,
             pdf,

@@ -47,6 +47,9 @@ pub struct Ggx {
     channels: Channels,
     alpha_x: f64,
     alpha_y: f64,
+    /// (1/α_x, 1/α_y) and 1/(π α_x α_y), so that D needs one division.
+    inv_alpha: (f64, f64),
+    inv_pi_axay: f64,
     ks_spec: Value,
     ks: Vec<f64>,
     fresnel_spec: FresnelSpec,
@@ -86,6 +89,8 @@ impl Ggx {
             channels: channels.clone(),
             alpha_x,
             alpha_y,
+            inv_alpha: (1.0 / alpha_x, 1.0 / alpha_y),
+            inv_pi_axay: 1.0 / (PI * alpha_x * alpha_y),
             ks: ks.resolve(channels),
             ks_spec: ks,
             fresnel: Fresnel::new(&fresnel, channels, "fresnel")?,
@@ -104,17 +109,20 @@ impl Ggx {
         if h.z.is_nan() || h.z <= 0.0 {
             return 0.0;
         }
-        let (ax, ay) = (self.alpha_x, self.alpha_y);
-        let e = (h.x / ax) * (h.x / ax) + (h.y / ay) * (h.y / ay) + h.z * h.z;
-        1.0 / (PI * ax * ay * e * e)
+        let (x, y) = (h.x * self.inv_alpha.0, h.y * self.inv_alpha.1);
+        let e = x * x + y * y + h.z * h.z;
+        self.inv_pi_axay / (e * e)
     }
 
     /// Smith's Λ(w) for a unit `w` above the horizon.
     #[inline]
     pub fn lambda(&self, w: DVec3) -> f64 {
-        let a2t2 = ((self.alpha_x * w.x).powi(2) + (self.alpha_y * w.y).powi(2)) / (w.z * w.z);
-        // (√(1 + x) − 1)/2 written without cancellation for small x.
-        0.5 * a2t2 / (1.0 + (1.0 + a2t2).sqrt())
+        // Λ = (√(1 + α²tan²θ) − 1)/2 = (r − w_z)/(2 w_z) with s² = (α_x w_x)² + (α_y w_y)² and
+        // r = √(w_z² + s²), written without cancellation (and with one root, one division) as
+        // s² / (2 w_z (r + w_z)).
+        let s2 = (self.alpha_x * w.x).powi(2) + (self.alpha_y * w.y).powi(2);
+        let r = (w.z * w.z + s2).sqrt();
+        s2 / (2.0 * w.z * (r + w.z))
     }
 
     /// Smith's masking G1(w) = 1 / (1 + Λ(w)) (0 below the horizon).
@@ -146,7 +154,7 @@ impl Ggx {
     /// (α_x, α_y).
     pub fn sample_half_vector(&self, u: DVec2) -> DVec3 {
         let r = (u.x / (1.0 - u.x)).sqrt();
-        let (sp, cp) = (2.0 * PI * u.y).sin_cos();
+        let (sp, cp) = crate::fastmath::sin_cos_2pi(u.y);
         let slope = DVec2::new(self.alpha_x * r * cp, self.alpha_y * r * sp);
         DVec3::new(-slope.x, -slope.y, 1.0).normalize()
     }
@@ -161,19 +169,21 @@ impl Ggx {
     pub fn sample_visible_normal(&self, wo: DVec3, u: DVec2) -> DVec3 {
         let (ax, ay) = (self.alpha_x, self.alpha_y);
         // Stretch wo to the hemisphere configuration of unit roughness.
-        let vh = DVec3::new(ax * wo.x, ay * wo.y, wo.z).normalize();
-        // Orthonormal basis around vh (T1 is undefined at vh = z; any tangent works there).
-        let lensq = vh.x * vh.x + vh.y * vh.y;
+        let stretched = DVec3::new(ax * wo.x, ay * wo.y, wo.z);
+        let vh = stretched.normalize();
+        // Orthonormal basis around vh (T1 is undefined at vh = z; any tangent works there). T1
+        // only needs the direction of vh's xy part, so it is taken from the stretched vector,
+        // in parallel with vh's normalization.
+        let lensq = stretched.x * stretched.x + stretched.y * stretched.y;
         let t1 = if lensq > 0.0 {
-            DVec3::new(-vh.y, vh.x, 0.0) / lensq.sqrt()
+            DVec3::new(-stretched.y, stretched.x, 0.0) / lensq.sqrt()
         } else {
             DVec3::X
         };
         let t2 = vh.cross(t1);
         // Uniform point on the disk, warped to the projected visible hemisphere.
         let r = u.x.sqrt();
-        let phi = 2.0 * PI * u.y;
-        let (sp, cp) = phi.sin_cos();
+        let (sp, cp) = crate::fastmath::sin_cos_2pi(u.y);
         let p1 = r * cp;
         let mut p2 = r * sp;
         let s = 0.5 * (1.0 + vh.z);
@@ -239,7 +249,7 @@ impl Brdf for Ggx {
     }
 
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        let wo = geometry::normalize(wo)?;
+        let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
             return None;
         }
@@ -248,20 +258,20 @@ impl Brdf for Ggx {
         if wo_h.is_nan() || wo_h <= 0.0 {
             return None;
         }
-        let wi = geometry::normalize(2.0 * wo_h * h - wo)?;
-        if wi.z <= 0.0 {
+        // The mirror image of a unit vector about a unit normal is unit (to rounding).
+        let wi = 2.0 * wo_h * h - wo;
+        if wi.z.is_nan() || wi.z <= 0.0 {
             return None;
         }
-        let g1o = self.g1(wo);
-        let pdf = g1o * self.ndf(h) / (4.0 * wo.z);
+        let lambda_o = self.lambda(wo);
+        let pdf = self.ndf(h) / (4.0 * wo.z * (1.0 + lambda_o));
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
-        // f cos θi / pdf = k_s F G2 / G1(wo).
-        let ratio = self.g2(wi, wo) / g1o;
-        for (c, (w, &k)) in weight[..self.ks.len()].iter_mut().zip(&self.ks).enumerate() {
-            *w = (k * ratio * self.fresnel.eval(wo_h, c)) as f32;
-        }
+        // f cos θi / pdf = k_s F G2 / G1(wo) = k_s F (1 + Λo) / (1 + Λi + Λo).
+        let ratio = (1.0 + lambda_o) / (1.0 + self.lambda(wi) + lambda_o);
+        self.fresnel
+            .eval_scaled(wo_h, &self.ks, ratio, &mut weight[..self.ks.len()]);
         Some(BrdfSample {
             wi,
             pdf,

@@ -86,7 +86,7 @@ impl Brdf for Lambert {
 
     /// Cosine-weighted sampling, pdf cos θi / π: the weight f·cos θi / pdf = k_d π is constant.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        let wo = geometry::normalize(wo)?;
+        let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
             return None;
         }

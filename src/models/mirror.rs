@@ -102,7 +102,7 @@ impl Brdf for Mirror {
 
     /// The lecture's `ReflectDir`: L = 2 (N·V) N − V, weight k_r(N·V), pdf 1, delta.
     fn sample(&self, wo: DVec3, _u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        let wo = geometry::normalize(wo)?;
+        let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
             return None;
         }
@@ -166,7 +166,7 @@ impl Refractor {
     /// The lecture's `RefractionDir` for a viewer direction `wo` in the local frame: `Some(wi)`
     /// on the other side of the surface, `None` on total internal reflection (or invalid `wo`).
     pub fn refraction_dir(&self, wo: DVec3) -> Option<DVec3> {
-        let wo = geometry::normalize(wo)?;
+        let wo = geometry::unit(wo)?;
         if wo.z == 0.0 {
             return None;
         }
@@ -232,7 +232,7 @@ impl Brdf for Refractor {
     /// total internal reflection.
     fn sample(&self, wo: DVec3, _u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let wi = self.refraction_dir(wo)?;
-        let cos = geometry::normalize(wo)?.z;
+        let cos = geometry::unit(wo)?.z;
         for (c, w) in weight[..self.channels.len()].iter_mut().enumerate() {
             *w = self.k_t(cos, c) as f32;
         }

@@ -62,6 +62,8 @@ pub struct Phong {
     n_int: Option<i32>,
     /// (n + 1) / 2π: normalization of cos^n ψ over the hemisphere around the reflection direction.
     lobe_norm: f64,
+    /// 1 / (n + 1): the exponent that inverts the lobe's CDF.
+    inv_n1: f64,
 }
 
 impl Phong {
@@ -82,6 +84,7 @@ impl Phong {
             n,
             n_int: (n.fract() == 0.0 && n <= 65536.0).then_some(n as i32),
             lobe_norm: (n + 1.0) / (2.0 * PI),
+            inv_n1: 1.0 / (n + 1.0),
         })
     }
 
@@ -128,17 +131,20 @@ impl Phong {
         if cos_psi.is_nan() || cos_psi <= 0.0 {
             return 0.0;
         }
-        let lobe = self.pow_n(cos_psi);
-        let (ci, co) = (wi.z, wo.z);
-        let x = match self.variant {
+        self.pow_n(cos_psi) / self.x(wi.z, wo.z)
+    }
+
+    /// The variant's divisor x(cos θi, cos θo) of cos^n ψ.
+    #[inline]
+    fn x(&self, ci: f64, co: f64) -> f64 {
+        match self.variant {
             PhongVariant::Original => ci,
             PhongVariant::Reciprocal => 1.0,
             PhongVariant::Max => ci.max(co),
             PhongVariant::Pumped(PumpX::Mean) => 0.5 * (ci + co),
             PhongVariant::Pumped(PumpX::Product) => ci * co,
             PhongVariant::Pumped(PumpX::Sqrt) => (ci * co).sqrt(),
-        };
-        lobe / x
+        }
     }
 
     /// Density of the cos^n ψ lobe around the reflection of `wo` (hemisphere-normalized).
@@ -207,22 +213,39 @@ impl Brdf for Phong {
     /// Mixture of the cos^n ψ lobe around reflect(wo) (probability [`LOBE_PROB`]) and cosine
     /// sampling; weight f_r cos θi / pdf with pdf the exact mixture density.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        let wo = geometry::normalize(wo)?;
+        let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
             return None;
         }
-        let wi = if u.x < LOBE_PROB {
+        if u.x < LOBE_PROB {
+            // Fused lobe branch: cos ψ = u₀^{1/(n+1)} gives cos^n ψ = u₀ / cos ψ without a
+            // second power, and f, the mixture pdf and the weight all follow from it.
             let u0 = u.x / LOBE_PROB;
-            // cos ψ = u^(1/(n+1)) has density ∝ cos^n ψ per solid angle.
-            let cos_psi = u0.powf(1.0 / (self.n + 1.0));
+            let cos_psi = u0.powf(self.inv_n1);
             let sin_psi = (1.0 - cos_psi * cos_psi).max(0.0).sqrt();
-            let (s, c) = (2.0 * PI * u.y).sin_cos();
+            let (s, c) = crate::fastmath::sin_cos_2pi(u.y);
             let r = geometry::reflect_z(wo);
-            Frame::from_normal(r).to_world(DVec3::new(sin_psi * c, sin_psi * s, cos_psi))
-        } else {
-            let u0 = ((u.x - LOBE_PROB) / (1.0 - LOBE_PROB)).min(1.0 - f64::EPSILON);
-            geometry::cosine_hemisphere(DVec2::new(u0, u.y))
-        };
+            let wi = Frame::from_normal(r).to_world(DVec3::new(sin_psi * c, sin_psi * s, cos_psi));
+            if !(wi.z > 0.0 && cos_psi > 0.0) {
+                return None;
+            }
+            let lobe = u0 / cos_psi;
+            let pdf = LOBE_PROB * self.lobe_norm * lobe + (1.0 - LOBE_PROB) * wi.z * FRAC_1_PI;
+            if !(pdf > 0.0 && pdf.is_finite()) {
+                return None;
+            }
+            let v = lobe / self.x(wi.z, wo.z) * wi.z / pdf;
+            for (w, &k) in weight[..self.ks.len()].iter_mut().zip(&self.ks) {
+                *w = (k * v).min(f32::MAX as f64) as f32;
+            }
+            return Some(BrdfSample {
+                wi,
+                pdf,
+                delta: false,
+            });
+        }
+        let u0 = ((u.x - LOBE_PROB) / (1.0 - LOBE_PROB)).min(1.0 - f64::EPSILON);
+        let wi = geometry::cosine_hemisphere(DVec2::new(u0, u.y));
         if wi.z <= 0.0 {
             return None;
         }

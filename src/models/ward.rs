@@ -148,7 +148,7 @@ impl Brdf for Ward {
     }
 
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        let wo = geometry::normalize(wo)?;
+        let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
             return None;
         }

@@ -312,7 +312,7 @@ impl TableSampler {
         u: DVec2,
         weight: &mut [f32],
     ) -> Option<BrdfSample> {
-        let wo = geometry::normalize(wo)?;
+        let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
             return None;
         }
