@@ -21,7 +21,7 @@
 //! # Sampling
 //!
 //! [`Brdf::sample`] draws visible normals (Heitz 2018, "Sampling the GGX distribution of visible
-//! normals"): h with density D_wo(h) = G1(wo) max(0, wo·h) D(h) / cos θo, reflected about h. The
+//! normals", by the spherical-cap construction of Dupuy & Benyoub 2023): h with density D_wo(h) = G1(wo) max(0, wo·h) D(h) / cos θo, reflected about h. The
 //! Jacobian 1/(4 wo·h) gives
 //!
 //! ```text
@@ -120,9 +120,17 @@ impl Ggx {
         // Λ = (√(1 + α²tan²θ) − 1)/2 = (r − w_z)/(2 w_z) with s² = (α_x w_x)² + (α_y w_y)² and
         // r = √(w_z² + s²), written without cancellation (and with one root, one division) as
         // s² / (2 w_z (r + w_z)).
+        let (s2, q) = self.lambda_parts(w);
+        s2 / q
+    }
+
+    /// Λ(w) as the quotient s² / q, s² = (α_x w_x)² + (α_y w_y)², q = 2 w_z (√(w_z² + s²) + w_z),
+    /// for callers that combine several Λ under one division.
+    #[inline]
+    fn lambda_parts(&self, w: DVec3) -> (f64, f64) {
         let s2 = (self.alpha_x * w.x).powi(2) + (self.alpha_y * w.y).powi(2);
         let r = (w.z * w.z + s2).sqrt();
-        s2 / (2.0 * w.z * (r + w.z))
+        (s2, 2.0 * w.z * (r + w.z))
     }
 
     /// Smith's masking G1(w) = 1 / (1 + Λ(w)) (0 below the horizon).
@@ -165,32 +173,23 @@ impl Ggx {
     }
 
     /// Draws a microfacet normal visible from the unit direction `wo` (above the horizon) with
-    /// density [`Ggx::pdf_visible_normal`] (Heitz 2018, listing 1).
+    /// density [`Ggx::pdf_visible_normal`].
+    ///
+    /// In the stretched configuration of unit roughness the visible normals are distributed like
+    /// the points of a uniformly sampled spherical cap of directions c with c·z ≥ −v_z, offset
+    /// by the stretched view direction v (Dupuy & Benyoub 2023, "Sampling visible GGX normals
+    /// with spherical caps"): h ∝ c + v, then unstretched. The same density as Heitz's (2018)
+    /// projected-disk construction, with three square roots and two divisions instead of five
+    /// and three.
     pub fn sample_visible_normal(&self, wo: DVec3, u: DVec2) -> DVec3 {
         let (ax, ay) = (self.alpha_x, self.alpha_y);
-        // Stretch wo to the hemisphere configuration of unit roughness.
-        let stretched = DVec3::new(ax * wo.x, ay * wo.y, wo.z);
-        let vh = stretched.normalize();
-        // Orthonormal basis around vh (T1 is undefined at vh = z; any tangent works there). T1
-        // only needs the direction of vh's xy part, so it is taken from the stretched vector,
-        // in parallel with vh's normalization.
-        let lensq = stretched.x * stretched.x + stretched.y * stretched.y;
-        let t1 = if lensq > 0.0 {
-            DVec3::new(-stretched.y, stretched.x, 0.0) / lensq.sqrt()
-        } else {
-            DVec3::X
-        };
-        let t2 = vh.cross(t1);
-        // Uniform point on the disk, warped to the projected visible hemisphere.
-        let r = u.x.sqrt();
+        let v = DVec3::new(ax * wo.x, ay * wo.y, wo.z).normalize();
+        // Uniform on the cap z ∈ [−v_z, 1].
+        let z = (1.0 - u.x) * (1.0 + v.z) - v.z;
+        let sin_t = (1.0 - z * z).max(0.0).sqrt();
         let (sp, cp) = crate::fastmath::sin_cos_2pi(u.y);
-        let p1 = r * cp;
-        let mut p2 = r * sp;
-        let s = 0.5 * (1.0 + vh.z);
-        p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
-        // Reproject onto the hemisphere and unstretch.
-        let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
-        DVec3::new(ax * nh.x, ay * nh.y, nh.z.max(0.0)).normalize()
+        let h = DVec3::new(sin_t * cp, sin_t * sp, z) + v;
+        DVec3::new(ax * h.x, ay * h.y, h.z.max(0.0)).normalize()
     }
 
     /// The density of visible normals D_wo(h) = G1(wo) max(0, wo·h) D(h) / cos θo for unit `wo`
@@ -263,13 +262,20 @@ impl Brdf for Ggx {
         if wi.z.is_nan() || wi.z <= 0.0 {
             return None;
         }
-        let lambda_o = self.lambda(wo);
-        let pdf = self.ndf(h) / (4.0 * wo.z * (1.0 + lambda_o));
+        // Λ = s²/q for both directions (see `lambda_parts`), so that pdf and weight each take
+        // one division:
+        // pdf = D / (4 cos θo (1 + Λo)) = q_o / (π α_x α_y e² · 4 cos θo (q_o + s_o²)),
+        // f cos θi / pdf = k_s F G2 / G1(wo) = k_s F (1 + Λo) / (1 + Λi + Λo)
+        //                = k_s F (q_o + s_o²) q_i / (q_i q_o + s_i² q_o + s_o² q_i).
+        let (s2o, qo) = self.lambda_parts(wo);
+        let (s2i, qi) = self.lambda_parts(wi);
+        let (x, y) = (h.x * self.inv_alpha.0, h.y * self.inv_alpha.1);
+        let e = x * x + y * y + h.z * h.z;
+        let pdf = self.inv_pi_axay * qo / (e * e * 4.0 * wo.z * (qo + s2o));
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
-        // f cos θi / pdf = k_s F G2 / G1(wo) = k_s F (1 + Λo) / (1 + Λi + Λo).
-        let ratio = (1.0 + lambda_o) / (1.0 + self.lambda(wi) + lambda_o);
+        let ratio = (qo + s2o) * qi / (qi * qo + s2i * qo + s2o * qi);
         self.fresnel
             .eval_scaled(wo_h, &self.ks, ratio, &mut weight[..self.ks.len()]);
         Some(BrdfSample {

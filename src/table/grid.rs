@@ -190,6 +190,9 @@ pub struct StoredAxis {
     pub nodes: Nodes,
     /// Whether the axis wraps around (φ axes that are not folded).
     pub periodic: bool,
+    /// 1 / (hi − lo) (0 for a single node), so that linear lookups multiply instead of divide.
+    #[serde(skip)]
+    inv_range: f64,
 }
 
 impl StoredAxis {
@@ -201,6 +204,7 @@ impl StoredAxis {
             mapping: a.mapping,
             nodes: a.nodes,
             periodic: false,
+            inv_range: 1.0 / FRAC_PI_2,
         }
     }
 
@@ -212,6 +216,7 @@ impl StoredAxis {
             mapping: Mapping::Uniform,
             nodes,
             periodic: true,
+            inv_range: 1.0 / period,
         }
     }
 
@@ -223,6 +228,7 @@ impl StoredAxis {
             mapping: Mapping::Uniform,
             nodes: Nodes::Edges,
             periodic: false,
+            inv_range: 1.0 / hi,
         }
     }
 
@@ -234,6 +240,7 @@ impl StoredAxis {
             mapping: Mapping::Uniform,
             nodes: Nodes::Edges,
             periodic: false,
+            inv_range: 0.0,
         }
     }
 
@@ -244,7 +251,15 @@ impl StoredAxis {
     /// [`StoredAxis::nearest`] still floors the unshifted cell coordinate, exactly as MERL.
     #[inline(always)]
     pub fn continuous(&self, x: f64) -> f64 {
-        let c = self.cell_coordinate(x);
+        self.continuous_impl::<true>(x)
+    }
+
+    /// [`StoredAxis::continuous`], exact (`EXACT`: divides by the range as MERL does, for
+    /// nearest lookups whose cell boundaries must match) or multiplying by the precomputed
+    /// reciprocal (a rounding-level difference; for linear lookups).
+    #[inline(always)]
+    fn continuous_impl<const EXACT: bool>(&self, x: f64) -> f64 {
+        let c = self.cell_coordinate::<EXACT>(x);
         if self.nodes == Nodes::CellStart && self.size > 1 {
             c - 0.5
         } else {
@@ -255,12 +270,16 @@ impl StoredAxis {
     /// The position of `x` in units of cells (node spacing), before the half-cell shift of
     /// [`Nodes::CellStart`] axes; for those it is the MERL index before truncation.
     #[inline(always)]
-    fn cell_coordinate(&self, x: f64) -> f64 {
+    fn cell_coordinate<const EXACT: bool>(&self, x: f64) -> f64 {
         if self.size <= 1 {
             return 0.0;
         }
         let n = self.size as f64;
-        let r = (x - self.lo) / (self.hi - self.lo);
+        let r = if EXACT {
+            (x - self.lo) / (self.hi - self.lo)
+        } else {
+            (x - self.lo) * self.inv_range
+        };
         if self.periodic {
             // Node i at i/n of the period on every periodic axis.
             return r * n;
@@ -327,9 +346,9 @@ impl StoredAxis {
     #[inline]
     pub fn nearest(&self, x: f64) -> usize {
         let i = if self.nodes == Nodes::CellStart {
-            self.cell_coordinate(x).floor()
+            floor(self.cell_coordinate::<true>(x))
         } else {
-            (self.continuous(x) + 0.5).floor()
+            floor(self.continuous(x) + 0.5)
         };
         self.index(i)
     }
@@ -355,7 +374,7 @@ impl StoredAxis {
         if n <= 1 {
             return (0, 0, 0.0);
         }
-        let s = self.continuous(x);
+        let s = self.continuous_impl::<false>(x);
         if self.periodic {
             if !s.is_finite() {
                 return (0, 1, 0.0);
@@ -383,6 +402,14 @@ impl StoredAxis {
             (i0, i0 + 1, (s - i0 as f64) as f32)
         }
     }
+}
+
+/// ⌊x⌋ without `f64::floor`, which is a libm call on baseline x86-64 (no SSE4.1): truncation
+/// (saturating, NaN → 0) corrected by one for negative non-integers.
+#[inline(always)]
+fn floor(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    if t > x { t - 1.0 } else { t }
 }
 
 /// A dense table's grid: parameterization, four full angular axes, channels and the symmetry

@@ -134,6 +134,13 @@ impl Lookup {
                 ];
                 if self.packed {
                     self.accumulate_packed(&l, out, chunk);
+                } else if l[1].2 == 0.0 && (c == 3 || c == 1) {
+                    // Isotropic tables (axis 1 of size 1) and any lookup on an axis-1 node.
+                    if c == 3 {
+                        self.accumulate_cube::<3>(&l, out, chunk);
+                    } else {
+                        self.accumulate_cube::<1>(&l, out, chunk);
+                    }
                 } else {
                     match c {
                         1 => self.accumulate::<1>(&l, out, chunk),
@@ -192,6 +199,47 @@ impl Lookup {
         if N > 0 {
             out[..N].copy_from_slice(&acc);
         }
+    }
+
+    /// Trilinear accumulation over axes 0, 2, 3 at axis-1 node `l[1].0` for exactly `N`
+    /// channels: all eight corners unconditionally (a corner of weight 0 adds 0 — stored values
+    /// are finite), with fixed trip counts, so the loops unroll and the eight loads are issued
+    /// together instead of one dependent branch at a time.
+    #[inline(always)]
+    fn accumulate_cube<'a, const N: usize>(
+        &self,
+        l: &[(usize, usize, f32); 4],
+        out: &mut [f32],
+        chunk: impl Fn(usize) -> &'a [f32],
+    ) {
+        let c = self.channels;
+        let s3 = self.shape[3];
+        let (sp, sb) = (self.shape[2] * s3 * c, s3 * c);
+        let base = l[1].0 * sp;
+        // A second θ1 node of weight 0 is not touched (it may be a chunk not yet decoded).
+        let d0 = chunk(l[0].0);
+        let data = [d0, if l[0].2 == 0.0 { d0 } else { chunk(l[0].1) }];
+        let ob = [base + l[2].0 * sb, base + l[2].1 * sb];
+        let oq = [l[3].0 * c, l[3].1 * c];
+        let wa = [1.0 - l[0].2, l[0].2];
+        let wb = [1.0 - l[2].2, l[2].2];
+        let wq = [1.0 - l[3].2, l[3].2];
+        let mut acc = [0.0f32; N];
+        for i in 0..2 {
+            for j in 0..2 {
+                let w = wa[i] * wb[j];
+                for k in 0..2 {
+                    let off = ob[j] + oq[k];
+                    if let Some(v) = data[i].get(off..off + N) {
+                        let wt = w * wq[k];
+                        for ch in 0..N {
+                            acc[ch] += wt * v[ch];
+                        }
+                    }
+                }
+            }
+        }
+        out[..N].copy_from_slice(&acc);
     }
 
     /// Multilinear accumulation for packed `inout` reciprocity: corners below the diagonal are

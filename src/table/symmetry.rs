@@ -210,7 +210,16 @@ pub fn fast_atan2(y: f64, x: f64) -> f64 {
 
 #[inline(always)]
 fn coords<const FAST: bool>(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -> Option<[f64; 4]> {
-    let (wi, wo) = geometry::upper_pair(wi, wo)?;
+    let (wi, wo) = if FAST {
+        // Unit inputs (the usual case) skip the two normalizations.
+        let (wi, wo) = (geometry::unit(wi)?, geometry::unit(wo)?);
+        if !(wi.z > 0.0 && wo.z > 0.0) {
+            return None;
+        }
+        (wi, wo)
+    } else {
+        geometry::upper_pair(wi, wo)?
+    };
     match param {
         Param::InOut => {
             let ti = acos::<FAST>(wi.z);
@@ -250,10 +259,17 @@ fn coords<const FAST: bool>(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -
             }
         }
         Param::HalfDiff => {
-            let (h, d) = geometry::half_diff_vectors(wi, wo)?;
-            let th = acos::<FAST>(h.z);
-            let td = acos::<FAST>(d.z);
-            let mut pd = atan2::<FAST>(d.y, d.x);
+            let (th, td, mut pd, h) = if FAST {
+                half_diff_angles_fast(wi, wo)?
+            } else {
+                let (h, d) = geometry::half_diff_vectors(wi, wo)?;
+                (
+                    acos::<FAST>(h.z),
+                    acos::<FAST>(d.z),
+                    atan2::<FAST>(d.y, d.x),
+                    h,
+                )
+            };
             let mut ph = 0.0;
             if !sym.isotropic {
                 ph = atan2::<FAST>(h.y, h.x);
@@ -282,6 +298,35 @@ fn coords<const FAST: bool>(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -
             Some([th, ph, td, pd])
         }
     }
+}
+
+/// (θh, θd, φd, h) of a pair of unit directions with the unnormalized half vector
+/// h = wi + wo, one square root and one reciprocal (besides the polynomial `atan2`):
+/// cos θh = h_z/|h|, cos θd = wi·h/|h|, and φd = atan2(d_y, d_x) where the difference vector's
+/// components, multiplied by the positive |h|·|h_xy|, are
+/// d_y ∝ (wi_y h_x − wi_x h_y)|h| and d_x ∝ (wi_x h_x + wi_y h_y) h_z − wi_z |h_xy|²
+/// (rotate wi by −φh about z, then by −θh about y; `geometry::half_diff_vectors` step by
+/// step). At the pole (h_xy = 0, φh = 0 by convention) d = wi.
+#[inline(always)]
+fn half_diff_angles_fast(wi: DVec3, wo: DVec3) -> Option<(f64, f64, f64, DVec3)> {
+    let h = wi + wo;
+    let hxy2 = h.x * h.x + h.y * h.y;
+    let hh = hxy2 + h.z * h.z;
+    if !(hh > 1e-300) {
+        return None;
+    }
+    let len = hh.sqrt();
+    let inv = 1.0 / len;
+    let th = fast_acos(h.z * inv);
+    let td = fast_acos(wi.dot(h) * inv);
+    let pd = if hxy2 > 1e-24 * hh {
+        let y = (wi.y * h.x - wi.x * h.y) * len;
+        let x = (wi.x * h.x + wi.y * h.y) * h.z - wi.z * hxy2;
+        fast_atan2(y, x)
+    } else {
+        fast_atan2(wi.y, wi.x)
+    };
+    Some((th, td, pd, h))
 }
 
 /// Canonicalizes a corner `[a, p, b, q]` of packed `inout` reciprocity (stored θ1 ≤ θ2): when
