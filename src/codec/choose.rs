@@ -58,7 +58,7 @@ pub fn plane_entropy<W: Word>(words: &[W]) -> f64 {
 fn trial_size<W: Word>(words: &[W]) -> Option<usize> {
     let mut b = Vec::with_capacity(words.len() * W::BYTES);
     filter::shuffle(words, &mut b);
-    zstd::bulk::compress(&b, 1).ok().map(|c| c.len())
+    super::zstd_compress(&b, 1).ok().map(|c| c.len())
 }
 
 /// Picks the filter whose residuals are likely to compress best (see the module docs).
