@@ -1,4 +1,4 @@
-//! log16: error-bounded 16-bit coding of values in the log domain, with prediction in the loop.
+//! log16: error-bounded 16-bit coding of values in the log domain, with prediction.
 //!
 //! Each value `v` is mapped to `L = g(v)`, where `g` is logarithmic above the floor `F` and
 //! linear below it, odd in `v` and C¹ at `|v| = F`:
@@ -9,25 +9,39 @@
 //! ```
 //!
 //! so a uniform step in `L` is a relative step above the floor and an absolute one below it,
-//! and negative values (measured data has them) are coded like positive ones. A predictor `P` (previous point along the
-//! innermost axis, or the planar `left + up − up-left`, optionally plus the previous channel's
-//! prediction error — the same family as [`Filter`]) is computed from the *reconstructed*
-//! neighbours `R`, and the residual is quantized: `q = round((L − P) / step)`, `R = P + q·step`,
-//! stored as a zigzagged 16-bit code. Decoding repeats the prediction and gives `v̂ = g⁻¹(R)`. Because the quantizer sits inside the prediction loop (DPCM, as
-//! in the SZ compressors), smooth data leaves residual codes that are mostly 0 — far fewer bits
-//! than quantizing first and predicting the noisy codes afterwards — and there is no limit on the
-//! dynamic range of a chunk: only the *residual* must fit 16 bits.
+//! and negative values (measured data has them) are coded like positive ones.
+//!
+//! Each `L` is rounded to the grid `lo + k·step` (`lo` = 0): `k = round((L − lo) / step)`, an
+//! integer of any size. A predictor `P` of `k` from earlier points (previous point along the
+//! innermost axis, the extrapolation `2·left − left-left`, or the planar `left + up − up-left`,
+//! optionally plus the previous channel's prediction error — the same family as [`Filter`]) runs
+//! in exact integer arithmetic, and the residual `q = k − P` is stored as a zigzagged 16-bit code.
+//! Decoding repeats the prediction, `k = P + q`, and gives `v̂ = g⁻¹(lo + k·step)`. There is no
+//! limit on the dynamic range of a chunk: a residual that does not fit 16 bits costs one escape
+//! (below). Because `k` does
+//! not depend on the predictor, the encoder quantizes once and tries predictors on integers
+//! (cheap), and `L = 0` (`v = 0`) decodes to exactly 0; a value below `step/2` in `L` decodes to 0
+//! rather than to the other sign.
+//!
+//! Chunk version 1 formed the reconstructions in f64 *inside* the prediction loop
+//! (`R = P + round((L − P)/step)·step`, DPCM as in the SZ compressors). With the second-order
+//! predictor that loop amplifies the rounding noise around zero so that thousands of tiny values
+//! decode with the wrong sign and must be stored exactly; on the grid the noise is the same and
+//! the sign comes for free. Version-1 chunks still decode ([`Log16Params::grid`] = false).
 //!
 //! # The guarantee
 //!
-//! `|R − L| ≤ step/2` gives `|v̂ − v| ≤ (v + floor)(e^{step/2} − 1)`; with
+//! `|lo + k·step − L| ≤ step/2` gives `|v̂ − v| ≤ (v + floor)(e^{step/2} − 1)`; with
 //! `step = 2·ln(1 + tol)·0.98` that is at most `0.98·tol·(v + floor)`, inside the bound
 //! `tol·max(v, floor)` except for values within a factor ~50 of the floor. The encoder therefore
 //! decodes every value exactly as the decoder will and checks the bound; a value that misses it
 //! — or would decode with the other sign, or whose residual does not fit 16 bits — is stored
-//! exactly in an escape list (the decoder then continues the prediction from its exact `L`). So
-//! **every** decoded value satisfies `|v̂ − v| ≤ tol·max(|v|, floor)` and has the sign of `v`
-//! (a non-negative table never decodes to a negative value, which a BRDF must not return).
+//! exactly in an escape list. Its residual's low 16 bits are stored all the same, and the decoder
+//! takes the rest from the exact value (the multiple of 2^16 that lands nearest its `L`), so the
+//! decoder's `k` — hence every later prediction — equals the encoder's, in integers, on every
+//! platform. So **every** decoded value satisfies
+//! `|v̂ − v| ≤ tol·max(|v|, floor)` and has the sign of `v` (a non-negative table never decodes
+//! to a negative value, which a BRDF must not return).
 //!
 //! The floor is `1e-7 ×` the chunk's largest magnitude unless given explicitly (absolute), and is
 //! stored in the chunk header: below it the error bound is absolute (`tol·floor`).
@@ -35,18 +49,21 @@
 //! Decoding uses `exp`/`ln` from the platform's libm; results are deterministic on a platform and
 //! may differ in the last ulp across platforms (well inside the 2% margin of the bound).
 
-use super::filter::{self, Filter, Layout, Word};
+use super::filter::{self, Filter, Layout, Spatial, Word};
 use crate::error::{Error, Result};
 
 /// The per-chunk parameters of log16, stored in the chunk header.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Log16Params {
-    /// The prediction for the first point of a chunk (0, i.e. `v = 0`).
+    /// The origin of the grid (0, i.e. `v = 0`); version 1: the prediction for the first point.
     pub lo: f64,
     /// Quantization step of the residuals, in ln units.
     pub step: f64,
     /// The absolute floor: below it the error is bounded by `tol·floor`.
     pub floor: f64,
+    /// Reconstructions on the integer grid `lo + k·step` (chunk version 2); `false`: formed in
+    /// f64 inside the prediction loop (version 1, decoded for old files).
+    pub grid: bool,
 }
 
 impl Log16Params {
@@ -77,7 +94,7 @@ pub fn step(tol: f64) -> f64 {
 pub struct Encoded {
     /// Predictor used.
     pub filter: Filter,
-    /// Zigzagged residual codes (0 at escaped positions).
+    /// Zigzagged residual codes (at escaped positions: the residual's low 16 bits).
     pub codes: Vec<u16>,
     /// Chunk parameters.
     pub params: Log16Params,
@@ -85,33 +102,68 @@ pub struct Encoded {
     pub escapes: Vec<(u32, f32)>,
 }
 
-/// The prediction loop shared by encoder and decoder. `step_fn(i, p)` returns the reconstructed
-/// value of point `i` given its prediction `p`.
+/// What the prediction loop runs on: grid indices (`i64`, wrapping, version 2) or
+/// reconstructions (`f64`, version 1).
+trait State: Copy {
+    fn add(self, o: Self) -> Self;
+    fn sub(self, o: Self) -> Self;
+}
+
+impl State for f64 {
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self + o
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self - o
+    }
+}
+
+impl State for i64 {
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self.wrapping_add(o)
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self.wrapping_sub(o)
+    }
+}
+
+/// The prediction loop shared by encoder and decoder. `step_fn(i, p)` returns the state of point
+/// `i` given its prediction `p`; `lo` predicts the first point of the chunk.
 #[inline(always)]
-fn run(
+fn run<T: State>(
     n: usize,
     layout: Layout,
     filter: Filter,
-    lo: f64,
-    r: &mut [f64],
-    mut step_fn: impl FnMut(usize, f64) -> f64,
+    lo: T,
+    r: &mut [T],
+    mut step_fn: impl FnMut(usize, T) -> T,
 ) {
     let ch = layout.channels;
     let row = layout.channels * layout.inner;
-    let (plane, chan) = (filter.plane(), filter.channel() && ch > 1);
-    let none = filter == Filter::None;
+    let spatial = filter.spatial();
+    let chan = filter.channel() && ch > 1;
+    let linear_first = filter.linear_first();
     for (s, len, up) in filter::rows(n, layout) {
-        let mut base_prev = 0.0;
+        let mut base_prev = lo;
         let mut c = 0usize;
         for j in 0..len {
             let i = s + j;
-            let base = if none {
+            let sp = if linear_first && c == 0 {
+                Spatial::Linear
+            } else {
+                spatial
+            };
+            let base = if sp == Spatial::None {
                 lo
             } else if j >= ch {
-                if plane && up {
-                    r[i - ch] + r[i - row] - r[i - row - ch]
-                } else {
-                    r[i - ch]
+                match sp {
+                    Spatial::Plane if up => r[i - ch].add(r[i - row]).sub(r[i - row - ch]),
+                    Spatial::Linear if j >= 2 * ch => r[i - ch].add(r[i - ch].sub(r[i - 2 * ch])),
+                    _ => r[i - ch],
                 }
             } else if s >= row {
                 r[i - row]
@@ -119,7 +171,20 @@ fn run(
                 lo
             };
             let p = if chan && c != 0 {
-                base + (r[i - 1] - base_prev)
+                base.add(r[i - 1].sub(base_prev))
+            } else {
+                base
+            };
+            // The next channel's prediction continues from this channel's own-axis prediction
+            // (for `LinearDeltaChannel`, the first channel's `Delta` one).
+            let base = if linear_first && c == 0 {
+                if j >= ch {
+                    r[i - ch]
+                } else if s >= row {
+                    r[i - row]
+                } else {
+                    lo
+                }
             } else {
                 base
             };
@@ -133,17 +198,29 @@ fn run(
     }
 }
 
-fn to_code(q: f64) -> Option<u16> {
-    (q.abs() <= i16::MAX as f64).then(|| (q as i16 as u16).zigzag())
+/// The zigzagged 16-bit code of residual `q` (its low 16 bits when it does not fit).
+fn to_code(q: i64) -> u16 {
+    (q as i16 as u16).zigzag()
 }
 
-fn from_code(c: u16) -> f64 {
-    c.unzigzag() as i16 as f64
+fn from_code(c: u16) -> i16 {
+    c.unzigzag() as i16
+}
+
+/// The grid index of an escaped value `v` predicted as `p`, as encoder and decoder both form it:
+/// the residual is `code`'s 16 bits plus the multiple of 2^16 that brings the index nearest to
+/// `v`'s own `(L − lo) / step`. That estimate is within ½ + ε of the encoder's index, so the
+/// result is exactly that index on any platform whose `ln` is off by less than 2^15 steps.
+fn resolve(p: i64, code: u16, v: f32, params: &Log16Params) -> i64 {
+    let q16 = from_code(code) as i64;
+    let ka = (to_log(v as f64, params.floor) - params.lo) / params.step;
+    let m = ((ka - p as f64 - q16 as f64) / 65536.0).round() as i64;
+    p.wrapping_add(q16).wrapping_add(m.wrapping_mul(65536))
 }
 
 /// Encodes `data` with relative tolerance `tol` (see the module docs for the guarantee).
 /// `floor`: absolute floor, or `None` for `1e-7 ×` the chunk's largest magnitude. `filter`: force
-/// a predictor, or `None` to pick the one with the cheapest residuals.
+/// a predictor, or `None` to pick one ([`choose`](super::choose::choose) on the grid indices).
 pub fn encode(
     data: &[f32],
     layout: Layout,
@@ -177,58 +254,43 @@ pub fn encode(
         lo: 0.0,
         step: step(tol),
         floor,
+        grid: true,
     };
     let n = data.len();
-    let l: Vec<f64> = data.iter().map(|&v| to_log(v as f64, floor)).collect();
     let inv = 1.0 / params.step;
-    let mut r = vec![0.0f64; n];
-
-    // Choose the predictor by the size of its residual codes (no verification; cheap).
+    // Grid index of every value, and whether it decodes within the bound and with its sign: both
+    // independent of the predictor. |L| ≤ 1 + ln(f32::MAX / MIN_FLOOR) < 160, so |k| < 1e8.
+    let mut k = Vec::with_capacity(n);
+    let mut ok = Vec::with_capacity(n);
+    for &v in data {
+        let kt = ((to_log(v as f64, floor) - params.lo) * inv).round();
+        let back = from_log(params.lo + kt * params.step, floor) as f64;
+        let a = v as f64;
+        // Sign-preserving: a non-negative value (a BRDF) must never decode negative.
+        let same_sign = if a >= 0.0 { back >= 0.0 } else { back <= 0.0 };
+        ok.push(same_sign && (back - a).abs() <= tol * a.abs().max(floor));
+        k.push(kt as i64);
+    }
+    // Residuals of the indices as wrapped 16-bit words equal the true ones whenever those fit.
     let filter = filter.unwrap_or_else(|| {
-        let mut best = (u64::MAX, Filter::None);
-        for f in Filter::ALL {
-            if f.channel() && layout.channels == 1 {
-                continue;
-            }
-            let mut bits = 0u64;
-            run(n, layout, f, params.lo, &mut r, |i, p| {
-                let q = ((l[i] - p) * inv).round();
-                match to_code(q) {
-                    Some(c) => {
-                        bits += c.bits() as u64 + 1;
-                        p + q * params.step
-                    }
-                    None => {
-                        bits += 64;
-                        l[i]
-                    }
-                }
-            });
-            if bits < best.0 {
-                best = (bits, f);
-            }
-        }
-        best.1
+        let words: Vec<u16> = k.iter().map(|&x| x as u16).collect();
+        super::choose::choose(&words, layout)
     });
 
     let mut codes = vec![0u16; n];
     let mut escapes = Vec::new();
-    run(n, layout, filter, params.lo, &mut r, |i, p| {
-        let v = data[i];
-        let q = ((l[i] - p) * inv).round();
-        if let Some(c) = to_code(q) {
-            let rec = p + q * params.step;
-            let back = from_log(rec, floor) as f64;
-            let a = v as f64;
-            // Sign-preserving: a non-negative value (a BRDF) must never decode negative.
-            let same_sign = if a >= 0.0 { back >= 0.0 } else { back <= 0.0 };
-            if same_sign && (back - a).abs() <= tol * a.abs().max(floor) {
-                codes[i] = c;
-                return rec;
-            }
+    let mut state = vec![0i64; n];
+    run(n, layout, filter, 0i64, &mut state, |i, p| {
+        let q = k[i].wrapping_sub(p);
+        let code = to_code(q);
+        codes[i] = code;
+        if q == from_code(code) as i64 && ok[i] {
+            return k[i];
         }
-        escapes.push((i as u32, v));
-        l[i]
+        escapes.push((i as u32, data[i]));
+        let r = resolve(p, code, data[i], &params);
+        debug_assert_eq!(r, k[i]);
+        r
     });
     if escapes.len() > n / 2 && n >= 16 {
         let neg = escapes.iter().filter(|e| e.1 < 0.0).count();
@@ -280,27 +342,144 @@ pub fn decode(
     out: &mut [f32],
 ) {
     let n = codes.len();
-    let mut r = vec![0.0f64; n];
     let mut e = escapes.iter().peekable();
-    let step = params.step;
-    let floor = params.floor;
-    run(n, layout, filter, params.lo, &mut r, |i, p| {
-        if let Some(&&(k, v)) = e.peek()
-            && k as usize == i
-        {
+    let (lo, step, floor) = (params.lo, params.step, params.floor);
+    let mut escaped = |i: usize| match e.peek() {
+        Some(&&(k, v)) if k as usize == i => {
             e.next();
-            out[i] = v;
-            return to_log(v as f64, floor);
+            Some(v)
         }
-        let rec = p + from_code(codes[i]) * step;
-        out[i] = from_log(rec, floor);
-        rec
-    });
+        _ => None,
+    };
+    if params.grid {
+        let mut state = vec![0i64; n];
+        run(n, layout, filter, 0i64, &mut state, |i, p| {
+            if let Some(v) = escaped(i) {
+                out[i] = v;
+                return resolve(p, codes[i], v, params);
+            }
+            let k = p.wrapping_add(from_code(codes[i]) as i64);
+            out[i] = from_log(lo + k as f64 * step, floor);
+            k
+        });
+    } else {
+        // Chunk version 1: an escaped value continues the prediction from its exact L.
+        let mut r = vec![0.0f64; n];
+        run(n, layout, filter, lo, &mut r, |i, p| {
+            if let Some(v) = escaped(i) {
+                out[i] = v;
+                return to_log(v as f64, floor);
+            }
+            let rec = p + from_code(codes[i]) as f64 * step;
+            out[i] = from_log(rec, floor);
+            rec
+        });
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    fn decoded(q: &Encoded, layout: Layout) -> Vec<f32> {
+        let mut out = vec![0.0; q.codes.len()];
+        decode(&q.codes, &q.params, layout, q.filter, &q.escapes, &mut out);
+        out
+    }
+
+    proptest! {
+        /// Without escapes, log16's prediction loop is the integer filter of the same id applied
+        /// to the grid indices: the chooser's proxy is exact, and the two implementations agree.
+        #[test]
+        fn codes_are_the_filter_residuals_of_the_grid_indices(
+            n in 0usize..400, ch in 1usize..5, inner in 1usize..12, next in 1usize..4,
+            f in 0u8..8, freq in 0.01f32..0.5, tol in prop_oneof![Just(1e-3), Just(1e-2)],
+        ) {
+            let data: Vec<f32> = (0..n).map(|k| 1.0 + 0.5 * (k as f32 * freq).sin()).collect();
+            let layout = Layout::new(ch, inner, next);
+            let filter = Filter::from_u8(f).unwrap();
+            let q = encode(&data, layout, tol, None, Some(filter)).unwrap();
+            prop_assert!(q.escapes.is_empty());
+            let k: Vec<u16> = data
+                .iter()
+                .map(|&v| (to_log(v as f64, q.params.floor) / q.params.step).round() as i64 as u16)
+                .collect();
+            let mut want = filter::forward(&k, layout, filter);
+            if filter == Filter::None {
+                want.iter_mut().for_each(|w| *w = w.zigzag());
+            }
+            prop_assert_eq!(&q.codes, &want);
+            for (a, b) in data.iter().zip(decoded(&q, layout)) {
+                prop_assert!((a - b).abs() as f64 <= tol * (*a as f64));
+            }
+        }
+
+        /// Every filter keeps the bound and the sign, on data with zeros, tiny values of both
+        /// signs around the floor, and jumps larger than 16-bit residuals (tolerance 1e-5).
+        #[test]
+        fn every_filter_keeps_the_bound_and_the_sign(
+            data in proptest::collection::vec(prop_oneof![
+                Just(0.0f32), -1e-6f32..1e-6, 0.5f32..2.0, 1e20f32..1e30, -1e3f32..-1e-3,
+            ], 0..200),
+            ch in 1usize..4, inner in 1usize..10, f in 0u8..8,
+            tol in prop_oneof![Just(1e-5), Just(1e-3), Just(0.1)],
+        ) {
+            let layout = Layout::new(ch, inner, 3);
+            let filter = Filter::from_u8(f).unwrap();
+            let q = match encode(&data, layout, tol, Some(1e-4), Some(filter)) {
+                Ok(q) => q,
+                Err(e) => {
+                    prop_assert!(e.to_string().contains("exactly"), "{}", e);
+                    return Ok(());
+                }
+            };
+            for (a, b) in data.iter().zip(decoded(&q, layout)) {
+                let (a, b) = (*a as f64, b as f64);
+                prop_assert!((a - b).abs() <= tol * a.abs().max(1e-4), "{} -> {}", a, b);
+                prop_assert!(a * b >= 0.0, "{} -> {} changed sign", a, b);
+            }
+        }
+    }
+
+    #[test]
+    fn zero_and_values_far_below_the_floor_decode_to_exactly_zero_without_escapes() {
+        let v: Vec<f32> = (0..300)
+            .map(|i| match i % 3 {
+                0 => 0.0,
+                1 => 1e-14 * (i as f32),
+                _ => 1.0 + (i as f32 * 0.01).sin(),
+            })
+            .collect();
+        let layout = Layout::new(3, 20, 5);
+        for filter in Filter::ALL {
+            let q = encode(&v, layout, 1e-3, None, Some(filter)).unwrap();
+            assert!(q.escapes.is_empty(), "{filter:?}: {:?}", q.escapes);
+            let out = decoded(&q, layout);
+            for (i, (a, b)) in v.iter().zip(&out).enumerate() {
+                if i % 3 != 2 {
+                    assert_eq!(*b, 0.0, "{filter:?} [{i}]: {a} -> {b}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn an_overflowing_residual_escapes_and_later_values_recover() {
+        // Tolerance 1e-5 and an explicit floor of 1e-30: the first value (predicted from 0) and
+        // the jumps to and from 1e30 are millions of steps, far beyond a 16-bit residual. Those
+        // three are escaped; the decoder recovers their exact grid index, so the rest is coded.
+        let mut v = vec![1.0f32; 60];
+        v[30] = 1e30;
+        let q = encode(&v, Layout::FLAT, 1e-5, Some(1e-30), Some(Filter::Delta)).unwrap();
+        let at: Vec<u32> = q.escapes.iter().map(|e| e.0).collect();
+        assert_eq!(at, [0, 30, 31]);
+        assert!(q.codes[1..30].iter().all(|&c| c == 0));
+        let out = decoded(&q, Layout::FLAT);
+        for (a, b) in v.iter().zip(&out) {
+            assert!(((a - b).abs() as f64) <= 1e-5 * *a as f64, "{a} -> {b}");
+        }
+    }
 
     #[test]
     fn nan_is_refused_naming_the_index() {

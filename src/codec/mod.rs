@@ -5,10 +5,11 @@
 //! 1. **quantize** ([`quantize`]): f32 bits (lossless), f16, or log16 (error-bounded 16-bit log
 //!    codes, with an exact escape list for negatives and anything the bound would miss);
 //! 2. **predict** ([`filter`]): integer residuals against the previous point along the innermost
-//!    angular axis, or a planar predictor over the two innermost axes, optionally minus the
-//!    previous channel's residual; zigzag-mapped. The caller describes the array with a
-//!    [`Layout`] (plain numbers: channels, inner, next). The encoder picks the cheapest filter per
-//!    chunk unless one is forced, and records it in the chunk header;
+//!    angular axis, the linear extrapolation from the two previous points, or a planar predictor
+//!    over the two innermost axes, optionally minus the previous channel's residual;
+//!    zigzag-mapped. The caller describes the array with a
+//!    [`Layout`] (plain numbers: channels, inner, next). The encoder picks a filter per chunk
+//!    ([`choose`]) unless one is forced, and records it in the chunk header;
 //! 3. **shuffle**: split words into byte planes (high bytes of small residuals are all zero);
 //! 4. **zstd** at a configurable level, multithreaded for large chunks.
 //!
@@ -29,6 +30,7 @@
 //! # Ok::<(), brdftab::Error>(())
 //! ```
 
+pub mod choose;
 pub mod filter;
 pub mod log16;
 pub mod quantize;
@@ -112,7 +114,8 @@ pub struct Codec {
     #[serde(default)]
     pub exhaustive: bool,
     /// Force byte or bit planes; `None`: byte planes (both tried with `exhaustive`). Bit planes
-    /// gain ~2% on f16 tables at half the speed.
+    /// gained ~2% on f16 tables with the first-order filters; with the second-order ones they
+    /// are 5% (f16) and 9% (log16) larger on the codec bench table, and slower.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shuffle: Option<Shuffle>,
 }
@@ -131,15 +134,19 @@ impl Default for Codec {
 
 /// Chunk magic (2 bytes), then version.
 pub const CHUNK_MAGIC: [u8; 2] = *b"BC";
-/// Chunk format version.
-pub const CHUNK_VERSION: u8 = 1;
+/// Chunk format version written. Version 2 forms log16 reconstructions on an integer grid
+/// (see [`log16`]); version 1 chunks (f64 reconstructions) are still read. f32 and f16 chunks
+/// mean the same in both.
+pub const CHUNK_VERSION: u8 = 2;
+/// Oldest chunk format version read.
+pub const CHUNK_VERSION_MIN: u8 = 1;
 /// Length of the fixed chunk header. Layout (little-endian):
 ///
 /// ```text
 ///  0  [u8;2] "BC"         8  u64 n values        28 u32 escapes      56  zstd frame of:
-///  2  u8  version (1)     16 u32 channels        32 f64 lo             byte-shuffled residuals
+///  2  u8  version (1, 2)  16 u32 channels        32 f64 lo             byte-shuffled residuals
 ///  3  u8  quant 0/1/2     20 u32 inner           40 f64 step           (n words), then escape
-///  4  u8  filter 0..4     24 u32 next            48 f64 floor          indices (u32 deltas)
+///  4  u8  filter 0..6     24 u32 next            48 f64 floor          indices (u32 deltas)
 ///  5  u8  shuffle 0/1                            (log16 only, else 0)  and values (f32)
 ///  6  u16 reserved (0)
 /// ```
@@ -148,9 +155,54 @@ pub const CHUNK_HEADER_LEN: usize = 56;
 /// Chunks above this many raw bytes are compressed with zstd's worker threads.
 const MT_THRESHOLD: usize = 8 << 20;
 
+/// zstd calls on up to this many bytes, at levels up to [`REUSE_MAX_LEVEL`], use a context kept
+/// per thread: creating and sizing a context costs about a tenth of compressing a 50 kB chunk,
+/// and the encoder makes three calls per chunk. Larger or slower calls take a fresh context, so
+/// that no thread keeps a large one.
+const REUSE_MAX: usize = 1 << 20;
+/// See [`REUSE_MAX`].
+const REUSE_MAX_LEVEL: i32 = 9;
+
+thread_local! {
+    static CCTX: std::cell::RefCell<Option<zstd::bulk::Compressor<'static>>> =
+        const { std::cell::RefCell::new(None) };
+    static DCTX: std::cell::RefCell<Option<zstd::bulk::Decompressor<'static>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// One zstd frame of `bytes` at `level` (single-threaded; see [`REUSE_MAX`]).
+pub(crate) fn zstd_compress(bytes: &[u8], level: i32) -> std::io::Result<Vec<u8>> {
+    if bytes.len() > REUSE_MAX || level > REUSE_MAX_LEVEL {
+        return zstd::bulk::compress(bytes, level);
+    }
+    CCTX.with(|c| {
+        let mut c = c.borrow_mut();
+        let z = match &mut *c {
+            Some(z) => z,
+            None => c.insert(zstd::bulk::Compressor::new(level)?),
+        };
+        z.set_compression_level(level)?;
+        z.compress(bytes)
+    })
+}
+
+/// Decompresses one zstd frame of at most `capacity` bytes (see [`REUSE_MAX`]).
+fn zstd_decompress(frame: &[u8], capacity: usize) -> std::io::Result<Vec<u8>> {
+    DCTX.with(|d| {
+        let mut d = d.borrow_mut();
+        let z = match &mut *d {
+            Some(z) => z,
+            None => d.insert(zstd::bulk::Decompressor::new()?),
+        };
+        z.decompress(frame, capacity)
+    })
+}
+
 /// What a chunk header says.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ChunkInfo {
+    /// Chunk format version.
+    pub version: u8,
     /// Quantizer name (`f32`, `f16`, `log16`).
     pub quant: &'static str,
     /// The filter the encoder chose.
@@ -211,6 +263,7 @@ pub fn encode(data: &[f32], layout: Layout, codec: &Codec) -> Result<Vec<u8>> {
         lo: 0.0,
         step: 0.0,
         floor: 0.0,
+        grid: false,
     });
     for x in [p.lo, p.step, p.floor] {
         out.extend_from_slice(&x.to_le_bytes());
@@ -272,7 +325,7 @@ fn filtered<W: Word>(
     }
     let f = codec
         .filter
-        .unwrap_or_else(|| filter::choose(words, layout));
+        .unwrap_or_else(|| choose::choose(words, layout));
     let (m, c) = pack(&filter::forward(words, layout, f), &[], codec)?;
     Ok((f, m, c))
 }
@@ -282,7 +335,7 @@ fn compress(bytes: &[u8], level: i32) -> Result<Vec<u8>> {
         msg: format!("zstd: {e}"),
     };
     if bytes.len() < MT_THRESHOLD {
-        return zstd::bulk::compress(bytes, level).map_err(enc_err);
+        return zstd_compress(bytes, level).map_err(enc_err);
     }
     let mut out = Vec::with_capacity(bytes.len() / 4);
     let mut enc = zstd::stream::Encoder::new(&mut out, level).map_err(enc_err)?;
@@ -325,13 +378,13 @@ pub fn chunk_info(bytes: &[u8]) -> Result<ChunkInfo> {
     if bytes[0..2] != CHUNK_MAGIC {
         return Err(bad("magic", 0, "not a brdftab chunk (bad magic)"));
     }
-    if bytes[2] != CHUNK_VERSION {
+    let version = bytes[2];
+    if !(CHUNK_VERSION_MIN..=CHUNK_VERSION).contains(&version) {
         return Err(bad(
             "version",
             2,
             format!(
-                "chunk version {} (this build reads {CHUNK_VERSION})",
-                bytes[2]
+                "chunk version {version} (this build reads {CHUNK_VERSION_MIN} to {CHUNK_VERSION})"
             ),
         ));
     }
@@ -364,6 +417,7 @@ pub fn chunk_info(bytes: &[u8]) -> Result<ChunkInfo> {
             lo: le_f64(bytes, 32),
             step: le_f64(bytes, 40),
             floor: le_f64(bytes, 48),
+            grid: version >= 2,
         };
         if !p.valid() {
             return Err(bad("log16", 32, format!("invalid log16 parameters {p:?}")));
@@ -383,6 +437,7 @@ pub fn chunk_info(bytes: &[u8]) -> Result<ChunkInfo> {
         ));
     }
     Ok(ChunkInfo {
+        version,
         quant,
         filter,
         shuffle,
@@ -444,7 +499,7 @@ fn payload(bytes: &[u8], info: &ChunkInfo) -> Result<Vec<u8>> {
     let frame = &bytes[CHUNK_HEADER_LEN..];
     let zerr = |e: std::io::Error| bad("payload", CHUNK_HEADER_LEN as u64, format!("zstd: {e}"));
     let raw = if raw_len <= 16 << 20 {
-        zstd::bulk::decompress(frame, raw_len).map_err(zerr)?
+        zstd_decompress(frame, raw_len).map_err(zerr)?
     } else {
         use std::io::Read;
         let mut raw = Vec::new();
@@ -581,7 +636,7 @@ mod tests {
 
         #[test]
         fn f32_round_trip_is_bit_exact(data in adversarial(), layout in layouts(),
-                                       f in proptest::option::of(0u8..5)) {
+                                       f in proptest::option::of(0u8..Filter::ALL.len() as u8)) {
             let c = Codec { filter: f.and_then(Filter::from_u8), ..codec(Quant::F32) };
             let b = encode(&data, layout, &c).unwrap();
             let back = decode(&b, data.len()).unwrap();
@@ -633,6 +688,24 @@ mod tests {
             }
         }
 
+        /// Valid chunks of every quantizer and filter with any header byte set to anything and
+        /// payload bytes flipped: decoding returns an error or values, never panics.
+        #[test]
+        fn damaged_chunks_never_panic(data in adversarial(), layout in layouts(),
+                                      q in 0usize..3, f in 0u8..Filter::ALL.len() as u8,
+                                      edits in proptest::collection::vec(
+                                          (any::<usize>(), any::<u8>()), 1..4)) {
+            let quant = [Quant::F32, Quant::F16, Quant::Log16 { tolerance: 1e-2, floor: None }][q];
+            let data: Vec<f32> = data.into_iter().filter(|v| v.abs() <= 65504.0).collect();
+            let c = Codec { filter: Filter::from_u8(f), ..codec(quant) };
+            let Ok(mut b) = encode(&data, layout, &c) else { return Ok(()) };
+            for (at, v) in edits {
+                let at = if at % 2 == 0 { at % CHUNK_HEADER_LEN } else { at % b.len() };
+                b[at] = v;
+            }
+            let _ = decode(&b, data.len());
+        }
+
         #[test]
         fn decode_never_panics_on_garbage(bytes in proptest::collection::vec(any::<u8>(), 0..200),
                                           n in 0usize..1000) {
@@ -653,6 +726,19 @@ mod tests {
         let info = chunk_info(&b).unwrap();
         assert_ne!(info.filter, Filter::None);
         assert!(b.len() * 5 < data.len() * 4, "{} bytes", b.len());
+    }
+
+    #[test]
+    fn chunk_versions_outside_the_readable_range_are_refused() {
+        let mut b = encode(&[1.0, 2.0], Layout::FLAT, &Codec::default()).unwrap();
+        assert_eq!(chunk_info(&b).unwrap().version, CHUNK_VERSION);
+        for v in [0, CHUNK_VERSION + 1, 255] {
+            b[2] = v;
+            let e = decode(&b, 2).unwrap_err().to_string();
+            assert!(e.contains("chunk version"), "{e}");
+        }
+        b[2] = CHUNK_VERSION_MIN;
+        assert_eq!(decode(&b, 2).unwrap(), [1.0, 2.0]);
     }
 
     #[test]
