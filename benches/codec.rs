@@ -1,6 +1,7 @@
 //! Codec benchmark: compressed size, ratio vs f32, compress/decompress MB/s (of f32 input) on a
-//! Cook-Torrance isotropic halfdiff table at the medium preset (90 × – × 90 × 360 full, stored
-//! 90 × 1 × 90 × 90 × RGB with reciprocity and bilateral symmetry), side by side with plain zstd
+//! Cook-Torrance isotropic halfdiff table at the medium (default) preset (90 × – × 180 × 360
+//! full with sqrt θh and uniform-in-cos θd, stored 90 × 1 × 180 × 90 × RGB with reciprocity and
+//! bilateral symmetry), side by side with plain zstd
 //! on the raw f32 bytes and with OpenEXR ZIP / PIZ (exr crate) on the same values. Then the time
 //! to open a 100-table database and do a first lookup.
 //!
@@ -11,6 +12,7 @@ use std::time::{Duration, Instant};
 
 use brdftab::codec::{self, Codec, Quant};
 use brdftab::store::{Source, Store, tables};
+use brdftab::table::presets::Preset;
 use brdftab::table::{Grid, Mapping, Param, Symmetry, Table, pair_of};
 use brdftab::{Channels, ModelSpec};
 use rayon::prelude::*;
@@ -35,7 +37,10 @@ fn time<T>(mut f: impl FnMut() -> T) -> (Duration, T) {
     (best, out.expect("at least one rep"))
 }
 
-fn cook_torrance_table(sizes: [usize; 4]) -> Table {
+/// The bench table: Cook-Torrance on the grid `brdftab bake` uses by default for an isotropic
+/// source (the medium preset: halfdiff, sqrt θh, uniform-in-cos θd, reciprocity + bilateral
+/// symmetry), or on a uniform-θd grid of the given full sizes.
+fn cook_torrance_table(sizes: Option<[usize; 4]>) -> Table {
     let spec =
         ModelSpec::parse(r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#)
             .unwrap();
@@ -45,14 +50,19 @@ fn cook_torrance_table(sizes: [usize; 4]) -> Table {
         reciprocal: true,
         bilateral: true,
     };
-    let g = Grid::with_sizes(
-        Param::HalfDiff,
-        sizes,
-        [Mapping::Sqrt, Mapping::Uniform],
-        Channels::Rgb,
-        sym,
-    )
-    .unwrap();
+    let g = match sizes {
+        None => Preset::Medium
+            .grid(Some(Param::HalfDiff), sym, Channels::Rgb)
+            .unwrap(),
+        Some(sizes) => Grid::with_sizes(
+            Param::HalfDiff,
+            sizes,
+            [Mapping::Sqrt, Mapping::Uniform],
+            Channels::Rgb,
+            sym,
+        )
+        .unwrap(),
+    };
     Table::from_fn(g, brdf.describe(), |_, a, out| {
         let (wi, wo) = pair_of(Param::HalfDiff, a);
         brdf.eval(wi, wo, out);
@@ -143,18 +153,21 @@ fn exr_read(b: &[u8]) -> usize {
     img.layer_data.len()
 }
 
-fn main() {
+/// Sizes, ratios and speeds of every codec on one table.
+fn compare(label: &str, sizes: Option<[usize; 4]>) {
     let t0 = Instant::now();
-    let table = cook_torrance_table([90, 360, 90, 360]);
+    let table = cook_torrance_table(sizes);
     let grid = table.grid().clone();
     let l = grid.layout();
     let raw = table.values().len() * 4;
+    let max = table.values().iter().fold(0.0f32, |m, v| m.max(v.abs()));
     println!(
-        "Cook-Torrance (m 0.3, Au) halfdiff medium: stored {:?} x {} ch = {} values ({:.1} MB f32), {} chunks; baked in {:.2?}; {} threads",
+        "\nCook-Torrance (m 0.3, Au) halfdiff, {label}: stored {:?} x {} ch = {} values ({:.1} MB f32), max {:.4e}, {} chunks; baked in {:.2?}; {} threads",
         l.shape,
         l.channels,
         table.values().len(),
         raw as f64 / 1e6,
+        max,
         l.chunk_count(),
         t0.elapsed(),
         rayon::current_num_threads()
@@ -217,6 +230,14 @@ fn main() {
             3,
         ),
         (
+            "log16 1e-3, zstd-6",
+            Quant::Log16 {
+                tolerance: 1e-3,
+                floor: None,
+            },
+            6,
+        ),
+        (
             "log16 1e-3, zstd-9",
             Quant::Log16 {
                 tolerance: 1e-3,
@@ -233,6 +254,10 @@ fn main() {
             3,
         ),
     ] {
+        if quant == Quant::F16 && max > 65504.0 {
+            println!("{name:<24} n/a: values up to {max:.4e} exceed the f16 range (±65504)");
+            continue;
+        }
         let codec = Codec {
             quant,
             level,
@@ -296,13 +321,21 @@ fn main() {
         let (d, _) = time(|| exr_read(&b));
         row(name, raw, b.len(), c, d, None);
     }
+}
+
+fn main() {
+    compare("medium (default) preset", None);
+    compare(
+        "medium sizes with uniform θd (90 x 360 x 90 x 360; θd nodes end 0.5° from grazing, where f16 holds Cook-Torrance)",
+        Some([90, 360, 90, 360]),
+    );
 
     // Open a 100-table database and do a first lookup.
     let dir = std::env::temp_dir().join(format!("brdftab-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join("db100.btdb");
     let _ = std::fs::remove_file(&p);
-    let small = cook_torrance_table([32, 64, 32, 64]);
+    let small = cook_torrance_table(Some([32, 64, 32, 64]));
     let mut wtr = brdftab::store::Writer::create(&p).unwrap();
     let codec = Codec {
         quant: Quant::F16,

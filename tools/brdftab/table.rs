@@ -47,9 +47,9 @@ pub struct BakeArgs {
     /// log16 absolute floor (default: 1e-7 of each chunk's largest value).
     #[arg(long)]
     pub floor: Option<f64>,
-    /// zstd level (1..=22).
-    #[arg(long, default_value_t = 3)]
-    pub level: i32,
+    /// zstd level (1..=22; default 3 for f32/f16, 6 for log16).
+    #[arg(long)]
+    pub level: Option<i32>,
     /// Try every filter through zstd per chunk and keep the smallest (slower).
     #[arg(long)]
     pub exhaustive: bool,
@@ -137,15 +137,13 @@ pub fn codec(a: &BakeArgs) -> Result<Codec> {
         None => (a.codec.as_str(), None),
     };
     let quant = brdftab::codec::Quant::parse(name.trim(), a.codec_tolerance.or(tol), a.floor)?;
-    if !(1..=22).contains(&a.level) {
-        return Err(Error::arg(
-            "--level",
-            format!("{} is outside 1..=22", a.level),
-        ));
+    let level = a.level.unwrap_or(quant.default_level());
+    if !(1..=22).contains(&level) {
+        return Err(Error::arg("--level", format!("{level} is outside 1..=22")));
     }
     Ok(Codec {
         quant,
-        level: a.level,
+        level,
         exhaustive: a.exhaustive,
         ..Codec::default()
     })
