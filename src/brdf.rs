@@ -128,7 +128,7 @@ pub trait Brdf: Send + Sync {
     ///
     /// The default draws cosine-weighted directions; models override with importance sampling.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        let wo = geometry::normalize(wo)?;
+        let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
             return None;
         }
@@ -156,6 +156,14 @@ pub trait Brdf: Send + Sync {
             (Some(wi), Some(wo)) if wi.z > 0.0 && wo.z > 0.0 => wi.z * std::f64::consts::FRAC_1_PI,
             _ => 0.0,
         }
+    }
+
+    /// `eval` and `pdf` of the same pair in one call (what multiple importance sampling and
+    /// mixtures need): writes f_r into `out[..channels]` and returns pdf(wi | wo). Models whose
+    /// value and density share work (microfacet models: the half vector, D) override it.
+    fn eval_pdf(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) -> f64 {
+        self.eval(wi, wo, out);
+        self.pdf(wi, wo)
     }
 }
 
@@ -190,6 +198,9 @@ macro_rules! forward_brdf {
             }
             fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
                 (**self).pdf(wi, wo)
+            }
+            fn eval_pdf(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) -> f64 {
+                (**self).eval_pdf(wi, wo, out)
             }
         }
     };

@@ -46,6 +46,10 @@ pub struct BlinnPhong {
     n: f64,
     /// (n + 8) / (8π), the normalization of f_r.
     norm: f64,
+    /// (n + 2) / (2π), the normalization of D.
+    ndf_norm: f64,
+    /// 1 / (n + 2), the exponent that inverts the CDF of cos θh.
+    inv_n2: f64,
 }
 
 impl BlinnPhong {
@@ -61,6 +65,8 @@ impl BlinnPhong {
             ks_spec: ks,
             n,
             norm: (n + 8.0) / (8.0 * PI),
+            ndf_norm: (n + 2.0) / (2.0 * PI),
+            inv_n2: 1.0 / (n + 2.0),
         })
     }
 
@@ -92,10 +98,20 @@ impl BlinnPhong {
     #[inline]
     pub fn sample_half_vector(&self, u: DVec2) -> DVec3 {
         // The CDF of cos θh is cos^{n+2} θh; 1 − u avoids u = 0 mapping to the horizon.
-        let cos_t = (1.0 - u.x).powf(1.0 / (self.n + 2.0));
-        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-        let (sp, cp) = (2.0 * PI * u.y).sin_cos();
-        DVec3::new(sin_t * cp, sin_t * sp, cos_t)
+        self.sample_half_vector_pow(u).0
+    }
+
+    /// [`BlinnPhong::sample_half_vector`] with cos^n θh at the drawn h for free: the inversion
+    /// sets cos^{n+2} θh = 1 − u₁, so cos^n θh = (1 − u₁) / cos² θh needs no second power.
+    #[inline]
+    fn sample_half_vector_pow(&self, u: DVec2) -> (DVec3, f64) {
+        let one_minus = 1.0 - u.x;
+        let cos_t = one_minus.powf(self.inv_n2);
+        let cos2 = cos_t * cos_t;
+        let sin_t = (1.0 - cos2).max(0.0).sqrt();
+        let (sp, cp) = crate::fastmath::sin_cos_2pi(u.y);
+        let pow_n = if cos2 > 0.0 { one_minus / cos2 } else { 0.0 };
+        (DVec3::new(sin_t * cp, sin_t * sp, cos_t), pow_n)
     }
 }
 
@@ -141,18 +157,20 @@ impl Brdf for BlinnPhong {
         if wo.z <= 0.0 {
             return None;
         }
-        let h = self.sample_half_vector(u);
+        let (h, pow_n) = self.sample_half_vector_pow(u);
         let wo_h = wo.dot(h);
-        let wi = geometry::normalize(2.0 * wo_h * h - wo)?;
-        if wi.z <= 0.0 || wo_h <= 0.0 {
+        // The mirror image of a unit vector about a unit normal is unit (to rounding).
+        let wi = 2.0 * wo_h * h - wo;
+        if !(wi.z > 0.0 && wo_h > 0.0) {
             return None;
         }
-        let pdf = self.ndf(h) * h.z / (4.0 * wo_h);
+        // pdf = D cos θh / (4 wo·h) with D = (n + 2)/(2π) cos^n θh.
+        let pdf = self.ndf_norm * pow_n * h.z / (4.0 * wo_h);
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
         // f cos θi / pdf with the lobe evaluated at the exact sampled h.
-        let ratio = self.norm * h.z.powf(self.n) * wi.z / pdf;
+        let ratio = self.norm * pow_n * wi.z / pdf;
         for (w, &k) in weight[..self.ks.len()].iter_mut().zip(&self.ks) {
             *w = (k * ratio) as f32;
         }

@@ -50,6 +50,8 @@ struct Geometry {
     l_dot_h: f64,
     /// The half-vector strategy's density D cos α / (4 V·H).
     d_cos_over_4vh: f64,
+    /// cos θ of the (normalized) first direction.
+    l_z: f64,
 }
 
 impl CookTorrance {
@@ -105,7 +107,8 @@ impl CookTorrance {
         (k * n_dot_v).min(k * n_dot_l).min(1.0)
     }
 
-    /// D·G / (4 (N·V)(N·L)) and L·H for a pair, or `None` when invalid or below the horizon.
+    /// D·G / (4 (N·V)(N·L)) and L·H for a pair, or `None` when invalid or below the horizon
+    /// (D·G = 0 where D underflows).
     ///
     /// Written for speed with the half vector left unnormalized: with l, v unit and h = l + v,
     /// cos² α = h_z² / |h|², L·H = V·H = |h| / 2, and the V-cavity factor
@@ -123,7 +126,12 @@ impl CookTorrance {
         let x = (inv_c2 - 1.0) * self.d.inv_m2();
         if x.is_nan() || x >= 700.0 {
             // exp(−x) underflows (or h_z² did): D = 0, and inv_c2 may be infinite.
-            return None;
+            return Some(Geometry {
+                dg: 0.0,
+                l_dot_h: 0.5 * hh.sqrt(),
+                d_cos_over_4vh: 0.0,
+                l_z: l.z,
+            });
         }
         let d = (-x).exp() * self.d.inv_pi_m2() * inv_c2 * inv_c2;
         let g = (4.0 * h.z / hh * l.z.min(v.z)).min(1.0);
@@ -133,6 +141,7 @@ impl CookTorrance {
             l_dot_h: 0.5 * len,
             // D cos α / (4 V·H) with cos α = h_z/|h| and V·H = |h|/2.
             d_cos_over_4vh: 0.5 * d * h.z / hh,
+            l_z: l.z,
         })
     }
 }
@@ -219,16 +228,7 @@ impl Brdf for CookTorrance {
         }
         // Cosine branch: one pass of `geometry` gives f's D·G and, since D cos α / (4 V·H) =
         // D·(h_z/|h|)/(2|h|) with the unnormalized h = l + v, the half-vector density too.
-        let Some(gm) = self.geometry(l, v) else {
-            // D underflows: only the cosine density remains, and f = 0.
-            weight[..c].fill(0.0);
-            let pdf = p * l.z * FRAC_1_PI;
-            return (pdf > 0.0).then_some(BrdfSample {
-                wi: l,
-                pdf,
-                delta: false,
-            });
-        };
+        let gm = self.geometry(l, v)?;
         let pdf = (1.0 - p) * gm.d_cos_over_4vh + p * l.z * FRAC_1_PI;
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
@@ -240,6 +240,18 @@ impl Brdf for CookTorrance {
             pdf,
             delta: false,
         })
+    }
+
+    /// One pass of the shared geometry gives f and the half-vector density.
+    fn eval_pdf(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) -> f64 {
+        let out = &mut out[..self.ks.len()];
+        let Some(g) = self.geometry(wi, wo) else {
+            out.fill(0.0);
+            return 0.0;
+        };
+        self.fresnel.eval_scaled(g.l_dot_h, &self.ks, g.dg, out);
+        let p = self.cos_prob;
+        (1.0 - p) * g.d_cos_over_4vh + p * g.l_z * FRAC_1_PI
     }
 
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {

@@ -181,6 +181,7 @@ impl Ggx {
     /// with spherical caps"): h ∝ c + v, then unstretched. The same density as Heitz's (2018)
     /// projected-disk construction, with three square roots and two divisions instead of five
     /// and three.
+    #[inline]
     pub fn sample_visible_normal(&self, wo: DVec3, u: DVec2) -> DVec3 {
         let (ax, ay) = (self.alpha_x, self.alpha_y);
         let v = DVec3::new(ax * wo.x, ay * wo.y, wo.z).normalize();

@@ -25,9 +25,9 @@
 //! its weight f_r·π = k_d π (A + B max(0, wi_xy·wo_xy)/max(cos θi, cos θo)) is bounded by
 //! k_d π (A + B tan θo).
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
-use crate::brdf::{Brdf, Flags};
+use crate::brdf::{Brdf, BrdfSample, Flags};
 use crate::error::{Error, Result};
 use crate::geometry;
 use crate::spectrum::{Channels, Value};
@@ -105,6 +105,29 @@ impl Brdf for OrenNayar {
 
     fn flags(&self) -> Flags {
         Flags::SMOOTH_SYMMETRIC
+    }
+
+    /// Cosine-weighted sampling (pdf cos θi / π), so the weight is k_d π (A + B …): the
+    /// trait's default strategy, with the factor taken directly from the (unit) directions.
+    fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+        let wo = geometry::unit(wo)?;
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = geometry::cosine_hemisphere(u);
+        let pdf = wi.z * std::f64::consts::FRAC_1_PI;
+        if !(pdf > 0.0) {
+            return None;
+        }
+        let g = self.factor(wi, wo) * std::f64::consts::PI;
+        for (w, &k) in weight[..self.kd.len()].iter_mut().zip(&self.kd) {
+            *w = (k * g) as f32;
+        }
+        Some(BrdfSample {
+            wi,
+            pdf,
+            delta: false,
+        })
     }
 
     fn describe(&self) -> String {

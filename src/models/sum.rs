@@ -337,15 +337,41 @@ impl Brdf for Sum {
                 delta: true,
             });
         }
-        let pdf = self.mixture_pdf(smp.wi, wo, total);
+        // The chosen term already knows its density and, through its weight, its f·cos θi =
+        // weight · pdf: only the other terms are evaluated.
+        let mut pdf = s / total * smp.pdf;
+        let mut fcos = [0.0f64; MAX_CHANNELS];
+        for k in 0..c {
+            fcos[k] = self.weights[j] * tw[k] as f64 * smp.pdf;
+        }
+        let cos_i = smp.wi.z.abs();
+        let mut tmp = [0.0f32; MAX_CHANNELS];
+        for (k, t) in self.terms.iter().enumerate() {
+            if k == j {
+                continue;
+            }
+            let sk = self.selection(k, wo.z);
+            let w = self.weights[k];
+            let pk = if w != 0.0 {
+                let pk = t.eval_pdf(smp.wi, wo, &mut tmp[..c]);
+                for ch in 0..c {
+                    fcos[ch] += w * tmp[ch] as f64 * cos_i;
+                }
+                pk
+            } else if sk > 0.0 {
+                t.pdf(smp.wi, wo)
+            } else {
+                0.0
+            };
+            if sk > 0.0 {
+                pdf += sk / total * pk;
+            }
+        }
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
-        let mut f = [0.0f32; MAX_CHANNELS];
-        self.eval(smp.wi, wo, &mut f[..c]);
-        let cos_i = smp.wi.z.abs();
-        for (o, &fk) in weight[..c].iter_mut().zip(&f[..c]) {
-            *o = (fk as f64 * cos_i / pdf) as f32;
+        for (o, &fk) in weight[..c].iter_mut().zip(&fcos[..c]) {
+            *o = (fk / pdf) as f32;
         }
         Some(BrdfSample {
             wi: smp.wi,

@@ -154,6 +154,21 @@ pub fn check_sampling_consistency<B: Brdf + ?Sized>(brdf: &B, wos: &[DVec3], n: 
             );
             let mut f = [0.0f32; MAX_CHANNELS];
             brdf.eval(s.wi, wo, &mut f[..c]);
+            // The fused eval_pdf agrees with eval and pdf.
+            let mut f2 = [0.0f32; MAX_CHANNELS];
+            let p2 = brdf.eval_pdf(s.wi, wo, &mut f2[..c]);
+            assert!(
+                (p2 - pdf).abs() <= 1e-12 * pdf,
+                "eval_pdf pdf {p2} vs {pdf}"
+            );
+            for k in 0..c {
+                assert!(
+                    (f2[k] - f[k]).abs() <= 1e-6 * f[k].abs(),
+                    "eval_pdf f {} vs {}",
+                    f2[k],
+                    f[k]
+                );
+            }
             for k in 0..c {
                 let expect = f[k] as f64 * s.wi.z / s.pdf;
                 assert!(
