@@ -151,7 +151,7 @@ fn main() {
         reciprocal: false,
         bilateral: false,
     };
-    for preset in [Preset::Medium, Preset::Large] {
+    for preset in [Preset::Small, Preset::Medium, Preset::Large] {
         let grid = preset.grid(None, iso, brdftab::Channels::Rgb).unwrap();
         let t = Instant::now();
         let (table, _) = bake(&b, &grid, &BakeOptions::default()).unwrap();
