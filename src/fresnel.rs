@@ -124,11 +124,24 @@ pub fn conductor(cos_i: f64, n: f64, k: f64) -> f64 {
 /// results), written over fixed-size arrays so that the square roots and divisions vectorize.
 #[inline]
 pub fn conductor_lanes<const N: usize>(cos_i: f64, n: [f64; N], k: [f64; N]) -> [f64; N] {
+    conductor_lanes_c2(cos_i, cos_i * cos_i, n, k)
+}
+
+/// [`conductor_lanes`] with cos² θ′ supplied by the caller (`cos2_i`, consistent with `cos_i`
+/// to rounding): a caller that has cos² before cos (a quotient before its square root) starts
+/// the two square roots of the formula, which need only cos², without waiting for cos.
+#[inline]
+pub fn conductor_lanes_c2<const N: usize>(
+    cos_i: f64,
+    cos2_i: f64,
+    n: [f64; N],
+    k: [f64; N],
+) -> [f64; N] {
     if cos_i.is_nan() || cos_i <= 0.0 {
         return [1.0; N];
     }
     let c = cos_i.min(1.0);
-    let cos2 = c * c;
+    let cos2 = cos2_i.min(1.0);
     let sin2 = 1.0 - cos2;
     let mut out = [0.0; N];
     let mut t0 = [0.0; N];
@@ -407,6 +420,13 @@ impl Fresnel {
     /// the loop is straight-line arithmetic the compiler can vectorize.
     #[inline]
     pub fn eval_scaled(&self, cos_i: f64, scale: &[f64], s: f64, out: &mut [f32]) {
+        self.eval_scaled_c2(cos_i, cos_i * cos_i, scale, s, out)
+    }
+
+    /// [`Fresnel::eval_scaled`] with cos² θ′ supplied by the caller (see
+    /// [`conductor_lanes_c2`]; other variants use `cos_i` alone).
+    #[inline]
+    pub fn eval_scaled_c2(&self, cos_i: f64, cos2_i: f64, scale: &[f64], s: f64, out: &mut [f32]) {
         match self {
             Fresnel::None => {
                 for (o, &k) in out.iter_mut().zip(scale) {
@@ -422,8 +442,12 @@ impl Fresnel {
                 ) {
                     // RGB: the three channels as lanes of one fixed-size computation, which the
                     // compiler turns into packed square roots and divisions.
-                    let f =
-                        conductor_lanes(cos_i, [n[0], n[1], n[2], n[0]], [k[0], k[1], k[2], k[0]]);
+                    let f = conductor_lanes_c2(
+                        cos_i,
+                        cos2_i,
+                        [n[0], n[1], n[2], n[0]],
+                        [k[0], k[1], k[2], k[0]],
+                    );
                     for c in 0..3 {
                         o[c] = (ks[c] * s * f[c]) as f32;
                     }

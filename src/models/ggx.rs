@@ -183,14 +183,28 @@ impl Ggx {
     /// and three.
     #[inline]
     pub fn sample_visible_normal(&self, wo: DVec3, u: DVec2) -> DVec3 {
+        self.visible_normal_unnormalized(wo, u).0.normalize()
+    }
+
+    /// The visible normal of [`Ggx::sample_visible_normal`] before its final normalization,
+    /// g = (α_x h_x, α_y h_y, h_z) for the stretched-space normal h = c + v (times |s|, see
+    /// below), together with |h|² (h_z clamped at 0). With n = g/|g|, the NDF's e = (n_x/α_x)² + (n_y/α_y)² + n_z²
+    /// is |h|² / |g|², so callers get D without normalizing.
+    #[inline]
+    fn visible_normal_unnormalized(&self, wo: DVec3, u: DVec2) -> (DVec3, f64) {
         let (ax, ay) = (self.alpha_x, self.alpha_y);
-        let v = DVec3::new(ax * wo.x, ay * wo.y, wo.z).normalize();
-        // Uniform on the cap z ∈ [−v_z, 1].
-        let z = (1.0 - u.x) * (1.0 + v.z) - v.z;
-        let sin_t = (1.0 - z * z).max(0.0).sqrt();
+        // The stretched view direction s, |s| = l, v = s/l. Everything below is scaled by l
+        // (only the direction of g matters, and |h|²/|g|² is scale-free), which spares the
+        // division that normalizing v would cost: l·z = (1 − u₁) l − u₁ s_z for z uniform on
+        // the cap [−v_z, 1], l·sin θ = √(l² − (l z)²), and l·h = l·c + s.
+        let s = DVec3::new(ax * wo.x, ay * wo.y, wo.z);
+        let l2 = s.length_squared();
+        let l = l2.sqrt();
+        let lz = (1.0 - u.x) * l - u.x * s.z;
+        let lsin = (l2 - lz * lz).max(0.0).sqrt();
         let (sp, cp) = crate::fastmath::sin_cos_2pi(u.y);
-        let h = DVec3::new(sin_t * cp, sin_t * sp, z) + v;
-        DVec3::new(ax * h.x, ay * h.y, h.z.max(0.0)).normalize()
+        let h = DVec3::new(lsin * cp + s.x, lsin * sp + s.y, (lz + s.z).max(0.0));
+        (DVec3::new(ax * h.x, ay * h.y, h.z), h.length_squared())
     }
 
     /// The density of visible normals D_wo(h) = G1(wo) max(0, wo·h) D(h) / cos θo for unit `wo`
@@ -253,16 +267,23 @@ impl Brdf for Ggx {
         if wo.z <= 0.0 {
             return None;
         }
-        let h = self.sample_visible_normal(wo, u);
-        let wo_h = wo.dot(h);
-        if wo_h.is_nan() || wo_h <= 0.0 {
+        // The reflection about n = g/|g| needs only 1/|g|² (wi = 2 (wo·g)/|g|² g − wo, unit to
+        // rounding); the square root for wo·n runs beside it, off the critical path.
+        let (g, hh) = self.visible_normal_unnormalized(wo, u);
+        let gg = g.length_squared();
+        let wo_g = wo.dot(g);
+        if !(wo_g > 0.0 && gg > 0.0) {
             return None;
         }
-        // The mirror image of a unit vector about a unit normal is unit (to rounding).
-        let wi = 2.0 * wo_h * h - wo;
+        let inv_gg = 1.0 / gg;
+        let wi = (2.0 * wo_g * inv_gg) * g - wo;
         if wi.z.is_nan() || wi.z <= 0.0 {
             return None;
         }
+        // cos and cos² of the Fresnel angle: the quotient is ready before the root, and the
+        // conductor formula's own roots need only cos².
+        let wo_h = wo_g / gg.sqrt();
+        let wo_h2 = wo_g * wo_g * inv_gg;
         // Λ = s²/q for both directions (see `lambda_parts`), so that pdf and weight each take
         // one division:
         // pdf = D / (4 cos θo (1 + Λo)) = q_o / (π α_x α_y e² · 4 cos θo (q_o + s_o²)),
@@ -270,15 +291,14 @@ impl Brdf for Ggx {
         //                = k_s F (q_o + s_o²) q_i / (q_i q_o + s_i² q_o + s_o² q_i).
         let (s2o, qo) = self.lambda_parts(wo);
         let (s2i, qi) = self.lambda_parts(wi);
-        let (x, y) = (h.x * self.inv_alpha.0, h.y * self.inv_alpha.1);
-        let e = x * x + y * y + h.z * h.z;
-        let pdf = self.inv_pi_axay * qo / (e * e * 4.0 * wo.z * (qo + s2o));
+        // e = |h|²/|g|² (see `visible_normal_unnormalized`).
+        let pdf = self.inv_pi_axay * qo * (gg * gg) / (hh * hh * 4.0 * wo.z * (qo + s2o));
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
         }
         let ratio = (qo + s2o) * qi / (qi * qo + s2i * qo + s2o * qi);
         self.fresnel
-            .eval_scaled(wo_h, &self.ks, ratio, &mut weight[..self.ks.len()]);
+            .eval_scaled_c2(wo_h, wo_h2, &self.ks, ratio, &mut weight[..self.ks.len()]);
         Some(BrdfSample {
             wi,
             pdf,
