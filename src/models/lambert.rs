@@ -105,6 +105,18 @@ impl Brdf for Lambert {
         })
     }
 
+    /// k_d and cos θi / π, normalizing only `wi` (the density needs its cosine; `wo` only its
+    /// sign).
+    fn eval_pdf(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) -> f64 {
+        self.eval(wi, wo, out);
+        let l2 = wi.length_squared();
+        if wi.z > 0.0 && wo.z > 0.0 && l2 > 0.0 && l2.is_finite() && wo.is_finite() {
+            wi.z / l2.sqrt() * std::f64::consts::FRAC_1_PI
+        } else {
+            0.0
+        }
+    }
+
     /// The cosine density cos θi / π (0 below the horizon or for invalid directions).
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
         match geometry::upper_pair(wi, wo) {

@@ -157,6 +157,101 @@ impl Sum {
             .sum()
     }
 
+    /// [`Brdf::sample`] with scratch arrays of `N` ≥ channels entries (4 for RGB, so the
+    /// per-call scratch is not a kilobyte of zeroes).
+    fn sample_n<const N: usize>(
+        &self,
+        wo: DVec3,
+        u: DVec2,
+        weight: &mut [f32],
+    ) -> Option<BrdfSample> {
+        let wo = geometry::unit(wo)?;
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let total = self.total_selection(wo.z);
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        // Choose term j by u.x and reuse the remainder of u.x within its interval.
+        let target = u.x * total;
+        let mut cum = 0.0;
+        let mut chosen = None;
+        let mut last = None;
+        for j in 0..self.terms.len() {
+            let s = self.selection(j, wo.z);
+            if s <= 0.0 {
+                continue;
+            }
+            if target < cum + s {
+                chosen = Some((j, s, ((target - cum) / s).clamp(0.0, 1.0 - f64::EPSILON)));
+                break;
+            }
+            cum += s;
+            last = Some(j);
+        }
+        // Rounding can leave target ≥ the accumulated total: that is the end of the last term.
+        let chosen =
+            chosen.or_else(|| last.map(|j| (j, self.selection(j, wo.z), 1.0 - f64::EPSILON)));
+        let (j, s, ux) = chosen?;
+        let pj = s / total;
+        let c = self.channels.len();
+        let mut tw = [0.0f32; N];
+        let smp = self.terms[j].sample(wo, DVec2::new(ux, u.y), &mut tw[..c])?;
+        if smp.delta {
+            let scale = self.weights[j] / pj;
+            for (o, &t) in weight[..c].iter_mut().zip(&tw[..c]) {
+                *o = (scale * t as f64) as f32;
+            }
+            return Some(BrdfSample {
+                wi: smp.wi,
+                pdf: pj * smp.pdf,
+                delta: true,
+            });
+        }
+        // The chosen term already knows its density and, through its weight, its f·cos θi =
+        // weight · pdf: only the other terms are evaluated.
+        let mut pdf = s / total * smp.pdf;
+        let mut fcos = [0.0f64; N];
+        for k in 0..c {
+            fcos[k] = self.weights[j] * tw[k] as f64 * smp.pdf;
+        }
+        let cos_i = smp.wi.z.abs();
+        let mut tmp = [0.0f32; N];
+        for (k, t) in self.terms.iter().enumerate() {
+            if k == j {
+                continue;
+            }
+            let sk = self.selection(k, wo.z);
+            let w = self.weights[k];
+            let pk = if w != 0.0 {
+                let pk = t.eval_pdf(smp.wi, wo, &mut tmp[..c]);
+                for ch in 0..c {
+                    fcos[ch] += w * tmp[ch] as f64 * cos_i;
+                }
+                pk
+            } else if sk > 0.0 {
+                t.pdf(smp.wi, wo)
+            } else {
+                0.0
+            };
+            if sk > 0.0 {
+                pdf += sk / total * pk;
+            }
+        }
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        for (o, &fk) in weight[..c].iter_mut().zip(&fcos[..c]) {
+            *o = (fk / pdf) as f32;
+        }
+        Some(BrdfSample {
+            wi: smp.wi,
+            pdf,
+            delta: false,
+        })
+    }
+
     /// The smooth mixture density Σ_j p_j pdf_j(wi, wo) for `total` = Σ_j w_j â_j.
     fn mixture_pdf(&self, wi: DVec3, wo: DVec3, total: f64) -> f64 {
         let mut pdf = 0.0;
@@ -293,91 +388,11 @@ impl Brdf for Sum {
     }
 
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 {
-            return None;
+        if self.channels.len() <= 4 {
+            self.sample_n::<4>(wo, u, weight)
+        } else {
+            self.sample_n::<MAX_CHANNELS>(wo, u, weight)
         }
-        let total = self.total_selection(wo.z);
-        if !(total > 0.0 && total.is_finite()) {
-            return None;
-        }
-        // Choose term j by u.x and reuse the remainder of u.x within its interval.
-        let target = u.x * total;
-        let mut cum = 0.0;
-        let mut chosen = None;
-        let mut last = None;
-        for j in 0..self.terms.len() {
-            let s = self.selection(j, wo.z);
-            if s <= 0.0 {
-                continue;
-            }
-            if target < cum + s {
-                chosen = Some((j, s, ((target - cum) / s).clamp(0.0, 1.0 - f64::EPSILON)));
-                break;
-            }
-            cum += s;
-            last = Some(j);
-        }
-        // Rounding can leave target ≥ the accumulated total: that is the end of the last term.
-        let chosen =
-            chosen.or_else(|| last.map(|j| (j, self.selection(j, wo.z), 1.0 - f64::EPSILON)));
-        let (j, s, ux) = chosen?;
-        let pj = s / total;
-        let c = self.channels.len();
-        let mut tw = [0.0f32; MAX_CHANNELS];
-        let smp = self.terms[j].sample(wo, DVec2::new(ux, u.y), &mut tw[..c])?;
-        if smp.delta {
-            let scale = self.weights[j] / pj;
-            for (o, &t) in weight[..c].iter_mut().zip(&tw[..c]) {
-                *o = (scale * t as f64) as f32;
-            }
-            return Some(BrdfSample {
-                wi: smp.wi,
-                pdf: pj * smp.pdf,
-                delta: true,
-            });
-        }
-        // The chosen term already knows its density and, through its weight, its f·cos θi =
-        // weight · pdf: only the other terms are evaluated.
-        let mut pdf = s / total * smp.pdf;
-        let mut fcos = [0.0f64; MAX_CHANNELS];
-        for k in 0..c {
-            fcos[k] = self.weights[j] * tw[k] as f64 * smp.pdf;
-        }
-        let cos_i = smp.wi.z.abs();
-        let mut tmp = [0.0f32; MAX_CHANNELS];
-        for (k, t) in self.terms.iter().enumerate() {
-            if k == j {
-                continue;
-            }
-            let sk = self.selection(k, wo.z);
-            let w = self.weights[k];
-            let pk = if w != 0.0 {
-                let pk = t.eval_pdf(smp.wi, wo, &mut tmp[..c]);
-                for ch in 0..c {
-                    fcos[ch] += w * tmp[ch] as f64 * cos_i;
-                }
-                pk
-            } else if sk > 0.0 {
-                t.pdf(smp.wi, wo)
-            } else {
-                0.0
-            };
-            if sk > 0.0 {
-                pdf += sk / total * pk;
-            }
-        }
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
-        for (o, &fk) in weight[..c].iter_mut().zip(&fcos[..c]) {
-            *o = (fk / pdf) as f32;
-        }
-        Some(BrdfSample {
-            wi: smp.wi,
-            pdf,
-            delta: false,
-        })
     }
 
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
