@@ -202,9 +202,7 @@ impl Lookup {
     }
 
     /// Trilinear accumulation over axes 0, 2, 3 at axis-1 node `l[1].0` for exactly `N`
-    /// channels: all eight corners unconditionally (a corner of weight 0 adds 0 — stored values
-    /// are finite), with fixed trip counts, so the loops unroll and the eight loads are issued
-    /// together instead of one dependent branch at a time.
+    /// channels (see [`Cube`]).
     #[inline(always)]
     fn accumulate_cube<'a, const N: usize>(
         &self,
@@ -212,34 +210,60 @@ impl Lookup {
         out: &mut [f32],
         chunk: impl Fn(usize) -> &'a [f32],
     ) {
+        self.cube(l, chunk).gather::<N>(out);
+    }
+
+    /// The eight corners of a lookup on an isotropic (or axis-1-node) unpacked table.
+    #[inline(always)]
+    fn cube<'a>(
+        &self,
+        l: &[(usize, usize, f32); 4],
+        chunk: impl Fn(usize) -> &'a [f32],
+    ) -> Cube<'a> {
         let c = self.channels;
         let s3 = self.shape[3];
         let (sp, sb) = (self.shape[2] * s3 * c, s3 * c);
         let base = l[1].0 * sp;
         // A second θ1 node of weight 0 is not touched (it may be a chunk not yet decoded).
         let d0 = chunk(l[0].0);
-        let data = [d0, if l[0].2 == 0.0 { d0 } else { chunk(l[0].1) }];
-        let ob = [base + l[2].0 * sb, base + l[2].1 * sb];
-        let oq = [l[3].0 * c, l[3].1 * c];
-        let wa = [1.0 - l[0].2, l[0].2];
-        let wb = [1.0 - l[2].2, l[2].2];
-        let wq = [1.0 - l[3].2, l[3].2];
-        let mut acc = [0.0f32; N];
-        for i in 0..2 {
-            for j in 0..2 {
-                let w = wa[i] * wb[j];
-                for k in 0..2 {
-                    let off = ob[j] + oq[k];
-                    if let Some(v) = data[i].get(off..off + N) {
-                        let wt = w * wq[k];
-                        for ch in 0..N {
-                            acc[ch] += wt * v[ch];
-                        }
-                    }
-                }
-            }
+        Cube {
+            data: [d0, if l[0].2 == 0.0 { d0 } else { chunk(l[0].1) }],
+            ob: [base + l[2].0 * sb, base + l[2].1 * sb],
+            oq: [l[3].0 * c, l[3].1 * c],
+            wa: [1.0 - l[0].2, l[0].2],
+            wb: [1.0 - l[2].2, l[2].2],
+            wq: [1.0 - l[3].2, l[3].2],
         }
-        out[..N].copy_from_slice(&acc);
+    }
+
+    /// The first phase of a linear lookup, for batches: coordinates, nodes and weights, without
+    /// reading any stored value, so that a caller can prefetch the corners of several lookups
+    /// before gathering them ([`Prepared::gather`]).
+    #[inline]
+    pub fn prepare<'a>(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        chunk: impl Fn(usize) -> &'a [f32],
+    ) -> Prepared<'a> {
+        let c = self.channels;
+        if self.packed || !(c == 3 || c == 1) {
+            return Prepared::General;
+        }
+        let Some(x) = canonical_coords_fast(self.param, self.sym, wi, wo) else {
+            return Prepared::Zero;
+        };
+        let ax = &self.axes;
+        let l = [
+            ax[0].linear(x[0]),
+            ax[1].linear(x[1]),
+            ax[2].linear(x[2]),
+            ax[3].linear(x[3]),
+        ];
+        if l[1].2 != 0.0 {
+            return Prepared::General;
+        }
+        Prepared::Cube(self.cube(&l, chunk))
     }
 
     /// Multilinear accumulation for packed `inout` reciprocity: corners below the diagonal are
@@ -272,6 +296,107 @@ impl Lookup {
                     }
                 }
             }
+        }
+    }
+}
+
+/// The eight corners of a trilinear lookup over stored axes 0, 2 and 3: the two θ1-node
+/// chunks, the offsets along axes 2 and 3 and the weights. All eight corners are read
+/// unconditionally (a corner of weight 0 adds 0 — stored values are finite), with fixed trip
+/// counts, so the loops unroll and the eight loads are issued together.
+#[derive(Debug, Clone, Copy)]
+pub struct Cube<'a> {
+    data: [&'a [f32]; 2],
+    ob: [usize; 2],
+    oq: [usize; 2],
+    wa: [f32; 2],
+    wb: [f32; 2],
+    wq: [f32; 2],
+}
+
+impl Cube<'_> {
+    /// Accumulates exactly `N` channels into `out[..N]` (a corner outside its chunk — a chunk
+    /// that could not be loaded — counts as 0).
+    #[inline(always)]
+    fn gather<const N: usize>(&self, out: &mut [f32]) {
+        let mut acc = [0.0f32; N];
+        for i in 0..2 {
+            for j in 0..2 {
+                let w = self.wa[i] * self.wb[j];
+                for k in 0..2 {
+                    let off = self.ob[j] + self.oq[k];
+                    if let Some(v) = self.data[i].get(off..off + N) {
+                        let wt = w * self.wq[k];
+                        for ch in 0..N {
+                            acc[ch] += wt * v[ch];
+                        }
+                    }
+                }
+            }
+        }
+        out[..N].copy_from_slice(&acc);
+    }
+
+    /// Hints the processor to fetch the cache lines of the four (θ1, θ2) corner rows.
+    #[inline(always)]
+    fn prefetch(&self) {
+        #[cfg(target_arch = "x86_64")]
+        for d in &self.data {
+            for &o in &self.ob {
+                if let Some(v) = d.get(o + self.oq[0]) {
+                    // SAFETY: prefetching is a hint with no effect on memory or on faults; the
+                    // address is in bounds anyway.
+                    #[allow(unused_unsafe)]
+                    unsafe {
+                        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+                            v as *const f32 as *const i8,
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A lookup after its first phase ([`Lookup::prepare`]).
+#[derive(Debug, Clone, Copy)]
+pub enum Prepared<'a> {
+    /// The pair is invalid or below the horizon: every channel is 0.
+    Zero,
+    /// An eight-corner lookup, ready to prefetch and gather.
+    Cube(Cube<'a>),
+    /// A lookup the two-phase path does not cover (packed `inout`, channel counts other than
+    /// 1 and 3, anisotropic off-node): use [`Lookup::eval`].
+    General,
+}
+
+impl Prepared<'_> {
+    /// Prefetches the corners' cache lines (a no-op for the other variants).
+    #[inline(always)]
+    pub fn prefetch(&self) {
+        if let Prepared::Cube(c) = self {
+            c.prefetch();
+        }
+    }
+
+    /// Writes the lookup's `channels` values into `out`; returns `false` for
+    /// [`Prepared::General`] (nothing written: call [`Lookup::eval`]).
+    #[inline(always)]
+    pub fn gather(&self, channels: usize, out: &mut [f32]) -> bool {
+        match self {
+            Prepared::Zero => {
+                out[..channels].fill(0.0);
+                true
+            }
+            Prepared::Cube(c) => {
+                if channels == 3 {
+                    c.gather::<3>(out);
+                } else {
+                    c.gather::<1>(out);
+                }
+                true
+            }
+            Prepared::General => false,
         }
     }
 }

@@ -21,8 +21,11 @@ use crate::error::{Error, Result};
 use crate::spectrum::Channels;
 use crate::table::Table;
 use crate::table::grid::Grid;
-use crate::table::lookup::{Interp, Lookup};
+use crate::table::lookup::{Interp, Lookup, Prepared};
 use crate::table::sampling::{SamplingResolution, TableSampler};
+
+/// Lookups per group in [`TabulatedBrdf::eval_batch`]'s two-phase loop.
+const GROUP: usize = 8;
 
 /// Supplies the values of a chunk on demand (decoding, reading from disk, ...).
 pub trait ChunkLoader: Send + Sync {
@@ -103,6 +106,34 @@ impl TabulatedBrdf {
             description: description.into(),
             error: Mutex::new(None),
             sampler: OnceLock::new(),
+        }
+    }
+
+    /// Evaluates `out.len() / channels` pairs. Linear lookups run in groups of [`GROUP`] in
+    /// two phases — coordinates and corners for the whole group, with a prefetch of each
+    /// lookup's cache lines, then the gathers — so that the group's memory accesses overlap
+    /// instead of each lookup waiting for its own.
+    fn eval_block(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
+        let c = self.lookup.channels();
+        if self.interp != Interp::Linear {
+            for (k, oc) in out.chunks_exact_mut(c).enumerate() {
+                self.eval(wi[k], wo[k], oc);
+            }
+            return;
+        }
+        for (g, og) in out.chunks_mut(GROUP * c).enumerate() {
+            let s = g * GROUP;
+            let m = og.len() / c;
+            let mut prep = [Prepared::Zero; GROUP];
+            for k in 0..m {
+                prep[k] = self.lookup.prepare(wi[s + k], wo[s + k], |a| self.chunk(a));
+                prep[k].prefetch();
+            }
+            for (k, oc) in og.chunks_exact_mut(c).enumerate() {
+                if !prep[k].gather(c, oc) {
+                    self.eval(wi[s + k], wo[s + k], oc);
+                }
+            }
         }
     }
 
@@ -274,14 +305,10 @@ impl Brdf for TabulatedBrdf {
                 .enumerate()
                 .for_each(|(b, o)| {
                     let s = b * BLOCK;
-                    for (k, oc) in o.chunks_exact_mut(c).enumerate() {
-                        self.eval(wi[s + k], wo[s + k], oc);
-                    }
+                    self.eval_block(&wi[s..], &wo[s..], o);
                 });
         } else {
-            for (k, oc) in out[..n * c].chunks_exact_mut(c).enumerate() {
-                self.eval(wi[k], wo[k], oc);
-            }
+            self.eval_block(wi, wo, &mut out[..n * c]);
         }
     }
 }
