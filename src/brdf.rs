@@ -105,11 +105,25 @@ pub trait Brdf: Send + Sync {
     }
 
     /// Evaluates many pairs: `out[k * c .. (k + 1) * c]` receives f_r(wi[k], wo[k]) where `c` is
-    /// the channel count. Tables override this for throughput.
+    /// the channel count. Batches of 16 384 pairs or more run on rayon's threads; tables
+    /// override this for throughput.
     fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
-        let c = self.channels().len();
-        for ((a, b), o) in wi.iter().zip(wo).zip(out.chunks_exact_mut(c)) {
-            self.eval(*a, *b, o);
+        use rayon::prelude::*;
+        let c = self.channels().len().max(1);
+        let n = wi.len().min(wo.len()).min(out.len() / c);
+        const BLOCK: usize = 4096;
+        let run = |s: usize, o: &mut [f32]| {
+            for ((a, b), o) in wi[s..].iter().zip(&wo[s..]).zip(o.chunks_exact_mut(c)) {
+                self.eval(*a, *b, o);
+            }
+        };
+        if n >= 4 * BLOCK {
+            out[..n * c]
+                .par_chunks_mut(BLOCK * c)
+                .enumerate()
+                .for_each(|(b, o)| run(b * BLOCK, o));
+        } else {
+            run(0, &mut out[..n * c]);
         }
     }
 

@@ -383,7 +383,7 @@ pub fn bench(a: BenchArgs) -> Result<()> {
         batch.push(n / t.elapsed().as_secs_f64());
         if let (Some(a0), Some(a1)) = (cpu, process_cpu_ns()) {
             // Per core of CPU time: independent of how busy the machine is and of how many
-            // threads `eval_batch` used (tables: all of rayon's; analytic models: one).
+            // threads `eval_batch` used.
             batch_cpu.push(n / ((a1 - a0) as f64 * 1e-9));
         }
         std::hint::black_box(&out);
