@@ -1,4 +1,4 @@
-//! Sine and cosine without libm on the hot paths of sampling.
+//! Sine, cosine and floor without libm on the hot paths of sampling and lookup.
 //!
 //! Every importance sampler turns a uniform number into an azimuth and needs its sine and cosine;
 //! glibc's `sincos` costs 15–20 ns there because it must handle any argument. The arguments in
@@ -8,6 +8,20 @@
 //! from the remainder bound: x¹⁷/17! ≤ 4.6·10⁻¹⁷ for |x| ≤ π/4, below half an ulp of 1.
 
 use std::f64::consts::FRAC_PI_2;
+
+/// ⌊x⌋ without `f64::floor`, which is a libm call on baseline x86-64 (no SSE4.1 `roundsd`):
+/// truncation corrected by one for negative non-integers. NaN gives 0 and |x| ≥ 2⁶³ saturates
+/// (callers clamp the result to an index range anyway).
+///
+/// ```
+/// use brdftab::fastmath::floor;
+/// assert_eq!((floor(2.7), floor(-2.5), floor(-3.0)), (2.0, -3.0, -3.0));
+/// ```
+#[inline(always)]
+pub fn floor(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    if t > x { t - 1.0 } else { t }
+}
 
 /// (sin x, cos x) for |x| ≤ π/4 (larger |x| loses accuracy quickly; NaN stays NaN).
 ///
@@ -75,6 +89,27 @@ pub fn sin_cos_2pi(u: f64) -> (f64, f64) {
 mod tests {
     use super::*;
     use std::f64::consts::{FRAC_PI_4, PI};
+
+    #[test]
+    fn floor_matches_libm_on_finite_input() {
+        let mut x = -1000.0f64;
+        while x < 1000.0 {
+            assert_eq!(floor(x), x.floor(), "{x}");
+            x += 0.173;
+        }
+        for x in [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0 - 1e-16,
+            -1e-300,
+            4503599627370497.0,
+        ] {
+            assert_eq!(floor(x), x.floor(), "{x}");
+        }
+        assert_eq!(floor(f64::NAN), 0.0);
+    }
 
     #[test]
     fn quarter_range_matches_libm_to_two_ulps_of_one() {

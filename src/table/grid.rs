@@ -360,9 +360,9 @@ impl StoredAxis {
     #[inline]
     pub fn nearest(&self, x: f64) -> usize {
         let i = if self.nodes == Nodes::CellStart {
-            floor(self.cell_coordinate::<true>(x))
+            crate::fastmath::floor(self.cell_coordinate::<true>(x))
         } else {
-            floor(self.continuous(x) + 0.5)
+            crate::fastmath::floor(self.continuous(x) + 0.5)
         };
         self.index(i)
     }
@@ -416,14 +416,6 @@ impl StoredAxis {
             (i0, i0 + 1, (s - i0 as f64) as f32)
         }
     }
-}
-
-/// ⌊x⌋ without `f64::floor`, which is a libm call on baseline x86-64 (no SSE4.1): truncation
-/// (saturating, NaN → 0) corrected by one for negative non-integers.
-#[inline(always)]
-fn floor(x: f64) -> f64 {
-    let t = x as i64 as f64;
-    if t > x { t - 1.0 } else { t }
 }
 
 /// A dense table's grid: parameterization, four full angular axes, channels and the symmetry

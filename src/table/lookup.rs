@@ -126,21 +126,14 @@ impl Lookup {
                 }
             }
             Interp::Linear => {
-                let l = [
-                    ax[0].linear(x[0]),
-                    ax[1].linear(x[1]),
-                    ax[2].linear(x[2]),
-                    ax[3].linear(x[3]),
-                ];
+                let l = self.linear_nodes(x);
                 if self.packed {
                     self.accumulate_packed(&l, out, chunk);
-                } else if l[1].2 == 0.0 && (c == 3 || c == 1) {
+                } else if l[1].2 == 0.0 && c == 3 {
                     // Isotropic tables (axis 1 of size 1) and any lookup on an axis-1 node.
-                    if c == 3 {
-                        self.accumulate_cube::<3>(&l, out, chunk);
-                    } else {
-                        self.accumulate_cube::<1>(&l, out, chunk);
-                    }
+                    self.cube(&l, &chunk).gather::<3>(out);
+                } else if l[1].2 == 0.0 && c == 1 {
+                    self.cube(&l, &chunk).gather::<1>(out);
                 } else {
                     match c {
                         1 => self.accumulate::<1>(&l, out, chunk),
@@ -201,24 +194,25 @@ impl Lookup {
         }
     }
 
-    /// Trilinear accumulation over axes 0, 2, 3 at axis-1 node `l[1].0` for exactly `N`
-    /// channels (see [`Cube`]).
+    /// Nodes and weights of a linear lookup at canonical coordinates `x`, per stored axis.
     #[inline(always)]
-    fn accumulate_cube<'a, const N: usize>(
-        &self,
-        l: &[(usize, usize, f32); 4],
-        out: &mut [f32],
-        chunk: impl Fn(usize) -> &'a [f32],
-    ) {
-        self.cube(l, chunk).gather::<N>(out);
+    fn linear_nodes(&self, x: [f64; 4]) -> [(usize, usize, f32); 4] {
+        let ax = &self.axes;
+        [
+            ax[0].linear(x[0]),
+            ax[1].linear(x[1]),
+            ax[2].linear(x[2]),
+            ax[3].linear(x[3]),
+        ]
     }
 
-    /// The eight corners of a lookup on an isotropic (or axis-1-node) unpacked table.
+    /// The eight corners of a lookup on an unpacked layout with axis 1 on a node (always so
+    /// for isotropic tables, where it has size 1); the caller checks both.
     #[inline(always)]
     fn cube<'a>(
         &self,
         l: &[(usize, usize, f32); 4],
-        chunk: impl Fn(usize) -> &'a [f32],
+        chunk: &impl Fn(usize) -> &'a [f32],
     ) -> Cube<'a> {
         let c = self.channels;
         let s3 = self.shape[3];
@@ -253,17 +247,11 @@ impl Lookup {
         let Some(x) = canonical_coords_fast(self.param, self.sym, wi, wo) else {
             return Prepared::Zero;
         };
-        let ax = &self.axes;
-        let l = [
-            ax[0].linear(x[0]),
-            ax[1].linear(x[1]),
-            ax[2].linear(x[2]),
-            ax[3].linear(x[3]),
-        ];
+        let l = self.linear_nodes(x);
         if l[1].2 != 0.0 {
             return Prepared::General;
         }
-        Prepared::Cube(self.cube(&l, chunk))
+        Prepared::Cube(self.cube(&l, &chunk))
     }
 
     /// Multilinear accumulation for packed `inout` reciprocity: corners below the diagonal are
@@ -337,6 +325,16 @@ impl Cube<'_> {
         out[..N].copy_from_slice(&acc);
     }
 
+    /// [`Cube::gather`] for `channels` = 3 or 1 (the only counts a cube is built for).
+    #[inline(always)]
+    fn gather_into(&self, channels: usize, out: &mut [f32]) {
+        if channels == 3 {
+            self.gather::<3>(out);
+        } else {
+            self.gather::<1>(out);
+        }
+    }
+
     /// Hints the processor to fetch the cache lines of the four (θ1, θ2) corner rows.
     #[inline(always)]
     fn prefetch(&self) {
@@ -389,11 +387,7 @@ impl Prepared<'_> {
                 true
             }
             Prepared::Cube(c) => {
-                if channels == 3 {
-                    c.gather::<3>(out);
-                } else {
-                    c.gather::<1>(out);
-                }
+                c.gather_into(channels, out);
                 true
             }
             Prepared::General => false,
