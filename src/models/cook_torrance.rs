@@ -81,19 +81,6 @@ impl CookTorrance {
         self.cos_prob
     }
 
-    /// Density of the half-vector strategy alone for unit `l`, `v` above the horizon.
-    #[inline]
-    fn half_vector_pdf(&self, l: DVec3, v: DVec3) -> f64 {
-        let Some(h) = geometry::normalize(l + v) else {
-            return 0.0;
-        };
-        let v_dot_h = v.dot(h);
-        if v_dot_h.is_nan() || v_dot_h <= 0.0 {
-            return 0.0;
-        }
-        self.d.pdf_h(h) / (4.0 * v_dot_h)
-    }
-
     /// The microfacet distribution.
     pub fn distribution(&self) -> &Beckmann {
         &self.d
@@ -255,11 +242,13 @@ impl Brdf for CookTorrance {
     }
 
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        let Some((l, v)) = geometry::upper_pair(wi, wo) else {
-            return 0.0;
-        };
-        let p = self.cos_prob;
-        (1.0 - p) * self.half_vector_pdf(l, v) + p * l.z * FRAC_1_PI
+        match self.geometry(wi, wo) {
+            Some(g) => {
+                let p = self.cos_prob;
+                (1.0 - p) * g.d_cos_over_4vh + p * g.l_z * FRAC_1_PI
+            }
+            None => 0.0,
+        }
     }
 }
 
