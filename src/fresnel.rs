@@ -429,6 +429,10 @@ impl Fresnel {
     pub fn eval_scaled_c2(&self, cos_i: f64, cos2_i: f64, scale: &[f64], s: f64, out: &mut [f32]) {
         match self {
             Fresnel::None => {
+                if let ([o0, o1, o2, ..], [k0, k1, k2]) = (&mut *out, scale) {
+                    (*o0, *o1, *o2) = ((k0 * s) as f32, (k1 * s) as f32, (k2 * s) as f32);
+                    return;
+                }
                 for (o, &k) in out.iter_mut().zip(scale) {
                     *o = (k * s) as f32;
                 }

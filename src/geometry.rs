@@ -25,11 +25,27 @@ pub fn normalize(v: DVec3) -> Option<DVec3> {
 #[inline]
 pub fn unit(v: DVec3) -> Option<DVec3> {
     let l2 = v.length_squared();
-    if (l2 - 1.0).abs() <= 1.0 / (1u64 << 40) as f64 {
+    if is_unit_l2(l2) {
         Some(v)
     } else {
         normalize(v)
     }
+}
+
+/// True when a squared length is 1 to within 2⁻⁴⁰: the vector counts as unit and is used as is
+/// (see [`unit`]).
+#[inline]
+pub fn is_unit_l2(l2: f64) -> bool {
+    (l2 - 1.0).abs() <= 1.0 / (1u64 << 40) as f64
+}
+
+/// True when `v` is finite and strictly above the horizon (z > 0): all a sampler needs to know
+/// about `wo` when only the sign of cos θo matters. Agrees with
+/// `normalize(v).is_some_and(|w| w.z > 0.0)` except for finite vectors so long that their
+/// squared length overflows, which this accepts.
+#[inline]
+pub fn is_upper(v: DVec3) -> bool {
+    v.z > 0.0 && v.z < f64::INFINITY && v.x.is_finite() && v.y.is_finite()
 }
 
 /// Normalizes a pair of directions and checks that both lie strictly above the horizon
@@ -195,8 +211,12 @@ pub fn concentric_disk(u: DVec2) -> DVec2 {
 /// Cosine-weighted direction on the upper hemisphere (density cos θ / π).
 #[inline]
 pub fn cosine_hemisphere(u: DVec2) -> DVec3 {
+    // The disk point has radius r = max(|2u − 1|) (the concentric map's radius), so z = √(1 − r²)
+    // needs only r and is computed alongside the sine and cosine rather than after them.
+    let a = 2.0 * u - DVec2::ONE;
+    let r = a.x.abs().max(a.y.abs());
+    let z = (1.0 - r * r).max(0.0).sqrt();
     let d = concentric_disk(u);
-    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
     DVec3::new(d.x, d.y, z)
 }
 
@@ -223,6 +243,36 @@ mod tests {
     use super::*;
     use crate::rng::Pcg32;
     use std::f64::consts::PI;
+
+    #[test]
+    fn cosine_hemisphere_gives_unit_vectors_above_the_horizon() {
+        let n = 300;
+        for i in 0..=n {
+            for j in 0..=n {
+                let u = DVec2::new(i as f64 / n as f64, j as f64 / n as f64);
+                let w = cosine_hemisphere(u.min(DVec2::splat(1.0 - f64::EPSILON)));
+                assert!((w.length_squared() - 1.0).abs() < 1e-15, "{u}: {w}");
+                assert!(w.z >= 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn is_upper_agrees_with_normalize() {
+        let cases = [
+            DVec3::Z,
+            DVec3::new(3.0, -4.0, 0.1),
+            DVec3::new(0.0, 0.0, -1.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(f64::NAN, 0.0, 1.0),
+            DVec3::new(0.0, f64::INFINITY, 1.0),
+            DVec3::new(0.0, 0.0, f64::INFINITY),
+            DVec3::ZERO,
+        ];
+        for v in cases {
+            assert_eq!(is_upper(v), normalize(v).is_some_and(|w| w.z > 0.0), "{v}");
+        }
+    }
 
     #[test]
     fn half_diff_round_trip() {

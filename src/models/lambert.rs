@@ -17,15 +17,22 @@ pub struct Lambert {
     channels: Channels,
     kd_spec: Value,
     kd: Vec<f32>,
+    /// k_d π per channel: the albedo, and the weight of every cosine-weighted sample.
+    kd_pi: Vec<f32>,
 }
 
 impl Lambert {
     /// A Lambert model with diffuse coefficient `kd` (the BRDF value; albedo kd·π).
     pub fn new(kd: Value, channels: &Channels) -> Result<Self> {
         kd.validate("kd", 0.0)?;
+        let kd32: Vec<f32> = kd.resolve(channels).iter().map(|&x| x as f32).collect();
         Ok(Lambert {
             channels: channels.clone(),
-            kd: kd.resolve(channels).iter().map(|&x| x as f32).collect(),
+            kd_pi: kd32
+                .iter()
+                .map(|&k| (k as f64 * std::f64::consts::PI) as f32)
+                .collect(),
+            kd: kd32,
             kd_spec: kd,
         })
     }
@@ -40,17 +47,7 @@ impl Brdf for Lambert {
     fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
         // Only the horizon test needs the directions; no normalization is needed for the sign.
         let above = wi.z > 0.0 && wo.z > 0.0 && wi.is_finite() && wo.is_finite();
-        let out = &mut out[..self.kd.len()];
-        // RGB fast path: three stores instead of a `memcpy`/`memset` call for a 12-byte copy
-        // (a third of the whole evaluation time).
-        if let ([o0, o1, o2], [k0, k1, k2]) = (&mut *out, self.kd.as_slice()) {
-            let m = if above { 1.0 } else { 0.0 };
-            (*o0, *o1, *o2) = (k0 * m, k1 * m, k2 * m);
-        } else if above {
-            out.copy_from_slice(&self.kd);
-        } else {
-            out.fill(0.0);
-        }
+        super::put_channels(out, &self.kd, above);
     }
 
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
@@ -86,18 +83,16 @@ impl Brdf for Lambert {
 
     /// Cosine-weighted sampling, pdf cos θi / π: the weight f·cos θi / pdf = k_d π is constant.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 {
+        // Only the sign of cos θo matters, so `wo` is checked, not normalized.
+        if !geometry::is_upper(wo) {
             return None;
         }
         let wi = geometry::cosine_hemisphere(u);
         let pdf = wi.z * std::f64::consts::FRAC_1_PI;
-        if pdf.is_nan() || pdf <= 0.0 {
+        if !(pdf > 0.0) {
             return None;
         }
-        for (w, &k) in weight[..self.kd.len()].iter_mut().zip(&self.kd) {
-            *w = (k as f64 * std::f64::consts::PI) as f32;
-        }
+        super::put_channels(weight, &self.kd_pi, true);
         Some(BrdfSample {
             wi,
             pdf,
@@ -105,15 +100,18 @@ impl Brdf for Lambert {
         })
     }
 
-    /// k_d and cos θi / π, normalizing only `wi` (the density needs its cosine; `wo` only its
-    /// sign).
+    /// k_d and cos θi / π; `wi` is normalized only when it is not already unit (the density
+    /// needs its cosine; `wo` only its sign).
     fn eval_pdf(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) -> f64 {
-        self.eval(wi, wo, out);
         let l2 = wi.length_squared();
-        if wi.z > 0.0 && wo.z > 0.0 && l2 > 0.0 && l2.is_finite() && wo.is_finite() {
-            wi.z / l2.sqrt() * std::f64::consts::FRAC_1_PI
-        } else {
+        let above = wi.z > 0.0 && l2 < f64::INFINITY && geometry::is_upper(wo);
+        super::put_channels(out, &self.kd, above);
+        if !above {
             0.0
+        } else if geometry::is_unit_l2(l2) {
+            wi.z * std::f64::consts::FRAC_1_PI
+        } else {
+            wi.z / l2.sqrt() * std::f64::consts::FRAC_1_PI
         }
     }
 
@@ -151,6 +149,31 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn eval_pdf_does_not_depend_on_the_length_of_wi() {
+        let l = Lambert::new(Value::Rgb([0.1, 0.2, 0.3]), &Channels::Rgb).unwrap();
+        let wo = geometry::spherical(0.4, 1.0);
+        for deg in [1.0f64, 30.0, 60.0, 89.0] {
+            let wi = geometry::spherical(deg.to_radians(), 2.0);
+            let mut f = [0.0f32; 3];
+            let p = l.eval_pdf(wi, wo, &mut f);
+            let expect = wi.z * std::f64::consts::FRAC_1_PI;
+            assert!((p - expect).abs() <= 1e-15, "{p} vs {expect}");
+            assert_eq!(f, [0.1, 0.2, 0.3]);
+            for scale in [1e-3, 0.5, 7.0, 1e6] {
+                let q = l.eval_pdf(wi * scale, wo * scale, &mut f);
+                assert!((q - p).abs() <= 1e-15, "{scale}: {q} vs {p}");
+                assert_eq!(q, l.pdf(wi * scale, wo));
+            }
+        }
+        let mut f = [1.0f32; 3];
+        assert_eq!(
+            l.eval_pdf(DVec3::Z, DVec3::new(f64::NAN, 0.0, 1.0), &mut f),
+            0.0
+        );
+        assert_eq!(f, [0.0; 3]);
     }
 
     #[test]
