@@ -42,6 +42,8 @@ pub struct CookTorrance {
     fresnel_spec: FresnelSpec,
     fresnel: Fresnel,
     cos_prob: f64,
+    /// 1 / (1 − cos_prob), to rescale u.x in the half-vector branch.
+    inv_1mp: f64,
 }
 
 /// The geometric part D·G / (4 (N·V)(N·L)) and the Fresnel cosine L·H of a pair.
@@ -72,6 +74,7 @@ impl CookTorrance {
             fresnel: Fresnel::new(fresnel, channels, "fresnel")?,
             fresnel_spec: fresnel.clone(),
             cos_prob: (0.5 * m).min(0.5),
+            inv_1mp: 1.0 / (1.0 - (0.5 * m).min(0.5)),
         })
     }
 
@@ -102,7 +105,7 @@ impl CookTorrance {
     /// 2 (N·H) / (V·H) = 4 h_z / |h|². Two square roots and one division normalize the inputs,
     /// one root gives L·H, one division each D, G and the final quotient; every expression is
     /// symmetric in (l, v), so reciprocity holds bit for bit.
-    #[inline]
+    #[inline(always)]
     fn geometry(&self, wi: DVec3, wo: DVec3) -> Option<Geometry> {
         let (l, v) = super::unit_upper_pair(wi, wo)?;
         let h = l + v;
@@ -120,14 +123,19 @@ impl CookTorrance {
                 l_z: l.z,
             });
         }
-        let d = (-x).exp() * self.d.inv_pi_m2() * inv_c2 * inv_c2;
-        let g = (4.0 * h.z / hh * l.z.min(v.z)).min(1.0);
-        let len = hh.sqrt();
+        // Everything but exp(−x) is grouped into factors computed while `exp` runs, so only
+        // one multiplication follows it on each output's dependency chain.
+        let inv_hh = 1.0 / hh;
+        let g = (4.0 * h.z * inv_hh * l.z.min(v.z)).min(1.0);
+        let d_scale = self.d.inv_pi_m2() * (inv_c2 * inv_c2);
+        let dg_scale = d_scale * (g / (4.0 * l.z * v.z));
+        // D cos α / (4 V·H) with cos α = h_z/|h| and V·H = |h|/2.
+        let pdf_scale = d_scale * (0.5 * h.z * inv_hh);
+        let e = (-x).exp();
         Some(Geometry {
-            dg: d * g / (4.0 * l.z * v.z),
-            l_dot_h: 0.5 * len,
-            // D cos α / (4 V·H) with cos α = h_z/|h| and V·H = |h|/2.
-            d_cos_over_4vh: 0.5 * d * h.z / hh,
+            dg: e * dg_scale,
+            l_dot_h: 0.5 * hh.sqrt(),
+            d_cos_over_4vh: e * pdf_scale,
             l_z: l.z,
         })
     }
@@ -182,25 +190,32 @@ impl Brdf for CookTorrance {
         let p = self.cos_prob;
         let c = self.ks.len();
         if u.x >= p {
-            let u0 = ((u.x - p) / (1.0 - p)).min(1.0 - f64::EPSILON);
-            let (h, d) = self.d.sample_h_d(DVec2::new(u0, u.y));
-            let v_dot_h = v.dot(h);
-            if v_dot_h.is_nan() || v_dot_h <= 0.0 {
+            // 1 − u0 for u0 = (u.x − p)/(1 − p), the half-vector branch's rescaled u.x; at least
+            // ε so that the logarithm stays finite.
+            let one_minus = ((1.0 - u.x) * self.inv_1mp).max(f64::EPSILON);
+            // With the slope-space normal h′ = H / cos α (|h′|² = 1/cos² α): V·H = (V·h′) cos α
+            // and L = 2 (V·H) H − V = 2 (V·h′) cos² α h′ − V. Every factor cos α cancels from
+            // the pdf and the weight below, so H is never normalized.
+            let (hp, cos2, d) = self.d.slope_d(one_minus, u.y);
+            let vhp = v.dot(hp);
+            if !(vhp > 0.0) {
                 return None;
             }
-            let l = 2.0 * v_dot_h * h - v;
-            if l.z.is_nan() || l.z <= 0.0 {
+            let l = (2.0 * vhp * cos2) * hp - v;
+            if !(l.z > 0.0) {
                 return None;
             }
-            // One reciprocal of V·H serves the pdf's Jacobian and the V-cavity G.
-            let inv_vh = 1.0 / v_dot_h;
-            let pdf = (1.0 - p) * 0.25 * d * h.z * inv_vh + p * l.z * FRAC_1_PI;
-            if !(pdf > 0.0 && pdf.is_finite()) {
+            // pdf = (1−p) D cos α / (4 V·H) + p cos θl / π = den / (4 V·h′), and
+            // f cos θl / pdf = D G (V·H) / ((N·V) den) · … with G·(V·h′) = min(V·h′, 2 min(N·V, N·L)):
+            // two independent divisions, no reciprocal of V·H.
+            let den = (1.0 - p) * d + 4.0 * vhp * p * l.z * FRAC_1_PI;
+            let pdf = den / (4.0 * vhp);
+            if !(pdf > 0.0 && pdf < f64::INFINITY) {
                 return None;
             }
-            let g = (2.0 * h.z * inv_vh * v.z.min(l.z)).min(1.0);
-            // f cos θl / pdf = ks F · D G / (4 (N·V)(N·L)) · (N·L) / pdf.
-            let s = d * g / (4.0 * v.z * pdf);
+            let s = d * vhp.min(2.0 * v.z.min(l.z)) / (v.z * den);
+            // Fresnel at V·H = (V·h′) cos α, computed off the critical path.
+            let v_dot_h = vhp * cos2.sqrt();
             self.fresnel
                 .eval_scaled(v_dot_h, &self.ks, s, &mut weight[..c]);
             return Some(BrdfSample {
@@ -217,7 +232,7 @@ impl Brdf for CookTorrance {
         // D·(h_z/|h|)/(2|h|) with the unnormalized h = l + v, the half-vector density too.
         let gm = self.geometry(l, v)?;
         let pdf = (1.0 - p) * gm.d_cos_over_4vh + p * l.z * FRAC_1_PI;
-        if !(pdf > 0.0 && pdf.is_finite()) {
+        if !(pdf > 0.0 && pdf < f64::INFINITY) {
             return None;
         }
         self.fresnel
