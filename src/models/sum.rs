@@ -16,10 +16,13 @@
 //!
 //! # Sampling
 //!
-//! One-sample mixture: for viewing direction wo a term is chosen with probability
-//! p_j(wo) ∝ w_j · â_j(cos θo), where â_j is an estimate of the term's albedo precomputed at
-//! construction at [`TABLE_SIZE`] values of cos θo (cell centres, (k + ½)/[`TABLE_SIZE`]) and
-//! interpolated linearly (constant beyond the first and last centres). â_j is the mean over
+//! One-sample mixture: for viewing direction wo a term is chosen with probability p_j(wo), a
+//! table over [`TABLE_SIZE`] equal bins of cos θo holding w_j · â_j normalized over the terms,
+//! where â_j is an estimate of the term's albedo at the bin centre (k + ½)/[`TABLE_SIZE`],
+//! precomputed at construction (a bin where no term reflects borrows the nearest bin's
+//! probabilities). The table is piecewise constant rather than interpolated so that the sampler
+//! can rescale u with a precomputed reciprocal: the choice of term then costs a table read, not
+//! a division, on the sampler's critical path. â_j is the mean over
 //! channels of the term's [`Brdf::albedo`] (averaged over φo = 0 and π/2 for anisotropic terms);
 //! for delta terms, which [`Brdf::albedo`] may not cover, it is the mean sample weight over a
 //! stratified 4 × 4 grid. Each â_j is floored at 10⁻³ of its own maximum so that a term that
@@ -36,16 +39,25 @@ use crate::error::{Error, Result};
 use crate::geometry;
 use crate::spectrum::{Channels, MAX_CHANNELS};
 
-/// Number of cos θo entries in each term's albedo table.
+/// Number of cos θo bins in the term-selection table.
 pub const TABLE_SIZE: usize = 24;
+
+/// The most terms a sum may have (nest sums for more): the per-call selection weights live in
+/// a fixed array on the stack.
+pub const MAX_TERMS: usize = 16;
 
 /// A weighted sum of BRDFs.
 pub struct Sum {
     channels: Channels,
     terms: Vec<Box<dyn Brdf>>,
     weights: Vec<f64>,
-    /// Per term: w_j · â_j at cos θo = (k + ½)/TABLE_SIZE.
+    /// Per term: the probability of choosing it in cos θo bin k (w_j · â_j at the bin centre,
+    /// normalized over the terms; all zero when no term reflects anywhere).
     select: Vec<[f64; TABLE_SIZE]>,
+    /// For two terms, per bin: (p_0, 1/p_0, 1/(1 − p_0)), the choice and the rescaling of u.x.
+    pair: [[f64; 3]; TABLE_SIZE],
+    /// Whether any term reflects anywhere (else `select` is all zero and nothing is sampled).
+    reflects: bool,
     flags: Flags,
 }
 
@@ -70,6 +82,15 @@ impl Sum {
             return Err(Error::arg(
                 "channels",
                 format!("{} channels, at most {MAX_CHANNELS}", channels.len()),
+            ));
+        }
+        if terms.len() > MAX_TERMS {
+            return Err(Error::spec(
+                "terms",
+                format!(
+                    "{} terms, at most {MAX_TERMS} (nest sums for more)",
+                    terms.len()
+                ),
             ));
         }
         let weights = weights.unwrap_or_else(|| vec![1.0; terms.len()]);
@@ -103,15 +124,22 @@ impl Sum {
             bilateral: fl.iter().all(|f| f.bilateral),
             transmission: fl.iter().any(|f| f.transmission),
         };
-        let select = terms
-            .iter()
-            .zip(&weights)
-            .map(|(t, &w)| selection_row(t.as_ref(), w))
-            .collect();
+        let select = normalized(
+            terms
+                .iter()
+                .zip(&weights)
+                .map(|(t, &w)| selection_row(t.as_ref(), w))
+                .collect(),
+        );
         Ok(Sum {
             channels: channels.clone(),
             terms,
             weights,
+            reflects: select.iter().any(|r| r.iter().any(|&p| p > 0.0)),
+            pair: std::array::from_fn(|k| {
+                let p0 = select[0][k];
+                [p0, 1.0 / p0, 1.0 / (1.0 - p0)]
+            }),
             select,
             flags,
         })
@@ -125,40 +153,49 @@ impl Sum {
             .zip(self.weights.iter().copied())
     }
 
-    /// The unnormalized selection weight w_j â_j(cos θo) of term `j`.
+    /// The selection-table bin of cos θo.
     #[inline]
-    fn selection(&self, j: usize, cos_o: f64) -> f64 {
-        let x = (cos_o * TABLE_SIZE as f64 - 0.5).clamp(0.0, (TABLE_SIZE - 1) as f64);
-        let k = (x as usize).min(TABLE_SIZE - 2);
-        let t = x - k as f64;
-        let row = &self.select[j];
-        (1.0 - t) * row[k] + t * row[k + 1]
+    fn bin(cos_o: f64) -> usize {
+        ((cos_o * TABLE_SIZE as f64) as usize).min(TABLE_SIZE - 1)
+    }
+
+    /// The probabilities p_j(cos θo) of choosing each term into `sel`, and their sum: 1 up to
+    /// rounding, or 0 when no term reflects. With two terms the second is 1 − p_0 exactly and
+    /// the sum exactly 1, as in the pair sampler.
+    #[inline]
+    fn selections(&self, cos_o: f64, sel: &mut [f64; MAX_TERMS]) -> f64 {
+        let k = Self::bin(cos_o);
+        let mut total = 0.0;
+        for (s, row) in sel.iter_mut().zip(&self.select) {
+            *s = row[k];
+            total += *s;
+        }
+        if self.terms.len() == 2 && total > 0.0 {
+            sel[1] = 1.0 - sel[0];
+            total = 1.0;
+        }
+        total
     }
 
     /// The probabilities p_j(wo) of choosing each term, normalized (for inspection and tests).
     /// All zero when no term reflects towards `wo`.
     pub fn selection_probabilities(&self, wo: DVec3) -> Vec<f64> {
         let cos_o = geometry::normalize(wo).map_or(0.0, |w| w.z);
-        let s: Vec<f64> = (0..self.terms.len())
-            .map(|j| self.selection(j, cos_o))
-            .collect();
-        let total: f64 = s.iter().sum();
+        let mut sel = [0.0; MAX_TERMS];
+        let total = self.selections(cos_o, &mut sel);
+        let n = self.terms.len();
         if total > 0.0 {
-            s.iter().map(|x| x / total).collect()
+            sel[..n].iter().map(|x| x / total).collect()
         } else {
-            vec![0.0; s.len()]
+            vec![0.0; n]
         }
-    }
-
-    #[inline]
-    fn total_selection(&self, cos_o: f64) -> f64 {
-        (0..self.terms.len())
-            .map(|j| self.selection(j, cos_o))
-            .sum()
     }
 
     /// [`Brdf::sample`] with scratch arrays of `N` ≥ channels entries (4 for RGB, so the
     /// per-call scratch is not a kilobyte of zeroes).
+    ///
+    /// Written for latency: the selection weights are computed once, the chosen term writes its
+    /// weight straight into `weight`, and the mixture density is normalized by one division.
     fn sample_n<const N: usize>(
         &self,
         wo: DVec3,
@@ -169,103 +206,266 @@ impl Sum {
         if wo.z <= 0.0 {
             return None;
         }
-        let total = self.total_selection(wo.z);
-        if !(total > 0.0 && total.is_finite()) {
+        let mut sel = [0.0; MAX_TERMS];
+        let total = self.selections(wo.z, &mut sel);
+        if !(total > 0.0 && total < f64::INFINITY) {
             return None;
         }
-        // Choose term j by u.x and reuse the remainder of u.x within its interval.
+        let n = self.terms.len();
+        // Choose term j by u.x and reuse the remainder of u.x within its interval. Terms with
+        // weight 0 are passed over (target ≥ cum always holds); rounding can leave target ≥ the
+        // accumulated total, and then the last term with a positive weight is the one.
         let target = u.x * total;
+        let mut j = 0;
         let mut cum = 0.0;
-        let mut chosen = None;
-        let mut last = None;
-        for j in 0..self.terms.len() {
-            let s = self.selection(j, wo.z);
-            if s <= 0.0 {
-                continue;
-            }
-            if target < cum + s {
-                chosen = Some((j, s, ((target - cum) / s).clamp(0.0, 1.0 - f64::EPSILON)));
-                break;
-            }
-            cum += s;
-            last = Some(j);
+        while j + 1 < n && target >= cum + sel[j] {
+            cum += sel[j];
+            j += 1;
         }
-        // Rounding can leave target ≥ the accumulated total: that is the end of the last term.
-        let chosen =
-            chosen.or_else(|| last.map(|j| (j, self.selection(j, wo.z), 1.0 - f64::EPSILON)));
-        let (j, s, ux) = chosen?;
-        let pj = s / total;
+        let mut ux = (target - cum) / sel[j];
+        if !(sel[j] > 0.0) {
+            j = sel[..n].iter().rposition(|&s| s > 0.0)?;
+            ux = 1.0;
+        }
+        let ux = ux.clamp(0.0, 1.0 - f64::EPSILON);
         let c = self.channels.len();
-        let mut tw = [0.0f32; N];
-        let smp = self.terms[j].sample(wo, DVec2::new(ux, u.y), &mut tw[..c])?;
-        if smp.delta {
+        // Only the fields are read from the returned sample (not the whole `Option`), so no
+        // load of its padding waits on the callee's narrower stores.
+        let (wi, tpdf, delta) =
+            match self.terms[j].sample(wo, DVec2::new(ux, u.y), &mut weight[..c]) {
+                Some(s) => (s.wi, s.pdf, s.delta),
+                None => return None,
+            };
+        let pj = sel[j] / total;
+        if delta {
             let scale = self.weights[j] / pj;
-            for (o, &t) in weight[..c].iter_mut().zip(&tw[..c]) {
-                *o = (scale * t as f64) as f32;
+            for w in &mut weight[..c] {
+                *w = (scale * *w as f64) as f32;
             }
             return Some(BrdfSample {
-                wi: smp.wi,
-                pdf: pj * smp.pdf,
+                wi,
+                pdf: pj * tpdf,
                 delta: true,
             });
         }
         // The chosen term already knows its density and, through its weight, its f·cos θi =
-        // weight · pdf: only the other terms are evaluated.
-        let mut pdf = s / total * smp.pdf;
+        // weight · pdf: only the other terms are evaluated. `mix` is Σ_k sel_k pdf_k, the
+        // mixture density times `total`.
+        let mut mix = sel[j] * tpdf;
         let mut fcos = [0.0f64; N];
-        for k in 0..c {
-            fcos[k] = self.weights[j] * tw[k] as f64 * smp.pdf;
+        let wj = self.weights[j] * tpdf;
+        for (f, &w) in fcos[..c].iter_mut().zip(&weight[..c]) {
+            *f = wj * w as f64;
         }
-        let cos_i = smp.wi.z.abs();
+        let cos_i = wi.z.abs();
         let mut tmp = [0.0f32; N];
         for (k, t) in self.terms.iter().enumerate() {
             if k == j {
                 continue;
             }
-            let sk = self.selection(k, wo.z);
             let w = self.weights[k];
-            let pk = if w != 0.0 {
-                let pk = t.eval_pdf(smp.wi, wo, &mut tmp[..c]);
-                for ch in 0..c {
-                    fcos[ch] += w * tmp[ch] as f64 * cos_i;
+            if w != 0.0 {
+                let pk = t.eval_pdf(wi, wo, &mut tmp[..c]);
+                let wc = w * cos_i;
+                for (f, &x) in fcos[..c].iter_mut().zip(&tmp[..c]) {
+                    *f += wc * x as f64;
                 }
-                pk
-            } else if sk > 0.0 {
-                t.pdf(smp.wi, wo)
-            } else {
-                0.0
-            };
-            if sk > 0.0 {
-                pdf += sk / total * pk;
+                mix += sel[k] * pk;
+            } else if sel[k] > 0.0 {
+                mix += sel[k] * t.pdf(wi, wo);
             }
         }
-        if !(pdf > 0.0 && pdf.is_finite()) {
+        let pdf = mix / total;
+        if !(pdf > 0.0 && pdf < f64::INFINITY) {
             return None;
         }
-        for (o, &fk) in weight[..c].iter_mut().zip(&fcos[..c]) {
-            *o = (fk / pdf) as f32;
+        let inv = total / mix;
+        for (o, &f) in weight[..c].iter_mut().zip(&fcos[..c]) {
+            *o = (f * inv) as f32;
         }
         Some(BrdfSample {
-            wi: smp.wi,
+            wi,
             pdf,
             delta: false,
         })
     }
 
-    /// The smooth mixture density Σ_j p_j pdf_j(wi, wo) for `total` = Σ_j w_j â_j.
-    fn mixture_pdf(&self, wi: DVec3, wo: DVec3, total: f64) -> f64 {
-        let mut pdf = 0.0;
-        for (j, t) in self.terms.iter().enumerate() {
-            let s = self.selection(j, wo.z);
-            if s > 0.0 {
-                pdf += s / total * t.pdf(wi, wo);
+    /// [`Brdf::sample`] for the common case, two RGB terms (a diffuse base and a specular lobe):
+    /// the same mixture as [`Sum::sample_n`], written as straight-line code. A sample of a sum
+    /// costs the chosen term's sample plus the other term's `eval_pdf`; this keeps what the sum
+    /// itself adds to a few dozen instructions.
+    fn sample_pair_rgb(
+        &self,
+        terms: [&dyn Brdf; 2],
+        wo: DVec3,
+        u: DVec2,
+        weight: &mut [f32],
+    ) -> Option<BrdfSample> {
+        let wo = geometry::unit(wo)?;
+        if wo.z <= 0.0 {
+            return None;
+        }
+        if !self.reflects {
+            return None;
+        }
+        let [s0, inv0, inv1] = self.pair[Self::bin(wo.z)];
+        let s1 = 1.0 - s0;
+        // Term 0 owns [0, s0) of u.x, term 1 the rest; a term with probability 0 is never chosen.
+        let first = if s1 > 0.0 { u.x < s0 } else { true };
+        let (j, sj, sk, ux) = if first {
+            (0, s0, s1, u.x * inv0)
+        } else {
+            (1, s1, s0, (u.x - s0) * inv1)
+        };
+        let ux = ux.clamp(0.0, 1.0 - f64::EPSILON);
+        let w = &mut weight[..3];
+        let (wi, tpdf, delta) = match terms[j].sample(wo, DVec2::new(ux, u.y), w) {
+            Some(s) => (s.wi, s.pdf, s.delta),
+            None => return None,
+        };
+        if delta {
+            let pj = sj;
+            let scale = self.weights[j] / pj;
+            for x in w.iter_mut() {
+                *x = (scale * *x as f64) as f32;
+            }
+            return Some(BrdfSample {
+                wi,
+                pdf: pj * tpdf,
+                delta: true,
+            });
+        }
+        let wj = self.weights[j] * tpdf;
+        let mut f = [wj * w[0] as f64, wj * w[1] as f64, wj * w[2] as f64];
+        let mut mix = sj * tpdf;
+        let wk = self.weights[1 - j];
+        if wk != 0.0 {
+            let mut e = [0.0f32; 3];
+            let pk = terms[1 - j].eval_pdf(wi, wo, &mut e);
+            let wc = wk * wi.z.abs();
+            f[0] += wc * e[0] as f64;
+            f[1] += wc * e[1] as f64;
+            f[2] += wc * e[2] as f64;
+            mix += sk * pk;
+        } else if sk > 0.0 {
+            mix += sk * terms[1 - j].pdf(wi, wo);
+        }
+        let pdf = mix;
+        if !(pdf > 0.0 && pdf < f64::INFINITY) {
+            return None;
+        }
+        w[0] = (f[0] / mix) as f32;
+        w[1] = (f[1] / mix) as f32;
+        w[2] = (f[2] / mix) as f32;
+        Some(BrdfSample {
+            wi,
+            pdf,
+            delta: false,
+        })
+    }
+
+    /// [`Brdf::eval`] with scratch arrays of `N` ≥ channels entries.
+    fn eval_n<const N: usize>(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+        let c = self.channels.len();
+        let mut acc = [0.0f64; N];
+        let mut tmp = [0.0f32; N];
+        for (t, &w) in self.terms.iter().zip(&self.weights) {
+            if w == 0.0 {
+                continue;
+            }
+            t.eval(wi, wo, &mut tmp[..c]);
+            for (a, &x) in acc[..c].iter_mut().zip(&tmp[..c]) {
+                *a += w * x as f64;
             }
         }
-        pdf
+        for (o, a) in out[..c].iter_mut().zip(&acc[..c]) {
+            *o = *a as f32;
+        }
+    }
+
+    /// [`Brdf::eval_pdf`] with scratch arrays of `N` ≥ channels entries.
+    fn eval_pdf_n<const N: usize>(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) -> f64 {
+        let c = self.channels.len();
+        let mut sel = [0.0; MAX_TERMS];
+        let total = match geometry::unit(wo) {
+            Some(v) if v.z > 0.0 => self.selections(v.z, &mut sel),
+            _ => 0.0,
+        };
+        if !(total > 0.0 && total < f64::INFINITY) {
+            // No density towards `wo`; f may still be defined (the terms decide).
+            self.eval_n::<N>(wi, wo, out);
+            return 0.0;
+        }
+        let mut acc = [0.0f64; N];
+        let mut tmp = [0.0f32; N];
+        let mut mix = 0.0;
+        for ((t, &w), &s) in self.terms.iter().zip(&self.weights).zip(&sel) {
+            if w != 0.0 {
+                let p = t.eval_pdf(wi, wo, &mut tmp[..c]);
+                for (a, &x) in acc[..c].iter_mut().zip(&tmp[..c]) {
+                    *a += w * x as f64;
+                }
+                if s > 0.0 {
+                    mix += s * p;
+                }
+            } else if s > 0.0 {
+                mix += s * t.pdf(wi, wo);
+            }
+        }
+        for (o, a) in out[..c].iter_mut().zip(&acc[..c]) {
+            *o = *a as f32;
+        }
+        mix / total
+    }
+
+    /// The smooth mixture density Σ_j p_j pdf_j(wi, wo), or 0 when `wo` is invalid, below the
+    /// horizon, or no term reflects towards it.
+    fn mixture_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        let Some(wo) = geometry::unit(wo) else {
+            return 0.0;
+        };
+        if wo.z <= 0.0 {
+            return 0.0;
+        }
+        let mut sel = [0.0; MAX_TERMS];
+        let total = self.selections(wo.z, &mut sel);
+        if !(total > 0.0 && total < f64::INFINITY) {
+            return 0.0;
+        }
+        let mut mix = 0.0;
+        for (t, &s) in self.terms.iter().zip(&sel) {
+            if s > 0.0 {
+                mix += s * t.pdf(wi, wo);
+            }
+        }
+        mix / total
     }
 }
 
-/// w · â(cos θo) at the table's cos θo values, floored at 10⁻³ of the row's maximum.
+/// The rows w_j â_j normalized over the terms at each table entry. An entry where no term
+/// reflects takes the probabilities of the nearest entry where one does; all rows stay zero when
+/// none does anywhere.
+fn normalized(rows: Vec<[f64; TABLE_SIZE]>) -> Vec<[f64; TABLE_SIZE]> {
+    let totals: Vec<f64> = (0..TABLE_SIZE)
+        .map(|k| rows.iter().map(|r| r[k]).sum())
+        .collect();
+    let good = |k: usize| totals[k] > 0.0 && totals[k].is_finite();
+    let mut out = vec![[0.0; TABLE_SIZE]; rows.len()];
+    for k in 0..TABLE_SIZE {
+        let Some(src) = (0..TABLE_SIZE)
+            .filter(|&i| good(i))
+            .min_by_key(|&i| i.abs_diff(k))
+        else {
+            return out;
+        };
+        for (o, r) in out.iter_mut().zip(&rows) {
+            o[k] = r[src] / totals[src];
+        }
+    }
+    out
+}
+
+/// w · â(cos θo) at the bin centres, floored at 10⁻³ of the row's maximum.
 fn selection_row(term: &dyn Brdf, w: f64) -> [f64; TABLE_SIZE] {
     let mut row = [0.0; TABLE_SIZE];
     if w == 0.0 {
@@ -331,20 +531,10 @@ impl Brdf for Sum {
     }
 
     fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
-        let c = self.channels.len();
-        let mut acc = [0.0f64; MAX_CHANNELS];
-        let mut tmp = [0.0f32; MAX_CHANNELS];
-        for (t, &w) in self.terms.iter().zip(&self.weights) {
-            if w == 0.0 {
-                continue;
-            }
-            t.eval(wi, wo, &mut tmp[..c]);
-            for k in 0..c {
-                acc[k] += w * tmp[k] as f64;
-            }
-        }
-        for (o, a) in out[..c].iter_mut().zip(&acc[..c]) {
-            *o = *a as f32;
+        if self.channels.len() <= 4 {
+            self.eval_n::<4>(wi, wo, out)
+        } else {
+            self.eval_n::<MAX_CHANNELS>(wi, wo, out)
         }
     }
 
@@ -388,6 +578,9 @@ impl Brdf for Sum {
     }
 
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+        if let ([a, b], 3) = (self.terms.as_slice(), self.channels.len()) {
+            return self.sample_pair_rgb([a.as_ref(), b.as_ref()], wo, u, weight);
+        }
         if self.channels.len() <= 4 {
             self.sample_n::<4>(wo, u, weight)
         } else {
@@ -396,17 +589,16 @@ impl Brdf for Sum {
     }
 
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        let Some(wo) = geometry::normalize(wo) else {
-            return 0.0;
-        };
-        if wo.z <= 0.0 {
-            return 0.0;
+        self.mixture_pdf(wi, wo)
+    }
+
+    /// f_r and the mixture density in one pass over the terms (each term's own `eval_pdf`).
+    fn eval_pdf(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) -> f64 {
+        if self.channels.len() <= 4 {
+            self.eval_pdf_n::<4>(wi, wo, out)
+        } else {
+            self.eval_pdf_n::<MAX_CHANNELS>(wi, wo, out)
         }
-        let total = self.total_selection(wo.z);
-        if !(total > 0.0 && total.is_finite()) {
-            return 0.0;
-        }
-        self.mixture_pdf(wi, wo, total)
     }
 }
 
@@ -641,6 +833,60 @@ mod tests {
         assert!(Sum::new(vec![lambert(0.1)], Some(vec![f64::NAN]), &Channels::Rgb).is_err());
         let ch = Channels::linspace(400.0, 700.0, 4).unwrap();
         assert!(Sum::new(vec![lambert(0.1)], None, &ch).is_err());
+        let many = (0..=MAX_TERMS).map(|_| lambert(0.01)).collect();
+        let err = Sum::new(many, None, &Channels::Rgb)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("at most 16"), "{err}");
+        let most = (0..MAX_TERMS).map(|_| lambert(0.01)).collect();
+        assert!(Sum::new(most, None, &Channels::Rgb).is_ok());
+    }
+
+    #[test]
+    fn nothing_is_sampled_when_no_term_reflects() {
+        // Weights 0: f = 0 everywhere, no term can be chosen, the density is 0 — for the pair
+        // sampler and the general one.
+        for n in [2, 3] {
+            let s = Sum::new(
+                (0..n).map(|_| lambert(0.2)).collect(),
+                Some(vec![0.0; n]),
+                &Channels::Rgb,
+            )
+            .unwrap();
+            let wo = geometry::spherical(0.3, 0.1);
+            let mut w = [1.0f32; 3];
+            assert!(s.sample(wo, DVec2::new(0.3, 0.7), &mut w).is_none());
+            assert_eq!(s.pdf(DVec3::Z, wo), 0.0);
+            assert_eq!(s.eval_pdf(DVec3::Z, wo, &mut w), 0.0);
+            assert_eq!(w, [0.0; 3]);
+            assert_eq!(s.selection_probabilities(wo), vec![0.0; n]);
+        }
+    }
+
+    #[test]
+    fn pair_sampler_agrees_with_the_general_one() {
+        // For two RGB terms `sample` takes the pair path; `sample_n` is the general one. Both
+        // choose with the same probabilities, so for every u they give the same direction, pdf
+        // and weight, up to the rounding of the rescaled u.x (a multiplication by a reciprocal
+        // against a division: one unit in the last place, which the warps amplify to ≲ 10⁻¹³).
+        let s = plastic();
+        let mut rng = Pcg32::new(77);
+        for _ in 0..20_000 {
+            let wo = geometry::cosine_hemisphere(rng.next_dvec2());
+            let u = rng.next_dvec2();
+            let (mut a, mut b) = ([0.0f32; 3], [0.0f32; 3]);
+            match (s.sample(wo, u, &mut a), s.sample_n::<4>(wo, u, &mut b)) {
+                (Some(x), Some(y)) => {
+                    assert!((x.wi - y.wi).length() < 1e-12, "{x:?} vs {y:?}");
+                    assert!((x.pdf - y.pdf).abs() <= 1e-10 * x.pdf, "{x:?} vs {y:?}");
+                    for c in 0..3 {
+                        assert!((a[c] - b[c]).abs() <= 1e-6 * a[c].abs(), "{a:?} vs {b:?}");
+                    }
+                }
+                (None, None) => {}
+                other => panic!("{other:?}"),
+            }
+        }
     }
 
     #[test]
