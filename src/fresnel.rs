@@ -418,8 +418,14 @@ impl Fresnel {
     /// Writes `scale[c] · s · F_c(cos_i)` as `f32` into `out[c]` for every channel: the last step
     /// of a microfacet model's `eval`. The variant is matched once, outside the channel loop, so
     /// the loop is straight-line arithmetic the compiler can vectorize.
-    #[inline]
+    #[inline(always)]
     pub fn eval_scaled(&self, cos_i: f64, scale: &[f64], s: f64, out: &mut [f32]) {
+        // No Fresnel term with RGB (the common case of plain microfacet lobes): three stores,
+        // inline, rather than a call.
+        if let (Fresnel::None, [o0, o1, o2, ..], [k0, k1, k2]) = (self, &mut *out, scale) {
+            (*o0, *o1, *o2) = ((k0 * s) as f32, (k1 * s) as f32, (k2 * s) as f32);
+            return;
+        }
         self.eval_scaled_c2(cos_i, cos_i * cos_i, scale, s, out)
     }
 
