@@ -69,7 +69,7 @@ impl Beckmann {
     #[inline]
     pub fn sample_h_d(&self, u: DVec2) -> (DVec3, f64) {
         let one_minus = 1.0 - u.x;
-        let tan2 = (-self.m * self.m * one_minus.ln()).max(0.0);
+        let tan2 = (-self.m * self.m * crate::fastmath::ln(one_minus)).max(0.0);
         // 1/cos² α = 1 + tan² α; cos α = 1/√(1 + tan²), sin α = tan α · cos α (two independent
         // roots, one division).
         let inv_c2 = 1.0 + tan2;
@@ -94,7 +94,7 @@ impl Beckmann {
     /// directly) and u.y.
     #[inline]
     pub(crate) fn slope_d(&self, one_minus: f64, uy: f64) -> (DVec3, f64, f64) {
-        let tan2 = (-self.m * self.m * one_minus.ln()).max(0.0);
+        let tan2 = (-self.m * self.m * crate::fastmath::ln(one_minus)).max(0.0);
         let inv_c2 = 1.0 + tan2;
         let cos2 = 1.0 / inv_c2;
         let tan_a = tan2.sqrt();

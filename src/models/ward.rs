@@ -100,7 +100,7 @@ impl Ward {
     #[inline]
     pub fn sample_half_vector(&self, u: DVec2) -> DVec3 {
         // 1 − u₁ ∈ (0, 1] keeps the logarithm finite.
-        let r = (-(1.0 - u.x).ln()).sqrt();
+        let r = (-crate::fastmath::ln(1.0 - u.x)).sqrt();
         let (sp, cp) = (2.0 * PI * u.y).sin_cos();
         DVec3::new(-self.alpha_x * r * cp, -self.alpha_y * r * sp, 1.0).normalize()
     }
