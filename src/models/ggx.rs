@@ -149,12 +149,33 @@ impl Ggx {
         1.0 / (1.0 + self.lambda(wi) + self.lambda(wo))
     }
 
-    /// D G2 / (4 cos θi cos θo) and wi·h for unit directions above the horizon.
-    #[inline]
-    fn lobe(&self, wi: DVec3, wo: DVec3) -> Option<(f64, f64)> {
-        let h = geometry::normalize(wi + wo)?;
-        let v = self.ndf(h) * self.g2(wi, wo) / (4.0 * wi.z * wo.z);
-        Some((v, wi.dot(h).max(0.0)))
+    /// D G2 / (4 cos θi cos θo), wi·h and the sampling density G1(wo) D / (4 cos θo) of a pair
+    /// (any lengths; `None` when invalid or below the horizon): one pass for `eval`, `pdf` and
+    /// `eval_pdf`.
+    ///
+    /// Written with the half vector unnormalized, h = l + v for unit l, v: D(h/|h|) =
+    /// |h|⁴ / (π α_x α_y e²) with e = (h_x/α_x)² + (h_y/α_y)² + h_z², l·h/|h| = |h|/2, and
+    /// G2 = q_l q_v / (q_l q_v + s_l q_v + s_v q_l) from Λ = s/q ([`Ggx::lambda`]), so each
+    /// output costs one division. Every product is formed symmetrically in (l, v), so
+    /// reciprocity holds bit for bit.
+    #[inline(always)]
+    fn lobe(&self, wi: DVec3, wo: DVec3) -> Option<Lobe> {
+        let (l, v) = super::unit_upper_pair(wi, wo)?;
+        let h = l + v;
+        let hh = h.length_squared();
+        let (x, y) = (h.x * self.inv_alpha.0, h.y * self.inv_alpha.1);
+        let e = x * x + y * y + h.z * h.z;
+        let (sl, ql) = self.lambda_parts(l);
+        let (sv, qv) = self.lambda_parts(v);
+        let d_num = self.inv_pi_axay * (hh * hh);
+        let e2 = e * e;
+        let qq = ql * qv;
+        let g_den = qq + (sl * qv + sv * ql);
+        Some(Lobe {
+            dg: d_num * qq / (e2 * g_den * (4.0 * (l.z * v.z))),
+            l_dot_h: 0.5 * hh.sqrt(),
+            pdf: d_num * qv / (e2 * (qv + sv) * (4.0 * v.z)),
+        })
     }
 
     /// Draws a half vector with density D(h) cos θh ([`Ggx::pdf_half_vector`]): the slope of a
@@ -217,6 +238,16 @@ impl Ggx {
     }
 }
 
+/// What [`Ggx::lobe`] computes for a pair.
+struct Lobe {
+    /// D G2 / (4 cos θi cos θo).
+    dg: f64,
+    /// wi·h, the Fresnel cosine.
+    l_dot_h: f64,
+    /// G1(wo) D / (4 cos θo), the density of visible-normal sampling.
+    pdf: f64,
+}
+
 impl Brdf for Ggx {
     fn channels(&self) -> &Channels {
         &self.channels
@@ -225,19 +256,30 @@ impl Brdf for Ggx {
     #[inline]
     fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
         let out = &mut out[..self.ks.len()];
-        let Some((v, cos_d)) = geometry::upper_pair(wi, wo).and_then(|(a, b)| self.lobe(a, b))
-        else {
+        let Some(lobe) = self.lobe(wi, wo) else {
             out.fill(0.0);
             return;
         };
-        for (c, (o, &k)) in out.iter_mut().zip(&self.ks).enumerate() {
-            *o = (k * v * self.fresnel.eval(cos_d, c)) as f32;
-        }
+        // k_s · D G2 / (4 cos θi cos θo) · F per channel; RGB conductors run as packed lanes.
+        self.fresnel
+            .eval_scaled(lobe.l_dot_h, &self.ks, lobe.dg, out);
+    }
+
+    /// One pass of the shared lobe gives f and the visible-normal density.
+    fn eval_pdf(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) -> f64 {
+        let out = &mut out[..self.ks.len()];
+        let Some(lobe) = self.lobe(wi, wo) else {
+            out.fill(0.0);
+            return 0.0;
+        };
+        self.fresnel
+            .eval_scaled(lobe.l_dot_h, &self.ks, lobe.dg, out);
+        lobe.pdf
     }
 
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
-        match geometry::upper_pair(wi, wo).and_then(|(a, b)| self.lobe(a, b)) {
-            Some((v, cos_d)) => self.ks_spec.at(nm) * v * self.fresnel.eval_at(cos_d, nm),
+        match self.lobe(wi, wo) {
+            Some(lobe) => self.ks_spec.at(nm) * lobe.dg * self.fresnel.eval_at(lobe.l_dot_h, nm),
             None => 0.0,
         }
     }
@@ -306,14 +348,9 @@ impl Brdf for Ggx {
         })
     }
 
+    /// The visible-normal density G1(wo) D(h) / (4 cos θo).
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        let Some((wi, wo)) = geometry::upper_pair(wi, wo) else {
-            return 0.0;
-        };
-        match geometry::normalize(wi + wo) {
-            Some(h) => self.g1(wo) * self.ndf(h) / (4.0 * wo.z),
-            None => 0.0,
-        }
+        self.lobe(wi, wo).map_or(0.0, |l| l.pdf)
     }
 }
 
