@@ -101,7 +101,7 @@ impl Ward {
     pub fn sample_half_vector(&self, u: DVec2) -> DVec3 {
         // 1 − u₁ ∈ (0, 1] keeps the logarithm finite.
         let r = (-crate::fastmath::ln(1.0 - u.x)).sqrt();
-        let (sp, cp) = (2.0 * PI * u.y).sin_cos();
+        let (sp, cp) = crate::fastmath::sin_cos_2pi(u.y);
         DVec3::new(-self.alpha_x * r * cp, -self.alpha_y * r * sp, 1.0).normalize()
     }
 }
@@ -152,21 +152,33 @@ impl Brdf for Ward {
         if wo.z <= 0.0 {
             return None;
         }
-        let h = self.sample_half_vector(u);
-        let wo_h = wo.dot(h);
-        if wo_h.is_nan() || wo_h <= 0.0 {
+        // Fused: the half vector in slope space, h′ = h / cos θh = (−α_x r cos φ, −α_y r sin φ, 1)
+        // with r² = −ln(1 − u₁), has Ward's exponent r², so exp(−exponent) = 1 − u₁ needs no
+        // `exp`; cos² θh = 1/|h′|², and the reflection 2 (wo·h) h − wo = 2 (wo·h′) cos² θh h′ − wo
+        // needs no normalization.
+        let one_minus = 1.0 - u.x;
+        let r = (-crate::fastmath::ln(one_minus)).max(0.0).sqrt();
+        let (sp, cp) = crate::fastmath::sin_cos_2pi(u.y);
+        let hp = DVec3::new(-self.alpha_x * r * cp, -self.alpha_y * r * sp, 1.0);
+        let cos2 = 1.0 / hp.length_squared();
+        let wo_hp = wo.dot(hp);
+        if !(wo_hp > 0.0) {
             return None;
         }
-        let wi = geometry::normalize(2.0 * wo_h * h - wo)?;
-        if wi.z <= 0.0 {
+        let wi = (2.0 * wo_hp * cos2) * hp - wo;
+        if !(wi.z > 0.0) {
             return None;
         }
-        let pdf = self.pdf_half_vector(h) / (4.0 * wo_h);
-        if !(pdf > 0.0 && pdf.is_finite()) {
+        let cos_h = cos2.sqrt();
+        let wo_h = wo_hp * cos_h;
+        let cos3 = cos2 * cos_h;
+        // pdf = (1 − u₁) / (π α_x α_y cos³θh) / (4 wo·h).
+        let pdf = one_minus / (PI * self.alpha_x * self.alpha_y * cos3 * 4.0 * wo_h);
+        if !(pdf > 0.0 && pdf < f64::INFINITY) {
             return None;
         }
         // ρ_s (wo·h) cos³θh √(cos θi / cos θo).
-        let ratio = wo_h * h.z * h.z * h.z * (wi.z / wo.z).sqrt();
+        let ratio = wo_h * cos3 * (wi.z / wo.z).sqrt();
         for (w, &k) in weight[..self.ks.len()].iter_mut().zip(&self.ks) {
             *w = (k * ratio) as f32;
         }
