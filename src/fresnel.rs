@@ -171,6 +171,55 @@ pub fn conductor_lanes_c2<const N: usize>(
     out
 }
 
+/// [`conductor_lanes`] at the cosine x / √gg of a direction w and an unnormalized normal g,
+/// given as x = w·g and gg = |g|², without the division and root that normalizing costs.
+///
+/// Every term of the formula is a power of gg times its normalized value (T0 = gg t0,
+/// A2B2 = gg a2b2, A x = gg a c, T1 = gg t1, T2 = gg t2, T3 = gg² t3, T4 = gg² t4), so the
+/// ratio F = (T1 − T2) T3 / ((T1 + T2)(T3 + T4)) is the same: a caller whose normal is still
+/// unnormalized starts the formula's square roots without waiting for 1/gg. 1 for x ≤ 0.
+#[inline]
+pub fn conductor_lanes_scaled<const N: usize>(
+    x: f64,
+    gg: f64,
+    n: [f64; N],
+    k: [f64; N],
+) -> [f64; N] {
+    if !(x > 0.0 && gg > 0.0 && gg < f64::INFINITY) {
+        return [1.0; N];
+    }
+    // gg cos² ≤ gg and gg sin² ≥ 0, as the normalized formula clamps cos ≤ 1.
+    let x2 = (x * x).min(gg);
+    let s = gg - x2;
+    let mut out = [0.0; N];
+    let mut t0 = [0.0; N];
+    let mut a2b2 = [0.0; N];
+    let mut a = [0.0; N];
+    for i in 0..N {
+        let (n2, k2) = (n[i] * n[i], k[i] * k[i]);
+        t0[i] = gg * (n2 - k2) - s;
+        let nkg = 2.0 * n[i] * k[i] * gg;
+        a2b2[i] = t0[i] * t0[i] + nkg * nkg;
+    }
+    for v in &mut a2b2 {
+        *v = v.sqrt();
+    }
+    for i in 0..N {
+        a[i] = (0.5 * (a2b2[i] + t0[i])).max(0.0);
+    }
+    for v in &mut a {
+        *v = v.sqrt();
+    }
+    for i in 0..N {
+        let t1 = a2b2[i] + x2;
+        let t2 = 2.0 * a[i] * x;
+        let t3 = x2 * a2b2[i] + s * s;
+        let t4 = t2 * s;
+        out[i] = (t1 - t2) * t3 / ((t1 + t2) * (t3 + t4));
+    }
+    out
+}
+
 /// Unpolarized dielectric reflectance for incidence cosine `cos_i` and relative index
 /// `eta` = n_transmitted / n_incident. A negative `cos_i` means the light arrives from inside
 /// (the other side of the normal); then the relative index is 1/eta. Total internal reflection
@@ -429,6 +478,26 @@ impl Fresnel {
         self.eval_scaled_c2(cos_i, cos_i * cos_i, scale, s, out)
     }
 
+    /// [`Fresnel::eval_scaled`] at the cosine x / √gg of a direction and an unnormalized normal
+    /// g (x = w·g, gg = |g|²): RGB conductors use [`conductor_lanes_scaled`], which needs
+    /// neither 1/gg nor √gg; other variants normalize.
+    #[inline]
+    pub fn eval_scaled_dot(&self, x: f64, gg: f64, scale: &[f64], s: f64, out: &mut [f32]) {
+        if let (Fresnel::Conductor { n, k, .. }, [o0, o1, o2, ..], [k0, k1, k2]) =
+            (self, &mut *out, scale)
+            && let (&[n0, n1, n2], &[c0, c1, c2]) = (n.as_slice(), k.as_slice())
+        {
+            let f = conductor_lanes_scaled(x, gg, [n0, n1, n2, n0], [c0, c1, c2, c0]);
+            (*o0, *o1, *o2) = (
+                (k0 * s * f[0]) as f32,
+                (k1 * s * f[1]) as f32,
+                (k2 * s * f[2]) as f32,
+            );
+            return;
+        }
+        self.eval_scaled(x / gg.sqrt(), scale, s, out)
+    }
+
     /// [`Fresnel::eval_scaled`] with cos² θ′ supplied by the caller (see
     /// [`conductor_lanes_c2`]; other variants use `cos_i` alone).
     #[inline]
@@ -501,6 +570,33 @@ impl Fresnel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scaled_conductor_matches_the_normalized_formula() {
+        // Au-like and Cu-like indices, random cosines and normal lengths: the scaled formula is
+        // the normalized one with every term multiplied by a power of gg, so they agree to
+        // rounding (a few ulps, amplified by the conditioning of the differences t1 − t2).
+        let n = [0.18, 0.42, 1.37, 0.27];
+        let k = [3.4, 2.35, 1.77, 2.8];
+        let mut rng = crate::rng::Pcg32::new(11);
+        for _ in 0..20_000 {
+            let cos = rng.next_f64().max(1e-6);
+            let len = 0.01 + 10.0 * rng.next_f64();
+            let (x, gg) = (cos * len, len * len);
+            let f = conductor_lanes_scaled(x, gg, n, k);
+            for i in 0..4 {
+                let expect = conductor(cos, n[i], k[i]);
+                assert!(
+                    (f[i] - expect).abs() <= 1e-12 * expect,
+                    "{cos} {len}: {} vs {expect}",
+                    f[i]
+                );
+            }
+        }
+        assert_eq!(conductor_lanes_scaled(0.0, 1.0, n, k), [1.0; 4]);
+        assert_eq!(conductor_lanes_scaled(-0.5, 1.0, n, k), [1.0; 4]);
+        assert_eq!(conductor_lanes_scaled(f64::NAN, 1.0, n, k), [1.0; 4]);
+    }
 
     #[test]
     fn lanes_are_bit_identical_to_the_scalar_formula() {

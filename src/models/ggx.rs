@@ -322,10 +322,6 @@ impl Brdf for Ggx {
         if wi.z.is_nan() || wi.z <= 0.0 {
             return None;
         }
-        // cos and cos² of the Fresnel angle: the quotient is ready before the root, and the
-        // conductor formula's own roots need only cos².
-        let wo_h = wo_g / gg.sqrt();
-        let wo_h2 = wo_g * wo_g * inv_gg;
         // Λ = s²/q for both directions (see `lambda_parts`), so that pdf and weight each take
         // one division:
         // pdf = D / (4 cos θo (1 + Λo)) = q_o / (π α_x α_y e² · 4 cos θo (q_o + s_o²)),
@@ -339,8 +335,9 @@ impl Brdf for Ggx {
             return None;
         }
         let ratio = (qo + s2o) * qi / (qi * qo + s2i * qo + s2o * qi);
+        // Fresnel at wo·n = (wo·g)/|g|, from wo·g and |g|² directly (no 1/|g|² on its path).
         self.fresnel
-            .eval_scaled_c2(wo_h, wo_h2, &self.ks, ratio, &mut weight[..self.ks.len()]);
+            .eval_scaled_dot(wo_g, gg, &self.ks, ratio, &mut weight[..self.ks.len()]);
         Some(BrdfSample {
             wi,
             pdf,
