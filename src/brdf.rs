@@ -65,7 +65,7 @@ pub struct BrdfSample {
 
 /// A bidirectional reflectance distribution function.
 ///
-/// Object safe and `Send + Sync`, so `Box<dyn Brdf>` and `&dyn Brdf` work everywhere.
+/// Object safe and `Send + Sync`, so `Box<dyn Brdf + Send + Sync>` and `&dyn Brdf` work everywhere.
 ///
 /// # Example
 /// ```

@@ -25,6 +25,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analysis;
+pub mod bake;
 pub mod brdf;
 pub mod codec;
 pub mod error;
@@ -35,16 +36,21 @@ pub mod geometry;
 pub mod measured;
 pub mod metals;
 pub mod models;
+pub mod progress;
 pub mod render;
 pub mod report;
 pub mod rng;
+pub mod source;
 pub mod spec;
 pub mod spectrum;
 pub mod store;
 pub mod table;
 
+pub use bake::{BakeReport, BakeRequest, BakeTarget};
 pub use brdf::{Brdf, BrdfSample, Flags};
 pub use error::{Error, Result};
+pub use progress::Progress;
+pub use source::{OpenOptions, SourceKind, classify, open, open_with};
 pub use spec::ModelSpec;
 pub use spectrum::{Channels, Value};
 

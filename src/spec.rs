@@ -3,7 +3,7 @@
 //! The same schema is used by the CLI (`brdftab eval '{"model": "lambert", "kd": 0.3}'`), stored
 //! in database metadata as a table's provenance, and produced by fitting, so a fitted result can
 //! be used directly as a source. A spec is parsed with [`ModelSpec::parse`] (errors name the field
-//! path, e.g. `terms[1].fresnel.n`), validated, and turned into a `Box<dyn Brdf>` for a channel
+//! path, e.g. `terms[1].fresnel.n`), validated, and turned into a `Box<dyn Brdf + Send + Sync>` for a channel
 //! set with [`ModelSpec::build`].
 //!
 //! ```
@@ -407,7 +407,7 @@ impl ModelSpec {
     }
 
     /// Builds the model for `channels` (validating first).
-    pub fn build(&self, channels: &Channels) -> Result<Box<dyn Brdf>> {
+    pub fn build(&self, channels: &Channels) -> Result<Box<dyn Brdf + Send + Sync>> {
         self.validate()?;
         crate::models::build(self, channels)
     }

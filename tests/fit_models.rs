@@ -4,7 +4,7 @@ use brdftab::fit::{self, ColorMode, FitOptions, ParamRequest};
 use brdftab::spec::ModelSpec;
 use brdftab::{Brdf, Channels};
 
-fn build(json: &str) -> Box<dyn Brdf> {
+fn build(json: &str) -> Box<dyn Brdf + Send + Sync> {
     ModelSpec::parse(json)
         .unwrap()
         .build(&Channels::Rgb)

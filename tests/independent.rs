@@ -61,7 +61,7 @@ fn pairs(seed: u64, n: usize) -> Vec<Pair> {
     out
 }
 
-fn build(spec: &str) -> Box<dyn Brdf> {
+fn build(spec: &str) -> Box<dyn Brdf + Send + Sync> {
     ModelSpec::parse(spec)
         .and_then(|s| s.build(&Channels::Rgb))
         .unwrap_or_else(|e| panic!("{spec}: {e}"))

@@ -11,7 +11,7 @@ use brdftab::{Brdf, Channels};
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 
-fn build(json: &str) -> Box<dyn Brdf> {
+fn build(json: &str) -> Box<dyn Brdf + Send + Sync> {
     ModelSpec::parse(json)
         .unwrap_or_else(|e| panic!("{json}: {e}"))
         .build(&Channels::Rgb)
@@ -86,7 +86,7 @@ fn every_smooth_spec_is_sampled_by_a_chi_square_test() {
 /// must fail. This guards against a harness that passes everything.
 #[test]
 fn chi_square_rejects_a_wrong_pdf() {
-    struct Wrong(Box<dyn Brdf>, Box<dyn Brdf>);
+    struct Wrong(Box<dyn Brdf + Send + Sync>, Box<dyn Brdf + Send + Sync>);
     impl Brdf for Wrong {
         fn channels(&self) -> &Channels {
             self.0.channels()

@@ -571,7 +571,7 @@ mod tests {
         assert!(rel(a[0], expect) < 1e-5, "{} vs {expect}", a[0]);
     }
 
-    fn model(spec: &str) -> Box<dyn Brdf> {
+    fn model(spec: &str) -> Box<dyn Brdf + Send + Sync> {
         crate::spec::ModelSpec::parse(spec)
             .unwrap()
             .build(&Channels::Rgb)

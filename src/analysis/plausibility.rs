@@ -473,7 +473,7 @@ mod tests {
         assert_eq!(r.max_albedo_theta_deg, 89.0);
     }
 
-    fn model(spec: &str) -> Box<dyn Brdf> {
+    fn model(spec: &str) -> Box<dyn Brdf + Send + Sync> {
         crate::spec::ModelSpec::parse(spec)
             .unwrap()
             .build(&Channels::Rgb)

@@ -576,7 +576,7 @@ fn flatten(
     spec: &ModelSpec,
     weight: f64,
     channels: &Channels,
-    out: &mut Vec<(f64, Box<dyn Brdf>)>,
+    out: &mut Vec<(f64, Box<dyn Brdf + Send + Sync>)>,
 ) -> Result<()> {
     match spec {
         ModelSpec::Sum { terms, weights } => {
@@ -647,7 +647,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 mod tests {
     use super::*;
 
-    fn build(json: &str) -> Box<dyn Brdf> {
+    fn build(json: &str) -> Box<dyn Brdf + Send + Sync> {
         ModelSpec::parse(json)
             .unwrap()
             .build(&Channels::Rgb)

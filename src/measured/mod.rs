@@ -15,6 +15,7 @@
 //! allocate in `eval`. Slice images of any source live in
 //! [`analysis::slice`](crate::analysis::slice).
 
+pub mod data;
 pub mod merl;
 pub mod merl_manifest;
 pub mod rgl;

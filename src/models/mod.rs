@@ -64,7 +64,7 @@ pub(crate) fn unit_upper_pair(
 }
 
 /// Builds the model a (validated) spec describes for a channel set.
-pub fn build(spec: &ModelSpec, channels: &Channels) -> Result<Box<dyn Brdf>> {
+pub fn build(spec: &ModelSpec, channels: &Channels) -> Result<Box<dyn Brdf + Send + Sync>> {
     Ok(match spec {
         ModelSpec::Lambert { kd } => Box::new(lambert::Lambert::new(kd.clone(), channels)?),
         ModelSpec::Mirror { fresnel } => Box::new(mirror::Mirror::new(fresnel, channels)?),

@@ -49,7 +49,7 @@ pub const MAX_TERMS: usize = 16;
 /// A weighted sum of BRDFs.
 pub struct Sum {
     channels: Channels,
-    terms: Vec<Box<dyn Brdf>>,
+    terms: Vec<Box<dyn Brdf + Send + Sync>>,
     weights: Vec<f64>,
     /// Per term: the probability of choosing it in cos θo bin k (w_j · â_j at the bin centre,
     /// normalized over the terms; all zero when no term reflects anywhere).
@@ -71,7 +71,7 @@ impl Sum {
     /// The sum Σ w_j f_j of `terms` with `weights` (default 1 each; finite and ≥ 0). Every term
     /// must use `channels`.
     pub fn new(
-        terms: Vec<Box<dyn Brdf>>,
+        terms: Vec<Box<dyn Brdf + Send + Sync>>,
         weights: Option<Vec<f64>>,
         channels: &Channels,
     ) -> Result<Self> {
@@ -149,7 +149,7 @@ impl Sum {
     pub fn terms(&self) -> impl Iterator<Item = (&dyn Brdf, f64)> {
         self.terms
             .iter()
-            .map(|t| t.as_ref())
+            .map(|t| -> &dyn Brdf { t.as_ref() })
             .zip(self.weights.iter().copied())
     }
 
@@ -615,11 +615,11 @@ mod tests {
     use crate::spectrum::Value;
     use proptest::prelude::*;
 
-    fn lambert(kd: f64) -> Box<dyn Brdf> {
+    fn lambert(kd: f64) -> Box<dyn Brdf + Send + Sync> {
         Box::new(Lambert::new(Value::Grey(kd), &Channels::Rgb).unwrap())
     }
 
-    fn ggx(ax: f64, ay: f64) -> Box<dyn Brdf> {
+    fn ggx(ax: f64, ay: f64) -> Box<dyn Brdf + Send + Sync> {
         Box::new(
             Ggx::new(
                 ax,
@@ -733,7 +733,7 @@ mod tests {
         assert_eq!(plastic().flags(), Flags::SMOOTH_SYMMETRIC);
         let aniso = Sum::new(vec![lambert(0.2), ggx(0.1, 0.3)], None, &Channels::Rgb).unwrap();
         assert!(!aniso.flags().isotropic && aniso.flags().reciprocal && !aniso.flags().delta);
-        let mirror = || -> Box<dyn Brdf> { Box::new(TestMirror(Channels::Rgb, 0.5)) };
+        let mirror = || -> Box<dyn Brdf + Send + Sync> { Box::new(TestMirror(Channels::Rgb, 0.5)) };
         let mixed = Sum::new(vec![lambert(0.2), mirror()], None, &Channels::Rgb).unwrap();
         assert!(!mixed.flags().delta);
         let all = Sum::new(vec![mirror(), mirror()], None, &Channels::Rgb).unwrap();

@@ -97,7 +97,7 @@ impl SourceDef {
     }
 
     /// Opens the source as a `Brdf` (RGB).
-    pub fn open(&self) -> Result<Box<dyn Brdf>> {
+    pub fn open(&self) -> Result<Box<dyn Brdf + Send + Sync>> {
         match &self.kind {
             SourceKind::Model(spec) => spec.build(&Channels::Rgb),
             SourceKind::Rgl(path) => Ok(Box::new(crate::measured::RglBrdf::open(path)?)),

@@ -48,6 +48,7 @@
 pub mod db;
 pub mod export;
 pub mod format;
+pub mod info;
 pub mod tables;
 mod writer;
 

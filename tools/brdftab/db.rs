@@ -1,12 +1,12 @@
 //! `db` subcommands (add, list, rm, verify) and `info` for brdftab files: thin over
 //! `brdftab::store`.
 
-use brdftab::store::{Store, db};
+use brdftab::bake::BakeTarget;
+use brdftab::store::{self, db};
 use brdftab::{Error, Result};
 use clap::{Args, Subcommand};
-use serde_json::json;
 
-use crate::table::{BakeArgs, Target};
+use crate::bake::BakeFlags;
 
 /// Arguments of `brdftab db`.
 #[derive(Args)]
@@ -34,8 +34,10 @@ struct AddArgs {
     /// Replace an existing table of the same name.
     #[arg(long)]
     replace: bool,
+    /// The source: a model spec (inline JSON or .json), a table, a MERL or RGL file.
+    source: String,
     #[command(flatten)]
-    bake: Box<BakeArgs>,
+    bake: Box<BakeFlags>,
 }
 
 #[derive(Args)]
@@ -70,20 +72,13 @@ pub fn run(a: DbArgs) -> Result<()> {
                 .name
                 .clone()
                 .ok_or_else(|| Error::arg("--name", "db add needs --name NAME"))?;
-            if a.bake.output.is_some() {
-                return Err(Error::arg(
-                    "--output",
-                    "db add writes into DB; drop --output",
-                ));
-            }
-            crate::table::bake_to(
-                *a.bake,
-                Target::Db {
-                    path: &a.db,
-                    name: &name,
-                    replace: a.replace,
-                },
-            )
+            let req = a.bake.request(&a.source)?;
+            let target = BakeTarget::Db {
+                path: a.db.clone(),
+                name,
+                replace: a.replace,
+            };
+            crate::bake::run(&req, &target).map(drop)
         }
         DbCommand::List(a) => list(&a.db, a.json),
         DbCommand::Rm(a) => {
@@ -99,34 +94,8 @@ pub fn run(a: DbArgs) -> Result<()> {
     }
 }
 
-fn summary(s: &Store, name: &str) -> Result<serde_json::Value> {
-    let t = s.table(name)?;
-    let h = t.header();
-    let bytes = t.compressed_bytes();
-    Ok(json!({
-        "name": h.name,
-        "source": h.source,
-        "parameterization": h.parameterization,
-        "symmetry": h.symmetry,
-        "channels": h.channels,
-        "units": h.units,
-        "codec": h.codec,
-        "tool": h.tool,
-        "shape": h.shape,
-        "values": h.values,
-        "chunks": t.chunk_count(),
-        "bytes": bytes,
-        "ratio_to_f32": (h.values as f64 * 4.0) / (bytes.max(1) as f64),
-    }))
-}
-
 fn list(path: &str, as_json: bool) -> Result<()> {
-    let s = Store::open(path)?;
-    let rows: Vec<serde_json::Value> = s
-        .tables()
-        .iter()
-        .map(|e| summary(&s, &e.name))
-        .collect::<Result<_>>()?;
+    let rows = store::info::list(path)?;
     if as_json {
         println!(
             "{}",
@@ -163,38 +132,20 @@ fn list(path: &str, as_json: bool) -> Result<()> {
 
 /// `brdftab info` for a brdftab file (`FILE` or `DB#NAME`).
 pub fn info(source: &str, as_json: bool) -> Result<()> {
-    let (path, name) = db::split_source(source);
-    let s = Store::open(path)?;
-    let names: Vec<String> = match name {
-        Some(n) => vec![n.to_owned()],
-        None => s.tables().iter().map(|e| e.name.clone()).collect(),
-    };
-    let tables: Vec<serde_json::Value> = names
-        .iter()
-        .map(|n| summary(&s, n))
-        .collect::<Result<_>>()?;
-    let values: u64 = tables
-        .iter()
-        .map(|t| t["values"].as_u64().unwrap_or(0))
-        .sum();
-    let v = json!({
-        "file": path,
-        "format": "btdb",
-        "bytes": s.file_len(),
-        "ratio_to_f32": values as f64 * 4.0 / s.file_len().max(1) as f64,
-        "tables": tables,
-    });
+    let v = store::info::file_info(source)?;
+    let tables = v["tables"].as_array().cloned().unwrap_or_default();
     if as_json {
         println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
         return Ok(());
     }
     println!(
-        "file:    {path} (brdftab format, {} tables)",
-        s.tables().len()
+        "file:    {} (brdftab format, {} tables)",
+        v["file"].as_str().unwrap_or(""),
+        tables.len()
     );
     println!(
         "bytes:   {} ({:.1}x smaller than f32)",
-        s.file_len(),
+        v["bytes"],
         v["ratio_to_f32"].as_f64().unwrap_or(0.0)
     );
     for t in &tables {

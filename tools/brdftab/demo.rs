@@ -162,7 +162,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     }
 
     // Sources: the models, then the RGL materials found on disk.
-    let mut sources: Vec<(String, Box<dyn Brdf>, Source)> = Vec::new();
+    let mut sources: Vec<(String, Box<dyn Brdf + Send + Sync>, Source)> = Vec::new();
     for (name, spec) in BAKED_MODELS {
         let s = ModelSpec::parse(spec)?;
         let b = s.build(&Channels::Rgb)?;

@@ -3,12 +3,16 @@
 
 mod accuracy;
 mod analysis;
+mod bake;
+mod bench;
+mod convert;
 mod db;
 mod demo;
 mod export;
 mod fit;
 mod measured;
 mod models;
+mod progress;
 mod render;
 mod sample;
 mod source;
@@ -32,7 +36,7 @@ enum Command {
     /// List every model with its parameters.
     Models(models::ModelsArgs),
     /// Bake SOURCE into a dense (symmetry-reduced) table file.
-    Bake(table::BakeArgs),
+    Bake(bake::BakeArgs),
     /// Databases of named tables: add, list, rm, verify.
     Db(db::DbArgs),
     /// Export a stored table as .npy, or a 2D slice of it as EXR.
@@ -40,13 +44,13 @@ enum Command {
     /// Describe a table file (grid, symmetry, channels, sizes) or a measured file (MERL, RGL).
     Info(table::InfoArgs),
     /// Time lookups of SOURCE on random pairs (single thread and batch on all cores).
-    Bench(table::BenchArgs),
+    Bench(bench::BenchArgs),
     /// Render SOURCE on a sphere (path tracer or lit sphere); --compare renders two side by side.
     Render(render::RenderArgs),
     /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
     Slice(measured::SliceArgs),
     /// Convert between formats (MERL .binary, RGL .bsdf read only, tables).
-    Convert(measured::ConvertArgs),
+    Convert(convert::ConvertArgs),
     /// Directional albedo a(θ′) per channel: one line `theta a_1 a_2 ...` per angle.
     Albedo(analysis::AlbedoArgs),
     /// Physical plausibility: positivity, reciprocity, energy conservation.
@@ -71,14 +75,14 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Eval(a) => models::eval(a),
         Command::Models(a) => models::models(a),
-        Command::Bake(a) => table::bake(a),
+        Command::Bake(a) => bake::bake(a),
         Command::Info(a) => table::info(a),
         Command::Db(a) => db::run(a),
         Command::Export(a) => export::run(a),
-        Command::Bench(a) => table::bench(a),
+        Command::Bench(a) => bench::bench(a),
         Command::Render(a) => render::run(a),
         Command::Slice(a) => measured::slice(a),
-        Command::Convert(a) => measured::convert(a),
+        Command::Convert(a) => convert::convert(a),
         Command::Albedo(a) => analysis::albedo(a),
         Command::Check(a) => analysis::check(a),
         Command::Demo(a) => demo::demo(a),

@@ -1,0 +1,702 @@
+//! One way to turn any SOURCE into a stored table: [`BakeRequest`].
+//!
+//! `brdftab bake`, `convert`, `db add`, the demo, the accuracy suite, the Python package and the
+//! C ABI all bake through this type, so the choices a bake makes — the grid, the symmetry and
+//! its tolerance, the codec, the provenance recorded in the file — are made in one place and the
+//! same for every host.
+//!
+//! ```
+//! use brdftab::bake::{BakeRequest, BakeTarget};
+//! use brdftab::table::presets::Preset;
+//! # let dir = std::env::temp_dir().join(format!("brdftab-bake-doc-{}", std::process::id()));
+//! # std::fs::create_dir_all(&dir)?;
+//! let out = dir.join("lambert.btdb");
+//! let report = BakeRequest::new(r#"{"model": "lambert", "kd": [0.1, 0.2, 0.3]}"#)
+//!     .preset(Preset::Small)
+//!     .run(&BakeTarget::file(out.to_str().unwrap()))?;
+//! assert_eq!(report.name, "lambert");
+//! assert_eq!(report.info["codec"]["quant"], "log16");
+//! # std::fs::remove_dir_all(&dir)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::brdf::Brdf;
+use crate::codec::{Codec, Quant};
+use crate::error::{Error, Result};
+use crate::progress::{Progress, Silent, Stage};
+use crate::source::{self, OpenOptions, SourceKind};
+use crate::spectrum::Channels;
+use crate::store::{TableHeader, Writer, db, tables};
+use crate::table::presets::Preset;
+use crate::table::{
+    BakeOptions, Grid, Interp, Mapping, Param, Symmetry, Table, TabulatedBrdf, bake_chunks,
+    symmetry,
+};
+
+/// The grid a bake samples on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GridChoice {
+    /// The source's natural grid: a MERL file's own cells for MERL sources, the medium preset
+    /// otherwise.
+    #[default]
+    Default,
+    /// A size preset.
+    Preset(Preset),
+    /// Full axis sizes θ1 × φ1 × θ2 × φ2 (halfdiff: sqrt θh, uniform θd; inout: uniform).
+    Sizes([usize; 4]),
+    /// The MERL grid (90 θh × 90 θd × 180 φd cell centres). A MERL source keeps its cells.
+    Merl,
+}
+
+impl GridChoice {
+    /// Parses `small`/`medium`/`large`, `merl`, or sizes `θ1xφ1xθ2xφ2`.
+    pub fn parse(s: &str) -> Result<GridChoice> {
+        let t = s.trim().to_ascii_lowercase();
+        match t.as_str() {
+            "merl" => Ok(GridChoice::Merl),
+            "default" => Ok(GridChoice::Default),
+            "small" | "medium" | "large" => Ok(GridChoice::Preset(Preset::parse(&t)?)),
+            _ => {
+                let v: Vec<usize> = t
+                    .split(['x', '×'])
+                    .map(|x| {
+                        x.trim()
+                            .parse::<usize>()
+                            .map_err(|_| Error::arg("grid", format!("`{x}` is not a size")))
+                    })
+                    .collect::<Result<_>>()?;
+                let sizes: [usize; 4] = v.try_into().map_err(|_| {
+                    Error::arg(
+                        "grid",
+                        format!("`{s}`: expected four sizes θ1xφ1xθ2xφ2, merl, or a preset"),
+                    )
+                })?;
+                Ok(GridChoice::Sizes(sizes))
+            }
+        }
+    }
+}
+
+/// The symmetry a bake reduces by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SymmetryChoice {
+    /// Detect the symmetries the source meets within the symmetry tolerance.
+    #[default]
+    Auto,
+    /// Exactly these (verified against the source unless forced).
+    Exactly(Symmetry),
+}
+
+impl SymmetryChoice {
+    /// Parses `auto`, `none`, `all` or a list of `isotropic,reciprocal,bilateral`.
+    pub fn parse(s: &str) -> Result<SymmetryChoice> {
+        match s.trim() {
+            "auto" => Ok(SymmetryChoice::Auto),
+            s => Ok(SymmetryChoice::Exactly(Symmetry::parse(s)?)),
+        }
+    }
+}
+
+/// Where a bake writes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum BakeTarget {
+    /// A single-table brdftab file, replaced atomically.
+    File(String),
+    /// Table `name` of database `path` (created if absent).
+    Db {
+        /// The database file.
+        path: String,
+        /// The table's name.
+        name: String,
+        /// Replace a table of that name (otherwise an existing name is an error).
+        replace: bool,
+    },
+    /// A raw (uncompressed f32) table file.
+    Raw(String),
+}
+
+impl BakeTarget {
+    /// A single-table file.
+    pub fn file(path: impl Into<String>) -> BakeTarget {
+        BakeTarget::File(path.into())
+    }
+
+    /// A new table of a database.
+    pub fn db(path: impl Into<String>, name: impl Into<String>) -> BakeTarget {
+        BakeTarget::Db {
+            path: path.into(),
+            name: name.into(),
+            replace: false,
+        }
+    }
+
+    /// Reads an output string the way `convert` does: `DB#NAME` is a database entry, a `.btdb`
+    /// file a single-table file (or, with `name`, an entry of that database), anything else a
+    /// raw table file.
+    pub fn parse(output: &str, name: Option<&str>, replace: bool) -> BakeTarget {
+        let (path, entry) = db::split_source(output);
+        match (entry.or(name), path.to_ascii_lowercase().ends_with(".btdb")) {
+            (Some(n), _) => BakeTarget::Db {
+                path: path.into(),
+                name: n.into(),
+                replace,
+            },
+            (None, true) => BakeTarget::File(path.into()),
+            (None, false) => BakeTarget::Raw(path.into()),
+        }
+    }
+
+    /// The file written.
+    pub fn path(&self) -> &str {
+        match self {
+            BakeTarget::File(p) | BakeTarget::Raw(p) | BakeTarget::Db { path: p, .. } => p,
+        }
+    }
+}
+
+/// Everything a bake decides, in one place. Builder-style setters; `new(source)` starts from the
+/// defaults every host shares (grid [`GridChoice::Default`], symmetry detected at 1e-3, codec
+/// log16 ≤ 1e-3 at zstd level 6).
+#[derive(Debug, Clone)]
+pub struct BakeRequest {
+    /// The SOURCE (see [`crate::source`]).
+    pub source: String,
+    /// The grid.
+    pub grid: GridChoice,
+    /// The parameterization (`None`: halfdiff).
+    pub param: Option<Param>,
+    /// The symmetry reduction.
+    pub symmetry: SymmetryChoice,
+    /// Relative tolerance of symmetry detection and verification.
+    pub symmetry_tolerance: f64,
+    /// Bake even when the source breaks the chosen symmetry beyond the tolerance.
+    pub force: bool,
+    /// The codec (quantization, its tolerance, zstd level).
+    pub codec: Codec,
+    /// The table's name (default: the output file's stem).
+    pub name: Option<String>,
+    /// Samples per stored axis and cell (box prefilter; 1 = node values).
+    pub supersample: usize,
+    /// Channels for model specs and RGL files (`None`: the source's own).
+    pub channels: Option<Channels>,
+    /// Random pairs for the accuracy report of the written table against its source (0 = none).
+    pub accuracy_pairs: usize,
+    /// Interpolation of the accuracy report.
+    pub accuracy_interp: Interp,
+}
+
+impl BakeRequest {
+    /// A request with the defaults for `source`.
+    pub fn new(source: impl Into<String>) -> BakeRequest {
+        BakeRequest {
+            source: source.into(),
+            grid: GridChoice::Default,
+            param: None,
+            symmetry: SymmetryChoice::Auto,
+            symmetry_tolerance: symmetry::DEFAULT_TOLERANCE,
+            force: false,
+            codec: default_codec(),
+            name: None,
+            supersample: 1,
+            channels: None,
+            accuracy_pairs: 0,
+            accuracy_interp: Interp::Linear,
+        }
+    }
+
+    /// Sets the grid to a preset.
+    pub fn preset(mut self, p: Preset) -> BakeRequest {
+        self.grid = GridChoice::Preset(p);
+        self
+    }
+
+    /// Sets the grid.
+    pub fn grid(mut self, g: GridChoice) -> BakeRequest {
+        self.grid = g;
+        self
+    }
+
+    /// Sets the parameterization.
+    pub fn param(mut self, p: Param) -> BakeRequest {
+        self.param = Some(p);
+        self
+    }
+
+    /// Sets the symmetry.
+    pub fn symmetry(mut self, s: SymmetryChoice) -> BakeRequest {
+        self.symmetry = s;
+        self
+    }
+
+    /// Sets the codec.
+    pub fn codec(mut self, c: Codec) -> BakeRequest {
+        self.codec = c;
+        self
+    }
+
+    /// Sets the table name.
+    pub fn name(mut self, n: impl Into<String>) -> BakeRequest {
+        self.name = Some(n.into());
+        self
+    }
+
+    /// Sets the channels.
+    pub fn channels(mut self, c: Channels) -> BakeRequest {
+        self.channels = Some(c);
+        self
+    }
+
+    /// Reports the accuracy of the written table on `pairs` random pairs.
+    pub fn accuracy(mut self, pairs: usize) -> BakeRequest {
+        self.accuracy_pairs = pairs;
+        self
+    }
+
+    /// Opens the source as the request says.
+    pub fn open_source(&self) -> Result<Box<dyn Brdf + Send + Sync>> {
+        let opts = OpenOptions {
+            channels: self.channels.clone(),
+            ..OpenOptions::default()
+        };
+        source::open_with(&self.source, &opts)
+    }
+
+    /// The symmetry this request reduces `src` by, with a note when detection disagrees with
+    /// what the source declares.
+    pub fn resolve_symmetry(&self, src: &dyn Brdf) -> (Symmetry, Option<String>) {
+        match self.symmetry {
+            SymmetryChoice::Exactly(s) => (s, None),
+            SymmetryChoice::Auto => {
+                let d = symmetry::detect(src, self.symmetry_tolerance);
+                let declared = Symmetry::from_flags(src.flags());
+                let note = (d != declared)
+                    .then(|| format!("the source declares {declared}, detected {d}; using {d}"));
+                (d, note)
+            }
+        }
+    }
+
+    /// The grid this request bakes `src` on.
+    pub fn resolve_grid(&self, src: &dyn Brdf, sym: Symmetry) -> Result<Grid> {
+        let ch = src.channels().clone();
+        match self.grid {
+            GridChoice::Merl => Grid::merl(ch).with_symmetry(sym),
+            GridChoice::Sizes(s) => {
+                let p = self.param.unwrap_or(Param::HalfDiff);
+                let m = match p {
+                    Param::HalfDiff => [Mapping::Sqrt, Mapping::Uniform],
+                    Param::InOut => [Mapping::Uniform, Mapping::Uniform],
+                };
+                Grid::with_sizes(p, s, m, ch, sym)
+            }
+            GridChoice::Preset(p) => p.grid(self.param, sym, ch),
+            GridChoice::Default => Preset::Medium.grid(self.param, sym, ch),
+        }
+    }
+
+    /// True when the request keeps a MERL file's own cells instead of resampling it.
+    fn keeps_merl_cells(&self) -> bool {
+        source::classify(&self.source) == SourceKind::Merl
+            && matches!(self.grid, GridChoice::Default | GridChoice::Merl)
+            && self.param.is_none_or(|p| p == Param::HalfDiff)
+            && self.supersample == 1
+    }
+
+    /// Bakes into memory: the table and what the bake did.
+    pub fn table(&self, progress: &dyn Progress) -> Result<(Table, BakeReport)> {
+        let src = self.open_source()?;
+        self.table_of(src.as_ref(), progress)
+    }
+
+    /// Bakes an already opened source (for callers that also use it, e.g. to compare).
+    pub fn table_of(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<(Table, BakeReport)> {
+        let t0 = Instant::now();
+        if self.keeps_merl_cells() {
+            let table = crate::measured::MerlBrdf::open(&self.source)?.to_table();
+            let report = self.report_for(src, table.grid(), None, t0, true);
+            return Ok((table, report));
+        }
+        let (sym, note) = self.resolve_symmetry(src);
+        let grid = self.resolve_grid(src, sym)?;
+        let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
+        let set = |done: u64, _total: u64| progress.set(done);
+        let opts = self.bake_options(&set);
+        let (table, r) = crate::table::bake(src, &grid, &opts)?;
+        let mut report = self.report_for(src, &grid, note, t0, false);
+        report.forced = r.forced;
+        Ok((table, report))
+    }
+
+    fn bake_options<'a>(&self, set: crate::table::bake::Progress<'a>) -> BakeOptions<'a> {
+        BakeOptions {
+            supersample: self.supersample,
+            force: self.force,
+            tolerance: self.symmetry_tolerance,
+            progress: Some(set),
+            ..BakeOptions::default()
+        }
+    }
+
+    fn report_for(
+        &self,
+        src: &dyn Brdf,
+        grid: &Grid,
+        note: Option<String>,
+        t0: Instant,
+        merl_cells: bool,
+    ) -> BakeReport {
+        BakeReport {
+            source: src.describe(),
+            name: String::new(),
+            output: String::new(),
+            grid: grid.clone(),
+            values: grid.stored_values() as u64,
+            seconds: t0.elapsed().as_secs_f64(),
+            symmetry_note: note,
+            forced: None,
+            merl_cells,
+            accuracy: None,
+            info: serde_json::Value::Null,
+        }
+    }
+
+    /// Bakes and writes to `target` with provenance; returns what the bake did and what `info`
+    /// reports of the written table. Chunks stream into the file as they are baked (bounded
+    /// memory), except for raw targets and MERL cells, which are built in memory.
+    pub fn run(&self, target: &BakeTarget) -> Result<BakeReport> {
+        self.run_with(target, &Silent)
+    }
+
+    /// [`run`](Self::run), reporting progress.
+    pub fn run_with(&self, target: &BakeTarget, progress: &dyn Progress) -> Result<BakeReport> {
+        let src = self.open_source()?;
+        let provenance = source::provenance(&self.source, src.as_ref())?;
+        let name = match (target, &self.name) {
+            (BakeTarget::Db { name, .. }, _) => name.clone(),
+            (_, Some(n)) => n.clone(),
+            (t, None) => stem(t.path()),
+        };
+        let (mut report, table) = match target {
+            BakeTarget::Raw(path) => {
+                let (table, r) = self.table_of(src.as_ref(), progress)?;
+                table.save_raw(path)?;
+                (r, Some(table))
+            }
+            _ if self.keeps_merl_cells() => {
+                let (table, r) = self.table_of(src.as_ref(), progress)?;
+                let (path, replace) = match target {
+                    BakeTarget::Db { path, replace, .. } => (path.as_str(), *replace),
+                    t => (t.path(), true),
+                };
+                if matches!(target, BakeTarget::File(_)) {
+                    let _ = std::fs::remove_file(path);
+                }
+                tables::save(path, &name, provenance, &table, self.codec, replace)?;
+                (r, Some(table))
+            }
+            _ => (
+                self.stream(src.as_ref(), target, &name, provenance, progress)?,
+                None,
+            ),
+        };
+        report.name = name.clone();
+        report.output = match target {
+            BakeTarget::Db { path, .. } => format!("{path}#{name}"),
+            t => t.path().to_owned(),
+        };
+        if !matches!(target, BakeTarget::Raw(_)) {
+            report.info = crate::store::info::table_info(target.path(), &name)?;
+        }
+        if self.accuracy_pairs > 0 {
+            let tab = match table {
+                Some(t) => TabulatedBrdf::from_table(t),
+                None => source::open_table(
+                    &format!("{}#{name}", target.path()),
+                    &OpenOptions::default(),
+                )?,
+            }
+            .with_interp(self.accuracy_interp);
+            report.accuracy = Some(Accuracy::measure(&tab, src.as_ref(), self.accuracy_pairs)?);
+        }
+        Ok(report)
+    }
+
+    fn stream(
+        &self,
+        src: &dyn Brdf,
+        target: &BakeTarget,
+        name: &str,
+        provenance: crate::store::Source,
+        progress: &dyn Progress,
+    ) -> Result<BakeReport> {
+        let t0 = Instant::now();
+        let (sym, note) = self.resolve_symmetry(src);
+        let grid = self.resolve_grid(src, sym)?;
+        let header = TableHeader::for_grid(name.to_owned(), provenance, &grid, self.codec);
+        let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
+        let set = |done: u64, _total: u64| progress.set(done);
+        let opts = self.bake_options(&set);
+        let mut baked = None;
+        let mut write = |w: &mut Writer| -> Result<()> {
+            baked = Some(bake_chunks(src, &grid, &opts, |i, v| {
+                w.chunk_with(v, tables::chunk_layout(&grid, i))
+            })?);
+            Ok(())
+        };
+        match target {
+            BakeTarget::Db { path, replace, .. } => db::put(path, header, *replace, write)?,
+            t => {
+                let mut w = Writer::create(t.path())?;
+                w.begin_table(header)?;
+                write(&mut w)?;
+                w.end_table()?;
+                w.finish()?;
+            }
+        }
+        let baked = baked.ok_or_else(|| Error::Unsupported("the bake wrote no table".into()))?;
+        let mut report = self.report_for(src, &grid, note, t0, false);
+        report.values = baked.values;
+        report.forced = baked.forced;
+        Ok(report)
+    }
+}
+
+/// The codec every host bakes with unless told otherwise: log16 ≤ 1e-3 at its default level.
+pub fn default_codec() -> Codec {
+    let quant = Quant::Log16 {
+        tolerance: 1e-3,
+        floor: None,
+    };
+    Codec {
+        quant,
+        level: quant.default_level(),
+        ..Codec::default()
+    }
+}
+
+/// Builds a codec from its parts as hosts name them: `name` is `f32`, `f16` or `log16` (also
+/// `log16:TOL`), `tolerance` log16's relative bound, `level` the zstd level (default per codec).
+pub fn codec(
+    name: &str,
+    tolerance: Option<f64>,
+    floor: Option<f64>,
+    level: Option<i32>,
+    exhaustive: bool,
+) -> Result<Codec> {
+    let (name, tol) = match name.split_once(':') {
+        Some((n, t)) => (
+            n,
+            Some(
+                t.trim()
+                    .parse::<f64>()
+                    .map_err(|_| Error::arg("codec", format!("`{t}` is not a tolerance")))?,
+            ),
+        ),
+        None => (name, None),
+    };
+    let quant = Quant::parse(name.trim(), tolerance.or(tol), floor)?;
+    let level = level.unwrap_or(quant.default_level());
+    if !(1..=22).contains(&level) {
+        return Err(Error::arg(
+            "level",
+            format!("zstd level {level} is outside 1..=22"),
+        ));
+    }
+    Ok(Codec {
+        quant,
+        level,
+        exhaustive,
+        ..Codec::default()
+    })
+}
+
+/// What a bake did and what was written.
+#[derive(Debug, Clone)]
+pub struct BakeReport {
+    /// The source's description.
+    pub source: String,
+    /// The table's name.
+    pub name: String,
+    /// What was written: a file, `DB#NAME`, or a raw file.
+    pub output: String,
+    /// The grid baked on.
+    pub grid: Grid,
+    /// Stored values.
+    pub values: u64,
+    /// Wall-clock seconds of the bake.
+    pub seconds: f64,
+    /// Set when symmetry detection disagreed with what the source declares.
+    pub symmetry_note: Option<String>,
+    /// The symmetry violation that `force` overrode, if any.
+    pub forced: Option<String>,
+    /// True when a MERL file's own cells were stored (no resampling).
+    pub merl_cells: bool,
+    /// The written table against its source, when asked for.
+    pub accuracy: Option<Accuracy>,
+    /// What `brdftab info --json` reports of the written table (null for raw files).
+    pub info: serde_json::Value,
+}
+
+/// Cosine-weighted accuracy of a table against its source.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Accuracy {
+    /// Random pairs compared.
+    pub pairs: usize,
+    /// Relative RMSE of f_r weighted by cos θi cos θo, whole hemisphere.
+    pub rel_rmse: f64,
+    /// Largest relative error, whole hemisphere.
+    pub max_rel: f64,
+    /// The same RMSE with both directions within 80° of the normal (Ngan et al.'s cut; the
+    /// grazing f_r of measured data grows as 1/cos θo).
+    pub rel_rmse_80: f64,
+    /// Largest relative error within 80°.
+    pub max_rel_80: f64,
+}
+
+impl Accuracy {
+    /// Compares `table` with `source` on `pairs` random pairs (seed 1).
+    pub fn measure(table: &dyn Brdf, source: &dyn Brdf, pairs: usize) -> Result<Accuracy> {
+        use crate::analysis::accuracy::{compare, compare_cap};
+        let all = compare(table, source, pairs, 1)?;
+        let cap = compare_cap(table, source, pairs, 1, 80f64.to_radians())?;
+        Ok(Accuracy {
+            pairs: all.pairs,
+            rel_rmse: all.rel_rmse,
+            max_rel: all.max_rel,
+            rel_rmse_80: cap.rel_rmse,
+            max_rel_80: cap.max_rel,
+        })
+    }
+}
+
+/// A file name's stem (`table` when it has none).
+pub fn stem(path: &str) -> String {
+    Path::new(db::split_source(path).0)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "table".into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("brdftab-bake-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn grid_choice_parses() {
+        assert_eq!(GridChoice::parse("merl").unwrap(), GridChoice::Merl);
+        assert_eq!(
+            GridChoice::parse("90x1x90x180").unwrap(),
+            GridChoice::Sizes([90, 1, 90, 180])
+        );
+        assert_eq!(
+            GridChoice::parse("small").unwrap(),
+            GridChoice::Preset(Preset::Small)
+        );
+        assert!(matches!(
+            GridChoice::parse("90x1x90"),
+            Err(Error::InvalidArgument { .. })
+        ));
+    }
+
+    #[test]
+    fn targets_parse_like_convert() {
+        assert_eq!(
+            BakeTarget::parse("a.btdb#x", None, false),
+            BakeTarget::db("a.btdb", "x")
+        );
+        assert_eq!(
+            BakeTarget::parse("a.btdb", None, false),
+            BakeTarget::file("a.btdb")
+        );
+        assert_eq!(
+            BakeTarget::parse("a.tbl", None, false),
+            BakeTarget::Raw("a.tbl".into())
+        );
+    }
+
+    #[test]
+    fn file_db_and_raw_targets_give_the_same_table() {
+        let d = tmp("targets");
+        let spec = r#"{"model":"cook_torrance","m":0.4,"ks":0.5}"#;
+        let req = BakeRequest::new(spec)
+            .preset(Preset::Small)
+            .codec(codec("f32", None, None, None, false).unwrap());
+        let file = d.join("ct.btdb").to_str().unwrap().to_owned();
+        let dbp = d.join("many.btdb").to_str().unwrap().to_owned();
+        let raw = d.join("ct.tbl").to_str().unwrap().to_owned();
+        let r1 = req.run(&BakeTarget::file(&file)).unwrap();
+        let r2 = req.run(&BakeTarget::db(&dbp, "ct")).unwrap();
+        let r3 = req.run(&BakeTarget::Raw(raw.clone())).unwrap();
+        assert_eq!(r1.name, "ct");
+        assert_eq!(r2.output, format!("{dbp}#ct"));
+        assert_eq!(r1.info["values"], r2.info["values"]);
+        assert_eq!(r1.values, r3.values);
+        let a = crate::source::open_table(&file, &OpenOptions::default())
+            .unwrap()
+            .to_table()
+            .unwrap();
+        let b = crate::source::open_table(&format!("{dbp}#ct"), &OpenOptions::default())
+            .unwrap()
+            .to_table()
+            .unwrap();
+        let c = Table::open_raw(&raw).unwrap();
+        assert_eq!(a.values(), b.values());
+        assert_eq!(a.values(), c.values());
+        // A second add of the same name is refused; with replace it succeeds.
+        assert!(req.run(&BakeTarget::db(&dbp, "ct")).is_err());
+        let replace = BakeTarget::Db {
+            path: dbp.clone(),
+            name: "ct".into(),
+            replace: true,
+        };
+        req.run(&replace).unwrap();
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn provenance_and_accuracy_are_reported() {
+        let d = tmp("prov");
+        let spec = r#"{"model":"lambert","kd":0.3}"#;
+        let out = d.join("l.btdb").to_str().unwrap().to_owned();
+        let r = BakeRequest::new(spec)
+            .preset(Preset::Small)
+            .accuracy(2000)
+            .run(&BakeTarget::file(&out))
+            .unwrap();
+        assert_eq!(r.info["source"]["kind"], "model");
+        let acc = r.accuracy.unwrap();
+        assert_eq!(acc.pairs, 2000);
+        // log16 ≤ 1e-3 relative on a constant: the error is the codec's bound at most.
+        assert!(acc.max_rel <= 1e-3, "{acc:?}");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn an_explicit_symmetry_the_source_breaks_is_refused_unless_forced() {
+        let d = tmp("sym");
+        // The original Phong is not reciprocal.
+        let spec = r#"{"model":"phong","ks":0.5,"n":20}"#;
+        let out = d.join("p.btdb").to_str().unwrap().to_owned();
+        let req = BakeRequest::new(spec)
+            .preset(Preset::Small)
+            .symmetry(SymmetryChoice::parse("isotropic,reciprocal").unwrap());
+        assert!(matches!(
+            req.run(&BakeTarget::file(&out)),
+            Err(Error::Symmetry { .. })
+        ));
+        let mut forced = req.clone();
+        forced.force = true;
+        let r = forced.run(&BakeTarget::file(&out)).unwrap();
+        assert!(r.forced.is_some());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}

@@ -1,0 +1,95 @@
+//! One progress type for every long operation of the library.
+//!
+//! Baking, converting, rendering, the accuracy suite and fitting can take seconds to minutes. The
+//! library reports how far they are through [`Progress`] and never prints: the CLI maps it to an
+//! indicatif bar (on a terminal only), the Python package to a callback, and the C ABI to
+//! nothing. [`Silent`] is the do-nothing implementation.
+
+/// Receives progress reports. Every method has an empty default, so an implementation overrides
+/// only what it shows. Calls may come from several threads (hence `Sync`).
+pub trait Progress: Sync {
+    /// A stage starts: `what` names it (e.g. `"baking"`), `total` is its number of units
+    /// (values, pixels, sources), 0 when unknown.
+    fn begin(&self, what: &str, total: u64) {
+        let _ = (what, total);
+    }
+
+    /// `done` units of the current stage are finished (monotone within a stage).
+    fn set(&self, done: u64) {
+        let _ = done;
+    }
+
+    /// The current stage is over (successfully or not).
+    fn end(&self) {}
+}
+
+/// Shows nothing.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Silent;
+
+impl Progress for Silent {}
+
+impl<P: Progress + ?Sized> Progress for &P {
+    fn begin(&self, what: &str, total: u64) {
+        (**self).begin(what, total)
+    }
+    fn set(&self, done: u64) {
+        (**self).set(done)
+    }
+    fn end(&self) {
+        (**self).end()
+    }
+}
+
+/// Ends the stage when dropped, so an early return through `?` still ends it.
+pub(crate) struct Stage<'a>(pub(crate) &'a dyn Progress);
+
+impl<'a> Stage<'a> {
+    /// Begins a stage on `p`.
+    pub(crate) fn begin(p: &'a dyn Progress, what: &str, total: u64) -> Stage<'a> {
+        p.begin(what, total);
+        Stage(p)
+    }
+}
+
+impl Drop for Stage<'_> {
+    fn drop(&mut self) {
+        self.0.end();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::Mutex;
+
+    #[derive(Default)]
+    struct Log(Mutex<Vec<String>>);
+    impl Progress for Log {
+        fn begin(&self, what: &str, total: u64) {
+            self.0.lock().unwrap().push(format!("begin {what} {total}"));
+        }
+        fn set(&self, done: u64) {
+            self.0.lock().unwrap().push(format!("set {done}"));
+        }
+        fn end(&self) {
+            self.0.lock().unwrap().push("end".into());
+        }
+    }
+
+    #[test]
+    fn a_stage_ends_on_early_return() {
+        let log = Log::default();
+        let run = |fail: bool| -> Result<(), ()> {
+            let _s = Stage::begin(&log, "x", 2);
+            log.set(1);
+            if fail {
+                return Err(());
+            }
+            log.set(2);
+            Ok(())
+        };
+        assert!(run(true).is_err());
+        assert_eq!(*log.0.lock().unwrap(), ["begin x 2", "set 1", "end"]);
+    }
+}

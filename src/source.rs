@@ -1,0 +1,310 @@
+//! Opening any SOURCE string as a [`Brdf`]: the one place that knows the source kinds.
+//!
+//! Every host — the `brdftab` CLI, the Python package, the C ABI, the Mitsuba 3 plugin — names
+//! what it wants to evaluate with one string, and this module turns that string into a `Brdf`.
+//! Keeping the dispatch here (and nowhere else) means a new kind, or a fix to an old one, reaches
+//! every host at once.
+//!
+//! | SOURCE | [`SourceKind`] | opened as |
+//! |---|---|---|
+//! | inline JSON (`{"model": ...}`) or a `.json` file | `Spec` | the analytic model ([`ModelSpec`]) |
+//! | a MERL `.binary` file | `Merl` | [`MerlBrdf`](crate::measured::MerlBrdf) (nearest cell, as the MERL reader) |
+//! | an RGL-EPFL `.bsdf` file | `Rgl` | [`RglBrdf`](crate::measured::RglBrdf) (the native adaptive evaluation) |
+//! | a brdftab file, `DB#NAME` for one table of a database, or a raw table | `Table` | [`TabulatedBrdf`] |
+//!
+//! Classification looks at the string only ([`classify`]); opening reads the file and reports a
+//! typed [`Error`] (missing file, bad magic, unknown model, ...) with the path in it.
+
+use std::path::Path;
+
+use crate::brdf::Brdf;
+use crate::error::{Error, Result};
+use crate::spec::ModelSpec;
+use crate::spectrum::Channels;
+use crate::table::{Interp, Table, TabulatedBrdf};
+
+/// What a SOURCE string names, judged from the string alone (see the module table).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SourceKind {
+    /// An analytic model: inline JSON or a `.json` spec file.
+    Spec,
+    /// A MERL `.binary` file.
+    Merl,
+    /// An RGL-EPFL `.bsdf` tensor file.
+    Rgl,
+    /// A brdftab table file, a database entry `DB#NAME`, or a raw table file.
+    Table,
+}
+
+impl SourceKind {
+    /// The kind's name as hosts print it: `spec`, `merl`, `rgl` or `table`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SourceKind::Spec => "spec",
+            SourceKind::Merl => "merl",
+            SourceKind::Rgl => "rgl",
+            SourceKind::Table => "table",
+        }
+    }
+
+    /// True for measured files (MERL and RGL).
+    pub fn is_measured(self) -> bool {
+        matches!(self, SourceKind::Merl | SourceKind::Rgl)
+    }
+}
+
+/// Classifies a SOURCE string without touching the file system.
+///
+/// ```
+/// use brdftab::source::{classify, SourceKind};
+/// assert_eq!(classify(r#"{"model": "lambert", "kd": 0.5}"#), SourceKind::Spec);
+/// assert_eq!(classify("paint.json"), SourceKind::Spec);
+/// assert_eq!(classify("gold-metallic-paint.binary"), SourceKind::Merl);
+/// assert_eq!(classify("paper_white_rgb.bsdf"), SourceKind::Rgl);
+/// assert_eq!(classify("materials.btdb#gold"), SourceKind::Table);
+/// ```
+pub fn classify(source: &str) -> SourceKind {
+    let s = source.trim_start();
+    let lower = s.to_ascii_lowercase();
+    if s.starts_with('{') || lower.ends_with(".json") {
+        SourceKind::Spec
+    } else if lower.ends_with(".binary") {
+        SourceKind::Merl
+    } else if lower.ends_with(".bsdf") {
+        SourceKind::Rgl
+    } else {
+        SourceKind::Table
+    }
+}
+
+/// How [`open_with`] opens a SOURCE. Builder-style: start from `OpenOptions::new()`.
+///
+/// ```
+/// use brdftab::source::OpenOptions;
+/// use brdftab::table::Interp;
+/// let opts = OpenOptions::new().interp(Interp::Nearest).wavelengths(&[450.0, 550.0, 650.0])?;
+/// let brdf = brdftab::open_with(r#"{"model": "lambert", "kd": 0.5}"#, &opts)?;
+/// assert_eq!(brdf.channels().names(), ["450nm", "550nm", "650nm"]);
+/// # Ok::<(), brdftab::Error>(())
+/// ```
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct OpenOptions {
+    /// Interpolation of tables (default linear). Measured and analytic sources ignore it.
+    pub interp: Interp,
+    /// Channels to evaluate: `None` keeps the source's own (RGB for model specs, the file's for
+    /// RGL files). Model specs evaluate their spectral data at these wavelengths; RGL files
+    /// resample their spectra. Tables and MERL files have fixed channels: asking them for other
+    /// channels is an error.
+    pub channels: Option<Channels>,
+    /// Decode every chunk of a table now (in parallel, checking each checksum) instead of on the
+    /// first lookup that touches it: the open fails on a corrupt table, and lookups never wait
+    /// on decoding.
+    pub eager: bool,
+}
+
+impl OpenOptions {
+    /// The defaults: linear interpolation, the source's own channels, lazy decoding.
+    pub fn new() -> OpenOptions {
+        OpenOptions::default()
+    }
+
+    /// Sets the interpolation of tables.
+    pub fn interp(mut self, interp: Interp) -> OpenOptions {
+        self.interp = interp;
+        self
+    }
+
+    /// Sets the channels.
+    pub fn channels(mut self, channels: Channels) -> OpenOptions {
+        self.channels = Some(channels);
+        self
+    }
+
+    /// Sets the channels to wavelengths in nm (strictly increasing, positive).
+    pub fn wavelengths(self, nm: &[f64]) -> Result<OpenOptions> {
+        Ok(self.channels(Channels::wavelengths(nm.to_vec())?))
+    }
+
+    /// Decode every chunk of a table when it is opened.
+    pub fn eager(mut self, eager: bool) -> OpenOptions {
+        self.eager = eager;
+        self
+    }
+}
+
+/// Opens SOURCE with the default [`OpenOptions`] (linear interpolation, the source's own
+/// channels).
+///
+/// An analytic model, inline:
+/// ```
+/// use glam::DVec3;
+/// let brdf = brdftab::open(r#"{"model": "lambert", "kd": [0.1, 0.2, 0.3]}"#)?;
+/// let mut f = [0.0f32; 3];
+/// brdf.eval(DVec3::Z, DVec3::Z, &mut f);
+/// assert_eq!(f, [0.1, 0.2, 0.3]);
+/// # Ok::<(), brdftab::Error>(())
+/// ```
+/// A table file, and one table of a database (`DB#NAME`):
+/// ```
+/// # let dir = std::env::temp_dir().join(format!("brdftab-open-doc-{}", std::process::id()));
+/// # std::fs::create_dir_all(&dir)?;
+/// # let db = dir.join("doc.btdb");
+/// # let db = db.to_str().unwrap();
+/// use brdftab::bake::{BakeRequest, BakeTarget};
+/// use brdftab::table::presets::Preset;
+/// let spec = r#"{"model": "lambert", "kd": 0.25}"#;
+/// BakeRequest::new(spec).preset(Preset::Small).run(&BakeTarget::db(db, "matte"))?;
+/// let table = brdftab::open(&format!("{db}#matte"))?;
+/// assert_eq!(table.channels().len(), 3);
+/// # std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+/// An RGL-EPFL measurement (the shipped `data/rgl` files):
+/// ```
+/// let dir = brdftab::measured::data::rgl_dir().expect("data/rgl ships with brdftab");
+/// let rgl = brdftab::open(dir.join("paper_white_rgb.bsdf").to_str().unwrap())?;
+/// assert_eq!(rgl.channels().names(), ["R", "G", "B"]);
+/// # Ok::<(), brdftab::Error>(())
+/// ```
+/// A MERL file is opened the same way (`brdftab::open("blue-metallic-paint.binary")`); a missing
+/// file is an error that names it:
+/// ```
+/// let e = brdftab::open("no-such-material.binary").unwrap_err();
+/// assert!(e.to_string().contains("no-such-material.binary"));
+/// ```
+pub fn open(source: &str) -> Result<Box<dyn Brdf + Send + Sync>> {
+    open_with(source, &OpenOptions::default())
+}
+
+/// Opens SOURCE as `opts` say (see [`open`] for the kinds).
+pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send + Sync>> {
+    let fixed_channels = |brdf: Box<dyn Brdf + Send + Sync>| match &opts.channels {
+        Some(c) if c != brdf.channels() => Err(Error::Unsupported(format!(
+            "{source}: stored with channels {}; it cannot be evaluated at {}",
+            brdf.channels().names().join(" "),
+            c.names().join(" ")
+        ))),
+        _ => Ok(brdf),
+    };
+    match classify(source) {
+        SourceKind::Spec => {
+            let channels = opts.channels.clone().unwrap_or(Channels::Rgb);
+            spec(source)?.build(&channels)
+        }
+        SourceKind::Merl => fixed_channels(Box::new(crate::measured::MerlBrdf::open(source)?)),
+        SourceKind::Rgl => match &opts.channels {
+            Some(c) => Ok(Box::new(crate::measured::RglBrdf::open_with_channels(
+                source, c,
+            )?)),
+            None => Ok(Box::new(crate::measured::RglBrdf::open(source)?)),
+        },
+        SourceKind::Table => fixed_channels(Box::new(open_table(source, opts)?)),
+    }
+}
+
+/// Opens a table SOURCE (`FILE`, `DB#NAME` or a raw table) as a [`TabulatedBrdf`].
+pub fn open_table(source: &str, opts: &OpenOptions) -> Result<TabulatedBrdf> {
+    let path = crate::store::db::split_source(source).0;
+    let brdf = if crate::store::tables::is_store_file(path) {
+        crate::store::tables::open_brdf(source, opts.eager)?
+    } else if Table::is_raw(source) {
+        TabulatedBrdf::from_table(Table::open_raw(source)?)
+    } else if !Path::new(path).exists() {
+        return Err(Error::NotFound(format!("{path}: no such file")));
+    } else {
+        return Err(Error::Unsupported(format!(
+            "{path}: not a file brdftab can read (no brdftab, MERL or RGL signature, and not a \
+             .json spec)"
+        )));
+    };
+    Ok(brdf.with_interp(opts.interp))
+}
+
+/// Parses a spec SOURCE: inline JSON (starting with `{`) or a `.json` file.
+pub fn spec(source: &str) -> Result<ModelSpec> {
+    if source.trim_start().starts_with('{') {
+        ModelSpec::parse(source)
+    } else {
+        ModelSpec::from_file(source)
+    }
+}
+
+/// Parses a comma-separated list of wavelengths in nm (`"450, 550, 650"`).
+pub fn parse_wavelengths(list: &str) -> Result<Channels> {
+    let nm = list
+        .split(',')
+        .map(|x| {
+            x.trim()
+                .parse::<f64>()
+                .map_err(|_| Error::arg("wavelengths", format!("`{}` is not a number", x.trim())))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Channels::wavelengths(nm)
+}
+
+/// The provenance a table baked from SOURCE records: the spec for models, the file's name and
+/// sha256 for measurements, the source's own description otherwise.
+pub fn provenance(source: &str, brdf: &dyn Brdf) -> Result<crate::store::Source> {
+    Ok(match classify(source) {
+        SourceKind::Spec => crate::store::Source::model(&spec(source)?),
+        SourceKind::Merl | SourceKind::Rgl => crate::store::Source::measured(source)?,
+        SourceKind::Table => crate::store::Source::Other {
+            description: format!("{source}: {}", brdf.describe()),
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn classify_is_by_string_only() {
+        assert_eq!(classify("  {\"model\": \"x\"}"), SourceKind::Spec);
+        assert_eq!(classify("A.JSON"), SourceKind::Spec);
+        assert_eq!(classify("x.BINARY"), SourceKind::Merl);
+        assert_eq!(classify("x.Bsdf"), SourceKind::Rgl);
+        assert_eq!(classify("x.btdb"), SourceKind::Table);
+        assert_eq!(classify("x.tbl"), SourceKind::Table);
+    }
+
+    #[test]
+    fn spec_with_wavelengths_evaluates_there() {
+        let opts = OpenOptions::new().wavelengths(&[500.0, 600.0]).unwrap();
+        let b = open_with(r#"{"model":"lambert","kd":0.5}"#, &opts).unwrap();
+        let mut f = [0.0f32; 2];
+        b.eval(DVec3::Z, DVec3::Z, &mut f);
+        assert_eq!(f, [0.5, 0.5]);
+    }
+
+    #[test]
+    fn errors_are_typed() {
+        assert!(matches!(
+            open(r#"{"model":"no_such_model"}"#),
+            Err(Error::Spec { .. })
+        ));
+        assert!(matches!(
+            open("/nonexistent/x.btdb"),
+            Err(Error::NotFound(_))
+        ));
+        assert!(matches!(
+            open("/nonexistent/x.binary"),
+            Err(Error::Io { .. }) | Err(Error::NotFound(_))
+        ));
+        assert!(matches!(
+            parse_wavelengths("400, x"),
+            Err(Error::InvalidArgument { .. })
+        ));
+        let dir = std::env::temp_dir().join(format!("brdftab-src-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let junk = dir.join("junk.tbl");
+        std::fs::write(&junk, b"not a table at all").unwrap();
+        assert!(matches!(
+            open(junk.to_str().unwrap()),
+            Err(Error::Unsupported(_))
+        ));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,167 @@
+//! `bake`, and the bake flags `convert` and `db add` share: parsed into the library's
+//! [`BakeRequest`], which makes every decision.
+
+use brdftab::bake::{self, BakeReport, BakeRequest, BakeTarget, GridChoice, SymmetryChoice};
+use brdftab::table::{Param, symmetry};
+use brdftab::{Error, Result};
+use clap::Args;
+
+use crate::progress::Bar;
+use crate::source;
+
+/// The flags of a bake (`bake`, `convert` to a table, `db add`): each means one thing everywhere.
+#[derive(Args, Clone)]
+pub struct BakeFlags {
+    /// Grid size preset: small, medium or large (default: a MERL file's own cells for MERL
+    /// sources, medium otherwise).
+    #[arg(long)]
+    pub preset: Option<String>,
+    /// Full grid sizes θ1xφ1xθ2xφ2 (e.g. 90x360x90x360), or `merl`; overrides --preset.
+    #[arg(long)]
+    pub grid: Option<String>,
+    /// Parameterization: halfdiff (default) or inout.
+    #[arg(long)]
+    pub param: Option<String>,
+    /// Wavelengths in nm (comma separated) instead of the source's channels (model specs and
+    /// RGL files).
+    #[arg(long)]
+    pub wavelengths: Option<String>,
+    /// Symmetry reduction: auto (detect), none, or a list of isotropic,reciprocal,bilateral.
+    #[arg(long, default_value = "auto")]
+    pub symmetry: String,
+    /// Relative tolerance of symmetry detection and verification (`--tolerance` is a deprecated
+    /// alias).
+    #[arg(long, alias = "tolerance", default_value_t = symmetry::DEFAULT_TOLERANCE)]
+    pub symmetry_tolerance: f64,
+    /// Bake even if the source breaks the chosen symmetry beyond the tolerance.
+    #[arg(long)]
+    pub force: bool,
+    /// Codec: f32 (lossless), f16 (fails above ±65504), or log16 (relative error bound at any
+    /// magnitude; `log16:1e-2` sets it). log16 by default: analytic lobes such as Cook-Torrance
+    /// reach 1e5 at grazing angles, beyond f16.
+    #[arg(long, default_value = "log16")]
+    pub codec: String,
+    /// log16 relative tolerance (default 1e-3).
+    #[arg(long)]
+    pub codec_tolerance: Option<f64>,
+    /// log16 absolute floor (default: 1e-7 of each chunk's largest value).
+    #[arg(long)]
+    pub floor: Option<f64>,
+    /// zstd level (1..=22; default 3 for f32/f16, 6 for log16).
+    #[arg(long)]
+    pub level: Option<i32>,
+    /// Try every filter through zstd per chunk and keep the smallest (slower).
+    #[arg(long)]
+    pub exhaustive: bool,
+    /// Table name inside the file (default: the output file's stem).
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Samples per axis and cell (box prefilter for very sharp lobes).
+    #[arg(long, default_value_t = 1)]
+    pub supersample: usize,
+}
+
+impl BakeFlags {
+    /// The library request these flags describe for `source`.
+    pub fn request(&self, source: &str) -> Result<BakeRequest> {
+        let grid = match (&self.grid, &self.preset) {
+            (Some(g), _) => GridChoice::parse(g),
+            (None, Some(p)) => GridChoice::parse(p),
+            (None, None) => Ok(GridChoice::Default),
+        }
+        .map_err(|e| {
+            flag(
+                e,
+                if self.grid.is_some() {
+                    "--grid"
+                } else {
+                    "--preset"
+                },
+            )
+        })?;
+        let mut r = BakeRequest::new(source).grid(grid);
+        r.param = self.param.as_deref().map(Param::parse).transpose()?;
+        r.symmetry = SymmetryChoice::parse(&self.symmetry).map_err(|e| flag(e, "--symmetry"))?;
+        r.symmetry_tolerance = self.symmetry_tolerance;
+        r.force = self.force;
+        r.codec = bake::codec(
+            &self.codec,
+            self.codec_tolerance,
+            self.floor,
+            self.level,
+            self.exhaustive,
+        )
+        .map_err(|e| flag(e, "--codec"))?;
+        r.name = self.name.clone();
+        r.supersample = self.supersample;
+        r.channels = source::channels(self.wavelengths.as_deref())?;
+        Ok(r)
+    }
+}
+
+/// Names the CLI flag in an argument error of the library (which names its own field).
+pub fn flag(e: Error, name: &str) -> Error {
+    match e {
+        Error::InvalidArgument { msg, .. } => Error::arg(name, msg),
+        e => e,
+    }
+}
+
+/// Arguments of `brdftab bake`.
+#[derive(Args)]
+pub struct BakeArgs {
+    /// The source: a model spec (inline JSON or .json), a table, a MERL or RGL file.
+    pub source: String,
+    /// Output table file (`.btdb`).
+    #[arg(short, long)]
+    pub output: Option<String>,
+    #[command(flatten)]
+    pub flags: BakeFlags,
+}
+
+/// `brdftab bake`.
+pub fn bake(a: BakeArgs) -> Result<()> {
+    let out = a
+        .output
+        .clone()
+        .ok_or_else(|| Error::arg("--output", "an output file is required"))?;
+    run(&a.flags.request(&a.source)?, &BakeTarget::file(out)).map(drop)
+}
+
+/// Runs a request with a progress bar and prints what it did on stderr.
+pub fn run(req: &BakeRequest, target: &BakeTarget) -> Result<BakeReport> {
+    let r = req.run_with(target, &Bar::values())?;
+    print_report(&r, req);
+    Ok(r)
+}
+
+/// The lines `bake` prints after a bake.
+pub fn print_report(r: &BakeReport, req: &BakeRequest) {
+    if let Some(n) = &r.symmetry_note {
+        eprintln!("note: {n}");
+    }
+    if let Some(f) = &r.forced {
+        eprintln!("warning: forced past a symmetry violation: {f}");
+    }
+    eprintln!(
+        "baked {}\n  grid: {}{}\n  {} stored values ({} unreduced, {:.1}x reduction)",
+        r.source,
+        r.grid.summary(),
+        if r.merl_cells {
+            ", the file's own cells"
+        } else {
+            ""
+        },
+        r.values,
+        r.grid.full_values(),
+        r.grid.full_values() as f64 / r.values.max(1) as f64
+    );
+    eprintln!(
+        "wrote {} ({} values in {:.2} s, {:.1} M values/s, codec {})",
+        r.output,
+        r.values,
+        r.seconds,
+        r.values as f64 / r.seconds.max(1e-9) / 1e6,
+        req.codec.quant.name()
+    );
+}
