@@ -1,0 +1,116 @@
+// brdftab.hpp — a header-only C++17 wrapper of brdftab.h: an RAII handle, span-style batch
+// calls over contiguous arrays, and exceptions that carry the library's message.
+//
+//   #include "brdftab.hpp"
+//   brdftab::Brdf b("materials.btdb#gold");
+//   std::vector<float> f(n * b.channels());
+//   b.eval(n, wi.data(), wo.data(), f.data());      // wi, wo: n x 3 doubles
+#pragma once
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "brdftab.h"
+
+namespace brdftab {
+
+/// A failure of the library, with its message.
+class Error : public std::runtime_error {
+public:
+    explicit Error(const std::string &what) : std::runtime_error(what) {}
+};
+
+namespace detail {
+inline void check(int rc) {
+    if (rc != 0) throw Error(brdftab_last_error());
+}
+}  // namespace detail
+
+/// A 3-vector in the local frame (z = normal), laid out as the C ABI's double[3].
+struct Vec3 {
+    double x, y, z;
+};
+static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 must be three packed doubles");
+
+/// One sample of Brdf::sample.
+struct Sample {
+    Vec3 wi;
+    double pdf;
+};
+
+/// An open BRDF (move-only). eval/pdf/sample/albedo may be called from several threads at once.
+class Brdf {
+public:
+    /// Opens any SOURCE (spec JSON, .json, table, DB#NAME, MERL .binary, RGL .bsdf).
+    explicit Brdf(const std::string &source) : h_(brdftab_open(source.c_str())) {
+        if (!h_) throw Error(brdftab_last_error());
+    }
+    /// Opens with options (interpolation, wavelengths, eager decoding).
+    Brdf(const std::string &source, const brdftab_open_options &opts)
+        : h_(brdftab_open_with(source.c_str(), &opts)) {
+        if (!h_) throw Error(brdftab_last_error());
+    }
+    Brdf(const Brdf &) = delete;
+    Brdf &operator=(const Brdf &) = delete;
+    Brdf(Brdf &&o) noexcept : h_(std::exchange(o.h_, nullptr)) {}
+    Brdf &operator=(Brdf &&o) noexcept {
+        if (this != &o) {
+            brdftab_close(h_);
+            h_ = std::exchange(o.h_, nullptr);
+        }
+        return *this;
+    }
+    ~Brdf() { brdftab_close(h_); }
+
+    /// Channels per value (3 for RGB).
+    std::size_t channels() const { return brdftab_channels(h_); }
+    /// Channel names ("R", "G", "B" or "550nm", ...).
+    std::vector<std::string> channel_names() const {
+        std::vector<std::string> v;
+        for (std::size_t i = 0; i < channels(); ++i) v.emplace_back(brdftab_channel_name(h_, i));
+        return v;
+    }
+
+    /// f_r (no cosine) for n pairs; f holds n * channels() floats.
+    void eval(std::size_t n, const Vec3 *wi, const Vec3 *wo, float *f) const {
+        detail::check(brdftab_eval(h_, n, &wi->x, &wo->x, f));
+    }
+    /// f_r for one pair into f[channels()].
+    void eval(const Vec3 &wi, const Vec3 &wo, float *f) const { eval(1, &wi, &wo, f); }
+    /// pdf(wi | wo) for n pairs.
+    void pdf(std::size_t n, const Vec3 *wi, const Vec3 *wo, double *p) const {
+        detail::check(brdftab_pdf(h_, n, &wi->x, &wo->x, p));
+    }
+    double pdf(const Vec3 &wi, const Vec3 &wo) const {
+        double p = 0.0;
+        pdf(1, &wi, &wo, &p);
+        return p;
+    }
+    /// Draws wi for n given wo from u (n x 2 in [0,1)^2); weight = f cos(theta_i) / pdf.
+    void sample(std::size_t n, const Vec3 *wo, const double *u, Vec3 *wi, double *p,
+                float *weight) const {
+        detail::check(brdftab_sample(h_, n, &wo->x, u, &wi->x, p, weight));
+    }
+    Sample sample(const Vec3 &wo, double u0, double u1, float *weight) const {
+        double u[2] = {u0, u1};
+        Sample s{};
+        sample(1, &wo, u, &s.wi, &s.pdf, weight);
+        return s;
+    }
+    /// Directional albedo at incidence theta (radians), one value per channel.
+    std::vector<double> albedo(double theta) const {
+        std::vector<double> a(channels());
+        detail::check(brdftab_albedo(h_, theta, a.data()));
+        return a;
+    }
+    /// The C handle, for calls the wrapper does not cover.
+    const brdftab_brdf *get() const { return h_; }
+
+private:
+    brdftab_brdf *h_;
+};
+
+}  // namespace brdftab

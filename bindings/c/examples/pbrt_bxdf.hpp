@@ -1,0 +1,78 @@
+// pbrt_bxdf.hpp — a pbrt-v4-style BxDF over brdftab (f, Sample_f, PDF, Flags), on the C++
+// wrapper. It mirrors pbrt-v4's BxDF interface (src/pbrt/bxdfs.h) with small stand-in types
+// so it compiles with g++ alone; in pbrt, replace the stand-ins by pbrt's own Vector3f,
+// SampledSpectrum (evaluate a spectral source at the sampled wavelengths, or an RGB one through
+// an RGBAlbedoSpectrum), BSDFSample and BxDFFlags.
+//
+// Conventions agree: pbrt's wo (to the viewer) and wi (to the light) are brdftab's wo and wi, in
+// the shading frame with z the normal; f() is f_r without the cosine; Sample_f draws wi given wo.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <optional>
+
+#include "brdftab.hpp"
+
+namespace pbrt_like {
+
+using Float = float;
+
+struct Vector3f {
+    Float x, y, z;
+};
+
+/// RGB stand-in for pbrt's SampledSpectrum.
+struct SampledSpectrum {
+    std::array<Float, 3> c{};
+    Float operator[](int i) const { return c[i]; }
+};
+
+enum class BxDFFlags : unsigned { Unset = 0, Reflection = 1, Diffuse = 4, Glossy = 8, Specular = 16 };
+inline BxDFFlags operator|(BxDFFlags a, BxDFFlags b) {
+    return BxDFFlags(unsigned(a) | unsigned(b));
+}
+
+struct BSDFSample {
+    SampledSpectrum f;
+    Vector3f wi;
+    Float pdf = 0;
+    BxDFFlags flags = BxDFFlags::Unset;
+};
+
+/// A BxDF whose values come from any brdftab SOURCE (RGB: three channels expected).
+class BrdftabBxDF {
+public:
+    explicit BrdftabBxDF(const brdftab::Brdf &b) : b_(&b) {
+        if (b.channels() != 3) throw brdftab::Error("BrdftabBxDF expects an RGB source");
+    }
+
+    BxDFFlags Flags() const { return BxDFFlags::Reflection | BxDFFlags::Glossy; }
+
+    SampledSpectrum f(Vector3f wo, Vector3f wi) const {
+        if (wo.z <= 0 || wi.z <= 0) return {};  // front side only, as pbrt's measured BxDF
+        float v[3];
+        b_->eval(to(wi), to(wo), v);
+        return {{v[0], v[1], v[2]}};
+    }
+
+    std::optional<BSDFSample> Sample_f(Vector3f wo, Float /*uc*/, std::array<Float, 2> u) const {
+        if (wo.z <= 0) return std::nullopt;
+        float w[3];
+        brdftab::Sample s = b_->sample(to(wo), u[0], u[1], w);
+        if (!(s.pdf > 0)) return std::nullopt;
+        Vector3f wi{Float(s.wi.x), Float(s.wi.y), Float(s.wi.z)};
+        return BSDFSample{f(wo, wi), wi, Float(s.pdf), Flags()};
+    }
+
+    Float PDF(Vector3f wo, Vector3f wi) const {
+        if (wo.z <= 0 || wi.z <= 0) return 0;
+        return Float(b_->pdf(to(wi), to(wo)));
+    }
+
+private:
+    static brdftab::Vec3 to(Vector3f v) { return {v.x, v.y, v.z}; }
+    const brdftab::Brdf *b_;
+};
+
+}  // namespace pbrt_like

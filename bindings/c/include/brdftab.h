@@ -1,0 +1,70 @@
+/*
+ * brdftab.h — the C ABI of brdftab (tabulated BRDFs: analytic models, dense compressed tables,
+ * MERL and RGL-EPFL measured data).
+ *
+ * Link: -lbrdftab_c (libbrdftab_c.so or libbrdftab_c.a; the static library also needs
+ * -lpthread -ldl -lm), or `pkg-config --cflags --libs brdftab`.
+ *
+ * Conventions (those of the Rust `Brdf` trait):
+ *   - local shading frame, z is the normal; wi (to the light) and wo (to the viewer) both point
+ *     away from the surface; directions need not be normalized; below the horizon f_r = 0;
+ *   - brdftab_eval returns f_r in 1/sr, NOT multiplied by a cosine;
+ *   - brdftab_sample draws wi for a given wo; weight = f_r * cos(theta_i) / pdf;
+ *   - arrays are pair-major: wi, wo are n x 3 doubles (x, y, z), u is n x 2, f and weight are
+ *     n x channels floats.
+ * Every int-returning function returns 0 on success and -1 on failure, with the reason in
+ * brdftab_last_error() (per thread). n = 0 succeeds whatever the pointers; a NULL handle or
+ * array with n > 0 fails. No call aborts the process on bad input.
+ * Thread safety: eval, pdf, sample and albedo may run concurrently on one handle.
+ */
+#ifndef BRDFTAB_H
+#define BRDFTAB_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* An open BRDF (opaque). */
+typedef struct brdftab_brdf brdftab_brdf;
+
+/* Options of brdftab_open_with; zero-initialized means the defaults. */
+typedef struct brdftab_open_options {
+    int interp;               /* tables: 0 linear (default), 1 nearest */
+    size_t n_wavelengths;     /* 0 keeps the source's channels */
+    const double *wavelengths; /* nm, strictly increasing (model specs, RGL files) */
+    int eager;                /* non-zero: decode every table chunk at open */
+} brdftab_open_options;
+
+/* Opens any SOURCE the brdftab CLI takes: a model spec as JSON text or a .json file, a table
+ * file, DB#NAME (a table of a database), a MERL .binary, an RGL .bsdf. NULL on failure. */
+brdftab_brdf *brdftab_open(const char *source);
+/* The same with options (opts NULL = defaults). */
+brdftab_brdf *brdftab_open_with(const char *source, const brdftab_open_options *opts);
+/* This thread's last failure, "" if none; valid until this thread's next brdftab call. */
+const char *brdftab_last_error(void);
+/* Closes a handle; NULL is a no-op. */
+void brdftab_close(brdftab_brdf *b);
+/* Number of channels (3 for RGB); 0 for NULL. */
+size_t brdftab_channels(const brdftab_brdf *b);
+/* Name of channel i ("R", "G", "B" or e.g. "550nm"); NULL if out of range. Valid while open. */
+const char *brdftab_channel_name(const brdftab_brdf *b, size_t i);
+/* f_r for n pairs into f (n x channels). */
+int brdftab_eval(const brdftab_brdf *b, size_t n, const double *wi, const double *wo, float *f);
+/* pdf(wi | wo) of brdftab_sample for n pairs. */
+int brdftab_pdf(const brdftab_brdf *b, size_t n, const double *wi, const double *wo, double *pdf);
+/* Draws wi for each wo from u in [0,1)^2: wi (n x 3), pdf (n), weight (n x channels). A pair
+ * with no sample gets wi = 0, pdf = 0, weight = 0. */
+int brdftab_sample(const brdftab_brdf *b, size_t n, const double *wo, const double *u,
+                   double *wi, double *pdf, float *weight);
+/* Directional albedo for light at polar angle theta (radians): one double per channel. */
+int brdftab_albedo(const brdftab_brdf *b, double theta, double *albedo);
+/* The version of the library, e.g. "0.1.0" (static). */
+const char *brdftab_version(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* BRDFTAB_H */

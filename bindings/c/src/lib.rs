@@ -1,0 +1,367 @@
+//! The C ABI of brdftab: `include/brdftab.h`.
+//!
+//! C and C++ renderers (pbrt, Cycles, Falcor, ...) link `libbrdftab_c.so` or `libbrdftab_c.a`
+//! and call these functions; no Rust toolchain is needed in their build. Every function is a thin
+//! shim over the library's one door, [`brdftab::open_with`], and the [`brdftab::Brdf`] trait, so
+//! the C side sees exactly the conventions of the Rust side: the local frame has z as the
+//! normal, `wi` (to the light) and `wo` (to the viewer) both point away from the surface,
+//! `eval` returns f_r without a cosine, and `sample` draws `wi` for a given `wo` with
+//! weight = f cos θi / pdf.
+//!
+//! Failure is `-1` (or `NULL` from the open functions) with the reason in
+//! [`brdftab_last_error`], kept per thread. No panic crosses the boundary: every entry point runs
+//! inside `catch_unwind`, and a caught panic becomes `-1` with its message. Batch calls allocate
+//! nothing beyond what the library's own `eval_batch` does: the caller's `double[n][3]` arrays
+//! are read in place as `DVec3` slices.
+
+#![deny(unsafe_op_in_unsafe_fn)]
+// The C types keep the C names of brdftab.h.
+#![allow(non_camel_case_types)]
+
+use std::cell::RefCell;
+use std::ffi::{CStr, CString, c_char, c_int};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+use brdftab::source::OpenOptions;
+use brdftab::table::Interp;
+use brdftab::{Brdf, Channels};
+use glam::{DVec2, DVec3};
+
+// `double[n][3]` is read as `[DVec3; n]`: glam's DVec3 is `#[repr(C)] {x, y, z}` of f64.
+const _: () = assert!(std::mem::size_of::<DVec3>() == 24 && std::mem::align_of::<DVec3>() == 8);
+const _: () = assert!(std::mem::size_of::<DVec2>() == 16 && std::mem::align_of::<DVec2>() == 8);
+
+/// An open BRDF. Opaque to C; `eval`, `pdf`, `sample` and `albedo` may run concurrently on one
+/// handle from any number of threads.
+pub struct brdftab_brdf {
+    brdf: Box<dyn Brdf + Send + Sync>,
+    names: Vec<CString>,
+}
+
+/// Options of [`brdftab_open_with`]. Zero-initialized means the defaults.
+#[repr(C)]
+pub struct brdftab_open_options {
+    /// Table interpolation: 0 linear (default), 1 nearest.
+    pub interp: c_int,
+    /// Number of wavelengths in `wavelengths`; 0 keeps the source's own channels.
+    pub n_wavelengths: usize,
+    /// Wavelengths in nm, strictly increasing (model specs and RGL files).
+    pub wavelengths: *const f64,
+    /// Non-zero: decode every chunk of a table at open (a corrupt table fails the open).
+    pub eager: c_int,
+}
+
+thread_local! {
+    static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
+}
+
+fn set_error(msg: &str) {
+    let c = CString::new(msg.replace('\0', " ")).unwrap_or_default();
+    LAST_ERROR.with(|e| *e.borrow_mut() = c);
+}
+
+/// Empties the last error; allocates nothing when it is already empty (the common case), so a
+/// successful call costs no allocation.
+fn clear_error() {
+    LAST_ERROR.with(|e| {
+        if !e.borrow().as_bytes().is_empty() {
+            *e.borrow_mut() = CString::default();
+        }
+    });
+}
+
+fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
+    let what = p
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| p.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into());
+    format!("internal error (panic): {what}")
+}
+
+/// Runs `f`, turning an error or a panic into -1 and the thread's last error.
+fn guard(f: impl FnOnce() -> Result<(), String>) -> c_int {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(Ok(())) => {
+            clear_error();
+            0
+        }
+        Ok(Err(msg)) => {
+            set_error(&msg);
+            -1
+        }
+        Err(p) => {
+            set_error(&panic_message(p));
+            -1
+        }
+    }
+}
+
+/// # Safety
+/// `p` is NULL or points to `len` readable `T`s.
+unsafe fn slice<'a, T>(p: *const T, len: usize, what: &str) -> Result<&'a [T], String> {
+    if p.is_null() {
+        return Err(format!("`{what}` is NULL"));
+    }
+    if !(p as usize).is_multiple_of(std::mem::align_of::<T>()) {
+        return Err(format!("`{what}` is not aligned for its type"));
+    }
+    // SAFETY: the caller promises `len` readable elements; NULL and alignment are checked.
+    Ok(unsafe { std::slice::from_raw_parts(p, len) })
+}
+
+/// # Safety
+/// `p` is NULL or points to `len` writable `T`s.
+unsafe fn slice_mut<'a, T>(p: *mut T, len: usize, what: &str) -> Result<&'a mut [T], String> {
+    if p.is_null() {
+        return Err(format!("`{what}` is NULL"));
+    }
+    if !(p as usize).is_multiple_of(std::mem::align_of::<T>()) {
+        return Err(format!("`{what}` is not aligned for its type"));
+    }
+    // SAFETY: the caller promises `len` writable elements; NULL and alignment are checked.
+    Ok(unsafe { std::slice::from_raw_parts_mut(p, len) })
+}
+
+/// # Safety
+/// `b` is NULL or a handle from `brdftab_open*` not yet closed.
+unsafe fn handle<'a>(b: *const brdftab_brdf) -> Result<&'a brdftab_brdf, String> {
+    // SAFETY: the caller promises a live handle or NULL.
+    unsafe { b.as_ref() }.ok_or_else(|| "the brdftab_brdf handle is NULL".to_string())
+}
+
+fn open_impl(source: *const c_char, opts: Option<&brdftab_open_options>) -> *mut brdftab_brdf {
+    let mut out = std::ptr::null_mut();
+    guard(|| {
+        if source.is_null() {
+            return Err("`source` is NULL".into());
+        }
+        // SAFETY: a non-NULL `source` is a NUL-terminated string (the header's contract).
+        let source = unsafe { CStr::from_ptr(source) }
+            .to_str()
+            .map_err(|_| "`source` is not valid UTF-8".to_string())?;
+        let mut o = OpenOptions::default();
+        if let Some(opts) = opts {
+            o.interp = match opts.interp {
+                0 => Interp::Linear,
+                1 => Interp::Nearest,
+                i => return Err(format!("interp {i}: expected 0 (linear) or 1 (nearest)")),
+            };
+            if opts.n_wavelengths > 0 {
+                // SAFETY: the caller promises `n_wavelengths` readable doubles.
+                let nm = unsafe { slice(opts.wavelengths, opts.n_wavelengths, "wavelengths") }?;
+                o.channels = Some(Channels::wavelengths(nm.to_vec()).map_err(|e| e.to_string())?);
+            }
+            o.eager = opts.eager != 0;
+        }
+        let brdf = brdftab::open_with(source, &o).map_err(|e| e.to_string())?;
+        let names = brdf
+            .channels()
+            .names()
+            .into_iter()
+            .map(|n| CString::new(n).unwrap_or_default())
+            .collect();
+        out = Box::into_raw(Box::new(brdftab_brdf { brdf, names }));
+        Ok(())
+    });
+    out
+}
+
+/// Opens any SOURCE the CLI takes (model spec JSON, `.json` file, table, `DB#NAME`, MERL
+/// `.binary`, RGL `.bsdf`) with the default options. NULL on failure (see
+/// [`brdftab_last_error`]).
+///
+/// # Safety
+/// `source` is NULL or a NUL-terminated string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_open(source: *const c_char) -> *mut brdftab_brdf {
+    open_impl(source, None)
+}
+
+/// Opens SOURCE with options (`opts` NULL = defaults). NULL on failure.
+///
+/// # Safety
+/// `source` is NULL or a NUL-terminated string; `opts` is NULL or points to a valid struct.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_open_with(
+    source: *const c_char,
+    opts: *const brdftab_open_options,
+) -> *mut brdftab_brdf {
+    // SAFETY: the caller promises NULL or a valid struct.
+    open_impl(source, unsafe { opts.as_ref() })
+}
+
+/// This thread's last failure, `""` if the last call succeeded. Valid until this thread's next
+/// brdftab call.
+#[unsafe(no_mangle)]
+pub extern "C" fn brdftab_last_error() -> *const c_char {
+    LAST_ERROR.with(|e| e.borrow().as_ptr())
+}
+
+/// Closes a handle; NULL is a no-op.
+///
+/// # Safety
+/// `b` is NULL or a handle from `brdftab_open*`, not used again.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_close(b: *mut brdftab_brdf) {
+    if !b.is_null() {
+        // SAFETY: the handle came from Box::into_raw in `open_impl` and is closed once.
+        let _ = catch_unwind(AssertUnwindSafe(|| drop(unsafe { Box::from_raw(b) })));
+    }
+}
+
+/// The number of channels (3 for RGB); 0 for a NULL handle.
+///
+/// # Safety
+/// `b` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_channels(b: *const brdftab_brdf) -> usize {
+    // SAFETY: the caller promises NULL or a live handle.
+    unsafe { b.as_ref() }.map_or(0, |b| b.names.len())
+}
+
+/// The name of channel `i` ("R", "G", "B", or e.g. "550nm"); NULL when `i` is out of range or
+/// the handle is NULL. Valid while the handle is open.
+///
+/// # Safety
+/// `b` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_channel_name(b: *const brdftab_brdf, i: usize) -> *const c_char {
+    // SAFETY: the caller promises NULL or a live handle.
+    unsafe { b.as_ref() }
+        .and_then(|b| b.names.get(i))
+        .map_or(std::ptr::null(), |n| n.as_ptr())
+}
+
+/// f_r for `n` pairs into `f` (n × channels floats, pair-major). 0 on success, -1 on failure.
+///
+/// # Safety
+/// With n > 0: `wi`, `wo` point to 3n doubles, `f` to n·channels floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_eval(
+    b: *const brdftab_brdf,
+    n: usize,
+    wi: *const f64,
+    wo: *const f64,
+    f: *mut f32,
+) -> c_int {
+    guard(|| {
+        if n == 0 {
+            return Ok(());
+        }
+        // SAFETY (all four): the header's contract on sizes; NULL and alignment are checked.
+        let b = unsafe { handle(b) }?;
+        let c = b.names.len();
+        let wi = unsafe { slice(wi as *const DVec3, n, "wi") }?;
+        let wo = unsafe { slice(wo as *const DVec3, n, "wo") }?;
+        let f = unsafe { slice_mut(f, n * c, "f") }?;
+        b.brdf.eval_batch(wi, wo, f);
+        Ok(())
+    })
+}
+
+/// pdf(wi | wo) of the sampler for `n` pairs into `pdf`. 0 on success, -1 on failure.
+///
+/// # Safety
+/// With n > 0: `wi`, `wo` point to 3n doubles, `pdf` to n doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_pdf(
+    b: *const brdftab_brdf,
+    n: usize,
+    wi: *const f64,
+    wo: *const f64,
+    pdf: *mut f64,
+) -> c_int {
+    guard(|| {
+        if n == 0 {
+            return Ok(());
+        }
+        // SAFETY (all four): the header's contract on sizes; NULL and alignment are checked.
+        let b = unsafe { handle(b) }?;
+        let wi = unsafe { slice(wi as *const DVec3, n, "wi") }?;
+        let wo = unsafe { slice(wo as *const DVec3, n, "wo") }?;
+        let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
+        for ((p, a), o) in pdf.iter_mut().zip(wi).zip(wo) {
+            *p = b.brdf.pdf(*a, *o);
+        }
+        Ok(())
+    })
+}
+
+/// Draws `wi` for each of `n` given `wo` from uniforms `u` (n × 2 in [0, 1)²): `wi` (n × 3),
+/// `pdf` (n) and `weight` (n × channels, f cos θi / pdf). A pair with no sample (wo below the
+/// horizon, a zero lobe) gets wi = (0, 0, 0), pdf = 0 and weight 0. For a delta source (mirror,
+/// refractor) pdf is the library's convention for deltas and the weight is the reflectance.
+///
+/// # Safety
+/// With n > 0: `wo` and `wi` point to 3n doubles, `u` to 2n, `pdf` to n, `weight` to
+/// n·channels floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_sample(
+    b: *const brdftab_brdf,
+    n: usize,
+    wo: *const f64,
+    u: *const f64,
+    wi: *mut f64,
+    pdf: *mut f64,
+    weight: *mut f32,
+) -> c_int {
+    guard(|| {
+        if n == 0 {
+            return Ok(());
+        }
+        // SAFETY (all six): the header's contract on sizes; NULL and alignment are checked.
+        let b = unsafe { handle(b) }?;
+        let c = b.names.len();
+        let wo = unsafe { slice(wo as *const DVec3, n, "wo") }?;
+        let u = unsafe { slice(u as *const DVec2, n, "u") }?;
+        let wi = unsafe { slice_mut(wi as *mut DVec3, n, "wi") }?;
+        let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
+        let weight = unsafe { slice_mut(weight, n * c, "weight") }?;
+        for k in 0..n {
+            let w = &mut weight[k * c..(k + 1) * c];
+            match b.brdf.sample(wo[k], u[k], w) {
+                Some(s) => {
+                    wi[k] = s.wi;
+                    pdf[k] = s.pdf;
+                }
+                None => {
+                    wi[k] = DVec3::ZERO;
+                    pdf[k] = 0.0;
+                    w.fill(0.0);
+                }
+            }
+        }
+        Ok(())
+    })
+}
+
+/// Directional albedo a(θ′) = ∫ f_r cos θ dω for light incident at polar angle `theta` (radians,
+/// azimuth 0), one double per channel into `albedo`. 0 on success, -1 on failure.
+///
+/// # Safety
+/// `albedo` points to `brdftab_channels(b)` doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_albedo(
+    b: *const brdftab_brdf,
+    theta: f64,
+    albedo: *mut f64,
+) -> c_int {
+    guard(|| {
+        // SAFETY (both): the header's contract; NULL and alignment are checked.
+        let b = unsafe { handle(b) }?;
+        let out = unsafe { slice_mut(albedo, b.names.len(), "albedo") }?;
+        if !theta.is_finite() {
+            return Err(format!("theta {theta} is not finite"));
+        }
+        let wi = DVec3::new(theta.sin(), 0.0, theta.cos());
+        b.brdf.albedo(wi, out);
+        Ok(())
+    })
+}
+
+/// The version of this ABI's crate (e.g. "0.1.0"), a static string.
+#[unsafe(no_mangle)]
+pub extern "C" fn brdftab_version() -> *const c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}

@@ -1,0 +1,129 @@
+/* The C side of tests/c_programs.rs: drives every function of brdftab.h from C.
+ *
+ *   abi_test SOURCE PAIRS OUT
+ * PAIRS: n lines "wix wiy wiz wox woy woz u0 u1". OUT: per pair one line
+ *   f_1..f_c pdf wi_x wi_y wi_z spdf w_1..w_c
+ * then "albedo a_1..a_c" for θ = 30°. Checks of bad arguments and of two threads on one handle
+ * print "FAIL ..." to stderr and make the exit status 1.
+ */
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "brdftab.h"
+
+#define BRDFTAB_PI 3.14159265358979323846
+
+static int failures = 0;
+#define CHECK(cond, what)                                                   \
+    do {                                                                    \
+        if (!(cond)) {                                                      \
+            fprintf(stderr, "FAIL %s (last error: %s)\n", what, brdftab_last_error()); \
+            failures++;                                                     \
+        }                                                                   \
+    } while (0)
+
+struct job {
+    const brdftab_brdf *b;
+    size_t n;
+    const double *wi, *wo;
+    float *f;
+    int rc;
+};
+
+static void *run_eval(void *p) {
+    struct job *j = p;
+    for (int rep = 0; rep < 20 && j->rc == 0; rep++) j->rc = brdftab_eval(j->b, j->n, j->wi, j->wo, j->f);
+    return NULL;
+}
+
+int main(int argc, char **argv) {
+    if (argc != 4) {
+        fprintf(stderr, "usage: %s SOURCE PAIRS OUT\n", argv[0]);
+        return 2;
+    }
+    FILE *in = fopen(argv[2], "r");
+    if (!in) return 2;
+    size_t cap = 1024, n = 0;
+    double *wi = malloc(cap * 3 * sizeof(double)), *wo = malloc(cap * 3 * sizeof(double)),
+           *u = malloc(cap * 2 * sizeof(double));
+    for (;;) {
+        if (n == cap) {
+            cap *= 2;
+            wi = realloc(wi, cap * 3 * sizeof(double));
+            wo = realloc(wo, cap * 3 * sizeof(double));
+            u = realloc(u, cap * 2 * sizeof(double));
+        }
+        if (fscanf(in, "%lf %lf %lf %lf %lf %lf %lf %lf", &wi[3 * n], &wi[3 * n + 1], &wi[3 * n + 2],
+                   &wo[3 * n], &wo[3 * n + 1], &wo[3 * n + 2], &u[2 * n], &u[2 * n + 1]) != 8)
+            break;
+        n++;
+    }
+    fclose(in);
+
+    /* A bad SOURCE: NULL and a message naming it. */
+    brdftab_brdf *bad = brdftab_open("/no/such/file.btdb");
+    CHECK(bad == NULL && strstr(brdftab_last_error(), "/no/such/file.btdb"), "bad source");
+    CHECK(brdftab_open(NULL) == NULL && strlen(brdftab_last_error()) > 0, "NULL source");
+    CHECK(brdftab_open("{\"model\": \"no_such_model\"}") == NULL, "unknown model");
+
+    brdftab_brdf *b = brdftab_open(argv[1]);
+    if (!b) {
+        fprintf(stderr, "error: %s\n", brdftab_last_error());
+        return 1;
+    }
+    CHECK(strcmp(brdftab_last_error(), "") == 0, "success clears the error");
+    size_t c = brdftab_channels(b);
+    CHECK(c > 0 && brdftab_channel_name(b, 0) != NULL, "channels");
+    CHECK(brdftab_channel_name(b, c) == NULL, "channel name out of range");
+    float *f = malloc(n * c * sizeof(float)), *w = malloc(n * c * sizeof(float));
+    double *pdf = malloc(n * sizeof(double)), *swi = malloc(n * 3 * sizeof(double)),
+           *spdf = malloc(n * sizeof(double)), *alb = malloc(c * sizeof(double));
+
+    /* Bad arguments: -1 with a message, never a crash; n = 0 succeeds with NULL pointers. */
+    CHECK(brdftab_eval(NULL, 1, wi, wo, f) == -1 && strstr(brdftab_last_error(), "NULL"), "NULL handle");
+    CHECK(brdftab_eval(b, 1, NULL, wo, f) == -1, "NULL wi");
+    CHECK(brdftab_pdf(b, 1, wi, wo, NULL) == -1, "NULL pdf");
+    CHECK(brdftab_sample(b, 1, wo, NULL, swi, spdf, w) == -1, "NULL u");
+    CHECK(brdftab_albedo(b, NAN, alb) == -1, "NaN theta");
+    CHECK(brdftab_albedo(NULL, 0.5, alb) == -1, "NULL albedo handle");
+    CHECK(brdftab_eval(b, 0, NULL, NULL, NULL) == 0, "n = 0");
+    CHECK(brdftab_eval(NULL, 0, NULL, NULL, NULL) == 0, "n = 0, NULL handle");
+    CHECK(brdftab_sample(b, 0, NULL, NULL, NULL, NULL, NULL) == 0, "sample n = 0");
+    brdftab_close(NULL);
+
+    CHECK(brdftab_eval(b, n, wi, wo, f) == 0, "eval");
+    CHECK(brdftab_pdf(b, n, wi, wo, pdf) == 0, "pdf");
+    CHECK(brdftab_sample(b, n, wo, u, swi, spdf, w) == 0, "sample");
+    CHECK(brdftab_albedo(b, 30.0 * BRDFTAB_PI / 180.0, alb) == 0, "albedo");
+
+    /* Two threads on one handle give what one thread gave, bit for bit. */
+    float *f1 = malloc(n * c * sizeof(float)), *f2 = malloc(n * c * sizeof(float));
+    struct job j1 = {b, n, wi, wo, f1, 0}, j2 = {b, n, wi, wo, f2, 0};
+    pthread_t t1, t2;
+    pthread_create(&t1, NULL, run_eval, &j1);
+    pthread_create(&t2, NULL, run_eval, &j2);
+    pthread_join(t1, NULL);
+    pthread_join(t2, NULL);
+    CHECK(j1.rc == 0 && j2.rc == 0, "threads succeeded");
+    CHECK(memcmp(f, f1, n * c * sizeof(float)) == 0 && memcmp(f, f2, n * c * sizeof(float)) == 0,
+          "threads agree with one thread");
+
+    FILE *out = fopen(argv[3], "w");
+    for (size_t k = 0; k < n; k++) {
+        for (size_t i = 0; i < c; i++) fprintf(out, "%.9g ", f[k * c + i]);
+        fprintf(out, "%.17g %.17g %.17g %.17g %.17g", pdf[k], swi[3 * k], swi[3 * k + 1], swi[3 * k + 2], spdf[k]);
+        for (size_t i = 0; i < c; i++) fprintf(out, " %.9g", w[k * c + i]);
+        fprintf(out, "\n");
+    }
+    fprintf(out, "albedo");
+    for (size_t i = 0; i < c; i++) fprintf(out, " %.17g", alb[i]);
+    fprintf(out, "\n");
+    fclose(out);
+    brdftab_close(b);
+    free(wi); free(wo); free(u); free(f); free(w); free(pdf); free(swi); free(spdf); free(alb);
+    free(f1); free(f2);
+    return failures ? 1 : 0;
+}

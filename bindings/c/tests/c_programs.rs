@@ -1,0 +1,263 @@
+//! Builds the C test program and the examples with the system compiler against the built
+//! library, runs them, and compares what they print with the Rust API on the same sources.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use brdftab::bake::{BakeRequest, BakeTarget};
+use brdftab::rng::Pcg32;
+use brdftab::table::presets::Preset;
+use brdftab::{Brdf, geometry};
+use glam::{DVec2, DVec3};
+
+const CRATE: &str = env!("CARGO_MANIFEST_DIR");
+
+/// target/release (or debug): where cargo put libbrdftab_c.{so,a} for this test run.
+fn lib_dir() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let dir = exe.parent().unwrap().parent().unwrap().to_path_buf();
+    assert!(
+        dir.join("libbrdftab_c.so").exists() && dir.join("libbrdftab_c.a").exists(),
+        "libbrdftab_c.so/.a not found in {} (cargo builds them with this test)",
+        dir.display()
+    );
+    dir
+}
+
+fn tmp() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("brdftab-c-tests-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(cmd: &mut Command) -> String {
+    let out = cmd.output().unwrap_or_else(|e| panic!("{cmd:?}: {e}"));
+    assert!(
+        out.status.success(),
+        "{cmd:?} failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// Compiles `src` (C or C++) against the shared library into `exe`.
+fn compile(compiler: &str, extra: &[&str], src: &Path, exe: &Path) {
+    let lib = lib_dir();
+    let mut c = Command::new(compiler);
+    c.args(extra)
+        .arg("-O2")
+        .arg("-Wall")
+        .arg("-Werror")
+        .arg(format!("-I{CRATE}/include"))
+        .arg(format!("-I{CRATE}/examples"))
+        .arg(src)
+        .arg(format!("-L{}", lib.display()))
+        .arg(format!("-Wl,-rpath,{}", lib.display()))
+        .arg("-lbrdftab_c")
+        .args(["-lpthread", "-lm"])
+        .arg("-o")
+        .arg(exe);
+    run(&mut c);
+}
+
+fn bake_table(dir: &Path) -> String {
+    let path = dir.join("ct.btdb").to_str().unwrap().to_owned();
+    BakeRequest::new(r#"{"model":"cook_torrance","m":0.3,"fresnel":{"conductor":"Au"}}"#)
+        .preset(Preset::Small)
+        .run(&BakeTarget::file(&path))
+        .unwrap();
+    path
+}
+
+fn pairs(n: usize) -> Vec<(DVec3, DVec3, DVec2)> {
+    let mut rng = Pcg32::new(11);
+    (0..n)
+        .map(|k| {
+            let wi = geometry::uniform_hemisphere(rng.next_dvec2());
+            // Some pairs below the horizon and unnormalized, as renderers pass them.
+            let mut wo = geometry::uniform_hemisphere(rng.next_dvec2()) * 2.5;
+            if k % 17 == 0 {
+                wo.z = -wo.z;
+            }
+            (wi, wo, rng.next_dvec2())
+        })
+        .collect()
+}
+
+fn nums(line: &str) -> Vec<f64> {
+    line.split_whitespace()
+        .map(|x| x.parse().unwrap_or_else(|_| panic!("`{x}` in `{line}`")))
+        .collect()
+}
+
+/// The C program's eval, pdf, sample and albedo equal the Rust API's for `source`.
+fn check_source(exe: &Path, dir: &Path, source: &str) {
+    let p = pairs(500);
+    let input = dir.join("pairs.txt");
+    let text: String = p
+        .iter()
+        .map(|(a, b, u)| {
+            format!(
+                "{:.17e} {:.17e} {:.17e} {:.17e} {:.17e} {:.17e} {:.17e} {:.17e}\n",
+                a.x, a.y, a.z, b.x, b.y, b.z, u.x, u.y
+            )
+        })
+        .collect();
+    std::fs::write(&input, text).unwrap();
+    let output = dir.join("out.txt");
+    run(Command::new(exe).arg(source).arg(&input).arg(&output));
+    let brdf = brdftab::open(source).unwrap();
+    let c = brdf.channels().len();
+    let out = std::fs::read_to_string(&output).unwrap();
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), p.len() + 1);
+    let mut f = vec![0.0f32; c];
+    let mut w = vec![0.0f32; c];
+    for ((a, b, u), line) in p.iter().zip(&lines) {
+        let v = nums(line);
+        assert_eq!(v.len(), 2 * c + 5, "{line}");
+        brdf.eval(*a, *b, &mut f);
+        for i in 0..c {
+            // %.9g prints an f32 exactly: the values must be bit-identical.
+            assert_eq!(v[i] as f32, f[i], "eval {source} {a} {b}");
+        }
+        assert_eq!(v[c], brdf.pdf(*a, *b), "pdf");
+        match brdf.sample(*b, *u, &mut w) {
+            Some(s) => {
+                assert_eq!(DVec3::new(v[c + 1], v[c + 2], v[c + 3]), s.wi);
+                assert_eq!(v[c + 4], s.pdf);
+                for i in 0..c {
+                    assert_eq!(v[c + 5 + i] as f32, w[i]);
+                }
+            }
+            None => assert!(v[c + 1..].iter().all(|x| *x == 0.0), "{line}"),
+        }
+    }
+    let alb = nums(lines[p.len()].trim_start_matches("albedo"));
+    let mut a = vec![0.0f64; c];
+    brdf.albedo(DVec3::new(0.5, 0.0, 3f64.sqrt() / 2.0), &mut a);
+    for i in 0..c {
+        assert!(
+            (alb[i] - a[i]).abs() <= 1e-12 * a[i].abs().max(1.0),
+            "albedo"
+        );
+    }
+}
+
+#[test]
+fn the_c_test_program_agrees_with_the_rust_api() {
+    let dir = tmp().join("abi");
+    std::fs::create_dir_all(&dir).unwrap();
+    let exe = dir.join("abi_test");
+    compile(
+        "cc",
+        &["-std=c11"],
+        &Path::new(CRATE).join("tests/abi_test.c"),
+        &exe,
+    );
+    let table = bake_table(&dir);
+    check_source(&exe, &dir, &table);
+    check_source(&exe, &dir, r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#);
+    let rgl = brdftab::measured::data::rgl_dir().expect("the RGL files ship in data/rgl");
+    check_source(
+        &exe,
+        &dir,
+        rgl.join("paper_white_rgb.bsdf").to_str().unwrap(),
+    );
+}
+
+#[test]
+fn the_examples_build_and_print_what_the_library_computes() {
+    let dir = tmp().join("examples");
+    std::fs::create_dir_all(&dir).unwrap();
+    let table = bake_table(&dir);
+    let ex = Path::new(CRATE).join("examples");
+
+    // slice.c, against the shared and against the static library.
+    let slice = dir.join("slice");
+    compile("cc", &["-std=c11"], &ex.join("slice.c"), &slice);
+    let text = run(Command::new(&slice).arg(&table).arg("4"));
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(nums)
+        .collect();
+    assert_eq!(rows.len(), 4);
+    assert!(rows.iter().all(|r| r.len() == 4));
+    // θh = 0, θd = 0 is the normal-incidence retro-reflection: wi = wo = z.
+    let brdf = brdftab::open(&table).unwrap();
+    let mut f = [0.0f32; 3];
+    brdf.eval(DVec3::Z, DVec3::Z, &mut f);
+    assert!((rows[0][0] as f32 - f[0]).abs() <= 1e-5 * f[0], "{text}");
+    let lib = lib_dir();
+    let slice_static = dir.join("slice_static");
+    run(Command::new("cc")
+        .args(["-std=c11", "-O2", &format!("-I{CRATE}/include")])
+        .arg(ex.join("slice.c"))
+        .arg(lib.join("libbrdftab_c.a"))
+        .args(["-lpthread", "-ldl", "-lm", "-o"])
+        .arg(&slice_static));
+    assert_eq!(run(Command::new(&slice_static).arg(&table).arg("4")), text);
+
+    // The pbrt-v4-style BxDF over the C++ wrapper: a Monte Carlo albedo from Sample_f agrees
+    // with the library's quadrature albedo (Lambert: the estimator's weight is exactly kd·π
+    // for every sample, so the two agree to f32 rounding; the CT table is reciprocal, so the
+    // estimate over wi matches the albedo over wo to the Monte Carlo error, < 2 % at 2·10^5).
+    let bxdf = dir.join("pbrt_bxdf");
+    compile("g++", &["-std=c++17"], &ex.join("pbrt_bxdf.cpp"), &bxdf);
+    for (src, tol) in [
+        (r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#, 1e-5),
+        (&table[..], 0.02),
+    ] {
+        let out = run(Command::new(&bxdf).arg(src).arg("30"));
+        let mut it = out.lines();
+        let mc = nums(it.next().unwrap().trim_start_matches("mc"));
+        let alb = nums(it.next().unwrap().trim_start_matches("albedo"));
+        for i in 0..3 {
+            assert!(
+                (mc[i] - alb[i]).abs() <= tol * alb[i] + 1e-6,
+                "{src}: mc {mc:?} vs albedo {alb:?}"
+            );
+        }
+    }
+    // A bad SOURCE: the C++ wrapper throws with the library's message; exit 1.
+    let out = Command::new(&bxdf).arg("/no/such.btdb").output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such.btdb"));
+}
+
+#[test]
+fn the_header_declares_exactly_the_exported_functions() {
+    let header = std::fs::read_to_string(Path::new(CRATE).join("include/brdftab.h")).unwrap();
+    let mut declared: Vec<String> = header
+        .lines()
+        .filter(|l| !l.trim_start().starts_with('*') && !l.trim_start().starts_with("/*"))
+        .flat_map(|l| {
+            l.match_indices("brdftab_")
+                .filter_map(|(i, _)| {
+                    let rest = &l[i..];
+                    let name: String = rest
+                        .chars()
+                        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                        .collect();
+                    rest[name.len()..].starts_with('(').then_some(name)
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    declared.sort();
+    declared.dedup();
+    let nm = run(Command::new("nm")
+        .args(["-D", "--defined-only"])
+        .arg(lib_dir().join("libbrdftab_c.so")));
+    let mut exported: Vec<String> = nm
+        .lines()
+        .filter_map(|l| l.split_whitespace().nth(2))
+        .filter(|s| s.starts_with("brdftab_"))
+        .map(str::to_owned)
+        .collect();
+    exported.sort();
+    assert_eq!(declared, exported);
+    assert!(declared.len() >= 11, "{declared:?}");
+}
