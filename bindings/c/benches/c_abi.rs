@@ -15,25 +15,23 @@ use brdftab::{Brdf, geometry};
 use brdftab_c::*;
 use glam::DVec3;
 
-/// CPU time of the whole process (every rayon worker) in seconds: on a shared machine the wall
-/// clock measures the neighbours as much as the code.
-fn cpu() -> f64 {
+/// CPU time of `clock` in seconds: the whole process (every rayon worker) or the calling
+/// thread. On a shared machine the wall clock measures the neighbours as much as the code.
+fn cpu_of(clock: libc::clockid_t) -> f64 {
     let mut t = libc::timespec {
         tv_sec: 0,
         tv_nsec: 0,
     };
-    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut t) };
+    unsafe { libc::clock_gettime(clock, &mut t) };
     t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
 }
 
-/// CPU time of the calling thread in seconds.
+fn cpu() -> f64 {
+    cpu_of(libc::CLOCK_PROCESS_CPUTIME_ID)
+}
+
 fn thread_cpu() -> f64 {
-    let mut t = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) };
-    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
+    cpu_of(libc::CLOCK_THREAD_CPUTIME_ID)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

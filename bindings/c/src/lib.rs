@@ -130,6 +130,23 @@ unsafe fn handle<'a>(b: *const brdftab_brdf) -> Result<&'a brdftab_brdf, String>
     unsafe { b.as_ref() }.ok_or_else(|| "the brdftab_brdf handle is NULL".to_string())
 }
 
+/// The handle and the `wi`, `wo` arrays of a pair-wise call.
+///
+/// # Safety
+/// `b` is NULL or a live handle; `wi` and `wo` are NULL or point to 3n doubles.
+unsafe fn pair_args<'a>(
+    b: *const brdftab_brdf,
+    n: usize,
+    wi: *const f64,
+    wo: *const f64,
+) -> Result<(&'a brdftab_brdf, &'a [DVec3], &'a [DVec3]), String> {
+    // SAFETY (all three): the caller's contract; NULL and alignment are checked.
+    let b = unsafe { handle(b) }?;
+    let wi = unsafe { slice(wi as *const DVec3, n, "wi") }?;
+    let wo = unsafe { slice(wo as *const DVec3, n, "wo") }?;
+    Ok((b, wi, wo))
+}
+
 fn open_impl(source: *const c_char, opts: Option<&brdftab_open_options>) -> *mut brdftab_brdf {
     let mut out = std::ptr::null_mut();
     guard(|| {
@@ -249,12 +266,9 @@ pub unsafe extern "C" fn brdftab_eval(
         if n == 0 {
             return Ok(());
         }
-        // SAFETY (all four): the header's contract on sizes; NULL and alignment are checked.
-        let b = unsafe { handle(b) }?;
-        let c = b.names.len();
-        let wi = unsafe { slice(wi as *const DVec3, n, "wi") }?;
-        let wo = unsafe { slice(wo as *const DVec3, n, "wo") }?;
-        let f = unsafe { slice_mut(f, n * c, "f") }?;
+        // SAFETY (both): the header's contract on sizes; NULL and alignment are checked.
+        let (b, wi, wo) = unsafe { pair_args(b, n, wi, wo) }?;
+        let f = unsafe { slice_mut(f, n * b.names.len(), "f") }?;
         b.brdf.eval_batch(wi, wo, f);
         Ok(())
     })
@@ -276,10 +290,8 @@ pub unsafe extern "C" fn brdftab_pdf(
         if n == 0 {
             return Ok(());
         }
-        // SAFETY (all four): the header's contract on sizes; NULL and alignment are checked.
-        let b = unsafe { handle(b) }?;
-        let wi = unsafe { slice(wi as *const DVec3, n, "wi") }?;
-        let wo = unsafe { slice(wo as *const DVec3, n, "wo") }?;
+        // SAFETY (both): the header's contract on sizes; NULL and alignment are checked.
+        let (b, wi, wo) = unsafe { pair_args(b, n, wi, wo) }?;
         let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
         for ((p, a), o) in pdf.iter_mut().zip(wi).zip(wo) {
             *p = b.brdf.pdf(*a, *o);
