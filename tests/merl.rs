@@ -232,11 +232,9 @@ fn wrong_size_and_dims_are_typed_errors() {
 
 #[test]
 fn embedded_manifest_matches_tsv() {
-    let tsv = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/data/measured/merl/merl_expected_files.tsv"
-    ))
-    .unwrap();
+    let path = brdftab::measured::data::merl_file("merl_expected_files.tsv")
+        .unwrap_or_else(|e| panic!("{e}"));
+    let tsv = std::fs::read_to_string(path).unwrap();
     let rows: Vec<Vec<&str>> = tsv
         .lines()
         .skip(1)

@@ -100,22 +100,12 @@ pub fn open_with(source: &str, channels: &Channels, interp: Interp) -> Result<Bo
     }
 }
 
-/// The directory of RGL `.bsdf` files used by `demo` and `accuracy`: `--rgl DIR`, else
-/// `$BRDFTAB_RGL_DIR`, else `../shared/data/measured/rgl` next to the working directory or to the
-/// crate; `None` when none exists.
+/// The directory of RGL `.bsdf` files used by `demo` and `accuracy`: `--rgl DIR`, else the
+/// library's search ([`brdftab::measured::data::rgl_dir`]: `$BRDFTAB_RGL_DIR`, the shipped
+/// `data/rgl`, `../shared/data/measured/rgl`); `None` when none exists.
 pub fn rgl_dir(arg: Option<&std::path::Path>) -> Option<std::path::PathBuf> {
-    use std::path::{Path, PathBuf};
-    if let Some(p) = arg {
-        return Some(p.to_path_buf());
+    match arg {
+        Some(p) => Some(p.to_path_buf()),
+        None => brdftab::measured::data::rgl_dir(),
     }
-    if let Some(p) = std::env::var_os("BRDFTAB_RGL_DIR") {
-        return Some(PathBuf::from(p));
-    }
-    let rel = Path::new("../shared/data/measured/rgl");
-    [
-        PathBuf::from(rel),
-        Path::new(env!("CARGO_MANIFEST_DIR")).join(rel),
-    ]
-    .into_iter()
-    .find(|p| p.is_dir())
 }
