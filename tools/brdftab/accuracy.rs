@@ -15,7 +15,7 @@ pub struct AccuracyArgs {
     /// Output directory (accuracy.csv, accuracy.md, rd_<source>.png).
     #[arg(long)]
     out: PathBuf,
-    /// The quick suite: 6 sources, small preset, fewer pairs, tiny renders (< 1 min).
+    /// The quick suite: 11 sources, small preset, fewer pairs, tiny renders (about 1 min).
     #[arg(long)]
     quick: bool,
     /// Directory of RGL `.bsdf` files (default: $BRDFTAB_RGL_DIR, else the shipped data/rgl,
