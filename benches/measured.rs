@@ -15,7 +15,14 @@ use brdftab::measured::{MerlBrdf, RglBrdf, merl};
 use brdftab::rng::Pcg32;
 use glam::DVec3;
 
-const RGL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/measured/rgl/");
+/// The shipped RGL file `name` (`data/rgl`, see `brdftab::measured::data`); a missing file
+/// fails loudly.
+fn rgl(name: &str) -> String {
+    brdftab::measured::data::rgl_file(name)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .display()
+        .to_string()
+}
 
 fn pairs(n: usize) -> Vec<(DVec3, DVec3)> {
     let mut rng = Pcg32::new(42);
@@ -93,7 +100,7 @@ fn main() {
         "cg_sunflower_rgb.bsdf",
     ] {
         let t = Instant::now();
-        let b = RglBrdf::open(format!("{RGL}{file}")).unwrap();
+        let b = RglBrdf::open(rgl(&file)).unwrap();
         let load = t.elapsed().as_secs_f64() * 1e3;
         println!(
             "rgl native eval   {file:<28} {:7.1} ns/eval   (open {load:.1} ms)",
@@ -141,7 +148,7 @@ fn main() {
     // The RGL material baked into tables (halfdiff, sqrt θh, isotropic) and the MERL grid.
     use brdftab::table::presets::Preset;
     use brdftab::table::{BakeOptions, Interp, Symmetry, TabulatedBrdf, bake};
-    let b = RglBrdf::open(format!("{RGL}cc_ibiza_sunset_rgb.bsdf")).unwrap();
+    let b = RglBrdf::open(rgl("cc_ibiza_sunset_rgb.bsdf")).unwrap();
     let native = ns_per_eval(&b, &p);
     let native_coh = ns_per_eval(&b, &coherent);
     println!("rgl native eval   cc_ibiza_sunset, coherent pairs {native_coh:7.1} ns/eval");

@@ -179,6 +179,21 @@ pub trait Brdf: Send + Sync {
         self.eval(wi, wo, out);
         self.pdf(wi, wo)
     }
+
+    /// For sources that are themselves values on nodes in the Rusinkiewicz angles — a MERL
+    /// measurement (cell centres), a `halfdiff` table (its nodes): when `hd` is one of those
+    /// nodes (to rounding), writes its value **as stored** into `out[..channels]` and returns
+    /// `true`. As stored means: also where a direction of the node's pair lies below the
+    /// horizon (a measured cell whose centre does), and negative where the source marks a cell
+    /// as unmeasured (MERL's −1, scaled like the other values), which `eval` reports as 0.
+    ///
+    /// Baking on a `halfdiff` grid and resampling on the MERL grid ask this first, so a table of
+    /// such a source on its own grid holds its cells verbatim, unmeasured markers included.
+    /// Returns `false` (the default) for every other source and angle: then evaluate directions.
+    fn stored_node(&self, hd: geometry::HalfDiff, out: &mut [f32]) -> bool {
+        let _ = (hd, out);
+        false
+    }
 }
 
 /// Smart pointers to a `Brdf` are `Brdf`s: every method forwards to the pointee (so overrides such
@@ -215,6 +230,9 @@ macro_rules! forward_brdf {
             }
             fn eval_pdf(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) -> f64 {
                 (**self).eval_pdf(wi, wo, out)
+            }
+            fn stored_node(&self, hd: geometry::HalfDiff, out: &mut [f32]) -> bool {
+                (**self).stored_node(hd, out)
             }
         }
     };

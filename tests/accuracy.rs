@@ -214,3 +214,70 @@ fn cli_writes_the_files() {
     assert_eq!(bad.status.code(), Some(1));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The lecture's Phong variants run in the quick suite, each named by its model so a reader of
+/// the CSV can tell them apart, and every one of their rows is finite.
+#[test]
+fn quick_suite_has_the_lecture_phong_variants_with_finite_rows() {
+    let lecture = [
+        "phong",
+        "max_phong",
+        "pumped_phong_mean",
+        "pumped_phong_product",
+        "pumped_phong_sqrt",
+    ];
+    let quick = SuiteConfig::quick(None).unwrap();
+    let names: Vec<&str> = quick.sources.iter().map(|s| s.name.as_str()).collect();
+    for n in lecture {
+        assert_eq!(
+            names.iter().filter(|&&m| m == n).count(),
+            1,
+            "{n} not once in {names:?}"
+        );
+    }
+    // Source names are unique (rows are keyed by them).
+    let mut sorted = names.clone();
+    sorted.sort();
+    sorted.dedup();
+    assert_eq!(sorted.len(), names.len(), "{names:?}");
+    // Their rows, with the quick preset and codecs, fewer pairs and no render to keep it short.
+    let cfg = SuiteConfig {
+        sources: quick
+            .sources
+            .into_iter()
+            .filter(|s| lecture.contains(&s.name.as_str()))
+            .collect(),
+        params: vec![Param::HalfDiff],
+        pairs: 2000,
+        render: None,
+        ..SuiteConfig::quick(None).unwrap()
+    };
+    let report = suite::run(&cfg, None).unwrap();
+    assert_eq!(report.rows.len(), lecture.len() * cfg.codecs.len());
+    for r in &report.rows {
+        let m = [
+            r.ratio_f32,
+            r.bits_per_value,
+            r.rel_rmse,
+            r.max_rel,
+            r.albedo_err,
+            r.render_rel_rmse,
+        ];
+        assert!(m.iter().all(|x| x.is_finite()), "{}: {m:?}", r.csv());
+        // Either measured (≥ 0) or not measured and said so.
+        if r.status == "ok" {
+            assert!(m[..5].iter().all(|&x| x >= 0.0), "{}", r.csv());
+        } else {
+            assert!(m[2] == NOT_MEASURED, "{}", r.csv());
+        }
+    }
+    // f32 stores every variant (the pumped X grow large near grazing, but stay finite).
+    for n in lecture {
+        let f32_row = report
+            .rows
+            .iter()
+            .find(|r| r.source == n && r.codec == "f32")
+            .unwrap();
+        assert_eq!(f32_row.status, "ok", "{}", f32_row.csv());
+    }
+}

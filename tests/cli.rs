@@ -232,9 +232,35 @@ fn check_text_and_models_and_demo_run() {
 fn demo_bakes_into_a_database_and_prints_where() {
     let dir = std::env::temp_dir().join(format!("brdftab-demo-test-{}", std::process::id()));
     let out = dir.to_str().unwrap();
-    let o = run(&["demo", "--quick", "--preset", "small", "--out", out], "");
+    std::fs::create_dir_all(&dir).unwrap();
+    // As a user of a checkout standing alone: no `$BRDFTAB_RGL_DIR`, run from elsewhere (no
+    // `data/` or `../shared` beside the working directory); the shipped `data/rgl` is found.
+    let o = Command::new(env!("CARGO_BIN_EXE_brdftab"))
+        .args(["demo", "--quick", "--preset", "small", "--out", out])
+        .env_remove("BRDFTAB_RGL_DIR")
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let o = Out {
+        code: o.status.code().unwrap_or(-1),
+        stdout: String::from_utf8(o.stdout).unwrap(),
+        stderr: String::from_utf8(o.stderr).unwrap(),
+    };
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(o.stdout.contains("cook_torrance_gold"), "{}", o.stdout);
+    assert!(!o.stderr.contains("no RGL directory"), "{}", o.stderr);
+    // The seven measured materials are baked and reported.
+    for m in [
+        "rgl_cc_ibiza_sunset",
+        "rgl_cc_iris_purple_gem",
+        "rgl_cg_sunflower",
+        "rgl_colodur_napoli_4f",
+        "rgl_paper_white",
+        "rgl_satin_rosaline",
+        "rgl_vch_golden_yellow",
+    ] {
+        assert!(o.stdout.contains(m), "{m} missing from:\n{}", o.stdout);
+    }
     assert!(o.stdout.contains("demo.btdb"), "{}", o.stdout);
     assert!(dir.join("demo.btdb").is_file());
     let _ = std::fs::remove_dir_all(&dir);

@@ -2,7 +2,14 @@
 
 use std::process::Command;
 
-const RGL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/measured/rgl/");
+/// The shipped RGL file `name` (`data/rgl`, see `brdftab::measured::data`); a missing file
+/// fails loudly.
+fn rgl(name: &str) -> String {
+    brdftab::measured::data::rgl_file(name)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .display()
+        .to_string()
+}
 
 fn run(args: &[&str], stdin: &str) -> (bool, String, String) {
     use std::io::Write;
@@ -29,7 +36,7 @@ fn run(args: &[&str], stdin: &str) -> (bool, String, String) {
 
 #[test]
 fn info_eval_slice_convert() {
-    let f = format!("{RGL}paper_white_rgb.bsdf");
+    let f = rgl("paper_white_rgb.bsdf");
     let (ok, out, err) = run(&["info", &f], "");
     assert!(ok, "{err}");
     assert!(out.contains("White A4 paper (160 gsm)"), "{out}");

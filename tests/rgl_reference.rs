@@ -10,7 +10,14 @@ use brdftab::measured::RglBrdf;
 use brdftab::measured::tensor::{Dtype, TensorFile, TensorWriter};
 use std::collections::BTreeMap;
 
-const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/measured/rgl/");
+/// The shipped RGL file `name` (`data/rgl`, see `brdftab::measured::data`); a missing file
+/// fails loudly.
+fn rgl(name: &str) -> String {
+    brdftab::measured::data::rgl_file(name)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .display()
+        .to_string()
+}
 
 fn dir(theta_deg: f64, phi_deg: f64) -> glam::DVec3 {
     spherical(theta_deg.to_radians(), phi_deg.to_radians())
@@ -18,7 +25,7 @@ fn dir(theta_deg: f64, phi_deg: f64) -> glam::DVec3 {
 
 #[test]
 fn matches_reference_reader() {
-    let tsv = std::fs::read_to_string(format!("{DIR}reference_eval_powitacq_rgb.tsv")).unwrap();
+    let tsv = std::fs::read_to_string(rgl("reference_eval_powitacq_rgb.tsv")).unwrap();
     let mut brdfs: BTreeMap<String, RglBrdf> = BTreeMap::new();
     // (max rel error off the pole, max rel error at θi = 0) per file
     let mut worst: BTreeMap<String, (f64, f64)> = BTreeMap::new();
@@ -29,7 +36,7 @@ fn matches_reference_reader() {
         let v: Vec<f64> = c[1..].iter().map(|x| x.parse().unwrap()).collect();
         let brdf = brdfs
             .entry(file.clone())
-            .or_insert_with(|| RglBrdf::open(format!("{DIR}{file}")).unwrap());
+            .or_insert_with(|| RglBrdf::open(rgl(&file)).unwrap());
         let (ti, pi, to, po) = (v[0], v[1], v[2], v[3]);
         let wi = dir(ti, pi);
         let wo = dir(to, po);
@@ -69,7 +76,7 @@ fn matches_reference_reader() {
 #[test]
 fn reference_cosine_convention() {
     // README: paper_white eval(60°, 0°) = 0.258 and eval(0°, 60°) = 0.127 ≈ 0.258 · cos 60°.
-    let b = RglBrdf::open(format!("{DIR}paper_white_rgb.bsdf")).unwrap();
+    let b = RglBrdf::open(rgl("paper_white_rgb.bsdf")).unwrap();
     let mut f = [0f32; 3];
     b.eval_cos(dir(60.0, 0.0), dir(0.0, 0.0), &mut f);
     assert!((f[1] - 0.258).abs() < 0.01, "{f:?}");
@@ -84,7 +91,7 @@ fn reference_cosine_convention() {
 
 #[test]
 fn below_horizon_and_nan_give_zero() {
-    let b = RglBrdf::open(format!("{DIR}paper_white_rgb.bsdf")).unwrap();
+    let b = RglBrdf::open(rgl("paper_white_rgb.bsdf")).unwrap();
     let mut f = [1f32; 3];
     b.eval(dir(30.0, 0.0), glam::DVec3::new(0.0, 0.3, -0.5), &mut f);
     assert_eq!(f, [0.0; 3]);
@@ -102,7 +109,7 @@ fn rebuild(
     file: &str,
     edit: impl Fn(&str, Dtype, &[u64], Vec<u8>) -> Option<(Dtype, Vec<u64>, Vec<u8>)>,
 ) -> Vec<u8> {
-    let t = TensorFile::open(format!("{DIR}{file}")).unwrap();
+    let t = TensorFile::open(rgl(&file)).unwrap();
     let mut w = TensorWriter::new();
     for f in t.fields() {
         let shape: Vec<u64> = f.shape.iter().map(|&d| d as u64).collect();
@@ -120,7 +127,7 @@ fn rebuilt_file_evaluates_identically() {
     });
     let t = TensorFile::from_bytes("rebuilt", bytes).unwrap();
     let a = RglBrdf::from_tensor(&t, None).unwrap();
-    let b = RglBrdf::open(format!("{DIR}paper_white_rgb.bsdf")).unwrap();
+    let b = RglBrdf::open(rgl("paper_white_rgb.bsdf")).unwrap();
     let (mut fa, mut fb) = ([0f32; 3], [0f32; 3]);
     for (ti, to) in [(10.0, 50.0), (45.0, 45.0), (70.0, 10.0)] {
         a.eval(dir(ti, 10.0), dir(to, 200.0), &mut fa);
@@ -133,7 +140,7 @@ fn rebuilt_file_evaluates_identically() {
 fn bad_files_are_typed_errors() {
     let tmp = std::env::temp_dir().join(format!("brdftab-rgl-{}", std::process::id()));
     std::fs::create_dir_all(&tmp).unwrap();
-    let orig = std::fs::read(format!("{DIR}paper_white_rgb.bsdf")).unwrap();
+    let orig = std::fs::read(rgl("paper_white_rgb.bsdf")).unwrap();
     // Truncated copies: every cut must be an error, never a panic.
     for cut in [0, 10, 17, 100, 1000, orig.len() / 2, orig.len() - 1] {
         let p = tmp.join("cut.bsdf");
@@ -211,7 +218,7 @@ fn bad_files_are_typed_errors() {
 #[test]
 fn spectral_file_matches_rgb_at_channel_wavelengths() {
     // A spectral file whose three wavelengths carry B, G, R of paper_white (ascending order).
-    let t = TensorFile::open(format!("{DIR}paper_white_rgb.bsdf")).unwrap();
+    let t = TensorFile::open(rgl("paper_white_rgb.bsdf")).unwrap();
     let mut w = TensorWriter::new();
     for f in t.fields() {
         let shape: Vec<u64> = f.shape.iter().map(|&d| d as u64).collect();
@@ -237,7 +244,7 @@ fn spectral_file_matches_rgb_at_channel_wavelengths() {
         None,
     )
     .unwrap();
-    let rgb = RglBrdf::open(format!("{DIR}paper_white_rgb.bsdf")).unwrap();
+    let rgb = RglBrdf::open(rgl("paper_white_rgb.bsdf")).unwrap();
     assert_eq!(spec.channels().len(), 3);
     let (mut a, mut b) = ([0f32; 3], [0f32; 3]);
     for (ti, to, po) in [(20.0, 40.0, 170.0), (65.0, 30.0, 10.0)] {
@@ -252,7 +259,7 @@ fn spectral_file_matches_rgb_at_channel_wavelengths() {
 
 /// paper_white's data replicated over `phis` incident azimuths (an anisotropic file).
 fn anisotropic(phis: &[f32]) -> RglBrdf {
-    let t = TensorFile::open(format!("{DIR}paper_white_rgb.bsdf")).unwrap();
+    let t = TensorFile::open(rgl("paper_white_rgb.bsdf")).unwrap();
     let np = phis.len();
     let mut w = TensorWriter::new();
     for f in t.fields() {
@@ -307,7 +314,7 @@ fn anisotropic_reductions_fold_by_symmetry() {
 fn corrupted_headers_never_panic() {
     // Flip random header bytes (names, dtypes, offsets, shapes) of a real file: every outcome must
     // be Ok or a typed error, never a panic or a huge allocation.
-    let orig = std::fs::read(format!("{DIR}paper_white_rgb.bsdf")).unwrap();
+    let orig = std::fs::read(rgl("paper_white_rgb.bsdf")).unwrap();
     let mut rng = brdftab::rng::Pcg32::new(5);
     for _ in 0..3000 {
         let mut b = orig.clone();
@@ -329,7 +336,7 @@ fn corrupted_headers_never_panic() {
 fn random_pairs_are_finite_and_non_negative() {
     let mut rng = brdftab::rng::Pcg32::new(8);
     for file in ["cg_sunflower_rgb.bsdf", "satin_rosaline_rgb.bsdf"] {
-        let b = RglBrdf::open(format!("{DIR}{file}")).unwrap();
+        let b = RglBrdf::open(rgl(&file)).unwrap();
         let mut f = [0f32; 3];
         for _ in 0..20_000 {
             let wi = brdftab::geometry::uniform_hemisphere(rng.next_dvec2());
@@ -356,7 +363,7 @@ fn sampler_passes_chi_square() {
         ..Chi2Options::default()
     };
     for file in files {
-        let b = RglBrdf::open(format!("{DIR}{file}")).unwrap();
+        let b = RglBrdf::open(rgl(&file)).unwrap();
         for wo in wos {
             let r = chi2::test(&b, wo, &opts);
             eprintln!("{file} wo={wo}: {r:?}");

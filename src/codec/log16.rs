@@ -100,6 +100,79 @@ pub struct Encoded {
     pub params: Log16Params,
     /// Exactly stored values: (index, value), indices strictly increasing.
     pub escapes: Vec<(u32, f32)>,
+    /// The grid origin of each channel (chunk version 3, see [the module docs](self)): channel
+    /// `c`'s grid is `anchors[c] + k·step` and index 0 decodes to exactly 0. Empty: the grid is
+    /// `params.lo + k·step` for every channel (version 2).
+    pub anchors: Vec<f64>,
+}
+
+/// The most frequent value of channel `c` (every `ch`-th value of `data` from `c`) and how
+/// often it occurs: a Misra–Gries pass with [`HEAVY`] counters (which finds every value making
+/// up more than 1/(HEAVY + 1) of the channel), then an exact count of the strongest candidate.
+/// `None` when no value occurs twice.
+fn most_common(data: &[f32], c: usize, ch: usize) -> Option<(f32, usize)> {
+    let mut keys = [0u32; HEAVY];
+    let mut count = [0usize; HEAVY];
+    'values: for v in data.iter().skip(c).step_by(ch) {
+        let b = v.to_bits();
+        for j in 0..HEAVY {
+            if count[j] > 0 && keys[j] == b {
+                count[j] += 1;
+                continue 'values;
+            }
+        }
+        for j in 0..HEAVY {
+            if count[j] == 0 {
+                keys[j] = b;
+                count[j] = 1;
+                continue 'values;
+            }
+        }
+        for n in &mut count {
+            *n -= 1;
+        }
+    }
+    let j = (0..HEAVY).max_by_key(|&j| count[j])?;
+    if count[j] == 0 {
+        return None;
+    }
+    let n = data
+        .iter()
+        .skip(c)
+        .step_by(ch)
+        .filter(|v| v.to_bits() == keys[j])
+        .count();
+    (n >= 2).then(|| (f32::from_bits(keys[j]), n))
+}
+
+/// Counters of [`most_common`].
+const HEAVY: usize = 4;
+
+/// The grid origin that puts `m` on the grid: `lo = g(m) − k_m·step` with `k_m` the nearest
+/// index, so `|lo| ≤ step/2` and `g⁻¹(lo + k_m·step)` rounds back to `m` exactly; 0 when `m` is
+/// within half a step of 0 (index 0 decodes to 0 anyway) or when that round trip misses `m`.
+fn anchor(m: f32, floor: f64, step: f64) -> f64 {
+    let l = to_log(m as f64, floor);
+    let km = (l / step).round();
+    if km == 0.0 {
+        return 0.0;
+    }
+    let lo = l - km * step;
+    if from_log(lo + km * step, floor).to_bits() == m.to_bits() {
+        lo
+    } else {
+        0.0
+    }
+}
+
+/// `g⁻¹(lo + k·step)` on an anchored grid: index 0 is exactly 0.
+#[inline(always)]
+fn value_at(k: i64, lo: f64, step: f64, floor: f64) -> f32 {
+    if k == 0 {
+        0.0
+    } else {
+        from_log(lo + k as f64 * step, floor)
+    }
 }
 
 /// What the prediction loop runs on: grid indices (`i64`, wrapping, version 2) or
@@ -131,8 +204,9 @@ impl State for i64 {
     }
 }
 
-/// The prediction loop shared by encoder and decoder. `step_fn(i, p)` returns the state of point
-/// `i` given its prediction `p`; `lo` predicts the first point of the chunk.
+/// The prediction loop shared by encoder and decoder. `step_fn(i, c, p)` returns the state of
+/// point `i` (of channel `c`, which is `i % channels`: rows start at multiples of the channel
+/// count) given its prediction `p`; `lo` predicts the first point of the chunk.
 #[inline(always)]
 fn run<T: State>(
     n: usize,
@@ -140,7 +214,7 @@ fn run<T: State>(
     filter: Filter,
     lo: T,
     r: &mut [T],
-    mut step_fn: impl FnMut(usize, T) -> T,
+    mut step_fn: impl FnMut(usize, usize, T) -> T,
 ) {
     let ch = layout.channels;
     let row = layout.channels * layout.inner;
@@ -189,7 +263,7 @@ fn run<T: State>(
                 base
             };
             base_prev = base;
-            r[i] = step_fn(i, p);
+            r[i] = step_fn(i, c, p);
             c += 1;
             if c == ch {
                 c = 0;
@@ -211,9 +285,9 @@ fn from_code(c: u16) -> i16 {
 /// the residual is `code`'s 16 bits plus the multiple of 2^16 that brings the index nearest to
 /// `v`'s own `(L − lo) / step`. That estimate is within ½ + ε of the encoder's index, so the
 /// result is exactly that index on any platform whose `ln` is off by less than 2^15 steps.
-fn resolve(p: i64, code: u16, v: f32, params: &Log16Params) -> i64 {
+fn resolve(p: i64, code: u16, v: f32, lo: f64, params: &Log16Params) -> i64 {
     let q16 = from_code(code) as i64;
-    let ka = (to_log(v as f64, params.floor) - params.lo) / params.step;
+    let ka = (to_log(v as f64, params.floor) - lo) / params.step;
     let m = ((ka - p as f64 - q16 as f64) / 65536.0).round() as i64;
     p.wrapping_add(q16).wrapping_add(m.wrapping_mul(65536))
 }
@@ -258,13 +332,20 @@ pub fn encode(
     };
     let n = data.len();
     let inv = 1.0 / params.step;
+    // Each channel's grid goes through its most common value, so a constant chunk — a Lambert
+    // table — and the value a chunk repeats most decode exactly.
+    let ch = layout.channels.max(1);
+    let anchors: Vec<f64> = (0..ch)
+        .map(|c| most_common(data, c, ch).map_or(0.0, |(m, _)| anchor(m, floor, params.step)))
+        .collect();
     // Grid index of every value, and whether it decodes within the bound and with its sign: both
     // independent of the predictor. |L| ≤ 1 + ln(f32::MAX / MIN_FLOOR) < 160, so |k| < 1e8.
     let mut k = Vec::with_capacity(n);
     let mut ok = Vec::with_capacity(n);
-    for &v in data {
-        let kt = ((to_log(v as f64, floor) - params.lo) * inv).round();
-        let back = from_log(params.lo + kt * params.step, floor) as f64;
+    for (i, &v) in data.iter().enumerate() {
+        let lo = anchors[i % ch];
+        let kt = ((to_log(v as f64, floor) - lo) * inv).round();
+        let back = value_at(kt as i64, lo, params.step, floor) as f64;
         let a = v as f64;
         // Sign-preserving: a non-negative value (a BRDF) must never decode negative.
         let same_sign = if a >= 0.0 { back >= 0.0 } else { back <= 0.0 };
@@ -280,7 +361,7 @@ pub fn encode(
     let mut codes = vec![0u16; n];
     let mut escapes = Vec::new();
     let mut state = vec![0i64; n];
-    run(n, layout, filter, 0i64, &mut state, |i, p| {
+    run(n, layout, filter, 0i64, &mut state, |i, c, p| {
         let q = k[i].wrapping_sub(p);
         let code = to_code(q);
         codes[i] = code;
@@ -288,7 +369,7 @@ pub fn encode(
             return k[i];
         }
         escapes.push((i as u32, data[i]));
-        let r = resolve(p, code, data[i], &params);
+        let r = resolve(p, code, data[i], anchors[c], &params);
         debug_assert_eq!(r, k[i]);
         r
     });
@@ -307,6 +388,7 @@ pub fn encode(
         codes,
         params,
         escapes,
+        anchors,
     })
 }
 
@@ -332,13 +414,16 @@ pub fn from_log(y: f64, floor: f64) -> f32 {
     }) as f32
 }
 
-/// Decodes codes into `out` (same length), given the chunk's escapes (sorted, in range).
+/// Decodes codes into `out` (same length), given the chunk's escapes (sorted, in range) and
+/// its per-channel grid origins (`anchors`, one per channel of `layout`; empty for chunks of
+/// version 1 and 2, whose grid starts at `params.lo`).
 pub fn decode(
     codes: &[u16],
     params: &Log16Params,
     layout: Layout,
     filter: Filter,
     escapes: &[(u32, f32)],
+    anchors: &[f64],
     out: &mut [f32],
 ) {
     let n = codes.len();
@@ -351,12 +436,25 @@ pub fn decode(
         }
         _ => None,
     };
-    if params.grid {
+    if !anchors.is_empty() {
+        // Chunk version 3: per-channel origins, index 0 is exactly 0.
         let mut state = vec![0i64; n];
-        run(n, layout, filter, 0i64, &mut state, |i, p| {
+        run(n, layout, filter, 0i64, &mut state, |i, c, p| {
+            let lo = anchors.get(c).copied().unwrap_or(0.0);
             if let Some(v) = escaped(i) {
                 out[i] = v;
-                return resolve(p, codes[i], v, params);
+                return resolve(p, codes[i], v, lo, params);
+            }
+            let k = p.wrapping_add(from_code(codes[i]) as i64);
+            out[i] = value_at(k, lo, step, floor);
+            k
+        });
+    } else if params.grid {
+        let mut state = vec![0i64; n];
+        run(n, layout, filter, 0i64, &mut state, |i, _, p| {
+            if let Some(v) = escaped(i) {
+                out[i] = v;
+                return resolve(p, codes[i], v, lo, params);
             }
             let k = p.wrapping_add(from_code(codes[i]) as i64);
             out[i] = from_log(lo + k as f64 * step, floor);
@@ -365,7 +463,7 @@ pub fn decode(
     } else {
         // Chunk version 1: an escaped value continues the prediction from its exact L.
         let mut r = vec![0.0f64; n];
-        run(n, layout, filter, lo, &mut r, |i, p| {
+        run(n, layout, filter, lo, &mut r, |i, _, p| {
             if let Some(v) = escaped(i) {
                 out[i] = v;
                 return to_log(v as f64, floor);
@@ -384,7 +482,9 @@ mod tests {
 
     fn decoded(q: &Encoded, layout: Layout) -> Vec<f32> {
         let mut out = vec![0.0; q.codes.len()];
-        decode(&q.codes, &q.params, layout, q.filter, &q.escapes, &mut out);
+        decode(
+            &q.codes, &q.params, layout, q.filter, &q.escapes, &q.anchors, &mut out,
+        );
         out
     }
 
@@ -403,7 +503,11 @@ mod tests {
             prop_assert!(q.escapes.is_empty());
             let k: Vec<u16> = data
                 .iter()
-                .map(|&v| (to_log(v as f64, q.params.floor) / q.params.step).round() as i64 as u16)
+                .enumerate()
+                .map(|(i, &v)| {
+                    let lo = q.anchors[i % ch];
+                    ((to_log(v as f64, q.params.floor) - lo) / q.params.step).round() as i64 as u16
+                })
                 .collect();
             let mut want = filter::forward(&k, layout, filter);
             if filter == Filter::None {
@@ -500,6 +604,7 @@ mod tests {
             Layout::FLAT,
             q.filter,
             &q.escapes,
+            &q.anchors,
             &mut out,
         );
         for (a, b) in v.iter().zip(&out) {
@@ -550,10 +655,83 @@ mod tests {
             Layout::new(1, 100, 10),
             q.filter,
             &q.escapes,
+            &q.anchors,
             &mut out,
         );
         for (a, b) in v.iter().zip(&out) {
             assert!((a - b).abs() as f64 <= 1e-3 * (*a as f64).max(q.params.floor));
         }
+    }
+}
+
+#[cfg(test)]
+mod anchor_tests {
+    use super::*;
+
+    fn round_trip(data: &[f32], layout: Layout, tol: f64) -> (Encoded, Vec<f32>) {
+        let q = encode(data, layout, tol, None, None).unwrap();
+        let mut out = vec![0.0; data.len()];
+        decode(
+            &q.codes, &q.params, layout, q.filter, &q.escapes, &q.anchors, &mut out,
+        );
+        (q, out)
+    }
+
+    /// A constant chunk per channel (a Lambert table) decodes bit for bit, without escapes, at
+    /// every tolerance, for channels up to 10^7 apart (the floor is 10^-7 of the largest value;
+    /// far below it the bound is absolute and a value may decode to 0).
+    #[test]
+    fn constant_channels_decode_exactly() {
+        for kd in [[0.1f32, 0.2, 0.3], [1e-6, 3.0e-5, 7.5], [4.0e4, 0.5, 1e-3]] {
+            let data: Vec<f32> = (0..3 * 90 * 46).map(|i| kd[i % 3]).collect();
+            for tol in [1e-3, 1e-2, 0.1] {
+                let (q, out) = round_trip(&data, Layout::new(3, 46, 90), tol);
+                assert!(q.escapes.is_empty(), "{kd:?} {tol}");
+                for (a, b) in data.iter().zip(&out) {
+                    assert_eq!(a.to_bits(), b.to_bits(), "{kd:?} tol {tol}");
+                }
+            }
+        }
+    }
+
+    /// The value a channel repeats most decodes exactly amid others (here 40 % of the values;
+    /// Misra–Gries with 4 counters finds anything above 20 %), zeros stay exactly 0, and every
+    /// other value keeps the bound.
+    #[test]
+    fn the_most_common_value_and_zero_decode_exactly() {
+        let mut rng = crate::rng::Pcg32::new(9);
+        let rec = 0.123_456_79f32;
+        let data: Vec<f32> = (0..5000)
+            .map(|_| match rng.next_u32() % 10 {
+                0..=3 => rec,
+                4 => 0.0,
+                _ => 1e-3 + rng.next_f64() as f32,
+            })
+            .collect();
+        let tol = 1e-3;
+        let (q, out) = round_trip(&data, Layout::new(1, 100, 50), tol);
+        assert_ne!(q.anchors[0], 0.0);
+        for (a, b) in data.iter().zip(&out) {
+            if *a == rec || *a == 0.0 {
+                assert_eq!(a.to_bits(), b.to_bits());
+            } else {
+                assert!(((a - b).abs() as f64) <= tol * (*a as f64), "{a} {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn most_common_counts_exactly_and_needs_a_repeat() {
+        assert_eq!(most_common(&[1.0, 2.0, 3.0], 0, 1), None);
+        assert_eq!(
+            most_common(&[1.0, 2.0, 1.0, 2.0, 1.0], 0, 1),
+            Some((1.0, 3))
+        );
+        // Channel 1 of an interleaved pair.
+        assert_eq!(
+            most_common(&[5.0, 7.0, 6.0, 7.0, 5.0, 8.0], 1, 2),
+            Some((7.0, 2))
+        );
+        assert_eq!(most_common(&[], 0, 1), None);
     }
 }

@@ -146,21 +146,25 @@ impl Default for Codec {
 
 /// Chunk magic (2 bytes), then version.
 pub const CHUNK_MAGIC: [u8; 2] = *b"BC";
-/// Chunk format version written. Version 2 forms log16 reconstructions on an integer grid
-/// (see [`log16`]); version 1 chunks (f64 reconstructions) are still read. f32 and f16 chunks
-/// mean the same in both.
-pub const CHUNK_VERSION: u8 = 2;
+/// Chunk format version written. Version 3 gives each channel of a log16 chunk its own grid
+/// origin, through the channel's most common value, so constant and recurring values decode
+/// exactly (the origins follow the escapes in the payload); version 2 forms log16
+/// reconstructions on an integer grid from 0 (see [`log16`]); version 1 chunks (f64
+/// reconstructions) are still read. f32 and f16 chunks mean the same in all three.
+pub const CHUNK_VERSION: u8 = 3;
 /// Oldest chunk format version read.
 pub const CHUNK_VERSION_MIN: u8 = 1;
 /// Length of the fixed chunk header. Layout (little-endian):
 ///
 /// ```text
 ///  0  [u8;2] "BC"         8  u64 n values        28 u32 escapes      56  zstd frame of:
-///  2  u8  version (1, 2)  16 u32 channels        32 f64 lo             byte-shuffled residuals
+///  2  u8  version (1..3) 16 u32 channels        32 f64 lo             byte-shuffled residuals
 ///  3  u8  quant 0/1/2     20 u32 inner           40 f64 step           (n words), then escape
-///  4  u8  filter 0..6     24 u32 next            48 f64 floor          indices (u32 deltas)
-///  5  u8  shuffle 0/1                            (log16 only, else 0)  and values (f32)
-///  6  u16 reserved (0)
+///  4  u8  filter 0..7     24 u32 next            48 f64 floor          indices (u32 deltas)
+///  5  u8  shuffle 1/2                            (log16 only, else 0)  and values (f32), then
+///  6  u16 reserved (0)                                                 (log16, version ≥ 3)
+///                                                                      one f64 grid origin
+///                                                                      per channel
 /// ```
 pub const CHUNK_HEADER_LEN: usize = 56;
 
@@ -246,7 +250,7 @@ pub fn encode(data: &[f32], layout: Layout, codec: &Codec) -> Result<Vec<u8>> {
             let q = log16::encode(data, layout, tolerance, floor, codec.filter)?;
             params = Some(q.params);
             escapes = q.escapes;
-            let mut tail = Vec::with_capacity(escapes.len() * 8);
+            let mut tail = Vec::with_capacity(escapes.len() * 8 + q.anchors.len() * 8);
             let mut prev = 0u32;
             for &(i, _) in &escapes {
                 tail.extend_from_slice(&(i - prev).to_le_bytes());
@@ -254,6 +258,10 @@ pub fn encode(data: &[f32], layout: Layout, codec: &Codec) -> Result<Vec<u8>> {
             }
             for &(_, v) in &escapes {
                 tail.extend_from_slice(&v.to_le_bytes());
+            }
+            debug_assert_eq!(q.anchors.len(), layout.channels.max(1));
+            for a in &q.anchors {
+                tail.extend_from_slice(&a.to_le_bytes());
             }
             let (sh, b) = pack(&q.codes, &tail, codec)?;
             (q.filter, sh, b)
@@ -507,6 +515,7 @@ fn payload(bytes: &[u8], info: &ChunkInfo) -> Result<Vec<u8>> {
     .ok_or_else(|| bad("len", 8, "size overflows"))?;
     let raw_len = Some(words_len)
         .and_then(|x| x.checked_add(info.escapes.checked_mul(8)?))
+        .and_then(|x| x.checked_add(anchor_count(info).checked_mul(8)?))
         .ok_or_else(|| bad("len", 8, "size overflows"))?;
     let frame = &bytes[CHUNK_HEADER_LEN..];
     let zerr = |e: std::io::Error| bad("payload", CHUNK_HEADER_LEN as u64, format!("zstd: {e}"));
@@ -530,6 +539,15 @@ fn payload(bytes: &[u8], info: &ChunkInfo) -> Result<Vec<u8>> {
         ));
     }
     Ok(raw)
+}
+
+/// Number of per-channel grid origins a chunk's payload ends with (log16 from version 3).
+fn anchor_count(info: &ChunkInfo) -> usize {
+    if info.quant == "log16" && info.version >= 3 {
+        info.layout.channels
+    } else {
+        0
+    }
 }
 
 /// Undoes shuffle, prediction and quantization of a decompressed payload.
@@ -561,7 +579,21 @@ fn finish(info: &ChunkInfo, raw: &[u8], out: &mut [f32]) -> Result<()> {
                 let p = info.log16.expect("log16 params validated");
                 let e = info.escapes;
                 let idx = &raw[words_len..words_len + 4 * e];
-                let val = &raw[words_len + 4 * e..];
+                let val = &raw[words_len + 4 * e..words_len + 8 * e];
+                let anchors: Vec<f64> = raw[words_len + 8 * e..]
+                    .chunks_exact(8)
+                    .map(|b| f64::from_le_bytes(b.try_into().unwrap_or([0; 8])))
+                    .collect();
+                if let Some(a) = anchors
+                    .iter()
+                    .find(|a| !(a.is_finite() && a.abs() <= p.step))
+                {
+                    return Err(bad(
+                        "anchors",
+                        CHUNK_HEADER_LEN as u64,
+                        format!("log16 grid origin {a} is not within one step of 0"),
+                    ));
+                }
                 let mut esc = Vec::with_capacity(e);
                 let mut pos = 0u64;
                 for k in 0..e {
@@ -579,7 +611,7 @@ fn finish(info: &ChunkInfo, raw: &[u8], out: &mut [f32]) -> Result<()> {
                     }
                     esc.push((pos as u32, v));
                 }
-                log16::decode(&w, &p, info.layout, info.filter, &esc, out);
+                log16::decode(&w, &p, info.layout, info.filter, &esc, &anchors, out);
             }
         }
     }

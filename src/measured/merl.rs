@@ -27,9 +27,27 @@
 //! Negative stored values (the database uses −1) mark cells that were never measured (mostly at
 //! grazing θd). [`MerlBrdf`] keeps them as stored — writing a file back is bit-exact — exposes
 //! them through [`MerlBrdf::is_valid`], and evaluates them as 0, as the reference reader's clamp
-//! does. Consequence for interpolating consumers (a table with `--interp linear`): a valid cell
-//! next to an invalid one is blended towards 0 over the half cell between them, so the measured
-//! data near the unmeasured region are darkened slightly. Nearest lookup is unaffected.
+//! does.
+//!
+//! A table of the file on [`Grid::merl`](crate::table::Grid::merl) ([`MerlBrdf::to_table`], or
+//! a bake on that grid, which copies the cells through [`Brdf::stored_node`]) keeps them too, as
+//! negative values (−1 × scale), so MERL → table → MERL gives the file back (to f32 precision,
+//! and within the codec's bound for lossy codecs, which keep the sign). Lookups in such a table
+//! see them as 0 ([`TabulatedBrdf`](crate::table::TabulatedBrdf)): a *nearest* lookup gives the
+//! reader's value (unmeasured → 0); a *linear* lookup next to an unmeasured cell blends towards
+//! 0 over the half cell between the two centres, so measured values bordering the unmeasured
+//! region are darkened slightly and nothing is extrapolated into it.
+//!
+//! # Below the horizon
+//!
+//! Many cells — most at large θh and small θd — have a centre whose direction pair dips below
+//! the horizon (e.g. θh index 83, θd 15, φd 145), though directions above it still fall in them.
+//! Such cells are measured data like any other: MERL → MERL and the tables above keep them, and
+//! a linear lookup above the horizon interpolates them with their neighbours. `eval` of either
+//! a file or a table is 0 when a direction itself is below the horizon. Only a source that is
+//! *not* on the MERL grid (an analytic model, an RGL file, a table on another grid) is resampled
+//! by directions, and there a cell whose centre is below the horizon has no value and is written
+//! as −1, as the database does.
 //!
 //! # Identification
 //!
@@ -95,6 +113,33 @@ pub fn phi_d_index(phi_d: f64) -> usize {
 #[inline]
 pub fn sample_index(ith: usize, itd: usize, ipd: usize) -> usize {
     ipd + RES_PHI_D * itd + RES_PHI_D * RES_THETA_D * ith
+}
+
+/// The cell whose centre is at `hd` (to within 1e-6 of a cell in index space on every axis;
+/// φh is ignored, φd is taken modulo π as the reader does), or `None` when `hd` is no cell
+/// centre. The inverse of [`cell_center`].
+pub fn cell_at_center(hd: HalfDiff) -> Option<(usize, usize, usize)> {
+    const EPS: f64 = 1e-6;
+    let node = |x: f64, n: usize| -> Option<usize> {
+        let s = x - 0.5;
+        let i = s.round();
+        ((s - i).abs() <= EPS && i >= 0.0 && i < n as f64).then_some(i as usize)
+    };
+    let pd = if hd.phi_d < 0.0 {
+        hd.phi_d + PI
+    } else if hd.phi_d >= PI {
+        hd.phi_d - PI
+    } else {
+        hd.phi_d
+    };
+    Some((
+        node(
+            (hd.theta_h.max(0.0) / FRAC_PI_2).sqrt() * RES_THETA_H as f64,
+            RES_THETA_H,
+        )?,
+        node(hd.theta_d / FRAC_PI_2 * RES_THETA_D as f64, RES_THETA_D)?,
+        node(pd / PI * RES_PHI_D as f64, RES_PHI_D)?,
+    ))
 }
 
 /// The half/difference angles at the centre of cell (ith, itd, ipd) (φh = 0).
@@ -256,12 +301,19 @@ impl MerlBrdf {
         })
     }
 
-    /// Resamples any BRDF at the cell centres of the MERL grid (RGB channels: `eval`; other
-    /// channel sets: [`Brdf::eval_wavelength`] at the representative RGB wavelengths) and stores
-    /// f_r / scale. Cells whose centre puts a direction below the horizon are stored as −1
+    /// Resamples any BRDF at the cell centres of the MERL grid and stores f_r / scale.
+    ///
+    /// A source that stores a value at the cell centre ([`Brdf::stored_node`]: a MERL
+    /// measurement, a `halfdiff` table on the MERL grid) gives it as stored, so MERL → MERL and
+    /// MERL → table → MERL keep every cell — to f32 precision, the precision of
+    /// [`Brdf::stored_node`] — and every unmeasured cell: a negative stored value is written as
+    /// the database's −1. Any other source is evaluated at the cell centre (RGB channels: `eval`;
+    /// other channel sets: [`Brdf::eval_wavelength`] at the representative RGB wavelengths);
+    /// there cells whose centre puts a direction below the horizon are stored as −1
     /// (unmeasured), as in the database. Runs in parallel.
     pub fn from_brdf(brdf: &dyn Brdf) -> Self {
         let rgb = *brdf.channels() == Channels::Rgb;
+        let stored = brdf.channels().len() == 3;
         let plane = RES_THETA_D * RES_PHI_D;
         let mut cells = vec![[0.0f64; 3]; SAMPLES];
         cells
@@ -270,14 +322,27 @@ impl MerlBrdf {
             .for_each(|(ith, chunk)| {
                 for itd in 0..RES_THETA_D {
                     for ipd in 0..RES_PHI_D {
-                        let (wi, wo) = geometry::from_half_diff(cell_center(ith, itd, ipd));
+                        let hd = cell_center(ith, itd, ipd);
                         let cell = &mut chunk[ipd + RES_PHI_D * itd];
+                        let mut f = [0.0f32; 3];
+                        if stored && brdf.stored_node(hd, &mut f) {
+                            for c in 0..3 {
+                                cell[c] = if f[c] < 0.0 {
+                                    -1.0
+                                } else if f[c].is_finite() {
+                                    f[c] as f64 / SCALE[c]
+                                } else {
+                                    0.0
+                                };
+                            }
+                            continue;
+                        }
+                        let (wi, wo) = geometry::from_half_diff(hd);
                         if wi.z <= 0.0 || wo.z <= 0.0 {
                             // Below the horizon: no value, marked as the database does.
                             *cell = [-1.0; 3];
                             continue;
                         }
-                        let mut f = [0.0f32; 3];
                         if rgb {
                             brdf.eval(wi, wo, &mut f);
                         } else {
@@ -347,6 +412,18 @@ impl MerlBrdf {
             .count()
     }
 
+    /// The stored value of cell (ith, itd, ipd) scaled to f_r per channel, as f32, unmeasured
+    /// cells negative (−1 × scale).
+    #[inline]
+    pub fn stored_cell(&self, ith: usize, itd: usize, ipd: usize) -> [f32; 3] {
+        let k = sample_index(ith, itd, ipd);
+        let mut f = [0.0f32; 3];
+        for (c, v) in f.iter_mut().enumerate() {
+            *v = (self.data[c * SAMPLES + k] * SCALE[c]) as f32;
+        }
+        f
+    }
+
     /// f_r of cell (ith, itd, ipd): scaled, invalid (negative) clamped to 0.
     #[inline]
     pub fn cell(&self, ith: usize, itd: usize, ipd: usize) -> [f32; 3] {
@@ -365,16 +442,18 @@ impl MerlBrdf {
 
 impl MerlBrdf {
     /// The measurement as a dense table on [`Grid::merl`](crate::table::Grid::merl): stored
-    /// node (θh i, φh 0, θd j, φd k) holds cell (i, j, k) scaled to f_r, unmeasured cells as 0.
+    /// node (θh i, φh 0, θd j, φd k) holds cell (i, j, k) scaled to f_r as f32, unmeasured cells
+    /// negative (−1 × scale, [`MerlBrdf::stored_cell`]), so the table keeps which cells were
+    /// measured and converts back to the same MERL file.
     ///
     /// The grid's nodes use [`Nodes::CellStart`](crate::table::Nodes::CellStart), so a *nearest*
-    /// lookup takes the same indices as [`MerlBrdf::eval`] (value for value); a *linear* lookup
-    /// interpolates between cells and, next to an unmeasured cell, towards 0 (see the module
-    /// docs).
+    /// lookup takes the same indices as [`MerlBrdf::eval`] (value for value, unmeasured as 0); a
+    /// *linear* lookup interpolates between cells and, next to an unmeasured cell, towards 0
+    /// (see the module docs).
     pub fn to_table(&self) -> crate::table::Table {
         let grid = crate::table::Grid::merl(Channels::Rgb);
         crate::table::Table::from_fn(grid, self.describe(), |idx, _, out| {
-            out.copy_from_slice(&self.cell(idx[0], idx[2], idx[3]));
+            out.copy_from_slice(&self.stored_cell(idx[0], idx[2], idx[3]));
         })
     }
 }
@@ -418,5 +497,16 @@ impl Brdf for MerlBrdf {
 
     fn describe(&self) -> String {
         format!("MERL measured BRDF ({})", self.name)
+    }
+
+    /// The stored cell whose centre is `hd` ([`cell_at_center`]), unmeasured cells negative.
+    fn stored_node(&self, hd: HalfDiff, out: &mut [f32]) -> bool {
+        match cell_at_center(hd) {
+            Some((ith, itd, ipd)) if out.len() >= 3 => {
+                out[..3].copy_from_slice(&self.stored_cell(ith, itd, ipd));
+                true
+            }
+            _ => false,
+        }
     }
 }

@@ -8,6 +8,8 @@
 //! - [`merl`]: MERL `.binary` files, read (the reference reader's nearest lookup, a validity
 //!   mask for unmeasured cells), written (bit-exact, or any `Brdf` resampled on the MERL grid)
 //!   and turned into a table on [`Grid::merl`](crate::table::Grid::merl) ([`MerlBrdf`]);
+//! - [`data`]: where the measured files the project ships (`data/rgl`, `data/merl`) and any
+//!   extra copies are found;
 //! - [`merl_manifest`]: the SHA-256 of the 100 published MERL files, to name a file a user
 //!   brings.
 //!

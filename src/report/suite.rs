@@ -127,6 +127,15 @@ pub fn lecture_sources() -> Vec<SourceDef> {
             ));
         }
     }
+    for x in ["mean", "product", "sqrt"] {
+        for n in [10, 100, 1000] {
+            let ks = 0.5 * (n as f64 + 2.0) / (2.0 * PI);
+            v.push((
+                format!("pumped_phong_{x}_n{n}"),
+                format!(r#"{{"model": "pumped_phong", "ks": {ks}, "n": {n}, "x": "{x}"}}"#),
+            ));
+        }
+    }
     for m in ["0.1", "0.3", "0.5"] {
         v.push((
             format!("cook_torrance_m{m}"),
@@ -273,20 +282,34 @@ impl SuiteConfig {
         })
     }
 
-    /// The quick suite (under a minute on 2 cores): Lambert, reciprocal Phong n = 100,
-    /// Cook-Torrance m = 0.3 (gold), GGX α = 0.3, Ward, and the first RGL file; the small preset;
-    /// 20 000 pairs; 3 albedo angles; 24×24 renders at 4 spp.
+    /// The quick suite (about a minute on 2 cores): Lambert, the lecture's Phong family at
+    /// n = 100 — the original Phong (`phong`), the reciprocal (`reciprocal_phong_n100`), the max
+    /// (`max_phong`) and the pumped-up Phong with X = mean, product and sqrt
+    /// (`pumped_phong_mean`, `pumped_phong_product`, `pumped_phong_sqrt`) —, Cook-Torrance
+    /// m = 0.3 (gold), GGX α = 0.3, Ward, and the first RGL file; the small preset; 20 000
+    /// pairs; 3 albedo angles; 24×24 renders at 4 spp.
     pub fn quick(rgl_dir: Option<&Path>) -> Result<SuiteConfig> {
+        // (name in the full suite, name in the quick one: the model's name where only one
+        // variant of it runs).
         let keep = [
-            "lambert",
-            "reciprocal_phong_n100",
-            "cook_torrance_m0.3",
-            "ggx_a0.3",
-            "ward_aniso",
+            ("lambert", "lambert"),
+            ("phong_n100", "phong"),
+            ("reciprocal_phong_n100", "reciprocal_phong_n100"),
+            ("max_phong_n100", "max_phong"),
+            ("pumped_phong_mean_n100", "pumped_phong_mean"),
+            ("pumped_phong_product_n100", "pumped_phong_product"),
+            ("pumped_phong_sqrt_n100", "pumped_phong_sqrt"),
+            ("cook_torrance_m0.3", "cook_torrance_m0.3"),
+            ("ggx_a0.3", "ggx_a0.3"),
+            ("ward_aniso", "ward_aniso"),
         ];
         let mut sources: Vec<SourceDef> = lecture_sources()
             .into_iter()
-            .filter(|s| keep.contains(&s.name.as_str()))
+            .filter_map(|mut s| {
+                let (_, quick) = keep.iter().find(|(full, _)| *full == s.name)?;
+                s.name = (*quick).to_owned();
+                Some(s)
+            })
             .collect();
         if let Some(d) = rgl_dir {
             sources.extend(rgl_sources(d)?.into_iter().take(1));

@@ -10,7 +10,10 @@
 //! Before a reduced grid is baked its symmetries are verified on the source
 //! ([`symmetry::verify`]); a violation is an error unless [`BakeOptions::force`] is set.
 //!
-//! A node's value is f at the node's representative pair ([`pair_of`](super::pair_of)); with
+//! A node's value is f at the node's representative pair ([`pair_of`](super::pair_of)) — or, on
+//! a `halfdiff` grid whose nodes the source itself stores ([`Brdf::stored_node`]: a MERL file
+//! on [`Grid::merl`], a table on its own grid), the stored value verbatim, including cells whose
+//! centre lies below the horizon and negative markers of unmeasured cells; with
 //! `supersample = k > 1` it is the mean of k^d stratified, jittered samples over the node's cell
 //! (d = stored angular axes of size > 1, cell = ±½ node spacing, [i, i+1) for
 //! [`Nodes::CellStart`](super::Nodes)) — a box prefilter for lobes narrower than a cell.
@@ -20,9 +23,10 @@ use std::time::Instant;
 
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
+use crate::geometry::HalfDiff;
 use crate::rng::Pcg32;
 use crate::spectrum::MAX_CHANNELS;
-use crate::table::grid::{Grid, Nodes, StoredAxis};
+use crate::table::grid::{Grid, Nodes, Param, StoredAxis};
 use crate::table::symmetry::{self, Symmetry};
 use crate::table::{Table, pair_of};
 
@@ -114,6 +118,12 @@ pub fn bake_chunks(
     let s3 = layout.shape[3];
     let row_len = s3 * c;
     let axes = *grid.stored_axes();
+    // A source that stores this grid's first node stores them all (it is on the same grid):
+    // its nodes are copied, not evaluated. Asked once, so other sources pay nothing.
+    let native = grid.param() == Param::HalfDiff
+        && opts.supersample <= 1
+        && layout.len() > 0
+        && brdf.stored_node(half_diff(grid.node_angles([0; 4])), &mut vec![0.0; c]);
     let budget = (opts.memory_budget / 4).max(1);
     let mut buf: Vec<f32> = Vec::new();
     let mut a = 0;
@@ -146,7 +156,16 @@ pub fn bake_chunks(
                     let (p, b) = layout.row_node(chunk, gr - row_starts[k]);
                     for q in 0..s3 {
                         let out = &mut row[q * c..(q + 1) * c];
-                        eval_node(brdf, grid, &axes, [chunk, p, b, q], opts.supersample, out);
+                        let idx = [chunk, p, b, q];
+                        if native && brdf.stored_node(half_diff(grid.node_angles(idx)), out) {
+                            for v in out.iter_mut() {
+                                if !v.is_finite() {
+                                    *v = 0.0;
+                                }
+                            }
+                            continue;
+                        }
+                        eval_node(brdf, grid, &axes, idx, opts.supersample, out);
                     }
                 });
         }
@@ -178,6 +197,16 @@ pub fn bake(brdf: &dyn Brdf, grid: &Grid, opts: &BakeOptions) -> Result<(Table, 
         Ok(())
     })?;
     Ok((Table::new(grid.clone(), values, brdf.describe())?, report))
+}
+
+/// Stored `halfdiff` coordinates as [`HalfDiff`] angles.
+fn half_diff(c: [f64; 4]) -> HalfDiff {
+    HalfDiff {
+        theta_h: c[0],
+        phi_h: c[1],
+        theta_d: c[2],
+        phi_d: c[3],
+    }
 }
 
 /// The value of one stored node (all channels) into `out`.

@@ -20,11 +20,9 @@ const CASES: usize = 15;
 /// Samples per chi-square case.
 const SAMPLES: usize = 1_000_000;
 
-fn rgl_path(name: &str) -> String {
-    format!(
-        "{}/../shared/data/measured/rgl/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    )
+/// The shipped RGL file `name` (`data/rgl`); a missing file fails the test loudly.
+fn rgl_path(name: &str) -> std::path::PathBuf {
+    crate::measured::data::rgl_file(name).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// A small isotropic `halfdiff` table (32 θh (sqrt) × 32 θd × 64 φd, folded by `sym`).

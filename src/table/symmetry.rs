@@ -259,7 +259,7 @@ fn coords<const FAST: bool>(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -
             }
         }
         Param::HalfDiff => {
-            let (th, td, mut pd, h) = if FAST {
+            let (th, td, pd, h) = if FAST {
                 half_diff_angles_fast(wi, wo)?
             } else {
                 let (h, d) = geometry::half_diff_vectors(wi, wo)?;
@@ -270,34 +270,67 @@ fn coords<const FAST: bool>(param: Param, sym: Symmetry, wi: DVec3, wo: DVec3) -
                     h,
                 )
             };
-            let mut ph = 0.0;
-            if !sym.isotropic {
-                ph = atan2::<FAST>(h.y, h.x);
-                if sym.bilateral && ph < 0.0 {
-                    ph = -ph;
-                    pd = -pd;
-                }
-                if ph < 0.0 {
-                    ph += TAU;
-                }
-            }
-            let iso_bilat = sym.isotropic && sym.bilateral;
-            if sym.reciprocal && iso_bilat {
-                let a = pd.abs();
-                pd = a.min(PI - a);
-            } else if sym.reciprocal {
-                // As the MERL reader: φd + π when negative.
-                if pd < 0.0 {
-                    pd += PI;
-                }
-            } else if iso_bilat {
-                pd = pd.abs();
-            } else if pd < 0.0 {
-                pd += TAU;
-            }
-            Some([th, ph, td, pd])
+            let ph = if sym.isotropic {
+                0.0
+            } else {
+                atan2::<FAST>(h.y, h.x)
+            };
+            Some(fold_half_diff(sym, th, ph, td, pd))
         }
     }
+}
+
+/// The symmetry folds of `halfdiff` coordinates: (θh, φh, θd, φd) with φh, φd in [−π, π] (φh
+/// ignored for isotropic grids) to the stored domains.
+#[inline(always)]
+fn fold_half_diff(sym: Symmetry, th: f64, mut ph: f64, td: f64, mut pd: f64) -> [f64; 4] {
+    if sym.isotropic {
+        ph = 0.0;
+    } else {
+        if sym.bilateral && ph < 0.0 {
+            ph = -ph;
+            pd = -pd;
+        }
+        if ph < 0.0 {
+            ph += TAU;
+        }
+    }
+    let iso_bilat = sym.isotropic && sym.bilateral;
+    if sym.reciprocal && iso_bilat {
+        let a = pd.abs();
+        pd = a.min(PI - a);
+    } else if sym.reciprocal {
+        // As the MERL reader: φd + π when negative.
+        if pd < 0.0 {
+            pd += PI;
+        }
+    } else if iso_bilat {
+        pd = pd.abs();
+    } else if pd < 0.0 {
+        pd += TAU;
+    }
+    [th, ph, td, pd]
+}
+
+/// Canonical stored `halfdiff` coordinates of Rusinkiewicz angles under `sym`: the folds of
+/// [`canonical_coords`] applied to angles directly, without going through directions (so a pair
+/// with a direction below the horizon still has coordinates). Azimuths may be given in any
+/// period; they are first brought to (−π, π].
+pub fn canonical_half_diff(sym: Symmetry, hd: geometry::HalfDiff) -> [f64; 4] {
+    let wrap = |a: f64| {
+        let a = a.rem_euclid(TAU);
+        if a > PI { a - TAU } else { a }
+    };
+    let [th, ph, td, pd] =
+        fold_half_diff(sym, hd.theta_h, wrap(hd.phi_h), hd.theta_d, wrap(hd.phi_d));
+    // φd = π folds to π under reciprocity alone (the reader's φd + π applies to negative φd
+    // only); it is the same direction pair as φd = 0.
+    let pd = if sym.reciprocal && !(sym.isotropic && sym.bilateral) && pd >= PI {
+        pd - PI
+    } else {
+        pd
+    };
+    [th, ph, td, pd]
 }
 
 /// (θh, θd, φd, h) of a pair of unit directions with the unnormalized half vector

@@ -11,6 +11,17 @@
 //! (so a lookup whose corners all lie in a failed chunk writes 0), and the first error is kept:
 //! check [`TabulatedBrdf::load_error`] after a batch, or call [`TabulatedBrdf::load_all`]
 //! up front to get a proper `Result`. Failed chunks are not retried.
+//!
+//! **Negative stored values** mark unmeasured data (a MERL file's −1 cells, kept by
+//! [`MerlBrdf::to_table`](crate::measured::MerlBrdf::to_table) and by bakes of such a file on
+//! its own grid). A BRDF is never negative, so when a chunk is loaded they are set aside and
+//! the lookup sees 0 there: a *nearest* lookup of an unmeasured cell gives 0, and a *linear*
+//! lookup next to one blends towards 0 over the half cell between the nodes (measured values
+//! near the unmeasured region are darkened, none is made up). The set-aside values stay with
+//! the table: [`Brdf::stored_node`] and [`TabulatedBrdf::to_table`] give them back, so a table
+//! converts back to the MERL file it came from. Below the horizon `eval` is 0 as for every
+//! `Brdf`; a node whose centre pair has a direction below the horizon still holds its stored
+//! value and is interpolated with its neighbours for pairs above it.
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -18,9 +29,10 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::brdf::{Brdf, BrdfSample, Flags};
 use crate::error::{Error, Result};
+use crate::geometry::HalfDiff;
 use crate::spectrum::Channels;
 use crate::table::Table;
-use crate::table::grid::Grid;
+use crate::table::grid::{Grid, Param};
 use crate::table::lookup::{Interp, Lookup, Prepared};
 use crate::table::sampling::{SamplingResolution, TableSampler};
 
@@ -50,6 +62,9 @@ pub struct TabulatedBrdf {
     grid: Grid,
     lookup: Lookup,
     chunks: Box<[OnceLock<Arc<[f32]>>]>,
+    /// Per chunk, the negative stored values (offset in the chunk, value) that `chunks` holds as
+    /// 0; set when the chunk is loaded (see the module docs).
+    unmeasured: Box<[OnceLock<Box<[(u32, f32)]>>]>,
     loader: Option<Box<dyn ChunkLoader>>,
     interp: Interp,
     description: String,
@@ -71,15 +86,21 @@ impl std::fmt::Debug for TabulatedBrdf {
 impl TabulatedBrdf {
     /// A tabulated BRDF over an in-memory table (every chunk present), linear interpolation.
     pub fn from_table(table: Table) -> TabulatedBrdf {
-        let (grid, values, description) = table.into_parts();
+        let (grid, mut values, description) = table.into_parts();
         let l = grid.layout();
+        let mut unmeasured = Vec::with_capacity(l.chunk_count());
         let chunks: Box<[OnceLock<Arc<[f32]>>]> = (0..l.chunk_count())
-            .map(|i| OnceLock::from(Arc::<[f32]>::from(&values[l.chunk_range(i)])))
+            .map(|i| {
+                let v = &mut values[l.chunk_range(i)];
+                unmeasured.push(OnceLock::from(set_aside_negatives(v)));
+                OnceLock::from(Arc::<[f32]>::from(&*v))
+            })
             .collect();
         TabulatedBrdf {
             lookup: Lookup::new(&grid),
             grid,
             chunks,
+            unmeasured: unmeasured.into(),
             loader: None,
             interp: Interp::Linear,
             description,
@@ -97,10 +118,14 @@ impl TabulatedBrdf {
         let chunks = (0..grid.layout().chunk_count())
             .map(|_| OnceLock::new())
             .collect();
+        let unmeasured = (0..grid.layout().chunk_count())
+            .map(|_| OnceLock::new())
+            .collect();
         TabulatedBrdf {
             lookup: Lookup::new(&grid),
             grid,
             chunks,
+            unmeasured,
             loader: Some(loader),
             interp: Interp::Linear,
             description: description.into(),
@@ -200,12 +225,16 @@ impl TabulatedBrdf {
         self.chunks.iter().filter(|c| c.get().is_some()).count()
     }
 
-    /// The whole table in memory (loads every chunk).
+    /// The whole table in memory as stored (loads every chunk; negative values included).
     pub fn to_table(&self) -> Result<Table> {
         self.load_all()?;
         let mut v = Vec::with_capacity(self.grid.stored_values());
         for i in 0..self.chunks.len() {
+            let start = v.len();
             v.extend_from_slice(self.chunk(i));
+            for &(k, x) in self.unmeasured_of(i) {
+                v[start + k as usize] = x;
+            }
         }
         Table::new(self.grid.clone(), v, self.description.clone())
     }
@@ -221,6 +250,14 @@ impl TabulatedBrdf {
         }
     }
 
+    /// The negative values chunk `a` holds as 0 (empty until it is loaded).
+    fn unmeasured_of(&self, a: usize) -> &[(u32, f32)] {
+        self.unmeasured
+            .get(a)
+            .and_then(|u| u.get())
+            .map_or(&[], |u| u)
+    }
+
     #[cold]
     fn load_chunk(&self, a: usize) -> &[f32] {
         self.chunks[a].get_or_init(|| {
@@ -230,7 +267,10 @@ impl TabulatedBrdf {
                 None => Err(Error::NotFound(format!("chunk {a}: no loader"))),
             };
             match r {
-                Ok(v) if v.len() == want => v.into(),
+                Ok(mut v) if v.len() == want => {
+                    let _ = self.unmeasured[a].set(set_aside_negatives(&mut v));
+                    v.into()
+                }
                 Ok(v) => {
                     self.record(format!(
                         "chunk {a}: {} values loaded, {want} expected",
@@ -244,6 +284,29 @@ impl TabulatedBrdf {
                 }
             }
         })
+    }
+
+    /// The node of stored coordinates `x` when `x` is one (to 1e-6 of a node spacing on every
+    /// axis of size > 1).
+    fn node_at(&self, x: [f64; 4]) -> Option<[usize; 4]> {
+        let mut idx = [0usize; 4];
+        for (d, ax) in self.grid.stored_axes().iter().enumerate() {
+            if ax.size <= 1 {
+                continue;
+            }
+            let s = ax.continuous(x[d]);
+            let i = s.round();
+            if !((s - i).abs() <= 1e-6) {
+                return None;
+            }
+            let n = ax.size as f64;
+            let i = if ax.periodic { i.rem_euclid(n) } else { i };
+            if !(0.0..n).contains(&i) {
+                return None;
+            }
+            idx[d] = i as usize;
+        }
+        Some(idx)
     }
 
     fn record(&self, msg: String) {
@@ -294,6 +357,31 @@ impl Brdf for TabulatedBrdf {
         self.sampler().pdf(wi, wo)
     }
 
+    /// The node at `hd` as stored, negative (unmeasured) values included, on `halfdiff` grids.
+    fn stored_node(&self, hd: HalfDiff, out: &mut [f32]) -> bool {
+        let c = self.lookup.channels();
+        if self.grid.param() != Param::HalfDiff || out.len() < c {
+            return false;
+        }
+        let x = crate::table::symmetry::canonical_half_diff(self.grid.symmetry(), hd);
+        let Some(idx) = self.node_at(x) else {
+            return false;
+        };
+        let Some(off) = self.grid.layout().offset_in_chunk(idx) else {
+            return false;
+        };
+        let Some(v) = self.chunk(idx[0]).get(off..off + c) else {
+            return false;
+        };
+        out[..c].copy_from_slice(v);
+        let neg = self.unmeasured_of(idx[0]);
+        let first = neg.partition_point(|e| (e.0 as usize) < off);
+        for &(k, x) in neg[first..].iter().take_while(|e| (e.0 as usize) < off + c) {
+            out[k as usize - off] = x;
+        }
+        true
+    }
+
     /// Parallel (rayon) above 16384 pairs, sequential below.
     fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
         let c = self.lookup.channels();
@@ -311,4 +399,16 @@ impl Brdf for TabulatedBrdf {
             self.eval_block(wi, wo, &mut out[..n * c]);
         }
     }
+}
+
+/// Replaces the negative values of `v` by 0 and returns them (offset, value), in order.
+fn set_aside_negatives(v: &mut [f32]) -> Box<[(u32, f32)]> {
+    let mut out = Vec::new();
+    for (k, x) in v.iter_mut().enumerate() {
+        if *x < 0.0 {
+            out.push((k as u32, *x));
+            *x = 0.0;
+        }
+    }
+    out.into()
 }

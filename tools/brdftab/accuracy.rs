@@ -15,11 +15,11 @@ pub struct AccuracyArgs {
     /// Output directory (accuracy.csv, accuracy.md, rd_<source>.png).
     #[arg(long)]
     out: PathBuf,
-    /// The quick suite: 6 sources, small preset, fewer pairs, tiny renders (< 1 min).
+    /// The quick suite: 11 sources, small preset, fewer pairs, tiny renders (about 1 min).
     #[arg(long)]
     quick: bool,
-    /// Directory of RGL `.bsdf` files (default: $BRDFTAB_RGL_DIR, else
-    /// ../shared/data/measured/rgl if present; none → models only).
+    /// Directory of RGL `.bsdf` files (default: $BRDFTAB_RGL_DIR, else the shipped data/rgl,
+    /// else ../shared/data/measured/rgl; none → models only).
     #[arg(long)]
     rgl: Option<PathBuf>,
     /// Grid presets, comma separated (default: small for --quick, else small,medium,large).
@@ -55,7 +55,7 @@ pub fn accuracy(a: AccuracyArgs) -> Result<()> {
         }
     } else {
         eprintln!(
-            "note: no RGL directory (--rgl DIR, $BRDFTAB_RGL_DIR or ../shared/data/measured/rgl): analytic models only"
+            "note: no RGL directory (--rgl DIR, $BRDFTAB_RGL_DIR, data/rgl or ../shared/data/measured/rgl): analytic models only"
         );
     }
     let mut cfg = if a.quick {

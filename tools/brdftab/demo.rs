@@ -38,8 +38,8 @@ pub struct DemoArgs {
     /// small for anisotropic models).
     #[arg(long)]
     preset: Option<String>,
-    /// Directory of RGL-EPFL `.bsdf` files (default: $BRDFTAB_RGL_DIR, else
-    /// ../shared/data/measured/rgl next to the working directory or the crate).
+    /// Directory of RGL-EPFL `.bsdf` files (default: $BRDFTAB_RGL_DIR, else the shipped
+    /// data/rgl, else ../shared/data/measured/rgl).
     #[arg(long)]
     rgl: Option<PathBuf>,
     /// Skip the preview renders and the rate–distortion sweep.

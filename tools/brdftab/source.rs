@@ -34,9 +34,12 @@ pub fn open_with(
     brdftab::open_with(source, &opts)
 }
 
-/// The directory of RGL files for `demo` and `accuracy`: `--rgl DIR`, else the library's search
-/// ([`brdftab::measured::data::rgl_dir`]).
+/// The directory of RGL `.bsdf` files used by `demo` and `accuracy`: `--rgl DIR`, else the
+/// library's search ([`brdftab::measured::data::rgl_dir`]: `$BRDFTAB_RGL_DIR`, the shipped
+/// `data/rgl`, `../shared/data/measured/rgl`); `None` when none exists.
 pub fn rgl_dir(arg: Option<&std::path::Path>) -> Option<std::path::PathBuf> {
-    arg.map(std::path::Path::to_path_buf)
-        .or_else(brdftab::measured::data::rgl_dir)
+    match arg {
+        Some(p) => Some(p.to_path_buf()),
+        None => brdftab::measured::data::rgl_dir(),
+    }
 }

@@ -1,0 +1,76 @@
+//! A table of a constant BRDF is constant: `brdftab bake` with every default (medium preset,
+//! log16 at 1e-3) of a Lambert BRDF evaluates to kd — the codec stores constant chunks exactly
+//! (chunk version 3 anchors each channel's log16 grid at its most common value).
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+use brdftab::geometry::uniform_hemisphere;
+use brdftab::rng::Pcg32;
+
+#[test]
+fn default_lambert_table_evaluates_to_kd() {
+    let dir = std::env::temp_dir().join(format!("brdftab-constant-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let table = dir.join("lam.btdb");
+    let kd = [0.1f64, 0.2, 0.3];
+    let spec = r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#;
+    let o = Command::new(env!("CARGO_BIN_EXE_brdftab"))
+        .args(["bake", spec, "-o"])
+        .arg(&table)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("log16"),
+        "the default codec is log16: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+
+    // Random pairs over both hemispheres' interiors, plus near-normal and near-grazing ones.
+    let mut rng = Pcg32::new(12);
+    let mut pairs = String::new();
+    for _ in 0..5000 {
+        let (wi, wo) = (
+            uniform_hemisphere(rng.next_dvec2()),
+            uniform_hemisphere(rng.next_dvec2()),
+        );
+        if wi.z > 1e-6 && wo.z > 1e-6 {
+            pairs += &format!("{} {} {} {} {} {}\n", wi.x, wi.y, wi.z, wo.x, wo.y, wo.z);
+        }
+    }
+    pairs += "0 0 1 0 0 1\n0.9999 0 0.0141 -0.9999 0 0.0141\n";
+    let mut child = Command::new(env!("CARGO_BIN_EXE_brdftab"))
+        .arg("eval")
+        .arg(&table)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Feed stdin from a thread: the output would fill its pipe before the input is written.
+    let mut stdin = child.stdin.take().unwrap();
+    let input = pairs.clone();
+    let feeder = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
+    let o = child.wait_with_output().unwrap();
+    feeder.join().unwrap().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8(o.stdout).unwrap();
+    let mut n = 0;
+    for line in out.lines() {
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(|t| t.parse().unwrap())
+            .collect();
+        assert_eq!(v.len(), 3, "{line}");
+        for c in 0..3 {
+            // kd is stored as f32 (relative rounding ≤ 2^-24) and interpolated with weights
+            // that sum to 1 in f32 (a few more roundings): 1e-6 is ten times that.
+            let rel = (v[c] - kd[c]).abs() / kd[c];
+            assert!(rel <= 1e-6, "channel {c}: {} vs {} ({rel:e})", v[c], kd[c]);
+        }
+        n += 1;
+    }
+    assert_eq!(n, pairs.lines().count());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,233 @@
+//! MERL → MERL, MERL baked on the MERL grid, and MERL → table → MERL keep every measured cell
+//! (to f32, the precision a table stores) and every unmeasured (−1) cell.
+//!
+//! The file is the one of issue 12: a random positive value in every cell, the −1 sentinel only
+//! where the θh index is ≥ 80 and the θd index ≥ 85. Many measured cells there have a centre
+//! pair with a direction below the horizon (e.g. θh 83, θd 15, φd 145), which resampling at
+//! directions cannot reach.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use brdftab::measured::MerlBrdf;
+use brdftab::measured::merl::{self, RES_PHI_D, RES_THETA_D, RES_THETA_H, SAMPLES, SCALE};
+use brdftab::rng::Pcg32;
+use brdftab::store::Store;
+
+fn tmpdir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("brdftab-merlrt-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn unmeasured(ith: usize, itd: usize) -> bool {
+    ith >= 80 && itd >= 85
+}
+
+/// The issue's file, written to `path`; returns its raw values.
+fn issue_file(path: &Path) -> Vec<f64> {
+    let mut rng = Pcg32::new(2012);
+    let mut data = vec![0.0f64; 3 * SAMPLES];
+    for ith in 0..RES_THETA_H {
+        for itd in 0..RES_THETA_D {
+            for ipd in 0..RES_PHI_D {
+                let k = merl::sample_index(ith, itd, ipd);
+                for c in 0..3 {
+                    data[c * SAMPLES + k] = if unmeasured(ith, itd) {
+                        -1.0
+                    } else {
+                        // [1, 3000): positive, with bits a f32 cannot all hold, and far
+                        // above log16's floor (1e-7 of a chunk's largest value), where its
+                        // bound is relative.
+                        1.0 + 2999.0 * rng.next_f64()
+                    };
+                }
+            }
+        }
+    }
+    MerlBrdf::from_raw("issue 12", data.clone())
+        .unwrap()
+        .write(path)
+        .unwrap();
+    data
+}
+
+fn brdftab(args: &[&str]) {
+    let o = Command::new(env!("CARGO_BIN_EXE_brdftab"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "brdftab {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// f32 rounding of the scaled value (relative 2^-24) and two f64 operations.
+const F32_REL: f64 = 1.0 / (1u64 << 24) as f64 + 1e-15;
+
+/// Every sentinel is −1 again and every measured value is back within `rel` (relative).
+fn assert_same_file(a: &[f64], path: &Path, rel: f64) {
+    let b = MerlBrdf::open(path).unwrap();
+    let b = b.raw();
+    let mut worst = 0.0f64;
+    for (k, (&x, &y)) in a.iter().zip(b).enumerate() {
+        if x < 0.0 {
+            assert_eq!(y, -1.0, "sentinel at {k} became {y}");
+        } else {
+            assert!(y > 0.0, "measured value {x} at {k} became {y}");
+            worst = worst.max((y - x).abs() / x);
+        }
+    }
+    assert!(worst <= rel, "worst relative change {worst:e} > {rel:e}");
+}
+
+#[test]
+fn merl_to_merl_keeps_every_cell() {
+    let dir = tmpdir("m2m");
+    let (a, b) = (dir.join("a.binary"), dir.join("b.binary"));
+    let data = issue_file(&a);
+    brdftab(&["convert", a.to_str().unwrap(), b.to_str().unwrap()]);
+    assert_same_file(&data, &b, F32_REL);
+    // The cell of the issue: (θh 83, θd 15, φd 145), channel R, measured, centre pair below the
+    // horizon.
+    let k = merl::sample_index(83, 15, 145);
+    assert!(MerlBrdf::open(&b).unwrap().raw()[k] > 0.0);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `bake --grid merl` stores cell (i, j, k) at node (i, 0, j, k) as the f32 of its f_r, the
+/// sentinels as −1 × scale; the store's f32 codec is lossless, so the check is bit for bit.
+#[test]
+fn bake_on_the_merl_grid_holds_the_cells_verbatim() {
+    let dir = tmpdir("bake");
+    let a = dir.join("a.binary");
+    let t = dir.join("t.btdb");
+    let data = issue_file(&a);
+    brdftab(&[
+        "bake",
+        a.to_str().unwrap(),
+        "--grid",
+        "merl",
+        "--codec",
+        "f32",
+        "-o",
+        t.to_str().unwrap(),
+    ]);
+    let s = Store::open(&t).unwrap();
+    let st = s.single().unwrap();
+    let grid = st.grid().unwrap();
+    assert_eq!(grid.stored_shape(), [90, 1, 90, 180]);
+    let values = st.read_all().unwrap();
+    for ith in 0..RES_THETA_H {
+        for itd in 0..RES_THETA_D {
+            for ipd in 0..RES_PHI_D {
+                let o = grid.layout().offset([ith, 0, itd, ipd]).unwrap();
+                let k = merl::sample_index(ith, itd, ipd);
+                for c in 0..3 {
+                    let want = (data[c * SAMPLES + k] * SCALE[c]) as f32;
+                    assert_eq!(
+                        values[o + c].to_bits(),
+                        want.to_bits(),
+                        "cell ({ith}, {itd}, {ipd}) channel {c}: {} vs {want}",
+                        values[o + c]
+                    );
+                }
+            }
+        }
+    }
+    // And back to MERL from the baked table.
+    let b = dir.join("b.binary");
+    brdftab(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
+    assert_same_file(&data, &b, F32_REL);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// MERL → table → MERL through `convert` (the file's own cells, no resampling): with the f32
+/// codec to f32 precision, with the default log16 codec within its 1e-3 bound — and every
+/// sentinel in both (log16 keeps the sign).
+#[test]
+fn merl_to_table_to_merl_keeps_every_cell() {
+    let dir = tmpdir("m2t2m");
+    let a = dir.join("a.binary");
+    let data = issue_file(&a);
+    for (codec, rel) in [("f32", F32_REL), ("log16", 1e-3 * (1.0 + 1e-6) + F32_REL)] {
+        let t = dir.join(format!("t-{codec}.btdb"));
+        let b = dir.join(format!("b-{codec}.binary"));
+        brdftab(&[
+            "convert",
+            a.to_str().unwrap(),
+            t.to_str().unwrap(),
+            "--codec",
+            codec,
+            "--pairs",
+            "0",
+        ]);
+        brdftab(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
+        assert_same_file(&data, &b, rel);
+    }
+    // A raw table file too.
+    let t = dir.join("t.tbl");
+    let b = dir.join("b-raw.binary");
+    brdftab(&[
+        "convert",
+        a.to_str().unwrap(),
+        t.to_str().unwrap(),
+        "--pairs",
+        "0",
+    ]);
+    brdftab(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
+    assert_same_file(&data, &b, F32_REL);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// What a lookup makes of the unmeasured cells: 0 at them (nearest), a blend towards 0 next to
+/// them (linear), never a negative value.
+#[test]
+fn lookups_see_unmeasured_cells_as_zero() {
+    use brdftab::Brdf;
+    use brdftab::table::{Interp, TabulatedBrdf};
+    let mut data = vec![1500.0f64; 3 * SAMPLES];
+    for ith in 0..RES_THETA_H {
+        for itd in 0..RES_THETA_D {
+            for ipd in 0..RES_PHI_D {
+                if unmeasured(ith, itd) {
+                    for c in 0..3 {
+                        data[c * SAMPLES + merl::sample_index(ith, itd, ipd)] = -1.0;
+                    }
+                }
+            }
+        }
+    }
+    let m = MerlBrdf::from_raw("step", data).unwrap();
+    let table = m.to_table();
+    // The table keeps the sentinels (negative), the lookups do not show them.
+    assert!(table.values().iter().any(|&v| v < 0.0));
+    let nearest = TabulatedBrdf::from_table(table.clone()).with_interp(Interp::Nearest);
+    let linear = TabulatedBrdf::from_table(table);
+    let mut rng = Pcg32::new(5);
+    let mut blended = 0;
+    for _ in 0..200_000 {
+        let wi = brdftab::geometry::uniform_hemisphere(rng.next_dvec2());
+        let wo = brdftab::geometry::uniform_hemisphere(rng.next_dvec2());
+        let (mut fr, mut fn_, mut fl) = ([0f32; 3], [0f32; 3], [0f32; 3]);
+        m.eval(wi, wo, &mut fr);
+        nearest.eval(wi, wo, &mut fn_);
+        linear.eval(wi, wo, &mut fl);
+        for c in 0..3 {
+            assert!(fn_[c] >= 0.0 && fl[c] >= 0.0);
+            // Nearest = the reader (unmeasured → 0), to f32.
+            assert!(
+                (fn_[c] - fr[c]).abs() <= 1e-6 * fr[c].max(1.0),
+                "{fn_:?} {fr:?}"
+            );
+            // Linear stays within [0, the measured value].
+            assert!(fl[c] <= (1500.0 * SCALE[c]) as f32 * (1.0 + 1e-6));
+        }
+        if fl[0] > 0.0 && fl[0] < (1500.0 * SCALE[0]) as f32 * 0.999 {
+            blended += 1;
+        }
+    }
+    assert!(blended > 0, "no lookup fell next to the unmeasured region");
+}
