@@ -12,7 +12,8 @@
 //!
 //! Iterating D ← f(ω, ω) cos θ σ_D(ω), normalized to ∫ D cos θ dω = 1 (so σ(normal) = 1, as in
 //! the published files), converges to it. The source's luminance (Rec. 709 Y; the channel mean
-//! for spectra) stands for f. Any source works — for non-microfacet ones D is simply an adapted
+//! for spectra) stands for f; where f(ω, ω) is 0 (a hole in measured data) the mean of four
+//! pairs 2° from retro-reflection stands in. Any source works — for non-microfacet ones D is simply an adapted
 //! sampling density — because the values stored later are divided by the same tables.
 //!
 //! The tables live on the readers' unit square: column u = sqrt(2θ/π), row v = (φ + π)/2π,
@@ -33,6 +34,9 @@ use crate::spectrum::{Channels, MAX_CHANNELS};
 /// Largest incident elevation at which the source is evaluated (radians): at exactly 90° every
 /// BRDF is 0 by convention.
 pub const MAX_EVAL_THETA: f64 = 89.5 * PI / 180.0;
+
+/// Angle of the near-retro pairs used where f(ω, ω) itself is 0 (radians).
+pub const NEAR_RETRO: f64 = 2.0 * PI / 180.0;
 
 /// Floor of D relative to its maximum, so that warps cover the whole hemisphere.
 pub const NDF_FLOOR: f64 = 1e-5;
@@ -157,21 +161,36 @@ fn retro(brdf: &dyn Brdf, nx: usize, ny: usize, isotropic: bool) -> Result<Vec<f
             let (theta, phi) = node_dir(ix, nx, iy, ny);
             let phi = if isotropic { 0.0 } else { phi };
             let w = geometry::spherical(theta.min(MAX_EVAL_THETA), phi);
-            brdf.eval(w, w, &mut f[..c]);
-            let mut y = 0.0;
-            for k in 0..c {
-                let v = f[k] as f64;
-                if !v.is_finite() {
-                    return Err(Error::arg(
-                        "source",
-                        format!(
-                            "the source returns {v} at the retro-reflection θ = {:.2}°, φ = {:.2}°",
-                            theta.to_degrees(),
-                            phi.to_degrees()
-                        ),
-                    ));
+            let mut lum = |wo: DVec3| -> Result<f64> {
+                brdf.eval(w, wo, &mut f[..c]);
+                let mut y = 0.0;
+                for k in 0..c {
+                    let v = f[k] as f64;
+                    if !v.is_finite() {
+                        return Err(Error::arg(
+                            "source",
+                            format!(
+                                "the source returns {v} near the retro-reflection θ = {:.2}°, φ = {:.2}°",
+                                theta.to_degrees(),
+                                phi.to_degrees()
+                            ),
+                        ));
+                    }
+                    y += wts[k] * v.max(0.0);
                 }
-                y += wts[k] * v.max(0.0);
+                Ok(y)
+            };
+            let mut y = lum(w)?;
+            if y <= 0.0 {
+                // A hole exactly at retro-reflection (e.g. unmeasured MERL cells, which the
+                // lookup hits for every θ at θd = 0): the mean of the four pairs 2° away.
+                let frame = geometry::Frame::from_normal(w);
+                let (s, co) = NEAR_RETRO.sin_cos();
+                let mut sum = 0.0;
+                for (dx, dy) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)] {
+                    sum += lum(frame.to_world(DVec3::new(dx * s, dy * s, co)))?;
+                }
+                y = 0.25 * sum;
             }
             out[ix + iy * nx] = y;
         }
