@@ -68,7 +68,7 @@ pub const DATABASE_THETA_I: [f32; 8] = [
     1.034_542_9,
     1.196_715_5,
     1.369_449,
-    1.570_796_3,
+    std::f32::consts::FRAC_PI_2,
 ];
 
 /// Default reflectance table resolution N for sources without a parameterization of their own.
