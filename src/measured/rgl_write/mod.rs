@@ -139,10 +139,11 @@ pub struct Parameterization {
     pub vndf: Vec<f32>,
     /// The file's reflectance resolution.
     pub resolution: usize,
-    /// The file's stored values (φi × θi × channels × N × N) and channel count: kept as they are
-    /// at the grid points whose ωo is below the horizon, where no source can be evaluated (they
-    /// matter only as corners of cells readers interpolate in).
-    pub values: (usize, Vec<f32>),
+    /// The file's channels (`None`: RGB, else its wavelengths) and stored values
+    /// (φi × θi × channels × N × N): kept as they are at the grid points whose ωo is below the
+    /// horizon, where no source can be evaluated (they matter only as corners of cells readers
+    /// interpolate in), when the source has the same channels and N.
+    pub values: (Option<Vec<f32>>, Vec<f32>),
 }
 
 impl Parameterization {
@@ -171,7 +172,11 @@ impl Parameterization {
             .ok_or_else(|| Error::format(tf.file_name(), Some("rgb"), None, "missing"))?;
         let resolution = table.shape[3];
         let square = table.shape[3] == table.shape[4];
-        let values = (table.shape[2], tf.to_f32(table)?);
+        let wavelengths = match tf.get("wavelengths") {
+            Some(w) if table.name == "spectra" => Some(tf.to_f32(w)?),
+            _ => None,
+        };
+        let values = (wavelengths, tf.to_f32(table)?);
         if !square || vs.len() != 4 || ns.len() != 2 {
             return Err(Error::Unsupported(format!(
                 "{}: only square reflectance tables can be re-encoded",
@@ -348,7 +353,7 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: Option<Progress<'_>>) -
     let keep = opts
         .parameterization
         .as_ref()
-        .filter(|p| p.resolution == layout.n && p.values.0 == nch)
+        .filter(|p| p.resolution == layout.n && same_channels(&p.values.0, brdf.channels()))
         .map(|p| p.values.1.as_slice());
     let values = values::sample(brdf, &ndf, &warps, &layout, keep, progress)?;
     if values.data.iter().all(|&v| v == 0.0) {
@@ -380,6 +385,17 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: Option<Progress<'_>>) -
             c => Some((0..c.len()).map(|i| c.wavelength(i) as f32).collect()),
         },
     })
+}
+
+/// Whether a file's channels (`None`: RGB) are `channels`.
+fn same_channels(file: &Option<Vec<f32>>, channels: &crate::spectrum::Channels) -> bool {
+    match (file, channels) {
+        (None, crate::spectrum::Channels::Rgb) => true,
+        (Some(w), c @ crate::spectrum::Channels::Wavelengths(_)) => {
+            w.len() == c.len() && (0..c.len()).all(|i| w[i] == c.wavelength(i) as f32)
+        }
+        _ => false,
+    }
 }
 
 /// What [`write`] wrote.
