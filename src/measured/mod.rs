@@ -5,6 +5,8 @@
 //! - [`rgl`]: RGL-EPFL `.bsdf` measurements evaluated natively by the published algorithm
 //!   ([`RglBrdf`], RGB or spectral, isotropic or anisotropic), with importance sampling by the
 //!   measurement's own warps;
+//! - [`rgl_write`]: any `Brdf` written as an RGL `.bsdf` file (the adaptive parameterization
+//!   rebuilt from the source: NDF by power iteration, warps, values), with its error report;
 //! - [`merl`]: MERL `.binary` files, read (the reference reader's nearest lookup, a validity
 //!   mask for unmeasured cells), written (bit-exact, or any `Brdf` resampled on the MERL grid)
 //!   and turned into a table on [`Grid::merl`](crate::table::Grid::merl) ([`MerlBrdf`]);
@@ -21,6 +23,7 @@ pub mod data;
 pub mod merl;
 pub mod merl_manifest;
 pub mod rgl;
+pub mod rgl_write;
 pub mod tensor;
 
 pub use merl::MerlBrdf;

@@ -46,10 +46,10 @@ use crate::spectrum::{Channels, MAX_CHANNELS};
 
 /// A bilinearly interpolated grid of `slices` planes of `ny` rows × `nx` columns on [0, 1]².
 #[derive(Debug, Clone)]
-struct Planes {
-    nx: usize,
-    ny: usize,
-    data: Vec<f32>,
+pub(crate) struct Planes {
+    pub(crate) nx: usize,
+    pub(crate) ny: usize,
+    pub(crate) data: Vec<f32>,
 }
 
 impl Planes {
@@ -69,12 +69,20 @@ impl Planes {
 
 /// Interpolation corners over the conditioning parameters (φi, θi): up to four slices.
 #[derive(Debug, Clone, Copy)]
-struct Corners {
+pub(crate) struct Corners {
     slice: [usize; 4],
     w: [f64; 4],
 }
 
 impl Corners {
+    /// Exactly slice `slice` (no interpolation over the conditioning parameters).
+    pub(crate) fn single(slice: usize) -> Self {
+        Corners {
+            slice: [slice; 4],
+            w: [1.0, 0.0, 0.0, 0.0],
+        }
+    }
+
     /// Σ w_k · data[slice_k · stride + offset].
     #[inline]
     fn lookup(&self, data: &[f32], stride: usize, offset: usize) -> f64 {
@@ -106,7 +114,7 @@ fn param_weight(values: &[f32], x: f64) -> (usize, usize, f64) {
 /// The VNDF warp: a normalized piecewise-bilinear density per slice with its conditional (per
 /// row) and marginal (over rows) CDFs.
 #[derive(Debug, Clone)]
-struct Warp {
+pub(crate) struct Warp {
     pdf: Planes,
     conditional: Vec<f32>,
     marginal: Vec<f32>,
@@ -116,6 +124,18 @@ impl Warp {
     /// Builds the CDFs of every slice (sums in f64, stored as f32 as the reference does), and
     /// normalizes each slice to integrate to 1 over the unit square.
     fn new(planes: Planes, file: &TensorFile, field: &Field) -> Result<Self> {
+        Self::build(planes).map_err(|(s, total)| {
+            file.error(
+                field,
+                format!("slice {s} integrates to {total}, not a positive density"),
+            )
+        })
+    }
+
+    /// [`Warp::new`] without a file: a slice that does not integrate to a positive finite value
+    /// is returned as `Err((slice, integral))`. (The RGL writer builds its warps with this, so
+    /// that it places samples exactly where the reader looks for them.)
+    pub(crate) fn build(planes: Planes) -> std::result::Result<Self, (usize, f32)> {
         let (nx, ny) = (planes.nx, planes.ny);
         let n = planes.plane_len();
         let slices = planes.data.len() / n;
@@ -143,10 +163,7 @@ impl Warp {
             }
             let total = m[ny - 1];
             if !(total > 0.0 && total.is_finite()) {
-                return Err(file.error(
-                    field,
-                    format!("slice {s} integrates to {total}, not a positive density"),
-                ));
+                return Err((s, total));
             }
             let norm = 1.0 / total;
             c.iter_mut().for_each(|v| *v *= norm);
@@ -162,7 +179,7 @@ impl Warp {
 
     /// The point of the unit square that the warp maps onto `u` (the inverse of sampling).
     #[inline]
-    fn invert(&self, u: [f64; 2], k: &Corners) -> [f64; 2] {
+    pub(crate) fn invert(&self, u: [f64; 2], k: &Corners) -> [f64; 2] {
         self.invert_pdf(u, k).0
     }
 
@@ -181,7 +198,7 @@ impl Warp {
     /// Maps a uniform point of the unit square through the warp: the marginal CDF picks the row,
     /// the conditional CDF the column, each inverted exactly for the bilinear patch (a quadratic).
     /// Returns the warped point and its density.
-    fn sample(&self, mut u: [f64; 2], k: &Corners) -> ([f64; 2], f64) {
+    pub(crate) fn sample(&self, mut u: [f64; 2], k: &Corners) -> ([f64; 2], f64) {
         const ONE_MINUS_EPS: f64 = 0.999_999_940_395_355_2;
         let (nx, ny) = (self.pdf.nx, self.pdf.ny);
         let stride = nx * ny;
@@ -306,19 +323,19 @@ const NO_PARAMS: Corners = Corners {
 
 /// u(θ) = sqrt(2θ/π).
 #[inline]
-fn theta2u(theta: f64) -> f64 {
+pub(crate) fn theta2u(theta: f64) -> f64 {
     (theta * FRAC_2_PI).sqrt()
 }
 
 /// u(φ) = (φ + π) / 2π.
 #[inline]
-fn phi2u(phi: f64) -> f64 {
+pub(crate) fn phi2u(phi: f64) -> f64 {
     (phi + PI) / (2.0 * PI)
 }
 
 /// Elevation of a unit vector, 2·asin(|d − z| / 2): equal to acos(d.z) but accurate near the pole.
 #[inline]
-fn elevation(d: DVec3) -> f64 {
+pub(crate) fn elevation(d: DVec3) -> f64 {
     let dist = (d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0)).sqrt();
     2.0 * (0.5 * dist).min(1.0).asin()
 }

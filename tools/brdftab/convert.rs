@@ -1,9 +1,9 @@
 //! `convert`: any SOURCE into a MERL file or a table, with the table's accuracy reported.
 
+use brdftab::Result;
 use brdftab::bake::BakeTarget;
-use brdftab::measured::MerlBrdf;
+use brdftab::measured::{MerlBrdf, RglBrdf, rgl_write};
 use brdftab::table::Interp;
-use brdftab::{Error, Result};
 use clap::Args;
 
 use crate::bake::BakeFlags;
@@ -14,8 +14,8 @@ use crate::source::{self, Kind};
 pub struct ConvertArgs {
     /// Any SOURCE: a MERL `.binary`, an RGL `.bsdf`, a spec, a table.
     input: String,
-    /// The output: a MERL `.binary` (the source resampled at the MERL cell centres), a table
-    /// database entry `DB#NAME` (or a `.btdb` file, named after the input), or a raw table file.
+    /// The output: an RGL `.bsdf` (loads in Mitsuba 3 and pbrt-v4), a MERL `.binary` (the
+    /// source resampled at the MERL cell centres), a table database entry `DB#NAME` (or a `.btdb` file, named after the input), or a raw table file.
     output: String,
     /// Interpolation for the reported accuracy: nearest or linear.
     #[arg(long, default_value = "linear")]
@@ -28,6 +28,26 @@ pub struct ConvertArgs {
     replace: bool,
     #[command(flatten)]
     flags: BakeFlags,
+    #[command(flatten)]
+    rgl: RglArgs,
+}
+
+/// Options of `.bsdf` outputs (defaults: the library's; a `.bsdf` input keeps its own layout
+/// unless --theta-i, --phi-i or --ndf-resolution is given).
+#[derive(Args, Clone)]
+pub struct RglArgs {
+    /// .bsdf output: reflectance table resolution N (default 64, a .bsdf input's own).
+    #[arg(long)]
+    resolution: Option<usize>,
+    /// .bsdf output: number of incident elevations θi (default 16; 8 = the RGL database's spacing).
+    #[arg(long)]
+    theta_i: Option<usize>,
+    /// .bsdf output: number of incident azimuths φi (default 1 if isotropic, else 17).
+    #[arg(long)]
+    phi_i: Option<usize>,
+    /// .bsdf output: NDF, σ and VNDF grid resolution (default 128).
+    #[arg(long)]
+    ndf_resolution: Option<usize>,
 }
 
 /// Converts between formats.
@@ -46,11 +66,45 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
             );
             Ok(())
         }
-        Kind::Rgl => Err(Error::Unsupported(
-            "writing RGL .bsdf files (they are read only)".into(),
-        )),
+        Kind::Rgl => to_rgl(a),
         _ => to_table(a),
     }
+}
+
+/// Writes the input as an RGL tensor file and reports the error of the file read back.
+fn to_rgl(a: ConvertArgs) -> Result<()> {
+    let brdf = source::open(&a.input, &source::channels(a.flags.wavelengths.as_deref())?)?;
+    let opts = rgl_write::Options {
+        resolution: a.rgl.resolution,
+        theta_i: a.rgl.theta_i,
+        phi_i: a.rgl.phi_i,
+        ndf_resolution: a.rgl.ndf_resolution,
+        ..Default::default()
+    }
+    .reuse_source_file(&a.input)?;
+    let t = std::time::Instant::now();
+    let w = rgl_write::write(&*brdf, &a.output, &opts, &crate::progress::Bar::values())?;
+    let f = &w.fields;
+    println!(
+        "{}: {} as an RGL tensor file ({} φi × {} θi, {}×{} table, {} bytes, {:.2} s)",
+        a.output,
+        brdf.describe(),
+        f.phi_i.len(),
+        f.theta_i.len(),
+        f.n,
+        f.n,
+        w.bytes,
+        t.elapsed().as_secs_f64()
+    );
+    if a.pairs > 0 {
+        let back = RglBrdf::open(&a.output)?;
+        let r = rgl_write::report(&back, &*brdf, a.pairs, 1)?;
+        println!(
+            "  error vs source (read back, {} pairs within 80°): relative RMSE of f_r weighted by cos θi cos θo {:.3e}, max relative {:.3e}",
+            r.pairs, r.rel_rmse, r.max_rel
+        );
+    }
+    Ok(())
 }
 
 /// Tabulates the input into `DB#NAME`, a `.btdb` file (a table named after the input) or a raw

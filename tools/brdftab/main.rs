@@ -49,7 +49,7 @@ enum Command {
     Render(render::RenderArgs),
     /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
     Slice(measured::SliceArgs),
-    /// Convert between formats (MERL .binary, RGL .bsdf read only, tables).
+    /// Convert between formats (MERL .binary, RGL .bsdf, tables).
     Convert(convert::ConvertArgs),
     /// Directional albedo a(θ′) per channel: one line `theta a_1 a_2 ...` per angle.
     Albedo(analysis::AlbedoArgs),

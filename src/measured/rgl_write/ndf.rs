@@ -1,0 +1,303 @@
+//! The microfacet NDF of any source, recovered from its retro-reflection by power iteration
+//! (Dupuy, Heitz, Iehl, Poulin, Ostromoukhov, "Extracting Microfacet-based BRDF Parameters from
+//! Arbitrary Materials with Power Iterations", 2015), and its projected area σ.
+//!
+//! For a microfacet BRDF at retro-reflection (ωi = ωo = ω, so h = ω and masking equals
+//! shadowing), f(ω, ω) = F D(ω) G1(ω) / (4 cos² θ) with G1(ω) = cos θ / σ(ω) and
+//! σ(ω) = ∫ D(m) max(0, m·ω) dm. Up to the (nearly constant) Fresnel factor,
+//!
+//! ```text
+//! D(ω) ∝ f(ω, ω) cos θ σ(ω)   — D is the dominant eigenvector of the operator on the right.
+//! ```
+//!
+//! Iterating D ← f(ω, ω) cos θ σ_D(ω), normalized to ∫ D cos θ dω = 1 (so σ(normal) = 1, as in
+//! the published files), converges to it. The source's luminance (Rec. 709 Y; the channel mean
+//! for spectra) stands for f; where f(ω, ω) is 0 (a hole in measured data) the mean of four
+//! pairs 2° from retro-reflection stands in. Any source works — for non-microfacet ones D is simply an adapted
+//! sampling density — because the values stored later are divided by the same tables.
+//!
+//! The tables live on the readers' unit square: column u = sqrt(2θ/π), row v = (φ + π)/2π,
+//! interpolated bilinearly. σ and the iteration integrate with the midpoint rule over that square
+//! (dω = 2π² u sin θ du dv).
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::Layout;
+use crate::brdf::Brdf;
+use crate::error::{Error, Result};
+use crate::geometry;
+use crate::spectrum::{Channels, MAX_CHANNELS};
+
+/// Largest incident elevation at which the source is evaluated (radians): at exactly 90° every
+/// BRDF is 0 by convention.
+pub const MAX_EVAL_THETA: f64 = 89.5 * PI / 180.0;
+
+/// Angle of the near-retro pairs used where f(ω, ω) itself is 0 (radians).
+pub const NEAR_RETRO: f64 = 2.0 * PI / 180.0;
+
+/// Floor of D relative to its maximum, so that warps cover the whole hemisphere.
+pub const NDF_FLOOR: f64 = 1e-5;
+
+/// Power iteration stops when the largest change relative to the maximum falls below this.
+pub const TOLERANCE: f64 = 1e-5;
+
+/// The recovered distribution and projected area, on `ny` rows (φ) × `nx` columns (θ).
+#[derive(Debug, Clone)]
+pub struct Ndf {
+    /// Columns (elevations).
+    pub nx: usize,
+    /// Rows (azimuths; 2 identical rows when isotropic).
+    pub ny: usize,
+    /// Isotropic: rows identical, azimuths relative to φi.
+    pub isotropic: bool,
+    /// D at the nodes, row-major.
+    pub ndf: Vec<f32>,
+    /// σ at the nodes, row-major.
+    pub sigma: Vec<f32>,
+    /// Iterations run.
+    pub iterations: usize,
+    /// Final relative change (below [`TOLERANCE`] when converged).
+    pub change: f64,
+}
+
+/// Bilinear interpolation of a `ny` × `nx` row-major table at unit point `u` = (column, row),
+/// exactly as the readers interpolate `ndf` and `sigma`.
+#[inline]
+pub fn bilinear(t: &[f32], nx: usize, ny: usize, u: [f64; 2]) -> f64 {
+    let locate = |u: f64, n: usize| {
+        let p = u * (n - 1) as f64;
+        let i = if p > 0.0 { (p as usize).min(n - 2) } else { 0 };
+        (i, p - i as f64)
+    };
+    let (ix, fx) = locate(u[0], nx);
+    let (iy, fy) = locate(u[1], ny);
+    let o = ix + iy * nx;
+    let v = |k: usize| t[k] as f64;
+    (1.0 - fy) * ((1.0 - fx) * v(o) + fx * v(o + 1))
+        + fy * ((1.0 - fx) * v(o + nx) + fx * v(o + nx + 1))
+}
+
+impl Ndf {
+    /// The tables of an existing parameterization.
+    pub fn given(p: &super::Parameterization, isotropic: bool) -> Self {
+        Ndf {
+            nx: p.ndf_shape[1],
+            ny: p.ndf_shape[0],
+            isotropic,
+            ndf: p.ndf.clone(),
+            sigma: p.sigma.clone(),
+            iterations: 0,
+            change: 0.0,
+        }
+    }
+
+    /// D at unit point `u` (bilinear).
+    #[inline]
+    pub fn d(&self, u: [f64; 2]) -> f64 {
+        bilinear(&self.ndf, self.nx, self.ny, u)
+    }
+
+    /// σ at unit point `u` (bilinear).
+    #[inline]
+    pub fn sigma(&self, u: [f64; 2]) -> f64 {
+        bilinear(&self.sigma, self.nx, self.ny, u)
+    }
+}
+
+/// Scalar weights turning a channel vector into the luminance used for D and for sampling.
+pub fn luminance_weights(channels: &Channels) -> Vec<f64> {
+    match channels {
+        Channels::Rgb => vec![0.2126, 0.7152, 0.0722],
+        c => vec![1.0 / c.len() as f64; c.len()],
+    }
+}
+
+/// The direction of node (column `ix` of `nx`, row `iy` of `ny`).
+fn node_dir(ix: usize, nx: usize, iy: usize, ny: usize) -> (f64, f64) {
+    let u = ix as f64 / (nx - 1) as f64;
+    let v = iy as f64 / (ny - 1) as f64;
+    (u * u * FRAC_PI_2, 2.0 * PI * v - PI)
+}
+
+/// Midpoint quadrature of the unit square: directions, dω weights and unit coordinates.
+struct Quadrature {
+    dirs: Vec<DVec3>,
+    weights: Vec<f64>,
+    uv: Vec<[f64; 2]>,
+}
+
+fn quadrature(qt: usize, qp: usize) -> Quadrature {
+    let mut q = Quadrature {
+        dirs: Vec::with_capacity(qt * qp),
+        weights: Vec::with_capacity(qt * qp),
+        uv: Vec::with_capacity(qt * qp),
+    };
+    for b in 0..qp {
+        let v = (b as f64 + 0.5) / qp as f64;
+        for a in 0..qt {
+            let u = (a as f64 + 0.5) / qt as f64;
+            let theta = u * u * FRAC_PI_2;
+            q.dirs.push(geometry::spherical(theta, 2.0 * PI * v - PI));
+            q.weights
+                .push(2.0 * PI * PI * u * theta.sin() / (qt * qp) as f64);
+            q.uv.push([u, v]);
+        }
+    }
+    q
+}
+
+/// Retro-reflection luminance f(ω, ω) at every node (rows of an isotropic source are equal).
+fn retro(brdf: &dyn Brdf, nx: usize, ny: usize, isotropic: bool) -> Result<Vec<f64>> {
+    let wts = luminance_weights(brdf.channels());
+    let c = wts.len();
+    let rows = if isotropic { 1 } else { ny };
+    let mut out = vec![0.0; nx * ny];
+    let mut f = [0.0f32; MAX_CHANNELS];
+    for iy in 0..rows {
+        for ix in 0..nx {
+            let (theta, phi) = node_dir(ix, nx, iy, ny);
+            let phi = if isotropic { 0.0 } else { phi };
+            let w = geometry::spherical(theta.min(MAX_EVAL_THETA), phi);
+            let mut lum = |wo: DVec3| -> Result<f64> {
+                brdf.eval(w, wo, &mut f[..c]);
+                let mut y = 0.0;
+                for k in 0..c {
+                    let v = f[k] as f64;
+                    if !v.is_finite() {
+                        return Err(Error::arg(
+                            "source",
+                            format!(
+                                "the source returns {v} near the retro-reflection θ = {:.2}°, φ = {:.2}°",
+                                theta.to_degrees(),
+                                phi.to_degrees()
+                            ),
+                        ));
+                    }
+                    y += wts[k] * v.max(0.0);
+                }
+                Ok(y)
+            };
+            let mut y = lum(w)?;
+            if y <= 0.0 {
+                // A hole exactly at retro-reflection (e.g. unmeasured MERL cells, which the
+                // lookup hits for every θ at θd = 0): the mean of the four pairs 2° away.
+                let frame = geometry::Frame::from_normal(w);
+                let (s, co) = NEAR_RETRO.sin_cos();
+                let mut sum = 0.0;
+                for (dx, dy) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)] {
+                    sum += lum(frame.to_world(DVec3::new(dx * s, dy * s, co)))?;
+                }
+                y = 0.25 * sum;
+            }
+            out[ix + iy * nx] = y;
+        }
+    }
+    if isotropic {
+        let (first, rest) = out.split_at_mut(nx);
+        for row in rest.chunks_mut(nx) {
+            row.copy_from_slice(first);
+        }
+    }
+    Ok(out)
+}
+
+/// σ at every node for the distribution `d_q` given at the quadrature points.
+fn project(q: &Quadrature, d_q: &[f64], nx: usize, ny: usize, isotropic: bool) -> Vec<f64> {
+    let rows = if isotropic { 1 } else { ny };
+    let mut s: Vec<f64> = (0..nx * rows)
+        .into_par_iter()
+        .map(|k| {
+            let (ix, iy) = (k % nx, k / nx);
+            let (theta, phi) = node_dir(ix, nx, iy, ny);
+            let w = geometry::spherical(theta, if isotropic { 0.0 } else { phi });
+            let mut acc = 0.0;
+            for ((m, &wt), &d) in q.dirs.iter().zip(&q.weights).zip(d_q) {
+                acc += wt * d * m.dot(w).max(0.0);
+            }
+            acc
+        })
+        .collect();
+    if isotropic {
+        let first = s.clone();
+        s.extend_from_slice(&first);
+        s.truncate(nx * ny);
+    }
+    s
+}
+
+/// Runs the power iteration for `brdf` on the layout's NDF grid.
+pub fn recover(brdf: &dyn Brdf, layout: &Layout) -> Result<Ndf> {
+    let (nx, ny, iso) = (layout.ndf_nx, layout.ndf_ny, layout.isotropic);
+    let f = retro(brdf, nx, ny, iso)?;
+    let fmax = f.iter().cloned().fold(0.0, f64::max);
+    if fmax <= 0.0 {
+        return Err(Error::arg(
+            "source",
+            "the source reflects nothing back along any incident direction (retro-reflection is 0 everywhere): no NDF to recover",
+        ));
+    }
+    let (qt, qp) = if iso { (nx, 64) } else { (nx.min(64), 64) };
+    let q = quadrature(qt, qp);
+    let at_q = |d: &[f32]| -> Vec<f64> { q.uv.iter().map(|&u| bilinear(d, nx, ny, u)).collect() };
+    let normalize = |d: &mut Vec<f32>| {
+        let dq = at_q(d);
+        let s: f64 = q
+            .dirs
+            .iter()
+            .zip(&q.weights)
+            .zip(&dq)
+            .map(|((m, w), d)| w * d * m.z)
+            .sum();
+        if s > 0.0 && s.is_finite() {
+            d.iter_mut().for_each(|v| *v = (*v as f64 / s) as f32);
+        }
+    };
+    let cos: Vec<f64> = (0..nx * ny)
+        .map(|k| node_dir(k % nx, nx, k / nx, ny).0.cos().max(0.0))
+        .collect();
+    let mut d = vec![(1.0 / PI) as f32; nx * ny];
+    let max_it = if iso { 200 } else { 32 };
+    let (mut iterations, mut change) = (0, f64::INFINITY);
+    while iterations < max_it && change > TOLERANCE {
+        let sigma = project(&q, &at_q(&d), nx, ny, iso);
+        let mut next: Vec<f32> = (0..nx * ny)
+            .map(|k| (f[k] * cos[k] * sigma[k]) as f32)
+            .collect();
+        normalize(&mut next);
+        let dmax = next.iter().cloned().fold(0.0f32, f32::max) as f64;
+        change = next
+            .iter()
+            .zip(&d)
+            .map(|(a, b)| (*a as f64 - *b as f64).abs())
+            .fold(0.0, f64::max)
+            / dmax.max(1e-300);
+        d = next;
+        iterations += 1;
+    }
+    if d.iter().any(|v| !v.is_finite()) || d.iter().all(|&v| v <= 0.0) {
+        return Err(Error::arg(
+            "source",
+            "power iteration on the retro-reflection gave no usable NDF",
+        ));
+    }
+    let dmax = d.iter().cloned().fold(0.0f32, f32::max);
+    let floor = (dmax as f64 * NDF_FLOOR) as f32;
+    d.iter_mut().for_each(|v| *v = v.max(floor));
+    normalize(&mut d);
+    let sigma: Vec<f32> = project(&q, &at_q(&d), nx, ny, iso)
+        .into_iter()
+        .map(|s| s as f32)
+        .collect();
+    Ok(Ndf {
+        nx,
+        ny,
+        isotropic: iso,
+        ndf: d,
+        sigma,
+        iterations,
+        change,
+    })
+}

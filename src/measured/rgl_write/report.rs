@@ -1,0 +1,70 @@
+//! The error of a written `.bsdf` file against its source.
+//!
+//! Metric (issue 15): brdftab's own RGL reader on the written file against the source, relative
+//! RMSE of f_r weighted by cos θi cos θo,
+//!
+//! ```text
+//! sqrt( Σ ((f̂ − f) cos θi cos θo)² / Σ (f cos θi cos θo)² )     (over pairs and channels)
+//! ```
+//!
+//! over pairs drawn uniformly with both directions within 80° of the normal (the cut
+//! [`analysis::accuracy`](crate::analysis::accuracy) uses for measured data). It is the table
+//! report's cosine-weighted RMSE applied to f_r·cos θo — the quantity the file stores.
+
+use glam::DVec3;
+
+use crate::analysis::accuracy;
+use crate::brdf::{Brdf, Flags};
+use crate::error::Result;
+use crate::spectrum::Channels;
+
+/// Directions farther than this from the normal are left out (radians).
+pub const MAX_THETA: f64 = 80.0 * std::f64::consts::PI / 180.0;
+
+/// What [`report`] measured.
+#[derive(Debug, Clone)]
+pub struct Report {
+    /// Pairs evaluated.
+    pub pairs: usize,
+    /// The relative RMSE (module docs).
+    pub rel_rmse: f64,
+    /// Per channel.
+    pub per_channel: Vec<f64>,
+    /// Largest relative error of f_r·cos θo (floored at 1% of its RMS, as in
+    /// [`accuracy`](crate::analysis::accuracy)).
+    pub max_rel: f64,
+}
+
+/// f_r · cos θo of a BRDF (what `.bsdf` readers return).
+struct CosO<'a>(&'a dyn Brdf);
+
+impl Brdf for CosO<'_> {
+    fn channels(&self) -> &Channels {
+        self.0.channels()
+    }
+    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+        self.0.eval(wi, wo, out);
+        let c = wo.normalize_or_zero().z.max(0.0);
+        for v in &mut out[..self.0.channels().len()] {
+            *v = (*v as f64 * c) as f32;
+        }
+    }
+    fn flags(&self) -> Flags {
+        self.0.flags()
+    }
+    fn describe(&self) -> String {
+        format!("{} × cos θo", self.0.describe())
+    }
+}
+
+/// Compares `written` (normally the file read back by [`RglBrdf`](crate::measured::RglBrdf))
+/// against `source` over `pairs` random pairs (seed `seed`).
+pub fn report(written: &dyn Brdf, source: &dyn Brdf, pairs: usize, seed: u64) -> Result<Report> {
+    let a = accuracy::compare_cap(&CosO(written), &CosO(source), pairs, seed, MAX_THETA)?;
+    Ok(Report {
+        pairs: a.pairs,
+        rel_rmse: a.rel_rmse,
+        per_channel: a.per_channel,
+        max_rel: a.max_rel,
+    })
+}

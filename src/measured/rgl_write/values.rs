@@ -1,0 +1,217 @@
+//! The sampler of values: the reflectance table of a `.bsdf` file.
+//!
+//! For incident direction ωi (slice (φi, θi)) and grid point s = (i, j)/(N − 1) of the VNDF
+//! warp's input square, the warp gives the half vector m, ωo = reflect(ωi, m), and the file
+//! stores
+//!
+//! ```text
+//! f_r(ωi, ωo) · cos θo · 4 σ(ωi) / D(m)
+//! ```
+//!
+//! with σ and D interpolated from the file's own tables at the coordinates the readers compute
+//! from (ωi, ωo) — so that a reader's `eval` (stored value × D/(4σ), the `jacobian` = 1
+//! convention) returns exactly f_r·cos θo at every grid point. Points whose ωo falls below the
+//! horizon are marked invalid and filled from their valid neighbours
+//! ([`fill_below_horizon`]).
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use rayon::prelude::*;
+
+use super::container::pack_bits;
+use super::ndf::{MAX_EVAL_THETA, Ndf};
+use super::warps::{Vndf, incident};
+use super::{Layout, Progress};
+use crate::brdf::Brdf;
+use crate::error::{Error, Result};
+use crate::geometry;
+use crate::measured::rgl::{Corners, elevation, phi2u, theta2u};
+use crate::spectrum::MAX_CHANNELS;
+
+/// The stored values and their validity bits.
+#[derive(Debug, Clone)]
+pub struct Values {
+    /// φi × θi × channels × N × N.
+    pub data: Vec<f32>,
+    /// One bit per (φi, θi, j, i), packed.
+    pub valid: Vec<u8>,
+}
+
+/// Fills the grid points whose ωo is below the horizon (never evaluated by readers, but
+/// corners of cells they interpolate in) outwards from the valid ones: each pass gives the
+/// points next to filled ones the mean of those neighbours (4-neighbourhood), so values continue
+/// the valid region instead of pulling it towards 0.
+pub fn fill_below_horizon(plane: &mut [f32], valid: &[bool], n: usize) {
+    let mut filled = valid.to_vec();
+    if !filled.iter().any(|&v| v) {
+        return;
+    }
+    loop {
+        let mut next = filled.clone();
+        let mut any = false;
+        for j in 0..n {
+            for i in 0..n {
+                let k = i + j * n;
+                if filled[k] {
+                    continue;
+                }
+                let (mut sum, mut cnt) = (0.0f64, 0);
+                let mut take = |kk: usize| {
+                    if filled[kk] {
+                        sum += plane[kk] as f64;
+                        cnt += 1;
+                    }
+                };
+                if i > 0 {
+                    take(k - 1);
+                }
+                if i + 1 < n {
+                    take(k + 1);
+                }
+                if j > 0 {
+                    take(k - n);
+                }
+                if j + 1 < n {
+                    take(k + n);
+                }
+                if cnt > 0 {
+                    plane[k] = (sum / cnt as f64) as f32;
+                    next[k] = true;
+                    any = true;
+                }
+            }
+        }
+        filled = next;
+        if !any {
+            break;
+        }
+    }
+}
+
+/// The readers' unit coordinates of ωi and of the half vector for a pair.
+pub fn reader_coords(wi: glam::DVec3, wo: glam::DVec3, isotropic: bool) -> ([f64; 2], [f64; 2]) {
+    let wm = (wi + wo).normalize_or_zero();
+    let phi_i = wi.y.atan2(wi.x);
+    let phi_m = wm.y.atan2(wm.x);
+    let u_wi = [theta2u(elevation(wi)), phi2u(phi_i)];
+    let mut u_wm = [
+        theta2u(elevation(wm)),
+        phi2u(if isotropic { phi_m - phi_i } else { phi_m }),
+    ];
+    u_wm[1] -= u_wm[1].floor();
+    (u_wi, u_wm)
+}
+
+/// Samples `brdf` at every grid point of every slice; below-horizon points take the values of
+/// `keep` (an existing table of the same layout) when given, else [`fill_below_horizon`].
+pub fn sample(
+    brdf: &dyn Brdf,
+    ndf: &Ndf,
+    vndf: &Vndf,
+    layout: &Layout,
+    keep: Option<&[f32]>,
+    progress: &dyn Progress,
+) -> Result<Values> {
+    let n = layout.n;
+    let c = brdf.channels().len();
+    if c > MAX_CHANNELS {
+        return Err(Error::arg(
+            "source",
+            format!("{c} channels, at most {MAX_CHANNELS}"),
+        ));
+    }
+    let (np, nt) = (layout.phi_i.len(), layout.theta_i.len());
+    let total = np * nt;
+    let done = AtomicUsize::new(0);
+    let plane = n * n;
+    let _stage = crate::progress::Stage::begin(progress, "sampling", total as u64);
+    let slices: Vec<(Vec<f32>, Vec<bool>)> = (0..total)
+        .into_par_iter()
+        .map(|s| {
+            let (p, t) = (s / nt, s % nt);
+            let wi = incident(layout, p, t);
+            let wi_eval = geometry::spherical(
+                (layout.theta_i[t] as f64).min(MAX_EVAL_THETA),
+                layout.phi_i[p] as f64,
+            );
+            let phi_i = if layout.isotropic {
+                layout.phi_i[p] as f64
+            } else {
+                0.0
+            };
+            let mut data = vec![0.0f32; c * plane];
+            let mut valid = vec![false; plane];
+            let mut f = [0.0f32; MAX_CHANNELS];
+            let k = Corners::single(0);
+            for j in 0..n {
+                for i in 0..n {
+                    let u = [i as f64 / (n - 1) as f64, j as f64 / (n - 1) as f64];
+                    let (um, _) = vndf.warps[s].sample(u, &k);
+                    let theta_m = um[0] * um[0] * std::f64::consts::FRAC_PI_2;
+                    let phi_m = (2.0 * um[1] - 1.0) * std::f64::consts::PI + phi_i;
+                    let m = geometry::spherical(theta_m, phi_m);
+                    let wo = geometry::reflect(wi, m);
+                    if wo.z <= 0.0 {
+                        continue;
+                    }
+                    brdf.eval(wi_eval, wo, &mut f[..c]);
+                    let (u_wi, u_wm) = reader_coords(wi, wo, layout.isotropic);
+                    let d = ndf.d(u_wm);
+                    let scale = if d > 0.0 {
+                        wo.z * 4.0 * ndf.sigma(u_wi) / d
+                    } else {
+                        0.0
+                    };
+                    for ch in 0..c {
+                        let v = f[ch] as f64;
+                        if !v.is_finite() {
+                            return Err(Error::arg(
+                                "source",
+                                format!(
+                                    "the source returns {v} at wi = {:?}, wo = {:?} (channel {ch})",
+                                    wi_eval.to_array(),
+                                    wo.to_array()
+                                ),
+                            ));
+                        }
+                        data[ch * plane + i + j * n] = (v.max(0.0) * scale) as f32;
+                    }
+                    valid[i + j * n] = true;
+                }
+            }
+            match keep {
+                Some(old) if old.len() == total * c * plane => {
+                    let old = &old[s * c * plane..(s + 1) * c * plane];
+                    for (k, v) in data.iter_mut().enumerate() {
+                        if !valid[k % plane] {
+                            *v = old[k];
+                        }
+                    }
+                }
+                _ => {
+                    for ch in 0..c {
+                        fill_below_horizon(&mut data[ch * plane..(ch + 1) * plane], &valid, n);
+                    }
+                }
+            }
+            progress.set((done.fetch_add(1, Ordering::Relaxed) + 1) as u64);
+            Ok((data, valid))
+        })
+        .collect::<Result<_>>()?;
+    let mut data = Vec::with_capacity(total * c * plane);
+    let mut bits = Vec::with_capacity(total * plane);
+    for (d, v) in slices {
+        data.extend_from_slice(&d);
+        bits.extend_from_slice(&v);
+    }
+    if data.iter().any(|v| !v.is_finite()) {
+        return Err(Error::arg(
+            "source",
+            "a stored value overflows f32 (the source's values are too large)",
+        ));
+    }
+    Ok(Values {
+        data,
+        valid: pack_bits(&bits),
+    })
+}
