@@ -225,7 +225,7 @@ fn bad_sources_are_clear_errors_or_documented_results() {
     let e = encode(
         &*model(r#"{"model": "lambert", "kd": 0}"#, &Channels::Rgb),
         &Options::default(),
-        None,
+        &Silent,
     )
     .unwrap_err()
     .to_string();
