@@ -89,6 +89,15 @@ fn f64_array<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonlyArr
         return Ok(a);
     }
     let py = obj.py();
+    if obj.is_none() || obj.is_instance_of::<pyo3::types::PyString>() {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: expected an array of real numbers, got {}",
+            obj.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        )));
+    }
     if let Ok(dt) = obj.getattr("dtype") {
         let kind: String = dt
             .getattr("kind")
@@ -375,6 +384,56 @@ impl PyBrdf {
             })?;
             self.check_loaded()?;
             shaped_f32(py, out, n, c, single)
+        })
+    }
+
+    /// f_r(wi, wo) at wavelengths `nm` (shape (k,) for every pair, or (n, k)): float32 (n, k).
+    /// Spectral channels are interpolated; analytic models use their spectral data.
+    fn eval_spectral(
+        &self,
+        py: Python<'_>,
+        wi: &Bound<'_, PyAny>,
+        wo: &Bound<'_, PyAny>,
+        nm: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| {
+            let (a, b, n, single) = pair_rows(wi, "wi", 3, wo, "wo", 3)?;
+            let l = f64_array(nm, "nm")?;
+            let (k, per_row) = match l.shape() {
+                [k] => (*k, false),
+                [m, k] if *m == n => (*k, true),
+                s => {
+                    return Err(PyValueError::new_err(format!(
+                        "nm: expected shape (k,) or ({n}, k), got {}",
+                        shape_str(s)
+                    )));
+                }
+            };
+            let nm: Vec<f64> = l.as_array().iter().copied().collect();
+            if nm.iter().any(|x| !x.is_finite()) {
+                return Err(PyValueError::new_err("nm: non-finite wavelength"));
+            }
+            let brdf = &self.inner;
+            let out = run_batch(py, n * k, || {
+                let (a, b) = (vec3s(&a), vec3s(&b));
+                let mut out = vec![0.0f32; n * k];
+                out.par_chunks_mut(k.max(1))
+                    .with_min_len(256)
+                    .enumerate()
+                    .for_each(|(r, o)| {
+                        let l = if per_row {
+                            &nm[r * k..(r + 1) * k]
+                        } else {
+                            &nm[..]
+                        };
+                        for (o, &x) in o.iter_mut().zip(l) {
+                            *o = brdf.eval_wavelength(a[r], b[r], x) as f32;
+                        }
+                    });
+                out
+            })?;
+            self.check_loaded()?;
+            shaped_f32(py, out, n, k, single)
         })
     }
 
