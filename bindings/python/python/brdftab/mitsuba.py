@@ -68,8 +68,9 @@ def plugin_class():
 
 def _prop(props, name, default=None):
     try:
-        if props.has_property(name):
+        if name in props:
             return props[name]
+        return default
     except Exception:  # older Properties API
         pass
     try:
