@@ -223,3 +223,17 @@ def test_jit_bad_input():
     si.wi = mi.Vector3f([0, math.nan, 0], [0, 0, 0], [1, 1, -1])
     v = np.array(b.eval(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1)))
     assert np.isfinite(v[:, 0]).all() and (v[:, 1:] == 0).all()
+
+
+def test_jit_spectral_evaluates_at_si_wavelengths():
+    use("llvm_ad_rgb")  # skips without libLLVM
+    use("llvm_ad_spectral")
+    spec = '{"model": "lambert", "kd": {"wavelengths": [400, 700], "values": [0.2, 0.8]}}'
+    b = mi.load_dict({"type": "brdftab", "source": spec, "preset": "small"})
+    si = dr.zeros(mi.SurfaceInteraction3f, 2)
+    si.wi = mi.Vector3f(0, 0, 1)
+    si.wavelengths = mi.Spectrum([450, 500], [550, 560], [600, 610], [700, 710])
+    v = np.array(b.eval(mi.BSDFContext(), si, mi.Vector3f(0.6, 0, 0.8)))
+    want = brdftab.open(spec).eval_spectral([0, 0, 1], [0.6, 0, 0.8],
+                                           np.array(si.wavelengths).T.ravel())
+    np.testing.assert_allclose(v.T.ravel(), want * 0.8, rtol=0.02)
