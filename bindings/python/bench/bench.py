@@ -5,7 +5,7 @@
 1. Python batch eval of 10^6 pairs vs `brdftab bench`'s batch rate on the same table (a
    medium table baked from an RGL file), and the time of a one-pair call.
 2. llvm_ad_rgb: render time of a 256x256, 64 spp scene with the plugin (that table) vs
-   Mitsuba's `measured` on the RGL file (best of 3 after a warm-up render that compiles kernels).
+   Mitsuba's `measured` on the RGL file (best of 4 interleaved renders after a warm-up render that compiles the kernels).
 Figures are ratios within one run (the machine is shared; absolute times vary).
 """
 
@@ -71,7 +71,7 @@ def scene(mi, bsdf, spp=64, size=256):
     })
 
 
-def render_times(rgl_file, table, png):
+def render_times(rgl_file, table, png, rounds=4):
     import drjit as dr
     import mitsuba as mi
 
@@ -79,22 +79,21 @@ def render_times(rgl_file, table, png):
     import brdftab.mitsuba
 
     brdftab.mitsuba.register()
-    res = {}
+    scenes = {"plugin": scene(mi, {"type": "brdftab", "source": table}),
+              "measured": scene(mi, {"type": "measured", "filename": rgl_file})}
     imgs = {}
-    for name, bsdf in [("plugin", {"type": "brdftab", "source": table}),
-                       ("measured", {"type": "measured", "filename": rgl_file})]:
-        s = scene(mi, bsdf)
-        img = mi.render(s, seed=0)
-        dr.eval(img)
-        ts = []
-        for k in range(3):
+    for name, s in scenes.items():  # warm-up: compiles the kernels
+        dr.eval(mi.render(s, seed=0))
+    times = {name: [] for name in scenes}
+    for k in range(rounds):  # interleaved, so that load from other processes hits both alike
+        for name, s in scenes.items():
             t0 = time.perf_counter()
             img = mi.render(s, seed=k + 1)
             dr.eval(img)
             dr.sync_thread()
-            ts.append(time.perf_counter() - t0)
-        res[name] = min(ts)
-        imgs[name] = np.array(img)
+            times[name].append(time.perf_counter() - t0)
+            imgs[name] = np.array(img)
+    res = {name: min(t) for name, t in times.items()}
     if png:
         both = np.concatenate([imgs["plugin"], imgs["measured"]], axis=1)
         mi.util.write_bitmap(png, mi.TensorXf(both))

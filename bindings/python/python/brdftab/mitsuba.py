@@ -214,6 +214,42 @@ class ScalarBrdftabBSDF(_Common):
 
 # ---- JIT variants: the table in Dr.Jit ------------------------------------------------------
 
+def _fast_acos(x):
+    """symmetry.rs `fast_acos` (Abramowitz & Stegun 4.4.46, |error| <= 2e-8), in Dr.Jit."""
+    import drjit as dr
+
+    a = dr.minimum(dr.abs(x), 1.0)
+    p = -0.0012624911
+    p = p * a + 0.0066700901
+    p = p * a - 0.0170881256
+    p = p * a + 0.0308918810
+    p = p * a - 0.0501743046
+    p = p * a + 0.0889789874
+    p = p * a - 0.2145988016
+    p = p * a + 1.5707963050
+    r = dr.sqrt(1.0 - a) * p
+    return dr.select(x < 0, math.pi - r, r)
+
+
+def _fast_atan2(y, x):
+    """symmetry.rs `fast_atan2` (Cephes atanf reduction, |error| <= 2e-7), in Dr.Jit."""
+    import drjit as dr
+
+    ax, ay = dr.abs(x), dr.abs(y)
+    swap = ay > ax
+    num, den = dr.select(swap, ax, ay), dr.select(swap, ay, ax)
+    z = dr.select(den > 0, num / dr.select(den > 0, den, 1.0), 0.0)
+    big = z > 0.414213562373095
+    base = dr.select(big, math.pi / 4, 0.0)
+    t = dr.select(big, (z - 1.0) / (z + 1.0), z)
+    t2 = t * t
+    r = base + (((8.05374449538e-2 * t2 - 1.38776856032e-1) * t2 + 1.99777106478e-1) * t2
+                - 3.33329491539e-1) * t2 * t + t
+    r = dr.select(swap, math.pi / 2 - r, r)
+    r = dr.select(x < 0, math.pi - r, r)
+    return dr.select(y < 0, -r, r)
+
+
 class JitTable:
     """A brdftab table uploaded to Dr.Jit and evaluated with Dr.Jit operations, mirroring
     ``src/table/lookup.rs`` (linear and nearest lookups), ``symmetry.rs`` (canonical
@@ -263,18 +299,25 @@ class JitTable:
         iso, rec, bil = self.sym["isotropic"], self.sym["reciprocal"], self.sym["bilateral"]
         pi, tau = math.pi, 2 * math.pi
 
+        # Linear lookups use the Rust code's polynomial acos/atan2 (canonical_coords_fast),
+        # nearest lookups the exact functions (canonical_coords), as lookup.rs does.
+        fast = self.interp != "nearest"
+
         def acos(x):
-            return dr.acos(dr.clip(x, -1.0, 1.0))
+            return _fast_acos(x) if fast else dr.acos(dr.clip(x, -1.0, 1.0))
+
+        def atan2(y, x):
+            return _fast_atan2(y, x) if fast else dr.atan2(y, x)
 
         if self.param == "inout":
             ti, to = acos(wi[2]), acos(wo[2])
             if iso:
                 dot = wi[0] * wo[0] + wi[1] * wo[1]
                 cross = wi[0] * wo[1] - wi[1] * wo[0]
-                d = dr.atan2(cross, dot)
+                d = atan2(cross, dot)
                 d = dr.abs(d) if bil else dr.select(d < 0, d + tau, d)
                 return [ti, F(0.0), to, d], valid
-            a1, a3 = dr.atan2(wi[1], wi[0]), dr.atan2(wo[1], wo[0])
+            a1, a3 = atan2(wi[1], wi[0]), atan2(wo[1], wo[0])
             if bil:
                 neg = a1 < 0
                 a1, a3 = dr.select(neg, -a1, a1), dr.select(neg, -a3, a3)
@@ -293,10 +336,10 @@ class JitTable:
         y = (wi[1] * h[0] - wi[0] * h[1]) * length
         x = (wi[0] * h[0] + wi[1] * h[1]) * h[2] - wi[2] * hxy2
         pole = ~(hxy2 > 1e-24 * hh)
-        pd = dr.select(pole, dr.atan2(wi[1], wi[0]), dr.atan2(y, x))
+        pd = dr.select(pole, atan2(wi[1], wi[0]), atan2(y, x))
         ph = F(0.0)
         if not iso:
-            ph = dr.atan2(h[1], h[0])
+            ph = atan2(h[1], h[0])
             if bil:
                 neg = ph < 0
                 ph, pd = dr.select(neg, -ph, ph), dr.select(neg, -pd, pd)
