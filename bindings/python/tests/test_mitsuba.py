@@ -243,3 +243,24 @@ def test_jit_spectral_evaluates_at_si_wavelengths():
     want = brdftab.open(spec).eval_spectral([0, 0, 1], [0.6, 0, 0.8],
                                            np.array(si.wavelengths).T.ravel())
     np.testing.assert_allclose(v.T.ravel(), want * 0.8, rtol=0.02)
+
+
+def test_scalar_flags_and_delta():
+    use("scalar_rgb")
+    F = mi.BSDFFlags
+    m = mi.load_dict({"type": "brdftab", "source": '{"model": "mirror"}'})
+    assert m.flags() & F.DeltaReflection and m.flags() & F.FrontSide
+    si = mi.SurfaceInteraction3f()
+    si.wi = mi.Vector3f(0.6, 0, 0.8)
+    bs, w = m.sample(mi.BSDFContext(), si, 0.5, mi.Point2f(0.3, 0.3))
+    np.testing.assert_allclose(np.array(bs.wo), [-0.6, 0, 0.8], atol=1e-6)
+    assert bs.pdf == 1 and np.all(np.array(w) > 0)
+    assert np.all(np.array(m.eval(mi.BSDFContext(), si, bs.wo)) == 0)
+    lam = mi.load_dict({"type": "brdftab", "source": '{"model": "lambert", "kd": 0.5}'})
+    assert lam.flags() & F.DiffuseReflection
+    ggx = mi.load_dict({"type": "brdftab", "source": '{"model": "ggx", "alpha": 0.3}'})
+    assert ggx.flags() & F.GlossyReflection
+    # back side: zero
+    si.wi = mi.Vector3f(0, 0, -1)
+    assert np.all(np.array(ggx.eval(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1))) == 0)
+    assert ggx.pdf(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1)) == 0
