@@ -223,6 +223,8 @@ def test_jit_bad_input():
     use("llvm_ad_rgb")
     with pytest.raises(Exception, match="no-such-file"):
         mi.load_dict({"type": "brdftab", "source": "/nonexistent/no-such-file.btdb"})
+    with pytest.raises(Exception, match="delta"):
+        mi.load_dict({"type": "brdftab", "source": '{"model": "mirror"}'})
     b = mi.load_dict({"type": "brdftab", "source": '{"model": "ggx", "alpha": 0.3}',
                       "preset": "small"})
     si = dr.zeros(mi.SurfaceInteraction3f, 3)

@@ -467,6 +467,11 @@ class JitBrdftabBSDF(_Common):
 
         self._base.__init__(self, props)
         self._init_common(props)
+        if self.delta:
+            raise brdftab.Error(
+                f"{self.source}: a delta (mirror/refractor) source has no table; the JIT "
+                "variants of the plugin do not support it (use a scalar variant)"
+            )
         options = {}
         for key in ("preset", "grid"):
             v = _prop(props, key)
@@ -489,7 +494,8 @@ class JitBrdftabBSDF(_Common):
             if not grid.get("packed"):
                 return values, grid
             options = {}
-        options.setdefault("preset", "medium")
+        if brdftab_kind(self.source) != "merl":  # MERL files keep their own cells
+            options.setdefault("preset", "medium")
         if options.get("preset") and options.get("grid"):
             options.pop("preset")
         b = self.brdf
