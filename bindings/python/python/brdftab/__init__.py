@@ -1,0 +1,100 @@
+"""brdftab: tabulated BRDFs from Python, numpy arrays in and out.
+
+Every function takes a SOURCE string, as the ``brdftab`` command line does: an analytic model
+spec (inline JSON such as ``'{"model": "ggx", "alpha": 0.2}'`` or a ``.json`` file), a brdftab
+table (``FILE.btdb`` or ``DB.btdb#NAME``), a MERL ``.binary`` or an RGL-EPFL ``.bsdf`` file.
+
+Conventions (those of the library): local shading frame with z the surface normal, both
+directions pointing away from the surface, ``wi`` towards the light and ``wo`` towards the
+viewer; :meth:`Brdf.eval` returns f_r in 1/sr, not multiplied by a cosine; angles in radians.
+
+>>> import numpy as np, brdftab
+>>> b = brdftab.open('{"model": "lambert", "kd": 0.5}')
+>>> b.eval([0, 0, 1], [0.3, 0, 1])
+array([0.5, 0.5, 0.5], dtype=float32)
+
+Errors of the library (missing file, unknown model, corrupt table) raise :class:`Error` with
+the library's message; wrong arguments raise ``ValueError`` or ``TypeError``.
+"""
+
+from __future__ import annotations
+
+from ._native import (  # noqa: F401
+    Brdf,
+    Error,
+    __version__,
+    bake,
+    check,
+    convert,
+    fit,
+    info,
+    open,
+)
+from . import _native
+
+__all__ = [
+    "Brdf",
+    "Database",
+    "Error",
+    "bake",
+    "check",
+    "convert",
+    "fit",
+    "info",
+    "open",
+]
+
+
+class Database:
+    """A brdftab database: many named tables in one ``.btdb`` file.
+
+    >>> db = brdftab.Database("materials.btdb")            # doctest: +SKIP
+    >>> db.add('{"model": "lambert", "kd": 0.5}', "matte")  # doctest: +SKIP
+    >>> db.open("matte").eval([0, 0, 1], [0, 0, 1])          # doctest: +SKIP
+    """
+
+    def __init__(self, path):
+        self.path = str(path)
+
+    def __repr__(self):
+        return f"brdftab.Database({self.path!r})"
+
+    def __reduce__(self):
+        return (Database, (self.path,))
+
+    def names(self):
+        """The table names, in file order."""
+        return _native.db_names(self.path)
+
+    def __contains__(self, name):
+        return name in self.names()
+
+    def add(self, source, name, *, replace=False, **options):
+        """Bakes SOURCE into table NAME (the database is created if absent); takes the keywords
+        of :func:`bake`. Returns what ``brdftab info --json DB#NAME`` reports."""
+        _check_name(name)
+        return _native.bake(source, f"{self.path}#{name}", replace=replace, **options)
+
+    def remove(self, name):
+        """Removes table NAME."""
+        _native.db_remove(self.path, name)
+
+    def open(self, name, **options):
+        """Opens table NAME as a :class:`Brdf` (keywords of :func:`open`)."""
+        _check_name(name)
+        return _native.open(f"{self.path}#{name}", **options)
+
+    def source(self, name):
+        """The SOURCE string of table NAME (``DB#NAME``), e.g. for worker processes."""
+        return f"{self.path}#{name}"
+
+    def info(self):
+        """What ``brdftab info --json DB`` reports: the file and every table."""
+        return _native.info(self.path)
+
+
+def _check_name(name):
+    if not isinstance(name, str):
+        raise TypeError(f"name: expected a string, got {type(name).__name__}")
+    if not name or "#" in name:
+        raise ValueError(f"name: {name!r}: a table name is non-empty and has no '#'")

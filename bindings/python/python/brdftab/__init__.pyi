@@ -1,0 +1,99 @@
+"""Type stubs of the brdftab package (the Rust extension `brdftab._native` and its wrappers)."""
+
+from os import PathLike
+from typing import Any, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+ArrayLike = npt.ArrayLike
+Wavelengths = Union[None, str, Sequence[float]]
+
+class Error(Exception):
+    """An error of the brdftab library; the message is the library's."""
+
+class Brdf:
+    """A BRDF opened from a SOURCE (spec, table, DB#NAME, MERL .binary, RGL .bsdf)."""
+
+    @property
+    def channels(self) -> list[str]: ...
+    @property
+    def wavelengths(self) -> list[float] | None: ...
+    @property
+    def flags(self) -> dict[str, bool]: ...
+    @property
+    def source(self) -> str: ...
+    @property
+    def interp(self) -> str: ...
+    def describe(self) -> str: ...
+    def eval(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float32]:
+        """f_r(wi, wo) in 1/sr: (n, c) float32, or (c,) for one pair of shape (3,)."""
+    def eval_spectral(self, wi: ArrayLike, wo: ArrayLike, nm: ArrayLike) -> npt.NDArray[np.float32]:
+        """f_r at wavelengths nm ((k,) or (n, k)): (n, k) float32."""
+    def pdf(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float64]:
+        """Density of `sample` drawing wi given wo: (n,) float64."""
+    def sample(
+        self, wo: ArrayLike, u: ArrayLike
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32]]:
+        """(wi (n, 3), pdf (n,), weight = f cos θi / pdf (n, c)) for u in [0, 1)² of shape (n, 2)."""
+    def albedo(self, theta: ArrayLike) -> npt.NDArray[np.float64]:
+        """Directional albedo at θ′ in radians: (k, c) float64."""
+    def table(self, **options: Any) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
+        """The decoded table (values λ innermost, grid description); other sources are baked."""
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+
+def open(
+    source: str, *, interp: str = "linear", wavelengths: Wavelengths = None, eager: bool = True
+) -> Brdf: ...
+def check(source: str, *, wavelengths: Wavelengths = None) -> dict[str, Any]: ...
+def info(source: str) -> dict[str, Any]: ...
+def bake(
+    source: str,
+    output: str,
+    *,
+    preset: str | None = ...,
+    grid: str | None = ...,
+    param: str | None = ...,
+    symmetry: str | None = ...,
+    symmetry_tolerance: float | None = ...,
+    force: bool = ...,
+    codec: str | None = ...,
+    codec_tolerance: float | None = ...,
+    floor: float | None = ...,
+    level: int | None = ...,
+    exhaustive: bool = ...,
+    name: str | None = ...,
+    supersample: int = ...,
+    wavelengths: Wavelengths = ...,
+    replace: bool = ...,
+) -> dict[str, Any]: ...
+def convert(source: str, output: str, **options: Any) -> dict[str, Any]: ...
+def fit(
+    source: str,
+    model: str,
+    *,
+    params: str | Sequence[str] | None = ...,
+    log: bool = ...,
+    starts: int = ...,
+    pairs: int = ...,
+    max_theta: float = ...,
+    seed: int = ...,
+    fresnel: str | None = ...,
+    grey: bool = ...,
+    wavelengths: Wavelengths = ...,
+    specular_fraction: float = ...,
+    max_iterations: int = ...,
+) -> dict[str, Any]: ...
+
+class Database:
+    path: str
+    def __init__(self, path: Union[str, PathLike[str]]) -> None: ...
+    def names(self) -> list[str]: ...
+    def __contains__(self, name: str) -> bool: ...
+    def add(self, source: str, name: str, *, replace: bool = False, **options: Any) -> dict[str, Any]: ...
+    def remove(self, name: str) -> None: ...
+    def open(self, name: str, **options: Any) -> Brdf: ...
+    def source(self, name: str) -> str: ...
+    def info(self) -> dict[str, Any]: ...

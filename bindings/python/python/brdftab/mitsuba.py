@@ -1,0 +1,644 @@
+"""A Mitsuba 3 BSDF plugin ``brdftab`` over any brdftab SOURCE.
+
+>>> import mitsuba as mi, brdftab.mitsuba
+>>> mi.set_variant("scalar_rgb")
+>>> brdftab.mitsuba.register()
+>>> bsdf = mi.load_dict({"type": "brdftab", "source": "paper_white_rgb.bsdf"})  # doctest: +SKIP
+
+Properties: ``source`` (string, any SOURCE: spec, table, ``DB#NAME``, MERL, RGL), optional
+``interp`` (``"linear"`` or ``"nearest"``), and for JIT variants optional ``preset`` / ``grid``
+(the table a non-table source is baked on, default ``medium``) and ``sampling_res`` (the
+resolution of the tabulated sampling distributions, default 64).
+
+Conventions are those of Mitsuba's ``measured`` plugin: ``si.wi`` is brdftab's ``wi`` (towards
+the light in brdftab's words; the tensor's incident axes for RGL data), Mitsuba's ``wo`` is
+brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only.
+
+- Scalar variants (``scalar_rgb``, ``scalar_spectral``) call the library for every query (the
+  native source: RGL files evaluate with their own adaptive parameterization).
+- JIT variants (``llvm_ad_rgb``, ``cuda_ad_rgb``) cannot call back into the host per query:
+  the plugin bakes (or loads) a table, uploads its decoded values once, and evaluates it in
+  Dr.Jit operations that mirror the Rust lookup (``src/table/{grid,symmetry,lookup}.rs``):
+  half/difference coordinates, symmetry folds, axis mappings and multilinear interpolation.
+  Sampling draws wo from tabulated 2D distributions of f_r cos θo conditioned on θ(wi)
+  (isotropic tables; Mitsuba's ``MarginalContinuous2D1``) with the exactly consistent pdf, mixed
+  with cosine-weighted sampling; anisotropic tables sample cosine-weighted only.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import brdftab
+
+_REGISTERED = set()
+
+
+def register():
+    """Registers the plugin ``brdftab`` for the current Mitsuba variant (set one first)."""
+    import mitsuba as mi
+
+    variant = mi.variant()
+    if variant is None:
+        raise RuntimeError("brdftab.mitsuba.register(): call mitsuba.set_variant(...) first")
+    mi.register_bsdf("brdftab", lambda props: plugin_class()(props))
+    _REGISTERED.add(variant)
+
+
+_CLASSES = {}
+
+
+def plugin_class():
+    """The plugin's class for the current variant (a subclass of that variant's ``mi.BSDF``)."""
+    import drjit as dr
+    import mitsuba as mi
+
+    variant = mi.variant()
+    if variant not in _CLASSES:
+        mixin = JitBrdftabBSDF if dr.is_jit_v(mi.Float) else ScalarBrdftabBSDF
+        # nanobind classes take one base: the methods of the mixins are copied in.
+        ns = {"_base": mi.BSDF}
+        for cls in reversed(mixin.__mro__[:-1]):
+            ns.update({k: v for k, v in vars(cls).items() if not k.startswith("__") or k == "__init__"})
+        _CLASSES[variant] = type("BrdftabBSDF", (mi.BSDF,), ns)
+    return _CLASSES[variant]
+
+
+def _prop(props, name, default=None):
+    try:
+        if name in props:
+            return props[name]
+        return default
+    except Exception:  # older Properties API
+        pass
+    try:
+        return props.get(name, default)
+    except Exception:
+        return default
+
+
+def _flags(brdf, source):
+    import mitsuba as mi
+
+    F = mi.BSDFFlags
+    if brdf.flags["delta"]:
+        lobe = F.DeltaReflection
+    elif brdftab_kind(source) == "spec" and _is_diffuse_spec(source):
+        lobe = F.DiffuseReflection
+    else:
+        lobe = F.GlossyReflection
+    return lobe | F.FrontSide
+
+
+def brdftab_kind(source):
+    s = source.strip()
+    low = s.lower()
+    if s.startswith("{") or low.endswith(".json"):
+        return "spec"
+    if low.endswith(".binary"):
+        return "merl"
+    if low.endswith(".bsdf"):
+        return "rgl"
+    return "table"
+
+
+def _is_diffuse_spec(source):
+    import json
+
+    try:
+        spec = json.loads(source) if source.strip().startswith("{") else json.load(open(source))
+    except Exception:
+        return False
+    return spec.get("model") in ("lambert", "oren_nayar")
+
+
+class _Common:
+    """What both plugin flavours share: properties, flags, description."""
+
+    def _init_common(self, props):
+        import mitsuba as mi
+
+        src = _prop(props, "source")
+        if not isinstance(src, str) or not src:
+            raise ValueError("brdftab plugin: the string property `source` is required")
+        self.source = src
+        self.interp = str(_prop(props, "interp", "linear"))
+        self.spectral = mi.is_spectral
+        self.brdf = brdftab.open(src, interp=self.interp)
+        if not self.spectral and len(self.brdf.channels) != 3:
+            raise brdftab.Error(
+                f"{src}: channels {' '.join(self.brdf.channels)}; an RGB variant needs R, G, B "
+                "(use a spectral variant)"
+            )
+        flags = _flags(self.brdf, src)
+        self.m_components = [flags]
+        self.m_flags = flags
+        self.delta = self.brdf.flags["delta"]
+
+    def to_string(self):
+        return f"BrdftabBSDF[source={self.source!r}, {self.brdf.describe()}]"
+
+
+class ScalarBrdftabBSDF(_Common):
+    """Scalar variants: every query calls the library (the native source)."""
+
+    def __init__(self, props):
+        self._base.__init__(self, props)
+        self._init_common(props)
+
+    def _f(self, wi, wo, si):
+        import mitsuba as mi
+
+        if self.spectral:
+            nm = [float(x) for x in si.wavelengths]
+            return mi.Spectrum(self.brdf.eval_spectral(wi, wo, nm).tolist())
+        return mi.Spectrum(self.brdf.eval(wi, wo).tolist())
+
+    @staticmethod
+    def _vec(v):
+        return [float(v[0]), float(v[1]), float(v[2])]
+
+    def eval(self, ctx, si, wo, active=True):
+        import mitsuba as mi
+
+        wi, wo = self._vec(si.wi), self._vec(wo)
+        if self.delta or not (wi[2] > 0 and wo[2] > 0) or not active:
+            return mi.Spectrum(0.0)
+        cos_o = wo[2] / math.sqrt(wo[0] ** 2 + wo[1] ** 2 + wo[2] ** 2)
+        return self._f(wi, wo, si) * cos_o
+
+    def pdf(self, ctx, si, wo, active=True):
+        wi, wo = self._vec(si.wi), self._vec(wo)
+        if self.delta or not (wi[2] > 0 and wo[2] > 0) or not active:
+            return 0.0
+        # Mitsuba's wo is drawn given si.wi: brdftab's sampler draws its `wi` given its `wo`,
+        # so it is asked with the roles swapped (see `sample`).
+        return float(self.brdf.pdf(wo, wi))
+
+    def eval_pdf(self, ctx, si, wo, active=True):
+        return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+
+    def sample(self, ctx, si, sample1, sample2, active=True):
+        import mitsuba as mi
+
+        bs = mi.BSDFSample3f()
+        wi = self._vec(si.wi)
+        u = [min(float(sample2[0]), 0.99999994), min(float(sample2[1]), 0.99999994)]
+        if not (wi[2] > 0) or not active:
+            return bs, mi.Spectrum(0.0)
+        d, pdf, w = self.brdf.sample(wi, u)
+        pdf = float(pdf)
+        if not (pdf > 0 and d[2] > 0):
+            return bs, mi.Spectrum(0.0)
+        bs.wo = mi.Vector3f(*[float(x) for x in d])
+        bs.eta = 1.0
+        bs.sampled_component = 0
+        if self.delta:
+            bs.pdf = 1.0
+            bs.sampled_type = mi.UInt32(+mi.BSDFFlags.DeltaReflection)
+            return bs, mi.Spectrum(w.tolist()) if not self.spectral else mi.Spectrum(float(w.mean()))
+        bs.pdf = pdf
+        bs.sampled_type = mi.UInt32(+self.m_flags & ~int(mi.BSDFFlags.FrontSide))
+        # The weight is recomputed from eval: exact also for sources that are not reciprocal.
+        value = self.eval(ctx, si, bs.wo)
+        return bs, value / pdf
+
+    def traverse(self, callback):
+        pass
+
+    def parameters_changed(self, keys):
+        pass
+
+
+# ---- JIT variants: the table in Dr.Jit ------------------------------------------------------
+
+def _fast_acos(x):
+    """symmetry.rs `fast_acos` (Abramowitz & Stegun 4.4.46, |error| <= 2e-8), in Dr.Jit."""
+    import drjit as dr
+
+    a = dr.minimum(dr.abs(x), 1.0)
+    p = -0.0012624911
+    p = p * a + 0.0066700901
+    p = p * a - 0.0170881256
+    p = p * a + 0.0308918810
+    p = p * a - 0.0501743046
+    p = p * a + 0.0889789874
+    p = p * a - 0.2145988016
+    p = p * a + 1.5707963050
+    r = dr.sqrt(1.0 - a) * p
+    return dr.select(x < 0, math.pi - r, r)
+
+
+def _fast_atan2(y, x):
+    """symmetry.rs `fast_atan2` (Cephes atanf reduction, |error| <= 2e-7), in Dr.Jit."""
+    import drjit as dr
+
+    ax, ay = dr.abs(x), dr.abs(y)
+    swap = ay > ax
+    num, den = dr.select(swap, ax, ay), dr.select(swap, ay, ax)
+    z = dr.select(den > 0, num / dr.select(den > 0, den, 1.0), 0.0)
+    big = z > 0.414213562373095
+    base = dr.select(big, math.pi / 4, 0.0)
+    t = dr.select(big, (z - 1.0) / (z + 1.0), z)
+    t2 = t * t
+    r = base + (((8.05374449538e-2 * t2 - 1.38776856032e-1) * t2 + 1.99777106478e-1) * t2
+                - 3.33329491539e-1) * t2 * t + t
+    r = dr.select(swap, math.pi / 2 - r, r)
+    r = dr.select(x < 0, math.pi - r, r)
+    return dr.select(y < 0, -r, r)
+
+
+class JitTable:
+    """A brdftab table uploaded to Dr.Jit and evaluated with Dr.Jit operations, mirroring
+    ``src/table/lookup.rs`` (linear and nearest lookups), ``symmetry.rs`` (canonical
+    coordinates) and ``grid.rs`` (stored axes: mappings, node placement, folds, periods).
+
+    Coordinates are computed in float64 (as the Rust code does), weights and values in float32.
+    """
+
+    def __init__(self, values, grid, interp="linear"):
+        import drjit as dr
+        import mitsuba as mi
+
+        if grid.get("packed"):
+            raise brdftab.Error("packed inout reciprocal tables are not supported by the JIT path")
+        self.param = grid["param"]
+        self.sym = grid["symmetry"]
+        self.axes = grid["stored_axes"]
+        self.shape = list(grid["stored_shape"])
+        self.c = int(values.shape[-1])
+        self.interp = interp
+        self.channel_names = grid["channel_names"]
+        self.wavelengths = None
+        if self.channel_names and self.channel_names[0].endswith("nm"):
+            self.wavelengths = [float(x[:-2]) for x in self.channel_names]
+        self.values = mi.Float(np.ascontiguousarray(values, dtype=np.float32).ravel())
+        dr.eval(self.values)
+        self.Float64 = dr.float64_array_t(mi.Float)
+        self.UInt = mi.UInt32
+
+    # -- symmetry.rs: canonical coordinates ----------------------------------------------
+    def coords(self, wi, wo):
+        """Canonical [x0, x1, x2, x3] (float64) and the validity mask."""
+        import drjit as dr
+
+        F = self.Float64
+        wi = [F(wi.x), F(wi.y), F(wi.z)]
+        wo = [F(wo.x), F(wo.y), F(wo.z)]
+
+        def unit(v):
+            n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+            inv = dr.rsqrt(dr.maximum(n2, 1e-300))
+            return [v[0] * inv, v[1] * inv, v[2] * inv], n2 > 0
+
+        wi, ok_i = unit(wi)
+        wo, ok_o = unit(wo)
+        valid = ok_i & ok_o & (wi[2] > 0) & (wo[2] > 0)
+        iso, rec, bil = self.sym["isotropic"], self.sym["reciprocal"], self.sym["bilateral"]
+        pi, tau = math.pi, 2 * math.pi
+
+        # Linear lookups use the Rust code's polynomial acos/atan2 (canonical_coords_fast),
+        # nearest lookups the exact functions (canonical_coords), as lookup.rs does.
+        fast = self.interp != "nearest"
+
+        def acos(x):
+            return _fast_acos(x) if fast else dr.acos(dr.clip(x, -1.0, 1.0))
+
+        def atan2(y, x):
+            return _fast_atan2(y, x) if fast else dr.atan2(y, x)
+
+        if self.param == "inout":
+            ti, to = acos(wi[2]), acos(wo[2])
+            if iso:
+                dot = wi[0] * wo[0] + wi[1] * wo[1]
+                cross = wi[0] * wo[1] - wi[1] * wo[0]
+                d = atan2(cross, dot)
+                d = dr.abs(d) if bil else dr.select(d < 0, d + tau, d)
+                return [ti, F(0.0), to, d], valid
+            a1, a3 = atan2(wi[1], wi[0]), atan2(wo[1], wo[0])
+            if bil:
+                neg = a1 < 0
+                a1, a3 = dr.select(neg, -a1, a1), dr.select(neg, -a3, a3)
+            a1 = dr.select(a1 < 0, a1 + tau, a1)
+            a3 = dr.select(a3 < 0, a3 + tau, a3)
+            return [ti, a1, to, a3], valid
+        # halfdiff, as half_diff_angles_fast: unnormalized h = wi + wo
+        h = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]
+        hxy2 = h[0] * h[0] + h[1] * h[1]
+        hh = hxy2 + h[2] * h[2]
+        valid &= hh > 1e-300
+        length = dr.sqrt(dr.maximum(hh, 1e-300))
+        inv = 1.0 / length
+        th = acos(h[2] * inv)
+        td = acos((wi[0] * h[0] + wi[1] * h[1] + wi[2] * h[2]) * inv)
+        y = (wi[1] * h[0] - wi[0] * h[1]) * length
+        x = (wi[0] * h[0] + wi[1] * h[1]) * h[2] - wi[2] * hxy2
+        pole = ~(hxy2 > 1e-24 * hh)
+        pd = dr.select(pole, atan2(wi[1], wi[0]), atan2(y, x))
+        ph = F(0.0)
+        if not iso:
+            ph = atan2(h[1], h[0])
+            if bil:
+                neg = ph < 0
+                ph, pd = dr.select(neg, -ph, ph), dr.select(neg, -pd, pd)
+            ph = dr.select(ph < 0, ph + tau, ph)
+        iso_bil = iso and bil
+        if rec and iso_bil:
+            a = dr.abs(pd)
+            pd = dr.minimum(a, pi - a)
+        elif rec:
+            pd = dr.select(pd < 0, pd + pi, pd)
+        elif iso_bil:
+            pd = dr.abs(pd)
+        else:
+            pd = dr.select(pd < 0, pd + tau, pd)
+        return [th, ph, td, pd], valid
+
+    # -- grid.rs: StoredAxis ---------------------------------------------------------------
+    @staticmethod
+    def _cell_coordinate(ax, x, exact):
+        import drjit as dr
+
+        n = float(ax["size"])
+        lo, hi = ax["lo"], ax["hi"]
+        r = (x - lo) / (hi - lo) if exact else (x - lo) * (1.0 / (hi - lo))
+        if ax["periodic"]:
+            return r * n
+        m, nodes = ax["mapping"], ax["nodes"]
+        if m == "sqrt" and nodes == "cell_start":
+            return dr.sqrt(dr.maximum(r * n * n, 0.0))
+        if m == "uniform" and nodes == "cell_start":
+            return r * n
+        if m == "uniform":
+            u = r
+        elif m == "sqrt":
+            u = dr.sqrt(dr.maximum(r, 0.0))
+        else:  # cos (θ axes, lo = 0)
+            u = (math.cos(lo) - dr.cos(x)) / (math.cos(lo) - math.cos(hi))
+        if nodes == "centers":
+            return u * n - 0.5
+        if nodes == "edges":
+            return u * (n - 1.0)
+        return u * n
+
+    def _continuous(self, ax, x):
+        s = self._cell_coordinate(ax, x, False)
+        return s - 0.5 if ax["nodes"] == "cell_start" else s
+
+    def _linear(self, ax, x):
+        """(i0, i1, t) as StoredAxis::linear."""
+        import drjit as dr
+
+        U, Fl = self.UInt, type(self.values)
+        n = ax["size"]
+        if n <= 1:
+            return U(0), U(0), Fl(0.0)
+        s = self._continuous(ax, x)
+        if ax["periodic"]:
+            fin = dr.isfinite(s)
+            s = dr.select(fin, s, 0.0)
+            fi = dr.floor(s)
+            t = Fl(s - fi)
+            i0 = fi - n * dr.floor(fi / n)  # rem_euclid
+            i0 = U(dr.clip(i0, 0, n - 1))
+            i1 = dr.select(i0 + 1 == n, U(0), i0 + 1)
+            return i0, i1, t
+        s = dr.select(s > 0, dr.minimum(s, n - 1.0), 0.0)
+        i0 = dr.minimum(U(dr.floor(s)), n - 2)
+        return i0, i0 + 1, Fl(s - self.Float64(i0))
+
+    def _nearest(self, ax, x):
+        import drjit as dr
+
+        n = ax["size"]
+        if n <= 1:
+            return self.UInt(0)
+        if ax["nodes"] == "cell_start":
+            i = dr.floor(self._cell_coordinate(ax, x, True))
+        else:
+            i = dr.floor(self._continuous(ax, x) + 0.5)
+        if ax["periodic"]:
+            i = dr.select(dr.isfinite(i), i, 0.0)
+            i = i - n * dr.floor(i / n)
+            return self.UInt(dr.clip(i, 0, n - 1))
+        i = dr.select(i > 0, dr.minimum(i, n - 1.0), 0.0)
+        return self.UInt(i)
+
+    # -- lookup.rs ---------------------------------------------------------------------------
+    def lookup(self, wi, wo, active=True):
+        """f_r per channel: a list of c float32 arrays (0 where invalid)."""
+        import drjit as dr
+
+        x, valid = self.coords(wi, wo)
+        valid &= active
+        n0, s1, n2, s3 = self.shape
+        c = self.c
+        Fl = type(self.values)
+        out = [Fl(0.0) for _ in range(c)]
+        if self.interp == "nearest":
+            idx = [self._nearest(self.axes[k], x[k]) for k in range(4)]
+            base = (((idx[0] * s1 + idx[1]) * n2 + idx[2]) * s3 + idx[3]) * c
+            return [dr.gather(Fl, self.values, base + k, valid) for k in range(c)]
+        lin = [self._linear(self.axes[k], x[k]) for k in range(4)]
+        corners1 = [(lin[1][0], 1.0 - lin[1][2])]
+        if s1 > 1:
+            corners1.append((lin[1][1], lin[1][2]))
+        for a, wa in ((lin[0][0], 1.0 - lin[0][2]), (lin[0][1], lin[0][2])):
+            for p, wp in corners1:
+                for b, wb in ((lin[2][0], 1.0 - lin[2][2]), (lin[2][1], lin[2][2])):
+                    w2 = wa * wp * wb
+                    row = ((a * s1 + p) * n2 + b) * s3
+                    for q, wq in ((lin[3][0], 1.0 - lin[3][2]), (lin[3][1], lin[3][2])):
+                        wt = w2 * wq
+                        base = (row + q) * c
+                        for k in range(c):
+                            out[k] = dr.fma(wt, dr.gather(Fl, self.values, base + k, valid), out[k])
+        return [dr.select(valid, o, 0.0) for o in out]
+
+
+class JitBrdftabBSDF(_Common):
+    """JIT variants: a table evaluated in Dr.Jit, tabulated importance sampling."""
+
+    def __init__(self, props):
+        import drjit as dr
+        import mitsuba as mi
+
+        self._base.__init__(self, props)
+        self._init_common(props)
+        if self.delta:
+            raise brdftab.Error(
+                f"{self.source}: a delta (mirror/refractor) source has no table; the JIT "
+                "variants of the plugin do not support it (use a scalar variant)"
+            )
+        options = {}
+        for key in ("preset", "grid"):
+            v = _prop(props, key)
+            if v is not None:
+                options[key] = str(v)
+        if self.spectral and brdftab_kind(self.source) in ("spec", "rgl"):
+            options.setdefault("wavelengths", list(range(380, 781, 20)))
+        values, grid = self._table(options)
+        self.table = JitTable(values, grid, self.interp)
+        self.sampling_res = int(_prop(props, "sampling_res", 64))
+        self.cos_fraction = float(_prop(props, "cosine_fraction", 0.1))
+        self.warp = None
+        if grid["symmetry"]["isotropic"] and not self.delta:
+            self.warp = self._build_warp()
+        dr.eval()
+
+    def _table(self, options):
+        if brdftab_kind(self.source) == "table" and not options:
+            values, grid = self.brdf.table()
+            if not grid.get("packed"):
+                return values, grid
+            options = {}
+        if brdftab_kind(self.source) != "merl":  # MERL files keep their own cells
+            options.setdefault("preset", "medium")
+        if options.get("preset") and options.get("grid"):
+            options.pop("preset")
+        b = self.brdf
+        if "wavelengths" in options:
+            b = brdftab.open(self.source, interp=self.interp, wavelengths=options.pop("wavelengths"))
+        return b.table(param="halfdiff", **options)
+
+    # -- tabulated sampling: wo ~ f(wi, wo) cos θo, conditioned on θi ---------------------------
+    def _build_warp(self):
+        import mitsuba as mi
+
+        n = self.sampling_res
+        n_t = 16
+        thetas = np.linspace(0, math.pi / 2, n_t) * 0.999
+        # node grid over the unit square: x → φo (relative to φi = 0), y → θo (uniform)
+        ys = np.linspace(0, 1, n)
+        xs = np.linspace(0, 1, 2 * n)
+        to = ys * (math.pi / 2)
+        po = xs * (2 * math.pi)
+        T, P = np.meshgrid(to, po, indexing="ij")
+        wo = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], -1).reshape(-1, 3)
+        wo[:, 2] = np.maximum(wo[:, 2], 1e-4)
+        data = np.empty((n_t, n, 2 * n), dtype=np.float32)
+        for j, ti in enumerate(thetas):
+            wi = np.array([math.sin(ti), 0.0, math.cos(ti)])
+            # the table itself is what is sampled (values as the JIT lookup sees them)
+            f = self._eval_table_np(np.tile(wi, (len(wo), 1)), wo)
+            lum = f.mean(axis=1).reshape(n, 2 * n)
+            g = lum * np.cos(T) * np.sin(T)
+            g = np.maximum(g, 0) + 1e-3 * max(g.mean(), 1e-12) * np.sin(T)
+            data[j] = g
+        self.warp_thetas = thetas
+        return mi.MarginalContinuous2D1(data, [thetas.tolist()], normalize=True)
+
+    def _eval_table_np(self, wi, wo):
+        import mitsuba as mi
+
+        vi = mi.Vector3f(wi[:, 0], wi[:, 1], wi[:, 2])
+        vo = mi.Vector3f(wo[:, 0], wo[:, 1], wo[:, 2])
+        f = self.table.lookup(vi, vo)
+        return np.stack([np.array(x) for x in f], -1)
+
+    def _f(self, wi, wo, si, active):
+        import drjit as dr
+        import mitsuba as mi
+
+        f = self.table.lookup(wi, wo, active)
+        if not self.spectral:
+            return mi.Spectrum(f[0], f[1], f[2])
+        wl = self.table.wavelengths
+        if wl is None:  # an RGB table in a spectral variant: its mean
+            return mi.Spectrum(sum(f) / len(f))
+        out = []
+        lam = si.wavelengths
+        for i in range(len(lam)):
+            x = lam[i]
+            v = dr.select(x <= wl[0], f[0], f[-1])
+            for k in range(len(wl) - 1):
+                t = (x - wl[k]) / (wl[k + 1] - wl[k])
+                v = dr.select((x > wl[k]) & (x <= wl[k + 1]), dr.lerp(f[k], f[k + 1], t), v)
+            out.append(v)
+        return mi.Spectrum(out)
+
+    def _polar(self, wi, wo):
+        """(frame-relative unit coordinates of wo, θi, ok): x = (φo − φi)/2π, y = θo/(π/2)."""
+        import drjit as dr
+        import mitsuba as mi
+
+        ti = dr.acos(dr.clip(dr.normalize(wi).z, -1, 1))
+        phi_i = dr.atan2(wi.y, wi.x)
+        won = dr.normalize(wo)
+        to = dr.acos(dr.clip(won.z, -1, 1))
+        po = dr.atan2(won.y, won.x) - phi_i
+        x = po * (0.5 / math.pi)
+        x = x - dr.floor(x)
+        return mi.Point2f(x, to * (2 / math.pi)), ti, phi_i, to
+
+    def eval(self, ctx, si, wo, active=True):
+        import drjit as dr
+        import mitsuba as mi
+
+        active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
+        if self.delta:
+            return mi.Spectrum(0.0)
+        cos_o = dr.normalize(wo).z
+        return dr.select(active, self._f(si.wi, wo, si, active) * cos_o, 0.0)
+
+    def _pdf(self, si, wo, active):
+        import drjit as dr
+        import mitsuba as mi
+
+        cos_o = dr.normalize(wo).z
+        p_cos = dr.maximum(cos_o, 0.0) / math.pi
+        if self.warp is None:
+            return dr.select(active, p_cos, 0.0)
+        pos, ti, _, to = self._polar(si.wi, wo)
+        ti = dr.minimum(ti, float(self.warp_thetas[-1]))
+        p_pos = self.warp.eval(pos, [ti], active)
+        p_w = p_pos / dr.maximum(math.pi * math.pi * dr.sin(to), 1e-12)
+        c = self.cos_fraction
+        return dr.select(active, c * p_cos + (1 - c) * p_w, 0.0)
+
+    def pdf(self, ctx, si, wo, active=True):
+        import mitsuba as mi
+
+        active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
+        if self.delta:
+            return mi.Float(0.0)
+        return self._pdf(si, wo, active)
+
+    def eval_pdf(self, ctx, si, wo, active=True):
+        return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+
+    def sample(self, ctx, si, sample1, sample2, active=True):
+        import drjit as dr
+        import mitsuba as mi
+
+        active = mi.Bool(active) & (si.wi.z > 0)
+        bs = dr.zeros(mi.BSDFSample3f)
+        wo_cos = mi.warp.square_to_cosine_hemisphere(sample2)
+        if self.warp is None:
+            wo = wo_cos
+        else:
+            _, ti, phi_i, _ = self._polar(si.wi, si.wi)
+            ti = dr.minimum(ti, float(self.warp_thetas[-1]))
+            use_cos = sample1 < self.cos_fraction
+            pos, _ = self.warp.sample(sample2, [ti], active & ~use_cos)
+            to = pos.y * (math.pi / 2)
+            po = pos.x * (2 * math.pi) + phi_i
+            st, ct = dr.sincos(to)
+            sp, cp = dr.sincos(po)
+            wo = dr.select(use_cos, wo_cos, mi.Vector3f(st * cp, st * sp, ct))
+        bs.wo = wo
+        bs.pdf = self._pdf(si, wo, active & (wo.z > 0))
+        bs.eta = 1.0
+        bs.sampled_type = mi.UInt32(+self.m_flags & ~int(mi.BSDFFlags.FrontSide))
+        bs.sampled_component = mi.UInt32(0)
+        ok = active & (wo.z > 0) & (bs.pdf > 0)
+        value = self.eval(ctx, si, wo, ok)
+        return bs, dr.select(ok, value / dr.maximum(bs.pdf, 1e-20), 0.0)
+
+    def traverse(self, callback):
+        pass
+
+    def parameters_changed(self, keys):
+        pass

@@ -1,0 +1,13 @@
+from typing import Any
+
+def register() -> None:
+    """Registers the Mitsuba 3 BSDF plugin `brdftab` for the current variant."""
+
+def plugin_class() -> type: ...
+
+class JitTable:
+    """A brdftab table evaluated in Dr.Jit operations (mirrors the Rust lookup)."""
+
+    def __init__(self, values: Any, grid: dict[str, Any], interp: str = "linear") -> None: ...
+    def coords(self, wi: Any, wo: Any) -> tuple[list[Any], Any]: ...
+    def lookup(self, wi: Any, wo: Any, active: Any = True) -> list[Any]: ...

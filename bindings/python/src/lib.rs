@@ -1,0 +1,1021 @@
+//! `brdftab._native`: the PyO3 extension behind the Python package `brdftab`.
+//!
+//! Thin over the library's two doors ([`brdftab::open_with`] and [`BakeRequest`]): this module
+//! converts numpy arrays and keyword arguments, releases the GIL around batch work (which runs on
+//! rayon, as `eval_batch` does), and maps errors — `brdftab::Error` to `brdftab.Error` (argument
+//! errors to `ValueError`), wrong shapes and dtypes to `ValueError`/`TypeError`. Every call runs
+//! under `catch_unwind`: a panic becomes `brdftab.Error`, never an abort of the interpreter.
+//!
+//! The pure-Python side (`python/brdftab/__init__.py`) re-exports these names and adds
+//! `Database` and `brdftab.mitsuba`.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::Arc;
+
+use brdftab::bake::{BakeRequest, BakeTarget, GridChoice, SymmetryChoice};
+use brdftab::source::{self, OpenOptions, SourceKind};
+use brdftab::table::{Interp, Param, TabulatedBrdf};
+use brdftab::{Brdf, Channels};
+use glam::{DVec2, DVec3};
+use numpy::ndarray::{Array1, Array2, ArrayD, IxDyn};
+use numpy::{IntoPyArray, PyArrayDyn, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyException, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use rayon::prelude::*;
+
+pyo3::create_exception!(
+    brdftab,
+    Error,
+    PyException,
+    "An error reported by the brdftab library (missing file, unknown model, corrupt table, ...); \
+     the message is the library's."
+);
+
+/// Batches at least this large release the GIL and run on rayon.
+const PARALLEL: usize = 4096;
+
+/// Maps a library error: argument errors are `ValueError`, everything else `brdftab.Error`.
+fn lib_err(e: brdftab::Error) -> PyErr {
+    match e {
+        brdftab::Error::InvalidArgument { .. } => PyValueError::new_err(e.to_string()),
+        e => Error::new_err(e.to_string()),
+    }
+}
+
+fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        (*s).to_owned()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".to_owned()
+    }
+}
+
+/// Runs `f`, turning a panic into `brdftab.Error` (no unwinding across the FFI boundary).
+fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| {
+        Err(Error::new_err(format!(
+            "internal error in brdftab (please report): {}",
+            panic_message(p)
+        )))
+    })
+}
+
+/// [`guard`] for work done without the GIL: the panic message comes back as a `String`.
+fn no_panic<T>(f: impl FnOnce() -> T) -> Result<T, String> {
+    catch_unwind(AssertUnwindSafe(f)).map_err(panic_message)
+}
+
+fn panic_err(m: String) -> PyErr {
+    Error::new_err(format!("internal error in brdftab (please report): {m}"))
+}
+
+/// Runs `f` with the GIL released when `n` is large enough to be worth it.
+fn run_batch<T: Send>(py: Python<'_>, n: usize, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    let r = if n >= PARALLEL {
+        py.detach(|| no_panic(f))
+    } else {
+        no_panic(f)
+    };
+    r.map_err(panic_err)
+}
+
+/// A float64 view of an array-like (numpy array, list, tuple); non-numeric dtypes are a
+/// `TypeError`.
+fn f64_array<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+    if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'py, f64>>() {
+        return Ok(a);
+    }
+    let py = obj.py();
+    if obj.is_none() || obj.is_instance_of::<pyo3::types::PyString>() {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: expected an array of real numbers, got {}",
+            obj.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        )));
+    }
+    if let Ok(dt) = obj.getattr("dtype") {
+        let kind: String = dt
+            .getattr("kind")
+            .and_then(|k| k.extract())
+            .unwrap_or_default();
+        if !matches!(kind.as_str(), "b" | "i" | "u" | "f") {
+            return Err(PyTypeError::new_err(format!(
+                "{name}: expected real numbers, got an array of dtype {}",
+                dt.str().map(|s| s.to_string()).unwrap_or_default()
+            )));
+        }
+    }
+    let np = py.import("numpy")?;
+    let arr = np
+        .call_method1("asarray", (obj, "float64"))
+        .map_err(|e| PyTypeError::new_err(format!("{name}: not an array of real numbers ({e})")))?;
+    arr.extract::<PyReadonlyArrayDyn<'py, f64>>()
+        .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))
+}
+
+/// Rows of `width` finite numbers: (rows, true when the input was one row of shape (width,)).
+fn rows(obj: &Bound<'_, PyAny>, name: &str, width: usize) -> PyResult<(Vec<f64>, bool)> {
+    let a = f64_array(obj, name)?;
+    let shape = a.shape().to_vec();
+    let single = match shape.as_slice() {
+        [w] if *w == width => true,
+        [_, w] if *w == width => false,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "{name}: expected shape (n, {width}) or ({width},), got {}",
+                shape_str(&shape)
+            )));
+        }
+    };
+    let v = a.as_array();
+    let flat: Vec<f64> = match v.as_slice() {
+        Some(s) => s.to_vec(),
+        None => v.iter().copied().collect(),
+    };
+    if let Some(k) = flat.iter().position(|x| !x.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "{name}: row {} holds a non-finite value (NaN or infinity)",
+            k / width
+        )));
+    }
+    Ok((flat, single))
+}
+
+fn shape_str(shape: &[usize]) -> String {
+    match shape {
+        [a] => format!("({a},)"),
+        s => format!(
+            "({})",
+            s.iter()
+                .map(|x| x.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+fn vec3s(flat: &[f64]) -> Vec<DVec3> {
+    flat.chunks_exact(3)
+        .map(|r| DVec3::new(r[0], r[1], r[2]))
+        .collect()
+}
+
+/// Two row sets of the same count; a single row broadcasts against many.
+fn pair_rows(
+    a: &Bound<'_, PyAny>,
+    an: &str,
+    aw: usize,
+    b: &Bound<'_, PyAny>,
+    bn: &str,
+    bw: usize,
+) -> PyResult<(Vec<f64>, Vec<f64>, usize, bool)> {
+    let (mut x, xs) = rows(a, an, aw)?;
+    let (mut y, ys) = rows(b, bn, bw)?;
+    let (nx, ny) = (x.len() / aw, y.len() / bw);
+    let n = match (xs, ys) {
+        (true, false) => {
+            x = x.repeat(ny);
+            ny
+        }
+        (false, true) => {
+            y = y.repeat(nx);
+            nx
+        }
+        _ if nx == ny => nx,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "{an} and {bn}: {nx} and {ny} rows; expected the same number (or one row)"
+            )));
+        }
+    };
+    Ok((x, y, n, xs && ys))
+}
+
+fn interp_of(s: &str) -> PyResult<Interp> {
+    Interp::parse(s).map_err(|_| {
+        PyValueError::new_err(format!("interp: `{s}`: expected \"linear\" or \"nearest\""))
+    })
+}
+
+/// `wavelengths=`: None, a comma-separated string, or a sequence of numbers (nm).
+fn channels_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Channels>> {
+    let Some(o) = obj else { return Ok(None) };
+    if o.is_none() {
+        return Ok(None);
+    }
+    if let Ok(s) = o.extract::<String>() {
+        return source::parse_wavelengths(&s).map(Some).map_err(lib_err);
+    }
+    let nm: Vec<f64> = o.extract().map_err(|_| {
+        PyTypeError::new_err("wavelengths: expected a sequence of numbers (nm) or a string")
+    })?;
+    Channels::wavelengths(nm).map(Some).map_err(lib_err)
+}
+
+fn wavelengths_of(c: &Option<Channels>) -> Option<Vec<f64>> {
+    match c {
+        Some(Channels::Wavelengths(w)) => Some(w.clone()),
+        _ => None,
+    }
+}
+
+/// A serde_json value as a Python object (through `json.loads`: dicts, lists, floats, ...).
+fn to_py(py: Python<'_>, v: &serde_json::Value) -> PyResult<Py<PyAny>> {
+    let s = serde_json::to_string(v).map_err(|e| Error::new_err(e.to_string()))?;
+    Ok(py.import("json")?.call_method1("loads", (s,))?.unbind())
+}
+
+fn ser<T: serde::Serialize>(py: Python<'_>, x: &T) -> PyResult<Py<PyAny>> {
+    let v = serde_json::to_value(x).map_err(|e| Error::new_err(e.to_string()))?;
+    to_py(py, &v)
+}
+
+/// A BRDF opened from a SOURCE: an analytic model spec, a table (`FILE`, `DB#NAME`), a MERL
+/// `.binary` or an RGL `.bsdf` file. Directions are in the local frame (z = normal), both
+/// pointing away from the surface; `wi` is the direction to the light, `wo` to the viewer.
+/// Pickles by its source and options.
+#[pyclass(name = "Brdf", module = "brdftab", frozen)]
+struct PyBrdf {
+    inner: Arc<dyn Brdf + Send + Sync>,
+    table: Option<Arc<TabulatedBrdf>>,
+    source: String,
+    interp: String,
+    wavelengths: Option<Vec<f64>>,
+    eager: bool,
+}
+
+impl PyBrdf {
+    fn open(
+        source: &str,
+        interp: &str,
+        channels: Option<Channels>,
+        eager: bool,
+    ) -> PyResult<PyBrdf> {
+        let opts = OpenOptions {
+            interp: interp_of(interp)?,
+            channels: channels.clone(),
+            eager,
+        };
+        let (inner, table): (Arc<dyn Brdf + Send + Sync>, _) =
+            if source::classify(source) == SourceKind::Table && channels.is_none() {
+                let t = Arc::new(source::open_table(source, &opts).map_err(lib_err)?);
+                (t.clone(), Some(t))
+            } else {
+                (
+                    Arc::from(brdftab::open_with(source, &opts).map_err(lib_err)?),
+                    None,
+                )
+            };
+        Ok(PyBrdf {
+            inner,
+            table,
+            source: source.to_owned(),
+            interp: interp.trim().to_ascii_lowercase(),
+            wavelengths: wavelengths_of(&channels),
+            eager,
+        })
+    }
+
+    fn c(&self) -> usize {
+        self.inner.channels().len()
+    }
+
+    /// A lazily decoded chunk that failed (corrupt data) is an error, not silent zeros.
+    fn check_loaded(&self) -> PyResult<()> {
+        match self.table.as_ref().and_then(|t| t.load_error()) {
+            Some(e) => Err(Error::new_err(format!("{}: {e}", self.source))),
+            None => Ok(()),
+        }
+    }
+}
+
+fn shaped_f32(
+    py: Python<'_>,
+    v: Vec<f32>,
+    n: usize,
+    c: usize,
+    single: bool,
+) -> PyResult<Py<PyAny>> {
+    let a = if single {
+        Array1::from_vec(v).into_dyn()
+    } else {
+        Array2::from_shape_vec((n, c), v)
+            .map_err(|e| Error::new_err(e.to_string()))?
+            .into_dyn()
+    };
+    Ok(a.into_pyarray(py).into_any().unbind())
+}
+
+fn shaped_f64(py: Python<'_>, v: Vec<f64>, shape: &[usize]) -> PyResult<Py<PyAny>> {
+    let a = ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| Error::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py).into_any().unbind())
+}
+
+#[pymethods]
+impl PyBrdf {
+    /// Channel names as the CLI prints them: ["R", "G", "B"] or ["450nm", ...].
+    #[getter]
+    fn channels(&self) -> Vec<String> {
+        self.inner.channels().names()
+    }
+
+    /// Wavelengths in nm of a spectral BRDF, or None for RGB.
+    #[getter]
+    fn wavelengths(&self) -> Option<Vec<f64>> {
+        match self.inner.channels() {
+            Channels::Wavelengths(w) => Some(w.clone()),
+            _ => None,
+        }
+    }
+
+    /// What the BRDF declares: {"delta", "reciprocal", "isotropic", "bilateral", "transmission"}.
+    #[getter]
+    fn flags(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        ser(py, &self.inner.flags())
+    }
+
+    /// The SOURCE string this BRDF was opened from.
+    #[getter]
+    fn source(&self) -> String {
+        self.source.clone()
+    }
+
+    /// The interpolation of tables ("linear" or "nearest").
+    #[getter]
+    fn interp(&self) -> String {
+        self.interp.clone()
+    }
+
+    /// A one-line description (model and parameters, or table and source).
+    fn describe(&self) -> String {
+        self.inner.describe()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<brdftab.Brdf {:?}: {}>",
+            self.source,
+            self.inner.describe()
+        )
+    }
+
+    /// f_r(wi, wo) in 1/sr (not times a cosine) as float32 of shape (n, c), or (c,) when both
+    /// wi and wo have shape (3,). Directions need not be normalized; below the horizon f_r = 0.
+    fn eval(
+        &self,
+        py: Python<'_>,
+        wi: &Bound<'_, PyAny>,
+        wo: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| {
+            let (a, b, n, single) = pair_rows(wi, "wi", 3, wo, "wo", 3)?;
+            let c = self.c();
+            let brdf = &self.inner;
+            let out = run_batch(py, n, || {
+                let (a, b) = (vec3s(&a), vec3s(&b));
+                let mut out = vec![0.0f32; n * c];
+                brdf.eval_batch(&a, &b, &mut out);
+                out
+            })?;
+            self.check_loaded()?;
+            shaped_f32(py, out, n, c, single)
+        })
+    }
+
+    /// f_r(wi, wo) at wavelengths `nm` (shape (k,) for every pair, or (n, k)): float32 (n, k).
+    /// Spectral channels are interpolated; analytic models use their spectral data.
+    fn eval_spectral(
+        &self,
+        py: Python<'_>,
+        wi: &Bound<'_, PyAny>,
+        wo: &Bound<'_, PyAny>,
+        nm: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| {
+            let (a, b, n, single) = pair_rows(wi, "wi", 3, wo, "wo", 3)?;
+            let l = f64_array(nm, "nm")?;
+            let (k, per_row) = match l.shape() {
+                [k] => (*k, false),
+                [m, k] if *m == n => (*k, true),
+                s => {
+                    return Err(PyValueError::new_err(format!(
+                        "nm: expected shape (k,) or ({n}, k), got {}",
+                        shape_str(s)
+                    )));
+                }
+            };
+            let nm: Vec<f64> = l.as_array().iter().copied().collect();
+            if nm.iter().any(|x| !x.is_finite()) {
+                return Err(PyValueError::new_err("nm: non-finite wavelength"));
+            }
+            let brdf = &self.inner;
+            let out = run_batch(py, n * k, || {
+                let (a, b) = (vec3s(&a), vec3s(&b));
+                let mut out = vec![0.0f32; n * k];
+                out.par_chunks_mut(k.max(1))
+                    .with_min_len(256)
+                    .enumerate()
+                    .for_each(|(r, o)| {
+                        let l = if per_row {
+                            &nm[r * k..(r + 1) * k]
+                        } else {
+                            &nm[..]
+                        };
+                        for (o, &x) in o.iter_mut().zip(l) {
+                            *o = brdf.eval_wavelength(a[r], b[r], x) as f32;
+                        }
+                    });
+                out
+            })?;
+            self.check_loaded()?;
+            shaped_f32(py, out, n, k, single)
+        })
+    }
+
+    /// The density (1/sr, solid angle) with which `sample(wo, u)` draws wi: float64 (n,).
+    fn pdf(
+        &self,
+        py: Python<'_>,
+        wi: &Bound<'_, PyAny>,
+        wo: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| {
+            let (a, b, n, single) = pair_rows(wi, "wi", 3, wo, "wo", 3)?;
+            let brdf = &self.inner;
+            let out = run_batch(py, n, || {
+                let (a, b) = (vec3s(&a), vec3s(&b));
+                let mut out = vec![0.0f64; n];
+                out.par_iter_mut()
+                    .with_min_len(1024)
+                    .enumerate()
+                    .for_each(|(k, o)| *o = brdf.pdf(a[k], b[k]));
+                out
+            })?;
+            self.check_loaded()?;
+            let shape: &[usize] = if single { &[] } else { &[n] };
+            shaped_f64(py, out, shape)
+        })
+    }
+
+    /// Draws wi for each wo from uniform numbers u in [0, 1)² (shape (n, 2)); returns
+    /// (wi (n, 3) float64, pdf (n,) float64, weight (n, c) float32) with
+    /// weight = f_r cos θi / pdf (`brdftab sample`'s conventions). Where no direction can be
+    /// drawn (wo below the horizon) wi, pdf and weight are 0.
+    fn sample(
+        &self,
+        py: Python<'_>,
+        wo: &Bound<'_, PyAny>,
+        u: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyTuple>> {
+        guard(|| {
+            let (a, uu, n, single) = pair_rows(wo, "wo", 3, u, "u", 2)?;
+            if let Some(k) = uu.iter().position(|x| !(0.0..1.0).contains(x)) {
+                return Err(PyValueError::new_err(format!(
+                    "u: row {}: {} is outside [0, 1)",
+                    k / 2,
+                    uu[k]
+                )));
+            }
+            let c = self.c();
+            let brdf = &self.inner;
+            let (wi, pdf, w) = run_batch(py, n, || {
+                let a = vec3s(&a);
+                let mut wi = vec![0.0f64; n * 3];
+                let mut pdf = vec![0.0f64; n];
+                let mut w = vec![0.0f32; n * c.max(1)];
+                wi.par_chunks_mut(3)
+                    .zip(pdf.par_iter_mut())
+                    .zip(w.par_chunks_mut(c.max(1)))
+                    .with_min_len(1024)
+                    .enumerate()
+                    .for_each(|(k, ((wi, p), w))| {
+                        let u = DVec2::new(uu[2 * k], uu[2 * k + 1]);
+                        match brdf.sample(a[k], u, w) {
+                            Some(s) => {
+                                wi.copy_from_slice(&s.wi.to_array());
+                                *p = s.pdf;
+                            }
+                            None => w.fill(0.0),
+                        }
+                    });
+                (wi, pdf, w)
+            })?;
+            self.check_loaded()?;
+            let (s3, s1): (&[usize], &[usize]) = if single { (&[3], &[]) } else { (&[n, 3], &[n]) };
+            let wi = shaped_f64(py, wi, s3)?;
+            let pdf = shaped_f64(py, pdf, s1)?;
+            let w = shaped_f32(py, w, n, c, single)?;
+            Ok(PyTuple::new(py, [wi, pdf, w])?.unbind())
+        })
+    }
+
+    /// Directional albedo ∫ f_r cos θo dωo at incidence angles θ′ (radians, in [0, π/2]):
+    /// float64 (k, c) (or (c,) for a scalar θ′).
+    fn albedo(&self, py: Python<'_>, theta: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+        guard(|| {
+            let a = f64_array(theta, "theta")?;
+            let single = a.ndim() == 0;
+            if a.ndim() > 1 {
+                return Err(PyValueError::new_err(format!(
+                    "theta: expected a number or a 1-d array, got shape {}",
+                    shape_str(a.shape())
+                )));
+            }
+            let t: Vec<f64> = a.as_array().iter().copied().collect();
+            if let Some(x) = t
+                .iter()
+                .find(|x| !(0.0..=std::f64::consts::FRAC_PI_2).contains(*x))
+            {
+                return Err(PyValueError::new_err(format!(
+                    "theta: {x} is outside [0, π/2] (radians)"
+                )));
+            }
+            let brdf = &self.inner;
+            let k = t.len();
+            let curve = run_batch(py, PARALLEL, || {
+                brdftab::analysis::albedo::albedo_curve(brdf.as_ref(), &t)
+            })?;
+            self.check_loaded()?;
+            let c = self.c();
+            let flat: Vec<f64> = curve.into_iter().flatten().collect();
+            let shape: Vec<usize> = if single { vec![c] } else { vec![k, c] };
+            shaped_f64(py, flat, &shape)
+        })
+    }
+
+    /// The decoded table: (values, grid). `values` is float32 of shape stored_shape + (c,)
+    /// (λ innermost; a packed `inout` reciprocal table comes flat, chunk a holding axis-2
+    /// indices a..n); `grid` describes it (parameterization, full axes, symmetry, stored axes
+    /// with their mappings and node placement, packing). A table SOURCE gives its stored table;
+    /// any other source is baked in memory with `options` (the keywords of `brdftab.bake`).
+    #[pyo3(signature = (**options))]
+    fn table(&self, py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<Py<PyTuple>> {
+        guard(|| {
+            let table = match (&self.table, options.is_some_and(|o| !o.is_empty())) {
+                (Some(t), false) => {
+                    let t = t.clone();
+                    run_batch(py, PARALLEL, move || t.to_table())?.map_err(lib_err)?
+                }
+                _ => {
+                    let mut req = BakeRequest::new(self.source.clone());
+                    if let Some(w) = &self.wavelengths {
+                        req.channels = Some(Channels::wavelengths(w.clone()).map_err(lib_err)?);
+                    }
+                    let (_, _) = apply_bake_options(&mut req, options, &[])?;
+                    run_batch(py, PARALLEL, || req.table(&brdftab::progress::Silent))?
+                        .map_err(lib_err)?
+                        .0
+                }
+            };
+            let grid = table.grid().clone();
+            let mut g = serde_json::to_value(&grid).map_err(|e| Error::new_err(e.to_string()))?;
+            g["stored_axes"] = serde_json::to_value(grid.stored_axes())
+                .map_err(|e| Error::new_err(e.to_string()))?;
+            g["stored_shape"] = serde_json::json!(grid.stored_shape());
+            g["packed"] = serde_json::json!(grid.layout().packed);
+            g["channel_names"] = serde_json::json!(grid.channels().names());
+            g["description"] = serde_json::json!(table.description());
+            let mut shape = grid.stored_shape().to_vec();
+            shape.push(grid.channels().len());
+            let packed = grid.layout().packed;
+            let (_, values, _) = table.into_parts();
+            if packed {
+                // Packed inout reciprocity (chunk a holds axis-2 indices a..n): flat values.
+                shape = vec![values.len()];
+            }
+            let arr = ArrayD::from_shape_vec(IxDyn(&shape), values)
+                .map_err(|e| Error::new_err(e.to_string()))?;
+            let arr: Bound<'_, PyArrayDyn<f32>> = arr.into_pyarray(py);
+            Ok(PyTuple::new(py, [arr.into_any().unbind(), to_py(py, &g)?])?.unbind())
+        })
+    }
+
+    fn __reduce__(&self, py: Python<'_>) -> PyResult<Py<PyTuple>> {
+        let module = py.import("brdftab._native")?;
+        let f = module.getattr("_reopen")?;
+        let args = (
+            self.source.clone(),
+            self.interp.clone(),
+            self.wavelengths.clone(),
+            self.eager,
+        )
+            .into_pyobject(py)?;
+        Ok(PyTuple::new(py, [f, args.into_any()])?.unbind())
+    }
+}
+
+/// Reads the bake keywords into `req`; returns (replace, accuracy interp given) and leaves the
+/// keys listed in `extra` to the caller. Unknown keywords are a `TypeError`.
+fn apply_bake_options(
+    req: &mut BakeRequest,
+    options: Option<&Bound<'_, PyDict>>,
+    extra: &[&str],
+) -> PyResult<(bool, bool)> {
+    let mut replace = false;
+    let mut interp_given = false;
+    let Some(opts) = options else {
+        return Ok((replace, interp_given));
+    };
+    let (mut codec, mut tol, mut floor, mut level, mut exhaustive) =
+        ("log16".to_owned(), None, None, None, false);
+    let mut codec_given = false;
+    for (k, v) in opts.iter() {
+        let key: String = k.extract()?;
+        if v.is_none() {
+            continue;
+        }
+        let bad = |what: &str| PyTypeError::new_err(format!("{key}: expected {what}"));
+        match key.as_str() {
+            "preset" | "grid" => {
+                let s: String = v.extract().map_err(|_| bad("a string"))?;
+                req.grid = GridChoice::parse(&s).map_err(lib_err)?;
+            }
+            "param" => {
+                let s: String = v.extract().map_err(|_| bad("\"halfdiff\" or \"inout\""))?;
+                req.param = Some(Param::parse(&s).map_err(lib_err)?);
+            }
+            "symmetry" => {
+                let s: String = v.extract().map_err(|_| bad("a string"))?;
+                req.symmetry = SymmetryChoice::parse(&s).map_err(lib_err)?;
+            }
+            "symmetry_tolerance" => {
+                req.symmetry_tolerance = v.extract().map_err(|_| bad("a number"))?
+            }
+            "force" => req.force = v.extract().map_err(|_| bad("a bool"))?,
+            "codec" => {
+                codec = v
+                    .extract()
+                    .map_err(|_| bad("\"f32\", \"f16\" or \"log16\""))?;
+                codec_given = true;
+            }
+            "codec_tolerance" => {
+                tol = Some(v.extract().map_err(|_| bad("a number"))?);
+                codec_given = true;
+            }
+            "floor" | "codec_floor" => {
+                floor = Some(v.extract().map_err(|_| bad("a number"))?);
+                codec_given = true;
+            }
+            "level" => {
+                level = Some(v.extract().map_err(|_| bad("an int"))?);
+                codec_given = true;
+            }
+            "exhaustive" => {
+                exhaustive = v.extract().map_err(|_| bad("a bool"))?;
+                codec_given = true;
+            }
+            "name" => req.name = Some(v.extract().map_err(|_| bad("a string"))?),
+            "supersample" => req.supersample = v.extract().map_err(|_| bad("an int"))?,
+            "wavelengths" => req.channels = channels_of(Some(&v))?,
+            "accuracy_pairs" | "pairs" => {
+                req.accuracy_pairs = v.extract().map_err(|_| bad("an int"))?
+            }
+            "accuracy_interp" | "interp" => {
+                let s: String = v.extract().map_err(|_| bad("a string"))?;
+                req.accuracy_interp = interp_of(&s)?;
+                interp_given = true;
+            }
+            "replace" => replace = v.extract().map_err(|_| bad("a bool"))?,
+            k if extra.contains(&k) => {}
+            _ => {
+                return Err(PyTypeError::new_err(format!(
+                    "unexpected keyword argument '{key}'"
+                )));
+            }
+        }
+    }
+    if req.supersample == 0 {
+        return Err(PyValueError::new_err("supersample: must be at least 1"));
+    }
+    if codec_given {
+        req.codec = brdftab::bake::codec(&codec, tol, floor, level, exhaustive).map_err(lib_err)?;
+    }
+    Ok((replace, interp_given))
+}
+
+/// Opens SOURCE (a spec, table, `DB#NAME`, MERL `.binary` or RGL `.bsdf`) as a `Brdf`.
+#[pyfunction]
+#[pyo3(signature = (source, *, interp = "linear", wavelengths = None, eager = true))]
+fn open(
+    source: &str,
+    interp: &str,
+    wavelengths: Option<&Bound<'_, PyAny>>,
+    eager: bool,
+) -> PyResult<PyBrdf> {
+    guard(|| PyBrdf::open(source, interp, channels_of(wavelengths)?, eager))
+}
+
+/// Unpickling: reopens a `Brdf` from its source and options.
+#[pyfunction]
+#[pyo3(signature = (source, interp, wavelengths, eager = true))]
+fn _reopen(
+    source: &str,
+    interp: &str,
+    wavelengths: Option<Vec<f64>>,
+    eager: bool,
+) -> PyResult<PyBrdf> {
+    guard(|| {
+        let ch = wavelengths
+            .map(Channels::wavelengths)
+            .transpose()
+            .map_err(lib_err)?;
+        PyBrdf::open(source, interp, ch, eager)
+    })
+}
+
+/// The plausibility report of SOURCE as a dict with the keys of `brdftab check --json`.
+#[pyfunction]
+#[pyo3(signature = (source, *, wavelengths = None))]
+fn check(
+    py: Python<'_>,
+    source: &str,
+    wavelengths: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        let opts = OpenOptions {
+            channels: channels_of(wavelengths)?,
+            ..OpenOptions::default()
+        };
+        let brdf = brdftab::open_with(source, &opts).map_err(lib_err)?;
+        let report = run_batch(py, PARALLEL, || {
+            brdftab::analysis::plausibility::check(
+                brdf.as_ref(),
+                &brdftab::analysis::plausibility::Options::default(),
+            )
+        })?;
+        ser(py, &report)
+    })
+}
+
+/// What `brdftab info --json` reports of a brdftab file (`FILE`) or one table (`DB#NAME`).
+#[pyfunction]
+fn info(py: Python<'_>, source: &str) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        to_py(
+            py,
+            &brdftab::store::info::file_info(source).map_err(lib_err)?,
+        )
+    })
+}
+
+/// The names of the tables of database `path`, in file order.
+#[pyfunction]
+fn db_names(path: &str) -> PyResult<Vec<String>> {
+    guard(|| {
+        Ok(brdftab::store::db::list(path)
+            .map_err(lib_err)?
+            .into_iter()
+            .map(|(e, _)| e.name)
+            .collect())
+    })
+}
+
+/// Removes table `name` from database `path`.
+#[pyfunction]
+fn db_remove(path: &str, name: &str) -> PyResult<()> {
+    guard(|| brdftab::store::db::remove(path, name).map_err(lib_err))
+}
+
+fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyAny>> {
+    let info = if r.info.is_null() {
+        serde_json::json!({
+            "file": r.output,
+            "format": "raw",
+            "tables": [{
+                "name": r.name,
+                "shape": r.grid.stored_shape(),
+                "values": r.values,
+                "channels": r.grid.channels().names(),
+            }],
+        })
+    } else {
+        brdftab::store::info::file_info(&r.output).map_err(lib_err)?
+    };
+    to_py(py, &info)
+}
+
+/// Bakes SOURCE into OUTPUT: a `.btdb` file, `DB#NAME` (a table of a database), or a raw table
+/// file. Keywords: preset, grid, param, symmetry, symmetry_tolerance, force, codec,
+/// codec_tolerance, floor, level, exhaustive, name, supersample, wavelengths, replace. Returns what
+/// `brdftab info --json OUTPUT` reports.
+#[pyfunction]
+#[pyo3(signature = (source, output, **options))]
+fn bake(
+    py: Python<'_>,
+    source: &str,
+    output: &str,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        let mut req = BakeRequest::new(source);
+        let (replace, _) = apply_bake_options(&mut req, options, &[])?;
+        let target = BakeTarget::parse(output, None, replace);
+        let r = run_batch(py, PARALLEL, || {
+            req.run_with(&target, &brdftab::progress::Silent)
+        })?
+        .map_err(lib_err)?;
+        report_dict(py, &r)
+    })
+}
+
+/// Converts SOURCE into OUTPUT like `brdftab convert`: a MERL `.binary` (resampled on the MERL
+/// cells), `DB#NAME`, a `.btdb` file (a table named after the input) or a raw table. Takes the
+/// bake keywords plus `pairs` (accuracy pairs, default 200 000; 0 skips) and `interp`. Returns
+/// {"output", "source", "grid", "values", "seconds", "accuracy", "info"}.
+#[pyfunction]
+#[pyo3(signature = (source, output, **options))]
+fn convert(
+    py: Python<'_>,
+    source: &str,
+    output: &str,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        let mut req = BakeRequest::new(source);
+        req.accuracy_pairs = 200_000;
+        let (replace, _) = apply_bake_options(&mut req, options, &[])?;
+        match source::classify(output) {
+            SourceKind::Merl => {
+                let brdf = req.open_source().map_err(lib_err)?;
+                let t = std::time::Instant::now();
+                run_batch(py, PARALLEL, || {
+                    brdftab::measured::MerlBrdf::from_brdf(brdf.as_ref()).write(output)
+                })?
+                .map_err(lib_err)?;
+                return to_py(
+                    py,
+                    &serde_json::json!({
+                        "output": output,
+                        "source": brdf.describe(),
+                        "grid": "merl 90x90x180 cell centres",
+                        "seconds": t.elapsed().as_secs_f64(),
+                    }),
+                );
+            }
+            SourceKind::Rgl => {
+                return Err(Error::new_err(
+                    "writing RGL .bsdf files is not supported (they are read only)",
+                ));
+            }
+            _ => {}
+        }
+        let name = req
+            .name
+            .clone()
+            .unwrap_or_else(|| brdftab::bake::stem(source));
+        let target = match BakeTarget::parse(output, None, replace) {
+            BakeTarget::File(p) => BakeTarget::Db {
+                path: p,
+                name,
+                replace,
+            },
+            t => t,
+        };
+        let r = run_batch(py, PARALLEL, || {
+            req.run_with(&target, &brdftab::progress::Silent)
+        })?
+        .map_err(lib_err)?;
+        let d = serde_json::json!({
+            "output": r.output,
+            "source": r.source,
+            "grid": r.grid.summary(),
+            "values": r.values,
+            "seconds": r.seconds,
+            "accuracy": r.accuracy,
+        });
+        let d = to_py(py, &d)?;
+        d.bind(py).set_item("info", report_dict(py, &r)?)?;
+        Ok(d)
+    })
+}
+
+/// Fits `model` (a name such as "ggx", a sum "lambert+ggx", or a JSON spec) to SOURCE; returns
+/// the dict of `brdftab fit --json`. Keywords: params (str or list), log, starts, pairs,
+/// max_theta (radians), seed, fresnel ("none"/"schlick"/"dielectric"), grey, wavelengths,
+/// specular_fraction, max_iterations.
+#[pyfunction]
+#[pyo3(signature = (source, model, **options))]
+fn fit(
+    py: Python<'_>,
+    source: &str,
+    model: &str,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Py<PyAny>> {
+    use brdftab::fit::{ColorMode, FitOptions, ParamRequest};
+    use brdftab::fresnel::FresnelSpec;
+    guard(|| {
+        let mut opts = FitOptions::default();
+        let mut channels = None;
+        let mut fresnel = None;
+        if let Some(o) = options {
+            for (k, v) in o.iter() {
+                let key: String = k.extract()?;
+                if v.is_none() {
+                    continue;
+                }
+                let bad = |what: &str| PyTypeError::new_err(format!("{key}: expected {what}"));
+                match key.as_str() {
+                    "params" => {
+                        let list: Vec<String> = match v.extract::<String>() {
+                            Ok(s) => s.split(',').map(str::to_owned).collect(),
+                            Err(_) => v
+                                .extract()
+                                .map_err(|_| bad("a string or a list of strings"))?,
+                        };
+                        opts.params = list
+                            .iter()
+                            .filter(|x| !x.trim().is_empty())
+                            .map(|x| ParamRequest::parse(x))
+                            .collect::<brdftab::Result<Vec<_>>>()
+                            .map_err(lib_err)?;
+                    }
+                    "log" => opts.log = v.extract().map_err(|_| bad("a bool"))?,
+                    "starts" => opts.starts = v.extract().map_err(|_| bad("an int"))?,
+                    "pairs" => opts.pairs = v.extract().map_err(|_| bad("an int"))?,
+                    "max_theta" => {
+                        opts.max_theta = v.extract().map_err(|_| bad("a number (radians)"))?
+                    }
+                    "seed" => opts.seed = v.extract().map_err(|_| bad("an int"))?,
+                    "specular_fraction" => {
+                        opts.specular_fraction = v.extract().map_err(|_| bad("a number"))?
+                    }
+                    "max_iterations" => {
+                        opts.max_iterations = v.extract().map_err(|_| bad("an int"))?
+                    }
+                    "grey" => {
+                        let g: bool = v.extract().map_err(|_| bad("a bool"))?;
+                        opts.color = if g {
+                            ColorMode::Grey
+                        } else {
+                            ColorMode::PerChannel
+                        };
+                    }
+                    "fresnel" => {
+                        let s: String = v.extract().map_err(|_| bad("a string"))?;
+                        fresnel = Some(match s.as_str() {
+                            "schlick" => FresnelSpec::Schlick(brdftab::Value::Grey(0.04)),
+                            "dielectric" => FresnelSpec::Dielectric(brdftab::Value::Grey(1.5)),
+                            "none" => FresnelSpec::None,
+                            o => {
+                                return Err(PyValueError::new_err(format!(
+                                    "fresnel: `{o}`: expected none, schlick or dielectric"
+                                )));
+                            }
+                        });
+                    }
+                    "wavelengths" => channels = channels_of(Some(&v))?,
+                    _ => {
+                        return Err(PyTypeError::new_err(format!(
+                            "unexpected keyword argument '{key}'"
+                        )));
+                    }
+                }
+            }
+        }
+        if opts.starts == 0 || opts.pairs == 0 {
+            return Err(PyValueError::new_err(
+                "starts and pairs: must be at least 1",
+            ));
+        }
+        let brdf = brdftab::open_with(
+            source,
+            &OpenOptions {
+                channels,
+                ..OpenOptions::default()
+            },
+        )
+        .map_err(lib_err)?;
+        let mut init = brdftab::fit::preset(model).map_err(lib_err)?;
+        if let Some(f) = &fresnel {
+            init = brdftab::fit::with_fresnel(&init, f).map_err(lib_err)?;
+        }
+        let result = run_batch(py, PARALLEL, || {
+            brdftab::fit::fit(brdf.as_ref(), &init, &opts)
+        })?
+        .map_err(lib_err)?;
+        ser(py, &result)
+    })
+}
+
+/// The extension module.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("Error", m.py().get_type::<Error>())?;
+    m.add_class::<PyBrdf>()?;
+    m.add_function(wrap_pyfunction!(open, m)?)?;
+    m.add_function(wrap_pyfunction!(_reopen, m)?)?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(info, m)?)?;
+    m.add_function(wrap_pyfunction!(db_names, m)?)?;
+    m.add_function(wrap_pyfunction!(db_remove, m)?)?;
+    m.add_function(wrap_pyfunction!(bake, m)?)?;
+    m.add_function(wrap_pyfunction!(convert, m)?)?;
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,316 @@
+"""The Python API against the CLI, the published RGL reference values, and its own contract."""
+
+import json
+import multiprocessing
+import pickle
+
+import numpy as np
+import pytest
+
+import brdftab
+
+LAMBERT = '{"model": "lambert", "kd": [0.1, 0.2, 0.3]}'
+GGX = '{"model": "ggx", "alpha": 0.3, "ks": 0.8}'
+
+
+def upper(n, seed=0):
+    """n random directions of the upper hemisphere (not normalized)."""
+    rng = np.random.default_rng(seed)
+    v = rng.normal(size=(n, 3))
+    v[:, 2] = np.abs(v[:, 2]) + 1e-3
+    return v
+
+
+def numbers(text):
+    return np.array([[float(x) for x in line.split()] for line in text.strip().splitlines()])
+
+
+def pairs_text(wi, wo):
+    return "".join(" ".join(repr(float(x)) for x in (*a, *b)) + "\n" for a, b in zip(wi, wo))
+
+
+# ---- evaluation ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("kind", ["spec", "rgl"])
+def test_eval_matches_cli(kind, cli, paper):
+    src = GGX if kind == "spec" else paper
+    b = brdftab.open(src)
+    wi, wo = upper(200, 1), upper(200, 2)
+    got = b.eval(wi, wo)
+    assert got.dtype == np.float32 and got.shape == (200, 3)
+    want = numbers(cli("eval", src, stdin=pairs_text(wi, wo)))
+    np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-30)
+
+
+def test_pdf_and_sample_match_cli(cli):
+    b = brdftab.open(GGX)
+    wo = np.array([0.3, -0.2, 0.9])
+    u = np.random.default_rng(3).random((500, 2))
+    wi, pdf, w = b.sample(wo, u)
+    assert wi.shape == (500, 3) and pdf.shape == (500,) and w.shape == (500, 3)
+    assert wi.dtype == np.float64 and pdf.dtype == np.float64 and w.dtype == np.float32
+    ok = pdf > 0
+    assert ok.mean() > 0.9
+    # pdf: the Python value, the CLI's, and the one sample() returned agree.
+    wos = np.tile(wo, (ok.sum(), 1))
+    cli_pdf = numbers(cli("pdf", GGX, stdin=pairs_text(wi[ok], wos)))[:, 0]
+    np.testing.assert_allclose(b.pdf(wi[ok], wos), cli_pdf, rtol=1e-9)
+    np.testing.assert_allclose(pdf[ok], cli_pdf, rtol=1e-6)
+    # weight = f cos θi / pdf (brdftab sample's convention)
+    f = b.eval(wi[ok], wos)
+    cos_i = wi[ok][:, 2] / np.linalg.norm(wi[ok], axis=1)
+    np.testing.assert_allclose(w[ok], f * (cos_i / pdf[ok])[:, None], rtol=1e-4)
+
+
+def test_rgl_matches_published_reference(rgl):
+    """rgl-epfl/brdf-loader's values (f_r cos θo) for the seven files, as tests/rgl_reference.rs."""
+    rows = [l.split("\t") for l in (rgl / "reference_eval_powitacq_rgb.tsv").read_text().splitlines()[1:]]
+    by_file = {}
+    for r in rows:
+        by_file.setdefault(r[0], []).append([float(x) for x in r[1:]])
+    for file, vals in by_file.items():
+        v = np.array(vals)
+        v = v[v[:, 0] > 0]  # the pole θi = 0 has an undefined azimuth (see the Rust test)
+        ti, pi, to, po = np.radians(v[:, :4]).T
+        sph = lambda t, p: np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], 1)
+        got = brdftab.open(str(rgl / file)).eval(sph(ti, pi), sph(to, po))
+        want = v[:, 4:] / np.cos(to)[:, None]
+        rel = np.abs(got - want) / np.maximum(np.abs(want), 1e-6)
+        assert rel.max() < 1e-4, (file, rel.max())
+
+
+def test_shapes_and_broadcast():
+    b = brdftab.open(LAMBERT)
+    one = b.eval([0, 0, 1], [0.3, 0, 1])
+    assert one.shape == (3,) and one.dtype == np.float32
+    np.testing.assert_allclose(one, [0.1, 0.2, 0.3], rtol=1e-7)
+    assert b.eval(upper(7), [0, 0, 1]).shape == (7, 3)
+    assert b.eval([0, 0, 1], upper(7)).shape == (7, 3)
+    assert b.eval(np.zeros((0, 3)), np.zeros((0, 3))).shape == (0, 3)
+    assert b.pdf([0, 0, 1], [0, 0, 1]).shape == ()
+    assert b.pdf(upper(4), upper(4)).shape == (4,)
+    # below the horizon: 0
+    assert b.eval([0, 0, -1], [0, 0, 1]).tolist() == [0, 0, 0]
+    # lists, tuples, float32 and int arrays are accepted; non-contiguous views too
+    assert b.eval(((0, 0, 1),), np.array([[0, 0, 1]], dtype=np.float32)).shape == (1, 3)
+    assert b.eval(np.array([0, 0, 2]), [0, 0, 1]).shape == (3,)
+    wi = upper(10)[::2]
+    np.testing.assert_array_equal(b.eval(wi, wi), b.eval(wi.copy(), wi.copy()))
+    wi, pdf, w = b.sample([0, 0, 1], [0.5, 0.5])
+    assert wi.shape == (3,) and pdf.shape == () and w.shape == (3,)
+
+
+def test_large_batch_is_consistent(paper):
+    b = brdftab.open(paper)
+    wi, wo = upper(50_000, 5), upper(50_000, 6)
+    big = b.eval(wi, wo)
+    np.testing.assert_array_equal(big[:100], b.eval(wi[:100], wo[:100]))
+    np.testing.assert_array_equal(big[-1], b.eval(wi[-1], wo[-1]))
+
+
+def test_channels_flags_wavelengths(paper):
+    b = brdftab.open(LAMBERT)
+    assert b.channels == ["R", "G", "B"]
+    assert b.flags == {"delta": False, "reciprocal": True, "isotropic": True,
+                       "bilateral": True, "transmission": False}
+    s = brdftab.open(LAMBERT.replace("[0.1, 0.2, 0.3]", "0.5"), wavelengths=[450, 550, 650.5])
+    assert s.channels == ["450nm", "550nm", "650.5nm"]
+    assert s.wavelengths == [450, 550, 650.5]
+    assert s.eval([0, 0, 1], [0, 0, 1]).shape == (3,)
+    assert brdftab.open(paper, wavelengths="500,600").channels == ["500nm", "600nm"]
+    assert brdftab.open('{"model": "mirror"}').flags["delta"]
+
+
+def test_albedo():
+    b = brdftab.open(LAMBERT)
+    a = b.albedo([0.0, 0.5, 1.2])
+    assert a.shape == (3, 3)
+    np.testing.assert_allclose(a, np.tile(np.array([0.1, 0.2, 0.3]) * np.pi, (3, 1)), rtol=1e-3)
+    assert b.albedo(0.3).shape == (3,)
+
+
+def test_albedo_matches_cli(cli):
+    b = brdftab.open(GGX)
+    got = b.albedo(np.radians([0, 30, 60]))
+    want = numbers(cli("albedo", GGX, "--theta", "0,30,60"))[:, 1:]
+    np.testing.assert_allclose(got, want, rtol=1e-6)
+
+
+# ---- check, bake, convert, databases, fit --------------------------------------------------
+
+def test_check_is_cli_json(cli):
+    got = brdftab.check(GGX)
+    want = json.loads(cli("check", GGX, "--json"))
+    assert got.keys() == want.keys()
+    assert got == want
+
+
+def test_bake_returns_info(tmp_path, cli):
+    out = str(tmp_path / "ggx.btdb")
+    info = brdftab.bake(GGX, out, preset="small", codec="log16", codec_tolerance=1e-3)
+    assert info == json.loads(cli("info", out, "--json"))
+    (t,) = info["tables"]
+    assert t["name"] == "ggx" and t["parameterization"] == "halfdiff"
+    table = brdftab.open(out)
+    rel = np.abs(table.eval(upper(100), upper(100, 9)) - brdftab.open(GGX).eval(upper(100), upper(100, 9)))
+    assert np.isfinite(rel).all()
+    # grid sizes, inout, explicit symmetry, another name
+    info = brdftab.bake(LAMBERT, out, grid="8x1x8x16", param="inout", symmetry="isotropic",
+                        name="tiny", codec="f32")
+    assert info["tables"][0]["name"] == "tiny"
+    assert info["tables"][0]["parameterization"] == "inout"
+
+
+def test_database(tmp_path):
+    db = brdftab.Database(tmp_path / "m.btdb")
+    db.add(LAMBERT, "matte", preset="small")
+    db.add(GGX, "shiny", preset="small")
+    assert db.names() == ["matte", "shiny"] and "matte" in db
+    with pytest.raises((brdftab.Error, ValueError), match="shiny"):
+        db.add(GGX, "shiny", preset="small")
+    db.add(GGX, "shiny", preset="small", replace=True)
+    m = db.open("matte", interp="nearest")
+    assert m.interp == "nearest"
+    np.testing.assert_allclose(m.eval([0, 0, 1], [0, 0, 1]), [0.1, 0.2, 0.3], rtol=2e-3)
+    assert len(db.info()["tables"]) == 2
+    db.remove("matte")
+    assert db.names() == ["shiny"]
+    with pytest.raises(brdftab.Error):
+        db.remove("matte")
+    with pytest.raises(brdftab.Error):
+        db.open("matte")
+    with pytest.raises(ValueError):
+        db.add(LAMBERT, "a#b")
+    assert pickle.loads(pickle.dumps(db)).names() == ["shiny"]
+
+
+def test_convert(tmp_path, paper):
+    r = brdftab.convert(paper, str(tmp_path / "rgl.btdb"), preset="small", pairs=2000)
+    assert r["output"].endswith("#paper_white_rgb")
+    assert r["accuracy"]["pairs"] == 2000 and r["accuracy"]["rel_rmse_80"] < 0.1
+    assert r["info"]["tables"][0]["name"] == "paper_white_rgb"
+    merl = str(tmp_path / "lambert.binary")
+    brdftab.convert(LAMBERT, merl)
+    np.testing.assert_allclose(brdftab.open(merl).eval([0, 0.1, 1], [0.2, 0, 1]), [0.1, 0.2, 0.3], rtol=1e-3)
+    with pytest.raises(brdftab.Error, match="read only"):
+        brdftab.convert(LAMBERT, str(tmp_path / "x.bsdf"))
+
+
+def test_fit_is_cli_json(cli):
+    src = '{"model": "lambert", "kd": 0.3}'
+    got = brdftab.fit(src, "lambert", pairs=300, starts=2)
+    want = json.loads(cli("fit", src, "--model", "lambert", "--json", "--pairs", "300", "--starts", "2"))
+    assert got.keys() == want.keys()
+    assert got["spec"] == want["spec"]
+    np.testing.assert_allclose(got["spec"]["kd"], 0.3, rtol=1e-5)
+    g = brdftab.fit(GGX, "ggx", pairs=400, starts=1, params="alpha", log=True)
+    assert g["spec"]["model"] == "ggx" and np.isfinite(g["rmse"])
+
+
+def test_table_values_and_grid(tmp_path):
+    out = str(tmp_path / "t.btdb")
+    brdftab.bake(GGX, out, preset="small")
+    values, grid = brdftab.open(out).table()
+    assert values.dtype == np.float32
+    assert list(values.shape) == grid["stored_shape"] + [3]
+    assert grid["param"] == "halfdiff" and len(grid["stored_axes"]) == 4
+    v2, g2 = brdftab.open(GGX).table(preset="small")
+    np.testing.assert_allclose(v2, values, rtol=2e-3, atol=1e-6)
+
+
+# ---- pickling and workers ------------------------------------------------------------------
+
+def _eval_in_worker(args):
+    brdf, wi, wo = args
+    return brdf.eval(wi, wo)
+
+
+def test_pickle_and_multiprocessing(paper):
+    b = brdftab.open(paper, interp="nearest")
+    c = pickle.loads(pickle.dumps(b))
+    assert c.source == paper and c.interp == "nearest"
+    wi, wo = upper(64), upper(64, 1)
+    np.testing.assert_array_equal(c.eval(wi, wo), b.eval(wi, wo))
+    s = pickle.loads(pickle.dumps(brdftab.open(LAMBERT, wavelengths=[500, 600])))
+    assert s.channels == ["500nm", "600nm"]
+    with multiprocessing.get_context("spawn").Pool(2) as pool:
+        outs = pool.map(_eval_in_worker, [(b, wi[:32], wo[:32]), (b, wi[32:], wo[32:])])
+    np.testing.assert_array_equal(np.concatenate(outs), b.eval(wi, wo))
+
+
+# ---- bad input -----------------------------------------------------------------------------
+
+def test_bad_sources(tmp_path):
+    with pytest.raises(brdftab.Error, match="no-such"):
+        brdftab.open(str(tmp_path / "no-such.btdb"))
+    with pytest.raises(brdftab.Error, match="no-such"):
+        brdftab.open(str(tmp_path / "no-such.bsdf"))
+    with pytest.raises(brdftab.Error, match="unknown variant `nope`"):
+        brdftab.open('{"model": "nope"}')
+    with pytest.raises(brdftab.Error, match="invalid"):
+        brdftab.open('{"model": "lambert", "kd": -1}')
+    junk = tmp_path / "junk.bsdf"
+    junk.write_bytes(b"definitely not a tensor file")
+    with pytest.raises(brdftab.Error):
+        brdftab.open(str(junk))
+    with pytest.raises(brdftab.Error):
+        brdftab.check(str(tmp_path / "missing.binary"))
+    with pytest.raises((brdftab.Error, ValueError), match="no_such_model"):
+        brdftab.fit(LAMBERT, "no_such_model")
+
+
+def test_corrupt_table(tmp_path):
+    out = tmp_path / "c.btdb"
+    brdftab.bake(GGX, str(out), preset="small")
+    data = bytearray(out.read_bytes())
+    mid = len(data) // 2
+    data[mid:mid + 64] = bytes(64)  # zero a stretch of compressed chunk bytes
+    out.write_bytes(bytes(data))
+    with pytest.raises(brdftab.Error):
+        brdftab.open(str(out))  # eager open checks every chunk
+    lazy = brdftab.open(str(out), eager=False)
+    with pytest.raises(brdftab.Error):
+        lazy.eval(upper(5000), upper(5000, 1))
+    out.write_bytes(bytes(data[: len(data) // 3]))  # truncated
+    with pytest.raises(brdftab.Error):
+        brdftab.open(str(out))
+
+
+def test_bad_arguments():
+    b = brdftab.open(LAMBERT)
+    for wi in ([0, 0], [[0, 0, 1, 1]], np.zeros((2, 3, 1)), 1.0):
+        with pytest.raises(ValueError, match="shape"):
+            b.eval(wi, [0, 0, 1])
+    with pytest.raises(ValueError, match="rows"):
+        b.eval(upper(3), upper(4))
+    for bad in ([np.nan, 0, 1], [0, np.inf, 1]):
+        with pytest.raises(ValueError, match="non-finite"):
+            b.eval(bad, [0, 0, 1])
+        with pytest.raises(ValueError, match="non-finite"):
+            b.pdf([0, 0, 1], bad)
+    with pytest.raises(TypeError):
+        b.eval(["a", "b", "c"], [0, 0, 1])
+    with pytest.raises(TypeError):
+        b.eval(np.array([1j, 0, 1]), [0, 0, 1])
+    with pytest.raises(TypeError):
+        b.eval(None, [0, 0, 1])
+    with pytest.raises(ValueError, match=r"\[0, 1\)"):
+        b.sample([0, 0, 1], [[0.2, 1.0]])
+    with pytest.raises(ValueError, match="shape"):
+        b.sample([0, 0, 1], [0.2, 0.3, 0.4])
+    with pytest.raises(ValueError):
+        b.albedo([2.0])
+    with pytest.raises(ValueError, match="interp"):
+        brdftab.open(LAMBERT, interp="cubic")
+    with pytest.raises(ValueError):
+        brdftab.open(LAMBERT, wavelengths=[600, 500])
+    with pytest.raises(TypeError):
+        brdftab.open(LAMBERT, wavelengths=object())
+    with pytest.raises(TypeError, match="unexpected keyword"):
+        brdftab.bake(LAMBERT, "/tmp/never.btdb", presett="small")
+    with pytest.raises(ValueError):
+        brdftab.bake(LAMBERT, "/tmp/never.btdb", grid="1x2x3")
+    with pytest.raises(TypeError, match="unexpected keyword"):
+        brdftab.fit(LAMBERT, "lambert", colour=True)
+    # one-pair evaluation does not leak state between bad and good calls
+    assert b.eval([0, 0, 1], [0, 0, 1]).tolist() == pytest.approx([0.1, 0.2, 0.3])

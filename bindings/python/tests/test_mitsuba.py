@@ -1,0 +1,268 @@
+"""The Mitsuba 3 plugin `brdftab` against Mitsuba's own `measured` plugin on the same RGL file,
+its Dr.Jit table lookup against the Rust lookup, and its sampler through `mitsuba.chi2`."""
+
+import math
+import os
+
+import numpy as np
+import pytest
+
+import brdftab
+
+mi = pytest.importorskip("mitsuba")
+dr = pytest.importorskip("drjit")
+
+RGL_FILE = "vch_golden_yellow_rgb.bsdf"  # glossy vinyl: the hard case for eval and sampling
+
+
+def have_llvm():
+    try:
+        mi.set_variant("llvm_ad_rgb")
+        dr.eval(mi.Float(1.0) + 1)
+        return True
+    except Exception:
+        return False
+
+
+def use(variant):
+    if variant.startswith("llvm") and not have_llvm():
+        pytest.skip("llvm_ad_rgb needs libLLVM (apt-get install libllvm19; DRJIT_LIBLLVM_PATH)")
+    mi.set_variant(variant)
+    import brdftab.mitsuba
+
+    brdftab.mitsuba.register()
+
+
+def random_dirs(n, seed, min_cos=0.1):
+    rng = np.random.default_rng(seed)
+    t = np.arccos(rng.uniform(min_cos, 1, n))
+    p = rng.uniform(0, 2 * math.pi, n)
+    return np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], 1)
+
+
+def eval_both(variant, ours, ref, wi, wo):
+    ctx = mi.BSDFContext()
+    if variant.startswith("scalar"):
+        a, b = [], []
+        for x, y in zip(wi, wo):
+            si = mi.SurfaceInteraction3f()
+            si.wi = mi.Vector3f(*x)
+            v = mi.Vector3f(*y)
+            a.append(np.array(ours.eval(ctx, si, v)))
+            b.append(np.array(ref.eval(ctx, si, v)))
+        return np.array(a), np.maximum(np.array(b), 0)
+    si = dr.zeros(mi.SurfaceInteraction3f, len(wi))
+    si.wi = mi.Vector3f(*wi.T)
+    v = mi.Vector3f(*wo.T)
+    # `measured` interpolates RGB to slightly negative values near sharp peaks; brdftab clips
+    # at 0 (as the RGL reference reader does)
+    return np.array(ours.eval(ctx, si, v)).T, np.maximum(np.array(ref.eval(ctx, si, v)).T, 0)
+
+
+def test_scalar_eval_matches_measured(rgl):
+    use("scalar_rgb")
+    f = str(rgl / RGL_FILE)
+    ours = mi.load_dict({"type": "brdftab", "source": f})
+    ref = mi.load_dict({"type": "measured", "filename": f})
+    wi, wo = random_dirs(300, 1), random_dirs(300, 2)
+    a, b = eval_both("scalar_rgb", ours, ref, wi, wo)
+    rel = np.abs(a - b) / np.maximum(np.abs(b), 1e-3 * np.abs(b).max())
+    assert rel.max() <= 1e-3, rel.max()
+    # eval = f_r cos θo with si.wi = brdftab's wi
+    f_r = brdftab.open(f).eval(wi, wo)
+    np.testing.assert_allclose(a, f_r * wo[:, 2:3], rtol=1e-5, atol=1e-7)
+
+
+def test_scalar_sample_pdf_consistent(rgl):
+    use("scalar_rgb")
+    ours = mi.load_dict({"type": "brdftab", "source": str(rgl / RGL_FILE)})
+    ctx = mi.BSDFContext()
+    si = mi.SurfaceInteraction3f()
+    si.wi = mi.Vector3f(0.3, 0.1, 0.9)
+    rng = np.random.default_rng(0)
+    for _ in range(50):
+        bs, w = ours.sample(ctx, si, float(rng.random()), mi.Point2f(*rng.random(2)))
+        if bs.pdf > 0:
+            np.testing.assert_allclose(bs.pdf, ours.pdf(ctx, si, bs.wo), rtol=1e-5)
+            np.testing.assert_allclose(np.array(w), np.array(ours.eval(ctx, si, bs.wo)) / bs.pdf,
+                                       rtol=1e-4)
+
+
+def test_scalar_spectral_and_errors():
+    use("scalar_spectral")
+    b = mi.load_dict({"type": "brdftab", "source": '{"model": "lambert", "kd": 0.5}'})
+    si = mi.SurfaceInteraction3f()
+    si.wi = mi.Vector3f(0, 0, 1)
+    si.wavelengths = mi.Spectrum([450, 500, 550, 600])
+    v = np.array(b.eval(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1)))
+    np.testing.assert_allclose(v, 0.5, rtol=1e-6)
+    use("scalar_rgb")
+    with pytest.raises(Exception, match="no-such-file"):
+        mi.load_dict({"type": "brdftab", "source": "/nonexistent/no-such-file.bsdf"})
+    with pytest.raises(Exception, match="unknown variant"):
+        mi.load_dict({"type": "brdftab", "source": '{"model": "nope"}'})
+    with pytest.raises(Exception, match="source"):
+        mi.load_dict({"type": "brdftab"})
+
+
+# ---- llvm_ad_rgb -----------------------------------------------------------------------------
+
+CASES = [
+    ('{"model": "ggx", "alpha": 0.3}', dict(preset="small")),
+    ('{"model": "ggx", "alpha": 0.3}', dict(grid="merl")),
+    ('{"model": "ggx", "alpha": 0.3}', dict(grid="16x1x16x32", param="inout", symmetry="isotropic")),
+    ('{"model": "ggx", "alpha": 0.3}', dict(grid="16x1x16x32", param="inout",
+                                            symmetry="isotropic,bilateral")),
+    ('{"model": "ward", "alpha_x": 0.2, "alpha_y": 0.4, "ks": 0.5}', dict(preset="small")),
+    ('{"model": "ward", "alpha_x": 0.2, "alpha_y": 0.4, "ks": 0.5}', dict(preset="small",
+                                                                          symmetry="none")),
+    ('{"model": "ward", "alpha_x": 0.2, "alpha_y": 0.4, "ks": 0.5}',
+     dict(grid="16x16x16x16", param="inout", symmetry="bilateral")),
+    ("RGL", dict(preset="small")),
+]
+
+
+@pytest.mark.parametrize("interp", ["linear", "nearest"])
+@pytest.mark.parametrize("case", range(len(CASES)))
+def test_jit_lookup_matches_rust(case, interp, tmp_path, rgl):
+    use("llvm_ad_rgb")
+    from brdftab.mitsuba import JitTable
+
+    src, opts = CASES[case]
+    if src == "RGL":
+        src = str(rgl / RGL_FILE)
+    out = str(tmp_path / "t.btdb")
+    brdftab.bake(src, out, **opts)
+    b = brdftab.open(out, interp=interp)
+    values, grid = b.table()
+    jt = JitTable(values, grid, interp)
+    rng = np.random.default_rng(case)
+    wi, wo = rng.normal(size=(20000, 3)), rng.normal(size=(20000, 3))
+    wi[:, 2], wo[:, 2] = np.abs(wi[:, 2]) + 1e-3, np.abs(wo[:, 2]) + 1e-3
+    wo[:5000] = wi[:5000] * [-1, -1, 1] + rng.normal(size=(5000, 3)) * 1e-3  # near specular
+    wi[::97, 2] = -0.5  # some below the horizon
+    # Mitsuba's directions are float32: the Rust lookup gets the same rounded directions
+    wi, wo = wi.astype(np.float32).astype(np.float64), wo.astype(np.float32).astype(np.float64)
+    want = b.eval(wi, wo)
+    got = np.stack([np.array(x) for x in jt.lookup(mi.Vector3f(*wi.T), mi.Vector3f(*wo.T))], -1)
+    rel = np.abs(got - want) / np.maximum(np.abs(want), 1e-6 * np.abs(want).max())
+    if interp == "linear":
+        # ~1e-5 everywhere; anisotropic inout tables show rare (1e-4 of the pairs) differences
+        # up to 5e-4 exactly at φ node boundaries (not understood yet, see the issue report)
+        assert np.mean(rel > 2e-5) <= 2e-4 and rel.max() < 1e-3, rel.max()
+    else:
+        # a nearest lookup exactly on a cell boundary may round to the other cell
+        assert np.mean(rel > 1e-6) < 1e-4, rel.max()
+    assert np.all(got[::97] == 0)
+
+
+def test_jit_eval_matches_measured_within_table_error(rgl, tmp_path):
+    use("llvm_ad_rgb")
+    f = str(rgl / RGL_FILE)
+    ours = mi.load_dict({"type": "brdftab", "source": f, "preset": "medium"})
+    ref = mi.load_dict({"type": "measured", "filename": f})
+    wi, wo = random_dirs(5000, 3, 0.2), random_dirs(5000, 4, 0.2)
+    a, b = eval_both("llvm_ad_rgb", ours, ref, wi, wo)
+    # the table's own error: Rust table lookup vs the native RGL evaluation, same pairs
+    out = str(tmp_path / "m.btdb")
+    brdftab.bake(f, out, preset="medium")
+    native = brdftab.open(f).eval(wi, wo) * wo[:, 2:3]
+    table = brdftab.open(out).eval(wi, wo) * wo[:, 2:3]
+    scale = np.abs(b).max()
+    err_plugin = np.sqrt(np.mean((a - b) ** 2)) / scale
+    err_table = np.sqrt(np.mean((table - native) ** 2)) / scale
+    err_native = np.sqrt(np.mean((native - b) ** 2)) / scale
+    print(f"rel RMSE: plugin vs measured {err_plugin:.2e}, table vs native {err_table:.2e}, "
+          f"native vs measured {err_native:.2e}")
+    assert err_plugin <= 1.05 * (err_table + err_native) + 1e-6
+
+
+def test_jit_chi2_sampling(rgl):
+    use("llvm_ad_rgb")
+    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
+
+    for src, wi in [(str(rgl / RGL_FILE), [0.4, 0.1, 0.91]),
+                    ('{"model": "ggx", "alpha": 0.4}', [0.0, 0.5, 0.866])]:
+        d = {"type": "brdftab", "source": src, "preset": "small"}
+        chi2 = ChiSquareTest(
+            domain=SphericalDomain(),
+            sample_func=BSDFAdapter("brdftab", d, wi=wi)[0],
+            pdf_func=BSDFAdapter("brdftab", d, wi=wi)[1],
+            sample_dim=3,
+            res=101,
+            ires=8,
+        )
+        assert chi2.run(), chi2.messages
+
+
+def test_jit_render_matches_measured(rgl):
+    use("llvm_ad_rgb")
+    f = str(rgl / RGL_FILE)
+
+    def scene(bsdf):
+        return mi.load_dict({
+            "type": "scene",
+            "integrator": {"type": "path", "max_depth": 3},
+            "sensor": {"type": "perspective", "fov": 30,
+                       "to_world": mi.ScalarTransform4f().look_at([0, -4, 2.5], [0, 0, 0], [0, 0, 1]),
+                       "film": {"type": "hdrfilm", "width": 48, "height": 48},
+                       "sampler": {"type": "independent", "sample_count": 32}},
+            "sphere": {"type": "sphere", "bsdf": bsdf},
+            "light": {"type": "point", "position": [2, -3, 4], "intensity": {"type": "rgb", "value": 60}},
+            "env": {"type": "constant", "radiance": {"type": "rgb", "value": 0.2}},
+        })
+
+    ours = np.array(mi.render(scene({"type": "brdftab", "source": f}), seed=1))
+    ref = np.array(mi.render(scene({"type": "measured", "filename": f}), seed=2))
+    assert np.isfinite(ours).all()
+    rel = abs(ours.mean() - ref.mean()) / ref.mean()
+    assert rel < 0.03, rel
+
+
+def test_jit_bad_input():
+    use("llvm_ad_rgb")
+    with pytest.raises(Exception, match="no-such-file"):
+        mi.load_dict({"type": "brdftab", "source": "/nonexistent/no-such-file.btdb"})
+    with pytest.raises(Exception, match="delta"):
+        mi.load_dict({"type": "brdftab", "source": '{"model": "mirror"}'})
+    b = mi.load_dict({"type": "brdftab", "source": '{"model": "ggx", "alpha": 0.3}',
+                      "preset": "small"})
+    si = dr.zeros(mi.SurfaceInteraction3f, 3)
+    si.wi = mi.Vector3f([0, math.nan, 0], [0, 0, 0], [1, 1, -1])
+    v = np.array(b.eval(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1)))
+    assert np.isfinite(v[:, 0]).all() and (v[:, 1:] == 0).all()
+
+
+def test_jit_spectral_evaluates_at_si_wavelengths():
+    use("llvm_ad_rgb")  # skips without libLLVM
+    use("llvm_ad_spectral")
+    spec = '{"model": "lambert", "kd": {"wavelengths": [400, 700], "values": [0.2, 0.8]}}'
+    b = mi.load_dict({"type": "brdftab", "source": spec, "preset": "small"})
+    si = dr.zeros(mi.SurfaceInteraction3f, 2)
+    si.wi = mi.Vector3f(0, 0, 1)
+    si.wavelengths = mi.Spectrum([450, 500], [550, 560], [600, 610], [700, 710])
+    v = np.array(b.eval(mi.BSDFContext(), si, mi.Vector3f(0.6, 0, 0.8)))
+    want = brdftab.open(spec).eval_spectral([0, 0, 1], [0.6, 0, 0.8],
+                                           np.array(si.wavelengths).T.ravel())
+    np.testing.assert_allclose(v.T.ravel(), want * 0.8, rtol=0.02)
+
+
+def test_scalar_flags_and_delta():
+    use("scalar_rgb")
+    F = mi.BSDFFlags
+    m = mi.load_dict({"type": "brdftab", "source": '{"model": "mirror"}'})
+    assert m.flags() & F.DeltaReflection and m.flags() & F.FrontSide
+    si = mi.SurfaceInteraction3f()
+    si.wi = mi.Vector3f(0.6, 0, 0.8)
+    bs, w = m.sample(mi.BSDFContext(), si, 0.5, mi.Point2f(0.3, 0.3))
+    np.testing.assert_allclose(np.array(bs.wo), [-0.6, 0, 0.8], atol=1e-6)
+    assert bs.pdf == 1 and np.all(np.array(w) > 0)
+    assert np.all(np.array(m.eval(mi.BSDFContext(), si, bs.wo)) == 0)
+    lam = mi.load_dict({"type": "brdftab", "source": '{"model": "lambert", "kd": 0.5}'})
+    assert lam.flags() & F.DiffuseReflection
+    ggx = mi.load_dict({"type": "brdftab", "source": '{"model": "ggx", "alpha": 0.3}'})
+    assert ggx.flags() & F.GlossyReflection
+    # back side: zero
+    si.wi = mi.Vector3f(0, 0, -1)
+    assert np.all(np.array(ggx.eval(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1))) == 0)
+    assert ggx.pdf(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1)) == 0
