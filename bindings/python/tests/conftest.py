@@ -10,6 +10,14 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 
 
+def unavailable(why):
+    """A prerequisite is missing: a skip on a developer's machine, a failure in CI (`CI` set),
+    where every prerequisite is installed by .ci/run and a skip would hide a broken install."""
+    if os.environ.get("CI"):
+        pytest.fail(f"CI: {why}", pytrace=False)  # noqa: PT016
+    pytest.skip(why, allow_module_level=True)
+
+
 def rgl_dir():
     """The RGL-EPFL files: $BRDFTAB_RGL_DIR, the repository's data/rgl, or ../shared's copy."""
     for d in [os.environ.get("BRDFTAB_RGL_DIR"), ROOT / "data" / "rgl",
@@ -32,7 +40,7 @@ def cli_path():
 def rgl():
     d = rgl_dir()
     if d is None:
-        pytest.skip("no RGL files (data/rgl or ../shared/data/measured/rgl)")
+        unavailable("no RGL files (data/rgl or ../shared/data/measured/rgl)")
     return d
 
 
@@ -45,7 +53,7 @@ def paper(rgl):
 def cli():
     p = cli_path()
     if p is None:
-        pytest.skip("no brdftab binary (cargo build --release)")
+        unavailable("no brdftab binary (cargo build --release)")
 
     def run(*args, stdin=None):
         r = subprocess.run([p, *args], input=stdin, capture_output=True, text=True, timeout=600)

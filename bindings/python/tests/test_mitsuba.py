@@ -9,8 +9,13 @@ import pytest
 
 import brdftab
 
-mi = pytest.importorskip("mitsuba")
-dr = pytest.importorskip("drjit")
+from conftest import unavailable
+
+try:
+    import drjit as dr
+    import mitsuba as mi
+except ImportError:
+    unavailable("mitsuba is not installed (pip install mitsuba)")
 
 RGL_FILE = "vch_golden_yellow_rgb.bsdf"  # glossy vinyl: the hard case for eval and sampling
 
@@ -26,7 +31,7 @@ def have_llvm():
 
 def use(variant):
     if variant.startswith("llvm") and not have_llvm():
-        pytest.skip("llvm_ad_rgb needs libLLVM (apt-get install libllvm19; DRJIT_LIBLLVM_PATH)")
+        unavailable("llvm_ad_rgb needs libLLVM (apt-get install libllvm19; DRJIT_LIBLLVM_PATH)")
     mi.set_variant(variant)
     import brdftab.mitsuba
 

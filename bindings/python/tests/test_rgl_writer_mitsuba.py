@@ -17,7 +17,12 @@ import subprocess
 import numpy as np
 import pytest
 
-mi = pytest.importorskip("mitsuba")
+from conftest import unavailable
+
+try:
+    import mitsuba as mi
+except ImportError:
+    unavailable("mitsuba is not installed (pip install mitsuba)")
 mi.set_variant("scalar_rgb")
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
