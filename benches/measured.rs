@@ -100,7 +100,7 @@ fn main() {
         "cg_sunflower_rgb.bsdf",
     ] {
         let t = Instant::now();
-        let b = RglBrdf::open(rgl(&file)).unwrap();
+        let b = RglBrdf::open(rgl(file)).unwrap();
         let load = t.elapsed().as_secs_f64() * 1e3;
         println!(
             "rgl native eval   {file:<28} {:7.1} ns/eval   (open {load:.1} ms)",

@@ -109,7 +109,7 @@ fn rebuild(
     file: &str,
     edit: impl Fn(&str, Dtype, &[u64], Vec<u8>) -> Option<(Dtype, Vec<u64>, Vec<u8>)>,
 ) -> Vec<u8> {
-    let t = TensorFile::open(rgl(&file)).unwrap();
+    let t = TensorFile::open(rgl(file)).unwrap();
     let mut w = TensorWriter::new();
     for f in t.fields() {
         let shape: Vec<u64> = f.shape.iter().map(|&d| d as u64).collect();
@@ -336,7 +336,7 @@ fn corrupted_headers_never_panic() {
 fn random_pairs_are_finite_and_non_negative() {
     let mut rng = brdftab::rng::Pcg32::new(8);
     for file in ["cg_sunflower_rgb.bsdf", "satin_rosaline_rgb.bsdf"] {
-        let b = RglBrdf::open(rgl(&file)).unwrap();
+        let b = RglBrdf::open(rgl(file)).unwrap();
         let mut f = [0f32; 3];
         for _ in 0..20_000 {
             let wi = brdftab::geometry::uniform_hemisphere(rng.next_dvec2());
@@ -363,7 +363,7 @@ fn sampler_passes_chi_square() {
         ..Chi2Options::default()
     };
     for file in files {
-        let b = RglBrdf::open(rgl(&file)).unwrap();
+        let b = RglBrdf::open(rgl(file)).unwrap();
         for wo in wos {
             let r = chi2::test(&b, wo, &opts);
             eprintln!("{file} wo={wo}: {r:?}");

@@ -23,6 +23,16 @@
 //! (cheap), and `L = 0` (`v = 0`) decodes to exactly 0; a value below `step/2` in `L` decodes to 0
 //! rather than to the other sign.
 //!
+//! **Anchored grids (chunk version 3).** A grid from 0 puts a constant up to half a step from
+//! the nearest grid point, so a Lambert table decoded 5.7e-4 (relative) off kd. From version 3
+//! each channel `c` has its own origin `lo_c` ([`Encoded::anchors`], |lo_c| ≤ step/2) chosen so
+//! that the channel's most common value `m` is a grid point, `g(m) = lo_c + k_m·step`, checked
+//! to round back to `m` bit for bit: constant chunks and the value a chunk repeats most decode
+//! exactly, and index 0 still decodes to exactly 0. The most common value is found with a
+//! Misra–Gries pass (4 counters: anything above a fifth of the channel is found) and one exact
+//! recount; with no repeated value, or one within half a step of 0, the origin is 0. Residuals,
+//! predictors and the bound below are unchanged: the grid is only shifted.
+//!
 //! Chunk version 1 formed the reconstructions in f64 *inside* the prediction loop
 //! (`R = P + round((L − P)/step)·step`, DPCM as in the SZ compressors). With the second-order
 //! predictor that loop amplifies the rounding noise around zero so that thousands of tiny values
@@ -55,7 +65,8 @@ use crate::error::{Error, Result};
 /// The per-chunk parameters of log16, stored in the chunk header.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Log16Params {
-    /// The origin of the grid (0, i.e. `v = 0`); version 1: the prediction for the first point.
+    /// The origin of the grid (0, i.e. `v = 0`; version 3 adds per-channel origins,
+    /// [`Encoded::anchors`]); version 1: the prediction for the first point.
     pub lo: f64,
     /// Quantization step of the residuals, in ln units.
     pub step: f64,

@@ -313,7 +313,7 @@ impl MerlBrdf {
     /// (unmeasured), as in the database. Runs in parallel.
     pub fn from_brdf(brdf: &dyn Brdf) -> Self {
         let rgb = *brdf.channels() == Channels::Rgb;
-        let stored = brdf.channels().len() == 3;
+        let stored = rgb;
         let plane = RES_THETA_D * RES_PHI_D;
         let mut cells = vec![[0.0f64; 3]; SAMPLES];
         cells

@@ -122,7 +122,7 @@ pub fn bake_chunks(
     // its nodes are copied, not evaluated. Asked once, so other sources pay nothing.
     let native = grid.param() == Param::HalfDiff
         && opts.supersample <= 1
-        && layout.len() > 0
+        && !layout.is_empty()
         && brdf.stored_node(half_diff(grid.node_angles([0; 4])), &mut vec![0.0; c]);
     let budget = (opts.memory_budget / 4).max(1);
     let mut buf: Vec<f32> = Vec::new();

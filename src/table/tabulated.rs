@@ -57,6 +57,9 @@ impl<T: ChunkLoader + ?Sized> ChunkLoader for Box<T> {
     }
 }
 
+/// The negative values of a chunk, (offset in the chunk, value), in order.
+type Unmeasured = Box<[(u32, f32)]>;
+
 /// A dense table as a [`Brdf`]: nearest or multilinear lookup, chunks loaded lazily.
 pub struct TabulatedBrdf {
     grid: Grid,
@@ -64,7 +67,7 @@ pub struct TabulatedBrdf {
     chunks: Box<[OnceLock<Arc<[f32]>>]>,
     /// Per chunk, the negative stored values (offset in the chunk, value) that `chunks` holds as
     /// 0; set when the chunk is loaded (see the module docs).
-    unmeasured: Box<[OnceLock<Box<[(u32, f32)]>>]>,
+    unmeasured: Box<[OnceLock<Unmeasured>]>,
     loader: Option<Box<dyn ChunkLoader>>,
     interp: Interp,
     description: String,
@@ -402,7 +405,7 @@ impl Brdf for TabulatedBrdf {
 }
 
 /// Replaces the negative values of `v` by 0 and returns them (offset, value), in order.
-fn set_aside_negatives(v: &mut [f32]) -> Box<[(u32, f32)]> {
+fn set_aside_negatives(v: &mut [f32]) -> Unmeasured {
     let mut out = Vec::new();
     for (k, x) in v.iter_mut().enumerate() {
         if *x < 0.0 {
