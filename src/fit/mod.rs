@@ -198,7 +198,7 @@ pub fn preset(name: &str) -> Result<ModelSpec> {
             }
             other => {
                 return Err(Error::arg(
-                    "--model",
+                    "model",
                     format!(
                         "`{other}` cannot be fit; use lambert, oren_nayar, phong, reciprocal_phong, \
                          max_phong, pumped_phong, blinn_phong, cook_torrance, ggx, ward, sums of \
@@ -309,10 +309,10 @@ pub fn fit_with_progress(
 ) -> Result<FitResult> {
     let clock = Instant::now();
     if opts.pairs == 0 {
-        return Err(Error::arg("--pairs", "at least one pair is needed"));
+        return Err(Error::arg("pairs", "at least one pair is needed"));
     }
     if opts.starts == 0 {
-        return Err(Error::arg("--starts", "at least one start is needed"));
+        return Err(Error::arg("starts", "at least one start is needed"));
     }
     if !(0.0..=1.0).contains(&opts.specular_fraction) {
         return Err(Error::arg("specular_fraction", "must be in [0, 1]"));
@@ -585,7 +585,7 @@ fn flatten(
                 flatten(t, weight * w, channels, out)?;
             }
         }
-        other => out.push((weight, crate::models::build(other, channels)?)),
+        other => out.push((weight, crate::spec::build(other, channels)?)),
     }
     Ok(())
 }

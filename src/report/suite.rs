@@ -514,21 +514,6 @@ pub fn file_safe(s: &str) -> String {
 /// Progress callback: (rows done, rows total, what was just done).
 pub type Progress<'a> = &'a (dyn Fn(usize, usize, &str) + Sync);
 
-fn param_name(p: Param) -> &'static str {
-    match p {
-        Param::HalfDiff => "halfdiff",
-        Param::InOut => "inout",
-    }
-}
-
-fn preset_name(p: Preset) -> &'static str {
-    match p {
-        Preset::Small => "small",
-        Preset::Medium => "medium",
-        Preset::Large => "large",
-    }
-}
-
 /// Albedo per θ and channel by [`albedo::integrate`] with [`ALBEDO_OPTIONS`].
 fn albedos(brdf: &dyn Brdf, thetas: &[f64]) -> Vec<Vec<f64>> {
     thetas
@@ -641,8 +626,8 @@ pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
                 let base = |codec: &str| Row {
                     source: sd.name.clone(),
                     kind: sd.kind_name().to_owned(),
-                    preset: preset_name(preset).to_owned(),
-                    param: param_name(param).to_owned(),
+                    preset: preset.name().to_owned(),
+                    param: param.name().to_owned(),
                     symmetry: String::new(),
                     codec: codec.to_owned(),
                     values: 0,
@@ -733,7 +718,7 @@ pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
                     p(
                         rows.len(),
                         total,
-                        &format!("{} {} {}", sd.name, preset_name(preset), param_name(param)),
+                        &format!("{} {} {}", sd.name, preset.name(), param.name()),
                     );
                 }
             }
@@ -745,12 +730,12 @@ pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
         cfg.sources.len(),
         cfg.presets
             .iter()
-            .map(|&p| preset_name(p))
+            .map(|&p| p.name())
             .collect::<Vec<_>>()
             .join(", "),
         cfg.params
             .iter()
-            .map(|&p| param_name(p))
+            .map(|&p| p.name())
             .collect::<Vec<_>>()
             .join(", "),
         cfg.codecs
