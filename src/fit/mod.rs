@@ -297,15 +297,15 @@ fn eval_cos(b: &dyn Brdf, pairs: &Pairs) -> Vec<f64> {
 
 /// Fits the parameters of `init` to `source`; see the module docs.
 pub fn fit(source: &dyn Brdf, init: &ModelSpec, opts: &FitOptions) -> Result<FitResult> {
-    fit_with_progress(source, init, opts, &mut |_, _| {})
+    fit_with_progress(source, init, opts, &crate::progress::Silent)
 }
 
-/// [`fit`], calling `progress(done, total)` after each start.
+/// [`fit`], reporting one stage, `"fitting"`, that counts the starts done.
 pub fn fit_with_progress(
     source: &dyn Brdf,
     init: &ModelSpec,
     opts: &FitOptions,
-    progress: &mut dyn FnMut(usize, usize),
+    progress: &dyn crate::progress::Progress,
 ) -> Result<FitResult> {
     let clock = Instant::now();
     if opts.pairs == 0 {
@@ -392,6 +392,7 @@ pub fn fit_with_progress(
     let mut best: Option<(usize, DVector<f64>)> = None;
     let mut problem = problem;
     let mut evaluations = 0;
+    let _stage = crate::progress::Stage::begin(progress, "fitting", opts.starts as u64);
     for s in 0..opts.starts {
         let x0 = start_values(s);
         let t0 = DVector::from_vec(to_free(&params, &x0));
@@ -437,7 +438,7 @@ pub fn fit_with_progress(
         {
             best = Some((s, problem.t.clone()));
         }
-        progress(s + 1, opts.starts);
+        progress.set(s as u64 + 1);
     }
     let Some((best_start, t_best)) = best else {
         return Err(Error::Unsupported(

@@ -8,6 +8,7 @@ mod bench;
 mod convert;
 mod db;
 mod demo;
+mod demo_extra;
 mod export;
 mod fit;
 mod measured;

@@ -1,6 +1,5 @@
 //! `render`: preview images of a SOURCE on a sphere, and comparisons of two sources.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -143,21 +142,9 @@ fn options(a: &RenderArgs) -> Result<RenderOptions> {
 /// Renders with a progress bar on a terminal, silently otherwise; reports the time on stderr.
 fn render_one(brdf: &dyn brdftab::Brdf, opts: &RenderOptions, label: &str) -> Result<Image> {
     let start = Instant::now();
-    let img = if std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new((opts.width * opts.height) as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {percent}% eta {eta}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-                .progress_chars("=> "),
-        );
-        bar.set_message(label.to_string());
-        let cb = |k: u64| bar.inc(k);
-        let r = render::render(brdf, opts, Some(&cb));
-        bar.finish_and_clear();
-        r?
-    } else {
-        render::render(brdf, opts, None)?
-    };
+    let bar = crate::progress::Bar::new("{msg} [{bar:40}] {percent}% eta {eta}");
+    bar.prefix(label);
+    let img = render::render(brdf, opts, &bar)?;
     eprintln!(
         "{label}: {}×{} at {} spp in {:.2} s",
         opts.width,
