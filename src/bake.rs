@@ -540,6 +540,46 @@ pub struct BakeReport {
     pub info: serde_json::Value,
 }
 
+impl BakeReport {
+    /// The grid line of a report: the grid's summary, and whether a MERL file's cells were kept.
+    pub fn grid_line(&self) -> String {
+        let cells = if self.merl_cells {
+            ", the file's own cells"
+        } else {
+            ""
+        };
+        format!("{}{cells}", self.grid.summary())
+    }
+
+    /// What the bake did, in a few lines for people: notes and warnings first, then the source,
+    /// grid, reduction, output and throughput (`codec` names the quantization).
+    pub fn summary(&self, codec: &Codec) -> String {
+        let mut s = String::new();
+        if let Some(n) = &self.symmetry_note {
+            s += &format!("note: {n}\n");
+        }
+        if let Some(f) = &self.forced {
+            s += &format!("warning: forced past a symmetry violation: {f}\n");
+        }
+        let full = self.grid.full_values();
+        s += &format!(
+            "baked {}\n  grid: {}\n  {} stored values ({full} unreduced, {:.1}x reduction)\n",
+            self.source,
+            self.grid_line(),
+            self.values,
+            full as f64 / self.values.max(1) as f64
+        );
+        s + &format!(
+            "wrote {} ({} values in {:.2} s, {:.1} M values/s, codec {})\n",
+            self.output,
+            self.values,
+            self.seconds,
+            self.values as f64 / self.seconds.max(1e-9) / 1e6,
+            codec.quant.name()
+        )
+    }
+}
+
 /// Cosine-weighted accuracy of a table against its source.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Accuracy {

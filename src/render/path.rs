@@ -90,6 +90,73 @@ pub enum LightChoice {
     Custom(Light),
 }
 
+/// A name from `choices` (`(name, value)`), or an argument error naming `what` and the choices.
+fn choose<T: Clone>(what: &str, s: &str, choices: &[(&str, T)]) -> Result<T> {
+    let t = s.trim().to_ascii_lowercase();
+    match choices.iter().find(|(n, _)| *n == t) {
+        Some((_, v)) => Ok(v.clone()),
+        None => {
+            let names: Vec<&str> = choices.iter().map(|c| c.0).collect();
+            Err(Error::arg(
+                what,
+                format!("`{s}`: expected {}", names.join(", ")),
+            ))
+        }
+    }
+}
+
+impl Mode {
+    /// Parses `path` or `lit`.
+    pub fn parse(s: &str) -> Result<Mode> {
+        choose("mode", s, &[("path", Mode::Path), ("lit", Mode::Lit)])
+    }
+}
+
+impl Sampling {
+    /// Parses `mis`, `brdf`, `light` or `fixed`.
+    pub fn parse(s: &str) -> Result<Sampling> {
+        let c = [
+            ("mis", Sampling::Mis),
+            ("brdf", Sampling::BrdfOnly),
+            ("light", Sampling::LightOnly),
+            ("fixed", Sampling::Fixed),
+        ];
+        choose("sampling", s, &c)
+    }
+}
+
+impl EnvChoice {
+    /// Parses `sky`, `white` (constant 1, the furnace), `none`, or a lat-long `.exr` file.
+    pub fn parse(s: &str) -> Result<EnvChoice> {
+        if s.to_ascii_lowercase().ends_with(".exr") {
+            return Ok(EnvChoice::Map(Arc::new(Environment::from_exr(s)?)));
+        }
+        let c = [
+            ("sky", EnvChoice::Sky),
+            ("white", EnvChoice::Constant([1.0; 3])),
+            ("none", EnvChoice::Black),
+        ];
+        choose("env", s, &c).map_err(|e| match e {
+            Error::InvalidArgument { name, msg } => {
+                Error::arg(name, format!("{msg} or a .exr file"))
+            }
+            e => e,
+        })
+    }
+}
+
+impl LightChoice {
+    /// Parses `none`, `point` or `area`.
+    pub fn parse(s: &str) -> Result<LightChoice> {
+        let c = [
+            ("none", LightChoice::None),
+            ("point", LightChoice::Point),
+            ("area", LightChoice::Area),
+        ];
+        choose("light", s, &c)
+    }
+}
+
 /// Everything a render needs besides the material.
 #[derive(Debug, Clone)]
 pub struct RenderOptions {

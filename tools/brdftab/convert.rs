@@ -74,13 +74,8 @@ fn to_table(a: ConvertArgs) -> Result<()> {
     let r = req.run_with(&target, &crate::progress::Bar::values())?;
     println!("{}: {}", r.output, r.source);
     println!(
-        "  grid: {}{} ({} values, {:.2} s)",
-        r.grid.summary(),
-        if r.merl_cells {
-            ", the file's own cells"
-        } else {
-            ""
-        },
+        "  grid: {} ({} values, {:.2} s)",
+        r.grid_line(),
         r.values,
         r.seconds
     );
