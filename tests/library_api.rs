@@ -204,3 +204,25 @@ fn the_lecture_table_has_a_row_per_model() {
         assert!(t.lines().any(|l| l.starts_with(label)), "{label}:\n{t}");
     }
 }
+
+#[test]
+fn declared_symmetry_is_taken_unverified() {
+    use brdftab::bake::SymmetryChoice;
+    assert_eq!(
+        SymmetryChoice::parse("declared").unwrap(),
+        SymmetryChoice::Declared
+    );
+    let src = ModelSpec::parse(LAMBERT)
+        .unwrap()
+        .build(&Channels::Rgb)
+        .unwrap();
+    let (t, _) = BakeRequest::new(LAMBERT)
+        .preset(Preset::Small)
+        .symmetry(SymmetryChoice::Declared)
+        .table(&Silent)
+        .unwrap();
+    assert_eq!(
+        t.grid().symmetry(),
+        brdftab::table::Symmetry::from_flags(src.flags())
+    );
+}

@@ -26,7 +26,8 @@ pub struct BakeFlags {
     /// RGL files).
     #[arg(long)]
     pub wavelengths: Option<String>,
-    /// Symmetry reduction: auto (detect), none, or a list of isotropic,reciprocal,bilateral.
+    /// Symmetry reduction: auto (detect), declared (what the source says, unverified), none,
+    /// or a list of isotropic,reciprocal,bilateral.
     #[arg(long, default_value = "auto")]
     pub symmetry: String,
     /// Relative tolerance of symmetry detection and verification (`--tolerance` is a deprecated

@@ -1,12 +1,12 @@
 //! `convert`: any SOURCE into a MERL file or a table, with the table's accuracy reported.
 
 use brdftab::bake::BakeTarget;
-use brdftab::measured::MerlBrdf;
 use brdftab::table::Interp;
 use brdftab::{Error, Result};
 use clap::Args;
 
 use crate::bake::BakeFlags;
+use crate::progress::Bar;
 use crate::source::{self, Kind};
 
 /// Arguments of `brdftab convert`.
@@ -34,15 +34,11 @@ pub struct ConvertArgs {
 pub fn convert(a: ConvertArgs) -> Result<()> {
     match source::kind(&a.output) {
         Kind::Merl => {
-            let brdf = source::open(&a.input, &source::channels(a.flags.wavelengths.as_deref())?)?;
-            let t = std::time::Instant::now();
-            let m = MerlBrdf::from_brdf(&*brdf);
-            m.write(&a.output)?;
+            let req = a.flags.request(&a.input)?;
+            let r = req.run_with(&BakeTarget::Merl(a.output.clone()), &Bar::values())?;
             println!(
                 "{}: {} resampled on the MERL grid (90 × 90 × 180 cell centres) in {:.2} s",
-                a.output,
-                brdf.describe(),
-                t.elapsed().as_secs_f64()
+                r.output, r.source, r.seconds
             );
             Ok(())
         }
@@ -71,7 +67,7 @@ fn to_table(a: ConvertArgs) -> Result<()> {
         },
         t => t,
     };
-    let r = req.run_with(&target, &crate::progress::Bar::values())?;
+    let r = req.run_with(&target, &Bar::values())?;
     println!("{}: {}", r.output, r.source);
     println!(
         "  grid: {} ({} values, {:.2} s)",
