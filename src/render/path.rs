@@ -833,7 +833,7 @@ mod tests {
                         seed: 9,
                         ..opts.clone()
                     },
-                    None,
+                    &Silent,
                 )
                 .unwrap();
                 let interior: Vec<usize> = (0..cov.len()).filter(|&i| cov[i] == 2).collect();
@@ -921,7 +921,7 @@ mod tests {
                 threads: Some(1),
                 ..opts.clone()
             },
-            None,
+            &Silent,
         )
         .unwrap();
         let b = render(
@@ -930,7 +930,7 @@ mod tests {
                 threads: Some(3),
                 ..opts.clone()
             },
-            None,
+            &Silent,
         )
         .unwrap();
         assert!(
