@@ -170,7 +170,7 @@ impl OpenOptions {
 /// A MERL file is opened the same way (`brdftab::open("blue-metallic-paint.binary")`); a missing
 /// file is an error that names it:
 /// ```
-/// let e = brdftab::open("no-such-material.binary").unwrap_err();
+/// let e = brdftab::open("no-such-material.binary").err().expect("no such file");
 /// assert!(e.to_string().contains("no-such-material.binary"));
 /// ```
 pub fn open(source: &str) -> Result<Box<dyn Brdf + Send + Sync>> {

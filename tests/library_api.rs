@@ -20,6 +20,13 @@ fn tmp(name: &str) -> std::path::PathBuf {
     d
 }
 
+fn lambert() -> Box<dyn brdftab::Brdf + Send + Sync> {
+    ModelSpec::parse(LAMBERT)
+        .unwrap()
+        .build(&Channels::Rgb)
+        .unwrap()
+}
+
 /// Records every call, so tests can check what a long operation reported.
 #[derive(Default)]
 struct Log(Mutex<Vec<String>>);
@@ -44,10 +51,7 @@ impl Log {
 
 #[test]
 fn render_reports_one_stage_counting_every_pixel() {
-    let brdf = ModelSpec::parse(LAMBERT)
-        .unwrap()
-        .build(&Channels::Rgb)
-        .unwrap();
+    let brdf = lambert();
     let opts = RenderOptions {
         width: 20,
         height: 10,
@@ -137,10 +141,7 @@ fn library_argument_errors_name_settings_not_flags() {
 
 #[test]
 fn suite_metrics_of_an_exact_table_are_zero_and_a_cap_is_honoured() {
-    let src = ModelSpec::parse(LAMBERT)
-        .unwrap()
-        .build(&Channels::Rgb)
-        .unwrap();
+    let src = lambert();
     let (t, _) = BakeRequest::new(LAMBERT)
         .preset(Preset::Small)
         .table(&Silent)
@@ -182,10 +183,7 @@ fn the_suite_reports_rows_through_progress() {
 
 #[test]
 fn fit_reports_its_starts() {
-    let src = ModelSpec::parse(LAMBERT)
-        .unwrap()
-        .build(&Channels::Rgb)
-        .unwrap();
+    let src = lambert();
     let init = ModelSpec::parse(r#"{"model": "lambert", "kd": 0.1}"#).unwrap();
     let opts = brdftab::fit::FitOptions {
         pairs: 500,
@@ -212,10 +210,7 @@ fn declared_symmetry_is_taken_unverified() {
         SymmetryChoice::parse("declared").unwrap(),
         SymmetryChoice::Declared
     );
-    let src = ModelSpec::parse(LAMBERT)
-        .unwrap()
-        .build(&Channels::Rgb)
-        .unwrap();
+    let src = lambert();
     let (t, _) = BakeRequest::new(LAMBERT)
         .preset(Preset::Small)
         .symmetry(SymmetryChoice::Declared)
