@@ -88,13 +88,17 @@ pub enum SymmetryChoice {
     Auto,
     /// Exactly these (verified against the source unless forced).
     Exactly(Symmetry),
+    /// What the source declares ([`Symmetry::from_flags`]), not verified: for measured data,
+    /// which declares the symmetries of the material but meets them only up to noise.
+    Declared,
 }
 
 impl SymmetryChoice {
-    /// Parses `auto`, `none`, `all` or a list of `isotropic,reciprocal,bilateral`.
+    /// Parses `auto`, `declared`, `none`, `all` or a list of `isotropic,reciprocal,bilateral`.
     pub fn parse(s: &str) -> Result<SymmetryChoice> {
         match s.trim() {
             "auto" => Ok(SymmetryChoice::Auto),
+            "declared" => Ok(SymmetryChoice::Declared),
             s => Ok(SymmetryChoice::Exactly(Symmetry::parse(s)?)),
         }
     }
@@ -116,6 +120,9 @@ pub enum BakeTarget {
     },
     /// A raw (uncompressed f32) table file.
     Raw(String),
+    /// A MERL `.binary` file: the source resampled at the MERL cell centres, in RGB (the grid,
+    /// symmetry and codec of the request do not apply; the format fixes them).
+    Merl(String),
 }
 
 impl BakeTarget {
@@ -152,7 +159,10 @@ impl BakeTarget {
     /// The file written.
     pub fn path(&self) -> &str {
         match self {
-            BakeTarget::File(p) | BakeTarget::Raw(p) | BakeTarget::Db { path: p, .. } => p,
+            BakeTarget::File(p)
+            | BakeTarget::Raw(p)
+            | BakeTarget::Merl(p)
+            | BakeTarget::Db { path: p, .. } => p,
         }
     }
 }
@@ -269,6 +279,7 @@ impl BakeRequest {
     pub fn resolve_symmetry(&self, src: &dyn Brdf) -> (Symmetry, Option<String>) {
         match self.symmetry {
             SymmetryChoice::Exactly(s) => (s, None),
+            SymmetryChoice::Declared => (Symmetry::from_flags(src.flags()), None),
             SymmetryChoice::Auto => {
                 let d = symmetry::detect(src, self.symmetry_tolerance);
                 let declared = Symmetry::from_flags(src.flags());
@@ -333,7 +344,7 @@ impl BakeRequest {
     fn bake_options<'a>(&self, set: crate::table::bake::Progress<'a>) -> BakeOptions<'a> {
         BakeOptions {
             supersample: self.supersample,
-            force: self.force,
+            force: self.force || self.symmetry == SymmetryChoice::Declared,
             tolerance: self.symmetry_tolerance,
             progress: Some(set),
             ..BakeOptions::default()
@@ -373,6 +384,16 @@ impl BakeRequest {
     /// [`run`](Self::run), reporting progress.
     pub fn run_with(&self, target: &BakeTarget, progress: &dyn Progress) -> Result<BakeReport> {
         let src = self.open_source()?;
+        if let BakeTarget::Merl(path) = target {
+            let t0 = Instant::now();
+            let _stage = Stage::begin(progress, "resampling on the MERL grid", 0);
+            crate::measured::MerlBrdf::from_brdf(src.as_ref()).write(path)?;
+            let mut report =
+                self.report_for(src.as_ref(), &Grid::merl(Channels::Rgb), None, t0, true);
+            report.name = stem(path);
+            report.output = path.clone();
+            return Ok(report);
+        }
         let provenance = source::provenance(&self.source, src.as_ref())?;
         let name = match (target, &self.name) {
             (BakeTarget::Db { name, .. }, _) => name.clone(),
@@ -407,7 +428,7 @@ impl BakeRequest {
             BakeTarget::Db { path, .. } => format!("{path}#{name}"),
             t => t.path().to_owned(),
         };
-        if !matches!(target, BakeTarget::Raw(_)) {
+        if matches!(target, BakeTarget::File(_) | BakeTarget::Db { .. }) {
             report.info = crate::store::info::table_info(target.path(), &name)?;
         }
         if self.accuracy_pairs > 0 {
@@ -540,6 +561,46 @@ pub struct BakeReport {
     pub info: serde_json::Value,
 }
 
+impl BakeReport {
+    /// The grid line of a report: the grid's summary, and whether a MERL file's cells were kept.
+    pub fn grid_line(&self) -> String {
+        let cells = if self.merl_cells {
+            ", the file's own cells"
+        } else {
+            ""
+        };
+        format!("{}{cells}", self.grid.summary())
+    }
+
+    /// What the bake did, in a few lines for people: notes and warnings first, then the source,
+    /// grid, reduction, output and throughput (`codec` names the quantization).
+    pub fn summary(&self, codec: &Codec) -> String {
+        let mut s = String::new();
+        if let Some(n) = &self.symmetry_note {
+            s += &format!("note: {n}\n");
+        }
+        if let Some(f) = &self.forced {
+            s += &format!("warning: forced past a symmetry violation: {f}\n");
+        }
+        let full = self.grid.full_values();
+        s += &format!(
+            "baked {}\n  grid: {}\n  {} stored values ({full} unreduced, {:.1}x reduction)\n",
+            self.source,
+            self.grid_line(),
+            self.values,
+            full as f64 / self.values.max(1) as f64
+        );
+        s + &format!(
+            "wrote {} ({} values in {:.2} s, {:.1} M values/s, codec {})\n",
+            self.output,
+            self.values,
+            self.seconds,
+            self.values as f64 / self.seconds.max(1e-9) / 1e6,
+            codec.quant.name()
+        )
+    }
+}
+
 /// Cosine-weighted accuracy of a table against its source.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
 pub struct Accuracy {
@@ -634,6 +695,10 @@ mod tests {
         let dbp = d.join("many.btdb").to_str().unwrap().to_owned();
         let raw = d.join("ct.tbl").to_str().unwrap().to_owned();
         let r1 = req.run(&BakeTarget::file(&file)).unwrap();
+        let merl = d.join("ct.binary").to_str().unwrap().to_owned();
+        let rm = req.run(&BakeTarget::Merl(merl.clone())).unwrap();
+        assert!(rm.merl_cells && rm.output == merl);
+        assert!(crate::measured::MerlBrdf::open(&merl).is_ok());
         let r2 = req.run(&BakeTarget::db(&dbp, "ct")).unwrap();
         let r3 = req.run(&BakeTarget::Raw(raw.clone())).unwrap();
         assert_eq!(r1.name, "ct");

@@ -107,10 +107,17 @@ pub trait Brdf: Send + Sync {
     /// Evaluates many pairs: `out[k * c .. (k + 1) * c]` receives f_r(wi[k], wo[k]) where `c` is
     /// the channel count. Batches of 16 384 pairs or more run on rayon's threads; tables
     /// override this for throughput.
+    ///
+    /// # Panics
+    ///
+    /// If `wi.len() != wo.len()` or `out.len() != wi.len() * c`: a mismatch is a caller's bug,
+    /// and silently evaluating fewer pairs would hide it. Every implementation (overrides
+    /// included) checks this with [`check_batch`]; hosts that take user arrays (the Python and
+    /// C bindings) check the lengths before calling.
     fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
         use rayon::prelude::*;
         let c = self.channels().len().max(1);
-        let n = wi.len().min(wo.len()).min(out.len() / c);
+        let n = check_batch(wi, wo, out, c);
         const BLOCK: usize = 4096;
         let run = |s: usize, o: &mut [f32]| {
             for ((a, b), o) in wi[s..].iter().zip(&wo[s..]).zip(o.chunks_exact_mut(c)) {
@@ -129,10 +136,16 @@ pub trait Brdf: Send + Sync {
 
     /// Directional albedo a(wi) = ∫ f_r(wi, wo) cos θo dωo for every channel into `out`.
     ///
-    /// The default integrates numerically ([`crate::analysis::albedo::quadrature`]); models with
+    /// The default integrates numerically ([`crate::analysis::albedo::integrate`] with the
+    /// default options); models with
     /// a closed form override it. For delta models it is the reflectance of the delta lobe.
     fn albedo(&self, wi: DVec3, out: &mut [f64]) {
-        crate::analysis::albedo::quadrature(self, wi, out);
+        let opts = crate::quadrature::Options::default();
+        let est = crate::quadrature::hemisphere(self.channels().len(), wi, &opts, |wi, wo, f| {
+            self.eval(wi, wo, f)
+        });
+        let c = est.value.len().min(out.len());
+        out[..c].copy_from_slice(&est.value[..c]);
     }
 
     /// Draws an incident direction `wi` for the outgoing direction `wo` from two uniform numbers
@@ -194,6 +207,20 @@ pub trait Brdf: Send + Sync {
         let _ = (hd, out);
         false
     }
+}
+
+/// The length check of [`Brdf::eval_batch`]: returns the number of pairs, panics (with both
+/// lengths) if `wi`, `wo` and `out` (`c` channels per pair) disagree.
+#[track_caller]
+pub fn check_batch(wi: &[DVec3], wo: &[DVec3], out: &[f32], c: usize) -> usize {
+    assert!(
+        wi.len() == wo.len() && out.len() == wi.len() * c,
+        "eval_batch: {} wi, {} wo and {} outputs do not match ({c} channels per pair)",
+        wi.len(),
+        wo.len(),
+        out.len()
+    );
+    wi.len()
 }
 
 /// Smart pointers to a `Brdf` are `Brdf`s: every method forwards to the pointee (so overrides such

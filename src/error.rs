@@ -71,7 +71,7 @@ pub enum Error {
         /// The file.
         file: String,
         /// Which block (table and chunk).
-        what: String,
+        what: Section,
         /// The checksum in the file.
         stored: u64,
         /// The checksum of the data read.
@@ -80,11 +80,11 @@ pub enum Error {
 
     /// A declared symmetry that the source breaks beyond tolerance.
     #[error(
-        "source is not {symmetry}: relative difference {error:.3e} > tolerance {tolerance:.1e} at {at} (use --force to bake anyway, or --symmetry none)"
+        "source is not {symmetry}: relative difference {error:.3e} > tolerance {tolerance:.1e} at {at}"
     )]
     Symmetry {
-        /// Name of the symmetry (`isotropic`, `reciprocal`, `bilateral`).
-        symmetry: String,
+        /// The symmetry broken.
+        symmetry: SymmetryKind,
         /// Worst relative difference found.
         error: f64,
         /// The tolerance in force.
@@ -93,10 +93,20 @@ pub enum Error {
         at: String,
     },
 
+    /// A name that is already taken (a table in a database, when replacing was not asked for).
+    #[error("{container} already holds a table `{name}`")]
+    Duplicate {
+        /// The database (or file) holding the name.
+        container: String,
+        /// The name.
+        name: String,
+    },
+
     /// An argument out of its valid range or otherwise unusable.
     #[error("invalid argument `{name}`: {msg}")]
     InvalidArgument {
-        /// The argument's name (`--grid`, `wavelengths`, ...).
+        /// The argument's name (`grid`, `wavelengths`, ...): the library's name of the setting,
+        /// never a host's flag (hosts map errors to their own words).
         name: String,
         /// What is wrong.
         msg: String,
@@ -116,6 +126,79 @@ pub enum Error {
     /// A named entry does not exist (a table in a database, a metal, ...).
     #[error("not found: {0}")]
     NotFound(String),
+}
+
+/// One of the symmetries a BRDF may have, as [`Error::Symmetry`] names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SymmetryKind {
+    /// f(wi, wo) unchanged by a common rotation about the normal.
+    Isotropic,
+    /// f(wi, wo) = f(wo, wi).
+    Reciprocal,
+    /// f unchanged by the mirror y → −y.
+    Bilateral,
+}
+
+impl SymmetryKind {
+    /// The three kinds, in the order of [`crate::table::Symmetry`]'s fields.
+    pub const ALL: [SymmetryKind; 3] = [
+        SymmetryKind::Isotropic,
+        SymmetryKind::Reciprocal,
+        SymmetryKind::Bilateral,
+    ];
+
+    /// `isotropic`, `reciprocal` or `bilateral`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SymmetryKind::Isotropic => "isotropic",
+            SymmetryKind::Reciprocal => "reciprocal",
+            SymmetryKind::Bilateral => "bilateral",
+        }
+    }
+}
+
+impl std::fmt::Display for SymmetryKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A checksummed block of a store file, as [`Error::Checksum`] (and format errors) name it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Section {
+    /// The fixed-size superblock at the start of the file.
+    Superblock,
+    /// The table of contents.
+    Toc,
+    /// A table's JSON header.
+    Header {
+        /// The table's name.
+        table: String,
+    },
+    /// A table's chunk index.
+    Index {
+        /// The table's name.
+        table: String,
+    },
+    /// One chunk of a table's values.
+    Chunk {
+        /// The table's name.
+        table: String,
+        /// The chunk's number.
+        chunk: usize,
+    },
+}
+
+impl std::fmt::Display for Section {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Section::Superblock => f.write_str("superblock"),
+            Section::Toc => f.write_str("table of contents"),
+            Section::Header { table } => write!(f, "table `{table}` header"),
+            Section::Index { table } => write!(f, "table `{table}` index"),
+            Section::Chunk { table, chunk } => write!(f, "table `{table}` chunk {chunk}"),
+        }
+    }
 }
 
 /// Shorthand for `std::result::Result<T, brdftab::Error>`.

@@ -37,6 +37,7 @@ pub mod measured;
 pub mod metals;
 pub mod models;
 pub mod progress;
+pub mod quadrature;
 pub mod render;
 pub mod report;
 pub mod rng;

@@ -19,6 +19,12 @@ pub trait Progress: Sync {
         let _ = done;
     }
 
+    /// What the current stage is working on now (e.g. the source being measured); shown beside
+    /// the stage's name where there is room.
+    fn note(&self, what: &str) {
+        let _ = what;
+    }
+
     /// The current stage is over (successfully or not).
     fn end(&self) {}
 }
@@ -36,8 +42,32 @@ impl<P: Progress + ?Sized> Progress for &P {
     fn set(&self, done: u64) {
         (**self).set(done)
     }
+    fn note(&self, what: &str) {
+        (**self).note(what)
+    }
     fn end(&self) {
         (**self).end()
+    }
+}
+
+/// Turns increments from several threads into [`Progress::set`] calls with the running total.
+pub(crate) struct Counter<'a> {
+    progress: &'a dyn Progress,
+    done: std::sync::atomic::AtomicU64,
+}
+
+impl<'a> Counter<'a> {
+    pub(crate) fn new(progress: &'a dyn Progress) -> Counter<'a> {
+        Counter {
+            progress,
+            done: std::sync::atomic::AtomicU64::new(0),
+        }
+    }
+
+    /// `k` more units are done.
+    pub(crate) fn add(&self, k: u64) {
+        let done = self.done.fetch_add(k, std::sync::atomic::Ordering::Relaxed) + k;
+        self.progress.set(done);
     }
 }
 

@@ -19,22 +19,14 @@ use serde::{Deserialize, Serialize};
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
 use crate::fresnel::FresnelSpec;
+pub use crate::models::phong::PumpX;
+use crate::models::{
+    blinn_phong, cook_torrance, ggx, lambert, mirror, oren_nayar, phong, sum, ward,
+};
 use crate::spectrum::{Channels, Value};
 
 fn one() -> Value {
     Value::Grey(1.0)
-}
-
-/// How the pumped-up Phong model symmetrizes cos θ′ (the lecture's X).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PumpX {
-    /// X = (cos θ′ + cos θ) / 2.
-    Mean,
-    /// X = cos θ′ · cos θ.
-    Product,
-    /// X = sqrt(cos θ′ · cos θ).
-    Sqrt,
 }
 
 /// An analytic BRDF model and its parameters. Serialized with a `"model"` tag, e.g.
@@ -154,100 +146,365 @@ pub enum ModelSpec {
     },
 }
 
-/// One entry of [`MODELS`]: a model's name, parameters and description (for `brdftab models`).
+/// How a parameter's numbers are bounded (checked by [`ModelSpec::validate`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Bound {
+    /// No check beyond being a well-formed value (enums, Fresnel specs, nested specs).
+    None,
+    /// Every number finite and ≥ 0.
+    NonNegative,
+    /// Every number finite and > 0.
+    Positive,
+}
+
+/// What a parameter holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Kind {
+    /// A [`Value`]: grey number, RGB triple or sampled spectrum.
+    Value,
+    /// One number.
+    Number,
+    /// One angle in radians.
+    Radians,
+    /// A [`FresnelSpec`].
+    Fresnel,
+    /// One of the listed names.
+    Choice(&'static [&'static str]),
+    /// A list of specs (the terms of a sum).
+    Specs,
+    /// A list of numbers, one per term.
+    Numbers,
+}
+
+/// One parameter of a model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ParamInfo {
+    /// Its JSON field name.
+    pub name: &'static str,
+    /// What it holds.
+    pub kind: Kind,
+    /// Its bound.
+    pub bound: Bound,
+    /// Its default when omitted, as written in JSON (`None`: required, or exclusive with
+    /// another parameter as [`ModelInfo::rule`] says).
+    pub default: Option<&'static str>,
+}
+
+/// One entry of [`MODELS`]: a model's name, parameters with their bounds, description and
+/// example. [`ModelSpec::validate`] checks a spec against its entry, `brdftab models` lists them.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct ModelInfo {
     /// The `"model"` tag.
     pub name: &'static str,
-    /// Parameters with their meaning.
-    pub params: &'static str,
+    /// The parameters.
+    pub params: &'static [ParamInfo],
+    /// A rule between parameters that their bounds cannot say, if any.
+    pub rule: Option<&'static str>,
     /// One line of description.
     pub description: &'static str,
     /// An example spec.
     pub example: &'static str,
 }
 
-/// Every model, for listings and help.
+impl ModelInfo {
+    /// The parameters as one line, e.g. `ks: Value ≥ 0, n: number ≥ 0`.
+    pub fn params_line(&self) -> String {
+        let mut v: Vec<String> = self
+            .params
+            .iter()
+            .map(|p| {
+                let kind = match p.kind {
+                    Kind::Value => "Value".to_owned(),
+                    Kind::Number => "number".to_owned(),
+                    Kind::Radians => "radians".to_owned(),
+                    Kind::Fresnel => "Fresnel".to_owned(),
+                    Kind::Choice(c) => c
+                        .iter()
+                        .map(|x| format!("\"{x}\""))
+                        .collect::<Vec<_>>()
+                        .join(" | "),
+                    Kind::Specs => "[spec, ...]".to_owned(),
+                    Kind::Numbers => "[number, ...]".to_owned(),
+                };
+                let bound = match p.bound {
+                    Bound::None => "",
+                    Bound::NonNegative => " ≥ 0",
+                    Bound::Positive => " > 0",
+                };
+                let default = p.default.map(|d| format!(" = {d}")).unwrap_or_default();
+                format!("{}: {kind}{bound}{default}", p.name)
+            })
+            .collect();
+        if let Some(r) = self.rule {
+            v.push(format!("({r})"));
+        }
+        v.join(", ")
+    }
+}
+
+const fn param(name: &'static str, kind: Kind, bound: Bound) -> ParamInfo {
+    ParamInfo {
+        name,
+        kind,
+        bound,
+        default: None,
+    }
+}
+
+const fn defaulted(name: &'static str, kind: Kind, bound: Bound, d: &'static str) -> ParamInfo {
+    ParamInfo {
+        name,
+        kind,
+        bound,
+        default: Some(d),
+    }
+}
+
+const KS: ParamInfo = param("ks", Kind::Value, Bound::NonNegative);
+const KS_1: ParamInfo = defaulted("ks", Kind::Value, Bound::NonNegative, "1");
+const KD: ParamInfo = param("kd", Kind::Value, Bound::NonNegative);
+const N: ParamInfo = param("n", Kind::Number, Bound::NonNegative);
+const FRESNEL: ParamInfo = defaulted("fresnel", Kind::Fresnel, Bound::None, "\"none\"");
+const ALPHA_X: ParamInfo = param("alpha_x", Kind::Number, Bound::Positive);
+const ALPHA_Y: ParamInfo = param("alpha_y", Kind::Number, Bound::Positive);
+
+/// Every model: the one declaration that validation, listings and help read (the serde enum
+/// [`ModelSpec`] gives the same fields their Rust types; a test checks the two agree).
 pub const MODELS: &[ModelInfo] = &[
     ModelInfo {
         name: "lambert",
-        params: "kd: Value",
+        params: &[KD],
+        rule: None,
         description: "diffuse, f = k_d; albedo k_d·π (energy conserving for k_d ≤ 1/π)",
         example: r#"{"model": "lambert", "kd": 0.3}"#,
     },
     ModelInfo {
         name: "mirror",
-        params: "fresnel: Fresnel = \"none\"",
+        params: &[FRESNEL],
+        rule: None,
         description: "ideal reflector (delta), direction 2(N·V)N − V, k_r = Fresnel",
         example: r#"{"model": "mirror", "fresnel": {"conductor": "Ag"}}"#,
     },
     ModelInfo {
         name: "refractor",
-        params: "eta: Value",
+        params: &[param("eta", Kind::Value, Bound::Positive)],
+        rule: None,
         description: "ideal refraction (delta), Snell's law, weight 1 − F; total internal reflection → none",
         example: r#"{"model": "refractor", "eta": 1.5}"#,
     },
     ModelInfo {
         name: "phong",
-        params: "ks: Value, n: number",
+        params: &[KS, N],
+        rule: None,
         description: "original Phong, k_s cos^n ψ / cos θ′ (not reciprocal)",
         example: r#"{"model": "phong", "ks": 0.5, "n": 20}"#,
     },
     ModelInfo {
         name: "reciprocal_phong",
-        params: "ks: Value, n: number",
+        params: &[KS, N],
+        rule: None,
         description: "reciprocal Phong, k_s cos^n ψ; albedo 2π k_s/(n+2) at normal incidence",
         example: r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 50}"#,
     },
     ModelInfo {
         name: "max_phong",
-        params: "ks: Value, n: number",
+        params: &[KS, N],
+        rule: None,
         description: "max Phong, k_s cos^n ψ / max(cos θ′, cos θ)",
         example: r#"{"model": "max_phong", "ks": 0.5, "n": 50}"#,
     },
     ModelInfo {
         name: "pumped_phong",
-        params: "ks: Value, n: number, x: \"mean\" | \"product\" | \"sqrt\"",
+        params: &[
+            KS,
+            N,
+            param("x", Kind::Choice(&["mean", "product", "sqrt"]), Bound::None),
+        ],
+        rule: None,
         description: "pumped-up reciprocal Phong, k_s cos^n ψ / X with a symmetric X",
         example: r#"{"model": "pumped_phong", "ks": 0.5, "n": 50, "x": "mean"}"#,
     },
     ModelInfo {
         name: "cook_torrance",
-        params: "m: number, ks: Value = 1, fresnel: Fresnel = \"none\"",
+        params: &[param("m", Kind::Number, Bound::Positive), KS_1, FRESNEL],
+        rule: None,
         description: "Cook-Torrance, D·G·F/(4 (N·V)(N·L)), normalized Beckmann D, V-cavity G, F at L·H",
         example: r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#,
     },
     ModelInfo {
         name: "blinn_phong",
-        params: "ks: Value, n: number",
+        params: &[KS, N],
+        rule: None,
         description: "normalized Blinn-Phong, k_s (n+8)/(8π) cos^n θh",
         example: r#"{"model": "blinn_phong", "ks": 0.5, "n": 100}"#,
     },
     ModelInfo {
         name: "ggx",
-        params: "alpha | alpha_x + alpha_y: number, ks: Value = 1, fresnel: Fresnel = \"none\"",
+        params: &[
+            param("alpha", Kind::Number, Bound::Positive),
+            ALPHA_X,
+            ALPHA_Y,
+            KS_1,
+            FRESNEL,
+        ],
+        rule: Some(GGX_RULE),
         description: "GGX / Trowbridge-Reitz microfacet model, k_s D G2 F(wi·h) / (4 cos θi cos θo), Smith height-correlated G2, isotropic or anisotropic; visible-normal sampling",
         example: r#"{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}"#,
     },
     ModelInfo {
         name: "ward",
-        params: "ks: Value, alpha_x: number, alpha_y: number",
+        params: &[KS, ALPHA_X, ALPHA_Y],
+        rule: None,
         description: "Ward (1992) anisotropic Gaussian lobe, k_s exp(−tan²θh (cos²φh/α_x² + sin²φh/α_y²)) / (4π α_x α_y √(cos θi cos θo)); not energy conserving at grazing angles",
         example: r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}"#,
     },
     ModelInfo {
         name: "oren_nayar",
-        params: "kd: Value, sigma: radians",
+        params: &[KD, param("sigma", Kind::Radians, Bound::NonNegative)],
+        rule: None,
         description: "Oren-Nayar rough diffuse (qualitative model), k_d (A + B max(0, cos Δφ) sin α tan β); sigma = 0 is Lambert",
         example: r#"{"model": "oren_nayar", "kd": 0.25, "sigma": 0.3}"#,
     },
     ModelInfo {
         name: "sum",
-        params: "terms: [spec, ...], weights: [number, ...] = all 1",
+        params: &[
+            param("terms", Kind::Specs, Bound::None),
+            defaulted("weights", Kind::Numbers, Bound::NonNegative, "all 1"),
+        ],
+        rule: Some(SUM_RULE),
         description: "weighted sum of models, e.g. diffuse + specular; sampling picks a term with probability ∝ weight × albedo",
         example: r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.2}, {"model": "cook_torrance", "m": 0.2}]}"#,
     },
 ];
+
+const GGX_RULE: &str = "give either `alpha` or both `alpha_x` and `alpha_y`";
+const SUM_RULE: &str = "at least one term; one weight per term";
+
+/// The entry of [`MODELS`] named `name`.
+pub fn model_info(name: &str) -> Option<&'static ModelInfo> {
+    MODELS.iter().find(|m| m.name == name)
+}
+
+/// Checks one parameter's JSON value against its bound. `field` names it in errors.
+fn check_param(p: &ParamInfo, field: &str, v: &serde_json::Value) -> Result<()> {
+    let number = |x: Option<f64>, field: &str| -> Result<()> {
+        let ok = match (x, p.bound) {
+            (Some(x), Bound::NonNegative) => x.is_finite() && x >= 0.0,
+            (Some(x), Bound::Positive) => x.is_finite() && x > 0.0,
+            (Some(_), Bound::None) => true,
+            (None, _) => false,
+        };
+        if ok {
+            return Ok(());
+        }
+        let what = x.map_or_else(|| "NaN".to_owned(), |x| x.to_string());
+        let rel = if p.bound == Bound::Positive {
+            ">"
+        } else {
+            "≥"
+        };
+        Err(Error::spec(
+            field,
+            format!("{what} must be a finite number {rel} 0"),
+        ))
+    };
+    match p.kind {
+        Kind::Number | Kind::Radians => number(v.as_f64(), field),
+        Kind::Numbers => match v.as_array() {
+            Some(a) => a
+                .iter()
+                .enumerate()
+                .try_for_each(|(i, x)| number(x.as_f64(), &format!("{field}[{i}]"))),
+            None => Err(Error::spec(field, "expected a list of numbers")),
+        },
+        Kind::Value => {
+            let value: Value = serde_json::from_value(v.clone()).map_err(|_| {
+                Error::spec(field, "must be a finite number, RGB triple or spectrum")
+            })?;
+            value.validate(field, 0.0)?;
+            if p.bound == Bound::Positive && value.numbers().iter().any(|&x| x <= 0.0) {
+                return Err(Error::spec(field, "must be > 0"));
+            }
+            Ok(())
+        }
+        // Checked by their own types (Fresnel when resolved, choices by serde, specs by
+        // recursion in `validate_at`).
+        Kind::Fresnel | Kind::Choice(_) | Kind::Specs => Ok(()),
+    }
+}
+
+/// Builds the model a (validated) spec describes for a channel set: the constructor of each
+/// family in [`crate::models`].
+pub(crate) fn build(spec: &ModelSpec, channels: &Channels) -> Result<Box<dyn Brdf + Send + Sync>> {
+    Ok(match spec {
+        ModelSpec::Lambert { kd } => Box::new(lambert::Lambert::new(kd.clone(), channels)?),
+        ModelSpec::Mirror { fresnel } => Box::new(mirror::Mirror::new(fresnel, channels)?),
+        ModelSpec::Refractor { eta } => Box::new(mirror::Refractor::new(eta.clone(), channels)?),
+        ModelSpec::Phong { ks, n } => Box::new(phong::Phong::original(ks.clone(), *n, channels)?),
+        ModelSpec::ReciprocalPhong { ks, n } => {
+            Box::new(phong::Phong::reciprocal(ks.clone(), *n, channels)?)
+        }
+        ModelSpec::MaxPhong { ks, n } => Box::new(phong::Phong::max(ks.clone(), *n, channels)?),
+        ModelSpec::PumpedPhong { ks, n, x } => {
+            Box::new(phong::Phong::pumped(ks.clone(), *n, *x, channels)?)
+        }
+        ModelSpec::CookTorrance { m, ks, fresnel } => Box::new(cook_torrance::CookTorrance::new(
+            *m,
+            ks.clone(),
+            fresnel,
+            channels,
+        )?),
+        ModelSpec::BlinnPhong { ks, n } => {
+            Box::new(blinn_phong::BlinnPhong::new(ks.clone(), *n, channels)?)
+        }
+        ModelSpec::Ggx {
+            alpha,
+            alpha_x,
+            alpha_y,
+            ks,
+            fresnel,
+        } => {
+            let (ax, ay) = match (alpha, alpha_x, alpha_y) {
+                (Some(a), None, None) => (*a, *a),
+                (None, Some(ax), Some(ay)) => (*ax, *ay),
+                _ => return Err(Error::spec("alpha", GGX_RULE)),
+            };
+            Box::new(ggx::Ggx::new(
+                ax,
+                ay,
+                ks.clone(),
+                fresnel.clone(),
+                channels,
+            )?)
+        }
+        ModelSpec::Ward {
+            ks,
+            alpha_x,
+            alpha_y,
+        } => Box::new(ward::Ward::new(ks.clone(), *alpha_x, *alpha_y, channels)?),
+        ModelSpec::OrenNayar { kd, sigma } => {
+            Box::new(oren_nayar::OrenNayar::new(kd.clone(), *sigma, channels)?)
+        }
+        ModelSpec::Sum { terms, weights } => {
+            let built = terms
+                .iter()
+                .enumerate()
+                .map(|(i, t)| build(t, channels).map_err(|e| prefix_field(e, i)))
+                .collect::<Result<Vec<_>>>()?;
+            Box::new(sum::Sum::new(built, weights.clone(), channels)?)
+        }
+    })
+}
+
+/// Prefixes the field of a spec error from term `i` of a sum with `terms[i].`.
+fn prefix_field(e: Error, i: usize) -> Error {
+    match e {
+        Error::Spec { field, msg } => Error::spec(format!("terms[{i}].{field}"), msg),
+        other => other,
+    }
+}
 
 impl ModelSpec {
     /// Parses a spec from JSON text; errors name the field path.
@@ -279,22 +536,28 @@ impl ModelSpec {
         })
     }
 
-    /// The `"model"` tag of this spec.
+    /// The `"model"` tag of this spec (read from the serde form, so it cannot disagree).
     pub fn name(&self) -> &'static str {
-        match self {
-            ModelSpec::Lambert { .. } => "lambert",
-            ModelSpec::Mirror { .. } => "mirror",
-            ModelSpec::Refractor { .. } => "refractor",
-            ModelSpec::Phong { .. } => "phong",
-            ModelSpec::ReciprocalPhong { .. } => "reciprocal_phong",
-            ModelSpec::MaxPhong { .. } => "max_phong",
-            ModelSpec::PumpedPhong { .. } => "pumped_phong",
-            ModelSpec::CookTorrance { .. } => "cook_torrance",
-            ModelSpec::BlinnPhong { .. } => "blinn_phong",
-            ModelSpec::Ggx { .. } => "ggx",
-            ModelSpec::Ward { .. } => "ward",
-            ModelSpec::OrenNayar { .. } => "oren_nayar",
-            ModelSpec::Sum { .. } => "sum",
+        self.tagged()
+            .0
+            .and_then(|n| model_info(&n))
+            .map_or("unknown", |m| m.name)
+    }
+
+    /// The entry of [`MODELS`] for this spec.
+    pub fn info(&self) -> &'static ModelInfo {
+        model_info(self.name()).expect("every variant has an entry in MODELS (tested)")
+    }
+
+    /// The externally tagged serde form split into (tag, fields).
+    fn tagged(&self) -> (Option<String>, serde_json::Map<String, serde_json::Value>) {
+        match ModelSpec::serialize(self, serde_json::value::Serializer) {
+            Ok(serde_json::Value::Object(o)) => match o.into_iter().next() {
+                Some((tag, serde_json::Value::Object(fields))) => (Some(tag), fields),
+                Some((tag, _)) => (Some(tag), serde_json::Map::new()),
+                None => (None, serde_json::Map::new()),
+            },
+            _ => (None, serde_json::Map::new()),
         }
     }
 
@@ -309,107 +572,51 @@ impl ModelSpec {
     }
 
     fn validate_at(&self, prefix: &str) -> Result<()> {
-        let f = |name: &str| format!("{prefix}{name}");
-        let nonneg = |name: &str, x: f64| -> Result<()> {
-            if !x.is_finite() || x < 0.0 {
-                return Err(Error::spec(
-                    f(name),
-                    format!("{x} must be a finite number ≥ 0"),
-                ));
+        let (_, fields) = self.tagged();
+        for p in self.info().params {
+            if let Some(v) = fields.get(p.name) {
+                check_param(p, &format!("{prefix}{}", p.name), v)?;
             }
-            Ok(())
-        };
-        let positive = |name: &str, x: f64| -> Result<()> {
-            if !x.is_finite() || x <= 0.0 {
-                return Err(Error::spec(
-                    f(name),
-                    format!("{x} must be a finite number > 0"),
-                ));
-            }
-            Ok(())
-        };
+        }
+        // The rules between parameters (ModelInfo::rule).
         match self {
-            ModelSpec::Lambert { kd } => kd.validate(&f("kd"), 0.0),
-            ModelSpec::Mirror { .. } => Ok(()), // Fresnel validated when resolved.
-            ModelSpec::Refractor { eta } => {
-                eta.validate(&f("eta"), 0.0)?;
-                if eta.numbers().iter().any(|&x| x <= 0.0) {
-                    return Err(Error::spec(f("eta"), "must be > 0"));
-                }
-                Ok(())
-            }
-            ModelSpec::Phong { ks, n }
-            | ModelSpec::ReciprocalPhong { ks, n }
-            | ModelSpec::MaxPhong { ks, n }
-            | ModelSpec::PumpedPhong { ks, n, .. }
-            | ModelSpec::BlinnPhong { ks, n } => {
-                ks.validate(&f("ks"), 0.0)?;
-                nonneg("n", *n)
-            }
-            ModelSpec::CookTorrance { m, ks, .. } => {
-                ks.validate(&f("ks"), 0.0)?;
-                positive("m", *m)
-            }
             ModelSpec::Ggx {
                 alpha,
                 alpha_x,
                 alpha_y,
-                ks,
                 ..
-            } => {
-                ks.validate(&f("ks"), 0.0)?;
-                match (alpha, alpha_x, alpha_y) {
-                    (Some(a), None, None) => positive("alpha", *a),
-                    (None, Some(ax), Some(ay)) => {
-                        positive("alpha_x", *ax)?;
-                        positive("alpha_y", *ay)
-                    }
-                    _ => Err(Error::spec(
-                        f("alpha"),
-                        "give either `alpha` or both `alpha_x` and `alpha_y`",
-                    )),
-                }
-            }
-            ModelSpec::Ward {
-                ks,
-                alpha_x,
-                alpha_y,
-            } => {
-                ks.validate(&f("ks"), 0.0)?;
-                positive("alpha_x", *alpha_x)?;
-                positive("alpha_y", *alpha_y)
-            }
-            ModelSpec::OrenNayar { kd, sigma } => {
-                kd.validate(&f("kd"), 0.0)?;
-                nonneg("sigma", *sigma)
-            }
+            } => match (alpha, alpha_x, alpha_y) {
+                (Some(_), None, None) | (None, Some(_), Some(_)) => Ok(()),
+                _ => Err(Error::spec(format!("{prefix}alpha"), GGX_RULE)),
+            },
             ModelSpec::Sum { terms, weights } => {
                 if terms.is_empty() {
-                    return Err(Error::spec(f("terms"), "a sum needs at least one term"));
+                    return Err(Error::spec(
+                        format!("{prefix}terms"),
+                        "a sum needs at least one term",
+                    ));
                 }
-                if let Some(w) = weights {
-                    if w.len() != terms.len() {
-                        return Err(Error::spec(
-                            f("weights"),
-                            format!("{} weights for {} terms", w.len(), terms.len()),
-                        ));
-                    }
-                    for (i, &x) in w.iter().enumerate() {
-                        nonneg(&format!("weights[{i}]"), x)?;
-                    }
+                if let Some(w) = weights
+                    && w.len() != terms.len()
+                {
+                    return Err(Error::spec(
+                        format!("{prefix}weights"),
+                        format!("{} weights for {} terms", w.len(), terms.len()),
+                    ));
                 }
                 for (i, t) in terms.iter().enumerate() {
                     t.validate_at(&format!("{prefix}terms[{i}]."))?;
                 }
                 Ok(())
             }
+            _ => Ok(()),
         }
     }
 
     /// Builds the model for `channels` (validating first).
     pub fn build(&self, channels: &Channels) -> Result<Box<dyn Brdf + Send + Sync>> {
         self.validate()?;
-        crate::models::build(self, channels)
+        build(self, channels)
     }
 }
 
@@ -490,6 +697,47 @@ mod tests {
             let back = ModelSpec::parse(&s.to_json()).unwrap();
             assert_eq!(back, s);
         }
+    }
+
+    #[test]
+    fn the_declaration_and_the_enum_agree() {
+        for m in MODELS {
+            let s = ModelSpec::parse(m.example).unwrap();
+            // Every field the enum writes is declared ...
+            for (k, _) in s.tagged().1 {
+                assert!(m.params.iter().any(|p| p.name == k), "{}.{k}", m.name);
+            }
+            // ... and a declared parameter that is not in the enum is rejected by serde.
+            for p in m.params {
+                let mut j: serde_json::Value = serde_json::from_str(m.example).unwrap();
+                if j.get(p.name).is_none() {
+                    continue;
+                }
+                j[p.name] = serde_json::json!(-1);
+                let e = ModelSpec::parse(&j.to_string());
+                if p.bound != Bound::None {
+                    let e = e.unwrap_err().to_string();
+                    assert!(e.contains(p.name), "{}.{}: {e}", m.name, p.name);
+                }
+            }
+        }
+        assert_eq!(MODELS.len(), 13, "one entry per ModelSpec variant");
+    }
+
+    #[test]
+    fn bounds_come_from_the_declaration() {
+        let e = ModelSpec::parse(r#"{"model": "cook_torrance", "m": 0}"#).unwrap_err();
+        assert!(e.to_string().contains("> 0"), "{e}");
+        let e = ModelSpec::parse(r#"{"model": "refractor", "eta": 0}"#).unwrap_err();
+        assert!(e.to_string().contains("eta"), "{e}");
+        let e = ModelSpec::parse(
+            r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.1}], "weights": [-1]}"#,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("weights[0]"), "{e}");
+        let e = ModelSpec::parse(r#"{"model": "ggx", "alpha": 0.1, "alpha_x": 0.2}"#).unwrap_err();
+        assert!(e.to_string().contains("alpha"), "{e}");
+        assert!(MODELS[9].params_line().contains("alpha_x: number > 0"));
     }
 
     #[test]

@@ -81,7 +81,7 @@ const METRICS: [&str; 8] = [
 #[test]
 fn tiny_suite_has_header_expected_rows_and_finite_metrics() {
     let cfg = tiny();
-    let report = suite::run(&cfg, None).unwrap();
+    let report = suite::run(&cfg, &brdftab::progress::Silent).unwrap();
     assert_eq!(report.rows.len(), 4);
     let (header, rows) = parse_csv(&report.csv());
     assert_eq!(header.join(","), CSV_HEADER);
@@ -122,7 +122,7 @@ fn lambert_table_has_no_error() {
     let mut cfg = tiny();
     cfg.sources.truncate(1);
     cfg.codecs = codecs(&["f32", "log16@1e-3"]);
-    let report = suite::run(&cfg, None).unwrap();
+    let report = suite::run(&cfg, &brdftab::progress::Silent).unwrap();
     let f32 = &report.rows[0];
     assert!(f32.rel_rmse < 1e-6, "{f32:?}");
     assert!(f32.max_rel < 1e-6, "{f32:?}");
@@ -140,7 +140,7 @@ fn unmeasured_render_is_minus_one_and_said_so() {
     cfg.sources.truncate(1);
     cfg.codecs.truncate(1);
     cfg.render = None;
-    let report = suite::run(&cfg, None).unwrap();
+    let report = suite::run(&cfg, &brdftab::progress::Silent).unwrap();
     let r = &report.rows[0];
     assert_eq!(r.render, "skipped");
     assert_eq!(r.render_rel_rmse, NOT_MEASURED);
@@ -156,7 +156,7 @@ fn unmeasured_render_is_minus_one_and_said_so() {
 
 #[test]
 fn write_all_writes_csv_markdown_and_valid_pngs() {
-    let report = suite::run(&tiny(), None).unwrap();
+    let report = suite::run(&tiny(), &brdftab::progress::Silent).unwrap();
     let dir = tmp("lib");
     let files = report.write_all(&dir).unwrap();
     assert_eq!(files.len(), 4, "{files:?}");

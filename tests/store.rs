@@ -633,3 +633,34 @@ fn stored_tables_evaluate_like_the_table_they_came_from() {
     assert!(e.contains("#NAME"), "{e}");
     assert!(tables::is_store_file(&p));
 }
+
+#[test]
+fn a_damaged_chunk_read_lazily_stays_a_checksum_error() {
+    let d = tmpdir("lazy-checksum");
+    let p = d.join("l.btdb");
+    brdftab::BakeRequest::new(r#"{"model": "lambert", "kd": 0.3}"#)
+        .preset(brdftab::table::presets::Preset::Small)
+        .run(&brdftab::BakeTarget::file(p.to_str().unwrap()))
+        .unwrap();
+    let mut b = std::fs::read(&p).unwrap();
+    let st = Store::from_bytes("x.btdb", b.clone(), OpenOptions::default()).unwrap();
+    let raw = st.table("l").unwrap().raw_chunk(0).unwrap().to_vec();
+    let at = b
+        .windows(raw.len())
+        .position(|w| w == raw.as_slice())
+        .unwrap();
+    b[at + raw.len() / 2] ^= 0x10;
+    let st = Store::from_bytes("x.btdb", b, OpenOptions::default()).unwrap();
+    let tab = st.table("l").unwrap().brdf().unwrap();
+    let e = tab.load_all().unwrap_err();
+    assert!(
+        matches!(
+            &e,
+            Error::Checksum {
+                what: brdftab::error::Section::Chunk { table, chunk: 0 },
+                ..
+            } if table == "l"
+        ),
+        "{e}"
+    );
+}

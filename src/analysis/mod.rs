@@ -5,3 +5,4 @@ pub mod albedo;
 pub mod chi2;
 pub mod plausibility;
 pub mod slice;
+pub mod timing;

@@ -145,7 +145,7 @@ pub fn write(img: &Image, channel: Option<usize>, path: impl AsRef<Path>) -> Res
             image::write_png(&fc, path, 0.0)?;
             Ok(format!("{}, {legend}", one.names[0]))
         }
-        _ => Err(Error::arg("--output", "must end in .exr or .png")),
+        _ => Err(Error::arg("output", "must end in .exr or .png")),
     }
 }
 

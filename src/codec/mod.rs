@@ -74,7 +74,7 @@ impl Quant {
                 floor,
             }),
             _ => Err(Error::arg(
-                "--codec",
+                "codec",
                 format!("unknown codec `{name}` (expected f32, f16 or log16)"),
             )),
         }

@@ -198,7 +198,7 @@ pub fn preset(name: &str) -> Result<ModelSpec> {
             }
             other => {
                 return Err(Error::arg(
-                    "--model",
+                    "model",
                     format!(
                         "`{other}` cannot be fit; use lambert, oren_nayar, phong, reciprocal_phong, \
                          max_phong, pumped_phong, blinn_phong, cook_torrance, ggx, ward, sums of \
@@ -297,22 +297,22 @@ fn eval_cos(b: &dyn Brdf, pairs: &Pairs) -> Vec<f64> {
 
 /// Fits the parameters of `init` to `source`; see the module docs.
 pub fn fit(source: &dyn Brdf, init: &ModelSpec, opts: &FitOptions) -> Result<FitResult> {
-    fit_with_progress(source, init, opts, &mut |_, _| {})
+    fit_with_progress(source, init, opts, &crate::progress::Silent)
 }
 
-/// [`fit`], calling `progress(done, total)` after each start.
+/// [`fit`], reporting one stage, `"fitting"`, that counts the starts done.
 pub fn fit_with_progress(
     source: &dyn Brdf,
     init: &ModelSpec,
     opts: &FitOptions,
-    progress: &mut dyn FnMut(usize, usize),
+    progress: &dyn crate::progress::Progress,
 ) -> Result<FitResult> {
     let clock = Instant::now();
     if opts.pairs == 0 {
-        return Err(Error::arg("--pairs", "at least one pair is needed"));
+        return Err(Error::arg("pairs", "at least one pair is needed"));
     }
     if opts.starts == 0 {
-        return Err(Error::arg("--starts", "at least one start is needed"));
+        return Err(Error::arg("starts", "at least one start is needed"));
     }
     if !(0.0..=1.0).contains(&opts.specular_fraction) {
         return Err(Error::arg("specular_fraction", "must be in [0, 1]"));
@@ -392,6 +392,7 @@ pub fn fit_with_progress(
     let mut best: Option<(usize, DVector<f64>)> = None;
     let mut problem = problem;
     let mut evaluations = 0;
+    let _stage = crate::progress::Stage::begin(progress, "fitting", opts.starts as u64);
     for s in 0..opts.starts {
         let x0 = start_values(s);
         let t0 = DVector::from_vec(to_free(&params, &x0));
@@ -437,7 +438,7 @@ pub fn fit_with_progress(
         {
             best = Some((s, problem.t.clone()));
         }
-        progress(s + 1, opts.starts);
+        progress.set(s as u64 + 1);
     }
     let Some((best_start, t_best)) = best else {
         return Err(Error::Unsupported(
@@ -585,7 +586,7 @@ fn flatten(
                 flatten(t, weight * w, channels, out)?;
             }
         }
-        other => out.push((weight, crate::models::build(other, channels)?)),
+        other => out.push((weight, crate::spec::build(other, channels)?)),
     }
     Ok(())
 }

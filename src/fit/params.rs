@@ -176,7 +176,7 @@ struct Segment {
 
 /// Parses `terms[1].m` into segments.
 fn parse_path(path: &str) -> Result<Vec<Segment>> {
-    let bad = |msg: &str| Error::arg("--params", format!("`{path}`: {msg}"));
+    let bad = |msg: &str| Error::arg("params", format!("`{path}`: {msg}"));
     if path.trim().is_empty() {
         return Err(bad("empty parameter path"));
     }
@@ -206,7 +206,7 @@ fn parse_path(path: &str) -> Result<Vec<Segment>> {
 /// The JSON value at `path` and the name of the model that owns its last field.
 fn lookup<'a>(root: &'a mut Json, path: &str) -> Result<(&'a mut Json, String, String)> {
     let segs = parse_path(path)?;
-    let missing = |what: String| Error::arg("--params", format!("`{path}`: {what}"));
+    let missing = |what: String| Error::arg("params", format!("`{path}`: {what}"));
     let mut cur = root;
     let mut model = String::new();
     let mut last = String::new();
@@ -262,7 +262,7 @@ impl ParamRequest {
         parse_path(path)?;
         let bad = || {
             Error::arg(
-                "--params",
+                "params",
                 format!("`{s}`: bounds are written `path=lo:hi` or `path=lo:hi:log`"),
             )
         };
@@ -359,14 +359,14 @@ pub fn resolve(
     };
     if requests.is_empty() {
         return Err(Error::arg(
-            "--params",
+            "params",
             "the model has no parameter with default bounds to fit",
         ));
     }
     let mut out: Vec<Param> = Vec::new();
     for r in &requests {
         if out.iter().any(|p| p.path == r.path) {
-            return Err(Error::arg("--params", format!("`{}` given twice", r.path)));
+            return Err(Error::arg("params", format!("`{}` given twice", r.path)));
         }
         let (v, model, key) = lookup(spec, &r.path)?;
         let numeric = match v {
@@ -377,7 +377,7 @@ pub fn resolve(
         };
         if !numeric {
             return Err(Error::arg(
-                "--params",
+                "params",
                 format!("`{}` is not a numeric parameter", r.path),
             ));
         }
@@ -385,7 +385,7 @@ pub fn resolve(
             Some(b) => b,
             None => {
                 return Err(Error::arg(
-                    "--params",
+                    "params",
                     format!(
                         "`{}` has no default bounds; give them as `{}=lo:hi`",
                         r.path, r.path
@@ -413,7 +413,7 @@ pub fn resolve(
 pub fn read(spec: &mut Json, p: &Param, channels: &Channels) -> Result<Vec<f64>> {
     let (v, _, _) = lookup(spec, &p.path)?;
     let value: crate::spectrum::Value = serde_json::from_value(v.clone())
-        .map_err(|e| Error::arg("--params", format!("`{}`: {e}", p.path)))?;
+        .map_err(|e| Error::arg("params", format!("`{}`: {e}", p.path)))?;
     let per = value.resolve(channels);
     Ok(if p.width == 1 {
         vec![per.iter().sum::<f64>() / per.len() as f64]

@@ -20,6 +20,7 @@
 //! [`analysis::slice`](crate::analysis::slice).
 
 pub mod data;
+pub mod info;
 pub mod merl;
 pub mod merl_manifest;
 pub mod rgl;

@@ -26,8 +26,20 @@ use std::f64::consts::{FRAC_1_PI, PI};
 use crate::brdf::{Brdf, BrdfSample, Flags};
 use crate::error::Result;
 use crate::geometry::{self, Frame};
-use crate::spec::PumpX;
 use crate::spectrum::{Channels, Value};
+use serde::{Deserialize, Serialize};
+
+/// How the pumped-up Phong model symmetrizes cos θ′ (the lecture's X).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PumpX {
+    /// X = (cos θ′ + cos θ) / 2.
+    Mean,
+    /// X = cos θ′ · cos θ.
+    Product,
+    /// X = sqrt(cos θ′ · cos θ).
+    Sqrt,
+}
 
 /// Which divisor X the Phong lobe k_s cos^n ψ is divided by.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -13,7 +13,7 @@
 //!
 //! let brdf = ModelSpec::parse(r#"{"model": "lambert", "kd": 0.2}"#)?.build(&Channels::Rgb)?;
 //! let opts = RenderOptions { width: 16, height: 16, spp: 4, mode: Mode::Lit, ..Default::default() };
-//! let img = render(brdf.as_ref(), &opts, None)?;
+//! let img = render(brdf.as_ref(), &opts, &brdftab::progress::Silent)?;
 //! assert_eq!((img.width, img.height, img.channels), (16, 16, 3));
 //! # Ok::<(), brdftab::Error>(())
 //! ```

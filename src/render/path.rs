@@ -31,6 +31,7 @@ use super::scene::{Environment, Hit, Light, Scene};
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
 use crate::geometry::{self, Frame};
+use crate::progress::{Counter, Progress, Stage};
 use crate::spectrum::{Channels, MAX_CHANNELS, RGB_WAVELENGTHS};
 
 /// What to compute.
@@ -87,6 +88,73 @@ pub enum LightChoice {
     Area,
     /// A given light.
     Custom(Light),
+}
+
+/// A name from `choices` (`(name, value)`), or an argument error naming `what` and the choices.
+fn choose<T: Clone>(what: &str, s: &str, choices: &[(&str, T)]) -> Result<T> {
+    let t = s.trim().to_ascii_lowercase();
+    match choices.iter().find(|(n, _)| *n == t) {
+        Some((_, v)) => Ok(v.clone()),
+        None => {
+            let names: Vec<&str> = choices.iter().map(|c| c.0).collect();
+            Err(Error::arg(
+                what,
+                format!("`{s}`: expected {}", names.join(", ")),
+            ))
+        }
+    }
+}
+
+impl Mode {
+    /// Parses `path` or `lit`.
+    pub fn parse(s: &str) -> Result<Mode> {
+        choose("mode", s, &[("path", Mode::Path), ("lit", Mode::Lit)])
+    }
+}
+
+impl Sampling {
+    /// Parses `mis`, `brdf`, `light` or `fixed`.
+    pub fn parse(s: &str) -> Result<Sampling> {
+        let c = [
+            ("mis", Sampling::Mis),
+            ("brdf", Sampling::BrdfOnly),
+            ("light", Sampling::LightOnly),
+            ("fixed", Sampling::Fixed),
+        ];
+        choose("sampling", s, &c)
+    }
+}
+
+impl EnvChoice {
+    /// Parses `sky`, `white` (constant 1, the furnace), `none`, or a lat-long `.exr` file.
+    pub fn parse(s: &str) -> Result<EnvChoice> {
+        if s.to_ascii_lowercase().ends_with(".exr") {
+            return Ok(EnvChoice::Map(Arc::new(Environment::from_exr(s)?)));
+        }
+        let c = [
+            ("sky", EnvChoice::Sky),
+            ("white", EnvChoice::Constant([1.0; 3])),
+            ("none", EnvChoice::Black),
+        ];
+        choose("env", s, &c).map_err(|e| match e {
+            Error::InvalidArgument { name, msg } => {
+                Error::arg(name, format!("{msg} or a .exr file"))
+            }
+            e => e,
+        })
+    }
+}
+
+impl LightChoice {
+    /// Parses `none`, `point` or `area`.
+    pub fn parse(s: &str) -> Result<LightChoice> {
+        let c = [
+            ("none", LightChoice::None),
+            ("point", LightChoice::Point),
+            ("area", LightChoice::Area),
+        ];
+        choose("light", s, &c)
+    }
 }
 
 /// Everything a render needs besides the material.
@@ -501,14 +569,12 @@ const TILE: usize = 16;
 
 /// Renders `brdf` on the sphere of the preview scene. Returns a linear RGB image (radiance).
 ///
-/// `progress`, when given, is called with the number of pixels just finished (increments; they
-/// add up to width × height) from worker threads.
-pub fn render(
-    brdf: &dyn Brdf,
-    opts: &RenderOptions,
-    progress: Option<&(dyn Fn(u64) + Sync)>,
-) -> Result<Image> {
+/// `progress` sees one stage, `"rendering"`, counting pixels up to width × height
+/// ([`Silent`](crate::progress::Silent) for none).
+pub fn render(brdf: &dyn Brdf, opts: &RenderOptions, progress: &dyn Progress) -> Result<Image> {
     opts.validate()?;
+    let _stage = Stage::begin(progress, "rendering", (opts.width * opts.height) as u64);
+    let counter = Counter::new(progress);
     let scene = opts.scene();
     let tracer = Tracer {
         scene: &scene,
@@ -551,9 +617,7 @@ pub fn render(
                 out.extend_from_slice(&[v.x as f32, v.y as f32, v.z as f32]);
             }
         }
-        if let Some(p) = progress {
-            p(((x1 - x0) * (y1 - y0)) as u64);
-        }
+        counter.add(((x1 - x0) * (y1 - y0)) as u64);
         out
     };
     let results: Vec<Vec<f32>> = match opts.threads {
@@ -583,6 +647,7 @@ mod tests {
     use super::*;
     use crate::brdf::{BrdfSample, Flags};
     use crate::models::lambert::Lambert;
+    use crate::progress::Silent;
     use crate::render::compare::compare;
     use crate::spectrum::Value;
 
@@ -696,7 +761,7 @@ mod tests {
                     seed: 1000 + s,
                     ..opts.clone()
                 };
-                let img = render(brdf, &o, None).unwrap();
+                let img = render(brdf, &o, &Silent).unwrap();
                 img.data.iter().map(|&v| v as f64).sum::<f64>() / img.data.len() as f64
             })
             .collect();
@@ -761,14 +826,14 @@ mod tests {
                     ..tiny()
                 };
                 let cov = coverage(&opts);
-                let a = render(&brdf, &opts, None).unwrap();
+                let a = render(&brdf, &opts, &Silent).unwrap();
                 let b = render(
                     &brdf,
                     &RenderOptions {
                         seed: 9,
                         ..opts.clone()
                     },
-                    None,
+                    &Silent,
                 )
                 .unwrap();
                 let interior: Vec<usize> = (0..cov.len()).filter(|&i| cov[i] == 2).collect();
@@ -825,7 +890,7 @@ mod tests {
                 ground,
                 ..tiny()
             };
-            let img = render(&brdf, &opts, None).unwrap();
+            let img = render(&brdf, &opts, &Silent).unwrap();
             let cov = coverage(&opts);
             let mut inside = 0;
             for (i, &c) in cov.iter().enumerate() {
@@ -856,7 +921,7 @@ mod tests {
                 threads: Some(1),
                 ..opts.clone()
             },
-            None,
+            &Silent,
         )
         .unwrap();
         let b = render(
@@ -865,7 +930,7 @@ mod tests {
                 threads: Some(3),
                 ..opts.clone()
             },
-            None,
+            &Silent,
         )
         .unwrap();
         assert!(
@@ -874,7 +939,7 @@ mod tests {
                 .zip(&b.data)
                 .all(|(x, y)| x.to_bits() == y.to_bits())
         );
-        let c = render(&brdf, &RenderOptions { seed: 1, ..opts }, None).unwrap();
+        let c = render(&brdf, &RenderOptions { seed: 1, ..opts }, &Silent).unwrap();
         assert_ne!(a.data, c.data);
         assert_eq!(compare(&a, &a).unwrap().rel_rmse, 0.0);
     }
@@ -945,7 +1010,7 @@ mod tests {
                 ..tiny()
             },
         ] {
-            assert!(render(&brdf, &o, None).is_err());
+            assert!(render(&brdf, &o, &Silent).is_err());
         }
     }
 
@@ -956,17 +1021,20 @@ mod tests {
         let spectral = Lambert::new(Value::Grey(0.2), &ch).unwrap();
         let rgb = lambert(0.2);
         let opts = RenderOptions { spp: 2, ..tiny() };
-        let a = render(&spectral, &opts, None).unwrap();
-        let b = render(&rgb, &opts, None).unwrap();
+        let a = render(&spectral, &opts, &Silent).unwrap();
+        let b = render(&rgb, &opts, &Silent).unwrap();
         assert!(compare(&a, &b).unwrap().rel_rmse < 1e-6);
     }
 
     #[test]
     fn progress_counts_every_pixel() {
-        let n = std::sync::atomic::AtomicU64::new(0);
-        let cb = |k: u64| {
-            n.fetch_add(k, std::sync::atomic::Ordering::Relaxed);
-        };
+        struct Max(std::sync::atomic::AtomicU64);
+        impl Progress for Max {
+            fn set(&self, done: u64) {
+                self.0.fetch_max(done, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
+        let n = Max(std::sync::atomic::AtomicU64::new(0));
         render(
             &lambert(0.1),
             &RenderOptions {
@@ -975,9 +1043,9 @@ mod tests {
                 height: 19,
                 ..tiny()
             },
-            Some(&cb),
+            &n,
         )
         .unwrap();
-        assert_eq!(n.into_inner(), 37 * 19);
+        assert_eq!(n.0.into_inner(), 37 * 19);
     }
 }

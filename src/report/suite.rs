@@ -39,15 +39,17 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::analysis::{accuracy, albedo};
+use crate::bake::{BakeRequest, SymmetryChoice};
 use crate::brdf::Brdf;
 use crate::codec::{self, Codec, Quant};
 use crate::error::{Error, Result};
 use crate::geometry;
+use crate::progress::{Progress, Silent, Stage};
 use crate::render::{self, LightChoice, Mode, RenderOptions, Sampling};
 use crate::spec::ModelSpec;
 use crate::spectrum::{Channels, MAX_CHANNELS};
 use crate::table::presets::Preset;
-use crate::table::{BakeOptions, Grid, Param, Symmetry, Table, TabulatedBrdf, bake};
+use crate::table::{Param, Symmetry, Table, TabulatedBrdf};
 
 /// Quadrature settings of the albedo metric: a 1e-4 target with bounded interval counts, so a
 /// piecewise-linear table (whose kinks defeat a 1e-6 target) costs at most ~30 000 evaluations
@@ -93,6 +95,14 @@ impl SourceDef {
         match self.kind {
             SourceKind::Model(_) => "model",
             SourceKind::Rgl(_) => "measured",
+        }
+    }
+
+    /// The source as a SOURCE string ([`crate::source`]): the spec's JSON or the file's path.
+    pub fn source(&self) -> String {
+        match &self.kind {
+            SourceKind::Model(spec) => spec.to_json(),
+            SourceKind::Rgl(path) => path.display().to_string(),
         }
     }
 
@@ -492,33 +502,6 @@ impl Report {
         }
         s
     }
-
-    /// Writes `accuracy.csv`, `accuracy.md` and one rate–distortion PNG per source
-    /// (`rd_<source>.png`) into `dir` (created if missing). Returns the files written.
-    pub fn write_all(&self, dir: impl AsRef<Path>) -> Result<Vec<PathBuf>> {
-        let dir = dir.as_ref();
-        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-        let mut out = Vec::new();
-        let csv = dir.join("accuracy.csv");
-        std::fs::write(&csv, self.csv()).map_err(|e| Error::io(&csv, e))?;
-        out.push(csv);
-        let md = dir.join("accuracy.md");
-        std::fs::write(&md, self.markdown()).map_err(|e| Error::io(&md, e))?;
-        out.push(md);
-        let mut sources: Vec<&str> = Vec::new();
-        for r in &self.rows {
-            if !sources.contains(&r.source.as_str()) {
-                sources.push(&r.source);
-            }
-        }
-        for s in sources {
-            let rows: Vec<&Row> = self.rows.iter().filter(|r| r.source == s).collect();
-            let p = dir.join(format!("rd_{}.png", file_safe(s)));
-            super::plot::rate_distortion(s, &rows, &p)?;
-            out.push(p);
-        }
-        Ok(out)
-    }
 }
 
 /// A name made safe for a file name (letters, digits, `-`, `_`, `.`).
@@ -534,26 +517,8 @@ pub fn file_safe(s: &str) -> String {
         .collect()
 }
 
-/// Progress callback: (rows done, rows total, what was just done).
-pub type Progress<'a> = &'a (dyn Fn(usize, usize, &str) + Sync);
-
-fn param_name(p: Param) -> &'static str {
-    match p {
-        Param::HalfDiff => "halfdiff",
-        Param::InOut => "inout",
-    }
-}
-
-fn preset_name(p: Preset) -> &'static str {
-    match p {
-        Preset::Small => "small",
-        Preset::Medium => "medium",
-        Preset::Large => "large",
-    }
-}
-
 /// Albedo per θ and channel by [`albedo::integrate`] with [`ALBEDO_OPTIONS`].
-fn albedos(brdf: &dyn Brdf, thetas: &[f64]) -> Vec<Vec<f64>> {
+pub fn albedos(brdf: &dyn Brdf, thetas: &[f64]) -> Vec<Vec<f64>> {
     thetas
         .par_iter()
         .map(|&t| albedo::integrate(brdf, geometry::spherical(t, 0.0), &ALBEDO_OPTIONS).value)
@@ -607,41 +572,96 @@ pub fn round_trip(table: &Table, codec: &Codec) -> Result<(u64, Table)> {
     ))
 }
 
-fn bake_table(src: &dyn Brdf, preset: Preset, param: Param) -> Result<Table> {
+/// Bakes `src` (opened from `sd`) through [`BakeRequest`] with the symmetry it declares; a
+/// source that breaks it (within tolerance) is baked with isotropy only if that holds, else
+/// without reduction.
+fn bake_table(sd: &SourceDef, src: &dyn Brdf, preset: Preset, param: Param) -> Result<Table> {
     let declared = Symmetry::from_flags(src.flags());
-    let grid = |sym: Symmetry| -> Result<Grid> { preset.grid(Some(param), sym, Channels::Rgb) };
-    match bake(src, &grid(declared)?, &BakeOptions::default()) {
-        Ok((t, _)) => Ok(t),
-        Err(Error::Symmetry { .. }) => {
-            // The source breaks what it declares (within tolerance): keep only isotropy if it
-            // holds, else no reduction.
-            let iso = Symmetry {
-                isotropic: declared.isotropic,
-                ..Symmetry::NONE
-            };
-            match bake(src, &grid(iso)?, &BakeOptions::default()) {
-                Ok((t, _)) => Ok(t),
-                Err(Error::Symmetry { .. }) => {
-                    Ok(bake(src, &grid(Symmetry::NONE)?, &BakeOptions::default())?.0)
-                }
-                Err(e) => Err(e),
-            }
+    let iso = Symmetry {
+        isotropic: declared.isotropic,
+        ..Symmetry::NONE
+    };
+    let mut last = None;
+    for sym in [declared, iso, Symmetry::NONE] {
+        let req = BakeRequest::new(sd.source())
+            .preset(preset)
+            .param(param)
+            .channels(Channels::Rgb)
+            .symmetry(SymmetryChoice::Exactly(sym));
+        match req.table_of(src, &Silent) {
+            Ok((t, _)) => return Ok(t),
+            Err(e @ Error::Symmetry { .. }) => last = Some(e),
+            Err(e) => return Err(e),
         }
-        Err(e) => Err(e),
     }
+    Err(last.unwrap_or_else(|| Error::Unsupported("no symmetry to bake with".into())))
+}
+
+/// The BRDF-space metrics of one table against its source.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Metrics {
+    /// Cosine-weighted relative RMSE ([`accuracy::compare`]).
+    pub rel_rmse: f64,
+    /// Max relative error.
+    pub max_rel: f64,
+    /// Max relative albedo error ([`albedo_error`]; 0 with no angles).
+    pub albedo_err: f64,
+}
+
+/// What [`metrics`] measures: random pairs (and their seed), the albedo angles, and an optional
+/// cap on both directions' polar angle (radians; measured data is compared within 80° of the
+/// normal, where its f_r does not grow like 1/cos θo).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MetricOptions {
+    /// Random direction pairs.
+    pub pairs: usize,
+    /// Seed of the pairs.
+    pub seed: u64,
+    /// Incidence angles (radians) of the albedo error.
+    pub albedo_thetas: Vec<f64>,
+    /// Largest polar angle of both directions (`None`: the whole hemisphere).
+    pub cap: Option<f64>,
+}
+
+/// `table` against `source`: the suite's metrics, for one table (the demo's rows use it too).
+/// `source_albedo` is [`albedos`] of the source at `opts.albedo_thetas` (computed once by
+/// callers that measure several tables of one source).
+pub fn metrics(
+    table: &dyn Brdf,
+    source: &dyn Brdf,
+    source_albedo: &[Vec<f64>],
+    opts: &MetricOptions,
+) -> Result<Metrics> {
+    let a = match opts.cap {
+        None => accuracy::compare(table, source, opts.pairs, opts.seed)?,
+        Some(cap) => accuracy::compare_cap(table, source, opts.pairs, opts.seed, cap)?,
+    };
+    Ok(Metrics {
+        rel_rmse: finite_or(a.rel_rmse, NOT_MEASURED),
+        max_rel: finite_or(a.max_rel, NOT_MEASURED),
+        albedo_err: albedo_error(&albedos(table, &opts.albedo_thetas), source_albedo),
+    })
 }
 
 fn finite_or(x: f64, alt: f64) -> f64 {
     if x.is_finite() { x } else { alt }
 }
 
-/// Runs the suite. `progress` is called after each grid (with the rows done so far).
-pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
+/// Runs the suite. `progress` sees one stage, `"accuracy"`, counting rows (set after each
+/// grid, with a note naming it).
+pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
     let start = Instant::now();
     if cfg.pairs == 0 {
         return Err(Error::arg("pairs", "must be at least 1"));
     }
     let total = cfg.row_count();
+    let _stage = Stage::begin(progress, "accuracy", total as u64);
+    let metric_opts = MetricOptions {
+        pairs: cfg.pairs,
+        seed: cfg.seed,
+        albedo_thetas: cfg.albedo_thetas.clone(),
+        cap: None,
+    };
     let mut rows = Vec::with_capacity(total);
     for sd in &cfg.sources {
         let src = sd.open()?;
@@ -656,7 +676,7 @@ pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
             .filter(|_| !measured || cfg.render_measured);
         let src_albedo = albedos(src.as_ref(), &cfg.albedo_thetas);
         let src_image = match render_opts {
-            Some(o) => Some(render::render(src.as_ref(), o, None)?),
+            Some(o) => Some(render::render(src.as_ref(), o, &Silent)?),
             None => None,
         };
         for &preset in &cfg.presets {
@@ -664,8 +684,8 @@ pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
                 let base = |codec: &str| Row {
                     source: sd.name.clone(),
                     kind: sd.kind_name().to_owned(),
-                    preset: preset_name(preset).to_owned(),
-                    param: param_name(param).to_owned(),
+                    preset: preset.name().to_owned(),
+                    param: param.name().to_owned(),
                     symmetry: String::new(),
                     codec: codec.to_owned(),
                     values: 0,
@@ -680,7 +700,7 @@ pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
                     status: "ok".to_owned(),
                     seconds: 0.0,
                 };
-                let table = match bake_table(src.as_ref(), preset, param) {
+                let table = match bake_table(sd, src.as_ref(), preset, param) {
                     Ok(t) => t,
                     Err(e) => {
                         for cd in &cfg.codecs {
@@ -714,17 +734,16 @@ pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
                         row.bytes = bytes;
                         row.bits_per_value = 8.0 * bytes as f64 / values.max(1) as f64;
                         let tab = TabulatedBrdf::from_table(decoded);
-                        match accuracy::compare(&tab, src.as_ref(), cfg.pairs, cfg.seed) {
-                            Ok(a) => {
-                                row.rel_rmse = finite_or(a.rel_rmse, NOT_MEASURED);
-                                row.max_rel = finite_or(a.max_rel, NOT_MEASURED);
+                        match metrics(&tab, src.as_ref(), &src_albedo, &metric_opts) {
+                            Ok(m) => {
+                                row.rel_rmse = m.rel_rmse;
+                                row.max_rel = m.max_rel;
+                                row.albedo_err = m.albedo_err;
                             }
                             Err(e) => row.status = format!("accuracy failed: {e}"),
                         }
-                        row.albedo_err =
-                            albedo_error(&albedos(&tab, &cfg.albedo_thetas), &src_albedo);
                         if let (Some(o), Some(reference)) = (render_opts, &src_image) {
-                            match render::render(&tab, o, None)
+                            match render::render(&tab, o, &Silent)
                                 .and_then(|img| render::compare(&img, reference))
                             {
                                 Ok(r) if r.rel_rmse.is_finite() => {
@@ -752,13 +771,8 @@ pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
                     }
                 }
                 rows.extend(group);
-                if let Some(p) = progress {
-                    p(
-                        rows.len(),
-                        total,
-                        &format!("{} {} {}", sd.name, preset_name(preset), param_name(param)),
-                    );
-                }
+                progress.note(&format!("{} {} {}", sd.name, preset.name(), param.name()));
+                progress.set(rows.len() as u64);
             }
         }
     }
@@ -768,12 +782,12 @@ pub fn run(cfg: &SuiteConfig, progress: Option<Progress>) -> Result<Report> {
         cfg.sources.len(),
         cfg.presets
             .iter()
-            .map(|&p| preset_name(p))
+            .map(|&p| p.name())
             .collect::<Vec<_>>()
             .join(", "),
         cfg.params
             .iter()
-            .map(|&p| param_name(p))
+            .map(|&p| p.name())
             .collect::<Vec<_>>()
             .join(", "),
         cfg.codecs

@@ -76,13 +76,10 @@ pub fn put(
         && !replace
         && s.tables().iter().any(|t| t.name == name)
     {
-        return Err(Error::arg(
-            "--name",
-            format!(
-                "{} already holds a table `{name}` (use --replace)",
-                path.display()
-            ),
-        ));
+        return Err(Error::Duplicate {
+            container: path.display().to_string(),
+            name,
+        });
     }
     let mut w = Writer::create(path)?;
     type Fill<'a> = Box<dyn FnOnce(&mut Writer) -> Result<()> + 'a>;

@@ -114,7 +114,7 @@ impl Slice {
     /// Parses `X,Y[:i0,i1,...]`, e.g. `3,2:45,0,0,0` (x along axis 3, y along axis 2, the other
     /// axes at the given indices; missing indices are 0).
     pub fn parse(s: &str, axes: usize) -> Result<Slice> {
-        let err = |m: String| Error::arg("--slice", m);
+        let err = |m: String| Error::arg("slice", m);
         let (xy, fixed) = s.split_once(':').unwrap_or((s, ""));
         let num = |t: &str| {
             t.trim()
@@ -161,14 +161,14 @@ pub fn slice(
     );
     if s.x >= axes.len() || s.y >= axes.len() || s.fixed.len() != axes.len() {
         return Err(Error::arg(
-            "--slice",
+            "slice",
             format!("the table has {} angular axes", axes.len()),
         ));
     }
     for (a, (&i, &d)) in s.fixed.iter().zip(axes).enumerate() {
         if a != s.x && a != s.y && i >= d {
             return Err(Error::arg(
-                "--slice",
+                "slice",
                 format!("index {i} of axis {a} is not below its length {d}"),
             ));
         }
@@ -227,7 +227,7 @@ pub fn exr(
     let (w, ht, v) = slice(table, s, offset)?;
     let nc = *table.header().shape.last().unwrap_or(&1) as usize;
     if w == 0 || ht == 0 {
-        return Err(crate::Error::arg("--slice", "empty slice"));
+        return Err(crate::Error::arg("slice", "empty slice"));
     }
     let names = channel_names(&table.header().channels, nc);
     let list: Vec<AnyChannel<FlatSamples>> = (0..nc)

@@ -26,7 +26,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::codec::{Codec, Layout};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Section};
 use crate::spectrum::Channels;
 
 /// File magic.
@@ -259,7 +259,7 @@ impl Superblock {
         if stored != computed {
             return Err(Error::Checksum {
                 file: file.into(),
-                what: "superblock".into(),
+                what: Section::Superblock,
                 stored,
                 computed,
             });
@@ -318,7 +318,7 @@ pub fn block<'a>(
     file: &str,
     data: &'a [u8],
     block: &Block,
-    what: &str,
+    what: &Section,
     max: u64,
 ) -> Result<&'a [u8]> {
     let end = block.offset.checked_add(block.len);
@@ -327,7 +327,7 @@ pub fn block<'a>(
         _ => {
             return Err(Error::format(
                 file,
-                Some(what),
+                Some(&what.to_string()),
                 Some(block.offset),
                 format!(
                     "range {}+{} lies outside the file ({} bytes)",
@@ -341,7 +341,7 @@ pub fn block<'a>(
     if block.len > max {
         return Err(Error::format(
             file,
-            Some(what),
+            Some(&what.to_string()),
             Some(block.offset),
             format!("{} bytes is more than the {max} allowed", block.len),
         ));
@@ -351,7 +351,7 @@ pub fn block<'a>(
     if computed != block.xxh3 {
         return Err(Error::Checksum {
             file: file.into(),
-            what: what.into(),
+            what: what.clone(),
             stored: block.xxh3,
             computed,
         });

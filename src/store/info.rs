@@ -6,10 +6,13 @@
 //! `tool`, `shape`, `values`, `chunks`, `bytes`, `ratio_to_f32` per table; `file`, `format`,
 //! `bytes`, `ratio_to_f32`, `tables` per file.
 
+use std::fmt::Write as _;
+
 use serde_json::{Value, json};
 
 use super::{Store, db};
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::table::Table;
 
 /// The summary of table `name` of an open store.
 pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
@@ -70,4 +73,126 @@ pub fn file_info(source: &str) -> Result<Value> {
         "ratio_to_f32": values as f64 * 4.0 / s.file_len().max(1) as f64,
         "tables": tables,
     }))
+}
+
+/// What `info` reports of a raw table file (`format` = `raw`).
+pub fn raw_info(path: &str) -> Result<Value> {
+    let t = Table::open_raw(path)?;
+    let g = t.grid();
+    let bytes = std::fs::metadata(path)
+        .map_err(|e| Error::io(path, e))?
+        .len();
+    Ok(json!({
+        "file": path,
+        "format": "raw",
+        "description": t.description(),
+        "grid": g,
+        "grid_summary": g.summary(),
+        "parameterization": g.param(),
+        "symmetry": g.symmetry().to_string(),
+        "channels": g.channels().names(),
+        "stored_shape": g.stored_shape(),
+        "chunks": g.layout().chunk_count(),
+        "stored_values": g.stored_values(),
+        "full_values": g.full_values(),
+        "bytes": bytes,
+    }))
+}
+
+/// [`raw_info`] as the text `brdftab info` prints.
+pub fn raw_text(v: &Value) -> String {
+    let s = |k: &str| v[k].as_str().unwrap_or("").to_owned();
+    let names: Vec<&str> = v["channels"]
+        .as_array()
+        .map(|a| a.iter().filter_map(Value::as_str).collect())
+        .unwrap_or_default();
+    let mut o = String::new();
+    let _ = writeln!(o, "file:          {}", s("file"));
+    let _ = writeln!(o, "source:        {}", s("description"));
+    let _ = writeln!(o, "grid:          {}", s("grid_summary"));
+    let _ = writeln!(o, "symmetry:      {}", s("symmetry"));
+    let _ = writeln!(o, "channels:      {}", names.join(" "));
+    for k in ["chunks", "stored_values", "full_values"] {
+        let _ = writeln!(o, "{:<15}{}", format!("{k}:"), v[k]);
+    }
+    let _ = writeln!(o, "bytes:         {}", v["bytes"]);
+    o
+}
+
+/// [`list`] as the table `brdftab db list` prints: one line per table.
+pub fn list_text(rows: &[Value]) -> String {
+    let mut o = format!(
+        "{:<24} {:<8} {:>12} {:>12} {:>7}  grid\n",
+        "name", "codec", "values", "bytes", "ratio"
+    );
+    for r in rows {
+        let shape = r["shape"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .map(|x| x.to_string())
+                    .collect::<Vec<_>>()
+                    .join("x")
+            })
+            .unwrap_or_default();
+        let _ = writeln!(
+            o,
+            "{:<24} {:<8} {:>12} {:>12} {:>6.1}x  {} {} {}",
+            r["name"].as_str().unwrap_or(""),
+            r["codec"]["quant"].as_str().unwrap_or(""),
+            r["values"].as_u64().unwrap_or(0),
+            r["bytes"].as_u64().unwrap_or(0),
+            r["ratio_to_f32"].as_f64().unwrap_or(0.0),
+            r["parameterization"].as_str().unwrap_or(""),
+            shape,
+            r["symmetry"].as_str().unwrap_or(""),
+        );
+    }
+    o
+}
+
+/// [`file_info`] as the text `brdftab info` prints.
+pub fn file_text(v: &Value) -> String {
+    let tables = v["tables"].as_array().cloned().unwrap_or_default();
+    let str_of = |t: &Value, k: &str| t[k].as_str().unwrap_or("").to_owned();
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "file:    {} (brdftab format, {} tables)",
+        str_of(v, "file"),
+        tables.len()
+    );
+    let _ = writeln!(
+        o,
+        "bytes:   {} ({:.1}x smaller than f32)",
+        v["bytes"],
+        v["ratio_to_f32"].as_f64().unwrap_or(0.0)
+    );
+    for t in &tables {
+        let _ = writeln!(o, "table `{}`:", str_of(t, "name"));
+        let _ = writeln!(o, "  source:   {}", t["source"]);
+        let _ = writeln!(
+            o,
+            "  grid:     {} {} {}",
+            str_of(t, "parameterization"),
+            t["shape"],
+            str_of(t, "symmetry")
+        );
+        let _ = writeln!(o, "  codec:    {}", t["codec"]);
+        let _ = writeln!(
+            o,
+            "  values:   {} in {} chunks, {} bytes ({:.1}x smaller than f32)",
+            t["values"],
+            t["chunks"],
+            t["bytes"],
+            t["ratio_to_f32"].as_f64().unwrap_or(0.0)
+        );
+        let _ = writeln!(
+            o,
+            "  units:    {}   tool: {}",
+            str_of(t, "units"),
+            str_of(t, "tool")
+        );
+    }
+    o
 }

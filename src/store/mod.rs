@@ -63,7 +63,7 @@ pub use format::{Source, TableHeader, TocEntry};
 pub use writer::Writer;
 
 use crate::codec;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Section};
 
 /// Options for [`Store::open_with`].
 #[derive(Debug, Clone, Copy)]
@@ -142,13 +142,7 @@ impl Store {
 
     fn from_backing(path: PathBuf, name: String, map: Backing, opts: OpenOptions) -> Result<Store> {
         let sb = Superblock::parse(&name, &map)?;
-        let toc_bytes = format::block(
-            &name,
-            &map,
-            &sb.toc,
-            "table of contents",
-            format::MAX_JSON_LEN,
-        )?;
+        let toc_bytes = format::block(&name, &map, &sb.toc, &Section::Toc, format::MAX_JSON_LEN)?;
         let toc: Toc = format::json(&name, "table of contents", toc_bytes)?;
         let mut seen = std::collections::HashSet::new();
         for t in &toc.tables {
@@ -231,7 +225,9 @@ impl Store {
             &self.name,
             &self.map,
             &e.header,
-            &what("header"),
+            &Section::Header {
+                table: e.name.clone(),
+            },
             format::MAX_JSON_LEN,
         )?;
         let header: TableHeader = format::json(&self.name, &what("header"), hb)?;
@@ -247,7 +243,9 @@ impl Store {
             &self.name,
             &self.map,
             &e.index,
-            &what("index"),
+            &Section::Index {
+                table: e.name.clone(),
+            },
             self.map.len() as u64,
         )?;
         let index = format::check_table(&self.name, self.map.len() as u64, &header, ib, e.chunks)?;
@@ -367,7 +365,10 @@ impl StoredTable {
         if computed != e.xxh3 {
             return Err(Error::Checksum {
                 file: self.file.clone(),
-                what: format!("table `{}` chunk {i}", self.header.name),
+                what: Section::Chunk {
+                    table: self.header.name.clone(),
+                    chunk: i,
+                },
                 stored: e.xxh3,
                 computed,
             });

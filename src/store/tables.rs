@@ -54,10 +54,7 @@ impl TableHeader {
         ];
         let mut h = TableHeader::new(name, source, shape, grid.channels().clone(), codec);
         h.grid = serde_json::to_value(grid).unwrap_or(serde_json::Value::Null);
-        h.parameterization = match grid.param() {
-            crate::table::Param::InOut => "inout".into(),
-            crate::table::Param::HalfDiff => "halfdiff".into(),
-        };
+        h.parameterization = grid.param().name().into();
         h.symmetry = grid.symmetry().to_string();
         h.values = grid.stored_values() as u64;
         h.layout = chunk_layout(grid, 0);

@@ -97,7 +97,7 @@ impl Writer {
         }
         if header.name.is_empty() || header.name.contains('#') {
             return Err(Error::arg(
-                "--name",
+                "name",
                 format!(
                     "table name `{}` must be non-empty and contain no `#`",
                     header.name
@@ -105,10 +105,10 @@ impl Writer {
             ));
         }
         if self.names().any(|n| n == header.name) {
-            return Err(Error::arg(
-                "--name",
-                format!("duplicate table name `{}`", header.name),
-            ));
+            return Err(Error::Duplicate {
+                container: self.path.display().to_string(),
+                name: header.name,
+            });
         }
         let dense = header.dense_values().unwrap_or(u64::MAX);
         if header.shape.is_empty() || header.values > dense || header.values > format::MAX_VALUES {

@@ -89,7 +89,7 @@ fn check(brdf: &dyn Brdf, grid: &Grid, opts: &BakeOptions) -> Result<Option<Stri
         ));
     }
     if opts.supersample == 0 || opts.supersample > 64 {
-        return Err(Error::arg("--supersample", "must be in 1..=64"));
+        return Err(Error::arg("supersample", "must be in 1..=64"));
     }
     if grid.symmetry() == Symmetry::NONE {
         return Ok(None);

@@ -68,41 +68,8 @@ use std::ops::Range;
 
 use crate::error::{Error, Result};
 use crate::spectrum::Channels;
+pub use crate::table::param::Param;
 use crate::table::symmetry::Symmetry;
-
-/// The angular parameterization of a table.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
-pub enum Param {
-    /// (θi, φi, θo, φo): incident and outgoing spherical angles (the lecture's table).
-    #[serde(rename = "inout")]
-    InOut,
-    /// (θh, φh, θd, φd): Rusinkiewicz half/difference angles (MERL).
-    #[default]
-    #[serde(rename = "halfdiff")]
-    HalfDiff,
-}
-
-impl Param {
-    /// Names of the four angular axes.
-    pub fn axis_names(self) -> [&'static str; 4] {
-        match self {
-            Param::InOut => ["theta_i", "phi_i", "theta_o", "phi_o"],
-            Param::HalfDiff => ["theta_h", "phi_h", "theta_d", "phi_d"],
-        }
-    }
-
-    /// Parses `inout` or `halfdiff`.
-    pub fn parse(s: &str) -> Result<Self> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "inout" | "in_out" => Ok(Param::InOut),
-            "halfdiff" | "half_diff" => Ok(Param::HalfDiff),
-            other => Err(Error::arg(
-                "--param",
-                format!("`{other}`: expected inout or halfdiff"),
-            )),
-        }
-    }
-}
 
 /// How an axis's coordinate x ∈ [lo, hi] maps to u ∈ [0, 1] before node placement.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
@@ -721,10 +688,7 @@ impl Grid {
         let s = self.stored_shape();
         format!(
             "{} full {}x{}x{}x{} stored {}x{}x{}x{} x{} ch, θ1 {:?}/{:?}, θ2 {:?}/{:?}, symmetry {}",
-            match self.param {
-                Param::InOut => "inout",
-                Param::HalfDiff => "halfdiff",
-            },
+            self.param.name(),
             self.axes[0].size,
             self.axes[1].size,
             self.axes[2].size,

@@ -35,7 +35,7 @@ impl Interp {
             "nearest" => Ok(Interp::Nearest),
             "linear" => Ok(Interp::Linear),
             o => Err(crate::Error::arg(
-                "--interp",
+                "interp",
                 format!("`{o}`: expected nearest or linear"),
             )),
         }

@@ -20,6 +20,7 @@
 pub mod bake;
 pub mod grid;
 pub mod lookup;
+pub mod param;
 pub mod presets;
 pub mod raw;
 pub mod sampling;

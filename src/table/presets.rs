@@ -55,6 +55,15 @@ pub enum Preset {
 }
 
 impl Preset {
+    /// `small`, `medium` or `large`: the name [`Preset::parse`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Small => "small",
+            Preset::Medium => "medium",
+            Preset::Large => "large",
+        }
+    }
+
     /// Parses `small`, `medium` or `large`.
     pub fn parse(s: &str) -> Result<Preset> {
         match s.trim().to_ascii_lowercase().as_str() {
@@ -62,7 +71,7 @@ impl Preset {
             "medium" => Ok(Preset::Medium),
             "large" => Ok(Preset::Large),
             o => Err(Error::arg(
-                "--preset",
+                "preset",
                 format!("`{o}`: expected small, medium or large"),
             )),
         }

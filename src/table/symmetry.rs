@@ -26,11 +26,12 @@ use std::f64::consts::{PI, TAU};
 use std::fmt;
 
 use crate::brdf::Brdf;
+pub use crate::error::SymmetryKind;
 use crate::error::{Error, Result};
 use crate::geometry;
 use crate::rng::Pcg32;
 use crate::spectrum::MAX_CHANNELS;
-use crate::table::grid::Param;
+use crate::table::param::Param;
 
 /// Which symmetries a table exploits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, Hash)]
@@ -80,7 +81,7 @@ impl Symmetry {
                 "bilateral" | "bilat" => out.bilateral = true,
                 other => {
                     return Err(Error::arg(
-                        "--symmetry",
+                        "symmetry",
                         format!(
                             "`{other}`: expected auto, none, all or a list of isotropic, reciprocal, bilateral"
                         ),
@@ -397,8 +398,6 @@ fn transformed(which: usize, wi: DVec3, wo: DVec3, angle: f64) -> (DVec3, DVec3)
     }
 }
 
-const NAMES: [&str; 3] = ["isotropic", "reciprocal", "bilateral"];
-
 /// The worst relative difference between f(wi, wo) and f at the transformed pair, for
 /// `which` = 0 (isotropy: common rotation), 1 (reciprocity: swap), 2 (bilateral: y → −y), over
 /// `pairs` random pairs uniform on the hemisphere (seeded). Relative to max(|a|, |b|) floored at
@@ -463,7 +462,7 @@ pub fn verify(brdf: &dyn Brdf, sym: Symmetry, tol: f64) -> Result<()> {
         let (e, at) = violation(brdf, k, CHECK_PAIRS, 0x5EED);
         if e > tol || e.is_nan() {
             return Err(Error::Symmetry {
-                symmetry: NAMES[k].into(),
+                symmetry: SymmetryKind::ALL[k],
                 error: e,
                 tolerance: tol,
                 at,

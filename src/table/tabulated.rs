@@ -10,7 +10,8 @@
 //! checksum, wrong length) the chunk is marked empty, its corners contribute 0 to every lookup
 //! (so a lookup whose corners all lie in a failed chunk writes 0), and the first error is kept:
 //! check [`TabulatedBrdf::load_error`] after a batch, or call [`TabulatedBrdf::load_all`]
-//! up front to get a proper `Result`. Failed chunks are not retried.
+//! up front to get a proper `Result` — with the loader's own error (a checksum failure stays
+//! [`Error::Checksum`]). Lookups do not retry failed chunks.
 //!
 //! **Negative stored values** mark unmeasured data (a MERL file's −1 cells, kept by
 //! [`MerlBrdf::to_table`](crate::measured::MerlBrdf::to_table) and by bakes of such a file on
@@ -71,7 +72,7 @@ pub struct TabulatedBrdf {
     loader: Option<Box<dyn ChunkLoader>>,
     interp: Interp,
     description: String,
-    error: Mutex<Option<String>>,
+    error: Mutex<Option<Error>>,
     /// Importance sampling distributions, built on first `sample`/`pdf` (see [`super::sampling`]).
     sampler: OnceLock<TableSampler>,
 }
@@ -207,20 +208,21 @@ impl TabulatedBrdf {
         &self.grid
     }
 
-    /// The first chunk-load error, if any (see the module docs).
+    /// The message of the first chunk-load error a lookup met, if any (see the module docs).
     pub fn load_error(&self) -> Option<String> {
-        self.error.lock().ok().and_then(|e| e.clone())
+        let e = self.error.lock().ok()?;
+        e.as_ref().map(|e| e.to_string())
     }
 
-    /// Loads every chunk now; returns the first error.
+    /// Loads every chunk now; returns the first failing chunk's own error (asking the loader
+    /// again for a chunk a lookup already found broken, so its error keeps its variant).
     pub fn load_all(&self) -> Result<()> {
         for i in 0..self.chunks.len() {
-            self.chunk(i);
+            if self.chunk(i).len() != self.grid.layout().chunk_len(i) {
+                self.fetch(i)?;
+            }
         }
-        match self.load_error() {
-            None => Ok(()),
-            Some(e) => Err(Error::format("<table>", None, None, e)),
-        }
+        Ok(())
     }
 
     /// Number of chunks currently loaded.
@@ -263,28 +265,16 @@ impl TabulatedBrdf {
 
     #[cold]
     fn load_chunk(&self, a: usize) -> &[f32] {
-        self.chunks[a].get_or_init(|| {
-            let want = self.grid.layout().chunk_len(a);
-            let r = match &self.loader {
-                Some(l) => l.load(a),
-                None => Err(Error::NotFound(format!("chunk {a}: no loader"))),
-            };
-            match r {
-                Ok(mut v) if v.len() == want => {
-                    let _ = self.unmeasured[a].set(set_aside_negatives(&mut v));
-                    v.into()
+        self.chunks[a].get_or_init(|| match self.fetch(a) {
+            Ok(mut v) => {
+                let _ = self.unmeasured[a].set(set_aside_negatives(&mut v));
+                v.into()
+            }
+            Err(e) => {
+                if let Ok(mut first) = self.error.lock() {
+                    first.get_or_insert(e);
                 }
-                Ok(v) => {
-                    self.record(format!(
-                        "chunk {a}: {} values loaded, {want} expected",
-                        v.len()
-                    ));
-                    Arc::from([])
-                }
-                Err(e) => {
-                    self.record(format!("chunk {a}: {e}"));
-                    Arc::from([])
-                }
+                Arc::from([])
             }
         })
     }
@@ -312,10 +302,22 @@ impl TabulatedBrdf {
         Some(idx)
     }
 
-    fn record(&self, msg: String) {
-        if let Ok(mut e) = self.error.lock() {
-            e.get_or_insert(msg);
+    /// Chunk `a` from the loader, checked for length.
+    fn fetch(&self, a: usize) -> Result<Vec<f32>> {
+        let want = self.grid.layout().chunk_len(a);
+        let v = match &self.loader {
+            Some(l) => l.load(a)?,
+            None => return Err(Error::NotFound(format!("chunk {a}: no loader"))),
+        };
+        if v.len() != want {
+            return Err(Error::format(
+                "<table>",
+                None,
+                None,
+                format!("chunk {a}: {} values loaded, {want} expected", v.len()),
+            ));
         }
+        Ok(v)
     }
 }
 
@@ -388,7 +390,7 @@ impl Brdf for TabulatedBrdf {
     /// Parallel (rayon) above 16384 pairs, sequential below.
     fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
         let c = self.lookup.channels();
-        let n = wi.len().min(wo.len()).min(out.len() / c.max(1));
+        let n = crate::brdf::check_batch(wi, wo, out, c.max(1));
         const BLOCK: usize = 4096;
         if n >= 4 * BLOCK {
             out[..n * c]

@@ -1,6 +1,5 @@
 //! `accuracy`: the accuracy suite (tables vs sources per grid and codec), CSV + Markdown + plots.
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use brdftab::report::suite::{self, SuiteConfig};
@@ -8,6 +7,8 @@ use brdftab::table::Param;
 use brdftab::table::presets::Preset;
 use brdftab::{Error, Result};
 use clap::Args;
+
+use crate::bake::flag;
 
 /// Arguments of `brdftab accuracy`.
 #[derive(Args)]
@@ -64,10 +65,14 @@ pub fn accuracy(a: AccuracyArgs) -> Result<()> {
         SuiteConfig::full(rgl.as_deref())?
     };
     if let Some(p) = &a.presets {
-        cfg.presets = list(p).map(Preset::parse).collect::<Result<_>>()?;
+        cfg.presets = list(p)
+            .map(|p| Preset::parse(p).map_err(|e| flag(e, "--presets")))
+            .collect::<Result<_>>()?;
     }
     if let Some(p) = &a.params {
-        cfg.params = list(p).map(Param::parse).collect::<Result<_>>()?;
+        cfg.params = list(p)
+            .map(|p| Param::parse(p).map_err(|e| flag(e, "--params")))
+            .collect::<Result<_>>()?;
     }
     if let Some(o) = &a.only {
         let keys: Vec<&str> = list(o).collect();
@@ -86,27 +91,8 @@ pub fn accuracy(a: AccuracyArgs) -> Result<()> {
             "nothing to run (no sources, presets or params)",
         ));
     }
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = indicatif::ProgressBar::new(cfg.row_count() as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "accuracy [{bar:30}] {pos}/{len} rows {elapsed} {msg}",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
-        );
-        b
-    });
-    let cb = |done: usize, _total: usize, what: &str| {
-        if let Some(b) = &bar {
-            b.set_position(done as u64);
-            b.set_message(what.to_owned());
-        }
-    };
-    let report = suite::run(&cfg, Some(&cb))?;
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
+    let bar = crate::progress::Bar::new("[{bar:30}] {pos}/{len} rows {elapsed} {msg}");
+    let report = suite::run(&cfg, &bar)?;
     let files = report.write_all(&a.out)?;
     eprintln!(
         "{} rows in {:.1} s; wrote {} files to {}",

@@ -26,7 +26,8 @@ pub struct BakeFlags {
     /// RGL files).
     #[arg(long)]
     pub wavelengths: Option<String>,
-    /// Symmetry reduction: auto (detect), none, or a list of isotropic,reciprocal,bilateral.
+    /// Symmetry reduction: auto (detect), declared (what the source says, unverified), none,
+    /// or a list of isotropic,reciprocal,bilateral.
     #[arg(long, default_value = "auto")]
     pub symmetry: String,
     /// Relative tolerance of symmetry detection and verification (`--tolerance` is a deprecated
@@ -131,37 +132,6 @@ pub fn bake(a: BakeArgs) -> Result<()> {
 /// Runs a request with a progress bar and prints what it did on stderr.
 pub fn run(req: &BakeRequest, target: &BakeTarget) -> Result<BakeReport> {
     let r = req.run_with(target, &Bar::values())?;
-    print_report(&r, req);
+    eprint!("{}", r.summary(&req.codec));
     Ok(r)
-}
-
-/// The lines `bake` prints after a bake.
-pub fn print_report(r: &BakeReport, req: &BakeRequest) {
-    if let Some(n) = &r.symmetry_note {
-        eprintln!("note: {n}");
-    }
-    if let Some(f) = &r.forced {
-        eprintln!("warning: forced past a symmetry violation: {f}");
-    }
-    eprintln!(
-        "baked {}\n  grid: {}{}\n  {} stored values ({} unreduced, {:.1}x reduction)",
-        r.source,
-        r.grid.summary(),
-        if r.merl_cells {
-            ", the file's own cells"
-        } else {
-            ""
-        },
-        r.values,
-        r.grid.full_values(),
-        r.grid.full_values() as f64 / r.values.max(1) as f64
-    );
-    eprintln!(
-        "wrote {} ({} values in {:.2} s, {:.1} M values/s, codec {})",
-        r.output,
-        r.values,
-        r.seconds,
-        r.values as f64 / r.seconds.max(1e-9) / 1e6,
-        req.codec.quant.name()
-    );
 }

@@ -2,11 +2,12 @@
 
 use brdftab::Result;
 use brdftab::bake::BakeTarget;
-use brdftab::measured::{MerlBrdf, RglBrdf, rgl_write};
+use brdftab::measured::{RglBrdf, rgl_write};
 use brdftab::table::Interp;
 use clap::Args;
 
 use crate::bake::BakeFlags;
+use crate::progress::Bar;
 use crate::source::{self, Kind};
 
 /// Arguments of `brdftab convert`.
@@ -54,15 +55,11 @@ pub struct RglArgs {
 pub fn convert(a: ConvertArgs) -> Result<()> {
     match source::kind(&a.output) {
         Kind::Merl => {
-            let brdf = source::open(&a.input, &source::channels(a.flags.wavelengths.as_deref())?)?;
-            let t = std::time::Instant::now();
-            let m = MerlBrdf::from_brdf(&*brdf);
-            m.write(&a.output)?;
+            let req = a.flags.request(&a.input)?;
+            let r = req.run_with(&BakeTarget::Merl(a.output.clone()), &Bar::values())?;
             println!(
                 "{}: {} resampled on the MERL grid (90 × 90 × 180 cell centres) in {:.2} s",
-                a.output,
-                brdf.describe(),
-                t.elapsed().as_secs_f64()
+                r.output, r.source, r.seconds
             );
             Ok(())
         }
@@ -125,16 +122,11 @@ fn to_table(a: ConvertArgs) -> Result<()> {
         },
         t => t,
     };
-    let r = req.run_with(&target, &crate::progress::Bar::values())?;
+    let r = req.run_with(&target, &Bar::values())?;
     println!("{}: {}", r.output, r.source);
     println!(
-        "  grid: {}{} ({} values, {:.2} s)",
-        r.grid.summary(),
-        if r.merl_cells {
-            ", the file's own cells"
-        } else {
-            ""
-        },
+        "  grid: {} ({} values, {:.2} s)",
+        r.grid_line(),
         r.values,
         r.seconds
     );

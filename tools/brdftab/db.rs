@@ -1,5 +1,4 @@
-//! `db` subcommands (add, list, rm, verify) and `info` for brdftab files: thin over
-//! `brdftab::store`.
+//! `db` subcommands (add, list, rm, verify): thin over `brdftab::store`.
 
 use brdftab::bake::BakeTarget;
 use brdftab::store::{self, db};
@@ -97,79 +96,10 @@ pub fn run(a: DbArgs) -> Result<()> {
 fn list(path: &str, as_json: bool) -> Result<()> {
     let rows = store::info::list(path)?;
     if as_json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&rows).unwrap_or_default()
-        );
-        return Ok(());
-    }
-    println!(
-        "{:<24} {:<8} {:>12} {:>12} {:>7}  grid",
-        "name", "codec", "values", "bytes", "ratio"
-    );
-    for r in &rows {
-        println!(
-            "{:<24} {:<8} {:>12} {:>12} {:>6.1}x  {} {} {}",
-            r["name"].as_str().unwrap_or(""),
-            r["codec"]["quant"].as_str().unwrap_or(""),
-            r["values"].as_u64().unwrap_or(0),
-            r["bytes"].as_u64().unwrap_or(0),
-            r["ratio_to_f32"].as_f64().unwrap_or(0.0),
-            r["parameterization"].as_str().unwrap_or(""),
-            r["shape"]
-                .as_array()
-                .map(|a| a
-                    .iter()
-                    .map(|x| x.to_string())
-                    .collect::<Vec<_>>()
-                    .join("x"))
-                .unwrap_or_default(),
-            r["symmetry"].as_str().unwrap_or(""),
-        );
-    }
-    Ok(())
-}
-
-/// `brdftab info` for a brdftab file (`FILE` or `DB#NAME`).
-pub fn info(source: &str, as_json: bool) -> Result<()> {
-    let v = store::info::file_info(source)?;
-    let tables = v["tables"].as_array().cloned().unwrap_or_default();
-    if as_json {
-        println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
-        return Ok(());
-    }
-    println!(
-        "file:    {} (brdftab format, {} tables)",
-        v["file"].as_str().unwrap_or(""),
-        tables.len()
-    );
-    println!(
-        "bytes:   {} ({:.1}x smaller than f32)",
-        v["bytes"],
-        v["ratio_to_f32"].as_f64().unwrap_or(0.0)
-    );
-    for t in &tables {
-        println!("table `{}`:", t["name"].as_str().unwrap_or(""));
-        println!("  source:   {}", t["source"]);
-        println!(
-            "  grid:     {} {} {}",
-            t["parameterization"].as_str().unwrap_or(""),
-            t["shape"],
-            t["symmetry"].as_str().unwrap_or("")
-        );
-        println!("  codec:    {}", t["codec"]);
-        println!(
-            "  values:   {} in {} chunks, {} bytes ({:.1}x smaller than f32)",
-            t["values"],
-            t["chunks"],
-            t["bytes"],
-            t["ratio_to_f32"].as_f64().unwrap_or(0.0)
-        );
-        println!(
-            "  units:    {}   tool: {}",
-            t["units"].as_str().unwrap_or(""),
-            t["tool"].as_str().unwrap_or("")
-        );
+        let json = serde_json::to_string_pretty(&rows).unwrap_or_default();
+        println!("{json}");
+    } else {
+        print!("{}", store::info::list_text(&rows));
     }
     Ok(())
 }

@@ -1,7 +1,5 @@
 //! `fit`: least-squares fit of a model's parameters to any SOURCE (see `brdftab::fit`).
 
-use std::io::IsTerminal;
-
 use brdftab::fit::{self, ColorMode, FitOptions, ParamRequest};
 use brdftab::fresnel::FresnelSpec;
 use brdftab::{Error, Result, Value};
@@ -89,24 +87,8 @@ pub fn fit(a: FitArgs) -> Result<()> {
         },
         ..Default::default()
     };
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = indicatif::ProgressBar::new(opts.starts as u64);
-        if let Ok(style) =
-            indicatif::ProgressStyle::with_template("fit {bar:30} {pos}/{len} starts {elapsed}")
-        {
-            b.set_style(style);
-        }
-        b
-    });
-    let result = fit::fit_with_progress(brdf.as_ref(), &init, &opts, &mut |done, _| {
-        if let Some(b) = &bar {
-            b.set_position(done as u64);
-        }
-    });
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    let result = result?;
+    let bar = crate::progress::Bar::new("fit {bar:30} {pos}/{len} starts {elapsed}");
+    let result = fit::fit_with_progress(brdf.as_ref(), &init, &opts, &bar)?;
     let text = if a.json {
         serde_json::to_string(&result).map_err(|e| Error::Json {
             context: "fit result".into(),

@@ -8,6 +8,7 @@ mod bench;
 mod convert;
 mod db;
 mod demo;
+mod demo_extra;
 mod export;
 mod fit;
 mod measured;
@@ -100,9 +101,18 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {e}{}", hint(&e));
             ExitCode::from(1)
         }
+    }
+}
+
+/// The flags that get past an error: the library's messages name none, the CLI adds them here.
+fn hint(e: &brdftab::Error) -> &'static str {
+    match e {
+        brdftab::Error::Duplicate { .. } => " (use --replace)",
+        brdftab::Error::Symmetry { .. } => " (use --force to bake anyway, or --symmetry none)",
+        _ => "",
     }
 }
 

@@ -1,97 +1,10 @@
-//! `info` for measured files and `slice` (any SOURCE).
+//! `slice`: a slice image of any SOURCE.
 
 use brdftab::analysis::slice;
-use brdftab::measured::{MerlBrdf, RglBrdf, merl, tensor::TensorFile};
 use brdftab::{Brdf, Error, Result};
 use clap::{Args, ValueEnum};
 
-use crate::source::{self, Kind};
-
-/// Arguments of `brdftab info`.
-#[derive(Args)]
-pub struct InfoArgs {
-    /// A MERL `.binary` or RGL `.bsdf` file.
-    source: String,
-}
-
-/// `info` for a measured file named by path (used by the table `info` command's dispatch).
-pub fn info_source(source: &str) -> Result<()> {
-    info(InfoArgs {
-        source: source.to_owned(),
-    })
-}
-
-/// Prints what a measured file holds: description, dimensions, channels, sha256.
-pub fn info(a: InfoArgs) -> Result<()> {
-    match source::kind(&a.source) {
-        Kind::Merl => info_merl(&a.source),
-        Kind::Rgl => info_rgl(&a.source),
-        _ => Err(Error::Unsupported(format!(
-            "{}: `info` handles measured files (.binary, .bsdf) here",
-            a.source
-        ))),
-    }
-}
-
-fn info_merl(path: &str) -> Result<()> {
-    let sha = merl::sha256_file(path)?;
-    let m = MerlBrdf::open(path)?;
-    println!("file:        {path}");
-    println!("format:      MERL BRDF database (.binary, Matusik et al. 2003)");
-    match merl::material_of(&sha) {
-        Some(name) => println!("material:    {name} (sha256 matches the published file)"),
-        None => println!("material:    unknown (sha256 matches none of the 100 published files)"),
-    }
-    println!(
-        "dims:        θh {} × θd {} × φd {} (sqrt θh axis), {} bytes",
-        merl::RES_THETA_H,
-        merl::RES_THETA_D,
-        merl::RES_PHI_D,
-        merl::FILE_SIZE
-    );
-    println!("channels:    R G B (scales 1/1500, 1.15/1500, 1.66/1500)");
-    println!(
-        "unmeasured:  {} of {} cells (negative, evaluated as 0)",
-        m.invalid_cells(),
-        merl::SAMPLES
-    );
-    println!("sha256:      {sha}");
-    Ok(())
-}
-
-fn info_rgl(path: &str) -> Result<()> {
-    let t = TensorFile::open(path)?;
-    let b = RglBrdf::from_tensor(&t, None)?;
-    let s = b.summary();
-    println!("file:        {path}");
-    println!(
-        "format:      RGL-EPFL tensor file (.bsdf, Dupuy & Jakob 2018), {} bytes",
-        t.size()
-    );
-    println!("description: {}", s.description);
-    println!("kind:        {}", s.kind);
-    println!(
-        "dims:        φi {} × θi {}, table {}×{}, vndf {}×{}, {}",
-        s.phi_i,
-        s.theta_i,
-        s.resolution.0,
-        s.resolution.1,
-        s.vndf_resolution.0,
-        s.vndf_resolution.1,
-        if s.isotropic {
-            "isotropic".to_string()
-        } else {
-            format!("anisotropic, reduction {}", s.reduction)
-        }
-    );
-    println!("channels:    {}", b.channels().names().join(" "));
-    println!("fields:");
-    for f in t.fields() {
-        println!("  {:<12} {:<22} @ {}", f.name, f.describe(), f.offset);
-    }
-    println!("sha256:      {}", b.sha256());
-    Ok(())
-}
+use crate::source;
 
 /// Which slice to draw.
 #[derive(Clone, Copy, ValueEnum)]

@@ -97,7 +97,12 @@ pub fn models(a: ModelsArgs) -> Result<()> {
         for m in MODELS {
             println!(
                 "{:<17} {}\n{:<17} params: {}\n{:<17} e.g. {}",
-                m.name, m.description, "", m.params, "", m.example
+                m.name,
+                m.description,
+                "",
+                m.params_line(),
+                "",
+                m.example
             );
         }
     }

@@ -10,6 +10,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 pub struct Bar {
     template: &'static str,
     bar: Mutex<Option<ProgressBar>>,
+    /// (prefix set by the command, name of the current stage).
+    label: Mutex<(String, String)>,
     visible: bool,
 }
 
@@ -19,8 +21,28 @@ impl Bar {
         Bar {
             template,
             bar: Mutex::new(None),
+            label: Mutex::new((String::new(), String::new())),
             visible: std::io::stderr().is_terminal(),
         }
+    }
+
+    /// Shows `prefix` before the stage names of the stages that follow (e.g. a source's name).
+    pub fn prefix(&self, prefix: &str) {
+        self.lock_label().0 = prefix.to_owned();
+    }
+
+    fn lock_label(&self) -> std::sync::MutexGuard<'_, (String, String)> {
+        self.label.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn message(&self, note: &str) -> String {
+        let l = self.lock_label();
+        [l.0.as_str(), l.1.as_str(), note]
+            .iter()
+            .filter(|s| !s.is_empty())
+            .copied()
+            .collect::<Vec<_>>()
+            .join(" ")
     }
 
     /// The default look: stage name, bar, percentage, counts and ETA.
@@ -38,6 +60,8 @@ impl Bar {
 impl brdftab::Progress for Bar {
     fn begin(&self, what: &str, total: u64) {
         let template = self.template;
+        self.lock_label().1 = what.to_owned();
+        let msg = self.message("");
         self.with(|b| {
             let bar = ProgressBar::new(total);
             bar.set_style(
@@ -45,7 +69,7 @@ impl brdftab::Progress for Bar {
                     .unwrap_or_else(|_| ProgressStyle::default_bar())
                     .progress_chars("=> "),
             );
-            bar.set_message(what.to_owned());
+            bar.set_message(msg);
             *b = Some(bar);
         });
     }
@@ -54,6 +78,15 @@ impl brdftab::Progress for Bar {
         self.with(|b| {
             if let Some(b) = b {
                 b.set_position(done);
+            }
+        });
+    }
+
+    fn note(&self, what: &str) {
+        let msg = self.message(what);
+        self.with(|b| {
+            if let Some(b) = b {
+                b.set_message(msg);
             }
         });
     }

@@ -1,16 +1,13 @@
 //! `render`: preview images of a SOURCE on a sphere, and comparisons of two sources.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
-use brdftab::render::{
-    self, EnvChoice, Environment, Image, LightChoice, Mode, RenderOptions, Sampling,
-};
+use brdftab::render::{self, EnvChoice, Image, LightChoice, Mode, RenderOptions, Sampling};
 use brdftab::{Error, Result};
 use clap::Args;
 
+use crate::bake::flag;
 use crate::source;
 
 /// Arguments of `brdftab render`.
@@ -81,49 +78,12 @@ fn parse_size(s: &str) -> Result<(usize, usize)> {
 
 fn options(a: &RenderArgs) -> Result<RenderOptions> {
     let (width, height) = parse_size(&a.size)?;
-    let mode = match a.mode.as_str() {
-        "path" => Mode::Path,
-        "lit" => Mode::Lit,
-        m => return Err(Error::arg("--mode", format!("`{m}`: expected path or lit"))),
-    };
-    let env = match a.env.as_str() {
-        "sky" => EnvChoice::Sky,
-        "white" => EnvChoice::Constant([1.0; 3]),
-        "none" => EnvChoice::Black,
-        f if f.to_ascii_lowercase().ends_with(".exr") => {
-            EnvChoice::Map(Arc::new(Environment::from_exr(f)?))
-        }
-        e => {
-            return Err(Error::arg(
-                "--env",
-                format!("`{e}`: expected sky, white, none or a .exr file"),
-            ));
-        }
-    };
-    let light = match a.light.as_str() {
-        "none" => LightChoice::None,
-        "point" => LightChoice::Point,
-        "area" => LightChoice::Area,
-        l => {
-            return Err(Error::arg(
-                "--light",
-                format!("`{l}`: expected none, point or area"),
-            ));
-        }
-    };
+    let mode = Mode::parse(&a.mode).map_err(|e| flag(e, "--mode"))?;
+    let env = EnvChoice::parse(&a.env).map_err(|e| flag(e, "--env"))?;
+    let light = LightChoice::parse(&a.light).map_err(|e| flag(e, "--light"))?;
     let default_sampling = if a.compare.is_some() { "fixed" } else { "mis" };
-    let sampling = match a.sampling.as_deref().unwrap_or(default_sampling) {
-        "mis" => Sampling::Mis,
-        "brdf" => Sampling::BrdfOnly,
-        "light" => Sampling::LightOnly,
-        "fixed" => Sampling::Fixed,
-        s => {
-            return Err(Error::arg(
-                "--sampling",
-                format!("`{s}`: expected mis, brdf, light or fixed"),
-            ));
-        }
-    };
+    let sampling = Sampling::parse(a.sampling.as_deref().unwrap_or(default_sampling))
+        .map_err(|e| flag(e, "--sampling"))?;
     Ok(RenderOptions {
         width,
         height,
@@ -143,21 +103,9 @@ fn options(a: &RenderArgs) -> Result<RenderOptions> {
 /// Renders with a progress bar on a terminal, silently otherwise; reports the time on stderr.
 fn render_one(brdf: &dyn brdftab::Brdf, opts: &RenderOptions, label: &str) -> Result<Image> {
     let start = Instant::now();
-    let img = if std::io::stderr().is_terminal() {
-        let bar = indicatif::ProgressBar::new((opts.width * opts.height) as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {percent}% eta {eta}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-                .progress_chars("=> "),
-        );
-        bar.set_message(label.to_string());
-        let cb = |k: u64| bar.inc(k);
-        let r = render::render(brdf, opts, Some(&cb));
-        bar.finish_and_clear();
-        r?
-    } else {
-        render::render(brdf, opts, None)?
-    };
+    let bar = crate::progress::Bar::new("{msg} [{bar:40}] {percent}% eta {eta}");
+    bar.prefix(label);
+    let img = render::render(brdf, opts, &bar)?;
     eprintln!(
         "{label}: {}×{} at {} spp in {:.2} s",
         opts.width,

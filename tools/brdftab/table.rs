@@ -1,12 +1,9 @@
-//! `info`: what a table file holds.
+//! `info`: what a table file or a measured file holds (the library's `store::info` and
+//! `measured::info` say it; this prints).
 
-use std::fmt::Write as _;
-
-use brdftab::store::{db, tables};
-use brdftab::table::Table;
+use brdftab::store::{db, info, tables};
 use brdftab::{Error, Result};
 use clap::Args;
-use serde_json::json;
 
 use crate::source;
 
@@ -29,53 +26,24 @@ pub struct InfoArgs {
     json: bool,
 }
 
-/// `brdftab info`.
+/// `brdftab info`: measured files as text, brdftab and raw files as JSON or text.
 pub fn info(a: InfoArgs) -> Result<()> {
     if matches!(
         source::kind(&a.file),
         source::Kind::Merl | source::Kind::Rgl
     ) {
-        return crate::measured::info_source(&a.file);
+        return print_out(&brdftab::measured::info::describe(&a.file)?);
     }
-    if tables::is_store_file(db::split_source(&a.file).0) {
-        return crate::db::info(&a.file, a.json);
-    }
-    let t = Table::open_raw(&a.file)?;
-    let g = t.grid();
-    let bytes = std::fs::metadata(&a.file)
-        .map_err(|e| Error::io(&a.file, e))?
-        .len();
-    let mut o = String::new();
-    let v = json!({
-        "file": a.file,
-        "format": "raw",
-        "description": t.description(),
-        "grid": g,
-        "parameterization": g.param(),
-        "symmetry": g.symmetry().to_string(),
-        "channels": g.channels().names(),
-        "stored_shape": g.stored_shape(),
-        "chunks": g.layout().chunk_count(),
-        "stored_values": g.stored_values(),
-        "full_values": g.full_values(),
-        "bytes": bytes,
-    });
+    let (v, text): (_, fn(&serde_json::Value) -> String) =
+        if tables::is_store_file(db::split_source(&a.file).0) {
+            (info::file_info(&a.file)?, info::file_text)
+        } else {
+            (info::raw_info(&a.file)?, info::raw_text)
+        };
     if a.json {
-        let _ = writeln!(
-            o,
-            "{}",
-            serde_json::to_string_pretty(&v).unwrap_or_default()
-        );
+        let json = serde_json::to_string_pretty(&v).unwrap_or_default();
+        print_out(&format!("{json}\n"))
     } else {
-        let _ = writeln!(o, "file:          {}", a.file);
-        let _ = writeln!(o, "source:        {}", t.description());
-        let _ = writeln!(o, "grid:          {}", g.summary());
-        let _ = writeln!(o, "symmetry:      {}", g.symmetry());
-        let _ = writeln!(o, "channels:      {}", g.channels().names().join(" "));
-        let _ = writeln!(o, "chunks:        {}", g.layout().chunk_count());
-        let _ = writeln!(o, "stored_values: {}", g.stored_values());
-        let _ = writeln!(o, "full_values:   {}", g.full_values());
-        let _ = writeln!(o, "bytes:         {bytes}");
+        print_out(&text(&v))
     }
-    print_out(&o)
 }

@@ -1,0 +1,135 @@
+//! Lookup timing: how fast a `Brdf` evaluates random pairs, one at a time on one thread and in
+//! batches ([`Brdf::eval_batch`]) on every core.
+//!
+//! The machines this runs on are shared, so each figure comes with its CPU-time twin (Linux
+//! schedstat; `None` elsewhere): wall-clock time alone says more about the neighbours than about
+//! the code. Medians over the repeats.
+
+use std::time::Instant;
+
+use glam::DVec3;
+use serde::Serialize;
+
+use crate::brdf::Brdf;
+use crate::error::{Error, Result};
+use crate::geometry;
+use crate::rng::Pcg32;
+
+/// What [`lookups`] measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct LookupTiming {
+    /// The source's description.
+    pub source: String,
+    /// Random pairs per repeat.
+    pub pairs: usize,
+    /// Channels per lookup.
+    pub channels: usize,
+    /// Repeats (the figures are medians).
+    pub repeats: usize,
+    /// Wall-clock ns per `eval` on one thread.
+    pub ns_per_lookup_single_thread: f64,
+    /// CPU ns per `eval` on one thread (NaN where unknown).
+    pub cpu_ns_per_lookup_single_thread: f64,
+    /// Lookups per wall-clock second of `eval_batch`.
+    pub lookups_per_s_batch: f64,
+    /// Lookups per second of CPU time of `eval_batch` (per core; NaN where unknown).
+    pub lookups_per_s_batch_per_core_cpu_time: f64,
+    /// Threads `eval_batch` may use.
+    pub threads: usize,
+}
+
+/// Times `src` on `pairs` random pairs (uniform on the hemisphere, fixed seed), `repeats` times.
+pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTiming> {
+    if pairs == 0 || repeats == 0 {
+        return Err(Error::arg("pairs", "pairs and repeats must be positive"));
+    }
+    let c = src.channels().len();
+    let mut rng = Pcg32::new(2024);
+    let (wi, wo): (Vec<DVec3>, Vec<DVec3>) = (0..pairs)
+        .map(|_| {
+            (
+                geometry::uniform_hemisphere(rng.next_dvec2()),
+                geometry::uniform_hemisphere(rng.next_dvec2()),
+            )
+        })
+        .unzip();
+    let mut out = vec![0.0f32; pairs * c];
+    // Warm up (loads lazy chunks, faults pages).
+    src.eval_batch(&wi, &wo, &mut out);
+    let n = pairs as f64;
+    let (mut single, mut single_cpu) = (Vec::new(), Vec::new());
+    for _ in 0..repeats {
+        let (t, cpu) = (Instant::now(), thread_cpu_ns());
+        for (k, o) in out.chunks_exact_mut(c).enumerate() {
+            src.eval(wi[k], wo[k], o);
+        }
+        single.push(t.elapsed().as_secs_f64() * 1e9 / n);
+        if let (Some(a0), Some(a1)) = (cpu, thread_cpu_ns()) {
+            single_cpu.push((a1 - a0) as f64 / n);
+        }
+        std::hint::black_box(&out);
+    }
+    let (mut batch, mut batch_cpu) = (Vec::new(), Vec::new());
+    for _ in 0..repeats {
+        let (t, cpu) = (Instant::now(), process_cpu_ns());
+        src.eval_batch(&wi, &wo, &mut out);
+        batch.push(n / t.elapsed().as_secs_f64());
+        if let (Some(a0), Some(a1)) = (cpu, process_cpu_ns()) {
+            // Per core of CPU time: independent of how busy the machine is and of how many
+            // threads `eval_batch` used.
+            batch_cpu.push(n / ((a1 - a0) as f64 * 1e-9));
+        }
+        std::hint::black_box(&out);
+    }
+    Ok(LookupTiming {
+        source: src.describe(),
+        pairs,
+        channels: c,
+        repeats,
+        ns_per_lookup_single_thread: median(&mut single),
+        cpu_ns_per_lookup_single_thread: median(&mut single_cpu),
+        lookups_per_s_batch: median(&mut batch),
+        lookups_per_s_batch_per_core_cpu_time: median(&mut batch_cpu),
+        threads: rayon::current_num_threads(),
+    })
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(|x, y| x.total_cmp(y));
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// CPU time of the calling thread in ns (Linux `/proc/thread-self/schedstat`).
+pub fn thread_cpu_ns() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    s.split_whitespace().next()?.parse().ok()
+}
+
+/// CPU time of every thread of the process in ns.
+pub fn process_cpu_ns() -> Option<u64> {
+    let mut total = 0;
+    for e in std::fs::read_dir("/proc/self/task").ok()? {
+        let p = e.ok()?.path().join("schedstat");
+        if let Ok(s) = std::fs::read_to_string(p) {
+            total += s.split_whitespace().next()?.parse::<u64>().ok()?;
+        }
+    }
+    Some(total)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn timing_a_model_gives_positive_figures() {
+        let m = crate::spec::ModelSpec::parse(r#"{"model": "lambert", "kd": 0.5}"#)
+            .unwrap()
+            .build(&crate::Channels::Rgb)
+            .unwrap();
+        let t = lookups(m.as_ref(), 2000, 3).unwrap();
+        assert_eq!((t.pairs, t.channels, t.repeats), (2000, 3, 3));
+        assert!(t.ns_per_lookup_single_thread > 0.0 && t.lookups_per_s_batch > 0.0);
+        assert!(lookups(m.as_ref(), 0, 3).is_err());
+    }
+}

@@ -1,0 +1,97 @@
+//! What `brdftab info` says of a measured file (MERL `.binary`, RGL `.bsdf`), as text every host
+//! can show: description, dimensions, channels, sha256.
+
+use std::fmt::Write as _;
+
+use super::{MerlBrdf, RglBrdf, merl, tensor::TensorFile};
+use crate::brdf::Brdf;
+use crate::error::{Error, Result};
+
+/// The description of the measured file at `path`, one `key: value` line each.
+pub fn describe(path: &str) -> Result<String> {
+    let lower = path.to_ascii_lowercase();
+    if lower.ends_with(".binary") {
+        describe_merl(path)
+    } else if lower.ends_with(".bsdf") {
+        describe_rgl(path)
+    } else {
+        Err(Error::Unsupported(format!(
+            "{path}: not a measured file (.binary, .bsdf)"
+        )))
+    }
+}
+
+fn describe_merl(path: &str) -> Result<String> {
+    let sha = merl::sha256_file(path)?;
+    let m = MerlBrdf::open(path)?;
+    let mut o = String::new();
+    let _ = writeln!(o, "file:        {path}");
+    let _ = writeln!(
+        o,
+        "format:      MERL BRDF database (.binary, Matusik et al. 2003)"
+    );
+    let _ = match merl::material_of(&sha) {
+        Some(name) => writeln!(o, "material:    {name} (sha256 matches the published file)"),
+        None => writeln!(
+            o,
+            "material:    unknown (sha256 matches none of the 100 published files)"
+        ),
+    };
+    let _ = writeln!(
+        o,
+        "dims:        θh {} × θd {} × φd {} (sqrt θh axis), {} bytes",
+        merl::RES_THETA_H,
+        merl::RES_THETA_D,
+        merl::RES_PHI_D,
+        merl::FILE_SIZE
+    );
+    let _ = writeln!(
+        o,
+        "channels:    R G B (scales 1/1500, 1.15/1500, 1.66/1500)"
+    );
+    let _ = writeln!(
+        o,
+        "unmeasured:  {} of {} cells (negative, evaluated as 0)",
+        m.invalid_cells(),
+        merl::SAMPLES
+    );
+    let _ = writeln!(o, "sha256:      {sha}");
+    Ok(o)
+}
+
+fn describe_rgl(path: &str) -> Result<String> {
+    let t = TensorFile::open(path)?;
+    let b = RglBrdf::from_tensor(&t, None)?;
+    let s = b.summary();
+    let mut o = String::new();
+    let _ = writeln!(o, "file:        {path}");
+    let _ = writeln!(
+        o,
+        "format:      RGL-EPFL tensor file (.bsdf, Dupuy & Jakob 2018), {} bytes",
+        t.size()
+    );
+    let _ = writeln!(o, "description: {}", s.description);
+    let _ = writeln!(o, "kind:        {}", s.kind);
+    let symmetry = if s.isotropic {
+        "isotropic".to_string()
+    } else {
+        format!("anisotropic, reduction {}", s.reduction)
+    };
+    let _ = writeln!(
+        o,
+        "dims:        φi {} × θi {}, table {}×{}, vndf {}×{}, {symmetry}",
+        s.phi_i,
+        s.theta_i,
+        s.resolution.0,
+        s.resolution.1,
+        s.vndf_resolution.0,
+        s.vndf_resolution.1,
+    );
+    let _ = writeln!(o, "channels:    {}", b.channels().names().join(" "));
+    let _ = writeln!(o, "fields:");
+    for f in t.fields() {
+        let _ = writeln!(o, "  {:<12} {:<22} @ {}", f.name, f.describe(), f.offset);
+    }
+    let _ = writeln!(o, "sha256:      {}", b.sha256());
+    Ok(o)
+}

@@ -1,0 +1,357 @@
+//! Hemispherical quadrature about a reflection lobe: the numeric core of directional albedo.
+//!
+//! The method and its accuracy are described in [`analysis::albedo`](crate::analysis::albedo),
+//! which is the interface to use. This room sits below [`brdf`](crate::brdf) (it integrates a
+//! closure, not a `Brdf`), so the trait's default `albedo` can call it without an import cycle.
+
+use glam::DVec3;
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+use crate::geometry;
+use crate::spectrum::MAX_CHANNELS;
+
+/// Accuracy settings of [`hemisphere`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// Target relative error of the albedo (of its largest channel).
+    pub rel_tol: f64,
+    /// Most intervals the outer (φ) rule may use.
+    pub max_outer: usize,
+    /// Most intervals each inner (α) rule may use.
+    pub max_inner: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            rel_tol: 1e-6,
+            max_outer: 128,
+            max_inner: 256,
+        }
+    }
+}
+
+/// The result of [`hemisphere`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Estimate {
+    /// The albedo per channel.
+    pub value: Vec<f64>,
+    /// The estimated absolute error (of the largest channel).
+    pub error: f64,
+    /// How many times `eval` was called.
+    pub evals: usize,
+    /// The lobe centre the integration frame was built around.
+    pub centre: DVec3,
+}
+
+/// ∫ f(wi, wo) cos θo dωo over the upper hemisphere for `c` channels, where `eval(wo, out)`
+/// writes f(wi, wo) for the fixed (normalized here) `wi`: the integrator behind
+/// [`analysis::albedo::integrate`](crate::analysis::albedo::integrate) and the default
+/// [`Brdf::albedo`](crate::Brdf::albedo), written against a closure so that the trait's default
+/// and this numeric room need not know each other.
+pub fn hemisphere(
+    c: usize,
+    wi: DVec3,
+    opts: &Options,
+    eval: impl Fn(DVec3, DVec3, &mut [f32]),
+) -> Estimate {
+    let c = c.min(MAX_CHANNELS);
+    let zero = Estimate {
+        value: vec![0.0; c],
+        error: 0.0,
+        evals: 0,
+        centre: DVec3::Z,
+    };
+    let Some(wi) = geometry::normalize(wi) else {
+        return zero;
+    };
+    if wi.z <= 0.0 || c == 0 {
+        return zero;
+    }
+    let mut evals = 0usize;
+    let mut fbuf = [0.0f32; MAX_CHANNELS];
+    // f·cos θo summed over channels: the scalar the lobe search maximizes.
+    let mut g = |wo: DVec3, evals: &mut usize| -> f64 {
+        *evals += 1;
+        if wo.z <= 0.0 {
+            return 0.0;
+        }
+        eval(wi, wo, &mut fbuf[..c]);
+        fbuf[..c].iter().map(|&x| x as f64).sum::<f64>() * wo.z
+    };
+    let (centre, scale) = lobe_centre(&mut g, wi, &mut evals);
+
+    // Orthonormal frame about the centre: e2 horizontal, e1 in the vertical plane through c
+    // (pointing down towards the horizon for φ = 0).
+    let e2 = geometry::normalize(DVec3::new(-centre.y, centre.x, 0.0)).unwrap_or(DVec3::Y);
+    let e1 = e2.cross(centre);
+
+    // Absolute floors from the coarse estimate of the albedo, so directions far from the lobe
+    // are not integrated to a pointless relative accuracy.
+    let outer_abs = opts.rel_tol * 0.1 * scale;
+    let inner_rel = opts.rel_tol * 0.01;
+    let inner_abs = opts.rel_tol * 0.01 * scale / TAU;
+
+    let mut inner_out = [0.0f64; MAX_CHANNELS];
+    let mut inner = |phi: f64, out: &mut [f64], evals: &mut usize| {
+        let (sp, cp) = phi.sin_cos();
+        let t = cp * e1 + sp * e2;
+        // z(α) = c_z cos α + t_z sin α = R cos(α − δ) first vanishes at α = δ + π/2.
+        let alpha_max = t.z.atan2(centre.z) + FRAC_PI_2;
+        let breaks: Vec<f64> = [0.0, 0.01, 0.04, 0.15, 0.5]
+            .into_iter()
+            .filter(|&a| a < alpha_max)
+            .chain(std::iter::once(alpha_max))
+            .collect();
+        let mut fb = [0.0f32; MAX_CHANNELS];
+        let mut f = |alpha: f64, o: &mut [f64], evals: &mut usize| {
+            *evals += 1;
+            let (sa, ca) = alpha.sin_cos();
+            let wo = ca * centre + sa * t;
+            if wo.z <= 0.0 {
+                o.fill(0.0);
+                return;
+            }
+            eval(wi, wo, &mut fb[..c]);
+            let w = wo.z * sa;
+            for (ok, &fk) in o.iter_mut().zip(&fb[..c]) {
+                *ok = fk as f64 * w;
+            }
+        };
+        adaptive(
+            &mut f,
+            &breaks,
+            c,
+            inner_rel,
+            inner_abs,
+            opts.max_inner,
+            &mut inner_out[..c],
+            evals,
+        );
+        out.copy_from_slice(&inner_out[..c]);
+    };
+    let mut value = vec![0.0; c];
+    let error = adaptive(
+        &mut inner,
+        &[0.0, FRAC_PI_2, PI, 1.5 * PI, TAU],
+        c,
+        opts.rel_tol,
+        outer_abs,
+        opts.max_outer,
+        &mut value,
+        &mut evals,
+    );
+    Estimate {
+        value,
+        error,
+        evals,
+        centre,
+    }
+}
+
+/// Finds the direction of the reflection lobe of `g` (f·cos θo summed over channels) and a coarse
+/// estimate of the albedo (a midpoint sum over the probe grid, at least g(centre)·1e-3).
+fn lobe_centre(
+    g: &mut impl FnMut(DVec3, &mut usize) -> f64,
+    wi: DVec3,
+    evals: &mut usize,
+) -> (DVec3, f64) {
+    const NT: usize = 12;
+    const NP: usize = 24;
+    let mirror = geometry::reflect_z(wi);
+    let g_mirror = g(mirror, evals);
+    let (mut best, mut best_t, mut best_p) = (f64::NEG_INFINITY, 0.0, 0.0);
+    let mut sum = 0.0;
+    let (dt, dp) = (FRAC_PI_2 / NT as f64, TAU / NP as f64);
+    for i in 0..NT {
+        let t = (i as f64 + 0.5) * dt;
+        for j in 0..NP {
+            let p = (j as f64 + 0.5) * dp;
+            let v = g(geometry::spherical(t, p), evals);
+            if v.is_finite() {
+                sum += v * t.sin() * dt * dp;
+                if v > best {
+                    (best, best_t, best_p) = (v, t, p);
+                }
+            }
+        }
+    }
+    let scale = sum.max(1e-3 * g_mirror.max(0.0)).max(f64::MIN_POSITIVE);
+    if g_mirror.is_nan() || best <= 2.0 * g_mirror {
+        return (mirror, scale);
+    }
+    // Pattern search from the best grid node, halving the step.
+    let (mut st, mut sp) = (dt, dp);
+    for _ in 0..24 {
+        let mut moved = false;
+        for (a, b) in [(st, 0.0), (-st, 0.0), (0.0, sp), (0.0, -sp)] {
+            let (t, p) = ((best_t + a).clamp(0.0, FRAC_PI_2 - 1e-6), best_p + b);
+            let v = g(geometry::spherical(t, p), evals);
+            if v > best {
+                (best, best_t, best_p, moved) = (v, t, p, true);
+            }
+        }
+        if !moved {
+            st *= 0.5;
+            sp *= 0.5;
+        }
+    }
+    (geometry::spherical(best_t, best_p), scale)
+}
+
+// Gauss-Kronrod 7/15 abscissae (non-negative half) and weights (QUADPACK's qk15).
+const XGK: [f64; 8] = [
+    0.991_455_371_120_812_6,
+    0.949_107_912_342_758_5,
+    0.864_864_423_359_769_1,
+    0.741_531_185_599_394_4,
+    0.586_087_235_467_691_1,
+    0.405_845_151_377_397_2,
+    0.207_784_955_007_898_5,
+    0.0,
+];
+const WGK: [f64; 8] = [
+    0.022_935_322_010_529_22,
+    0.063_092_092_629_978_55,
+    0.104_790_010_322_250_2,
+    0.140_653_259_715_525_9,
+    0.169_004_726_639_267_9,
+    0.190_350_578_064_785_4,
+    0.204_432_940_075_298_9,
+    0.209_482_141_084_727_8,
+];
+// Gauss 7-point weights for XGK[1], XGK[3], XGK[5], XGK[7].
+const WG: [f64; 4] = [
+    0.129_484_966_168_869_7,
+    0.279_705_391_489_276_7,
+    0.381_830_050_505_118_9,
+    0.417_959_183_673_469_4,
+];
+
+/// One G7/K15 rule on [a, b] for a vector integrand: Kronrod result into `k`, returns the error
+/// estimate max_channel |K15 − G7|.
+fn gk15<F: FnMut(f64, &mut [f64], &mut usize)>(
+    f: &mut F,
+    a: f64,
+    b: f64,
+    k: &mut [f64],
+    evals: &mut usize,
+) -> f64 {
+    let c = k.len();
+    let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+    let mut gs = [0.0f64; MAX_CHANNELS];
+    let mut v = [0.0f64; MAX_CHANNELS];
+    k.fill(0.0);
+    for (j, (&x, &wk)) in XGK.iter().zip(&WGK).enumerate() {
+        let pts: &[f64] = if x == 0.0 {
+            &[mid]
+        } else {
+            &[mid - half * x, mid + half * x]
+        };
+        for &p in pts {
+            f(p, &mut v[..c], evals);
+            for ch in 0..c {
+                k[ch] += wk * v[ch];
+                if j % 2 == 1 {
+                    gs[ch] += WG[j / 2] * v[ch];
+                }
+            }
+        }
+    }
+    let mut err = 0.0f64;
+    for ch in 0..c {
+        k[ch] *= half;
+        err = err.max((k[ch] - gs[ch] * half).abs());
+    }
+    if err.is_nan() { f64::INFINITY } else { err }
+}
+
+/// Globally adaptive G7/K15 quadrature of a vector integrand over the intervals between
+/// consecutive `breaks`: bisects the interval with the largest error estimate until the total
+/// estimate is ≤ max(`abs`, `rel`·max_channel |I|) or `max_segs` intervals are used. Writes the
+/// integral into `out` and returns the error estimate.
+#[allow(clippy::too_many_arguments)]
+fn adaptive<F: FnMut(f64, &mut [f64], &mut usize)>(
+    f: &mut F,
+    breaks: &[f64],
+    c: usize,
+    rel: f64,
+    abs: f64,
+    max_segs: usize,
+    out: &mut [f64],
+    evals: &mut usize,
+) -> f64 {
+    // Segments (a, b, err) and their values, c per segment.
+    let mut segs: Vec<(f64, f64, f64)> = Vec::with_capacity(max_segs + 8);
+    let mut vals: Vec<f64> = Vec::with_capacity((max_segs + 8) * c);
+    let mut tmp = [0.0f64; MAX_CHANNELS];
+    for w in breaks.windows(2) {
+        if w[1] > w[0] {
+            let e = gk15(f, w[0], w[1], &mut tmp[..c], evals);
+            segs.push((w[0], w[1], e));
+            vals.extend_from_slice(&tmp[..c]);
+        }
+    }
+    loop {
+        out[..c].fill(0.0);
+        let mut err = 0.0;
+        for (s, v) in segs.iter().zip(vals.chunks_exact(c)) {
+            err += s.2;
+            for ch in 0..c {
+                out[ch] += v[ch];
+            }
+        }
+        let mag = out[..c].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if err <= abs.max(rel * mag) || segs.len() >= max_segs || err.is_nan() {
+            return err;
+        }
+        // Bisect the worst segment.
+        let (worst, _) =
+            segs.iter().enumerate().fold(
+                (0, -1.0),
+                |(bi, be), (i, s)| if s.2 > be { (i, s.2) } else { (bi, be) },
+            );
+        let (a, b, _) = segs[worst];
+        let m = 0.5 * (a + b);
+        if m <= a || m >= b {
+            // Cannot split further: accept this segment as it is.
+            segs[worst].2 = 0.0;
+            continue;
+        }
+        let e1 = gk15(f, a, m, &mut tmp[..c], evals);
+        segs[worst] = (a, m, e1);
+        vals[worst * c..(worst + 1) * c].copy_from_slice(&tmp[..c]);
+        let e2 = gk15(f, m, b, &mut tmp[..c], evals);
+        segs.push((m, b, e2));
+        vals.extend_from_slice(&tmp[..c]);
+    }
+}
+
+/// Gauss-Legendre nodes and weights on [-1, 1] (Newton iteration on the Legendre polynomial).
+pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut x = vec![0.0; n];
+    let mut w = vec![0.0; n];
+    for i in 0..n.div_ceil(2) {
+        let mut z = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 0.0;
+        for _ in 0..100 {
+            let (mut p0, mut p1) = (1.0, 0.0);
+            for j in 0..n {
+                let p2 = p1;
+                p1 = p0;
+                p0 = ((2 * j + 1) as f64 * z * p1 - j as f64 * p2) / (j + 1) as f64;
+            }
+            dp = n as f64 * (z * p0 - p1) / (z * z - 1.0);
+            let z1 = z;
+            z = z1 - p0 / dp;
+            if (z - z1).abs() < 1e-15 {
+                break;
+            }
+        }
+        x[i] = -z;
+        x[n - 1 - i] = z;
+        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
+        w[n - 1 - i] = w[i];
+    }
+    (x, w)
+}

@@ -1,0 +1,223 @@
+//! The library functions hosts call instead of re-implementing them (issue 13): one progress type,
+//! the suite's metrics, `info` as text, option parsing, typed errors without CLI flags.
+
+use std::sync::Mutex;
+
+use brdftab::bake::{BakeRequest, BakeTarget};
+use brdftab::progress::{Progress, Silent};
+use brdftab::render::{self, EnvChoice, LightChoice, Mode, RenderOptions, Sampling};
+use brdftab::report::suite::{self, MetricOptions};
+use brdftab::store::info;
+use brdftab::table::TabulatedBrdf;
+use brdftab::table::presets::Preset;
+use brdftab::{Channels, Error, ModelSpec};
+
+const LAMBERT: &str = r#"{"model": "lambert", "kd": 0.25}"#;
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("brdftab-api-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn lambert() -> Box<dyn brdftab::Brdf + Send + Sync> {
+    ModelSpec::parse(LAMBERT)
+        .unwrap()
+        .build(&Channels::Rgb)
+        .unwrap()
+}
+
+/// Records every call, so tests can check what a long operation reported.
+#[derive(Default)]
+struct Log(Mutex<Vec<String>>);
+
+impl Progress for Log {
+    fn begin(&self, what: &str, total: u64) {
+        self.0.lock().unwrap().push(format!("begin {what} {total}"));
+    }
+    fn set(&self, done: u64) {
+        self.0.lock().unwrap().push(format!("set {done}"));
+    }
+    fn end(&self) {
+        self.0.lock().unwrap().push("end".into());
+    }
+}
+
+impl Log {
+    fn calls(&self) -> Vec<String> {
+        self.0.lock().unwrap().clone()
+    }
+}
+
+#[test]
+fn render_reports_one_stage_counting_every_pixel() {
+    let brdf = lambert();
+    let opts = RenderOptions {
+        width: 20,
+        height: 10,
+        spp: 1,
+        mode: Mode::Lit,
+        ..RenderOptions::default()
+    };
+    let log = Log::default();
+    render::render(brdf.as_ref(), &opts, &log).unwrap();
+    let calls = log.calls();
+    assert_eq!(
+        calls.first().map(String::as_str),
+        Some("begin rendering 200")
+    );
+    assert_eq!(calls.last().map(String::as_str), Some("end"));
+    assert!(calls.contains(&"set 200".to_owned()), "{calls:?}");
+}
+
+#[test]
+fn bake_reports_its_values_and_the_report_reads_as_text() {
+    let d = tmp("bake");
+    let out = d.join("l.btdb");
+    let log = Log::default();
+    let req = BakeRequest::new(LAMBERT).preset(Preset::Small);
+    let r = req
+        .run_with(&BakeTarget::file(out.to_str().unwrap()), &log)
+        .unwrap();
+    assert_eq!(log.calls()[0], format!("begin baking {}", r.values));
+    let text = r.summary(&req.codec);
+    assert!(
+        text.starts_with("baked ") && text.contains("wrote "),
+        "{text}"
+    );
+    let v = info::file_info(out.to_str().unwrap()).unwrap();
+    let t = info::file_text(&v);
+    assert!(
+        t.contains("table `l`:") && t.contains("brdftab format, 1 tables"),
+        "{t}"
+    );
+    let rows = info::list(out.to_str().unwrap()).unwrap();
+    let l = info::list_text(&rows);
+    assert!(
+        l.lines().count() == 2 && l.lines().nth(1).unwrap().starts_with('l'),
+        "{l}"
+    );
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn a_taken_name_is_a_duplicate_error_naming_no_flag() {
+    let d = tmp("dup");
+    let db = d.join("x.btdb").display().to_string();
+    let req = BakeRequest::new(LAMBERT).preset(Preset::Small);
+    req.run(&BakeTarget::db(&db, "a")).unwrap();
+    let e = req.run(&BakeTarget::db(&db, "a")).unwrap_err();
+    assert!(
+        matches!(&e, Error::Duplicate { name, .. } if name == "a"),
+        "{e}"
+    );
+    assert!(!e.to_string().contains("--"), "{e}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn library_argument_errors_name_settings_not_flags() {
+    let errors = [
+        Preset::parse("huge").unwrap_err(),
+        brdftab::table::Param::parse("polar").unwrap_err(),
+        brdftab::table::Interp::parse("cubic").unwrap_err(),
+        Mode::parse("fast").unwrap_err(),
+        Sampling::parse("random").unwrap_err(),
+        LightChoice::parse("sun").unwrap_err(),
+        EnvChoice::parse("dark").unwrap_err(),
+    ];
+    for e in errors {
+        assert!(matches!(e, Error::InvalidArgument { .. }), "{e}");
+        assert!(!e.to_string().contains("--"), "{e}");
+    }
+    assert_eq!(Mode::parse("lit").unwrap(), Mode::Lit);
+    assert_eq!(Sampling::parse("fixed").unwrap(), Sampling::Fixed);
+    assert_eq!(LightChoice::parse("area").unwrap(), LightChoice::Area);
+    assert!(matches!(
+        EnvChoice::parse("white").unwrap(),
+        EnvChoice::Constant(_)
+    ));
+}
+
+#[test]
+fn suite_metrics_of_an_exact_table_are_zero_and_a_cap_is_honoured() {
+    let src = lambert();
+    let (t, _) = BakeRequest::new(LAMBERT)
+        .preset(Preset::Small)
+        .table(&Silent)
+        .unwrap();
+    let tab = TabulatedBrdf::from_table(t);
+    let thetas = vec![0.2, 0.8];
+    let src_albedo = suite::albedos(src.as_ref(), &thetas);
+    for cap in [None, Some(80f64.to_radians())] {
+        let opts = MetricOptions {
+            pairs: 2000,
+            seed: 3,
+            albedo_thetas: thetas.clone(),
+            cap,
+        };
+        let m = suite::metrics(&tab, src.as_ref(), &src_albedo, &opts).unwrap();
+        assert!(m.rel_rmse < 1e-6 && m.max_rel < 1e-5, "{m:?}");
+        assert!(m.albedo_err < 1e-3, "{m:?}");
+    }
+}
+
+#[test]
+fn the_suite_reports_rows_through_progress() {
+    let cfg = suite::SuiteConfig {
+        sources: vec![suite::SourceDef::model("lambert", LAMBERT).unwrap()],
+        presets: vec![Preset::Small],
+        params: vec![brdftab::table::Param::HalfDiff],
+        codecs: suite::default_codecs().into_iter().take(1).collect(),
+        pairs: 500,
+        albedo_thetas: vec![0.3],
+        render: None,
+        render_measured: false,
+        seed: 1,
+    };
+    let log = Log::default();
+    let report = suite::run(&cfg, &log).unwrap();
+    assert_eq!(report.rows.len(), 1);
+    assert_eq!(log.calls(), ["begin accuracy 1", "set 1", "end"]);
+}
+
+#[test]
+fn fit_reports_its_starts() {
+    let src = lambert();
+    let init = ModelSpec::parse(r#"{"model": "lambert", "kd": 0.1}"#).unwrap();
+    let opts = brdftab::fit::FitOptions {
+        pairs: 500,
+        starts: 2,
+        ..Default::default()
+    };
+    let log = Log::default();
+    brdftab::fit::fit_with_progress(src.as_ref(), &init, &opts, &log).unwrap();
+    assert_eq!(log.calls(), ["begin fitting 2", "set 1", "set 2", "end"]);
+}
+
+#[test]
+fn the_lecture_table_has_a_row_per_model() {
+    let t = brdftab::analysis::plausibility::lecture_table();
+    for (label, _) in brdftab::analysis::plausibility::LECTURE_MODELS {
+        assert!(t.lines().any(|l| l.starts_with(label)), "{label}:\n{t}");
+    }
+}
+
+#[test]
+fn declared_symmetry_is_taken_unverified() {
+    use brdftab::bake::SymmetryChoice;
+    assert_eq!(
+        SymmetryChoice::parse("declared").unwrap(),
+        SymmetryChoice::Declared
+    );
+    let src = lambert();
+    let (t, _) = BakeRequest::new(LAMBERT)
+        .preset(Preset::Small)
+        .symmetry(SymmetryChoice::Declared)
+        .table(&Silent)
+        .unwrap();
+    assert_eq!(
+        t.grid().symmetry(),
+        brdftab::table::Symmetry::from_flags(src.flags())
+    );
+}

@@ -1,0 +1,106 @@
+//! The demo's other parts: the plausibility table of the lecture's models, the preview renders
+//! and the rate–distortion sweep (through the accuracy suite and its plot).
+
+use std::path::{Path, PathBuf};
+
+use brdftab::analysis::plausibility;
+use brdftab::progress::Silent;
+use brdftab::render::{self, EnvChoice, RenderOptions};
+use brdftab::report::{plot, suite};
+use brdftab::table::presets::Preset;
+use brdftab::table::{Param, TabulatedBrdf};
+use brdftab::{Brdf, Error, Result};
+
+use crate::analysis::emit;
+
+/// The spec of the rate–distortion sweep and of the render acceptance figure.
+pub const CT_GOLD: &str = r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#;
+
+/// Prints the plausibility table of the lecture's models ([`plausibility::lecture_table`]).
+pub fn plausibility_table() -> Result<()> {
+    emit(&plausibility::lecture_table())
+}
+
+/// Renders source | table | difference for each preview, small, and writes PNGs.
+pub fn preview_renders(
+    out: &Path,
+    previews: &[(String, &dyn Brdf, TabulatedBrdf)],
+) -> Result<Vec<PathBuf>> {
+    let opts = RenderOptions {
+        width: 96,
+        height: 96,
+        spp: 16,
+        max_depth: 3,
+        // Material-independent directions: the difference shows the materials, not the noise.
+        sampling: render::Sampling::Fixed,
+        env: EnvChoice::Sky,
+        ..Default::default()
+    };
+    emit(&format!(
+        "\nPreview renders ({}×{}, {} spp, path tracer ≤ 3 bounces, sky, fixed sampling; same seed for both):\n",
+        opts.width, opts.height, opts.spp
+    ))?;
+    let mut files = Vec::new();
+    for (name, src, tab) in previews {
+        let a = render::render(*src, &opts, &Silent)?;
+        let b = render::render(tab, &opts, &Silent)?;
+        let cmp = render::compare(&b, &a)?;
+        let (diff, _legend) = render::difference_image(&b, &a)?;
+        let side = render::image::Image::hstack(&[&a, &b, &diff.to_rgb()?], 4, 0.0)?;
+        let path = out.join(format!("render_{name}.png"));
+        render::image::write_png(&side, &path, 0.0)?;
+        emit(&format!(
+            "  {:<24} rendered rel RMSE table vs source {:.3}%\n",
+            name,
+            100.0 * cmp.rel_rmse
+        ))?;
+        files.push(path);
+    }
+    Ok(files)
+}
+
+/// Cook-Torrance gold on the small and medium presets × f32, f16 and log16 ≤ 1e-2, through the
+/// accuracy suite: compressed bytes vs rel RMSE. Writes `rd.csv` (the suite's columns) and the
+/// suite's rate–distortion plot `rd.png`.
+pub fn rate_distortion(out: &Path) -> Result<Vec<PathBuf>> {
+    let name = "cook_torrance_gold";
+    let cfg = suite::SuiteConfig {
+        sources: vec![suite::SourceDef::model(name, CT_GOLD)?],
+        presets: vec![Preset::Small, Preset::Medium],
+        params: vec![Param::HalfDiff],
+        codecs: suite::default_codecs()
+            .into_iter()
+            .filter(|c| ["f32", "f16", "log16@1e-2"].contains(&c.name))
+            .collect(),
+        pairs: 20_000,
+        albedo_thetas: Vec::new(),
+        render: None,
+        render_measured: false,
+        seed: 2,
+    };
+    let report = suite::run(&cfg, &Silent)?;
+    emit("\nRate–distortion, Cook-Torrance m = 0.3 gold (bytes vs cosine-weighted rel RMSE):\n")?;
+    for r in &report.rows {
+        if r.status != "ok" {
+            // f16 cannot hold the sharpest peaks of some grids: that point is skipped, say so.
+            eprintln!(
+                "note: rate–distortion {} {} skipped: {}",
+                r.preset, r.codec, r.status
+            );
+            continue;
+        }
+        emit(&format!(
+            "  {:<7} {:<11} {:>10} bytes  {:.3}%\n",
+            r.preset,
+            r.codec,
+            r.bytes,
+            100.0 * r.rel_rmse
+        ))?;
+    }
+    let csv_path = out.join("rd.csv");
+    std::fs::write(&csv_path, report.csv()).map_err(|e| Error::io(&csv_path, e))?;
+    let png_path = out.join("rd.png");
+    let rows: Vec<&suite::Row> = report.rows.iter().collect();
+    plot::rate_distortion(name, &rows, &png_path)?;
+    Ok(vec![csv_path, png_path])
+}
