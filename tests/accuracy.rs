@@ -252,7 +252,7 @@ fn quick_suite_has_the_lecture_phong_variants_with_finite_rows() {
         render: None,
         ..SuiteConfig::quick(None).unwrap()
     };
-    let report = suite::run(&cfg, None).unwrap();
+    let report = suite::run(&cfg, &brdftab::progress::Silent).unwrap();
     assert_eq!(report.rows.len(), lecture.len() * cfg.codecs.len());
     for r in &report.rows {
         let m = [
