@@ -26,6 +26,7 @@ use std::time::Instant;
 use crate::brdf::Brdf;
 use crate::codec::{Codec, Quant};
 use crate::error::{Error, Result};
+use crate::measured::rgl_write;
 use crate::progress::{Progress, Silent, Stage};
 use crate::source::{self, OpenOptions, SourceKind};
 use crate::spectrum::Channels;
@@ -639,6 +640,57 @@ pub fn stem(path: &str) -> String {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "table".into())
+}
+
+/// What [`to_rgl`] did: the file written, the source's description, the seconds it took and,
+/// when asked for, the error of the file read back against the source.
+#[derive(Debug, Clone)]
+pub struct Converted {
+    /// The file written.
+    pub written: rgl_write::Written,
+    /// The source's description.
+    pub source: String,
+    /// Wall-clock seconds of the encoding and writing.
+    pub seconds: f64,
+    /// The written file (through brdftab's reader) against the source, within 80°.
+    pub error: Option<rgl_write::Report>,
+}
+
+/// Opens SOURCE (with `channels`, `None` = its own), writes it to `output` as an RGL file (a
+/// `.bsdf` source keeps its own layout unless `opts` change it, see
+/// [`rgl_write::Options::reuse_source_file`]) and, with `pairs > 0`, reports the written file's error.
+pub fn to_rgl(
+    source: &str,
+    channels: Option<Channels>,
+    output: &str,
+    opts: &rgl_write::Options,
+    pairs: usize,
+    progress: &dyn Progress,
+) -> Result<Converted> {
+    let open = OpenOptions {
+        channels,
+        ..Default::default()
+    };
+    let brdf = source::open_with(source, &open)?;
+    let opts = opts.clone().reuse_source_file(source)?;
+    let t = std::time::Instant::now();
+    let written = rgl_write::write(&*brdf, output, &opts, progress)?;
+    let seconds = t.elapsed().as_secs_f64();
+    let error = match pairs {
+        0 => None,
+        n => Some(rgl_write::report(
+            &crate::measured::RglBrdf::open(output)?,
+            &*brdf,
+            n,
+            1,
+        )?),
+    };
+    Ok(Converted {
+        written,
+        source: brdf.describe(),
+        seconds,
+        error,
+    })
 }
 
 #[cfg(test)]

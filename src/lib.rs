@@ -46,6 +46,7 @@ pub mod spec;
 pub mod spectrum;
 pub mod store;
 pub mod table;
+pub mod text;
 
 pub use bake::{BakeReport, BakeRequest, BakeTarget};
 pub use brdf::{Brdf, BrdfSample, Flags};

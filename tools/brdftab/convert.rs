@@ -2,7 +2,7 @@
 
 use brdftab::Result;
 use brdftab::bake::BakeTarget;
-use brdftab::measured::{RglBrdf, rgl_write};
+use brdftab::measured::rgl_write;
 use brdftab::table::Interp;
 use clap::Args;
 
@@ -70,35 +70,30 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
 
 /// Writes the input as an RGL tensor file and reports the error of the file read back.
 fn to_rgl(a: ConvertArgs) -> Result<()> {
-    let brdf = source::open(&a.input, &source::channels(a.flags.wavelengths.as_deref())?)?;
     let opts = rgl_write::Options {
         resolution: a.rgl.resolution,
         theta_i: a.rgl.theta_i,
         phi_i: a.rgl.phi_i,
         ndf_resolution: a.rgl.ndf_resolution,
         ..Default::default()
-    }
-    .reuse_source_file(&a.input)?;
-    let t = std::time::Instant::now();
-    let w = rgl_write::write(&*brdf, &a.output, &opts, &crate::progress::Bar::values())?;
-    let f = &w.fields;
+    };
+    let ch = source::channels(a.flags.wavelengths.as_deref())?;
+    let r = brdftab::bake::to_rgl(&a.input, ch, &a.output, &opts, a.pairs, &Bar::values())?;
+    let f = &r.written.fields;
     println!(
-        "{}: {} as an RGL tensor file ({} φi × {} θi, {}×{} table, {} bytes, {:.2} s)",
+        "{}: {} as an RGL tensor file ({} φi × {} θi, {n}×{n} table, {} bytes, {:.2} s)",
         a.output,
-        brdf.describe(),
+        r.source,
         f.phi_i.len(),
         f.theta_i.len(),
-        f.n,
-        f.n,
-        w.bytes,
-        t.elapsed().as_secs_f64()
+        r.written.bytes,
+        r.seconds,
+        n = f.n
     );
-    if a.pairs > 0 {
-        let back = RglBrdf::open(&a.output)?;
-        let r = rgl_write::report(&back, &*brdf, a.pairs, 1)?;
+    if let Some(e) = r.error {
         println!(
             "  error vs source (read back, {} pairs within 80°): relative RMSE of f_r weighted by cos θi cos θo {:.3e}, max relative {:.3e}",
-            r.pairs, r.rel_rmse, r.max_rel
+            e.pairs, e.rel_rmse, e.max_rel
         );
     }
     Ok(())

@@ -1,11 +1,10 @@
 //! `eval` and `models`.
 
-use std::io::{BufRead, Write};
+use std::io::Write;
 
 use brdftab::spec::MODELS;
 use brdftab::{Error, Result};
 use clap::Args;
-use glam::DVec3;
 
 use crate::source;
 
@@ -37,53 +36,13 @@ pub fn eval(a: EvalArgs) -> Result<()> {
     let brdf = source::open_with(&a.source, &channels, interp)?;
     let c = brdf.channels().len();
     let mut f = vec![0.0f32; c];
-    let stdin = std::io::stdin().lock();
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-    for (i, line) in stdin.lines().enumerate() {
-        let line = line.map_err(|e| Error::io("stdin", e))?;
-        let Some(v) = parse_numbers::<6>(&line, i + 1)? else {
-            continue;
-        };
-        brdf.eval(
-            DVec3::new(v[0], v[1], v[2]),
-            DVec3::new(v[3], v[4], v[5]),
-            &mut f,
-        );
+    brdftab::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
+        brdf.eval(wi, wo, &mut f);
         let s: Vec<String> = f.iter().map(|x| format!("{x:e}")).collect();
-        writeln!(out, "{}", s.join(" ")).map_err(|e| Error::io("stdout", e))?;
-    }
+        writeln!(out, "{}", s.join(" ")).map_err(|e| Error::io("stdout", e))
+    })?;
     out.flush().map_err(|e| Error::io("stdout", e))
-}
-
-/// Parses a line of exactly `N` numbers; `None` for blank and `#` lines.
-pub fn parse_numbers<const N: usize>(line: &str, lineno: usize) -> Result<Option<[f64; N]>> {
-    let t = line.trim();
-    if t.is_empty() || t.starts_with('#') {
-        return Ok(None);
-    }
-    let mut v = [0.0; N];
-    let mut k = 0;
-    for tok in t.split_whitespace() {
-        if k == N {
-            return Err(parse_err(lineno, format!("expected {N} numbers, got more")));
-        }
-        v[k] = tok
-            .parse()
-            .map_err(|_| parse_err(lineno, format!("`{tok}` is not a number")))?;
-        k += 1;
-    }
-    if k < N {
-        return Err(parse_err(lineno, format!("expected {N} numbers, got {k}")));
-    }
-    Ok(Some(v))
-}
-
-fn parse_err(line: usize, msg: String) -> Error {
-    Error::Parse {
-        source_name: "stdin".into(),
-        line,
-        msg,
-    }
 }
 
 /// Lists every model.

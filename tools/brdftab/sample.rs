@@ -7,14 +7,13 @@
 //! Draws for which the sampler returns no direction (e.g. `wo` below the horizon) print nothing, so
 //! fewer than `--count` lines may appear.
 
-use std::io::{BufRead, Write};
+use std::io::Write;
 
 use brdftab::rng::Pcg32;
 use brdftab::{Error, Result};
 use clap::Args;
 use glam::DVec3;
 
-use crate::models::parse_numbers;
 use crate::source;
 
 /// Arguments of `brdftab sample`.
@@ -92,15 +91,9 @@ pub fn sample(a: SampleArgs) -> Result<()> {
 pub fn pdf(a: PdfArgs) -> Result<()> {
     let channels = source::channels(a.wavelengths.as_deref())?;
     let brdf = source::open(&a.source, &channels)?;
-    let stdin = std::io::stdin().lock();
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-    for (i, line) in stdin.lines().enumerate() {
-        let line = line.map_err(|e| Error::io("stdin", e))?;
-        let Some(v) = parse_numbers::<6>(&line, i + 1)? else {
-            continue;
-        };
-        let p = brdf.pdf(DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]));
-        writeln!(out, "{p}").map_err(out_err)?;
-    }
+    brdftab::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
+        writeln!(out, "{}", brdf.pdf(wi, wo)).map_err(out_err)
+    })?;
     out.flush().map_err(out_err)
 }

@@ -199,6 +199,15 @@ impl Parameterization {
 
 pub use crate::progress::Progress;
 
+/// The stored values and their validity bits.
+#[derive(Debug, Clone)]
+pub struct Values {
+    /// φi × θi × channels × N × N.
+    pub data: Vec<f32>,
+    /// One bit per (φi, θi, j, i), packed.
+    pub valid: Vec<u8>,
+}
+
 /// Checked layout of a file to write.
 #[derive(Debug, Clone)]
 pub struct Layout {

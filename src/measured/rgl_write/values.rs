@@ -21,21 +21,12 @@ use rayon::prelude::*;
 use super::container::pack_bits;
 use super::ndf::{MAX_EVAL_THETA, Ndf};
 use super::warps::{Vndf, incident};
-use super::{Layout, Progress};
+use super::{Layout, Progress, Values};
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
 use crate::geometry;
 use crate::measured::rgl::{Corners, elevation, phi2u, theta2u};
 use crate::spectrum::MAX_CHANNELS;
-
-/// The stored values and their validity bits.
-#[derive(Debug, Clone)]
-pub struct Values {
-    /// φi × θi × channels × N × N.
-    pub data: Vec<f32>,
-    /// One bit per (φi, θi, j, i), packed.
-    pub valid: Vec<u8>,
-}
 
 /// Fills the grid points whose ωo is below the horizon (never evaluated by readers, but
 /// corners of cells they interpolate in) outwards from the valid ones: each pass gives the

@@ -15,9 +15,8 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use super::Layout;
 use super::ndf::{Ndf, luminance_weights};
-use super::values::Values;
+use super::{Layout, Values};
 use crate::error::{Error, Result};
 use crate::geometry;
 use crate::measured::rgl::{Planes, Warp};
