@@ -12,16 +12,23 @@ use glam::{DVec2, DVec3};
 
 const CRATE: &str = env!("CARGO_MANIFEST_DIR");
 
-/// target/release (or debug): where cargo put libbrdftab_c.{so,a} for this test run.
+/// Where cargo put libbrdftab_c.{so,a} for this test run: `cargo test` leaves the cdylib and
+/// staticlib of the package under test in target/<profile>/deps (only `cargo build` copies them
+/// up to target/<profile>), so deps is searched first, then its parent.
 fn lib_dir() -> PathBuf {
     let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().unwrap().parent().unwrap().to_path_buf();
-    assert!(
-        dir.join("libbrdftab_c.so").exists() && dir.join("libbrdftab_c.a").exists(),
-        "libbrdftab_c.so/.a not found in {} (cargo builds them with this test)",
-        dir.display()
-    );
-    dir
+    let deps = exe.parent().unwrap().to_path_buf();
+    let profile = deps.parent().unwrap().to_path_buf();
+    let has = |d: &Path| d.join("libbrdftab_c.so").exists() && d.join("libbrdftab_c.a").exists();
+    [deps, profile.clone()]
+        .into_iter()
+        .find(|d| has(d))
+        .unwrap_or_else(|| {
+            panic!(
+                "libbrdftab_c.so/.a not found in {0}/deps or {0} (cargo builds them with this test)",
+                profile.display()
+            )
+        })
 }
 
 fn tmp() -> PathBuf {
