@@ -31,6 +31,7 @@ use crate::progress::{Progress, Silent, Stage};
 use crate::source::{self, OpenOptions, SourceKind};
 use crate::spectrum::Channels;
 use crate::store::{TableHeader, Writer, db, tables};
+use crate::table::adaptive;
 use crate::table::presets::Preset;
 use crate::table::{
     BakeOptions, Grid, Interp, Mapping, Param, Symmetry, Table, TabulatedBrdf, bake_chunks,
@@ -50,25 +51,43 @@ pub enum GridChoice {
     Sizes([usize; 4]),
     /// The MERL grid (90 θh × 90 θd × 180 φd cell centres). A MERL source keeps its cells.
     Merl,
+    /// An adaptive `halfdiff` grid ([`crate::table::adaptive`]): θh, θd and φd warped by the
+    /// source's own variation, with these node counts (θh, θd, stored φd) or
+    /// [`adaptive::DEFAULT_NODES`]. The default for RGL measurements.
+    Adaptive(Option<[usize; 3]>),
 }
 
 impl GridChoice {
-    /// Parses `small`/`medium`/`large`, `merl`, or sizes `θ1xφ1xθ2xφ2`.
+    /// Parses `small`/`medium`/`large`, `merl`, sizes `θ1xφ1xθ2xφ2`, `adaptive` or
+    /// `adaptive:NHxNDxNP` (θh, θd and stored φd nodes).
     pub fn parse(s: &str) -> Result<GridChoice> {
         let t = s.trim().to_ascii_lowercase();
+        if let Some(rest) = t.strip_prefix("adaptive") {
+            let Some(n) = rest.strip_prefix(':') else {
+                return if rest.is_empty() {
+                    Ok(GridChoice::Adaptive(None))
+                } else {
+                    Err(Error::arg(
+                        "grid",
+                        format!("`{s}`: expected adaptive[:NHxNDxNP]"),
+                    ))
+                };
+            };
+            let v = sizes(n)?;
+            let n: [usize; 3] = v.try_into().map_err(|_| {
+                Error::arg(
+                    "grid",
+                    format!("`{s}`: expected adaptive:NHxNDxNP (three sizes)"),
+                )
+            })?;
+            return Ok(GridChoice::Adaptive(Some(n)));
+        }
         match t.as_str() {
             "merl" => Ok(GridChoice::Merl),
             "default" => Ok(GridChoice::Default),
             "small" | "medium" | "large" => Ok(GridChoice::Preset(Preset::parse(&t)?)),
             _ => {
-                let v: Vec<usize> = t
-                    .split(['x', '×'])
-                    .map(|x| {
-                        x.trim()
-                            .parse::<usize>()
-                            .map_err(|_| Error::arg("grid", format!("`{x}` is not a size")))
-                    })
-                    .collect::<Result<_>>()?;
+                let v = sizes(&t)?;
                 let sizes: [usize; 4] = v.try_into().map_err(|_| {
                     Error::arg(
                         "grid",
@@ -79,6 +98,35 @@ impl GridChoice {
             }
         }
     }
+}
+
+/// `AxBxC…` as sizes.
+fn sizes(t: &str) -> Result<Vec<usize>> {
+    t.split(['x', '×'])
+        .map(|x| {
+            x.trim()
+                .parse::<usize>()
+                .map_err(|_| Error::arg("grid", format!("`{x}` is not a size")))
+        })
+        .collect()
+}
+
+/// How far a measured source may break bilateral symmetry (largest relative difference over
+/// [`symmetry::CHECK_PAIRS`] mirrored pairs) for an adaptive grid to assume it anyway: measured
+/// isotropic materials meet it up to noise (RGL files: ≤ 1%), and the table's error reports
+/// what assuming it costs.
+pub const MEASURED_BILATERAL_TOLERANCE: f64 = 0.02;
+
+/// What a bake will do with a source: the grid, why the symmetry differs from what the source
+/// declares, and whether the symmetry is assumed rather than verified.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The grid to bake on.
+    pub grid: Grid,
+    /// A note on the symmetry (detection vs declaration, or an assumption).
+    pub note: Option<String>,
+    /// The bake does not verify the symmetry (forced, declared or assumed).
+    pub force: bool,
 }
 
 /// The symmetry a bake reduces by.
@@ -291,9 +339,68 @@ impl BakeRequest {
         }
     }
 
+    /// True when this request bakes `src` on an adaptive grid: asked for, or the default grid
+    /// of an RGL measurement.
+    fn adaptive(&self) -> bool {
+        match self.grid {
+            GridChoice::Adaptive(_) => true,
+            GridChoice::Default => {
+                source::classify(&self.source) == SourceKind::Rgl
+                    && self.param.is_none_or(|p| p == Param::HalfDiff)
+                    && self.supersample == 1
+            }
+            _ => false,
+        }
+    }
+
+    /// The grid, symmetry note and verification this request uses for `src`.
+    pub fn plan(&self, src: &dyn Brdf) -> Result<Plan> {
+        let (mut sym, mut note) = self.resolve_symmetry(src);
+        let mut force = self.force || self.symmetry == SymmetryChoice::Declared;
+        if self.adaptive()
+            && sym.isotropic
+            && !sym.bilateral
+            && self.symmetry == SymmetryChoice::Auto
+        {
+            let (v, _) = symmetry::violation(src, 2, symmetry::CHECK_PAIRS, 0x5EED);
+            if v <= MEASURED_BILATERAL_TOLERANCE {
+                sym.bilateral = true;
+                force = true;
+                note = Some(format!(
+                    "bilateral symmetry assumed (largest relative violation {:.2}%, within {}%); \
+                     using {sym}",
+                    v * 100.0,
+                    MEASURED_BILATERAL_TOLERANCE * 100.0
+                ));
+            }
+        }
+        let grid = match self.grid {
+            GridChoice::Default if self.adaptive() && !(sym.isotropic && sym.bilateral) => {
+                // Not a source an adaptive grid serves: the preset, as for any other.
+                Preset::Medium.grid(self.param, sym, src.channels().clone())?
+            }
+            _ => self.resolve_grid(src, sym)?,
+        };
+        Ok(Plan { grid, note, force })
+    }
+
     /// The grid this request bakes `src` on.
     pub fn resolve_grid(&self, src: &dyn Brdf, sym: Symmetry) -> Result<Grid> {
         let ch = src.channels().clone();
+        if self.adaptive() {
+            let nodes = match self.grid {
+                GridChoice::Adaptive(Some(n)) => n,
+                _ => adaptive::DEFAULT_NODES,
+            };
+            if self.param.is_some_and(|p| p != Param::HalfDiff) {
+                return Err(Error::arg("grid", "an adaptive grid is halfdiff"));
+            }
+            let opts = adaptive::AdaptiveOptions {
+                nodes,
+                ..Default::default()
+            };
+            return adaptive::adaptive_grid(src, sym, &opts);
+        }
         match self.grid {
             GridChoice::Merl => Grid::merl(ch).with_symmetry(sym),
             GridChoice::Sizes(s) => {
@@ -305,7 +412,9 @@ impl BakeRequest {
                 Grid::with_sizes(p, s, m, ch, sym)
             }
             GridChoice::Preset(p) => p.grid(self.param, sym, ch),
-            GridChoice::Default => Preset::Medium.grid(self.param, sym, ch),
+            GridChoice::Default | GridChoice::Adaptive(_) => {
+                Preset::Medium.grid(self.param, sym, ch)
+            }
         }
     }
 
@@ -331,21 +440,24 @@ impl BakeRequest {
             let report = self.report_for(src, table.grid(), None, t0, true);
             return Ok((table, report));
         }
-        let (sym, note) = self.resolve_symmetry(src);
-        let grid = self.resolve_grid(src, sym)?;
+        let Plan { grid, note, force } = self.plan(src)?;
         let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
         let set = |done: u64, _total: u64| progress.set(done);
-        let opts = self.bake_options(&set);
+        let opts = self.bake_options(&set, force);
         let (table, r) = crate::table::bake(src, &grid, &opts)?;
         let mut report = self.report_for(src, &grid, note, t0, false);
         report.forced = r.forced;
         Ok((table, report))
     }
 
-    fn bake_options<'a>(&self, set: crate::table::bake::Progress<'a>) -> BakeOptions<'a> {
+    fn bake_options<'a>(
+        &self,
+        set: crate::table::bake::Progress<'a>,
+        force: bool,
+    ) -> BakeOptions<'a> {
         BakeOptions {
             supersample: self.supersample,
-            force: self.force || self.symmetry == SymmetryChoice::Declared,
+            force,
             tolerance: self.symmetry_tolerance,
             progress: Some(set),
             ..BakeOptions::default()
@@ -455,12 +567,11 @@ impl BakeRequest {
         progress: &dyn Progress,
     ) -> Result<BakeReport> {
         let t0 = Instant::now();
-        let (sym, note) = self.resolve_symmetry(src);
-        let grid = self.resolve_grid(src, sym)?;
+        let Plan { grid, note, force } = self.plan(src)?;
         let header = TableHeader::for_grid(name.to_owned(), provenance, &grid, self.codec);
         let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
         let set = |done: u64, _total: u64| progress.set(done);
-        let opts = self.bake_options(&set);
+        let opts = self.bake_options(&set, force);
         let mut baked = None;
         let mut write = |w: &mut Writer| -> Result<()> {
             baked = Some(bake_chunks(src, &grid, &opts, |i, v| {

@@ -41,6 +41,7 @@ pub mod quadrature;
 pub mod render;
 pub mod report;
 pub mod rng;
+pub mod simd;
 pub mod source;
 pub mod spec;
 pub mod spectrum;

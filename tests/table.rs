@@ -233,7 +233,7 @@ proptest! {
             static T: std::cell::RefCell<Option<Vec<TabulatedBrdf>>> = const { std::cell::RefCell::new(None) };
         }
         let full_g = grid(param, sizes, Symmetry::NONE);
-        let ax = *full_g.stored_axes();
+        let ax = full_g.stored_axes().clone();
         let coords = [ax[0].node(a), ax[1].node(p), ax[2].node(b), ax[3].node(q)];
         let coords_r = [ax[0].node(ar), ax[1].node(pr), ax[2].node(br), ax[3].node(qr)];
         T.with(|t| {
@@ -331,9 +331,9 @@ fn linear_interpolation_reproduces_multilinear_functions() {
         Grid::new(
             param,
             [
-                Axis::theta(sizes[0], m[0], Nodes::Edges),
+                Axis::theta(sizes[0], m[0].clone(), Nodes::Edges),
                 Axis::phi(sizes[1]),
-                Axis::theta(sizes[2], m[1], Nodes::Edges),
+                Axis::theta(sizes[2], m[1].clone(), Nodes::Edges),
                 Axis::phi(sizes[3]),
             ],
             Channels::Rgb,
@@ -378,7 +378,7 @@ fn linear_interpolation_reproduces_multilinear_functions() {
     for g in grids {
         let src = Multilinear(g.clone());
         let tb = tab(&src, &g, Interp::Linear);
-        let ax = *g.stored_axes();
+        let ax = g.stored_axes().clone();
         let mut rng = Pcg32::new(1);
         let mut n = 0;
         while n < 20_000 {

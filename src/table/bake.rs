@@ -117,7 +117,7 @@ pub fn bake_chunks(
     let c = layout.channels;
     let s3 = layout.shape[3];
     let row_len = s3 * c;
-    let axes = *grid.stored_axes();
+    let axes = grid.stored_axes().clone();
     // A source that stores this grid's first node stores them all (it is on the same grid):
     // its nodes are copied, not evaluated. Asked once, so other sources pay nothing.
     let native = grid.param() == Param::HalfDiff

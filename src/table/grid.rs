@@ -70,9 +70,10 @@ use crate::error::{Error, Result};
 use crate::spectrum::Channels;
 pub use crate::table::param::Param;
 use crate::table::symmetry::Symmetry;
+pub use crate::table::warp::{Warp, WarpVar};
 
 /// How an axis's coordinate x ∈ [lo, hi] maps to u ∈ [0, 1] before node placement.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
 #[serde(rename_all = "snake_case")]
 pub enum Mapping {
     /// u = (x − lo)/(hi − lo).
@@ -83,6 +84,9 @@ pub enum Mapping {
     /// Uniform in cos θ: u = (cos lo − cos x)/(cos lo − cos hi) (θ axes; dense near the horizon
     /// in θ, uniform in projected solid angle for the polar part).
     Cos,
+    /// A data-adaptive warp ([`Warp`]): θ axes, and φd of an isotropic `halfdiff` table folded
+    /// by bilateral symmetry; with [`Nodes::Edges`].
+    Warp(Warp),
 }
 
 /// Where the nodes of an axis sit (see the module docs).
@@ -100,7 +104,7 @@ pub enum Nodes {
 
 /// One full (unreduced) angular axis: its size, mapping and node placement. The domain follows
 /// from the axis's role: θ axes [0, π/2], φ axes periodic [0, 2π).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Hash)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Hash)]
 pub struct Axis {
     /// Number of nodes (≥ 1).
     pub size: usize,
@@ -143,7 +147,7 @@ impl Axis {
 
 /// A stored axis: domain, size, mapping, node placement and periodicity — everything lookups
 /// need. Derived from a [`Grid`] by [`Grid::stored_axes`].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StoredAxis {
     /// Number of stored nodes.
     pub size: usize,
@@ -171,7 +175,7 @@ impl StoredAxis {
             size: a.size,
             lo: 0.0,
             hi: FRAC_PI_2,
-            mapping: a.mapping,
+            mapping: a.mapping.clone(),
             nodes: a.nodes,
             periodic: false,
             inv_range: 1.0 / FRAC_PI_2,
@@ -192,12 +196,12 @@ impl StoredAxis {
         }
     }
 
-    fn folded(size: usize, hi: f64) -> Self {
+    fn folded(size: usize, hi: f64, mapping: Mapping) -> Self {
         StoredAxis {
             size,
             lo: 0.0,
             hi,
-            mapping: Mapping::Uniform,
+            mapping,
             nodes: Nodes::Edges,
             periodic: false,
             inv_range: 1.0 / hi,
@@ -258,7 +262,7 @@ impl StoredAxis {
             // Node i at i/n of the period on every periodic axis.
             return r * n;
         }
-        match (self.mapping, self.nodes) {
+        match (&self.mapping, self.nodes) {
             // MERL arithmetic order: sqrt(((θ/(π/2))·n)·n).
             (Mapping::Sqrt, Nodes::CellStart) => (r * n * n).max(0.0).sqrt(),
             (Mapping::Uniform, Nodes::CellStart) => r * n,
@@ -277,6 +281,7 @@ impl StoredAxis {
                             crate::fastmath::sin_cos_2pi(x * (0.5 * std::f64::consts::FRAC_1_PI)).1;
                         (1.0 - c) * self.inv_cos_range
                     }
+                    Mapping::Warp(w) => w.u_of_angle(x, self.hi),
                 };
                 match nodes {
                     Nodes::Centers => u * n - 0.5,
@@ -305,9 +310,10 @@ impl StoredAxis {
             Nodes::Centers | Nodes::CellStart => (s + 0.5) / n,
             Nodes::Edges => s / (n - 1.0),
         };
-        let r = match self.mapping {
+        let r = match &self.mapping {
             Mapping::Uniform => u,
             Mapping::Sqrt => u * u,
+            Mapping::Warp(w) => return w.angle_of_u(u, self.hi),
             Mapping::Cos => {
                 let (cl, ch) = (self.lo.cos(), self.hi.cos());
                 let c = (cl - u * (cl - ch)).clamp(-1.0, 1.0);
@@ -435,10 +441,10 @@ impl From<Grid> for GridRepr {
     fn from(g: Grid) -> GridRepr {
         GridRepr {
             param: g.param,
-            theta1: g.axes[0],
-            phi1: g.axes[1],
-            theta2: g.axes[2],
-            phi2: g.axes[3],
+            theta1: g.axes[0].clone(),
+            phi1: g.axes[1].clone(),
+            theta2: g.axes[2].clone(),
+            phi2: g.axes[3].clone(),
             channels: g.channels,
             symmetry: g.symmetry,
         }
@@ -464,7 +470,20 @@ impl Grid {
             if a.size == 0 {
                 return Err(Error::arg("grid", format!("axis {} has size 0", name[k])));
             }
-            if k % 2 == 1 && (a.mapping != Mapping::Uniform || a.nodes == Nodes::Centers) {
+            let warp_ok =
+                k == 3 && param == Param::HalfDiff && symmetry.isotropic && symmetry.bilateral;
+            if let Mapping::Warp(_) = a.mapping {
+                if a.nodes != Nodes::Edges || (k % 2 == 1 && !warp_ok) {
+                    return Err(Error::arg(
+                        "grid",
+                        format!(
+                            "a warped axis needs edges nodes and is a θ axis or the φd of an \
+                             isotropic halfdiff table with bilateral symmetry ({})",
+                            name[k]
+                        ),
+                    ));
+                }
+            } else if k % 2 == 1 && (a.mapping != Mapping::Uniform || a.nodes == Nodes::Centers) {
                 return Err(Error::arg(
                     "grid",
                     format!(
@@ -474,7 +493,7 @@ impl Grid {
                 ));
             }
         }
-        let [t1, p1, t2, p2] = axes;
+        let [t1, p1, t2, p2] = &axes;
         if p1.size == 1 && !symmetry.isotropic && p2.size > 1 {
             return Err(Error::arg(
                 "grid",
@@ -500,13 +519,13 @@ impl Grid {
                     StoredAxis::single()
                 } else if s.bilateral {
                     even(p1.size, name[1], 2)?;
-                    StoredAxis::folded(p1.size / 2 + 1, PI)
+                    StoredAxis::folded(p1.size / 2 + 1, PI, Mapping::Uniform)
                 } else {
                     StoredAxis::periodic(p1.size, TAU, p1.nodes)
                 };
                 let sp2 = if iso && s.bilateral {
                     even(p2.size, name[3], 2)?;
-                    StoredAxis::folded(p2.size / 2 + 1, PI)
+                    StoredAxis::folded(p2.size / 2 + 1, PI, Mapping::Uniform)
                 } else {
                     StoredAxis::periodic(p2.size, TAU, p2.nodes)
                 };
@@ -524,21 +543,21 @@ impl Grid {
                         ));
                     }
                 }
-                [StoredAxis::theta(&t1), sp1, StoredAxis::theta(&t2), sp2]
+                [StoredAxis::theta(t1), sp1, StoredAxis::theta(t2), sp2]
             }
             Param::HalfDiff => {
                 let sp1 = if iso {
                     StoredAxis::single()
                 } else if s.bilateral {
                     even(p1.size, name[1], 2)?;
-                    StoredAxis::folded(p1.size / 2 + 1, PI)
+                    StoredAxis::folded(p1.size / 2 + 1, PI, Mapping::Uniform)
                 } else {
                     StoredAxis::periodic(p1.size, TAU, p1.nodes)
                 };
                 let sp2 = match (s.reciprocal, s.bilateral && iso) {
                     (true, true) => {
                         even(p2.size, name[3], 4)?;
-                        StoredAxis::folded(p2.size / 4 + 1, FRAC_PI_2)
+                        StoredAxis::folded(p2.size / 4 + 1, FRAC_PI_2, p2.mapping.clone())
                     }
                     (true, false) => {
                         even(p2.size, name[3], 2)?;
@@ -546,11 +565,11 @@ impl Grid {
                     }
                     (false, true) => {
                         even(p2.size, name[3], 2)?;
-                        StoredAxis::folded(p2.size / 2 + 1, PI)
+                        StoredAxis::folded(p2.size / 2 + 1, PI, p2.mapping.clone())
                     }
                     (false, false) => StoredAxis::periodic(p2.size, TAU, p2.nodes),
                 };
-                [StoredAxis::theta(&t1), sp1, StoredAxis::theta(&t2), sp2]
+                [StoredAxis::theta(t1), sp1, StoredAxis::theta(t2), sp2]
             }
         };
         let packed = param == Param::InOut && s.reciprocal;
@@ -587,12 +606,13 @@ impl Grid {
         channels: Channels,
         symmetry: Symmetry,
     ) -> Result<Grid> {
+        let [m1, m2] = mappings;
         Grid::new(
             param,
             [
-                Axis::theta(sizes[0], mappings[0], Nodes::Centers),
+                Axis::theta(sizes[0], m1, Nodes::Centers),
                 Axis::phi(sizes[1]),
-                Axis::theta(sizes[2], mappings[1], Nodes::Centers),
+                Axis::theta(sizes[2], m2, Nodes::Centers),
                 Axis::phi(sizes[3]),
             ],
             channels,
@@ -664,12 +684,17 @@ impl Grid {
 
     /// The same grid with another symmetry reduction.
     pub fn with_symmetry(&self, symmetry: Symmetry) -> Result<Grid> {
-        Grid::new(self.param, self.axes, self.channels.clone(), symmetry)
+        Grid::new(
+            self.param,
+            self.axes.clone(),
+            self.channels.clone(),
+            symmetry,
+        )
     }
 
     /// The same grid with other channels.
     pub fn with_channels(&self, channels: Channels) -> Result<Grid> {
-        Grid::new(self.param, self.axes, channels, self.symmetry)
+        Grid::new(self.param, self.axes.clone(), channels, self.symmetry)
     }
 
     /// The angles of stored node `idx` (in the stored domains; for isotropic `inout`, axis 3 is
@@ -826,7 +851,7 @@ mod tests {
             Grid::with_sizes(
                 Param::InOut,
                 [90, 360, 90, 360],
-                [Mapping::Uniform; 2],
+                [Mapping::Uniform, Mapping::Uniform],
                 ch.clone(),
                 s,
             )
@@ -848,7 +873,7 @@ mod tests {
     #[test]
     fn merl_indices_match_the_reader_formulas() {
         let g = Grid::merl(Channels::Rgb);
-        let [th, _, td, pd] = *g.stored_axes();
+        let [th, _, td, pd] = g.stored_axes().clone();
         let mut rng = crate::rng::Pcg32::new(5);
         for _ in 0..100_000 {
             let a = rng.next_f64() * FRAC_PI_2;
@@ -867,7 +892,7 @@ mod tests {
     fn continuous_and_coord_are_inverse() {
         for nodes in [Nodes::Centers, Nodes::Edges, Nodes::CellStart] {
             for m in [Mapping::Uniform, Mapping::Sqrt, Mapping::Cos] {
-                let ax = StoredAxis::theta(&Axis::theta(17, m, nodes));
+                let ax = StoredAxis::theta(&Axis::theta(17, m.clone(), nodes));
                 for i in 0..17 {
                     let x = ax.node(i);
                     assert!(
@@ -885,7 +910,7 @@ mod tests {
         let g = Grid::with_sizes(
             Param::InOut,
             [5, 4, 5, 4],
-            [Mapping::Uniform; 2],
+            [Mapping::Uniform, Mapping::Uniform],
             Channels::Rgb,
             sym(false, true, true),
         )
@@ -933,7 +958,7 @@ mod tests {
         let bad = Grid::with_sizes(
             Param::InOut,
             [8, 1, 8, 8],
-            [Mapping::Uniform; 2],
+            [Mapping::Uniform, Mapping::Uniform],
             Channels::Rgb,
             sym(false, false, false),
         );

@@ -62,7 +62,7 @@ impl Lookup {
         Lookup {
             param: grid.param(),
             sym: grid.symmetry(),
-            axes: *grid.stored_axes(),
+            axes: grid.stored_axes().clone(),
             shape: l.shape,
             packed: l.packed,
             channels: l.channels,

@@ -17,8 +17,10 @@
 //! Values are stored λ innermost: the values of one node for every channel are contiguous, so
 //! one set of angular interpolation weights serves all channels.
 
+pub mod adaptive;
 pub mod bake;
 pub mod grid;
+pub mod kernel;
 pub mod lookup;
 pub mod param;
 pub mod presets;
@@ -26,6 +28,7 @@ pub mod raw;
 pub mod sampling;
 pub mod symmetry;
 pub mod tabulated;
+pub mod warp;
 
 pub use bake::{BakeOptions, BakeReport, bake, bake_chunks};
 pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, StoredAxis};

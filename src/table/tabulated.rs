@@ -34,6 +34,7 @@ use crate::geometry::HalfDiff;
 use crate::spectrum::Channels;
 use crate::table::Table;
 use crate::table::grid::{Grid, Param};
+use crate::table::kernel::Kernel;
 use crate::table::lookup::{Interp, Lookup, Prepared};
 use crate::table::sampling::{SamplingResolution, TableSampler};
 
@@ -65,6 +66,12 @@ type Unmeasured = Box<[(u32, f32)]>;
 pub struct TabulatedBrdf {
     grid: Grid,
     lookup: Lookup,
+    /// The fast linear lookup of adaptive grids ([`super::kernel`]), when it applies. Such a
+    /// table is small (it is meant to stay in cache) and is held in `dense`, all chunks in one
+    /// array, instead of `chunks`.
+    kernel: Option<Kernel>,
+    /// Every chunk, contiguous (tables with a kernel only), loaded on first use.
+    dense: OnceLock<Box<[f32]>>,
     chunks: Box<[OnceLock<Arc<[f32]>>]>,
     /// Per chunk, the negative stored values (offset in the chunk, value) that `chunks` holds as
     /// 0; set when the chunk is loaded (see the module docs).
@@ -92,18 +99,28 @@ impl TabulatedBrdf {
     pub fn from_table(table: Table) -> TabulatedBrdf {
         let (grid, mut values, description) = table.into_parts();
         let l = grid.layout();
+        let kernel = Kernel::new(&grid);
         let mut unmeasured = Vec::with_capacity(l.chunk_count());
-        let chunks: Box<[OnceLock<Arc<[f32]>>]> = (0..l.chunk_count())
-            .map(|i| {
-                let v = &mut values[l.chunk_range(i)];
-                unmeasured.push(OnceLock::from(set_aside_negatives(v)));
+        let mut chunks = Vec::with_capacity(l.chunk_count());
+        for i in 0..l.chunk_count() {
+            let v = &mut values[l.chunk_range(i)];
+            unmeasured.push(OnceLock::from(set_aside_negatives(v)));
+            chunks.push(if kernel.is_some() {
+                OnceLock::new()
+            } else {
                 OnceLock::from(Arc::<[f32]>::from(&*v))
-            })
-            .collect();
+            });
+        }
+        let dense = match kernel {
+            Some(_) => OnceLock::from(values.into_boxed_slice()),
+            None => OnceLock::new(),
+        };
         TabulatedBrdf {
             lookup: Lookup::new(&grid),
+            kernel,
+            dense,
             grid,
-            chunks,
+            chunks: chunks.into(),
             unmeasured: unmeasured.into(),
             loader: None,
             interp: Interp::Linear,
@@ -127,6 +144,8 @@ impl TabulatedBrdf {
             .collect();
         TabulatedBrdf {
             lookup: Lookup::new(&grid),
+            kernel: Kernel::new(&grid),
+            dense: OnceLock::new(),
             grid,
             chunks,
             unmeasured,
@@ -144,7 +163,9 @@ impl TabulatedBrdf {
     /// instead of each lookup waiting for its own.
     fn eval_block(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
         let c = self.lookup.channels();
-        if self.interp != Interp::Linear {
+        if self.interp != Interp::Linear || self.kernel.is_some() {
+            // Nearest lookups, and the kernel (its tables are cache resident: nothing to
+            // prefetch), go one pair at a time.
             for (k, oc) in out.chunks_exact_mut(c).enumerate() {
                 self.eval(wi[k], wo[k], oc);
             }
@@ -227,7 +248,63 @@ impl TabulatedBrdf {
 
     /// Number of chunks currently loaded.
     pub fn loaded_chunks(&self) -> usize {
+        if self.kernel.is_some() {
+            return match self.dense.get() {
+                Some(d) if !d.is_empty() => self.chunks.len(),
+                _ => 0,
+            };
+        }
         self.chunks.iter().filter(|c| c.get().is_some()).count()
+    }
+
+    /// Bytes of decoded values this table holds in memory now (what a lookup reads).
+    pub fn resident_bytes(&self) -> usize {
+        let f = std::mem::size_of::<f32>();
+        let dense = self.dense.get().map_or(0, |d| d.len() * f);
+        let chunks: usize = self
+            .chunks
+            .iter()
+            .filter_map(|c| c.get())
+            .map(|c| c.len() * f)
+            .sum();
+        let unmeasured: usize = self
+            .unmeasured
+            .iter()
+            .filter_map(|u| u.get())
+            .map(|u| u.len() * std::mem::size_of::<(u32, f32)>())
+            .sum();
+        dense + chunks + unmeasured
+    }
+
+    /// All chunks in one array (tables with a kernel), decoded on first use; empty when a chunk
+    /// could not be loaded (the error is recorded, lookups give 0).
+    #[cold]
+    fn load_dense(&self) -> Box<[f32]> {
+        let l = self.grid.layout();
+        let mut all = Vec::with_capacity(l.len());
+        for a in 0..l.chunk_count() {
+            match self.fetch(a) {
+                Ok(mut v) => {
+                    let _ = self.unmeasured[a].set(set_aside_negatives(&mut v));
+                    all.extend_from_slice(&v);
+                }
+                Err(e) => {
+                    if let Ok(mut first) = self.error.lock() {
+                        first.get_or_insert(e);
+                    }
+                    return Box::new([]);
+                }
+            }
+        }
+        all.into_boxed_slice()
+    }
+
+    #[inline(always)]
+    fn dense(&self) -> &[f32] {
+        match self.dense.get() {
+            Some(d) => d,
+            None => self.dense.get_or_init(|| self.load_dense()),
+        }
     }
 
     /// The whole table in memory as stored (loads every chunk; negative values included).
@@ -246,6 +323,10 @@ impl TabulatedBrdf {
 
     #[inline(always)]
     fn chunk(&self, a: usize) -> &[f32] {
+        if self.kernel.is_some() {
+            let d = self.dense();
+            return d.get(self.grid.layout().chunk_range(a)).unwrap_or(&[]);
+        }
         match self.chunks.get(a) {
             Some(c) => match c.get() {
                 Some(v) => v,
@@ -328,8 +409,12 @@ impl Brdf for TabulatedBrdf {
 
     #[inline]
     fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
-        self.lookup
-            .eval(self.interp, wi, wo, out, |a| self.chunk(a))
+        match &self.kernel {
+            Some(k) if self.interp == Interp::Linear => k.eval(wi, wo, out, self.dense()),
+            _ => self
+                .lookup
+                .eval(self.interp, wi, wo, out, |a| self.chunk(a)),
+        }
     }
 
     /// Only the symmetries the table stores are declared (a reduced table has them exactly).
