@@ -43,8 +43,8 @@ fn main() -> brdftab::Result<()> {
             let (t, _) = bake(src.as_ref(), &grid, &bo)?;
             let n = t.values().len();
             let tb = TabulatedBrdf::from_table(t);
-            let a = accuracy::compare_cap(&tb, src.as_ref(), 20000, 1, 80f64.to_radians())?;
-            let a2 = accuracy::compare_cap(&tb, src.as_ref(), 20000, 2, 80f64.to_radians())?;
+            let a = accuracy::compare_weighted(&tb, src.as_ref(), 20000, 1, 80f64.to_radians(), accuracy::Weight::CosInCosOut)?;
+            let a2 = accuracy::compare_weighted(&tb, src.as_ref(), std::env::var("PAIRS2").ok().and_then(|s| s.parse().ok()).unwrap_or(20000), 2, 80f64.to_radians(), accuracy::Weight::CosInCosOut)?;
             let tt = brdftab::analysis::timing::lookups(&tb, 300_000, 3)?;
             {
                 let wi = glam::DVec3::new(0.3, 0.2, (1.0f64 - 0.13).sqrt());

@@ -829,6 +829,20 @@ mod tests {
             GridChoice::parse("90x1x90"),
             Err(Error::InvalidArgument { .. })
         ));
+        assert_eq!(
+            GridChoice::parse("adaptive").unwrap(),
+            GridChoice::Adaptive(None)
+        );
+        assert_eq!(
+            GridChoice::parse("Adaptive:96x48x25").unwrap(),
+            GridChoice::Adaptive(Some([96, 48, 25]))
+        );
+        for bad in ["adaptive:96x48", "adaptivex", "adaptive:", "adaptive:axbxc"] {
+            assert!(
+                matches!(GridChoice::parse(bad), Err(Error::InvalidArgument { .. })),
+                "{bad}"
+            );
+        }
     }
 
     #[test]

@@ -58,6 +58,18 @@ pub fn compare(
     compare_cap(approx, reference, pairs, seed, std::f64::consts::FRAC_PI_2)
 }
 
+/// The cosine weight of the relative RMSE.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Weight {
+    /// f_r cos θi: the reflected-radiance integrand for one outgoing direction (the default of
+    /// [`compare`] and [`compare_cap`]).
+    #[default]
+    CosIn,
+    /// f_r cos θi cos θo: symmetric in the two directions (the measured-table benchmark).
+    CosInCosOut,
+}
+
 /// Like [`compare`], with both directions drawn uniformly over the cap θ ≤ `max_theta`.
 pub fn compare_cap(
     approx: &dyn Brdf,
@@ -65,6 +77,18 @@ pub fn compare_cap(
     pairs: usize,
     seed: u64,
     max_theta: f64,
+) -> Result<Accuracy> {
+    compare_weighted(approx, reference, pairs, seed, max_theta, Weight::CosIn)
+}
+
+/// Like [`compare_cap`], with the cosine weight `weight`.
+pub fn compare_weighted(
+    approx: &dyn Brdf,
+    reference: &dyn Brdf,
+    pairs: usize,
+    seed: u64,
+    max_theta: f64,
+    weight: Weight,
 ) -> Result<Accuracy> {
     if !(max_theta > 0.0 && max_theta <= std::f64::consts::FRAC_PI_2) {
         return Err(Error::arg(
@@ -104,11 +128,15 @@ pub fn compare_cap(
                 let wo = cap(rng.next_dvec2());
                 approx.eval(wi, wo, &mut fa[..c]);
                 reference.eval(wi, wo, &mut fr[..c]);
+                let w = match weight {
+                    Weight::CosIn => wi.z,
+                    Weight::CosInCosOut => wi.z * wo.z,
+                };
                 for k in 0..c {
                     let (a, r) = (fa[k] as f64, fr[k] as f64);
                     let err = a - r;
-                    e2[k] += (err * wi.z).powi(2);
-                    r2[k] += (r * wi.z).powi(2);
+                    e2[k] += (err * w).powi(2);
+                    r2[k] += (r * w).powi(2);
                     f2 += r * r;
                     worst.push((err.abs(), r.abs(), wi, wo));
                 }

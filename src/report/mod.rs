@@ -2,8 +2,10 @@
 //!
 //! - [`suite`]: which sources, grids and codecs; running them ([`suite::run`]); the rows and
 //!   their CSV and Markdown forms;
+//! - [`measured`]: RGL files against their default tables (error, bytes, memory, speed);
 //! - [`plot`]: rate–distortion PNGs (error vs bytes stored) with plotters and an embedded font.
 
+pub mod measured;
 pub mod plot;
 pub mod suite;
 

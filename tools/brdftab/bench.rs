@@ -14,8 +14,14 @@ use crate::table::print_out;
 /// Arguments of `brdftab bench`.
 #[derive(Args)]
 pub struct BenchArgs {
-    /// The source: a table file or a model spec.
-    source: String,
+    /// The source: a table file or a model spec (not with --measured).
+    #[arg(required_unless_present = "measured")]
+    source: Option<String>,
+    /// Instead of one source: bake every RGL `.bsdf` file of DIR (default: the shipped
+    /// data/rgl) with the defaults and compare each table with the file's own evaluation in
+    /// the same run — error, bytes, resident memory, ns per lookup, batch rate.
+    #[arg(long, value_name = "DIR", num_args = 0..=1, default_missing_value = "")]
+    measured: Option<String>,
     /// Number of random pairs.
     #[arg(long, default_value_t = 1_000_000)]
     pairs: usize,
@@ -30,11 +36,50 @@ pub struct BenchArgs {
     json: bool,
 }
 
+/// `brdftab bench --measured`.
+fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
+    use brdftab::report::measured;
+    let dir = match dir {
+        "" => brdftab::measured::data::rgl_dir().ok_or_else(|| {
+            brdftab::Error::NotFound(format!(
+                "no RGL directory (searched {:?})",
+                brdftab::measured::data::rgl_dirs()
+            ))
+        })?,
+        d => std::path::PathBuf::from(d),
+    };
+    let files = measured::rgl_files(&dir)?;
+    let opts = measured::MeasuredOptions {
+        timing_pairs: a.pairs,
+        ..Default::default()
+    };
+    let bar = crate::progress::Bar::values();
+    let rows = measured::run(&files, &opts, &bar)?;
+    let mut o = String::new();
+    if a.json {
+        let _ = writeln!(o, "{}", serde_json::to_string_pretty(&rows).unwrap_or_default());
+    } else {
+        let _ = writeln!(o, "{}", measured::markdown(&rows));
+        let _ = writeln!(
+            o,
+            "error: relative RMSE of f_r cos θi cos θo, both directions within 80°, {} pairs; \
+             ns: wall time per lookup on one thread, median of {} rounds each timing the native \
+             evaluation then the table on the same pairs (speedup: median of the per-round \
+             ratios); batch: eval_batch lookups per second of CPU time",
+            opts.error_pairs, opts.repeats
+        );
+    }
+    print_out(&o)
+}
+
 /// `brdftab bench`.
 pub fn bench(a: BenchArgs) -> Result<()> {
+    if let Some(d) = &a.measured {
+        return measured(d, &a);
+    }
     let interp = Interp::parse(&a.interp).map_err(|e| flag(e, "--interp"))?;
     let channels = source::channels(a.wavelengths.as_deref())?;
-    let src = source::open_with(&a.source, &channels, interp)?;
+    let src = source::open_with(a.source.as_deref().unwrap_or_default(), &channels, interp)?;
     let t = timing::lookups(src.as_ref(), a.pairs, 5).map_err(|e| flag(e, "--pairs"))?;
     let mut o = String::new();
     if a.json {
