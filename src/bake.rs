@@ -41,7 +41,9 @@ use crate::table::{
 /// The grid a bake samples on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum GridChoice {
-    /// The source's natural grid: a MERL file's own cells for MERL sources, the medium preset
+    /// The source's natural grid: a MERL file's own cells for MERL sources, an adaptive grid
+    /// ([`GridChoice::Adaptive`]) for RGL files (the medium preset when the file is not
+    /// isotropic and bilateral within [`MEASURED_BILATERAL_TOLERANCE`]), the medium preset
     /// otherwise.
     #[default]
     Default,

@@ -97,6 +97,34 @@ impl F4 {
             }
         }
     }
+    /// Lanes (a[L], a[L], b[L], b[L]).
+    #[inline(always)]
+    pub fn pair_lanes<const L: i32>(a: F4, b: F4) -> F4 {
+        use std::arch::x86_64::*;
+        unsafe {
+            match L {
+                0 => F4(_mm_shuffle_ps::<0x00>(a.0, b.0)),
+                1 => F4(_mm_shuffle_ps::<0x55>(a.0, b.0)),
+                2 => F4(_mm_shuffle_ps::<0xAA>(a.0, b.0)),
+                _ => F4(_mm_shuffle_ps::<0xFF>(a.0, b.0)),
+            }
+        }
+    }
+    /// Lanes (a0, b0, a1, b1).
+    #[inline(always)]
+    pub fn interleave_lo(a: F4, b: F4) -> F4 {
+        unsafe { F4(std::arch::x86_64::_mm_unpacklo_ps(a.0, b.0)) }
+    }
+    /// Lanes (x1, x2, x3, 0): every lane moved down by one.
+    #[inline(always)]
+    pub fn shift_down(self) -> F4 {
+        use std::arch::x86_64::*;
+        unsafe {
+            F4(_mm_castsi128_ps(_mm_srli_si128::<4>(_mm_castps_si128(
+                self.0,
+            ))))
+        }
+    }
     /// The lanes.
     #[inline(always)]
     pub fn to_array(self) -> [f32; 4] {
@@ -176,6 +204,22 @@ impl F4 {
     pub fn lane<const L: i32>(self) -> F4 {
         F4([self.0[L as usize]; 4])
     }
+    /// Lanes (a[L], a[L], b[L], b[L]).
+    #[inline(always)]
+    pub fn pair_lanes<const L: i32>(a: F4, b: F4) -> F4 {
+        let l = L as usize;
+        F4([a.0[l], a.0[l], b.0[l], b.0[l]])
+    }
+    /// Lanes (a0, b0, a1, b1).
+    #[inline(always)]
+    pub fn interleave_lo(a: F4, b: F4) -> F4 {
+        F4([a.0[0], b.0[0], a.0[1], b.0[1]])
+    }
+    /// Lanes (x1, x2, x3, 0): every lane moved down by one.
+    #[inline(always)]
+    pub fn shift_down(self) -> F4 {
+        F4([self.0[1], self.0[2], self.0[3], 0.0])
+    }
     /// The lanes.
     #[inline(always)]
     pub fn to_array(self) -> [f32; 4] {
@@ -218,6 +262,9 @@ mod tests {
         assert_eq!(a.min(b).to_array(), [0.5, -2.0, 3.0, -8.0]);
         assert_eq!(a.max(b).to_array(), [1.5, 4.0, 9.0, 0.25]);
         assert_eq!(a.lane::<2>().to_array(), [9.0; 4]);
+        assert_eq!(F4::pair_lanes::<1>(a, b).to_array(), [-2.0, -2.0, 4.0, 4.0]);
+        assert_eq!(F4::interleave_lo(a, b).to_array(), [1.5, 0.5, -2.0, 4.0]);
+        assert_eq!(a.shift_down().to_array(), [-2.0, 9.0, 0.25, 0.0]);
         let (i, f) = F4::new(2.7, 0.2, 7.999, 3.0).trunc();
         assert_eq!(i, [2, 0, 7, 3]);
         assert_eq!(f.to_array(), [2.0, 0.0, 7.0, 3.0]);

@@ -40,7 +40,10 @@ fn rgl_defaults_meet_size_error_and_memory_bars() {
         );
         let rgl_bytes = std::fs::metadata(&f).unwrap().len();
         let table_bytes = std::fs::metadata(&out).unwrap().len();
-        assert!(table_bytes <= rgl_bytes, "{name}: {table_bytes} > {rgl_bytes} bytes");
+        assert!(
+            table_bytes <= rgl_bytes,
+            "{name}: {table_bytes} > {rgl_bytes} bytes"
+        );
         let native = source::open(&f.to_string_lossy()).unwrap();
         let table = source::open_table(&out, &OpenOptions::default()).unwrap();
         let e = compare_weighted(
@@ -52,8 +55,16 @@ fn rgl_defaults_meet_size_error_and_memory_bars() {
             Weight::CosInCosOut,
         )
         .unwrap();
-        assert!(e.rel_rmse <= 0.01, "{name}: error {:.3}%", e.rel_rmse * 100.0);
-        assert!(table.resident_bytes() <= 4 << 20, "{name}: {} bytes", table.resident_bytes());
+        assert!(
+            e.rel_rmse <= 0.01,
+            "{name}: error {:.3}%",
+            e.rel_rmse * 100.0
+        );
+        assert!(
+            table.resident_bytes() <= 4 << 20,
+            "{name}: {} bytes",
+            table.resident_bytes()
+        );
         assert!(table.resident_bytes() > 0, "{name}: evaluated, so loaded");
     }
 }
@@ -62,7 +73,11 @@ fn rgl_defaults_meet_size_error_and_memory_bars() {
 fn the_warps_survive_the_file_and_select_the_fast_lookup() {
     let (out, report) = bake_default("paper_white_rgb.bsdf");
     let table = source::open_table(&out, &OpenOptions::default()).unwrap();
-    assert_eq!(table.grid(), &report.grid, "the grid reads back equal, warps included");
+    assert_eq!(
+        table.grid(),
+        &report.grid,
+        "the grid reads back equal, warps included"
+    );
     assert!(Kernel::new(table.grid()).is_some());
     // Nearest lookups on the same table take the general path and stay close to linear.
     let near = source::open_table(
@@ -79,7 +94,10 @@ fn the_warps_survive_the_file_and_select_the_fast_lookup() {
     table.eval(wi, wo, &mut a);
     near.eval(wi, wo, &mut b);
     for k in 0..3 {
-        assert!(a[k] > 0.0 && (a[k] - b[k]).abs() <= 0.1 * a[k], "{a:?} {b:?}");
+        assert!(
+            a[k] > 0.0 && (a[k] - b[k]).abs() <= 0.1 * a[k],
+            "{a:?} {b:?}"
+        );
     }
 }
 

@@ -521,7 +521,14 @@ fn grid_tables_round_trip_including_packed_layouts() {
     .into_iter()
     .enumerate()
     {
-        let g = Grid::with_sizes(param, sizes, [Mapping::Uniform, Mapping::Uniform], Channels::Rgb, sym).unwrap();
+        let g = Grid::with_sizes(
+            param,
+            sizes,
+            [Mapping::Uniform, Mapping::Uniform],
+            Channels::Rgb,
+            sym,
+        )
+        .unwrap();
         let t = Table::from_fn(g, "test", |i, a, out| {
             for (c, o) in out.iter_mut().enumerate() {
                 *o = (a[0].cos() * a[2].cos()).abs() as f32 * (1.0 + c as f32) + i[3] as f32 * 1e-3;

@@ -20,10 +20,10 @@ use glam::DVec3;
 
 use crate::bake::{BakeRequest, BakeTarget};
 use crate::brdf::Brdf;
-use crate::geometry;
-use crate::rng::Pcg32;
 use crate::error::{Error, Result};
+use crate::geometry;
 use crate::progress::{Progress, Stage};
+use crate::rng::Pcg32;
 use crate::source::{self, OpenOptions};
 
 /// How [`run`] measures.
@@ -86,7 +86,6 @@ pub struct MeasuredRow {
     pub bake_seconds: f64,
 }
 
-
 /// The `.bsdf` files of `dir`, sorted.
 pub fn rgl_files(dir: &Path) -> Result<Vec<PathBuf>> {
     let rd = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
@@ -142,7 +141,11 @@ fn row(f: &Path, opts: &MeasuredOptions) -> Result<MeasuredRow> {
     let single = paired(native.as_ref(), &table, opts.timing_pairs, opts.repeats);
     let tn = timing::lookups(native.as_ref(), opts.timing_pairs / 4, opts.repeats)?;
     let tt = timing::lookups(&table, opts.timing_pairs, opts.repeats)?;
-    let bytes = |p: &Path| std::fs::metadata(p).map(|m| m.len()).map_err(|e| Error::io(p, e));
+    let bytes = |p: &Path| {
+        std::fs::metadata(p)
+            .map(|m| m.len())
+            .map_err(|e| Error::io(p, e))
+    };
     Ok(MeasuredRow {
         file,
         grid: report.grid.summary(),

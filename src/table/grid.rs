@@ -34,8 +34,9 @@
 //!
 //! # Node placement
 //!
-//! An axis maps a coordinate x in its domain [lo, hi] to u ∈ [0, 1] ([`Mapping`]), then u to a
-//! fractional node index s ([`Nodes`]):
+//! An axis maps a coordinate x in its domain [lo, hi] to u ∈ [0, 1] ([`Mapping`]: uniform,
+//! square root, cosine, or a data-fitted [`Warp`] carried by the axis — see
+//! [`crate::table::warp`]), then u to a fractional node index s ([`Nodes`]):
 //!
 //! - [`Nodes::Centers`]: node i at u = (i + ½)/n, s = u·n − ½. No node on the domain ends; lookups
 //!   beyond the first/last node clamp. The default for θ axes: the horizon (where many models

@@ -250,22 +250,19 @@ impl Kernel {
         let (i, if_) = s.max(zero).min(ncap).trunc();
         let w = s - if_;
         let om = F4::splat(1.0) - w;
-        let [th, td, _, _] = w.to_array();
-        let [oh, od, _, _] = om.to_array();
         // Row weights (1−th)(1−td), (1−th)td, th(1−td), th·td, times each φd corner's weight.
-        let rw = F4::new(oh * od, oh * td, th * od, th * td);
+        let rw = F4::pair_lanes::<0>(om, w) * F4::interleave_lo(om.lane::<1>(), w.lane::<1>());
         let (p0, p1) = (rw * om.lane::<2>(), rw * w.lane::<2>());
         let o = i[0] as usize * self.chunk + i[1] as usize * self.row + i[2] as usize * 3;
         let rows = [o, o + self.row, o + self.chunk, o + self.chunk + self.row];
         let mut acc = zero;
         let mut add = |r: usize, w0: F4, w1: F4| {
             // The row's six values r..r+6: lanes 0..3 at r (φd corner 0) and at r + 3 (corner
-            // 1), the latter loaded from r + 2 and shifted so that no read passes r + 6.
+            // 1), the latter loaded from r + 2 and shifted down so that no read passes r + 6.
             if let Some(x) = values.get(r..r + 6)
                 && let (Some(a), Some(b)) = (F4::load(x), F4::load(&x[2..]))
             {
-                let [_, b1, b2, b3] = b.to_array();
-                acc = acc + (w0 * a + w1 * F4::new(b1, b2, b3, 0.0));
+                acc = acc + (w0 * a + w1 * b.shift_down());
             }
         };
         add(rows[0], p0.lane::<0>(), p1.lane::<0>());

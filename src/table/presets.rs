@@ -1,5 +1,8 @@
 //! Grid presets: `small`, `medium` (default), `large`.
 //!
+//! (RGL measurements bake by default on an adaptive grid instead, whose node positions follow
+//! the material: see [`crate::table::adaptive`] and `GridChoice::Adaptive` in [`crate::bake`].)
+//!
 //! Full axis sizes (θ1 × φ1 × θ2 × φ2); θ axes use cell-centre nodes. `halfdiff` θh uses the
 //! square-root mapping; isotropic `halfdiff` θd is uniform in cos θd (dense towards grazing, where
 //! microfacet models grow), anisotropic θd uniform. What is stored follows from the symmetry (an

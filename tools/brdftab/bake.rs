@@ -13,10 +13,12 @@ use crate::source;
 #[derive(Args, Clone)]
 pub struct BakeFlags {
     /// Grid size preset: small, medium or large (default: a MERL file's own cells for MERL
-    /// sources, medium otherwise).
+    /// sources, an adaptive grid for RGL files, medium otherwise).
     #[arg(long)]
     pub preset: Option<String>,
-    /// Full grid sizes θ1xφ1xθ2xφ2 (e.g. 90x360x90x360), or `merl`; overrides --preset.
+    /// Full grid sizes θ1xφ1xθ2xφ2 (e.g. 90x360x90x360), `merl`, or `adaptive[:NHxNDxNP]`
+    /// (halfdiff θh, θd and stored φd nodes placed by the source's own variation; isotropic
+    /// bilateral sources; default 128x48x25); overrides --preset.
     #[arg(long)]
     pub grid: Option<String>,
     /// Parameterization: halfdiff (default) or inout.

@@ -57,7 +57,11 @@ fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
     let rows = measured::run(&files, &opts, &bar)?;
     let mut o = String::new();
     if a.json {
-        let _ = writeln!(o, "{}", serde_json::to_string_pretty(&rows).unwrap_or_default());
+        let _ = writeln!(
+            o,
+            "{}",
+            serde_json::to_string_pretty(&rows).unwrap_or_default()
+        );
     } else {
         let _ = writeln!(o, "{}", measured::markdown(&rows));
         let _ = writeln!(

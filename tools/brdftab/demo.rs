@@ -37,8 +37,8 @@ pub struct DemoArgs {
     /// Output directory (created).
     #[arg(long, default_value = "demo-out")]
     out: PathBuf,
-    /// Grid preset of every table: small, medium, large (default: medium for isotropic sources,
-    /// small for anisotropic models).
+    /// Grid preset of every table: small, medium, large (default: medium for isotropic models,
+    /// small for anisotropic ones, the adaptive default grid for RGL files).
     #[arg(long)]
     preset: Option<String>,
     /// Directory of RGL-EPFL `.bsdf` files (default: $BRDFTAB_RGL_DIR, else the shipped
@@ -110,7 +110,9 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     emit(&format!(
         "\nBaking {} sources ({} preset) into {}\n",
         sources.len(),
-        a.preset.as_deref().unwrap_or("medium/small"),
+        a.preset
+            .as_deref()
+            .unwrap_or("medium/small; RGL files adaptive"),
         db.display()
     ))?;
     let bar = crate::progress::Bar::values();
@@ -119,11 +121,13 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     for s in &sources {
         let small = !s.brdf.flags().isotropic;
         let p = preset.unwrap_or(if small { Preset::Small } else { Preset::Medium });
-        // What each source declares (measured data meets it only up to noise).
-        let req = BakeRequest::new(s.source.as_str())
-            .preset(p)
-            .channels(Channels::Rgb)
-            .symmetry(SymmetryChoice::Declared);
+        let req = BakeRequest::new(s.source.as_str()).channels(Channels::Rgb);
+        let req = match preset {
+            // RGL measurements: the library's default, an adaptive grid.
+            None if s.name.starts_with("rgl_") => req,
+            // What each source declares (measured data meets it only up to noise).
+            _ => req.preset(p).symmetry(SymmetryChoice::Declared),
+        };
         bar.prefix(&s.name);
         seconds.push(req.run_with(&target(&s.name), &bar)?.seconds);
     }

@@ -124,6 +124,7 @@ CASES = [
     ('{"model": "ward", "alpha_x": 0.2, "alpha_y": 0.4, "ks": 0.5}',
      dict(grid="16x16x16x16", param="inout", symmetry="bilateral")),
     ("RGL", dict(preset="small")),
+    ("RGL", dict()),  # the default: an adaptive grid with warped axes
 ]
 
 

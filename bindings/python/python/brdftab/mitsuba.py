@@ -266,7 +266,7 @@ class JitTable:
             raise brdftab.Error("packed inout reciprocal tables are not supported by the JIT path")
         self.param = grid["param"]
         self.sym = grid["symmetry"]
-        self.axes = grid["stored_axes"]
+        self.axes = [dict(ax) for ax in grid["stored_axes"]]
         self.shape = list(grid["stored_shape"])
         self.c = int(values.shape[-1])
         self.interp = interp
@@ -278,6 +278,10 @@ class JitTable:
         dr.eval(self.values)
         self.Float64 = dr.float64_array_t(mi.Float)
         self.UInt = mi.UInt32
+        for ax in self.axes:
+            # Warped axes (adaptive grids): the knots as a Dr.Jit array, for gathers.
+            if isinstance(ax["mapping"], dict) and "warp" in ax["mapping"]:
+                ax["_knots"] = self.Float64(np.asarray(ax["mapping"]["warp"]["knots"], np.float64))
 
     # -- symmetry.rs: canonical coordinates ----------------------------------------------
     def coords(self, wi, wo):
@@ -367,6 +371,9 @@ class JitTable:
         if ax["periodic"]:
             return r * n
         m, nodes = ax["mapping"], ax["nodes"]
+        if isinstance(m, dict):
+            u = JitTable._warp(ax, m["warp"], x, hi)
+            return u * (n - 1.0)  # warped axes have edge nodes
         if m == "sqrt" and nodes == "cell_start":
             return dr.sqrt(dr.maximum(r * n * n, 0.0))
         if m == "uniform" and nodes == "cell_start":
@@ -382,6 +389,35 @@ class JitTable:
         if nodes == "edges":
             return u * (n - 1.0)
         return u * n
+
+    @staticmethod
+    def _warp(ax, w, x, hi):
+        """u of angle x on a warped axis (``warp.rs``: Warp::u_of_angle)."""
+        import drjit as dr
+
+        Fx = type(x)
+        var = w["var"]
+        if var == "sqrt_sine":
+            v = dr.sqrt(dr.maximum(dr.sin(x), 0.0))
+        elif var == "half_power":
+            v = math.sqrt(2.0) * dr.abs(dr.sin(0.5 * x))
+        elif var == "pseudo_angle":
+            def pseudo(sn, cs):
+                d = abs(cs) + abs(sn)
+                return 0.5 - 0.5 * cs / d if d > 0 else 0.0
+            sn, cs = dr.sin(x), dr.cos(x)
+            d = dr.abs(cs) + dr.abs(sn)
+            p = dr.select(d > 0, 0.5 - 0.5 * cs / dr.maximum(d, 1e-300), 0.0)
+            v = p / pseudo(math.sin(hi), math.cos(hi))
+        else:
+            raise brdftab.Error(f"warp variable {var!r} is not supported by the JIT path")
+        k = float(len(w["knots"]) - 1)
+        t = dr.clip(v * k, 0.0, k)
+        j = dr.minimum(dr.floor(t), k - 1.0)
+        ju = dr.uint32_array_t(Fx)(j)
+        a = dr.gather(Fx, ax["_knots"], ju)
+        b = dr.gather(Fx, ax["_knots"], ju + 1)
+        return a + (t - j) * (b - a)
 
     def _continuous(self, ax, x):
         s = self._cell_coordinate(ax, x, False)
