@@ -85,8 +85,8 @@ pub enum Mapping {
     /// Uniform in cos θ: u = (cos lo − cos x)/(cos lo − cos hi) (θ axes; dense near the horizon
     /// in θ, uniform in projected solid angle for the polar part).
     Cos,
-    /// A data-adaptive warp ([`Warp`]): θ axes, and φd of an isotropic `halfdiff` table folded
-    /// by bilateral symmetry; with [`Nodes::Edges`].
+    /// A data-adaptive warp ([`Warp`]): θ axes ([`Nodes::Centers`] or [`Nodes::Edges`]), and φd
+    /// of an isotropic `halfdiff` table folded by bilateral symmetry ([`Nodes::Edges`]).
     Warp(Warp),
 }
 
@@ -474,12 +474,16 @@ impl Grid {
             let warp_ok =
                 k == 3 && param == Param::HalfDiff && symmetry.isotropic && symmetry.bilateral;
             if let Mapping::Warp(_) = a.mapping {
-                if a.nodes != Nodes::Edges || (k % 2 == 1 && !warp_ok) {
+                let nodes_ok = match k % 2 {
+                    0 => matches!(a.nodes, Nodes::Centers | Nodes::Edges),
+                    _ => a.nodes == Nodes::Edges && warp_ok,
+                };
+                if !nodes_ok {
                     return Err(Error::arg(
                         "grid",
                         format!(
-                            "a warped axis needs edges nodes and is a θ axis or the φd of an \
-                             isotropic halfdiff table with bilateral symmetry ({})",
+                            "a warped axis is a θ axis (centers or edges nodes) or the φd of an \
+                             isotropic halfdiff table with bilateral symmetry (edges) ({})",
                             name[k]
                         ),
                     ));

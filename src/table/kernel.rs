@@ -42,10 +42,15 @@ struct Axis {
 }
 
 impl Axis {
-    fn new(w: &Warp, n: usize) -> Axis {
-        let scale = (n - 1) as f32;
+    /// `centers`: node i at u = (i + ½)/n, s = u·n − ½; otherwise at u = i/(n − 1).
+    fn new(w: &Warp, n: usize, centers: bool) -> Axis {
+        let (scale, shift) = if centers {
+            (n as f32, -0.5)
+        } else {
+            ((n - 1) as f32, 0.0)
+        };
         Axis {
-            s: w.knots().iter().map(|&u| u * scale).collect(),
+            s: w.knots().iter().map(|&u| u * scale + shift).collect(),
             k: (w.knots().len() - 1) as f32,
             n,
             kmax: (w.knots().len() - 2) as i32,
@@ -102,12 +107,18 @@ impl Kernel {
         ];
         let mut axes = Vec::with_capacity(3);
         for (k, var) in want {
+            let nodes_ok = match ax[k].nodes {
+                Nodes::Edges => true,
+                Nodes::Centers => k != 3,
+                Nodes::CellStart => false,
+            };
             match &ax[k].mapping {
-                Mapping::Warp(w) if w.var() == var && ax[k].nodes == Nodes::Edges => {
+                Mapping::Warp(w) if w.var() == var && nodes_ok => {
                     if ax[k].size < 2 {
                         return None;
                     }
-                    axes.push(Axis::new(w, ax[k].size));
+                    let centers = ax[k].nodes == Nodes::Centers;
+                    axes.push(Axis::new(w, ax[k].size, centers));
                 }
                 _ => return None,
             }
@@ -230,7 +241,7 @@ impl Kernel {
     /// the same operations as `blend::<3>`, which stays as its reference (tested equal).
     #[inline(always)]
     fn eval_rgb(&self, v: F4, out: &mut [f32], values: &[f32]) {
-        let [k, kcap, _, ncap] = self.lanes;
+        let [k, kcap, nmax, ncap] = self.lanes;
         let zero = F4::splat(0.0);
         // Knot interval j and its fraction per axis (lane 3: 0).
         // v ∈ [0, 1] by construction (each is a ratio bounded by 1), so t ∈ [0, K] up to
@@ -244,10 +255,10 @@ impl Kernel {
         };
         let lo = F4::new(knot(0, 0), knot(1, 0), knot(2, 0), 0.0);
         let hi = F4::new(knot(0, 1), knot(1, 1), knot(2, 1), 0.0);
-        // Fractional node index s ∈ [0, n − 1], its lower node (≤ n − 2) and the weight of the
-        // upper one.
-        let s = lo + f * (hi - lo);
-        let (i, if_) = s.max(zero).min(ncap).trunc();
+        // Fractional node index s, clamped to [0, n − 1] (beyond the first and last cell
+        // centres the end values hold), its lower node (≤ n − 2) and the upper one's weight.
+        let s = (lo + f * (hi - lo)).max(zero).min(nmax);
+        let (i, if_) = s.min(ncap).trunc();
         let w = s - if_;
         let om = F4::splat(1.0) - w;
         // Row weights (1−th)(1−td), (1−th)td, th(1−td), th·td, times each φd corner's weight.
@@ -368,7 +379,8 @@ mod tests {
     }
 
     fn test_kernel(quarter: bool) -> Kernel {
-        let axes = std::array::from_fn(|_| Axis::new(&Warp::identity(WarpVar::HalfPower), 2));
+        let axes =
+            std::array::from_fn(|_| Axis::new(&Warp::identity(WarpVar::HalfPower), 2, false));
         let per = |x: f32| F4::new(x, x, x, 0.0);
         Kernel {
             axes,

@@ -7,7 +7,8 @@
 
 Properties: ``source`` (string, any SOURCE: spec, table, ``DB#NAME``, MERL, RGL), optional
 ``interp`` (``"linear"`` or ``"nearest"``), and for JIT variants optional ``preset`` / ``grid``
-(the table a non-table source is baked on, default ``medium``) and ``sampling_res`` (the
+(the table a non-table source is baked on, default ``medium``; RGL files: the library's
+adaptive grid, MERL files: their own cells) and ``sampling_res`` (the
 resolution of the tabulated sampling distributions, default 64).
 
 Conventions are those of Mitsuba's ``measured`` plugin: ``si.wi`` is brdftab's ``wi`` (towards
@@ -282,6 +283,28 @@ class JitTable:
             # Warped axes (adaptive grids): the knots as a Dr.Jit array, for gathers.
             if isinstance(ax["mapping"], dict) and "warp" in ax["mapping"]:
                 ax["_knots"] = self.Float64(np.asarray(ax["mapping"]["warp"]["knots"], np.float64))
+        # Adaptive grids: Rust looks them up with table/kernel.rs (float32 warp variables from
+        # the vectors); mirror it, so that both compute the same node weights.
+        self.kernel = None
+        want = {0: "sqrt_sine", 2: "half_power", 3: "pseudo_angle"}
+        if (interp == "linear" and self.param == "halfdiff" and self.sym["isotropic"]
+                and self.sym["bilateral"]
+                and all(isinstance(self.axes[k]["mapping"], dict)
+                        and self.axes[k]["mapping"].get("warp", {}).get("var") == v
+                        and self.axes[k]["nodes"] in (("edges",) if k == 3 else ("edges", "centers"))
+                        and self.axes[k]["size"] >= 2
+                        for k, v in want.items())):
+            ks = []
+            for k in (0, 2, 3):
+                knots = np.asarray(self.axes[k]["mapping"]["warp"]["knots"], np.float32)
+                n = self.axes[k]["size"]
+                # s = u·n − ½ (centers) or u·(n − 1) (edges) in float32, as Axis::new in kernel.rs.
+                if self.axes[k]["nodes"] == "centers":
+                    s_ = knots * np.float32(n) + np.float32(-0.5)
+                else:
+                    s_ = knots * np.float32(n - 1)
+                ks.append((mi.Float(s_), float(len(knots) - 1), n))
+            self.kernel = ks
 
     # -- symmetry.rs: canonical coordinates ----------------------------------------------
     def coords(self, wi, wo):
@@ -373,7 +396,7 @@ class JitTable:
         m, nodes = ax["mapping"], ax["nodes"]
         if isinstance(m, dict):
             u = JitTable._warp(ax, m["warp"], x, hi)
-            return u * (n - 1.0)  # warped axes have edge nodes
+            return u * n - 0.5 if nodes == "centers" else u * (n - 1.0)
         if m == "sqrt" and nodes == "cell_start":
             return dr.sqrt(dr.maximum(r * n * n, 0.0))
         if m == "uniform" and nodes == "cell_start":
@@ -467,6 +490,8 @@ class JitTable:
         """f_r per channel: a list of c float32 arrays (0 where invalid)."""
         import drjit as dr
 
+        if self.kernel is not None:
+            return self._kernel_lookup(wi, wo, active)
         x, valid = self.coords(wi, wo)
         valid &= active
         n0, s1, n2, s3 = self.shape
@@ -492,6 +517,67 @@ class JitTable:
                         for k in range(c):
                             out[k] = dr.fma(wt, dr.gather(Fl, self.values, base + k, valid), out[k])
         return [dr.select(valid, o, 0.0) for o in out]
+
+
+    # -- kernel.rs (adaptive grids) -----------------------------------------------------------
+    def _kernel_lookup(self, wi, wo, active):
+        """Kernel::eval: float32 warp variables, knot and node split per axis, eight corners."""
+        import drjit as dr
+
+        F64, Fl, U = self.Float64, type(self.values), self.UInt
+        wi = [F64(wi.x), F64(wi.y), F64(wi.z)]
+        wo = [F64(wo.x), F64(wo.y), F64(wo.z)]
+
+        def unit(v):
+            n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+            inv = dr.rsqrt(dr.maximum(n2, 1e-300))
+            return [Fl(c * inv) for c in v], n2 > 0
+
+        (ix, iy, iz), ok_i = unit(wi)
+        (ox, oy, oz), ok_o = unit(wo)
+        valid = ok_i & ok_o & (iz > 0) & (oz > 0) & active
+        hx, hy, hz = ix + ox, iy + oy, iz + oz
+        r2 = hx * hx + hy * hy
+        hh = r2 + hz * hz
+        vh = dr.sqrt(dr.sqrt(r2 / hh))
+        hl = dr.sqrt(hh)
+        ex, ey, ez = ix - ox, iy - oy, iz - oz
+        e2 = ex * ex + ey * ey + ez * ez
+        dx = hz * (hx * ix + hy * iy) - r2 * iz
+        dy = dr.abs(hl * (hx * iy - hy * ix))
+        den = dr.abs(dx) + dy
+        vd = dr.sqrt(e2 / (2.0 * (2.0 + hl)))
+        safe = dr.select(den > 0, den, 1.0)
+        if self.sym["reciprocal"]:
+            vp = dr.select(den > 0, dy / safe, 0.0)
+        else:
+            vp = dr.select(den > 0, 0.5 - 0.5 * (dx / safe), 0.0)
+        nodes = []
+        for (s_, k, n), v in zip(self.kernel, (vh, vd, vp)):
+            t = v * k
+            j = dr.trunc(dr.minimum(t, k - 0.5))
+            f = t - j
+            ju = U(j)
+            a = dr.gather(Fl, s_, ju)
+            b = dr.gather(Fl, s_, ju + 1)
+            sv = dr.minimum(dr.maximum(a + f * (b - a), 0.0), n - 1.0)
+            i = dr.trunc(dr.minimum(sv, n - 1.5))
+            nodes.append((U(i), sv - i))
+        (ih, th), (id_, td), (ip, tp) = nodes
+        c = self.c
+        row = self.shape[3] * c
+        chunk = self.shape[2] * row
+        o = ih * chunk + id_ * row + ip * c
+        oh, od, op = 1.0 - th, 1.0 - td, 1.0 - tp
+        rows = [(o, oh * od), (o + row, oh * td), (o + chunk, th * od), (o + chunk + row, th * td)]
+        out = [Fl(0.0) for _ in range(c)]
+        for r, w in rows:
+            w0, w1 = w * op, w * tp
+            for ch in range(c):
+                x0 = dr.gather(Fl, self.values, r + ch, valid)
+                x1 = dr.gather(Fl, self.values, r + c + ch, valid)
+                out[ch] = out[ch] + (w0 * x0 + w1 * x1)
+        return [dr.select(valid, x, 0.0) for x in out]
 
 
 class JitBrdftabBSDF(_Common):
@@ -530,7 +616,8 @@ class JitBrdftabBSDF(_Common):
             if not grid.get("packed"):
                 return values, grid
             options = {}
-        if brdftab_kind(self.source) != "merl":  # MERL files keep their own cells
+        # MERL files keep their own cells, RGL files get the library's adaptive grid.
+        if brdftab_kind(self.source) not in ("merl", "rgl"):
             options.setdefault("preset", "medium")
         if options.get("preset") and options.get("grid"):
             options.pop("preset")
