@@ -129,6 +129,9 @@ pub struct Plan {
     pub note: Option<String>,
     /// The bake does not verify the symmetry (forced, declared or assumed).
     pub force: bool,
+    /// The symmetry is assumed for a measured source (the note says by how much it is broken;
+    /// the bake's own violation report would repeat it).
+    pub assumed: bool,
 }
 
 /// The symmetry a bake reduces by.
@@ -359,6 +362,7 @@ impl BakeRequest {
     pub fn plan(&self, src: &dyn Brdf) -> Result<Plan> {
         let (mut sym, mut note) = self.resolve_symmetry(src);
         let mut force = self.force || self.symmetry == SymmetryChoice::Declared;
+        let mut assumed = false;
         if self.adaptive()
             && sym.isotropic
             && !sym.bilateral
@@ -368,6 +372,7 @@ impl BakeRequest {
             if v <= MEASURED_BILATERAL_TOLERANCE {
                 sym.bilateral = true;
                 force = true;
+                assumed = true;
                 note = Some(format!(
                     "bilateral symmetry assumed (largest relative violation {:.2}%, within {}%); \
                      using {sym}",
@@ -383,7 +388,12 @@ impl BakeRequest {
             }
             _ => self.resolve_grid(src, sym)?,
         };
-        Ok(Plan { grid, note, force })
+        Ok(Plan {
+            grid,
+            note,
+            force,
+            assumed,
+        })
     }
 
     /// The grid this request bakes `src` on.
@@ -442,13 +452,18 @@ impl BakeRequest {
             let report = self.report_for(src, table.grid(), None, t0, true);
             return Ok((table, report));
         }
-        let Plan { grid, note, force } = self.plan(src)?;
+        let Plan {
+            grid,
+            note,
+            force,
+            assumed,
+        } = self.plan(src)?;
         let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
         let set = |done: u64, _total: u64| progress.set(done);
         let opts = self.bake_options(&set, force);
         let (table, r) = crate::table::bake(src, &grid, &opts)?;
         let mut report = self.report_for(src, &grid, note, t0, false);
-        report.forced = r.forced;
+        report.forced = r.forced.filter(|_| !assumed);
         Ok((table, report))
     }
 
@@ -569,7 +584,12 @@ impl BakeRequest {
         progress: &dyn Progress,
     ) -> Result<BakeReport> {
         let t0 = Instant::now();
-        let Plan { grid, note, force } = self.plan(src)?;
+        let Plan {
+            grid,
+            note,
+            force,
+            assumed,
+        } = self.plan(src)?;
         let header = TableHeader::for_grid(name.to_owned(), provenance, &grid, self.codec);
         let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
         let set = |done: u64, _total: u64| progress.set(done);
@@ -594,7 +614,7 @@ impl BakeRequest {
         let baked = baked.ok_or_else(|| Error::Unsupported("the bake wrote no table".into()))?;
         let mut report = self.report_for(src, &grid, note, t0, false);
         report.values = baked.values;
-        report.forced = baked.forced;
+        report.forced = baked.forced.filter(|_| !assumed);
         Ok(report)
     }
 }

@@ -90,6 +90,16 @@ pub enum Mapping {
     Warp(Warp),
 }
 
+impl Mapping {
+    /// A short name for summaries: `Uniform`, `Sqrt`, `Cos`, `Warp(SqrtSine, 129 knots)`.
+    pub fn label(&self) -> String {
+        match self {
+            Mapping::Warp(w) => format!("Warp({:?}, {} knots)", w.var(), w.knots().len()),
+            m => format!("{m:?}"),
+        }
+    }
+}
+
 /// Where the nodes of an axis sit (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
 #[serde(rename_all = "snake_case")]
@@ -717,7 +727,7 @@ impl Grid {
     pub fn summary(&self) -> String {
         let s = self.stored_shape();
         format!(
-            "{} full {}x{}x{}x{} stored {}x{}x{}x{} x{} ch, θ1 {:?}/{:?}, θ2 {:?}/{:?}, symmetry {}",
+            "{} full {}x{}x{}x{} stored {}x{}x{}x{} x{} ch, θ1 {}/{:?}, θ2 {}/{:?}, symmetry {}",
             self.param.name(),
             self.axes[0].size,
             self.axes[1].size,
@@ -728,12 +738,15 @@ impl Grid {
             s[2],
             s[3],
             self.channels.len(),
-            self.axes[0].mapping,
+            self.axes[0].mapping.label(),
             self.axes[0].nodes,
-            self.axes[2].mapping,
+            self.axes[2].mapping.label(),
             self.axes[2].nodes,
             self.symmetry,
-        )
+        ) + &match &self.axes[3].mapping {
+            Mapping::Warp(_) => format!(", φ2 {}", self.axes[3].mapping.label()),
+            _ => String::new(),
+        }
     }
 }
 
