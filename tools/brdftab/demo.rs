@@ -108,11 +108,11 @@ pub fn demo(a: DemoArgs) -> Result<()> {
 
     // Bake every source into the database.
     emit(&format!(
-        "\nBaking {} sources ({} preset) into {}\n",
+        "\nBaking {} sources (grids: {}) into {}\n",
         sources.len(),
         a.preset
             .as_deref()
-            .unwrap_or("medium/small; RGL files adaptive"),
+            .unwrap_or("medium preset, small for anisotropic models, adaptive for RGL files"),
         db.display()
     ))?;
     let bar = crate::progress::Bar::values();
