@@ -51,7 +51,7 @@ impl Default for AdaptiveOptions {
 }
 
 /// The default node counts (θh, θd, stored φd) of an adaptive grid for measured data: 1.8 MB
-/// of f32 RGB in memory (cache resident), a quarter to a third of an RGL file on disk.
+/// of f32 RGB in memory (cache resident), a third to a half of an RGL file on disk.
 /// Measured on the seven shipped RGL files (BENCHMARKS.md, "Measured materials"): θd and φd
 /// below 48 and 25 raise the glossy films' error towards 1%; θh below 128 leaves the
 /// near-mirror peak of `cg_sunflower` (0.4° wide) under-resolved on its flanks.
