@@ -6,6 +6,9 @@
 //! its three axes (θh, θd, φd) and on three colour channels; on one register that is a third
 //! of the instructions and one latency chain instead of three.
 
+/// 2^112: an f16's exponent bias (15) moved to an f32's (127).
+const F16_BIAS: f32 = 5.192_297e33;
+
 /// Four f32 lanes (see the module docs).
 #[derive(Clone, Copy, Debug)]
 pub struct F4(
@@ -23,6 +26,60 @@ impl F4 {
     #[inline(always)]
     pub fn new(a: f32, b: f32, c: f32, d: f32) -> F4 {
         unsafe { F4(std::arch::x86_64::_mm_set_ps(d, c, b, a)) }
+    }
+    /// The pairs (a, b, c) transposed: lanes (a₀, b₀, c₀, c₀) and (a₁, b₁, c₁, c₁) (three
+    /// eight-byte loads and two shuffles).
+    #[inline(always)]
+    pub fn transpose_pairs(a: &[f32; 2], b: &[f32; 2], c: &[f32; 2]) -> (F4, F4) {
+        use std::arch::x86_64::*;
+        // SAFETY: each reference is to eight readable bytes.
+        unsafe {
+            let x = _mm_castpd_ps(_mm_loadh_pd(
+                _mm_load_sd(a.as_ptr() as *const f64),
+                b.as_ptr() as *const f64,
+            ));
+            let y = _mm_castpd_ps(_mm_load_sd(c.as_ptr() as *const f64));
+            (
+                F4(_mm_shuffle_ps::<0x08>(x, y)),
+                F4(_mm_shuffle_ps::<0x5D>(x, y)),
+            )
+        }
+    }
+    /// The first four f16 values of `v` (bits), which must each be +0 or a positive normal f16
+    /// (as [`crate::table::kernel::Packed`] stores them), in SSE2 integer operations: the bits
+    /// shifted into an f32's exponent and mantissa, times 2^112 (the exponent bias difference);
+    /// exact for those values. `None` if `v` holds fewer than four.
+    #[inline(always)]
+    pub fn from_f16_positive(v: &[u16]) -> Option<F4> {
+        use std::arch::x86_64::*;
+        if v.len() < 4 {
+            return None;
+        }
+        // SAFETY: `v` holds at least four u16, the eight bytes read.
+        unsafe {
+            let h = _mm_loadl_epi64(v.as_ptr() as *const __m128i);
+            let w = _mm_slli_epi32::<13>(_mm_unpacklo_epi16(h, _mm_setzero_si128()));
+            Some(F4(_mm_mul_ps(_mm_castsi128_ps(w), _mm_set1_ps(F16_BIAS))))
+        }
+    }
+    /// The first four f16 values of `v` (bits; any f16) with the F16C instruction; for the
+    /// values [`F4::from_f16_positive`] takes, the same result. `None` if `v` holds fewer than
+    /// four.
+    ///
+    /// # Safety
+    /// The CPU must have F16C (`is_x86_feature_detected!("f16c")`).
+    #[inline]
+    #[target_feature(enable = "f16c")]
+    pub fn from_f16_f16c(v: &[u16]) -> Option<F4> {
+        use std::arch::x86_64::*;
+        if v.len() < 4 {
+            return None;
+        }
+        // SAFETY: `v` holds at least four u16, the eight bytes read; F16C is enabled here.
+        unsafe {
+            let h = _mm_loadl_epi64(v.as_ptr() as *const __m128i);
+            Some(F4(_mm_cvtph_ps(h)))
+        }
     }
     /// Every lane x.
     #[inline(always)]
@@ -140,6 +197,21 @@ impl F4 {
     #[inline(always)]
     pub fn new(a: f32, b: f32, c: f32, d: f32) -> F4 {
         F4([a, b, c, d])
+    }
+    /// See the x86-64 version.
+    #[inline(always)]
+    pub fn transpose_pairs(a: &[f32; 2], b: &[f32; 2], c: &[f32; 2]) -> (F4, F4) {
+        (F4([a[0], b[0], c[0], c[0]]), F4([a[1], b[1], c[1], c[1]]))
+    }
+    /// See the x86-64 version.
+    #[inline(always)]
+    pub fn from_f16_positive(v: &[u16]) -> Option<F4> {
+        if v.len() < 4 {
+            return None;
+        }
+        Some(F4(std::array::from_fn(|k| {
+            f32::from_bits((v[k] as u32) << 13) * F16_BIAS
+        })))
     }
     /// Every lane x.
     #[inline(always)]
@@ -273,9 +345,36 @@ mod tests {
         assert_eq!(n.max(F4::splat(0.0)).to_array(), [0.0; 4]);
         assert_eq!(n.min(F4::splat(1.0)).to_array(), [1.0; 4]);
         assert!(F4::load(&[1.0, 2.0, 3.0]).is_none());
+        assert!(F4::from_f16_positive(&[1, 2, 3]).is_none());
+        let (x, y) = F4::transpose_pairs(&[1.0, 2.0], &[3.0, 4.0], &[5.0, 6.0]);
+        assert_eq!(
+            (x.to_array(), y.to_array()),
+            ([1.0, 3.0, 5.0, 5.0], [2.0, 4.0, 6.0, 6.0])
+        );
         assert_eq!(
             F4::load(&[1.0, 2.0, 3.0, 4.0, 5.0]).unwrap().to_array(),
             [1.0, 2.0, 3.0, 4.0]
         );
+    }
+
+    #[test]
+    fn f16_lanes_are_exact_on_positive_normals_and_zero() {
+        assert_eq!(F16_BIAS, 2f32.powi(112));
+        // Every positive normal f16 and zero, four at a time against the half crate.
+        let bits: Vec<u16> = std::iter::once(0).chain(0x0400..0x7c00).collect();
+        for q in bits.chunks(4).filter(|q| q.len() == 4) {
+            let want: Vec<f32> = q
+                .iter()
+                .map(|&b| half::f16::from_bits(b).to_f32())
+                .collect();
+            let got = F4::from_f16_positive(q).unwrap().to_array();
+            assert_eq!(&got[..], &want[..], "{q:?}");
+            #[cfg(target_arch = "x86_64")]
+            if std::is_x86_feature_detected!("f16c") {
+                // SAFETY: F16C is present (just detected).
+                let h = unsafe { F4::from_f16_f16c(q) }.unwrap().to_array();
+                assert_eq!(h, got, "{q:?}");
+            }
+        }
     }
 }

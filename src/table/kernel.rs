@@ -13,9 +13,11 @@
 //!   factor sin θh |h|², d_x ∝ h_z (h_x ωi_x + h_y ωi_y) − (h_x² + h_y²) ωi_z and
 //!   d_y ∝ |h| (h_x ωi_y − h_y ωi_x), and the pseudo-angle of φd is a ratio of these.
 //!
-//! Then per axis one knot interpolation gives the fractional node index, and eight corners
-//! (λ innermost: two runs of 2 × channels adjacent values per (θh, θd) pair) are blended in
-//! f32. [`Kernel::eval`] is tested against the reference path (angles through
+//! Then per axis one line on the variable's knot interval (one eight-byte load) gives the
+//! fractional node index, and eight corners (λ innermost: two runs of 2 × channels adjacent
+//! values per (θh, θd) pair) are blended in f32 from the table's f16 codes ([`Packed`]: half
+//! the bytes, so a measured material's table stays in L2; expanded with F16C when the CPU has
+//! it, chosen once per kernel). [`Kernel::eval`] is tested against the reference path (angles through
 //! [`super::symmetry::canonical_coords`] and [`super::StoredAxis::linear`]) in this module's
 //! tests.
 
@@ -26,17 +28,116 @@ use crate::simd::F4;
 use crate::table::grid::{Grid, Mapping, Nodes, Param};
 use crate::table::warp::{Warp, WarpVar};
 
-/// One warped axis as the kernel reads it: fractional node index s at the knots.
+/// A kernel table's values as its lookups read them: f16, scaled by a power of two.
+///
+/// Half the bytes of f32, so a measured material's table (≈ 0.9 MB) stays in a core's L2
+/// cache, and a corner row (two φd corners × RGB) is 12 bytes. The scale 2^e puts the largest
+/// value in [2^14, 2^15), well inside f16's range; values below 2^-14 after scaling (2^-28 of
+/// the largest and less) are stored as 0, so every code is +0 or a positive normal f16 and
+/// expands exactly with [`F4::from_f16_positive`] (or F16C). The rounding costs at most
+/// 2^-11 of a value (f16's half ulp), far below a measured table's interpolation error.
+/// Negative values (unmeasured cells, set aside by [`super::TabulatedBrdf`]) are stored as 0.
+#[derive(Debug, Clone)]
+pub struct Packed {
+    /// The codes, then [`PACK_PAD`] zeros (a row's second four-value load reads past its end).
+    bits: Box<[u16]>,
+    /// 2^−e: multiplies the blended scaled values (exact).
+    unscale: f32,
+}
+
+/// Zero codes after a [`Packed`] table's values.
+const PACK_PAD: usize = 4;
+
+impl Packed {
+    /// Packs `values` (finite; negative and non-finite ones become 0).
+    pub fn new(values: &[f32]) -> Packed {
+        let max = values
+            .iter()
+            .filter(|x| x.is_finite())
+            .fold(0f32, |m, &x| m.max(x));
+        // max · 2^e ∈ [2^14, 2^15): e = 14 − ⌊log2 max⌋, read off max's exponent bits (exact);
+        // within f32's normal exponents.
+        let e = if max >= f32::MIN_POSITIVE {
+            (14 - (((max.to_bits() >> 23) & 0xff) as i32 - 127)).clamp(-120, 120)
+        } else if max > 0.0 {
+            120
+        } else {
+            0
+        };
+        let pow2 = |e: i32| f32::from_bits(((e + 127) as u32) << 23);
+        let scale = pow2(e);
+        let min_normal = half::f16::MIN_POSITIVE.to_f32();
+        let bits = values
+            .iter()
+            .map(|&v| {
+                let x = v * scale;
+                if x >= min_normal && x.is_finite() {
+                    half::f16::from_f32(x).to_bits()
+                } else {
+                    0
+                }
+            })
+            .chain(std::iter::repeat_n(0, PACK_PAD))
+            .collect();
+        Packed {
+            bits,
+            unscale: pow2(-e),
+        }
+    }
+
+    /// No values (a table that could not be loaded: every lookup gives 0).
+    pub fn empty() -> Packed {
+        Packed {
+            bits: Box::new([]),
+            unscale: 1.0,
+        }
+    }
+
+    /// Number of values (0 for [`Packed::empty`]).
+    pub fn len(&self) -> usize {
+        self.bits.len().saturating_sub(PACK_PAD)
+    }
+
+    /// Whether no values are held.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.bits.len() * std::mem::size_of::<u16>()
+    }
+
+    /// Value `i` as lookups see it (0 beyond the end).
+    pub fn get(&self, i: usize) -> f32 {
+        if i >= self.len() {
+            return 0.0;
+        }
+        half::f16::from_bits(self.bits[i]).to_f32() * self.unscale
+    }
+
+    /// The scaled value of code `i` (0 beyond the end).
+    #[inline(always)]
+    fn scaled(&self, i: usize) -> f32 {
+        self.bits
+            .get(i)
+            .map_or(0.0, |&b| half::f16::from_bits(b).to_f32())
+    }
+}
+
+/// One warped axis as the kernel reads it: the fractional node index s as a line in t = v·K
+/// on each knot interval.
 #[derive(Debug, Clone)]
 struct Axis {
-    /// s = u·(n − 1) at v = k/K, k = 0..=K.
-    s: Box<[f32]>,
+    /// Interval j (t ∈ [j, j + 1]): s = c + t·d, as `[c, d]`, where s = u·(n − 1) (edges)
+    /// or u·n − ½ (centres) at the knots. One eight-byte load per lookup and no t − j.
+    lines: Box<[[f32; 2]]>,
     /// K as f32.
     k: f32,
     /// Number of nodes (≥ 2).
     n: usize,
     /// The last knot interval (K − 1).
-    kmax: i32,
+    kmax: u32,
     /// The last lower node (n − 2).
     imax: i32,
 }
@@ -45,32 +146,54 @@ impl Axis {
     /// `centers`: node i at u = (i + ½)/n, s = u·n − ½; otherwise at u = i/(n − 1).
     fn new(w: &Warp, n: usize, centers: bool) -> Axis {
         let (scale, shift) = if centers {
-            (n as f32, -0.5)
+            (n as f64, -0.5)
         } else {
-            ((n - 1) as f32, 0.0)
+            ((n - 1) as f64, 0.0)
         };
+        let s: Vec<f64> = w
+            .knots()
+            .iter()
+            .map(|&u| u as f64 * scale + shift)
+            .collect();
+        let lines = s
+            .windows(2)
+            .enumerate()
+            .map(|(j, p)| {
+                let d = p[1] - p[0];
+                [(p[0] - j as f64 * d) as f32, d as f32]
+            })
+            .collect();
         Axis {
-            s: w.knots().iter().map(|&u| u * scale + shift).collect(),
+            lines,
             k: (w.knots().len() - 1) as f32,
             n,
-            kmax: (w.knots().len() - 2) as i32,
+            kmax: (w.knots().len() - 2) as u32,
             imax: (n - 2) as i32,
         }
     }
 
-    /// The lower node and the weight of the upper one at variable `v` (clamped to [0, 1]).
+    /// The line of knot interval `j` (clamped to the last; a negative j — never made — to it
+    /// too).
+    #[inline(always)]
+    fn line(&self, j: i32) -> &[f32; 2] {
+        let j = (j as u32).min(self.kmax) as usize;
+        // `lines` has kmax + 1 entries.
+        &self.lines[j]
+    }
+
+    /// The lower node and the weight of the upper one at variable `v` ∈ [0, 1] (the scalar
+    /// reference of the lane code in [`Kernel::eval_rgb`], the same operations).
     ///
     /// Indices go through i32: a saturating f32 → usize conversion costs about three times as
     /// many instructions, and every value here is in [0, 2^16].
     #[inline(always)]
     fn node(&self, v: f32) -> (usize, f32) {
-        // max/min, not clamp: NaN becomes 0 instead of propagating.
-        let t = (v * self.k).max(0.0).min(self.k);
-        let j = (t as i32).min(self.kmax);
-        let (a, b) = (self.s[j as usize], self.s[j as usize + 1]);
-        let s = a + (t - j as f32) * (b - a);
-        let i = (s as i32).clamp(0, self.imax);
-        (i as usize, (s - i as f32).clamp(0.0, 1.0))
+        let t = v * self.k;
+        // max/min, not clamp: NaN becomes the bound instead of propagating.
+        let [c, d] = *self.line(t.min(self.k - 0.5) as i32);
+        let s = (c + t * d).max(0.0).min((self.n - 1) as f32);
+        let i = (s.min(self.n as f32 - 1.5) as i32).clamp(0, self.imax);
+        (i as usize, s - i as f32)
     }
 }
 
@@ -88,6 +211,8 @@ pub struct Kernel {
     /// Lane constants of [`Kernel::eval_rgb`]: K per axis, K − ½ (the last knot interval's
     /// truncation bound), n − 1 and n − 1.5 per axis; lane 3 is unused (0).
     lanes: [F4; 4],
+    /// The CPU has F16C (checked once, at construction): RGB lookups expand codes with it.
+    f16c: bool,
 }
 
 impl Kernel {
@@ -139,6 +264,7 @@ impl Kernel {
             axes,
             quarter: s.reciprocal,
             channels,
+            f16c: has_f16c(),
         })
     }
 
@@ -212,16 +338,19 @@ impl Kernel {
         Some(v)
     }
 
-    /// Evaluates into `out[..channels]` from the table's stored `values` (all chunks, in
-    /// order; corners beyond its end — an empty slice when the table could not be loaded —
+    /// Evaluates into `out[..channels]` from the table's `values` (all chunks, in order, packed;
+    /// corners beyond its end — none for [`Packed::empty`], a table that could not be loaded —
     /// count as 0).
     #[inline]
-    pub fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &[f32]) {
+    pub fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &Packed) {
         if self.channels == 3 {
-            match self.vars_lanes(wi, wo) {
-                Some(v) => self.eval_rgb(v, out, values),
-                None => out[..3].fill(0.0),
+            #[cfg(target_arch = "x86_64")]
+            if self.f16c {
+                // SAFETY: `f16c` is set only when the CPU has F16C (`has_f16c`).
+                unsafe { self.rgb_f16c(wi, wo, out, values) };
+                return;
             }
+            self.rgb::<false>(wi, wo, out, values);
             return;
         }
         let Some(v) = self.vars(wi, wo) else {
@@ -229,9 +358,24 @@ impl Kernel {
             return;
         };
         match self.channels {
-            3 => self.blend::<3>(v, out, values),
             1 => self.blend::<1>(v, out, values),
             _ => self.blend::<0>(v, out, values),
+        }
+    }
+
+    /// The RGB lookup compiled with F16C (and the VEX encoding it brings).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "f16c")]
+    fn rgb_f16c(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &Packed) {
+        self.rgb::<true>(wi, wo, out, values);
+    }
+
+    /// The RGB lookup; `F16C`: expand codes with F16C (only inside [`Kernel::rgb_f16c`]).
+    #[inline(always)]
+    fn rgb<const F16C: bool>(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &Packed) {
+        match self.vars_lanes(wi, wo) {
+            Some(v) => self.eval_rgb::<F16C>(v, out, values),
+            None => out[..3].fill(0.0),
         }
     }
 
@@ -240,24 +384,22 @@ impl Kernel {
     /// as two four-lane loads (RGB of the two φd corners; the fourth lane is ignored). Computes
     /// the same operations as `blend::<3>`, which stays as its reference (tested equal).
     #[inline(always)]
-    fn eval_rgb(&self, v: F4, out: &mut [f32], values: &[f32]) {
+    fn eval_rgb<const F16C: bool>(&self, v: F4, out: &mut [f32], values: &Packed) {
         let [k, kcap, nmax, ncap] = self.lanes;
         let zero = F4::splat(0.0);
         // Knot interval j and its fraction per axis (lane 3: 0).
         // v ∈ [0, 1] by construction (each is a ratio bounded by 1), so t ∈ [0, K] up to
         // rounding; the truncation bound K − ½ keeps j ≤ K − 1 (and maps NaN there too).
         let t = v * k;
-        let (j, jf) = t.min(kcap).trunc();
-        let f = t - jf;
-        let knot = |a: usize, d: usize| {
-            let s = &self.axes[a].s;
-            s.get(j[a] as usize + d).copied().unwrap_or(0.0)
-        };
-        let lo = F4::new(knot(0, 0), knot(1, 0), knot(2, 0), 0.0);
-        let hi = F4::new(knot(0, 1), knot(1, 1), knot(2, 1), 0.0);
+        let (j, _) = t.min(kcap).trunc();
+        let (c, d) = F4::transpose_pairs(
+            self.axes[0].line(j[0]),
+            self.axes[1].line(j[1]),
+            self.axes[2].line(j[2]),
+        );
         // Fractional node index s, clamped to [0, n − 1] (beyond the first and last cell
         // centres the end values hold), its lower node (≤ n − 2) and the upper one's weight.
-        let s = (lo + f * (hi - lo)).max(zero).min(nmax);
+        let s = (c + t * d).max(zero).min(nmax);
         let (i, if_) = s.min(ncap).trunc();
         let w = s - if_;
         let om = F4::splat(1.0) - w;
@@ -265,28 +407,38 @@ impl Kernel {
         let rw = F4::pair_lanes::<0>(om, w) * F4::interleave_lo(om.lane::<1>(), w.lane::<1>());
         let (p0, p1) = (rw * om.lane::<2>(), rw * w.lane::<2>());
         let o = i[0] as usize * self.chunk + i[1] as usize * self.row + i[2] as usize * 3;
-        let rows = [o, o + self.row, o + self.chunk, o + self.chunk + self.row];
         let mut acc = zero;
-        let mut add = |r: usize, w0: F4, w1: F4| {
-            // The row's six values r..r+6: lanes 0..3 at r (φd corner 0) and at r + 3 (corner
-            // 1), the latter loaded from r + 2 and shifted down so that no read passes r + 6.
-            if let Some(x) = values.get(r..r + 6)
-                && let (Some(a), Some(b)) = (F4::load(x), F4::load(&x[2..]))
-            {
-                acc = acc + (w0 * a + w1 * b.shift_down());
+        let load = |x: &[u16]| {
+            if F16C {
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: `F16C` is true only in `rgb_f16c`, which runs when the CPU has F16C.
+                return unsafe { F4::from_f16_f16c(x) };
             }
+            F4::from_f16_positive(x)
         };
-        add(rows[0], p0.lane::<0>(), p1.lane::<0>());
-        add(rows[1], p0.lane::<1>(), p1.lane::<1>());
-        add(rows[2], p0.lane::<2>(), p1.lane::<2>());
-        add(rows[3], p0.lane::<3>(), p1.lane::<3>());
-        let [r, g, b, _] = acc.to_array();
+        // The four rows' codes, all within o .. o + chunk + row + 7 (one bounds check; only an
+        // empty table fails it).
+        if let Some(x) = values.bits.get(o..o + self.chunk + self.row + 7) {
+            let mut add = |r: usize, w0: F4, w1: F4| {
+                // The row's six codes r..r+6: four at r (φd corner 0 in lanes 0..3) and four at
+                // r + 3 (corner 1; the fourth lane reads the next row or the padding, ignored).
+                if let (Some(a), Some(b)) = (load(&x[r..]), load(&x[r + 3..])) {
+                    acc = acc + (w0 * a + w1 * b);
+                }
+            };
+            add(0, p0.lane::<0>(), p1.lane::<0>());
+            add(self.row, p0.lane::<1>(), p1.lane::<1>());
+            add(self.chunk, p0.lane::<2>(), p1.lane::<2>());
+            add(self.chunk + self.row, p0.lane::<3>(), p1.lane::<3>());
+        }
+        let [r, g, b, _] = (acc * F4::splat(values.unscale)).to_array();
         out[..3].copy_from_slice(&[r, g, b]);
     }
 
-    /// Trilinear blend of the eight corners; `N` > 0: exactly N channels in registers.
+    /// Trilinear blend of the eight corners; `N` > 0: exactly N channels in registers. The
+    /// reference of [`Kernel::eval_rgb`] (which computes the same operations in lanes).
     #[inline(always)]
-    fn blend<const N: usize>(&self, v: [f32; 3], out: &mut [f32], values: &[f32]) {
+    fn blend<const N: usize>(&self, v: [f32; 3], out: &mut [f32], values: &Packed) {
         let c = if N > 0 { N } else { self.channels };
         let (ih, th) = self.axes[0].node(v[0]);
         let (id, td) = self.axes[1].node(v[1]);
@@ -302,28 +454,31 @@ impl Kernel {
         ];
         let (wp0, wp1) = (1.0 - tp, tp);
         let out = &mut out[..c];
-        if N > 0 {
-            let mut acc = [0f32; N];
-            for (r, w) in rows.iter().zip(w) {
-                if let Some(x) = values.get(*r..*r + 2 * N) {
-                    let (w0, w1) = (w * wp0, w * wp1);
-                    for k in 0..N {
-                        acc[k] += w0 * x[k] + w1 * x[N + k];
-                    }
-                }
-            }
-            out.copy_from_slice(&acc);
-        } else {
-            out.fill(0.0);
-            for (r, w) in rows.iter().zip(w) {
-                if let Some(x) = values.get(*r..*r + 2 * c) {
-                    let (w0, w1) = (w * wp0, w * wp1);
-                    for k in 0..c {
-                        out[k] += w0 * x[k] + w1 * x[c + k];
-                    }
+        out.fill(0.0);
+        let n = values.len();
+        for (r, w) in rows.iter().zip(w) {
+            if *r + 2 * c <= n {
+                let (w0, w1) = (w * wp0, w * wp1);
+                for (k, o) in out.iter_mut().enumerate() {
+                    *o += w0 * values.scaled(r + k) + w1 * values.scaled(r + c + k);
                 }
             }
         }
+        for x in out.iter_mut() {
+            *x *= values.unscale;
+        }
+    }
+}
+
+/// Whether the CPU has F16C (x86-64 only).
+fn has_f16c() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("f16c")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
     }
 }
 
@@ -389,7 +544,38 @@ mod tests {
             row: 2,
             chunk: 4,
             lanes: [per(1.0), per(0.5), per(1.0), per(0.5)],
+            f16c: false,
         }
+    }
+
+    #[test]
+    fn packed_values_round_to_f16_within_half_an_ulp() {
+        for peak in [1e-3f32, 0.7, 3.0e4, 1.0e7] {
+            let mut r = Pcg32::new(5);
+            let v: Vec<f32> = (0..20_000)
+                .map(|i| match i {
+                    0 => peak,
+                    1 => -1.0,
+                    2 => f32::NAN,
+                    // log-uniform over 2^-40 .. 1 of the peak
+                    _ => peak * 2f32.powf(-40.0 * r.next_f64() as f32),
+                })
+                .collect();
+            let p = Packed::new(&v);
+            assert_eq!(p.len(), v.len());
+            assert_eq!((p.get(1), p.get(2), p.get(v.len())), (0.0, 0.0, 0.0));
+            for (i, &x) in v.iter().enumerate().skip(3).chain([(0, &peak)]) {
+                let y = p.get(i);
+                if x >= peak * 2f32.powi(-28) {
+                    // f16 keeps 11 significant bits: round to nearest is within 2^-11.
+                    assert!((y - x).abs() <= x * 2f32.powi(-11), "{x} {y} (peak {peak})");
+                } else if x < peak * 2f32.powi(-29) {
+                    assert_eq!(y, 0.0, "{x} (peak {peak})");
+                }
+            }
+        }
+        assert!(Packed::new(&[]).is_empty() && Packed::empty().is_empty());
+        assert_eq!(Packed::new(&[0.0; 3]).get(1), 0.0);
     }
 
     #[test]
@@ -440,26 +626,32 @@ mod tests {
             let k = Kernel::new(t.grid()).expect("an adaptive grid has a kernel");
             let general = Lookup::new(t.grid());
             let tb = TabulatedBrdf::from_table(t.clone());
+            let packed = Packed::new(t.values());
             let mut r = Pcg32::new(32);
             let (mut a, mut b, mut c, mut d) = ([0f32; 3], [0f32; 3], [0f32; 3], [0f32; 3]);
+            let mut soft = [0f32; 3];
             let peak = t.values().iter().fold(0f32, |m, &x| m.max(x));
             let mut worst = 0f32;
             for _ in 0..50_000 {
                 let (wi, wo) = random_pair(&mut r);
-                k.eval(wi, wo, &mut a, t.values());
+                k.eval(wi, wo, &mut a, &packed);
+                // Without F16C (the integer expansion) exactly the same.
+                k.rgb::<false>(wi, wo, &mut soft, &packed);
+                assert_eq!(a, soft, "{wi} {wo}");
                 general.eval(Interp::Linear, wi, wo, &mut b, |i| t.chunk(i));
                 tb.eval(wi, wo, &mut c);
                 // The four-lane RGB path against its scalar reference, `blend::<3>`.
                 if let Some(v) = k.vars(wi, wo) {
-                    k.blend::<3>(v, &mut d, t.values());
+                    k.blend::<3>(v, &mut d, &packed);
                     for ch in 0..3 {
                         assert!((a[ch] - d[ch]).abs() <= 1e-6 * d[ch].abs(), "{a:?} {d:?}");
                     }
                 }
                 for ch in 0..3 {
-                    // Both interpolate the same nodes; they differ by the f32 variables (a
-                    // few 1e-7) times the slope in node units, below 1e-3 of the value plus
-                    // 1e-4 of the table's peak.
+                    // Both interpolate the same nodes; they differ by the values' f16
+                    // rounding (≤ 2^-11 of each, so of the blend of these positive values) and
+                    // the f32 variables (a few 1e-7) times the slope in node units: below 1e-3
+                    // of the value plus 1e-4 of the table's peak.
                     let e = (a[ch] - b[ch]).abs() / (b[ch].abs() * 1e-3 + peak * 1e-4);
                     worst = worst.max(e);
                     assert_eq!(a[ch], c[ch], "TabulatedBrdf uses the kernel");

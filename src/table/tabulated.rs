@@ -34,7 +34,7 @@ use crate::geometry::HalfDiff;
 use crate::spectrum::Channels;
 use crate::table::Table;
 use crate::table::grid::{Grid, Param};
-use crate::table::kernel::Kernel;
+use crate::table::kernel::{Kernel, Packed};
 use crate::table::lookup::{Interp, Lookup, Prepared};
 use crate::table::sampling::{SamplingResolution, TableSampler};
 
@@ -67,11 +67,12 @@ pub struct TabulatedBrdf {
     grid: Grid,
     lookup: Lookup,
     /// The fast linear lookup of adaptive grids ([`super::kernel`]), when it applies. Such a
-    /// table is small (it is meant to stay in cache) and is held in `dense`, all chunks in one
-    /// array, instead of `chunks`.
+    /// table is small (it is meant to stay in cache): its lookups read `packed`, all chunks in
+    /// one f16 array; `chunks` are then loaded only for other readers (nearest lookups,
+    /// [`TabulatedBrdf::to_table`], [`Brdf::stored_node`]).
     kernel: Option<Kernel>,
-    /// Every chunk, contiguous (tables with a kernel only), loaded on first use.
-    dense: OnceLock<Box<[f32]>>,
+    /// Every chunk, contiguous and packed (tables with a kernel only), loaded on first use.
+    packed: OnceLock<Packed>,
     chunks: Box<[OnceLock<Arc<[f32]>>]>,
     /// Per chunk, the negative stored values (offset in the chunk, value) that `chunks` holds as
     /// 0; set when the chunk is loaded (see the module docs).
@@ -105,20 +106,16 @@ impl TabulatedBrdf {
         for i in 0..l.chunk_count() {
             let v = &mut values[l.chunk_range(i)];
             unmeasured.push(OnceLock::from(set_aside_negatives(v)));
-            chunks.push(if kernel.is_some() {
-                OnceLock::new()
-            } else {
-                OnceLock::from(Arc::<[f32]>::from(&*v))
-            });
+            chunks.push(OnceLock::from(Arc::<[f32]>::from(&*v)));
         }
-        let dense = match kernel {
-            Some(_) => OnceLock::from(values.into_boxed_slice()),
+        let packed = match kernel {
+            Some(_) => OnceLock::from(Packed::new(&values)),
             None => OnceLock::new(),
         };
         TabulatedBrdf {
             lookup: Lookup::new(&grid),
             kernel,
-            dense,
+            packed,
             grid,
             chunks: chunks.into(),
             unmeasured: unmeasured.into(),
@@ -145,7 +142,7 @@ impl TabulatedBrdf {
         TabulatedBrdf {
             lookup: Lookup::new(&grid),
             kernel: Kernel::new(&grid),
-            dense: OnceLock::new(),
+            packed: OnceLock::new(),
             grid,
             chunks,
             unmeasured,
@@ -248,11 +245,10 @@ impl TabulatedBrdf {
 
     /// Number of chunks currently loaded.
     pub fn loaded_chunks(&self) -> usize {
-        if self.kernel.is_some() {
-            return match self.dense.get() {
-                Some(d) if !d.is_empty() => self.chunks.len(),
-                _ => 0,
-            };
+        if let Some(p) = self.packed.get()
+            && !p.is_empty()
+        {
+            return self.chunks.len();
         }
         self.chunks.iter().filter(|c| c.get().is_some()).count()
     }
@@ -260,7 +256,7 @@ impl TabulatedBrdf {
     /// Bytes of decoded values this table holds in memory now (what a lookup reads).
     pub fn resident_bytes(&self) -> usize {
         let f = std::mem::size_of::<f32>();
-        let dense = self.dense.get().map_or(0, |d| d.len() * f);
+        let packed = self.packed.get().map_or(0, |p| p.bytes());
         let chunks: usize = self
             .chunks
             .iter()
@@ -273,16 +269,25 @@ impl TabulatedBrdf {
             .filter_map(|u| u.get())
             .map(|u| u.len() * std::mem::size_of::<(u32, f32)>())
             .sum();
-        dense + chunks + unmeasured
+        packed + chunks + unmeasured
     }
 
-    /// All chunks in one array (tables with a kernel), decoded on first use; empty when a chunk
-    /// could not be loaded (the error is recorded, lookups give 0).
+    /// All chunks in one packed array (tables with a kernel), decoded on first use (without
+    /// keeping the f32 chunks); empty when a chunk could not be loaded (the error is recorded,
+    /// lookups give 0).
     #[cold]
-    fn load_dense(&self) -> Box<[f32]> {
+    fn load_packed(&self) -> Packed {
         let l = self.grid.layout();
         let mut all = Vec::with_capacity(l.len());
         for a in 0..l.chunk_count() {
+            if let Some(c) = self.chunks[a].get() {
+                if c.len() != l.chunk_len(a) {
+                    // A chunk that failed to load (its error is recorded).
+                    return Packed::empty();
+                }
+                all.extend_from_slice(c);
+                continue;
+            }
             match self.fetch(a) {
                 Ok(mut v) => {
                     let _ = self.unmeasured[a].set(set_aside_negatives(&mut v));
@@ -292,18 +297,18 @@ impl TabulatedBrdf {
                     if let Ok(mut first) = self.error.lock() {
                         first.get_or_insert(e);
                     }
-                    return Box::new([]);
+                    return Packed::empty();
                 }
             }
         }
-        all.into_boxed_slice()
+        Packed::new(&all)
     }
 
     #[inline(always)]
-    fn dense(&self) -> &[f32] {
-        match self.dense.get() {
-            Some(d) => d,
-            None => self.dense.get_or_init(|| self.load_dense()),
+    fn packed(&self) -> &Packed {
+        match self.packed.get() {
+            Some(p) => p,
+            None => self.packed.get_or_init(|| self.load_packed()),
         }
     }
 
@@ -323,10 +328,6 @@ impl TabulatedBrdf {
 
     #[inline(always)]
     fn chunk(&self, a: usize) -> &[f32] {
-        if self.kernel.is_some() {
-            let d = self.dense();
-            return d.get(self.grid.layout().chunk_range(a)).unwrap_or(&[]);
-        }
         match self.chunks.get(a) {
             Some(c) => match c.get() {
                 Some(v) => v,
@@ -410,7 +411,7 @@ impl Brdf for TabulatedBrdf {
     #[inline]
     fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
         match &self.kernel {
-            Some(k) if self.interp == Interp::Linear => k.eval(wi, wo, out, self.dense()),
+            Some(k) if self.interp == Interp::Linear => k.eval(wi, wo, out, self.packed()),
             _ => self
                 .lookup
                 .eval(self.interp, wi, wo, out, |a| self.chunk(a)),

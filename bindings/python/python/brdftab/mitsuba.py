@@ -298,13 +298,20 @@ class JitTable:
             for k in (0, 2, 3):
                 knots = np.asarray(self.axes[k]["mapping"]["warp"]["knots"], np.float32)
                 n = self.axes[k]["size"]
-                # s = u·n − ½ (centers) or u·(n − 1) (edges) in float32, as Axis::new in kernel.rs.
+                # Axis::new in kernel.rs: s = u·n − ½ (centers) or u·(n − 1) (edges) in float64,
+                # and on knot interval j the line s = c + t·d (t = v·K), c and d in float32.
                 if self.axes[k]["nodes"] == "centers":
-                    s_ = knots * np.float32(n) + np.float32(-0.5)
+                    s_ = knots.astype(np.float64) * float(n) + -0.5
                 else:
-                    s_ = knots * np.float32(n - 1)
-                ks.append((mi.Float(s_), float(len(knots) - 1), n))
+                    s_ = knots.astype(np.float64) * float(n - 1) + 0.0
+                d = np.diff(s_)
+                c = s_[:-1] - np.arange(len(d), dtype=np.float64) * d
+                ks.append((mi.Float(c.astype(np.float32)), mi.Float(d.astype(np.float32)),
+                           float(len(knots) - 1), n))
             self.kernel = ks
+            # Packed::new in kernel.rs: the kernel reads f16 codes of the values scaled by 2^e.
+            self.kernel_values = mi.Float(kernel_values(values).ravel())
+            dr.eval(self.kernel_values)
 
     # -- symmetry.rs: canonical coordinates ----------------------------------------------
     def coords(self, wi, wo):
@@ -553,14 +560,11 @@ class JitTable:
         else:
             vp = dr.select(den > 0, 0.5 - 0.5 * (dx / safe), 0.0)
         nodes = []
-        for (s_, k, n), v in zip(self.kernel, (vh, vd, vp)):
+        for (c_, d_, k, n), v in zip(self.kernel, (vh, vd, vp)):
             t = v * k
-            j = dr.trunc(dr.minimum(t, k - 0.5))
-            f = t - j
-            ju = U(j)
-            a = dr.gather(Fl, s_, ju)
-            b = dr.gather(Fl, s_, ju + 1)
-            sv = dr.minimum(dr.maximum(a + f * (b - a), 0.0), n - 1.0)
+            ju = U(dr.trunc(dr.minimum(t, k - 0.5)))
+            sv = dr.gather(Fl, c_, ju) + t * dr.gather(Fl, d_, ju)
+            sv = dr.minimum(dr.maximum(sv, 0.0), n - 1.0)
             i = dr.trunc(dr.minimum(sv, n - 1.5))
             nodes.append((U(i), sv - i))
         (ih, th), (id_, td), (ip, tp) = nodes
@@ -574,10 +578,29 @@ class JitTable:
         for r, w in rows:
             w0, w1 = w * op, w * tp
             for ch in range(c):
-                x0 = dr.gather(Fl, self.values, r + ch, valid)
-                x1 = dr.gather(Fl, self.values, r + c + ch, valid)
+                x0 = dr.gather(Fl, self.kernel_values, r + ch, valid)
+                x1 = dr.gather(Fl, self.kernel_values, r + c + ch, valid)
                 out[ch] = out[ch] + (w0 * x0 + w1 * x1)
         return [dr.select(valid, x, 0.0) for x in out]
+
+
+def kernel_values(values):
+    """The values as the Rust kernel (``Packed::new`` in ``src/table/kernel.rs``) reads them:
+    scaled by 2^e so that the largest finite one lies in [2^14, 2^15), rounded to float16 (to
+    nearest even), scaled values below 2^-14 (and negative or non-finite ones) set to 0, and
+    scaled back (exactly: a power of two). Returns float32 values of the same shape."""
+    v = np.asarray(values, np.float32)
+    fin = v[np.isfinite(v)]
+    mx = max(float(fin.max()), 0.0) if fin.size else 0.0
+    if mx >= float(np.finfo(np.float32).tiny):
+        e = int(np.clip(14 - (int(np.frexp(np.float32(mx))[1]) - 1), -120, 120))
+    else:
+        e = 120 if mx > 0 else 0
+    x = v * np.float32(2.0**e)
+    with np.errstate(invalid="ignore"):
+        keep = np.isfinite(x) & (x >= np.float32(2.0**-14))
+    q = np.where(keep, x, np.float32(0)).astype(np.float16).astype(np.float32)
+    return q * np.float32(2.0**-e)
 
 
 class JitBrdftabBSDF(_Common):
