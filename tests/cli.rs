@@ -149,6 +149,44 @@ fn bad_arguments_are_errors() {
 }
 
 #[test]
+fn bake_target_error_reports_the_search_and_names_its_flag() {
+    let out = std::env::temp_dir().join(format!("brdftab-cli-target-{}.btdb", std::process::id()));
+    let out = out.to_string_lossy().into_owned();
+    let ggx = r#"{"model": "ggx", "alpha": 0.3}"#;
+    let o = run(&["bake", ggx, "-o", &out, "--target-error", "1%"], "");
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("note: target error 1.00%: met by"),
+        "{}",
+        o.stderr
+    );
+    for bad in [
+        "--target-error=abc",
+        "--target-error=0",
+        "--target-error=-1%",
+    ] {
+        let o = run(&["bake", ggx, "-o", &out, bad], "");
+        assert_error(&o, "--target-error");
+    }
+    // A fixed grid cannot take a target: the library's refusal names the flag.
+    let o = run(
+        &[
+            "bake",
+            ggx,
+            "-o",
+            &out,
+            "--preset",
+            "small",
+            "--target-error",
+            "1%",
+        ],
+        "",
+    );
+    assert_error(&o, "--target-error");
+    let _ = std::fs::remove_file(&out);
+}
+
+#[test]
 fn help_and_version_succeed() {
     let o = run(&["--help"], "");
     assert_eq!(o.code, 0);

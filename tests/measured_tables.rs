@@ -38,6 +38,11 @@ fn rgl_defaults_meet_size_error_and_memory_bars() {
             matches!(report.grid.stored_axes()[0].mapping, Mapping::Warp(_)),
             "{name}: the default grid of an RGL file is adaptive"
         );
+        // Its node counts come from the default error target, which the search met.
+        let t = report.target.as_ref().expect("the default bake searched");
+        assert_eq!(t.target, brdftab::bake::MEASURED_TARGET_ERROR);
+        assert!(t.met && t.error <= t.target, "{name}: {}", t.summary());
+        assert_eq!(report.grid.stored_shape()[0], t.nodes[0]);
         let rgl_bytes = std::fs::metadata(&f).unwrap().len();
         let table_bytes = std::fs::metadata(&out).unwrap().len();
         assert!(

@@ -50,11 +50,10 @@ impl Default for AdaptiveOptions {
     }
 }
 
-/// The default node counts (θh, θd, stored φd) of an adaptive grid for measured data: 1.8 MB
-/// of f32 RGB in memory (cache resident), a third to a half of an RGL file on disk.
-/// Measured on the seven shipped RGL files (BENCHMARKS.md, "Measured materials"): θd and φd
-/// below 48 and 25 raise the glossy films' error towards 1%; θh below 128 leaves the
-/// near-mirror peak of `cg_sunflower` (0.4° wide) under-resolved on its flanks.
+/// The node counts (θh, θd, stored φd) of an adaptive grid asked for without counts or an
+/// error target (RGL files' default bakes search the counts: [`crate::table::target`]): 1.8 MB
+/// of f32 RGB, a third to a half of an RGL file on disk, within 1 % of every shipped RGL file
+/// on average (BENCHMARKS.md, "Measured materials").
 pub const DEFAULT_NODES: [usize; 3] = [128, 48, 25];
 
 /// The warp variables of the three axes.
@@ -76,8 +75,37 @@ pub fn adaptive_grid(src: &dyn Brdf, symmetry: Symmetry, opts: &AdaptiveOptions)
             "an adaptive grid needs at least 2 nodes and 4 fine samples per axis",
         ));
     }
-    let phi_hi = if symmetry.reciprocal { FRAC_PI_2 } else { PI };
-    let warps = fit_warps(src, phi_hi, opts)?;
+    let warps = fit_warps(src, phi_hi(symmetry), opts)?;
+    grid_with_warps(src.channels().clone(), symmetry, opts.nodes, warps)
+}
+
+/// The end of the stored φd axis: π, or π/2 with reciprocity.
+pub fn phi_hi(symmetry: Symmetry) -> f64 {
+    if symmetry.reciprocal { FRAC_PI_2 } else { PI }
+}
+
+/// The adaptive grid of `nodes` (θh, θd, stored φd) on already fitted `warps` (from
+/// [`fit_warps`] with [`phi_hi`] of `symmetry`): the warps do not depend on the node counts, so
+/// grids of several sizes share one fit.
+pub fn grid_with_warps(
+    channels: crate::spectrum::Channels,
+    symmetry: Symmetry,
+    nodes: [usize; 3],
+    warps: [Warp; 3],
+) -> Result<Grid> {
+    if !(symmetry.isotropic && symmetry.bilateral) {
+        return Err(Error::arg(
+            "grid",
+            format!("an adaptive grid needs an isotropic, bilateral source (it is {symmetry})"),
+        ));
+    }
+    let [nh, nd, np] = nodes;
+    if nh < 2 || nd < 2 || np < 2 {
+        return Err(Error::arg(
+            "grid",
+            "an adaptive grid needs at least 2 nodes per axis",
+        ));
+    }
     let [wh, wd, wp] = warps;
     // Full φd size: the stored np nodes over [0, hi] mirrored over [0, 2π).
     let full_phi = if symmetry.reciprocal {
@@ -97,7 +125,7 @@ pub fn adaptive_grid(src: &dyn Brdf, symmetry: Symmetry, opts: &AdaptiveOptions)
                 nodes: Nodes::Edges,
             },
         ],
-        src.channels().clone(),
+        channels,
         symmetry,
     )
 }

@@ -28,6 +28,7 @@ pub mod raw;
 pub mod sampling;
 pub mod symmetry;
 pub mod tabulated;
+pub mod target;
 pub mod warp;
 
 pub use bake::{BakeOptions, BakeReport, bake, bake_chunks};

@@ -671,6 +671,7 @@ fn apply_bake_options(
             }
             "name" => req.name = Some(v.extract().map_err(|_| bad("a string"))?),
             "supersample" => req.supersample = v.extract().map_err(|_| bad("an int"))?,
+            "target_error" => req.target_error = Some(v.extract().map_err(|_| bad("a number"))?),
             "wavelengths" => req.channels = channels_of(Some(&v))?,
             "accuracy_pairs" | "pairs" => {
                 req.accuracy_pairs = v.extract().map_err(|_| bad("an int"))?
@@ -801,7 +802,8 @@ fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyA
 
 /// Bakes SOURCE into OUTPUT: a `.btdb` file, `DB#NAME` (a table of a database), or a raw table
 /// file. Keywords: preset, grid, param, symmetry, symmetry_tolerance, force, codec,
-/// codec_tolerance, floor, level, exhaustive, name, supersample, wavelengths, replace. Returns what
+/// codec_tolerance, floor, level, exhaustive, name, supersample, wavelengths, target_error (the
+/// smallest adaptive grid within this error, e.g. 0.005), replace. Returns what
 /// `brdftab info --json OUTPUT` reports.
 #[pyfunction]
 #[pyo3(signature = (source, output, **options))]

@@ -161,6 +161,17 @@ def test_bake_returns_info(tmp_path, cli):
     assert info["tables"][0]["parameterization"] == "inout"
 
 
+def test_bake_target_error_matches_the_cli(tmp_path, cli):
+    # the same request from Python and the CLI picks the same adaptive grid
+    a, b = str(tmp_path / "a.btdb"), str(tmp_path / "b.btdb")
+    info = brdftab.bake(GGX, a, target_error=0.01)
+    cli("bake", GGX, "-o", b, "--target-error", "1%")
+    (ta,), (tb,) = info["tables"], json.loads(cli("info", b, "--json"))["tables"]
+    assert ta["stored_shape"] == tb["stored_shape"]
+    with pytest.raises(brdftab.Error, match="target_error"):
+        brdftab.bake(GGX, a, preset="small", target_error=0.01)
+
+
 def test_database(tmp_path):
     db = brdftab.Database(tmp_path / "m.btdb")
     db.add(LAMBERT, "matte", preset="small")

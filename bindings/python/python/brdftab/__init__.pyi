@@ -67,6 +67,7 @@ def bake(
     name: str | None = ...,
     supersample: int = ...,
     wavelengths: Wavelengths = ...,
+    target_error: float | None = ...,
     replace: bool = ...,
 ) -> dict[str, Any]: ...
 def convert(source: str, output: str, **options: Any) -> dict[str, Any]: ...
