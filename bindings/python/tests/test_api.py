@@ -167,8 +167,8 @@ def test_bake_target_error_matches_the_cli(tmp_path, cli):
     info = brdftab.bake(GGX, a, target_error=0.01)
     cli("bake", GGX, "-o", b, "--target-error", "1%")
     (ta,), (tb,) = info["tables"], json.loads(cli("info", b, "--json"))["tables"]
-    assert ta["stored_shape"] == tb["stored_shape"]
-    with pytest.raises(brdftab.Error, match="target_error"):
+    assert ta["shape"] == tb["shape"]
+    with pytest.raises((brdftab.Error, ValueError), match="target_error"):
         brdftab.bake(GGX, a, preset="small", target_error=0.01)
 
 
