@@ -140,6 +140,12 @@ impl F4 {
             (a, F4(_mm_cvtepi32_ps(i)))
         }
     }
+    /// Whether any lane of `self` is ≥ the same lane of `o` (false for NaN lanes).
+    #[inline(always)]
+    pub fn any_ge(self, o: F4) -> bool {
+        use std::arch::x86_64::*;
+        unsafe { _mm_movemask_ps(_mm_cmpge_ps(self.0, o.0)) != 0 }
+    }
     /// Every lane set to lane `L` (0..4).
     #[inline(always)]
     pub fn lane<const L: i32>(self) -> F4 {
@@ -271,6 +277,11 @@ impl F4 {
         let i = self.0.map(|x| x as i32);
         (i, F4(i.map(|x| x as f32)))
     }
+    /// See the x86-64 version.
+    #[inline(always)]
+    pub fn any_ge(self, o: F4) -> bool {
+        (0..4).any(|k| self.0[k] >= o.0[k])
+    }
     /// Every lane set to lane `L` (0..4).
     #[inline(always)]
     pub fn lane<const L: i32>(self) -> F4 {
@@ -334,6 +345,7 @@ mod tests {
         assert_eq!(a.min(b).to_array(), [0.5, -2.0, 3.0, -8.0]);
         assert_eq!(a.max(b).to_array(), [1.5, 4.0, 9.0, 0.25]);
         assert_eq!(a.lane::<2>().to_array(), [9.0; 4]);
+        assert!(a.any_ge(b) && !F4::splat(-9.0).any_ge(b) && !F4::splat(f32::NAN).any_ge(b));
         assert_eq!(F4::pair_lanes::<1>(a, b).to_array(), [-2.0, -2.0, 4.0, 4.0]);
         assert_eq!(F4::interleave_lo(a, b).to_array(), [1.5, 0.5, -2.0, 4.0]);
         assert_eq!(a.shift_down().to_array(), [-2.0, 9.0, 0.25, 0.0]);

@@ -17,7 +17,15 @@
 //! fractional node index, and eight corners (λ innermost: two runs of 2 × channels adjacent
 //! values per (θh, θd) pair) are blended in f32 from the table's f16 codes ([`Packed`]: half
 //! the bytes, so a measured material's table stays in L2; expanded with F16C when the CPU has
-//! it, chosen once per kernel). [`Kernel::eval`] is tested against the reference path (angles through
+//! it, chosen once per kernel).
+//!
+//! Grids on the MERL-style fixed mappings (sqrt θh, uniform θd and φd: `--grid
+//! 90x1x90x180 --param halfdiff`) take the same path: their mappings are *resampled* as knot
+//! lines in the same variables ([`RESAMPLED_KNOTS`] per axis, within [`RESAMPLE_TOLERANCE`]
+//! node units of the exact mapping). θd and φd are smooth in them; sqrt θh has a square-root
+//! singularity at θh = 90°, so pairs beyond the last interval that meets the tolerance (v_h ≳
+//! 0.98, both directions near the horizon) go to the general lookup ([`Kernel::eval`] returns
+//! false). Such tables keep exact f32 values ([`Packed::exact`]). [`Kernel::eval`] is tested against the reference path (angles through
 //! [`super::symmetry::canonical_coords`] and [`super::StoredAxis::linear`]) in this module's
 //! tests.
 
@@ -25,7 +33,9 @@ use glam::DVec3;
 
 use crate::geometry;
 use crate::simd::F4;
-use crate::table::grid::{Grid, Mapping, Nodes, Param};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use crate::table::grid::{Grid, Mapping, Nodes, Param, StoredAxis};
 use crate::table::warp::{Warp, WarpVar};
 
 /// A kernel table's values as its lookups read them: f16, scaled by a power of two.
@@ -37,11 +47,18 @@ use crate::table::warp::{Warp, WarpVar};
 /// expands exactly with [`F4::from_f16_positive`] (or F16C). The rounding costs at most
 /// 2^-11 of a value (f16's half ulp), far below a measured table's interpolation error.
 /// Negative values (unmeasured cells, set aside by [`super::TabulatedBrdf`]) are stored as 0.
+///
+/// Tables whose kernel resamples a fixed mapping ([`Kernel::exact_values`]) keep f32 values
+/// instead ([`Packed::exact`]): such a table is what a user baked on a grid of their own
+/// choosing, and its lookups give the stored values at the nodes exactly.
 #[derive(Debug, Clone)]
 pub struct Packed {
-    /// The codes, then [`PACK_PAD`] zeros (a row's second four-value load reads past its end).
+    /// The codes, then [`PACK_PAD`] zeros (a row's second four-value load reads past its end);
+    /// empty for exact values.
     bits: Box<[u16]>,
-    /// 2^−e: multiplies the blended scaled values (exact).
+    /// Exact values (f32), then [`PACK_PAD`] zeros; empty for codes.
+    full: Box<[f32]>,
+    /// 2^−e: multiplies the blended scaled values (exact; 1 for exact values).
     unscale: f32,
 }
 
@@ -81,7 +98,31 @@ impl Packed {
             .collect();
         Packed {
             bits,
+            full: Box::new([]),
             unscale: pow2(-e),
+        }
+    }
+
+    /// `values` as they are (f32; negative and non-finite ones become 0).
+    pub fn exact(values: &[f32]) -> Packed {
+        let full = values
+            .iter()
+            .map(|&v| if v >= 0.0 && v.is_finite() { v } else { 0.0 })
+            .chain(std::iter::repeat_n(0.0, PACK_PAD))
+            .collect();
+        Packed {
+            bits: Box::new([]),
+            full,
+            unscale: 1.0,
+        }
+    }
+
+    /// `values` as `kernel` reads them: exact or f16 codes ([`Kernel::exact_values`]).
+    pub fn for_kernel(kernel: &Kernel, values: &[f32]) -> Packed {
+        if kernel.exact_values() {
+            Packed::exact(values)
+        } else {
+            Packed::new(values)
         }
     }
 
@@ -89,13 +130,14 @@ impl Packed {
     pub fn empty() -> Packed {
         Packed {
             bits: Box::new([]),
+            full: Box::new([]),
             unscale: 1.0,
         }
     }
 
     /// Number of values (0 for [`Packed::empty`]).
     pub fn len(&self) -> usize {
-        self.bits.len().saturating_sub(PACK_PAD)
+        (self.bits.len() + self.full.len()).saturating_sub(PACK_PAD)
     }
 
     /// Whether no values are held.
@@ -105,7 +147,7 @@ impl Packed {
 
     /// Bytes held.
     pub fn bytes(&self) -> usize {
-        self.bits.len() * std::mem::size_of::<u16>()
+        self.bits.len() * std::mem::size_of::<u16>() + self.full.len() * std::mem::size_of::<f32>()
     }
 
     /// Value `i` as lookups see it (0 beyond the end).
@@ -113,17 +155,27 @@ impl Packed {
         if i >= self.len() {
             return 0.0;
         }
-        half::f16::from_bits(self.bits[i]).to_f32() * self.unscale
+        self.scaled(i) * self.unscale
     }
 
     /// The scaled value of code `i` (0 beyond the end).
     #[inline(always)]
     fn scaled(&self, i: usize) -> f32 {
+        if !self.full.is_empty() {
+            return self.full.get(i).copied().unwrap_or(0.0);
+        }
         self.bits
             .get(i)
             .map_or(0.0, |&b| half::f16::from_bits(b).to_f32())
     }
 }
+
+/// Knots of a resampled axis (a fixed mapping read in the kernel's variable).
+pub const RESAMPLED_KNOTS: usize = 1024;
+
+/// How far (node units) a resampled axis's knot lines may stray from the exact mapping; from
+/// the first interval that strays further, lookups take the general path.
+pub const RESAMPLE_TOLERANCE: f64 = 1e-4;
 
 /// One warped axis as the kernel reads it: the fractional node index s as a line in t = v·K
 /// on each knot interval.
@@ -155,6 +207,40 @@ impl Axis {
             .iter()
             .map(|&u| u as f64 * scale + shift)
             .collect();
+        Axis::from_knots(&s, n)
+    }
+
+    /// The axis of a fixed mapping (not a warp) in the kernel's variable `var`: s at
+    /// [`RESAMPLED_KNOTS`] + 1 knots uniform in v, computed exactly ([`StoredAxis::continuous`],
+    /// unclamped), and the variable `vcut` from which the knot lines stray from the exact s by
+    /// more than [`RESAMPLE_TOLERANCE`] node units (checked at three points per interval; 2
+    /// when they never do). `None` when that leaves less than half the axis.
+    fn resampled(ax: &StoredAxis, var: WarpVar, hi: f64) -> Option<(Axis, f32)> {
+        let k = RESAMPLED_KNOTS;
+        let s_at = |v: f64| ax.continuous(var.angle_of(v, hi));
+        let s: Vec<f64> = (0..=k).map(|j| s_at(j as f64 / k as f64)).collect();
+        if s.iter().any(|x| !x.is_finite()) {
+            return None;
+        }
+        let n = ax.size;
+        let clamp = |x: f64| x.clamp(0.0, (n - 1) as f64);
+        let bad = (0..k).find(|&j| {
+            [0.25, 0.5, 0.75].iter().any(|&f| {
+                let line = s[j] + f * (s[j + 1] - s[j]);
+                let exact = s_at((j as f64 + f) / k as f64);
+                (clamp(line) - clamp(exact)).abs() > RESAMPLE_TOLERANCE
+            })
+        });
+        let vcut = match bad {
+            None => 2.0,
+            Some(j) if j >= k / 2 => (j as f64 / k as f64) as f32,
+            Some(_) => return None,
+        };
+        Some((Axis::from_knots(&s, n), vcut))
+    }
+
+    /// The knot lines of s given at K + 1 knots uniform in v, for an axis of `n` nodes.
+    fn from_knots(s: &[f64], n: usize) -> Axis {
         let lines = s
             .windows(2)
             .enumerate()
@@ -165,9 +251,9 @@ impl Axis {
             .collect();
         Axis {
             lines,
-            k: (w.knots().len() - 1) as f32,
+            k: (s.len() - 1) as f32,
             n,
-            kmax: (w.knots().len() - 2) as u32,
+            kmax: (s.len() - 2) as u32,
             imax: (n - 2) as i32,
         }
     }
@@ -213,6 +299,11 @@ pub struct Kernel {
     lanes: [F4; 4],
     /// The CPU has F16C (checked once, at construction): RGB lookups expand codes with it.
     f16c: bool,
+    /// Per axis the variable from which lookups take the general path (resampled axes; 2 on
+    /// warped ones, never; lane 3: 2).
+    cut: F4,
+    /// Some axis is resampled: the values are kept exact ([`Packed::exact`]).
+    exact: bool,
 }
 
 impl Kernel {
@@ -225,25 +316,38 @@ impl Kernel {
             return None;
         }
         let ax = grid.stored_axes();
+        let phi_hi = if s.reciprocal { FRAC_PI_2 } else { PI };
         let want = [
-            (0, WarpVar::SqrtSine),
-            (2, WarpVar::HalfPower),
-            (3, WarpVar::PseudoAngle),
+            (0, WarpVar::SqrtSine, FRAC_PI_2),
+            (2, WarpVar::HalfPower, FRAC_PI_2),
+            (3, WarpVar::PseudoAngle, phi_hi),
         ];
         let mut axes = Vec::with_capacity(3);
-        for (k, var) in want {
-            let nodes_ok = match ax[k].nodes {
+        let mut cut = [2f32; 4];
+        let mut exact = false;
+        for (i, (k, var, hi)) in want.into_iter().enumerate() {
+            let a = &ax[k];
+            let nodes_ok = match a.nodes {
                 Nodes::Edges => true,
                 Nodes::Centers => k != 3,
                 Nodes::CellStart => false,
             };
-            match &ax[k].mapping {
-                Mapping::Warp(w) if w.var() == var && nodes_ok => {
-                    if ax[k].size < 2 {
-                        return None;
-                    }
-                    let centers = ax[k].nodes == Nodes::Centers;
-                    axes.push(Axis::new(w, ax[k].size, centers));
+            if a.size < 2 || !nodes_ok || a.periodic {
+                return None;
+            }
+            let centers = a.nodes == Nodes::Centers;
+            match &a.mapping {
+                Mapping::Warp(w) if w.var() == var => axes.push(Axis::new(w, a.size, centers)),
+                // MERL-style fixed mappings (sqrt θh, uniform θd and φd), resampled.
+                m @ (Mapping::Sqrt | Mapping::Uniform)
+                    if (k == 0) == (*m == Mapping::Sqrt)
+                        && a.lo == 0.0
+                        && (a.hi - hi).abs() < 1e-12 =>
+                {
+                    let (axis, vcut) = Axis::resampled(a, var, hi)?;
+                    axes.push(axis);
+                    cut[i] = vcut;
+                    exact = true;
                 }
                 _ => return None,
             }
@@ -265,7 +369,15 @@ impl Kernel {
             quarter: s.reciprocal,
             channels,
             f16c: has_f16c(),
+            cut: F4::new(cut[0], cut[1], cut[2], cut[3]),
+            exact,
         })
+    }
+
+    /// Whether this kernel reads exact (f32) values ([`Packed::exact`]): some axis resamples a
+    /// fixed mapping. Warped (adaptive) tables read f16 codes ([`Packed::new`]).
+    pub fn exact_values(&self) -> bool {
+        self.exact
     }
 
     /// The warp variables (v_h, v_d, v_φ) of a pair, or `None` below the horizon (the fast
@@ -338,44 +450,64 @@ impl Kernel {
         Some(v)
     }
 
-    /// Evaluates into `out[..channels]` from the table's `values` (all chunks, in order, packed;
-    /// corners beyond its end — none for [`Packed::empty`], a table that could not be loaded —
-    /// count as 0).
+    /// Evaluates into `out[..channels]` from the table's `values` (all chunks, in order, as
+    /// [`Packed::for_kernel`] makes them; corners beyond its end — none for [`Packed::empty`], a
+    /// table that could not be loaded — count as 0). Returns false, with `out` untouched, for a
+    /// pair beyond a resampled axis's cut: the caller looks it up on the general path.
     #[inline]
-    pub fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &Packed) {
+    pub fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &Packed) -> bool {
         if self.channels == 3 {
+            if self.exact {
+                return self.rgb::<false, true>(wi, wo, out, values);
+            }
             #[cfg(target_arch = "x86_64")]
             if self.f16c {
                 // SAFETY: `f16c` is set only when the CPU has F16C (`has_f16c`).
-                unsafe { self.rgb_f16c(wi, wo, out, values) };
-                return;
+                return unsafe { self.rgb_f16c(wi, wo, out, values) };
             }
-            self.rgb::<false>(wi, wo, out, values);
-            return;
+            return self.rgb::<false, false>(wi, wo, out, values);
         }
         let Some(v) = self.vars(wi, wo) else {
             out[..self.channels].fill(0.0);
-            return;
+            return true;
         };
+        if F4::new(v[0], v[1], v[2], 0.0).any_ge(self.cut) {
+            return false;
+        }
         match self.channels {
             1 => self.blend::<1>(v, out, values),
             _ => self.blend::<0>(v, out, values),
         }
+        true
     }
 
-    /// The RGB lookup compiled with F16C (and the VEX encoding it brings).
+    /// The RGB lookup of f16 codes compiled with F16C (and the VEX encoding it brings).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "f16c")]
-    fn rgb_f16c(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &Packed) {
-        self.rgb::<true>(wi, wo, out, values);
+    fn rgb_f16c(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &Packed) -> bool {
+        self.rgb::<true, false>(wi, wo, out, values)
     }
 
-    /// The RGB lookup; `F16C`: expand codes with F16C (only inside [`Kernel::rgb_f16c`]).
+    /// The RGB lookup; `F16C`: expand codes with F16C (only inside [`Kernel::rgb_f16c`]);
+    /// `EXACT`: read exact values.
     #[inline(always)]
-    fn rgb<const F16C: bool>(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &Packed) {
+    fn rgb<const F16C: bool, const EXACT: bool>(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        out: &mut [f32],
+        values: &Packed,
+    ) -> bool {
         match self.vars_lanes(wi, wo) {
-            Some(v) => self.eval_rgb::<F16C>(v, out, values),
-            None => out[..3].fill(0.0),
+            Some(v) if EXACT && v.any_ge(self.cut) => false,
+            Some(v) => {
+                self.eval_rgb::<F16C, EXACT>(v, out, values);
+                true
+            }
+            None => {
+                out[..3].fill(0.0);
+                true
+            }
         }
     }
 
@@ -384,7 +516,12 @@ impl Kernel {
     /// as two four-lane loads (RGB of the two φd corners; the fourth lane is ignored). Computes
     /// the same operations as `blend::<3>`, which stays as its reference (tested equal).
     #[inline(always)]
-    fn eval_rgb<const F16C: bool>(&self, v: F4, out: &mut [f32], values: &Packed) {
+    fn eval_rgb<const F16C: bool, const EXACT: bool>(
+        &self,
+        v: F4,
+        out: &mut [f32],
+        values: &Packed,
+    ) {
         let [k, kcap, nmax, ncap] = self.lanes;
         let zero = F4::splat(0.0);
         // Knot interval j and its fraction per axis (lane 3: 0).
@@ -416,20 +553,32 @@ impl Kernel {
             }
             F4::from_f16_positive(x)
         };
-        // The four rows' codes, all within o .. o + chunk + row + 7 (one bounds check; only an
-        // empty table fails it).
-        if let Some(x) = values.bits.get(o..o + self.chunk + self.row + 7) {
-            let mut add = |r: usize, w0: F4, w1: F4| {
-                // The row's six codes r..r+6: four at r (φd corner 0 in lanes 0..3) and four at
-                // r + 3 (corner 1; the fourth lane reads the next row or the padding, ignored).
+        // The four rows' values, all within o .. o + chunk + row + 7 (one bounds check; only
+        // an empty table fails it). Each row's six values r..r+6: four at r (φd corner 0 in
+        // lanes 0..3) and four at r + 3 (corner 1; the fourth lane reads the next row or the
+        // padding, ignored).
+        let span = o..o + self.chunk + self.row + 7;
+        let offsets = [0, self.row, self.chunk, self.chunk + self.row];
+        let weights = [
+            (p0.lane::<0>(), p1.lane::<0>()),
+            (p0.lane::<1>(), p1.lane::<1>()),
+            (p0.lane::<2>(), p1.lane::<2>()),
+            (p0.lane::<3>(), p1.lane::<3>()),
+        ];
+        if EXACT {
+            if let Some(x) = values.full.get(span) {
+                for (r, (w0, w1)) in offsets.into_iter().zip(weights) {
+                    if let (Some(a), Some(b)) = (F4::load(&x[r..]), F4::load(&x[r + 3..])) {
+                        acc = acc + (w0 * a + w1 * b);
+                    }
+                }
+            }
+        } else if let Some(x) = values.bits.get(span) {
+            for (r, (w0, w1)) in offsets.into_iter().zip(weights) {
                 if let (Some(a), Some(b)) = (load(&x[r..]), load(&x[r + 3..])) {
                     acc = acc + (w0 * a + w1 * b);
                 }
-            };
-            add(0, p0.lane::<0>(), p1.lane::<0>());
-            add(self.row, p0.lane::<1>(), p1.lane::<1>());
-            add(self.chunk, p0.lane::<2>(), p1.lane::<2>());
-            add(self.chunk + self.row, p0.lane::<3>(), p1.lane::<3>());
+            }
         }
         let [r, g, b, _] = (acc * F4::splat(values.unscale)).to_array();
         out[..3].copy_from_slice(&[r, g, b]);
@@ -545,6 +694,8 @@ mod tests {
             chunk: 4,
             lanes: [per(1.0), per(0.5), per(1.0), per(0.5)],
             f16c: false,
+            cut: F4::splat(2.0),
+            exact: false,
         }
     }
 
@@ -636,7 +787,7 @@ mod tests {
                 let (wi, wo) = random_pair(&mut r);
                 k.eval(wi, wo, &mut a, &packed);
                 // Without F16C (the integer expansion) exactly the same.
-                k.rgb::<false>(wi, wo, &mut soft, &packed);
+                k.rgb::<false, false>(wi, wo, &mut soft, &packed);
                 assert_eq!(a, soft, "{wi} {wo}");
                 general.eval(Interp::Linear, wi, wo, &mut b, |i| t.chunk(i));
                 tb.eval(wi, wo, &mut c);
@@ -658,6 +809,69 @@ mod tests {
                 }
             }
             assert!(worst <= 1.0, "worst scaled difference {worst}");
+        }
+    }
+
+    #[test]
+    fn fixed_merl_style_mappings_are_resampled_and_agree_with_the_general_lookup() {
+        use crate::table::grid::Grid;
+        let src = ModelSpec::parse(r#"{"model": "cook_torrance", "m": 0.3}"#)
+            .unwrap()
+            .build(&Channels::Rgb)
+            .unwrap();
+        for reciprocal in [false, true] {
+            let sym = Symmetry {
+                isotropic: true,
+                reciprocal,
+                bilateral: true,
+            };
+            // The MERL-size grid of `--grid 90x1x90x180 --param halfdiff`: sqrt θh, uniform θd.
+            let grid = Grid::with_sizes(
+                crate::table::Param::HalfDiff,
+                [90, 1, 90, 180],
+                [Mapping::Sqrt, Mapping::Uniform],
+                Channels::Rgb,
+                sym,
+            )
+            .unwrap();
+            let k = Kernel::new(&grid).expect("sqrt/uniform axes are resampled");
+            assert!(k.exact_values());
+            // θh's sqrt mapping strays at grazing θh (v_h → 1): a cut there; θd and φd none.
+            let cut = k.cut.to_array();
+            assert!(cut[0] > 0.9 && cut[0] < 1.0, "{cut:?}");
+            assert_eq!((cut[1], cut[2]), (2.0, 2.0));
+            let (t, _) = bake(src.as_ref(), &grid, &BakeOptions::default()).unwrap();
+            let general = Lookup::new(t.grid());
+            let packed = Packed::for_kernel(&k, t.values());
+            let tb = TabulatedBrdf::from_table(t.clone());
+            let peak = t.values().iter().fold(0f32, |m, &x| m.max(x));
+            let (mut a, mut b, mut c) = ([0f32; 3], [0f32; 3], [0f32; 3]);
+            let (mut worst, mut fell_back) = (0f32, 0);
+            let mut r = Pcg32::new(8);
+            for i in 0..60_000 {
+                let (mut wi, mut wo) = random_pair(&mut r);
+                if i % 10 == 0 {
+                    // Near-grazing opposite pairs: θh near 90°, beyond θh's cut.
+                    wi = DVec3::new(0.999, 0.0, 0.0447).normalize();
+                    wo = DVec3::new(-0.9, -0.4, 0.02 + 0.01 * r.next_f64()).normalize();
+                }
+                general.eval(Interp::Linear, wi, wo, &mut b, |i| t.chunk(i));
+                tb.eval(wi, wo, &mut c);
+                if !k.eval(wi, wo, &mut a, &packed) {
+                    fell_back += 1;
+                    assert_eq!(b, c, "beyond the cut TabulatedBrdf takes the general path");
+                    continue;
+                }
+                assert_eq!(a, c, "TabulatedBrdf uses the kernel");
+                for ch in 0..3 {
+                    // The same nodes; the kernel's f32 variables and knot lines (≤ 1e-4 node
+                    // units from the mapping) against the general lookup's f64 coordinates.
+                    let e = (a[ch] - b[ch]).abs() / (b[ch].abs() * 1e-3 + peak * 1e-5);
+                    worst = worst.max(e);
+                }
+            }
+            assert!(worst <= 1.0, "worst scaled difference {worst}");
+            assert!(fell_back > 1000, "{fell_back}");
         }
     }
 }

@@ -108,8 +108,8 @@ impl TabulatedBrdf {
             unmeasured.push(OnceLock::from(set_aside_negatives(v)));
             chunks.push(OnceLock::from(Arc::<[f32]>::from(&*v)));
         }
-        let packed = match kernel {
-            Some(_) => OnceLock::from(Packed::new(&values)),
+        let packed = match &kernel {
+            Some(k) => OnceLock::from(Packed::for_kernel(k, &values)),
             None => OnceLock::new(),
         };
         TabulatedBrdf {
@@ -301,7 +301,10 @@ impl TabulatedBrdf {
                 }
             }
         }
-        Packed::new(&all)
+        match &self.kernel {
+            Some(k) => Packed::for_kernel(k, &all),
+            None => Packed::empty(),
+        }
     }
 
     #[inline(always)]
@@ -410,12 +413,15 @@ impl Brdf for TabulatedBrdf {
 
     #[inline]
     fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
-        match &self.kernel {
-            Some(k) if self.interp == Interp::Linear => k.eval(wi, wo, out, self.packed()),
-            _ => self
-                .lookup
-                .eval(self.interp, wi, wo, out, |a| self.chunk(a)),
+        if let Some(k) = &self.kernel
+            && self.interp == Interp::Linear
+            && k.eval(wi, wo, out, self.packed())
+        {
+            return;
         }
+        // Not a kernel table, a nearest lookup, or a pair beyond a resampled axis's cut.
+        self.lookup
+            .eval(self.interp, wi, wo, out, |a| self.chunk(a))
     }
 
     /// Only the symmetries the table stores are declared (a reduced table has them exactly).
