@@ -5,7 +5,8 @@
 //! as `brdftab bake` does, writes the same model as a MERL `.binary` file, compiles
 //! `benches/c/merl_nearest.c` with `gcc -O2` (or `$CC`), and then in each round times the C
 //! lookup (its own process, 10^6 random pairs) and the table (10^6 random pairs, one thread,
-//! linear and nearest) back to back. Prints per round and the medians of the paired ratios.
+//! linear and nearest, and the same model on the adaptive grid `--target-error 0.5%` picks)
+//! back to back. Prints per round and the medians of the paired ratios.
 //!
 //! `cargo run --release --example merl_c_compare [ROUNDS]`
 
@@ -37,6 +38,16 @@ fn main() -> Result<()> {
         .table(&brdftab::progress::Silent)?;
     println!("table: {}", table.grid().summary());
     let linear = TabulatedBrdf::from_table(table);
+    // The same model on the adaptive grid an error target of 0.5 % picks (for comparison).
+    let (adaptive, r) = BakeRequest::new(SPEC)
+        .target_error(0.005)
+        .table(&brdftab::progress::Silent)?;
+    println!(
+        "adaptive: {} ({})",
+        adaptive.grid().summary(),
+        r.target.map(|t| t.summary()).unwrap_or_default()
+    );
+    let adaptive = TabulatedBrdf::from_table(adaptive);
     let nearest = TabulatedBrdf::from_table(linear.to_table()?).with_interp(Interp::Nearest);
     let merl = dir.join("ct.binary");
     MerlBrdf::from_brdf(brdftab::open(SPEC)?.as_ref()).write(&merl)?;
@@ -85,27 +96,32 @@ fn main() -> Result<()> {
             .ok_or_else(|| Error::Unsupported(format!("merl_nearest printed `{s}`")))
     };
     time(&linear);
-    let (mut rl, mut rn) = (Vec::new(), Vec::new());
+    let (mut rl, mut rn, mut ra) = (Vec::new(), Vec::new(), Vec::new());
     for r in 0..rounds {
         let c = c_lookup()?;
         let l = time(&linear);
         let n = time(&nearest);
+        let a = time(&adaptive);
         println!(
-            "round {r}: C nearest {c:.1} ns, table linear {l:.1} ns ({:.2}x), nearest {n:.1} ns ({:.2}x)",
+            "round {r}: C nearest {c:.1} ns, table linear {l:.1} ns ({:.2}x), nearest {n:.1} ns \
+             ({:.2}x), adaptive {a:.1} ns ({:.2}x)",
             c / l,
-            c / n
+            c / n,
+            c / a
         );
         rl.push(c / l);
         rn.push(c / n);
+        ra.push(c / a);
     }
     let med = |v: &mut Vec<f64>| {
         v.sort_by(|a, b| a.total_cmp(b));
         v[v.len() / 2]
     };
     println!(
-        "median ratio C / table: linear {:.2}x, nearest {:.2}x",
+        "median ratio C / table: linear {:.2}x, nearest {:.2}x, adaptive {:.2}x",
         med(&mut rl),
-        med(&mut rn)
+        med(&mut rn),
+        med(&mut ra)
     );
     std::fs::remove_dir_all(&dir).map_err(io)?;
     Ok(())

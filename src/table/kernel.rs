@@ -499,7 +499,7 @@ impl Kernel {
         values: &Packed,
     ) -> bool {
         match self.vars_lanes(wi, wo) {
-            Some(v) if EXACT && v.any_ge(self.cut) => false,
+            Some(v) if v.any_ge(self.cut) => false,
             Some(v) => {
                 self.eval_rgb::<F16C, EXACT>(v, out, values);
                 true
