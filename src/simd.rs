@@ -160,7 +160,7 @@ impl F4 {
             }
         }
     }
-    /// Lanes (a[L], a[L], b[L], b[L]).
+    /// Lanes `(a[L], a[L], b[L], b[L])`.
     #[inline(always)]
     pub fn pair_lanes<const L: i32>(a: F4, b: F4) -> F4 {
         use std::arch::x86_64::*;

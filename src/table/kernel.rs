@@ -3,7 +3,7 @@
 //!
 //! The general lookup ([`super::lookup`]) computes the four Rusinkiewicz angles with acos and
 //! atan2 and maps each through its axis. On a table whose θh, θd and φd axes are all
-//! [`Warp`](super::Warp)s ([`super::adaptive`]), every axis only needs its warp *variable*, and
+//! [`Warp`]s ([`super::adaptive`]), every axis only needs its warp *variable*, and
 //! those come from the direction vectors without any transcendental function. With
 //! h = ωi + ωo (not normalized) and unit ωi, ωo:
 //!
@@ -499,7 +499,8 @@ impl Kernel {
         values: &Packed,
     ) -> bool {
         match self.vars_lanes(wi, wo) {
-            Some(v) if v.any_ge(self.cut) => false,
+            // Only resampled axes have a cut (< 2), and they make the kernel exact.
+            Some(v) if EXACT && v.any_ge(self.cut) => false,
             Some(v) => {
                 self.eval_rgb::<F16C, EXACT>(v, out, values);
                 true
