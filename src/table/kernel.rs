@@ -135,6 +135,12 @@ impl Packed {
         }
     }
 
+    /// The exact values ([`Packed::exact`]; empty for codes), without the padding.
+    pub fn exact_values(&self) -> &[f32] {
+        let n = self.full.len().saturating_sub(PACK_PAD);
+        &self.full[..n]
+    }
+
     /// Number of values (0 for [`Packed::empty`]).
     pub fn len(&self) -> usize {
         (self.bits.len() + self.full.len()).saturating_sub(PACK_PAD)
@@ -169,6 +175,11 @@ impl Packed {
             .map_or(0.0, |&b| half::f16::from_bits(b).to_f32())
     }
 }
+
+/// The most stored values a grid with resampled axes may have for the kernel to take it: the
+/// kernel holds a table in one array, loaded whole at the first lookup; larger tables keep
+/// their lazily loaded chunks (and the general lookup). 8 M values is 32 MB of f32.
+pub const RESAMPLED_MAX_VALUES: usize = 8 << 20;
 
 /// Knots of a resampled axis (a fixed mapping read in the kernel's variable).
 pub const RESAMPLED_KNOTS: usize = 1024;
@@ -341,6 +352,7 @@ impl Kernel {
                 // MERL-style fixed mappings (sqrt θh, uniform θd and φd), resampled.
                 m @ (Mapping::Sqrt | Mapping::Uniform)
                     if (k == 0) == (*m == Mapping::Sqrt)
+                        && grid.stored_values() <= RESAMPLED_MAX_VALUES
                         && a.lo == 0.0
                         && (a.hi - hi).abs() < 1e-12 =>
                 {

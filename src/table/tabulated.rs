@@ -66,10 +66,11 @@ type Unmeasured = Box<[(u32, f32)]>;
 pub struct TabulatedBrdf {
     grid: Grid,
     lookup: Lookup,
-    /// The fast linear lookup of adaptive grids ([`super::kernel`]), when it applies. Such a
-    /// table is small (it is meant to stay in cache): its lookups read `packed`, all chunks in
-    /// one f16 array; `chunks` are then loaded only for other readers (nearest lookups,
-    /// [`TabulatedBrdf::to_table`], [`Brdf::stored_node`]).
+    /// The fast linear lookup ([`super::kernel`]) of adaptive grids and of small MERL-style
+    /// fixed grids, when it applies. Its lookups read `packed`, all chunks in one array loaded
+    /// at first use: f16 codes for adaptive grids, whose `chunks` are then loaded only for other
+    /// readers (nearest lookups, [`TabulatedBrdf::to_table`], [`Brdf::stored_node`]), or the
+    /// exact values, which `chunk` then serves instead of `chunks`.
     kernel: Option<Kernel>,
     /// Every chunk, contiguous and packed (tables with a kernel only), loaded on first use.
     packed: OnceLock<Packed>,
@@ -106,7 +107,11 @@ impl TabulatedBrdf {
         for i in 0..l.chunk_count() {
             let v = &mut values[l.chunk_range(i)];
             unmeasured.push(OnceLock::from(set_aside_negatives(v)));
-            chunks.push(OnceLock::from(Arc::<[f32]>::from(&*v)));
+            // An exact kernel's array serves as the chunks (`chunk`).
+            chunks.push(match &kernel {
+                Some(k) if k.exact_values() => OnceLock::new(),
+                _ => OnceLock::from(Arc::<[f32]>::from(&*v)),
+            });
         }
         let packed = match &kernel {
             Some(k) => OnceLock::from(Packed::for_kernel(k, &values)),
@@ -331,6 +336,13 @@ impl TabulatedBrdf {
 
     #[inline(always)]
     fn chunk(&self, a: usize) -> &[f32] {
+        if let Some(k) = &self.kernel
+            && k.exact_values()
+        {
+            // The exact kernel's array is the chunks, contiguous: no second copy.
+            let r = self.grid.layout().chunk_range(a);
+            return self.packed().exact_values().get(r).unwrap_or(&[]);
+        }
         match self.chunks.get(a) {
             Some(c) => match c.get() {
                 Some(v) => v,
