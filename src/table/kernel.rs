@@ -25,7 +25,15 @@
 //! node units of the exact mapping). θd and φd are smooth in them; sqrt θh has a square-root
 //! singularity at θh = 90°, so pairs beyond the last interval that meets the tolerance (v_h ≳
 //! 0.98, both directions near the horizon) go to the general lookup ([`Kernel::eval`] returns
-//! false). Such tables keep exact f32 values ([`Packed::exact`]). [`Kernel::eval`] is tested against the reference path (angles through
+//! false). Such a table keeps exact f32 values ([`Packed::exact`]) while they fit in a core's L2
+//! cache ([`RESAMPLED_EXACT_MAX_VALUES`]); a larger one (the MERL-size table: 4.4 MB of f32) is
+//! read from f16 codes like an adaptive table. Its lookups are bound by the lines they fetch
+//! from L3, and half the bytes made them a median 1.17× faster (27 paired rounds, 0.98–1.57×;
+//! `examples/merl_c_compare.rs`), at a rounding of at most 2^-11 of a value, far below such a
+//! grid's interpolation error; the stored f32 values stay what
+//! [`super::TabulatedBrdf::to_table`], nearest lookups and the pairs beyond the cut read.
+//!
+//! [`Kernel::eval`] is tested against the reference path (angles through
 //! [`super::symmetry::canonical_coords`] and [`super::StoredAxis::linear`]) in this module's
 //! tests.
 
@@ -48,9 +56,10 @@ use crate::table::warp::{Warp, WarpVar};
 /// 2^-11 of a value (f16's half ulp), far below a measured table's interpolation error.
 /// Negative values (unmeasured cells, set aside by [`super::TabulatedBrdf`]) are stored as 0.
 ///
-/// Tables whose kernel resamples a fixed mapping ([`Kernel::exact_values`]) keep f32 values
-/// instead ([`Packed::exact`]): such a table is what a user baked on a grid of their own
-/// choosing, and its lookups give the stored values at the nodes exactly.
+/// Small tables whose kernel resamples a fixed mapping ([`Kernel::exact_values`]) keep f32
+/// values instead ([`Packed::exact`]): such a table is what a user baked on a grid of their own
+/// choosing, and while it fits in L2 its lookups give the stored values at the nodes exactly
+/// at no cost in speed.
 #[derive(Debug, Clone)]
 pub struct Packed {
     /// The codes, then [`PACK_PAD`] zeros (a row's second four-value load reads past its end);
@@ -180,6 +189,11 @@ impl Packed {
 /// kernel holds a table in one array, loaded whole at the first lookup; larger tables keep
 /// their lazily loaded chunks (and the general lookup). 8 M values is 32 MB of f32.
 pub const RESAMPLED_MAX_VALUES: usize = 8 << 20;
+
+/// The most stored values a grid with resampled axes may have for its kernel to read exact f32
+/// values ([`Packed::exact`]): 256 Ki values, 1 MiB, a core's L2 cache on the machines this was
+/// measured on. Larger tables are read from f16 codes ([`Packed::new`]), half the bytes.
+pub const RESAMPLED_EXACT_MAX_VALUES: usize = 256 << 10;
 
 /// Knots of a resampled axis (a fixed mapping read in the kernel's variable).
 pub const RESAMPLED_KNOTS: usize = 1024;
@@ -313,7 +327,10 @@ pub struct Kernel {
     /// Per axis the variable from which lookups take the general path (resampled axes; 2 on
     /// warped ones, never; lane 3: 2).
     cut: F4,
-    /// Some axis is resampled: the values are kept exact ([`Packed::exact`]).
+    /// Some axis is resampled: RGB lookups check the cut.
+    resampled: bool,
+    /// Values are read exact ([`Packed::exact`]): resampled, and at most
+    /// [`RESAMPLED_EXACT_MAX_VALUES`] of them.
     exact: bool,
 }
 
@@ -335,7 +352,7 @@ impl Kernel {
         ];
         let mut axes = Vec::with_capacity(3);
         let mut cut = [2f32; 4];
-        let mut exact = false;
+        let mut resampled = false;
         for (i, (k, var, hi)) in want.into_iter().enumerate() {
             let a = &ax[k];
             let nodes_ok = match a.nodes {
@@ -359,7 +376,7 @@ impl Kernel {
                     let (axis, vcut) = Axis::resampled(a, var, hi)?;
                     axes.push(axis);
                     cut[i] = vcut;
-                    exact = true;
+                    resampled = true;
                 }
                 _ => return None,
             }
@@ -382,14 +399,22 @@ impl Kernel {
             channels,
             f16c: has_f16c(),
             cut: F4::new(cut[0], cut[1], cut[2], cut[3]),
-            exact,
+            resampled,
+            exact: resampled && grid.stored_values() <= RESAMPLED_EXACT_MAX_VALUES,
         })
     }
 
     /// Whether this kernel reads exact (f32) values ([`Packed::exact`]): some axis resamples a
-    /// fixed mapping. Warped (adaptive) tables read f16 codes ([`Packed::new`]).
+    /// fixed mapping, on a table of at most [`RESAMPLED_EXACT_MAX_VALUES`] values. Warped
+    /// (adaptive) tables and larger fixed grids read f16 codes ([`Packed::new`]).
     pub fn exact_values(&self) -> bool {
         self.exact
+    }
+
+    /// Whether some axis resamples a fixed mapping (MERL-style grids), so that pairs beyond its
+    /// cut take the general lookup; false on adaptive (warped) grids.
+    pub fn resampled(&self) -> bool {
+        self.resampled
     }
 
     /// The warp variables (v_h, v_d, v_φ) of a pair, or `None` below the horizon (the fast
@@ -470,14 +495,24 @@ impl Kernel {
     pub fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &Packed) -> bool {
         if self.channels == 3 {
             if self.exact {
-                return self.rgb::<false, true>(wi, wo, out, values);
+                return self.rgb::<false, true, true>(wi, wo, out, values);
             }
             #[cfg(target_arch = "x86_64")]
             if self.f16c {
                 // SAFETY: `f16c` is set only when the CPU has F16C (`has_f16c`).
-                return unsafe { self.rgb_f16c(wi, wo, out, values) };
+                return unsafe {
+                    if self.resampled {
+                        self.rgb_f16c::<true>(wi, wo, out, values)
+                    } else {
+                        self.rgb_f16c::<false>(wi, wo, out, values)
+                    }
+                };
             }
-            return self.rgb::<false, false>(wi, wo, out, values);
+            return if self.resampled {
+                self.rgb::<false, false, true>(wi, wo, out, values)
+            } else {
+                self.rgb::<false, false, false>(wi, wo, out, values)
+            };
         }
         let Some(v) = self.vars(wi, wo) else {
             out[..self.channels].fill(0.0);
@@ -496,14 +531,21 @@ impl Kernel {
     /// The RGB lookup of f16 codes compiled with F16C (and the VEX encoding it brings).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "f16c")]
-    fn rgb_f16c(&self, wi: DVec3, wo: DVec3, out: &mut [f32], values: &Packed) -> bool {
-        self.rgb::<true, false>(wi, wo, out, values)
+    fn rgb_f16c<const CUT: bool>(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        out: &mut [f32],
+        values: &Packed,
+    ) -> bool {
+        self.rgb::<true, false, CUT>(wi, wo, out, values)
     }
 
     /// The RGB lookup; `F16C`: expand codes with F16C (only inside [`Kernel::rgb_f16c`]);
-    /// `EXACT`: read exact values.
+    /// `EXACT`: read exact values; `CUT`: check the resampled axes' cut (warped axes have none:
+    /// the check is left out).
     #[inline(always)]
-    fn rgb<const F16C: bool, const EXACT: bool>(
+    fn rgb<const F16C: bool, const EXACT: bool, const CUT: bool>(
         &self,
         wi: DVec3,
         wo: DVec3,
@@ -511,8 +553,8 @@ impl Kernel {
         values: &Packed,
     ) -> bool {
         match self.vars_lanes(wi, wo) {
-            // Only resampled axes have a cut (< 2), and they make the kernel exact.
-            Some(v) if EXACT && v.any_ge(self.cut) => false,
+            // Only resampled axes have a cut (< 2).
+            Some(v) if CUT && v.any_ge(self.cut) => false,
             Some(v) => {
                 self.eval_rgb::<F16C, EXACT>(v, out, values);
                 true
@@ -708,6 +750,7 @@ mod tests {
             lanes: [per(1.0), per(0.5), per(1.0), per(0.5)],
             f16c: false,
             cut: F4::splat(2.0),
+            resampled: false,
             exact: false,
         }
     }
@@ -800,7 +843,7 @@ mod tests {
                 let (wi, wo) = random_pair(&mut r);
                 k.eval(wi, wo, &mut a, &packed);
                 // Without F16C (the integer expansion) exactly the same.
-                k.rgb::<false, false>(wi, wo, &mut soft, &packed);
+                k.rgb::<false, false, false>(wi, wo, &mut soft, &packed);
                 assert_eq!(a, soft, "{wi} {wo}");
                 general.eval(Interp::Linear, wi, wo, &mut b, |i| t.chunk(i));
                 tb.eval(wi, wo, &mut c);
@@ -848,7 +891,18 @@ mod tests {
             )
             .unwrap();
             let k = Kernel::new(&grid).expect("sqrt/uniform axes are resampled");
-            assert!(k.exact_values());
+            // 1.1 M values, more than L2: read as f16 codes. A small grid keeps exact values.
+            assert!(k.resampled() && !k.exact_values());
+            let small = Grid::with_sizes(
+                crate::table::Param::HalfDiff,
+                [16, 1, 16, 32],
+                [Mapping::Sqrt, Mapping::Uniform],
+                Channels::Rgb,
+                sym,
+            )
+            .unwrap();
+            let ks = Kernel::new(&small).expect("sqrt/uniform axes are resampled");
+            assert!(ks.resampled() && ks.exact_values());
             // θh's sqrt mapping strays at grazing θh (v_h → 1): a cut there; θd and φd none.
             let cut = k.cut.to_array();
             assert!(cut[0] > 0.9 && cut[0] < 1.0, "{cut:?}");
@@ -876,9 +930,14 @@ mod tests {
                     continue;
                 }
                 assert_eq!(a, c, "TabulatedBrdf uses the kernel");
+                // Without F16C (the integer expansion) exactly the same.
+                let mut soft = [0f32; 3];
+                assert!(k.rgb::<false, false, true>(wi, wo, &mut soft, &packed));
+                assert_eq!(a, soft, "{wi} {wo}");
                 for ch in 0..3 {
-                    // The same nodes; the kernel's f32 variables and knot lines (≤ 1e-4 node
-                    // units from the mapping) against the general lookup's f64 coordinates.
+                    // The same nodes; the kernel's f16 codes (≤ 2^-11 of each value, so of the
+                    // blend), f32 variables and knot lines (≤ 1e-4 node units from the
+                    // mapping) against the general lookup's f32 values and f64 coordinates.
                     let e = (a[ch] - b[ch]).abs() / (b[ch].abs() * 1e-3 + peak * 1e-5);
                     worst = worst.max(e);
                 }
