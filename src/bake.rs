@@ -384,6 +384,11 @@ impl BakeRequest {
 
     /// The grid, symmetry note and verification this request uses for `src`.
     pub fn plan(&self, src: &dyn Brdf) -> Result<Plan> {
+        self.plan_with(src, &Silent)
+    }
+
+    /// [`plan`](Self::plan), reporting an error-target search (about a second) on `progress`.
+    pub fn plan_with(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<Plan> {
         let (mut sym, mut note) = self.resolve_symmetry(src);
         let mut force = self.force || self.symmetry == SymmetryChoice::Declared;
         let mut assumed = false;
@@ -417,7 +422,7 @@ impl BakeRequest {
             }
             _ => match self.effective_target() {
                 Some(e) => {
-                    let (g, s) = self.search_grid(src, sym, e, force)?;
+                    let (g, s) = self.search_grid(src, sym, e, force, progress)?;
                     search = Some(s);
                     g
                 }
@@ -451,6 +456,7 @@ impl BakeRequest {
         sym: Symmetry,
         e: f64,
         force: bool,
+        progress: &dyn Progress,
     ) -> Result<(Grid, TargetSearch)> {
         if !self.adaptive() {
             return Err(Error::arg(
@@ -477,6 +483,7 @@ impl BakeRequest {
             &adaptive::AdaptiveOptions::default(),
             &target::TargetOptions::new(e),
             force,
+            progress,
         )
     }
 
@@ -543,7 +550,7 @@ impl BakeRequest {
             force,
             assumed,
             search,
-        } = self.plan(src)?;
+        } = self.plan_with(src, progress)?;
         let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
         let set = |done: u64, _total: u64| progress.set(done);
         let opts = self.bake_options(&set, force);
@@ -678,7 +685,7 @@ impl BakeRequest {
             force,
             assumed,
             search,
-        } = self.plan(src)?;
+        } = self.plan_with(src, progress)?;
         let header = TableHeader::for_grid(name.to_owned(), provenance, &grid, self.codec);
         let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
         let set = |done: u64, _total: u64| progress.set(done);

@@ -16,6 +16,7 @@
 use crate::analysis::accuracy::{Weight, compare_weighted};
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
+use crate::progress::{Progress, Stage};
 use crate::table::adaptive::{self, AdaptiveOptions};
 use crate::table::symmetry::Symmetry;
 use crate::table::{BakeOptions, Grid, TabulatedBrdf, bake};
@@ -108,13 +109,15 @@ impl TargetSearch {
 /// The smallest grid of [`LADDER`] whose table meets `opts.target` against `src` (see the
 /// module docs), with what was measured. `symmetry` must be isotropic and bilateral; `force`
 /// bakes without verifying it (an assumed symmetry). When no grid meets the target, the largest
-/// is returned with `met: false`.
+/// is returned with `met: false`. Reports a stage `"searching grid"` on `progress` (of unknown
+/// length), noting each grid as it is tried.
 pub fn search(
     src: &dyn Brdf,
     symmetry: Symmetry,
     adaptive_opts: &AdaptiveOptions,
     opts: &TargetOptions,
     force: bool,
+    progress: &dyn Progress,
 ) -> Result<(Grid, TargetSearch)> {
     if !(opts.target > 0.0 && opts.target.is_finite()) {
         return Err(Error::arg(
@@ -125,6 +128,8 @@ pub fn search(
     if opts.pairs == 0 {
         return Err(Error::arg("target_error", "needs at least one pair"));
     }
+    let _stage = Stage::begin(progress, "searching grid", 0);
+    progress.note("fitting warps");
     let warps = adaptive::fit_warps(src, adaptive::phi_hi(symmetry), adaptive_opts)?;
     let grid_of =
         |nodes| adaptive::grid_with_warps(src.channels().clone(), symmetry, nodes, warps.clone());
@@ -135,10 +140,13 @@ pub fn search(
     let cap = opts.cap_deg.to_radians();
     let mut tried = Vec::new();
     let mut error_of = |k: usize| -> Result<f64> {
+        let [h, d, p] = LADDER[k];
+        progress.note(&format!("{h}x{d}x{p}"));
         let (t, _) = bake(src, &grid_of(LADDER[k])?, &bake_opts)?;
         let tb = TabulatedBrdf::from_table(t);
         let a = compare_weighted(&tb, src, opts.pairs, SEED, cap, Weight::CosInCosOut)?;
         tried.push((LADDER[k], a.rel_rmse));
+        progress.set(tried.len() as u64);
         Ok(a.rel_rmse)
     };
     let start = START;
@@ -182,6 +190,7 @@ pub fn search(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::progress::Silent;
     use crate::spec::ModelSpec;
     use crate::spectrum::Channels;
 
@@ -213,13 +222,13 @@ mod tests {
         };
         // Oren-Nayar is smooth: the smallest grid of the ladder meets 1 %.
         let on = model(r#"{"model": "oren_nayar", "sigma": 0.3, "kd": 0.5}"#);
-        let (g, s) = search(on.as_ref(), SYM, &fine, &quick(0.01), false).unwrap();
+        let (g, s) = search(on.as_ref(), SYM, &fine, &quick(0.01), false, &Silent).unwrap();
         assert!(s.met && s.nodes == LADDER[0], "{}", s.summary());
         assert_eq!(g.stored_shape()[0], LADDER[0][0]);
         // The measured errors decide: every candidate tried below the chosen one failed, the
         // chosen one passed (or is the largest).
         let ggx = model(r#"{"model": "ggx", "alpha": 0.03}"#);
-        let (_, s) = search(ggx.as_ref(), SYM, &fine, &quick(0.004), false).unwrap();
+        let (_, s) = search(ggx.as_ref(), SYM, &fine, &quick(0.004), false, &Silent).unwrap();
         let k = LADDER.iter().position(|&n| n == s.nodes).unwrap();
         assert!(k > 0, "{}", s.summary());
         for (n, e) in &s.tried {
@@ -245,10 +254,20 @@ mod tests {
             pairs: 2000,
             ..TargetOptions::new(1e-7)
         };
-        let (g, s) = search(ggx.as_ref(), SYM, &fine, &o, false).unwrap();
+        let (g, s) = search(ggx.as_ref(), SYM, &fine, &o, false, &Silent).unwrap();
         assert!(!s.met && s.nodes == LADDER[LADDER.len() - 1]);
         assert_eq!(g.stored_shape()[0], LADDER[LADDER.len() - 1][0]);
         assert!(s.summary().contains("NOT met"));
-        assert!(search(ggx.as_ref(), SYM, &fine, &TargetOptions::new(0.0), false).is_err());
+        assert!(
+            search(
+                ggx.as_ref(),
+                SYM,
+                &fine,
+                &TargetOptions::new(0.0),
+                false,
+                &Silent
+            )
+            .is_err()
+        );
     }
 }
