@@ -155,6 +155,7 @@ fn suite_metrics_of_an_exact_table_are_zero_and_a_cap_is_honoured() {
             seed: 3,
             albedo_thetas: thetas.clone(),
             cap,
+            weight: Default::default(),
         };
         let m = suite::metrics(&tab, src.as_ref(), &src_albedo, &opts).unwrap();
         assert!(m.rel_rmse < 1e-6 && m.max_rel < 1e-5, "{m:?}");

@@ -11,13 +11,13 @@
 //! 3. decodes those bytes back into a [`TabulatedBrdf`] (linear interpolation): every metric is
 //!    measured on the *decoded* table, quantization error included;
 //! 4. measures, against the source:
-//!    - `rel_rmse`, `max_rel`: [`analysis::accuracy::compare`] over `pairs` uniform random pairs
+//!    - `rel_rmse`, `max_rel`: [`analysis::accuracy::compare`](crate::analysis::accuracy::compare) over `pairs` uniform random pairs
 //!      (cosine-weighted relative RMSE; max relative error with a 1 %-of-RMS floor);
 //!    - `albedo_err`: max over the incidence angles `albedo_thetas` and channels of
 //!      |a_table − a_source| / a_source (denominator floored at 1e-3 × the largest source
 //!      albedo), both albedos by the same adaptive quadrature ([`albedo::integrate`]) with
 //!      [`ALBEDO_OPTIONS`], so quadrature error cancels as far as possible;
-//!    - `render_rel_rmse`: [`render::compare`] of a small lit-sphere render of the table against
+//!    - `render_rel_rmse`: [`render::compare`](fn@crate::render::compare) of a small lit-sphere render of the table against
 //!      the same render of the source, both with [`Sampling::Fixed`] and the same seed, so the
 //!      sampled directions coincide and the difference is (nearly) free of Monte Carlo noise.
 //!
@@ -621,6 +621,9 @@ pub struct MetricOptions {
     pub albedo_thetas: Vec<f64>,
     /// Largest polar angle of both directions (`None`: the whole hemisphere).
     pub cap: Option<f64>,
+    /// The cosine weight of the relative RMSE (default f_r cos θi; measured tables are judged
+    /// with f_r cos θi cos θo, as `brdftab bench --measured` does).
+    pub weight: accuracy::Weight,
 }
 
 /// `table` against `source`: the suite's metrics, for one table (the demo's rows use it too).
@@ -632,9 +635,16 @@ pub fn metrics(
     source_albedo: &[Vec<f64>],
     opts: &MetricOptions,
 ) -> Result<Metrics> {
-    let a = match opts.cap {
-        None => accuracy::compare(table, source, opts.pairs, opts.seed)?,
-        Some(cap) => accuracy::compare_cap(table, source, opts.pairs, opts.seed, cap)?,
+    let a = match (opts.cap, opts.weight) {
+        (None, accuracy::Weight::CosIn) => accuracy::compare(table, source, opts.pairs, opts.seed)?,
+        (cap, w) => accuracy::compare_weighted(
+            table,
+            source,
+            opts.pairs,
+            opts.seed,
+            cap.unwrap_or(std::f64::consts::FRAC_PI_2),
+            w,
+        )?,
     };
     Ok(Metrics {
         rel_rmse: finite_or(a.rel_rmse, NOT_MEASURED),
@@ -661,6 +671,7 @@ pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
         seed: cfg.seed,
         albedo_thetas: cfg.albedo_thetas.clone(),
         cap: None,
+        weight: accuracy::Weight::CosIn,
     };
     let mut rows = Vec::with_capacity(total);
     for sd in &cfg.sources {
