@@ -104,7 +104,7 @@ pub trait Brdf: Send + Sync {
         (1.0 - t) * buf[i0] as f64 + t * buf[i1] as f64
     }
 
-    /// Evaluates many pairs: `out[k * c .. (k + 1) * c]` receives f_r(wi[k], wo[k]) where `c` is
+    /// Evaluates many pairs: `out[k * c .. (k + 1) * c]` receives `f_r(wi[k], wo[k])` where `c` is
     /// the channel count. Batches of 16 384 pairs or more run on rayon's threads; tables
     /// override this for throughput.
     ///

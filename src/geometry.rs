@@ -33,7 +33,7 @@ pub fn unit(v: DVec3) -> Option<DVec3> {
 }
 
 /// True when a squared length is 1 to within 2⁻⁴⁰: the vector counts as unit and is used as is
-/// (see [`unit`]).
+/// (see [`unit()`]).
 #[inline]
 pub fn is_unit_l2(l2: f64) -> bool {
     (l2 - 1.0).abs() <= 1.0 / (1u64 << 40) as f64

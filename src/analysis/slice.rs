@@ -9,7 +9,7 @@
 //!   outside the disk are NaN in the data and the darkest colour in PNGs.
 //!
 //! Images are [`render::image::Image`](crate::render::image::Image)s: linear f32, one channel per
-//! BRDF channel, named after them. [`write`] stores them as EXR (as they are) or as PNG (one
+//! BRDF channel, named after them. [`write()`] stores them as EXR (as they are) or as PNG (one
 //! channel or the luminance, log scale through viridis with a colorbar strip below, via
 //! [`false_color`](crate::render::image::false_color)) and returns the legend line.
 

@@ -3,7 +3,7 @@
 //!
 //! A parameter is addressed by a path into the spec's JSON form: `kd`, `m`, `terms[1].m`,
 //! `terms[0].kd`. Paths are resolved on the JSON object (`serde_json::Value`) so that every model
-//! of [`ModelSpec`] — present and future — is addressable without a per-model table of setters;
+//! of [`ModelSpec`](crate::spec::ModelSpec) — present and future — is addressable without a per-model table of setters;
 //! the only per-parameter knowledge is the table of default bounds in [`default_bounds`].
 //!
 //! Bounds are enforced by a reparameterization: the optimizer sees an unconstrained `t ∈ ℝ` and

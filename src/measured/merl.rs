@@ -10,7 +10,7 @@
 //!
 //! 34,992,012 bytes in all. Sample (θh, θd, φd) of channel c is at `c·N + φd + 180·θd + 180·90·θh`
 //! and scales to f_r by R 1/1500, G 1.15/1500, B 1.66/1500. The angles are the Rusinkiewicz
-//! half/difference angles of ([`geometry::to_half_diff`](crate::geometry::to_half_diff), with the
+//! half/difference angles of ([`geometry::to_half_diff`], with the
 //! MERL reader's "in" direction = our `wi`), indexed as the reference reader `BRDFRead.cpp` does:
 //!
 //! - θh: `int(sqrt(θh / (π/2)) · 90)`, 0 when θh ≤ 0 — a square-root axis, dense near the

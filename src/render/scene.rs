@@ -448,7 +448,7 @@ impl Scene {
         }
     }
 
-    /// The primary ray direction through image position (sx, sy) ∈ [0,1]² (y down), for an
+    /// The primary ray direction through image position (sx, sy) ∈ \[0,1\]² (y down), for an
     /// image of aspect ratio `aspect` = width / height.
     pub fn camera_ray(&self, sx: f64, sy: f64, aspect: f64) -> DVec3 {
         let px = (2.0 * sx - 1.0) * self.tan_half_fov * aspect;

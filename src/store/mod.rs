@@ -1,7 +1,7 @@
 //! The brdftab file format and database of named tables.
 //!
 //! One format serves a single table and a database of many (suggested extension `.btdb`); see
-//! [`format`] for the byte layout. A table is stored as independently decodable, checksummed
+//! [`format`](mod@format) for the byte layout. A table is stored as independently decodable, checksummed
 //! chunks (slabs of its outermost axis, λ innermost), so a lookup decodes only the chunks it
 //! touches and whole-table reads decode in parallel.
 //!

@@ -10,7 +10,7 @@
 //! Before a reduced grid is baked its symmetries are verified on the source
 //! ([`symmetry::verify`]); a violation is an error unless [`BakeOptions::force`] is set.
 //!
-//! A node's value is f at the node's representative pair ([`pair_of`](super::pair_of)) — or, on
+//! A node's value is f at the node's representative pair ([`pair_of`]) — or, on
 //! a `halfdiff` grid whose nodes the source itself stores ([`Brdf::stored_node`]: a MERL file
 //! on [`Grid::merl`], a table on its own grid), the stored value verbatim, including cells whose
 //! centre lies below the horizon and negative markers of unmeasured cells; with

@@ -365,7 +365,7 @@ impl StoredAxis {
     }
 
     /// The two nodes and the weight of the second for linear interpolation at `x`:
-    /// value = (1 − t)·v[i0] + t·v[i1].
+    /// `value = (1 − t)·v[i0] + t·v[i1]`.
     #[inline(always)]
     pub fn linear(&self, x: f64) -> (usize, usize, f32) {
         let n = self.size;

@@ -1,7 +1,7 @@
 //! Interpolated lookup in stored values: nearest and multilinear.
 //!
 //! A lookup maps the pair to canonical stored coordinates
-//! ([`canonical_coords`](super::symmetry::canonical_coords)), then per stored axis to nodes and
+//! ([`canonical_coords`]), then per stored axis to nodes and
 //! weights ([`StoredAxis::nearest`], [`StoredAxis::linear`]): clamped on θ axes and folded φ
 //! axes, wrapping on periodic φ axes. Linear interpolation visits the 2^k corners of the cell
 //! (k = axes whose weight is not 0, so axes of size 1 and exact node coordinates cost nothing)

@@ -12,7 +12,7 @@
 //!   by vector algebra (cos φo = wo.x/|wo.xy|, sin φo = wo.y/|wo.xy|). Anisotropic sources: also
 //!   `phi_o` periodic nodes over φo (no rotation).
 //! - **Per node**: the hemisphere of `wi` is parameterized by the **equal-area** map
-//!   square [0,1]² → concentric disk (Shirley–Chiu) → hemisphere (z = 1 − r², xy scaled by
+//!   square \[0,1\]² → concentric disk (Shirley–Chiu) → hemisphere (z = 1 − r², xy scaled by
 //!   √(2 − r²), Lambert's azimuthal projection), so a uniform density on the square is the
 //!   uniform density 1/(2π) on the hemisphere and a square cell has solid angle 2π/n². Cells
 //!   near the pole are as compact as elsewhere (unlike (cos θ, φ) cells), which matters for lobes
@@ -117,7 +117,7 @@ struct Mix {
     len: usize,
 }
 
-/// The equal-area map square [0,1]² → upper hemisphere (constant Jacobian 2π).
+/// The equal-area map square \[0,1\]² → upper hemisphere (constant Jacobian 2π).
 #[inline]
 pub fn square_to_hemisphere(p: DVec2) -> DVec3 {
     let d = geometry::concentric_disk(p);

@@ -1,8 +1,9 @@
 //! The fields of a `.bsdf` file and their layout in the tensor container, in the order and with
-//! the dtypes of the published files: `version` u32[2] = {1, 0}, `description` u8[len],
-//! `phi_i` f32[φi], `theta_i` f32[θi], `sigma` and `ndf` f32[rows, cols], `vndf`
-//! f32[φi, θi, n, n], `luminance` f32[φi, θi, N, N], `rgb` f32[φi, θi, 3, N, N] (or `spectra`
-//! f32[φi, θi, λ, N, N] followed by `wavelengths` f32[λ]), `jacobian` u8[1] = 1, `valid` u8[bytes].
+//! the dtypes of the published files: `version: u32[2] = {1, 0}`, `description: u8[len]`,
+//! `phi_i: f32[φi]`, `theta_i: f32[θi]`, `sigma` and `ndf: f32[rows, cols]`,
+//! `vndf: f32[φi, θi, n, n]`, `luminance: f32[φi, θi, N, N]`, `rgb: f32[φi, θi, 3, N, N]` (or
+//! `spectra: f32[φi, θi, λ, N, N]` followed by `wavelengths: f32[λ]`), `jacobian: u8[1] = 1`,
+//! `valid: u8[bytes]`.
 
 use crate::measured::tensor::{Dtype, TensorWriter};
 

@@ -19,7 +19,7 @@
 //! 4. the `luminance` table (Rec. 709 Y of the stored values; the channel mean for spectra) that
 //!    the readers sample by, and [`container`] lays the fields out as the published files do.
 //!
-//! [`report`] measures a written file against its source with brdftab's own reader.
+//! [`report()`] measures a written file against its source with brdftab's own reader.
 //!
 //! The positions in step 3 are found with the reader's warp code itself
 //! ([`rgl`](super::rgl)), so writer and reader agree on where every stored value lives.
@@ -31,7 +31,7 @@
 //! the database's 8 non-uniform elevations, asked for with 8) serves measurements, whose
 //! parameterization follows the material, but it interpolates analytic lobes poorly over θi:
 //! Cook-Torrance m = 0.3 gold measured 3.6% with it, 1.3% with 16 elevations at N = 32, 0.35%
-//! at N = 64 (the metric of [`report`]). `.bsdf` sources are instead resampled into their own
+//! at N = 64 (the metric of [`report()`]). `.bsdf` sources are instead resampled into their own
 //! parameterization ([`Options::reuse_source_file`]): same elevations, NDF, warps and N, and
 //! the stored values at below-horizon grid points kept, so a re-encoded file evaluates like the
 //! original (measured 0.005% to 0.5%).
@@ -406,7 +406,7 @@ fn same_channels(file: &Option<Vec<f32>>, channels: &crate::spectrum::Channels) 
     }
 }
 
-/// What [`write`] wrote.
+/// What [`write()`] wrote.
 #[derive(Debug, Clone)]
 pub struct Written {
     /// File size in bytes.

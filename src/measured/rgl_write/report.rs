@@ -31,7 +31,7 @@ pub struct Report {
     /// Per channel.
     pub per_channel: Vec<f64>,
     /// Largest relative error of f_r·cos θo (floored at 1% of its RMS, as in
-    /// [`accuracy`](crate::analysis::accuracy)).
+    /// [`accuracy`]).
     pub max_rel: f64,
 }
 
