@@ -1,0 +1,86 @@
+//! Any bytes through the C ABI's `brdftab_open_with`: the first byte picks how — an inline
+//! SOURCE string, or a file of each kind (`.btdb`, `.bsdf`, `.binary`, `.json`) holding the
+//! rest, opened lazily or eagerly — then `brdftab_eval`/`_pdf`/`_sample`/`_albedo` on a few
+//! pairs, including counts that overflow. Every call must return 0 or -1; -1 must leave a
+//! message in `brdftab_last_error`.
+#![no_main]
+
+use std::ffi::{CStr, CString};
+use std::io::Write;
+
+use brdftab_c::*;
+use libfuzzer_sys::fuzz_target;
+
+fn last_error() -> String {
+    // SAFETY: a NUL-terminated string owned by this thread.
+    unsafe { CStr::from_ptr(brdftab_last_error()) }.to_string_lossy().into_owned()
+}
+
+fuzz_target!(|data: &[u8]| {
+    let Some((&mode, rest)) = data.split_first() else { return };
+    let ext = ["btdb", "bsdf", "binary", "json"];
+    let file;
+    let source = if mode % 5 == 4 {
+        match CString::new(rest) {
+            Ok(s) => s,
+            Err(_) => return,
+        }
+    } else {
+        file = std::env::temp_dir().join(format!(
+            "brdftab-fuzz-{}.{}",
+            std::process::id(),
+            ext[(mode % 5) as usize]
+        ));
+        let mut f = std::fs::File::create(&file).expect("temp file");
+        f.write_all(rest).expect("temp write");
+        CString::new(file.to_str().expect("utf-8 temp path")).expect("no NUL")
+    };
+    let opts = brdftab_open_options {
+        interp: (mode >> 4 & 1) as i32,
+        n_wavelengths: 0,
+        wavelengths: std::ptr::null(),
+        eager: (mode >> 5 & 1) as i32,
+    };
+    // SAFETY: a valid NUL-terminated string and a valid options struct.
+    let b = unsafe { brdftab_open_with(source.as_ptr(), &opts) };
+    if b.is_null() {
+        assert!(!last_error().is_empty(), "NULL without a message");
+        return;
+    }
+    // SAFETY (all calls): `b` is live; the arrays hold what n says (or n overflows and the
+    // call must refuse before reading).
+    unsafe {
+        let c = brdftab_channels(b);
+        assert!(c >= 1);
+        let n = 4;
+        let wi = [0.0, 0.0, 1.0, 0.6, 0.0, 0.8, f64::NAN, 0.0, 1.0, 0.1, 0.2, -0.9];
+        let wo = [0.0, 0.0, 1.0, -0.3, 0.1, 0.9, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+        let u = [0.1, 0.2, 0.5, 0.5, 0.9, 0.01, 0.3, 0.3];
+        let mut f = vec![0.0f32; n * c];
+        let (mut pdf, mut swi, mut w) = ([0.0f64; 4], [0.0f64; 12], vec![0.0f32; n * c]);
+        for count in [n, usize::MAX / 3 + 1, usize::MAX / 24 + 1] {
+            let r = [
+                brdftab_eval(b, count, wi.as_ptr(), wo.as_ptr(), f.as_mut_ptr()),
+                brdftab_pdf(b, count, wi.as_ptr(), wo.as_ptr(), pdf.as_mut_ptr()),
+                brdftab_sample(
+                    b,
+                    count,
+                    wo.as_ptr(),
+                    u.as_ptr(),
+                    swi.as_mut_ptr(),
+                    pdf.as_mut_ptr(),
+                    w.as_mut_ptr(),
+                ),
+            ];
+            for r in r {
+                assert!(r == 0 || r == -1);
+                assert!(r == 0 || !last_error().is_empty());
+                assert!(count == n || r == -1, "an overflowing count succeeded");
+            }
+        }
+        let mut a = vec![0.0f64; c];
+        let r = brdftab_albedo(b, 0.5, a.as_mut_ptr());
+        assert!(r == 0 || r == -1);
+        brdftab_close(b);
+    }
+});
