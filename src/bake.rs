@@ -555,6 +555,8 @@ impl BakeRequest {
         let set = |done: u64, _total: u64| progress.set(done);
         let opts = self.bake_options(&set, force);
         let (table, r) = crate::table::bake(src, &grid, &opts)?;
+        // A lazily read table source whose chunk failed gave zeros: refuse them.
+        src.health()?;
         let mut report = self.report_for(src, &grid, note, t0, false);
         report.forced = r.forced.filter(|_| !assumed);
         report.target = search;
@@ -608,11 +610,14 @@ impl BakeRequest {
 
     /// [`run`](Self::run), reporting progress.
     pub fn run_with(&self, target: &BakeTarget, progress: &dyn Progress) -> Result<BakeReport> {
+        self.refuse_overwrite(target)?;
         let src = self.open_source()?;
         if let BakeTarget::Merl(path) = target {
             let t0 = Instant::now();
             let _stage = Stage::begin(progress, "resampling on the MERL grid", 0);
-            crate::measured::MerlBrdf::from_brdf(src.as_ref()).write(path)?;
+            let merl = crate::measured::MerlBrdf::from_brdf(src.as_ref());
+            src.health()?;
+            merl.write(path)?;
             let mut report =
                 self.report_for(src.as_ref(), &Grid::merl(Channels::Rgb), None, t0, true);
             report.name = stem(path);
@@ -670,6 +675,19 @@ impl BakeRequest {
         Ok(report)
     }
 
+    /// Refuses a target that is the source's own file (`convert p.bsdf p.bsdf`, `bake t.btdb
+    /// -o t.btdb`): the write would replace the source with its resample. Another entry of the
+    /// database a `DB#NAME` source reads is fine (the source entry is kept as it is).
+    fn refuse_overwrite(&self, target: &BakeTarget) -> Result<()> {
+        if let BakeTarget::Db { name, .. } = target
+            && let (_, Some(entry)) = db::split_source(&self.source)
+            && entry != name
+        {
+            return Ok(());
+        }
+        crate::files::refuse_input(std::path::Path::new(target.path()), &[&self.source])
+    }
+
     fn stream(
         &self,
         src: &dyn Brdf,
@@ -693,9 +711,11 @@ impl BakeRequest {
         let mut baked = None;
         let mut write = |w: &mut Writer| -> Result<()> {
             baked = Some(bake_chunks(src, &grid, &opts, |i, v| {
+                src.health()?; // a failed table source: stop before its zeros are written
                 w.chunk_with(v, tables::chunk_layout(&grid, i))
             })?);
-            Ok(())
+            // Before the file is committed (an error here leaves the old file as it was).
+            src.health()
         };
         match target {
             BakeTarget::Db { path, replace, .. } => db::put(path, header, *replace, write)?,
@@ -907,6 +927,7 @@ pub fn to_rgl(
         channels,
         ..Default::default()
     };
+    crate::files::refuse_input(std::path::Path::new(output), &[source])?;
     let brdf = source::open_with(source, &open)?;
     let opts = opts.clone().reuse_source_file(source)?;
     let t = std::time::Instant::now();

@@ -125,10 +125,12 @@ pub trait Brdf: Send + Sync {
             }
         };
         if n >= 4 * BLOCK {
-            out[..n * c]
-                .par_chunks_mut(BLOCK * c)
-                .enumerate()
-                .for_each(|(b, o)| run(b * BLOCK, o));
+            crate::par::install(|| {
+                out[..n * c]
+                    .par_chunks_mut(BLOCK * c)
+                    .enumerate()
+                    .for_each(|(b, o)| run(b * BLOCK, o))
+            });
         } else {
             run(0, &mut out[..n * c]);
         }
@@ -207,6 +209,17 @@ pub trait Brdf: Send + Sync {
         let _ = (hd, out);
         false
     }
+
+    /// Whether every value this BRDF has returned so far was real. `eval` cannot return an
+    /// error, so a source whose data can fail while it is read — a lazily decoded table whose
+    /// chunk fails its checksum — returns 0 for the lookups it cannot serve and reports the
+    /// failure here from then on (sticky: a failed source stays failed). Call it after a batch
+    /// of lookups (a tile, a frame) and discard the batch on an error; it is one atomic load
+    /// for a healthy table. Always `Ok` for analytic models and measured files (read whole at
+    /// open).
+    fn health(&self) -> crate::Result<()> {
+        Ok(())
+    }
 }
 
 /// The length check of [`Brdf::eval_batch`]: returns the number of pairs, panics (with both
@@ -260,6 +273,9 @@ macro_rules! forward_brdf {
             }
             fn stored_node(&self, hd: geometry::HalfDiff, out: &mut [f32]) -> bool {
                 (**self).stored_node(hd, out)
+            }
+            fn health(&self) -> crate::Result<()> {
+                (**self).health()
             }
         }
     };

@@ -213,11 +213,13 @@ impl Error {
         }
     }
 
-    /// A spec error naming `field`.
+    /// A spec error naming `field`. What the message quotes of the input (between backticks:
+    /// a model name, an unknown field) is shortened to an [`excerpt`], so a huge spec does not
+    /// make a huge message.
     pub fn spec(field: impl Into<String>, msg: impl Into<String>) -> Self {
         Error::Spec {
-            field: field.into(),
-            msg: msg.into(),
+            field: excerpt(&field.into()).into_owned(),
+            msg: shorten_quoted(&msg.into()),
         }
     }
 
@@ -243,4 +245,108 @@ impl Error {
             msg: msg.into(),
         }
     }
+
+    /// A copy of this error with the same variant and message, for errors that are reported
+    /// more than once (a table's sticky chunk failure, [`crate::Brdf::health`]). The wrapped
+    /// sources that cannot be cloned are rebuilt from their message: an I/O error keeps its
+    /// kind, a JSON error becomes a format error with the same text.
+    pub fn replicate(&self) -> Error {
+        match self {
+            Error::Io { context, source } => Error::Io {
+                context: context.clone(),
+                source: std::io::Error::new(source.kind(), source.to_string()),
+            },
+            Error::Spec { field, msg } => Error::spec(field.clone(), msg.clone()),
+            Error::Json { context, source } => Error::format(
+                context.clone(),
+                None,
+                None,
+                format!("invalid JSON: {source}"),
+            ),
+            Error::Parse {
+                source_name,
+                line,
+                msg,
+            } => Error::Parse {
+                source_name: source_name.clone(),
+                line: *line,
+                msg: msg.clone(),
+            },
+            Error::Format {
+                file,
+                field,
+                offset,
+                msg,
+            } => Error::Format {
+                file: file.clone(),
+                field: field.clone(),
+                offset: *offset,
+                msg: msg.clone(),
+            },
+            Error::Checksum {
+                file,
+                what,
+                stored,
+                computed,
+            } => Error::Checksum {
+                file: file.clone(),
+                what: what.clone(),
+                stored: *stored,
+                computed: *computed,
+            },
+            Error::Symmetry {
+                symmetry,
+                error,
+                tolerance,
+                at,
+            } => Error::Symmetry {
+                symmetry: *symmetry,
+                error: *error,
+                tolerance: *tolerance,
+                at: at.clone(),
+            },
+            Error::Duplicate { container, name } => Error::Duplicate {
+                container: container.clone(),
+                name: name.clone(),
+            },
+            Error::InvalidArgument { name, msg } => Error::arg(name.clone(), msg.clone()),
+            Error::Encode { msg } => Error::Encode { msg: msg.clone() },
+            Error::Unsupported(m) => Error::Unsupported(m.clone()),
+            Error::NotFound(m) => Error::NotFound(m.clone()),
+        }
+    }
+}
+
+/// `msg` with every word (a run without spaces) longer than an [`excerpt`] shortened to one —
+/// such a word is input echoed back: a model name, a field, a string value — and the whole
+/// bounded to a few kilobytes.
+fn shorten_quoted(msg: &str) -> String {
+    let mut out = String::with_capacity(msg.len().min(4096));
+    for (i, word) in msg.split(' ').enumerate() {
+        if i > 0 {
+            out.push(' ');
+        }
+        out.push_str(&excerpt(word));
+    }
+    match out.len() {
+        n if n > 2048 => excerpt_to(&out, 2048).into_owned(),
+        _ => out,
+    }
+}
+
+/// `s` as it may appear in a message: whole when short, else its first characters and its
+/// length (a 10 MB spec is not echoed whole into an error).
+pub fn excerpt(s: &str) -> std::borrow::Cow<'_, str> {
+    excerpt_to(s, 120)
+}
+
+fn excerpt_to(s: &str, max: usize) -> std::borrow::Cow<'_, str> {
+    if s.len() <= max {
+        return s.into();
+    }
+    let mut end = max;
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!("{}… ({} bytes)", &s[..end], s.len()).into()
 }

@@ -18,7 +18,7 @@
 use std::path::Path;
 
 use crate::brdf::Brdf;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, excerpt};
 use crate::spec::ModelSpec;
 use crate::spectrum::Channels;
 use crate::table::{Interp, Table, TabulatedBrdf};
@@ -192,9 +192,14 @@ pub fn open(source: &str) -> Result<Box<dyn Brdf + Send + Sync>> {
 
 /// Opens SOURCE as `opts` say (see [`open`] for the kinds).
 pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send + Sync>> {
+    // Stat before any open: a FIFO, socket, device or directory is refused at once.
+    if let Some(f) = crate::files::source_file(source) {
+        crate::files::require_regular(f)?;
+    }
     let fixed_channels = |brdf: Box<dyn Brdf + Send + Sync>| match &opts.channels {
         Some(c) if c != brdf.channels() => Err(Error::Unsupported(format!(
-            "{source}: stored with channels {}; it cannot be evaluated at {}",
+            "{}: stored with channels {}; it cannot be evaluated at {}",
+            excerpt(source),
             brdf.channels().names().join(" "),
             c.names().join(" ")
         ))),
@@ -219,16 +224,18 @@ pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send
 /// Opens a table SOURCE (`FILE`, `DB#NAME` or a raw table) as a [`TabulatedBrdf`].
 pub fn open_table(source: &str, opts: &OpenOptions) -> Result<TabulatedBrdf> {
     let path = crate::store::db::split_source(source).0;
+    crate::files::require_regular(path)?;
     let brdf = if crate::store::tables::is_store_file(path) {
         crate::store::tables::open_brdf(source, opts.eager)?
     } else if Table::is_raw(source) {
         TabulatedBrdf::from_table(Table::open_raw(source)?)
     } else if !Path::new(path).exists() {
-        return Err(Error::NotFound(format!("{path}: no such file")));
+        return Err(Error::NotFound(format!("{}: no such file", excerpt(path))));
     } else {
         return Err(Error::Unsupported(format!(
-            "{path}: not a file brdftab can read (no brdftab, MERL or RGL signature, and not a \
-             .json spec)"
+            "{}: not a file brdftab can read (no brdftab, MERL or RGL signature, and not a \
+             .json spec)",
+            excerpt(path)
         )));
     };
     Ok(brdf.with_interp(opts.interp))

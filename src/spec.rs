@@ -526,6 +526,7 @@ impl ModelSpec {
 
     /// Reads a spec from a `.json` file.
     pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<Self> {
+        crate::files::require_regular(path.as_ref())?;
         let text = std::fs::read_to_string(path.as_ref()).map_err(|e| Error::io(&path, e))?;
         Self::parse(&text).map_err(|e| match e {
             Error::Json { source, .. } => Error::Json {

@@ -34,7 +34,7 @@ pub fn parse_numbers<const N: usize>(
         }
         v[k] = tok
             .parse()
-            .map_err(|_| err(format!("`{tok}` is not a number")))?;
+            .map_err(|_| err(format!("`{}` is not a number", crate::error::excerpt(tok))))?;
         k += 1;
     }
     if k < N {

@@ -112,38 +112,40 @@ pub fn compare_weighted(
     let blocks = pairs.div_ceil(BLOCK);
     // Per block: (Σ err² per channel, Σ ref² per channel, Σ f² unweighted, samples (|err|, |f|, wi, wo)).
     type Block = (Vec<f64>, Vec<f64>, f64, Vec<(f64, f64, DVec3, DVec3)>);
-    let parts: Vec<Block> = (0..blocks)
-        .into_par_iter()
-        .map(|b| {
-            let mut rng = Pcg32::with_stream(seed, b as u64);
-            let n = BLOCK.min(pairs - b * BLOCK);
-            let mut e2 = vec![0.0; c];
-            let mut r2 = vec![0.0; c];
-            let mut f2 = 0.0;
-            let mut worst = Vec::with_capacity(n * c);
-            let mut fa = [0.0f32; MAX_CHANNELS];
-            let mut fr = [0.0f32; MAX_CHANNELS];
-            for _ in 0..n {
-                let wi = cap(rng.next_dvec2());
-                let wo = cap(rng.next_dvec2());
-                approx.eval(wi, wo, &mut fa[..c]);
-                reference.eval(wi, wo, &mut fr[..c]);
-                let w = match weight {
-                    Weight::CosIn => wi.z,
-                    Weight::CosInCosOut => wi.z * wo.z,
-                };
-                for k in 0..c {
-                    let (a, r) = (fa[k] as f64, fr[k] as f64);
-                    let err = a - r;
-                    e2[k] += (err * w).powi(2);
-                    r2[k] += (r * w).powi(2);
-                    f2 += r * r;
-                    worst.push((err.abs(), r.abs(), wi, wo));
+    let parts: Vec<Block> = crate::par::install(|| {
+        (0..blocks)
+            .into_par_iter()
+            .map(|b| {
+                let mut rng = Pcg32::with_stream(seed, b as u64);
+                let n = BLOCK.min(pairs - b * BLOCK);
+                let mut e2 = vec![0.0; c];
+                let mut r2 = vec![0.0; c];
+                let mut f2 = 0.0;
+                let mut worst = Vec::with_capacity(n * c);
+                let mut fa = [0.0f32; MAX_CHANNELS];
+                let mut fr = [0.0f32; MAX_CHANNELS];
+                for _ in 0..n {
+                    let wi = cap(rng.next_dvec2());
+                    let wo = cap(rng.next_dvec2());
+                    approx.eval(wi, wo, &mut fa[..c]);
+                    reference.eval(wi, wo, &mut fr[..c]);
+                    let w = match weight {
+                        Weight::CosIn => wi.z,
+                        Weight::CosInCosOut => wi.z * wo.z,
+                    };
+                    for k in 0..c {
+                        let (a, r) = (fa[k] as f64, fr[k] as f64);
+                        let err = a - r;
+                        e2[k] += (err * w).powi(2);
+                        r2[k] += (r * w).powi(2);
+                        f2 += r * r;
+                        worst.push((err.abs(), r.abs(), wi, wo));
+                    }
                 }
-            }
-            (e2, r2, f2, worst)
-        })
-        .collect();
+                (e2, r2, f2, worst)
+            })
+            .collect()
+    });
     let mut e2 = vec![0.0; c];
     let mut r2 = vec![0.0; c];
     let mut f2 = 0.0;

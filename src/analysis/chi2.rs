@@ -97,34 +97,36 @@ pub fn histogram<B: Brdf + ?Sized>(
     let chunks = 64usize;
     let per = o.samples.div_ceil(chunks);
     let c = brdf.channels().len().min(MAX_CHANNELS);
-    let parts: Vec<(Vec<u64>, usize, usize)> = (0..chunks)
-        .into_par_iter()
-        .map(|k| {
-            let mut rng = Pcg32::with_stream(o.seed, k as u64 + 1);
-            let mut counts = vec![0u64; nbins];
-            let (mut refused, mut invalid) = (0, 0);
-            let mut weight = [0.0f32; MAX_CHANNELS];
-            let n = per.min(o.samples.saturating_sub(k * per));
-            for _ in 0..n {
-                let u = rng.next_dvec2();
-                match brdf.sample(wo, u, &mut weight[..c]) {
-                    None => refused += 1,
-                    Some(s) => {
-                        let ok = s.pdf.is_finite()
-                            && s.pdf > 0.0
-                            && (s.wi.length() - 1.0).abs() < 1e-6
-                            && !s.delta;
-                        if ok {
-                            counts[bin_of(s.wi, o)] += 1;
-                        } else {
-                            invalid += 1;
+    let parts: Vec<(Vec<u64>, usize, usize)> = crate::par::install(|| {
+        (0..chunks)
+            .into_par_iter()
+            .map(|k| {
+                let mut rng = Pcg32::with_stream(o.seed, k as u64 + 1);
+                let mut counts = vec![0u64; nbins];
+                let (mut refused, mut invalid) = (0, 0);
+                let mut weight = [0.0f32; MAX_CHANNELS];
+                let n = per.min(o.samples.saturating_sub(k * per));
+                for _ in 0..n {
+                    let u = rng.next_dvec2();
+                    match brdf.sample(wo, u, &mut weight[..c]) {
+                        None => refused += 1,
+                        Some(s) => {
+                            let ok = s.pdf.is_finite()
+                                && s.pdf > 0.0
+                                && (s.wi.length() - 1.0).abs() < 1e-6
+                                && !s.delta;
+                            if ok {
+                                counts[bin_of(s.wi, o)] += 1;
+                            } else {
+                                invalid += 1;
+                            }
                         }
                     }
                 }
-            }
-            (counts, refused, invalid)
-        })
-        .collect();
+                (counts, refused, invalid)
+            })
+            .collect()
+    });
     let mut counts = vec![0u64; nbins];
     let (mut refused, mut invalid) = (0, 0);
     for (c, r, i) in parts {
@@ -141,25 +143,27 @@ pub fn histogram<B: Brdf + ?Sized>(
 /// cos θ and φ.
 pub fn expected_mass<B: Brdf + ?Sized>(brdf: &B, wo: DVec3, o: &Chi2Options) -> Vec<f64> {
     let nbins = o.cos_bins * o.phi_bins;
-    (0..nbins)
-        .into_par_iter()
-        .map(|b| {
-            let (ci, pi) = (b / o.phi_bins, b % o.phi_bins);
-            let z0 = -1.0 + 2.0 * ci as f64 / o.cos_bins as f64;
-            let z1 = -1.0 + 2.0 * (ci + 1) as f64 / o.cos_bins as f64;
-            let p0 = 2.0 * PI * pi as f64 / o.phi_bins as f64;
-            let p1 = 2.0 * PI * (pi + 1) as f64 / o.phi_bins as f64;
-            // dω = dz dφ on the sphere.
-            let f = |z: f64, phi: f64| {
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                let wi = DVec3::new(r * phi.cos(), r * phi.sin(), z);
-                let p = brdf.pdf(wi, wo);
-                if p.is_finite() { p } else { 0.0 }
-            };
-            let inner = |z: f64| adaptive_simpson(&|phi| f(z, phi), p0, p1, 1e-7, 8);
-            adaptive_simpson(&inner, z0, z1, 1e-7, 8)
-        })
-        .collect()
+    crate::par::install(|| {
+        (0..nbins)
+            .into_par_iter()
+            .map(|b| {
+                let (ci, pi) = (b / o.phi_bins, b % o.phi_bins);
+                let z0 = -1.0 + 2.0 * ci as f64 / o.cos_bins as f64;
+                let z1 = -1.0 + 2.0 * (ci + 1) as f64 / o.cos_bins as f64;
+                let p0 = 2.0 * PI * pi as f64 / o.phi_bins as f64;
+                let p1 = 2.0 * PI * (pi + 1) as f64 / o.phi_bins as f64;
+                // dω = dz dφ on the sphere.
+                let f = |z: f64, phi: f64| {
+                    let r = (1.0 - z * z).max(0.0).sqrt();
+                    let wi = DVec3::new(r * phi.cos(), r * phi.sin(), z);
+                    let p = brdf.pdf(wi, wo);
+                    if p.is_finite() { p } else { 0.0 }
+                };
+                let inner = |z: f64| adaptive_simpson(&|phi| f(z, phi), p0, p1, 1e-7, 8);
+                adaptive_simpson(&inner, z0, z1, 1e-7, 8)
+            })
+            .collect()
+    })
 }
 
 /// Adaptive Simpson quadrature of `f` over [a, b] with absolute tolerance `eps` and at most

@@ -201,20 +201,21 @@ pub fn check(brdf: &dyn Brdf, opts: &Options) -> Report {
         .iter()
         .flat_map(|&t| azimuths.iter().map(move |&p| (t, p)))
         .collect();
-    let albedos: Vec<Vec<f64>> = jobs
-        .par_iter()
-        .map(|&(t, p)| {
-            let wi = geometry::spherical(t.to_radians(), p.to_radians());
-            match &opts.albedo {
-                Some(o) => super::albedo::integrate(brdf, wi, o).value,
-                None => {
-                    let mut a = vec![0.0; c];
-                    brdf.albedo(wi, &mut a);
-                    a
+    let albedos: Vec<Vec<f64>> = crate::par::install(|| {
+        jobs.par_iter()
+            .map(|&(t, p)| {
+                let wi = geometry::spherical(t.to_radians(), p.to_radians());
+                match &opts.albedo {
+                    Some(o) => super::albedo::integrate(brdf, wi, o).value,
+                    None => {
+                        let mut a = vec![0.0; c];
+                        brdf.albedo(wi, &mut a);
+                        a
+                    }
                 }
-            }
-        })
-        .collect();
+            })
+            .collect()
+    });
     let (mut max_albedo, mut max_t, mut max_p, mut max_ch) = (0.0f64, 0.0, 0.0, 0usize);
     let mut curve = Vec::with_capacity(opts.thetas_deg.len());
     for (&(t, p), a) in jobs.iter().zip(&albedos) {

@@ -33,23 +33,25 @@ fn render(
 ) -> Image {
     let c = brdf.channels().len().min(MAX_CHANNELS);
     let mut data = vec![0.0f32; width * height * c];
-    data.par_chunks_mut(width * c)
-        .enumerate()
-        .for_each(|(y, row)| {
-            let mut f = [0.0f32; MAX_CHANNELS];
-            for x in 0..width {
-                let px = &mut row[x * c..(x + 1) * c];
-                match pair(x, y) {
-                    Some((wi, wo, w)) => {
-                        brdf.eval(wi, wo, &mut f[..c]);
-                        for k in 0..c {
-                            px[k] = (f[k] as f64 * w) as f32;
+    crate::par::install(|| {
+        data.par_chunks_mut(width * c)
+            .enumerate()
+            .for_each(|(y, row)| {
+                let mut f = [0.0f32; MAX_CHANNELS];
+                for x in 0..width {
+                    let px = &mut row[x * c..(x + 1) * c];
+                    match pair(x, y) {
+                        Some((wi, wo, w)) => {
+                            brdf.eval(wi, wo, &mut f[..c]);
+                            for k in 0..c {
+                                px[k] = (f[k] as f64 * w) as f32;
+                            }
                         }
+                        None => px.fill(f32::NAN),
                     }
-                    None => px.fill(f32::NAN),
                 }
-            }
-        });
+            })
+    });
     Image {
         width,
         height,

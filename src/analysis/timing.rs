@@ -90,7 +90,7 @@ pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTim
         cpu_ns_per_lookup_single_thread: median(&mut single_cpu),
         lookups_per_s_batch: median(&mut batch),
         lookups_per_s_batch_per_core_cpu_time: median(&mut batch_cpu),
-        threads: rayon::current_num_threads(),
+        threads: crate::par::threads(),
     })
 }
 

@@ -166,6 +166,7 @@ pub fn sha256_file(path: impl AsRef<Path>) -> Result<String> {
     use sha2::Digest;
     use std::io::Read;
     let path = path.as_ref();
+    crate::files::require_regular(path)?;
     let mut f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let mut h = sha2::Sha256::new();
     let mut buf = vec![0u8; 1 << 20];
@@ -203,6 +204,7 @@ impl MerlBrdf {
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let file = path.display().to_string();
+        crate::files::require_regular(path)?;
         let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
         if meta.len() != FILE_SIZE {
             // Read the header anyway (if present) for a more helpful message.
@@ -316,46 +318,48 @@ impl MerlBrdf {
         let stored = rgb;
         let plane = RES_THETA_D * RES_PHI_D;
         let mut cells = vec![[0.0f64; 3]; SAMPLES];
-        cells
-            .par_chunks_mut(plane)
-            .enumerate()
-            .for_each(|(ith, chunk)| {
-                for itd in 0..RES_THETA_D {
-                    for ipd in 0..RES_PHI_D {
-                        let hd = cell_center(ith, itd, ipd);
-                        let cell = &mut chunk[ipd + RES_PHI_D * itd];
-                        let mut f = [0.0f32; 3];
-                        if stored && brdf.stored_node(hd, &mut f) {
+        crate::par::install(|| {
+            cells
+                .par_chunks_mut(plane)
+                .enumerate()
+                .for_each(|(ith, chunk)| {
+                    for itd in 0..RES_THETA_D {
+                        for ipd in 0..RES_PHI_D {
+                            let hd = cell_center(ith, itd, ipd);
+                            let cell = &mut chunk[ipd + RES_PHI_D * itd];
+                            let mut f = [0.0f32; 3];
+                            if stored && brdf.stored_node(hd, &mut f) {
+                                for c in 0..3 {
+                                    cell[c] = if f[c] < 0.0 {
+                                        -1.0
+                                    } else if f[c].is_finite() {
+                                        f[c] as f64 / SCALE[c]
+                                    } else {
+                                        0.0
+                                    };
+                                }
+                                continue;
+                            }
+                            let (wi, wo) = geometry::from_half_diff(hd);
+                            if wi.z <= 0.0 || wo.z <= 0.0 {
+                                // Below the horizon: no value, marked as the database does.
+                                *cell = [-1.0; 3];
+                                continue;
+                            }
+                            if rgb {
+                                brdf.eval(wi, wo, &mut f);
+                            } else {
+                                for (c, nm) in RGB_WAVELENGTHS.iter().enumerate() {
+                                    f[c] = brdf.eval_wavelength(wi, wo, *nm) as f32;
+                                }
+                            }
                             for c in 0..3 {
-                                cell[c] = if f[c] < 0.0 {
-                                    -1.0
-                                } else if f[c].is_finite() {
-                                    f[c] as f64 / SCALE[c]
-                                } else {
-                                    0.0
-                                };
+                                cell[c] = f[c] as f64 / SCALE[c];
                             }
-                            continue;
-                        }
-                        let (wi, wo) = geometry::from_half_diff(hd);
-                        if wi.z <= 0.0 || wo.z <= 0.0 {
-                            // Below the horizon: no value, marked as the database does.
-                            *cell = [-1.0; 3];
-                            continue;
-                        }
-                        if rgb {
-                            brdf.eval(wi, wo, &mut f);
-                        } else {
-                            for (c, nm) in RGB_WAVELENGTHS.iter().enumerate() {
-                                f[c] = brdf.eval_wavelength(wi, wo, *nm) as f32;
-                            }
-                        }
-                        for c in 0..3 {
-                            cell[c] = f[c] as f64 / SCALE[c];
                         }
                     }
-                }
-            });
+                })
+        });
         let mut data = vec![0.0f64; 3 * SAMPLES];
         for (k, cell) in cells.iter().enumerate() {
             for c in 0..3 {
@@ -383,10 +387,7 @@ impl MerlBrdf {
 
     /// Writes the file (through a temporary file renamed into place).
     pub fn write(&self, path: impl AsRef<Path>) -> Result<()> {
-        let path = path.as_ref();
-        let tmp = path.with_extension("binary.tmp");
-        std::fs::write(&tmp, self.to_bytes()).map_err(|e| Error::io(&tmp, e))?;
-        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+        crate::files::write_atomic(path.as_ref(), &self.to_bytes())
     }
 
     /// Name (file name or what it was resampled from).

@@ -201,6 +201,7 @@ impl TensorFile {
     /// Reads and parses a tensor file.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
+        crate::files::require_regular(path)?;
         let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
         Self::from_bytes(path.display().to_string(), bytes)
     }

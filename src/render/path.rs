@@ -621,7 +621,7 @@ pub fn render(brdf: &dyn Brdf, opts: &RenderOptions, progress: &dyn Progress) ->
         out
     };
     let results: Vec<Vec<f32>> = match opts.threads {
-        None => tiles.par_iter().map(render_tile).collect(),
+        None => crate::par::install(|| tiles.par_iter().map(render_tile).collect()),
         Some(n) => {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(n)

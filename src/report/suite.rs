@@ -519,10 +519,12 @@ pub fn file_safe(s: &str) -> String {
 
 /// Albedo per θ and channel by [`albedo::integrate`] with [`ALBEDO_OPTIONS`].
 pub fn albedos(brdf: &dyn Brdf, thetas: &[f64]) -> Vec<Vec<f64>> {
-    thetas
-        .par_iter()
-        .map(|&t| albedo::integrate(brdf, geometry::spherical(t, 0.0), &ALBEDO_OPTIONS).value)
-        .collect()
+    crate::par::install(|| {
+        thetas
+            .par_iter()
+            .map(|&t| albedo::integrate(brdf, geometry::spherical(t, 0.0), &ALBEDO_OPTIONS).value)
+            .collect()
+    })
 }
 
 /// Max over θ and channels of |a − a_ref| / max(a_ref, 1e-3 · max a_ref).
@@ -549,18 +551,20 @@ pub fn albedo_error(a: &[Vec<f64>], reference: &[Vec<f64>]) -> f64 {
 pub fn round_trip(table: &Table, codec: &Codec) -> Result<(u64, Table)> {
     let grid = table.grid();
     let n = grid.layout().chunk_count();
-    let parts: Vec<(usize, Vec<f32>)> = (0..n)
-        .into_par_iter()
-        .map(|a| {
-            let bytes = codec::encode(
-                table.chunk(a),
-                crate::store::tables::chunk_layout(grid, a),
-                codec,
-            )?;
-            let back = codec::decode(&bytes, grid.layout().chunk_len(a))?;
-            Ok((bytes.len(), back))
-        })
-        .collect::<Result<_>>()?;
+    let parts: Vec<(usize, Vec<f32>)> = crate::par::install(|| {
+        (0..n)
+            .into_par_iter()
+            .map(|a| {
+                let bytes = codec::encode(
+                    table.chunk(a),
+                    crate::store::tables::chunk_layout(grid, a),
+                    codec,
+                )?;
+                let back = codec::decode(&bytes, grid.layout().chunk_len(a))?;
+                Ok((bytes.len(), back))
+            })
+            .collect::<Result<_>>()
+    })?;
     let bytes = parts.iter().map(|p| p.0 as u64).sum();
     let mut values = Vec::with_capacity(grid.stored_values());
     for (_, v) in parts {
@@ -725,50 +729,51 @@ pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
                 };
                 let sym = table.grid().symmetry().to_string();
                 let values = table.grid().stored_values() as u64;
-                let mut group: Vec<Row> = cfg
-                    .codecs
-                    .par_iter()
-                    .map(|cd| {
-                        let t0 = Instant::now();
-                        let mut row = Row {
-                            symmetry: sym.clone(),
-                            values,
-                            ..base(cd.name)
-                        };
-                        let (bytes, decoded) = match round_trip(&table, &cd.codec) {
-                            Ok(x) => x,
-                            Err(e) => {
-                                row.status = format!("encode failed: {e}");
-                                return row;
-                            }
-                        };
-                        row.bytes = bytes;
-                        row.bits_per_value = 8.0 * bytes as f64 / values.max(1) as f64;
-                        let tab = TabulatedBrdf::from_table(decoded);
-                        match metrics(&tab, src.as_ref(), &src_albedo, &metric_opts) {
-                            Ok(m) => {
-                                row.rel_rmse = m.rel_rmse;
-                                row.max_rel = m.max_rel;
-                                row.albedo_err = m.albedo_err;
-                            }
-                            Err(e) => row.status = format!("accuracy failed: {e}"),
-                        }
-                        if let (Some(o), Some(reference)) = (render_opts, &src_image) {
-                            match render::render(&tab, o, &Silent)
-                                .and_then(|img| render::compare(&img, reference))
-                            {
-                                Ok(r) if r.rel_rmse.is_finite() => {
-                                    row.render_rel_rmse = r.rel_rmse;
-                                    row.render = "ok".to_owned();
+                let mut group: Vec<Row> = crate::par::install(|| {
+                    cfg.codecs
+                        .par_iter()
+                        .map(|cd| {
+                            let t0 = Instant::now();
+                            let mut row = Row {
+                                symmetry: sym.clone(),
+                                values,
+                                ..base(cd.name)
+                            };
+                            let (bytes, decoded) = match round_trip(&table, &cd.codec) {
+                                Ok(x) => x,
+                                Err(e) => {
+                                    row.status = format!("encode failed: {e}");
+                                    return row;
                                 }
-                                Ok(_) => row.render = "undefined (black reference)".to_owned(),
-                                Err(e) => row.render = format!("failed: {e}"),
+                            };
+                            row.bytes = bytes;
+                            row.bits_per_value = 8.0 * bytes as f64 / values.max(1) as f64;
+                            let tab = TabulatedBrdf::from_table(decoded);
+                            match metrics(&tab, src.as_ref(), &src_albedo, &metric_opts) {
+                                Ok(m) => {
+                                    row.rel_rmse = m.rel_rmse;
+                                    row.max_rel = m.max_rel;
+                                    row.albedo_err = m.albedo_err;
+                                }
+                                Err(e) => row.status = format!("accuracy failed: {e}"),
                             }
-                        }
-                        row.seconds = t0.elapsed().as_secs_f64();
-                        row
-                    })
-                    .collect();
+                            if let (Some(o), Some(reference)) = (render_opts, &src_image) {
+                                match render::render(&tab, o, &Silent)
+                                    .and_then(|img| render::compare(&img, reference))
+                                {
+                                    Ok(r) if r.rel_rmse.is_finite() => {
+                                        row.render_rel_rmse = r.rel_rmse;
+                                        row.render = "ok".to_owned();
+                                    }
+                                    Ok(_) => row.render = "undefined (black reference)".to_owned(),
+                                    Err(e) => row.render = format!("failed: {e}"),
+                                }
+                            }
+                            row.seconds = t0.elapsed().as_secs_f64();
+                            row
+                        })
+                        .collect()
+                });
                 let f32_bytes = group
                     .iter()
                     .zip(&cfg.codecs)

@@ -28,6 +28,7 @@ pub fn lock(path: &Path) -> Result<Lock> {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
+    crate::files::check_dir(path, &dir)?;
     let lp = dir.join(format!(".{name}.lock"));
     let f = File::options()
         .create(true)

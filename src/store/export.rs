@@ -38,10 +38,24 @@ pub type NodeOffset<'a> = Option<&'a (dyn Fn(&[usize]) -> Option<usize> + Sync)>
 /// Writes the table as `.npy`: shape = stored grid dims + channels, dtype `<f4`, C order. Dense
 /// tables stream chunk by chunk; packed tables (fewer values than the shape) are expanded with
 /// `offset`, unstored nodes written as NaN.
+///
+/// The file is written through a temporary file renamed into place: a chunk that fails (its
+/// checksum, its decoding) leaves no partial `.npy` behind.
 pub fn npy(table: &StoredTable, out: impl AsRef<Path>, offset: NodeOffset<'_>) -> Result<()> {
     let path = out.as_ref();
+    crate::files::refuse_input(path, &[table.file()])?;
+    let tmp = crate::files::temp_path(path)?;
+    let r = npy_to(table, &tmp, path, offset)
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
+    if r.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    r
+}
+
+fn npy_to(table: &StoredTable, tmp: &Path, path: &Path, offset: NodeOffset<'_>) -> Result<()> {
     let h = table.header();
-    let f = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+    let f = std::fs::File::create(tmp).map_err(|e| Error::io(path, e))?;
     let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
     let io = |e| Error::io(path, e);
     w.write_all(&npy_header(&h.shape)).map_err(io)?;
@@ -248,6 +262,7 @@ pub fn exr(
         AnyChannels::sort(list.into()),
     );
     let path = out.as_ref();
+    crate::files::refuse_input(path, &[table.file()])?;
     Image::from_layer(layer)
         .write()
         .to_file(path)

@@ -113,6 +113,7 @@ impl Store {
     pub fn open_with(path: impl AsRef<Path>, opts: OpenOptions) -> Result<Store> {
         let path = path.as_ref().to_path_buf();
         let name = path.display().to_string();
+        crate::files::require_regular(&path)?; // before the open: a FIFO would block it
         let f = std::fs::File::open(&path).map_err(|e| Error::io(&path, e))?;
         let len = f.metadata().map_err(|e| Error::io(&path, e))?.len();
         if len < format::SUPERBLOCK_LEN as u64 {
@@ -267,9 +268,11 @@ impl Store {
             id: i,
         };
         if self.opts.eager {
-            (0..t.index.len())
-                .into_par_iter()
-                .try_for_each(|c| t.chunk(c).map(drop))?;
+            crate::par::install(|| {
+                (0..t.index.len())
+                    .into_par_iter()
+                    .try_for_each(|c| t.chunk(c).map(drop))
+            })?;
         }
         Ok(t)
     }
@@ -446,18 +449,22 @@ impl StoredTable {
             parts.push(a);
             rest = b;
         }
-        parts.into_par_iter().enumerate().try_for_each(|(i, dst)| {
-            let b = self.raw_chunk(i)?;
-            codec::decode_into(b, dst).map_err(|e| self.in_chunk(e, i))
+        crate::par::install(|| {
+            parts.into_par_iter().enumerate().try_for_each(|(i, dst)| {
+                let b = self.raw_chunk(i)?;
+                codec::decode_into(b, dst).map_err(|e| self.in_chunk(e, i))
+            })
         })?;
         Ok(out)
     }
 
     /// Checks every chunk's checksum and decodes it (in parallel).
     pub fn verify(&self) -> Result<()> {
-        (0..self.index.len())
-            .into_par_iter()
-            .try_for_each(|i| self.decode_chunk(i).map(drop))
+        crate::par::install(|| {
+            (0..self.index.len())
+                .into_par_iter()
+                .try_for_each(|i| self.decode_chunk(i).map(drop))
+        })
     }
 
     /// A loader of this table's chunks, for `TabulatedBrdf`.

@@ -22,6 +22,7 @@ impl Source {
     pub fn measured(path: impl AsRef<Path>) -> Result<Source> {
         use sha2::Digest;
         let path = path.as_ref();
+        crate::files::require_regular(path)?;
         let mut f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
         let mut h = sha2::Sha256::new();
         std::io::copy(&mut f, &mut h).map_err(|e| Error::io(path, e))?;
@@ -210,9 +211,10 @@ impl StoredTable {
 pub fn is_store_file(path: impl AsRef<Path>) -> bool {
     use std::io::Read;
     let mut m = [0u8; 8];
-    std::fs::File::open(path)
-        .and_then(|mut f| f.read_exact(&mut m))
-        .is_ok()
+    crate::files::is_regular(path.as_ref())
+        && std::fs::File::open(path)
+            .and_then(|mut f| f.read_exact(&mut m))
+            .is_ok()
         && m == super::format::MAGIC
 }
 
@@ -228,10 +230,12 @@ pub fn open_brdf(source: &str, eager: bool) -> Result<crate::table::TabulatedBrd
     };
     if eager {
         use rayon::prelude::*;
-        let chunks: Vec<Vec<f32>> = (0..t.chunk_count())
-            .into_par_iter()
-            .map(|i| t.decode_chunk(i))
-            .collect::<Result<_>>()?;
+        let chunks: Vec<Vec<f32>> = crate::par::install(|| {
+            (0..t.chunk_count())
+                .into_par_iter()
+                .map(|i| t.decode_chunk(i))
+                .collect::<Result<_>>()
+        })?;
         let table = Table::new(
             t.grid()?,
             chunks.concat(),

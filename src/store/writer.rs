@@ -40,16 +40,7 @@ impl Writer {
     /// Starts writing a file that will replace `path` when finished.
     pub fn create(path: impl AsRef<Path>) -> Result<Writer> {
         let path = path.as_ref().to_path_buf();
-        let dir = parent(&path);
-        let fname = path
-            .file_name()
-            .ok_or_else(|| Error::arg("path", format!("{} has no file name", path.display())))?
-            .to_string_lossy()
-            .into_owned();
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.subsec_nanos());
-        let tmp = dir.join(format!(".{fname}.tmp.{}.{nanos}", std::process::id()));
+        let tmp = crate::files::temp_path(&path)?;
         let f = File::options()
             .write(true)
             .create_new(true)
@@ -196,10 +187,12 @@ impl Writer {
             .as_ref()
             .ok_or_else(|| Error::arg("table", "no table begun"))?;
         let c = t.header.codec;
-        let encoded: Vec<Result<Vec<u8>>> = chunks
-            .par_iter()
-            .map(|(v, l)| codec::encode(v, *l, &c))
-            .collect();
+        let encoded: Vec<Result<Vec<u8>>> = crate::par::install(|| {
+            chunks
+                .par_iter()
+                .map(|(v, l)| codec::encode(v, *l, &c))
+                .collect()
+        });
         for (e, (v, _)) in encoded.into_iter().zip(chunks) {
             self.encoded_chunk(&e?, v.len() as u64)?;
         }

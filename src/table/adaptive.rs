@@ -142,33 +142,35 @@ pub fn fit_warps(src: &dyn Brdf, phi_hi: f64, opts: &AdaptiveOptions) -> Result<
     let row = md * mp * c;
     let mut f = vec![0f32; mh * row];
     let mut w = vec![0f64; mh * md * mp];
-    f.par_chunks_mut(row)
-        .zip(w.par_chunks_mut(md * mp))
-        .enumerate()
-        .for_each(|(ih, (fr, wr))| {
-            let th = ang(0, ih);
-            for id in 0..md {
-                let td = ang(1, id);
-                for ip in 0..mp {
-                    let pd = ang(2, ip);
-                    let (wi, wo) = crate::table::pair_of(Param::HalfDiff, [th, 0.0, td, pd]);
-                    let o = id * mp + ip;
-                    src.eval(wi, wo, &mut fr[o * c..(o + 1) * c]);
-                    // Unlifted directions decide the cap (lifted ones sit at the horizon).
-                    let (ri, ro) = crate::geometry::from_half_diff(crate::geometry::HalfDiff {
-                        theta_h: th,
-                        phi_h: 0.0,
-                        theta_d: td,
-                        phi_d: pd,
-                    });
-                    wr[o] = if ri.z >= cap && ro.z >= cap {
-                        (ri.z * ro.z).powi(2) * 4.0 * td.cos() * th.sin() * td.sin()
-                    } else {
-                        0.0
-                    };
+    crate::par::install(|| {
+        f.par_chunks_mut(row)
+            .zip(w.par_chunks_mut(md * mp))
+            .enumerate()
+            .for_each(|(ih, (fr, wr))| {
+                let th = ang(0, ih);
+                for id in 0..md {
+                    let td = ang(1, id);
+                    for ip in 0..mp {
+                        let pd = ang(2, ip);
+                        let (wi, wo) = crate::table::pair_of(Param::HalfDiff, [th, 0.0, td, pd]);
+                        let o = id * mp + ip;
+                        src.eval(wi, wo, &mut fr[o * c..(o + 1) * c]);
+                        // Unlifted directions decide the cap (lifted ones sit at the horizon).
+                        let (ri, ro) = crate::geometry::from_half_diff(crate::geometry::HalfDiff {
+                            theta_h: th,
+                            phi_h: 0.0,
+                            theta_d: td,
+                            phi_d: pd,
+                        });
+                        wr[o] = if ri.z >= cap && ro.z >= cap {
+                            (ri.z * ro.z).powi(2) * 4.0 * td.cos() * th.sin() * td.sin()
+                        } else {
+                            0.0
+                        };
+                    }
                 }
-            }
-        });
+            })
+    });
     for x in f.iter_mut() {
         if !x.is_finite() || *x < 0.0 {
             // Unmeasured (negative) or invalid: no variation from it.

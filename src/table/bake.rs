@@ -147,27 +147,29 @@ pub fn bake_chunks(
         }
         row_starts.push(acc);
         if row_len > 0 {
-            buf.par_chunks_mut(row_len)
-                .with_min_len(8)
-                .enumerate()
-                .for_each(|(gr, row)| {
-                    let k = row_starts.partition_point(|&s| s <= gr) - 1;
-                    let chunk = a + k;
-                    let (p, b) = layout.row_node(chunk, gr - row_starts[k]);
-                    for q in 0..s3 {
-                        let out = &mut row[q * c..(q + 1) * c];
-                        let idx = [chunk, p, b, q];
-                        if native && brdf.stored_node(half_diff(grid.node_angles(idx)), out) {
-                            for v in out.iter_mut() {
-                                if !v.is_finite() {
-                                    *v = 0.0;
+            crate::par::install(|| {
+                buf.par_chunks_mut(row_len)
+                    .with_min_len(8)
+                    .enumerate()
+                    .for_each(|(gr, row)| {
+                        let k = row_starts.partition_point(|&s| s <= gr) - 1;
+                        let chunk = a + k;
+                        let (p, b) = layout.row_node(chunk, gr - row_starts[k]);
+                        for q in 0..s3 {
+                            let out = &mut row[q * c..(q + 1) * c];
+                            let idx = [chunk, p, b, q];
+                            if native && brdf.stored_node(half_diff(grid.node_angles(idx)), out) {
+                                for v in out.iter_mut() {
+                                    if !v.is_finite() {
+                                        *v = 0.0;
+                                    }
                                 }
+                                continue;
                             }
-                            continue;
+                            eval_node(brdf, grid, &axes, idx, opts.supersample, out);
                         }
-                        eval_node(brdf, grid, &axes, idx, opts.supersample, out);
-                    }
-                });
+                    })
+            });
         }
         let mut off = 0;
         let mut done = layout.chunk_range(a).start as u64;

@@ -53,7 +53,7 @@ impl RawWriter {
             context: path.display().to_string(),
             source: e,
         })?;
-        let tmp = path.with_extension("tmp-raw");
+        let tmp = crate::files::temp_path(&path)?;
         let f = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
         let mut head = MAGIC.to_vec();
@@ -110,9 +110,10 @@ impl Table {
     /// True when the file starts with the raw table magic.
     pub fn is_raw(path: impl AsRef<Path>) -> bool {
         let mut m = [0u8; 12];
-        std::fs::File::open(path)
-            .and_then(|mut f| f.read_exact(&mut m))
-            .is_ok()
+        crate::files::is_regular(path.as_ref())
+            && std::fs::File::open(path)
+                .and_then(|mut f| f.read_exact(&mut m))
+                .is_ok()
             && &m == MAGIC
     }
 
@@ -120,6 +121,7 @@ impl Table {
     pub fn open_raw(path: impl AsRef<Path>) -> Result<Table> {
         let path = path.as_ref();
         let name = path.display().to_string();
+        crate::files::require_regular(path)?;
         let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
         if bytes.len() < 20 || &bytes[..12] != MAGIC {
             return Err(Error::format(

@@ -8,9 +8,14 @@
 //!
 //! **Load failures.** `eval` cannot return an error. When a chunk fails to load (I/O error,
 //! checksum, wrong length) the chunk is marked empty, its corners contribute 0 to every lookup
-//! (so a lookup whose corners all lie in a failed chunk writes 0), and the first error is kept:
-//! check [`TabulatedBrdf::load_error`] after a batch, or call [`TabulatedBrdf::load_all`]
-//! up front to get a proper `Result` — with the loader's own error (a checksum failure stays
+//! (so a lookup whose corners all lie in a failed chunk writes 0), and the table enters a sticky
+//! *failed* state that keeps the first error: [`Brdf::health`] (one atomic load while the table
+//! is healthy) returns it from then on, for the life of the table. A renderer that calls `eval`
+//! pair by pair checks `health()` after each batch (or frame); every host does so after each
+//! batch (the CLI's `eval`/`pdf`/`sample`, the C ABI's `brdftab_eval`/`_pdf`/`_sample`, the
+//! Python methods), and every writer (bake, convert, export) before it commits a file, so a
+//! corrupt table is an error wherever it is read. [`TabulatedBrdf::load_all`] (or an eager
+//! open) gets the error up front, with the loader's own variant (a checksum failure stays
 //! [`Error::Checksum`]). Lookups do not retry failed chunks.
 //!
 //! **Negative stored values** mark unmeasured data (a MERL file's −1 cells, kept by
@@ -26,6 +31,7 @@
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::brdf::{Brdf, BrdfSample, Flags};
@@ -83,6 +89,8 @@ pub struct TabulatedBrdf {
     description: String,
     error: Mutex<Option<Error>>,
     /// Importance sampling distributions, built on first `sample`/`pdf` (see [`super::sampling`]).
+    /// Set (once, never cleared) when `error` is: the cheap test of [`Brdf::health`].
+    failed: AtomicBool,
     sampler: OnceLock<TableSampler>,
 }
 
@@ -128,6 +136,7 @@ impl TabulatedBrdf {
             interp: Interp::Linear,
             description,
             error: Mutex::new(None),
+            failed: AtomicBool::new(false),
             sampler: OnceLock::new(),
         }
     }
@@ -155,6 +164,7 @@ impl TabulatedBrdf {
             interp: Interp::Linear,
             description: description.into(),
             error: Mutex::new(None),
+            failed: AtomicBool::new(false),
             sampler: OnceLock::new(),
         }
     }
@@ -233,8 +243,16 @@ impl TabulatedBrdf {
 
     /// The message of the first chunk-load error a lookup met, if any (see the module docs).
     pub fn load_error(&self) -> Option<String> {
-        let e = self.error.lock().ok()?;
-        e.as_ref().map(|e| e.to_string())
+        self.health().err().map(|e| e.to_string())
+    }
+
+    /// Keeps the first chunk-load error and marks the table failed (sticky).
+    #[cold]
+    fn record_failure(&self, e: Error) {
+        if let Ok(mut first) = self.error.lock() {
+            first.get_or_insert(e);
+        }
+        self.failed.store(true, Ordering::Release);
     }
 
     /// Loads every chunk now; returns the first failing chunk's own error (asking the loader
@@ -299,9 +317,7 @@ impl TabulatedBrdf {
                     all.extend_from_slice(&v);
                 }
                 Err(e) => {
-                    if let Ok(mut first) = self.error.lock() {
-                        first.get_or_insert(e);
-                    }
+                    self.record_failure(e);
                     return Packed::empty();
                 }
             }
@@ -368,9 +384,7 @@ impl TabulatedBrdf {
                 v.into()
             }
             Err(e) => {
-                if let Ok(mut first) = self.error.lock() {
-                    first.get_or_insert(e);
-                }
+                self.record_failure(e);
                 Arc::from([])
             }
         })
@@ -436,6 +450,22 @@ impl Brdf for TabulatedBrdf {
             .eval(self.interp, wi, wo, out, |a| self.chunk(a))
     }
 
+    /// The first chunk-load error any lookup met (sticky, see the module docs); one atomic load
+    /// while the table is healthy.
+    #[inline]
+    fn health(&self) -> Result<()> {
+        if !self.failed.load(Ordering::Acquire) {
+            return Ok(());
+        }
+        match self.error.lock() {
+            Ok(e) => e.as_ref().map_or(Ok(()), |e| Err(e.replicate())),
+            Err(_) => Err(Error::Unsupported(format!(
+                "{}: a chunk failed to load",
+                self.description
+            ))),
+        }
+    }
+
     /// Only the symmetries the table stores are declared (a reduced table has them exactly).
     fn flags(&self) -> Flags {
         let s = self.grid.symmetry();
@@ -497,13 +527,15 @@ impl Brdf for TabulatedBrdf {
         let n = crate::brdf::check_batch(wi, wo, out, c.max(1));
         const BLOCK: usize = 4096;
         if n >= 4 * BLOCK {
-            out[..n * c]
-                .par_chunks_mut(BLOCK * c)
-                .enumerate()
-                .for_each(|(b, o)| {
-                    let s = b * BLOCK;
-                    self.eval_block(&wi[s..], &wo[s..], o);
-                });
+            crate::par::install(|| {
+                out[..n * c]
+                    .par_chunks_mut(BLOCK * c)
+                    .enumerate()
+                    .for_each(|(b, o)| {
+                        let s = b * BLOCK;
+                        self.eval_block(&wi[s..], &wo[s..], o);
+                    })
+            });
         } else {
             self.eval_block(wi, wo, &mut out[..n * c]);
         }

@@ -44,6 +44,7 @@ pub fn albedo(a: AlbedoArgs) -> Result<()> {
     let brdf = source::open(&a.source, &channels)?;
     let radians: Vec<f64> = thetas.iter().map(|t| t.to_radians()).collect();
     let curve = albedo::albedo_curve(&*brdf, &radians);
+    brdf.health()?;
     let mut text = String::new();
     for (t, row) in thetas.iter().zip(curve) {
         let vals: Vec<String> = row.iter().map(|&x| sig7(x)).collect();
@@ -57,6 +58,7 @@ pub fn check(a: CheckArgs) -> Result<()> {
     let channels = source::channels(a.wavelengths.as_deref())?;
     let brdf = source::open(&a.source, &channels)?;
     let report = plausibility::check(&*brdf, &plausibility::Options::default());
+    brdf.health()?;
     if a.json {
         let json = serde_json::to_string(&report)
             .map_err(|e| Error::Unsupported(format!("cannot serialize the report: {e}")))?;

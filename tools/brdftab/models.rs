@@ -39,6 +39,8 @@ pub fn eval(a: EvalArgs) -> Result<()> {
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     brdftab::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
         brdf.eval(wi, wo, &mut f);
+        // A lazily read table whose chunk failed its checksum gave 0: stop with its error.
+        brdf.health()?;
         let s: Vec<String> = f.iter().map(|x| format!("{x:e}")).collect();
         writeln!(out, "{}", s.join(" ")).map_err(|e| Error::io("stdout", e))
     })?;

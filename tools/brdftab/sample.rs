@@ -75,7 +75,9 @@ pub fn sample(a: SampleArgs) -> Result<()> {
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     for _ in 0..a.count {
         let u = rng.next_dvec2();
-        let Some(s) = brdf.sample(wo, u, &mut w) else {
+        let s = brdf.sample(wo, u, &mut w);
+        brdf.health()?; // a corrupt table chunk: its error, not zeros
+        let Some(s) = s else {
             continue;
         };
         write!(out, "{} {} {} {}", s.wi.x, s.wi.y, s.wi.z, s.pdf).map_err(out_err)?;
@@ -93,7 +95,9 @@ pub fn pdf(a: PdfArgs) -> Result<()> {
     let brdf = source::open(&a.source, &channels)?;
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     brdftab::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
-        writeln!(out, "{}", brdf.pdf(wi, wo)).map_err(out_err)
+        let p = brdf.pdf(wi, wo);
+        brdf.health()?;
+        writeln!(out, "{p}").map_err(out_err)
     })?;
     out.flush().map_err(out_err)
 }

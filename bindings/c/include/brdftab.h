@@ -14,7 +14,19 @@
  *     n x channels floats.
  * Every int-returning function returns 0 on success and -1 on failure, with the reason in
  * brdftab_last_error() (per thread). n = 0 succeeds whatever the pointers; a NULL handle or
- * array with n > 0 fails. No call aborts the process on bad input.
+ * array with n > 0 fails, and so does an n whose arrays would exceed PTRDIFF_MAX bytes (or
+ * whose n x channels overflows size_t). No call aborts the process or prints on stderr on bad
+ * input (an internal panic is caught, reported as -1 and printed nowhere).
+ *
+ * Corrupt tables: a table opened lazily (the default) decodes each chunk on the first lookup
+ * that needs it. A chunk that fails its checksum leaves the handle failed for good: the eval,
+ * pdf, sample or albedo call that met it, and every later one on that handle, returns -1 with
+ * the checksum error; the values that call wrote are not to be used. Open with eager = 1 to
+ * check every chunk up front instead (brdftab_open_with then returns NULL).
+ *
+ * NaN: a direction with a NaN or infinite component, or a zero vector, is not an error: f_r and
+ * pdf are 0 for it and sample gives wi = 0, pdf = 0, weight = 0 (as the library does); a NaN
+ * in u gives no sample either. A non-finite theta in brdftab_albedo is an error (-1).
  * Thread safety: eval, pdf, sample and albedo may run concurrently on one handle.
  */
 #ifndef BRDFTAB_H

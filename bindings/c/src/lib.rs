@@ -10,7 +10,19 @@
 //!
 //! Failure is `-1` (or `NULL` from the open functions) with the reason in
 //! [`brdftab_last_error`], kept per thread. No panic crosses the boundary: every entry point runs
-//! inside `catch_unwind`, and a caught panic becomes `-1` with its message. Batch calls allocate
+//! inside `catch_unwind`, and a caught panic becomes `-1` with its message, printing nothing on
+//! the host's stderr. Every size computed from a caller's count (`n` pairs × 3 doubles, × the
+//! channels) is checked for overflow and against `isize::MAX` bytes before a slice is made.
+//!
+//! **Corrupt tables.** A table opened lazily (the default) decodes a chunk the first time a
+//! lookup needs it; a chunk that fails its checksum puts the handle in a sticky failed state
+//! ([`brdftab::Brdf::health`]). `brdftab_eval`, `_pdf`, `_sample` and `_albedo` check it after
+//! their batch: the call that met the bad chunk and every later call on that handle return -1
+//! with the checksum error. Values written by a failed call are not to be used.
+//!
+//! **NaN.** A direction with a NaN or infinite component (or a zero vector) is not an error: its
+//! f_r and pdf are 0 and it has no sample (wi = 0, pdf = 0, weight = 0), as in the library; a
+//! non-finite `theta` in `brdftab_albedo` is an error. Batch calls allocate
 //! nothing beyond what the library's own `eval_batch` does: the caller's `double[n][3]` arrays
 //! are read in place as `DVec3` slices.
 
@@ -20,7 +32,6 @@
 
 use std::cell::RefCell;
 use std::ffi::{CStr, CString, c_char, c_int};
-use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use brdftab::source::OpenOptions;
 use brdftab::table::Interp;
@@ -70,18 +81,10 @@ fn clear_error() {
     });
 }
 
-fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
-    let what = p
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| p.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "unknown panic".into());
-    format!("internal error (panic): {what}")
-}
-
-/// Runs `f`, turning an error or a panic into -1 and the thread's last error.
+/// Runs `f`, turning an error or a panic into -1 and the thread's last error. A caught panic
+/// prints nothing on the host's stderr ([`brdftab::host::catch_quietly`]).
 fn guard(f: impl FnOnce() -> Result<(), String>) -> c_int {
-    match catch_unwind(AssertUnwindSafe(f)) {
+    match brdftab::host::catch_quietly(f) {
         Ok(Ok(())) => {
             clear_error();
             0
@@ -91,10 +94,34 @@ fn guard(f: impl FnOnce() -> Result<(), String>) -> c_int {
             -1
         }
         Err(p) => {
-            set_error(&panic_message(p));
+            set_error(&format!("internal error (panic): {p}"));
             -1
         }
     }
+}
+
+/// Checks that `len` elements of `T` fit in one slice (at most `isize::MAX` bytes), before any
+/// slice is made: a count near `SIZE_MAX` is an error, never a wrapped size.
+fn check_len<T>(len: usize, what: &str) -> Result<(), String> {
+    match len.checked_mul(std::mem::size_of::<T>()) {
+        Some(bytes) if bytes <= isize::MAX as usize => Ok(()),
+        _ => Err(format!(
+            "`{what}`: {len} elements of {} bytes exceed the largest array (isize::MAX bytes)",
+            std::mem::size_of::<T>()
+        )),
+    }
+}
+
+/// `n · c` (pairs times channels), checked.
+fn times(n: usize, c: usize, what: &str) -> Result<usize, String> {
+    n.checked_mul(c)
+        .ok_or_else(|| format!("`{what}`: n = {n} pairs × {c} channels overflows size_t"))
+}
+
+/// A table's sticky chunk failure ([`Brdf::health`]) as this call's error: the batch just
+/// written came (partly) from a chunk that could not be read.
+fn healthy(b: &brdftab_brdf) -> Result<(), String> {
+    b.brdf.health().map_err(|e| e.to_string())
 }
 
 /// # Safety
@@ -106,7 +133,9 @@ unsafe fn slice<'a, T>(p: *const T, len: usize, what: &str) -> Result<&'a [T], S
     if !(p as usize).is_multiple_of(std::mem::align_of::<T>()) {
         return Err(format!("`{what}` is not aligned for its type"));
     }
-    // SAFETY: the caller promises `len` readable elements; NULL and alignment are checked.
+    check_len::<T>(len, what)?;
+    // SAFETY: the caller promises `len` readable elements; NULL, alignment and the size
+    // (at most isize::MAX bytes) are checked.
     Ok(unsafe { std::slice::from_raw_parts(p, len) })
 }
 
@@ -119,7 +148,9 @@ unsafe fn slice_mut<'a, T>(p: *mut T, len: usize, what: &str) -> Result<&'a mut 
     if !(p as usize).is_multiple_of(std::mem::align_of::<T>()) {
         return Err(format!("`{what}` is not aligned for its type"));
     }
-    // SAFETY: the caller promises `len` writable elements; NULL and alignment are checked.
+    check_len::<T>(len, what)?;
+    // SAFETY: the caller promises `len` writable elements; NULL, alignment and the size
+    // (at most isize::MAX bytes) are checked.
     Ok(unsafe { std::slice::from_raw_parts_mut(p, len) })
 }
 
@@ -223,7 +254,7 @@ pub extern "C" fn brdftab_last_error() -> *const c_char {
 pub unsafe extern "C" fn brdftab_close(b: *mut brdftab_brdf) {
     if !b.is_null() {
         // SAFETY: the handle came from Box::into_raw in `open_impl` and is closed once.
-        let _ = catch_unwind(AssertUnwindSafe(|| drop(unsafe { Box::from_raw(b) })));
+        let _ = brdftab::host::catch_quietly(|| drop(unsafe { Box::from_raw(b) }));
     }
 }
 
@@ -268,9 +299,9 @@ pub unsafe extern "C" fn brdftab_eval(
         }
         // SAFETY (both): the header's contract on sizes; NULL and alignment are checked.
         let (b, wi, wo) = unsafe { pair_args(b, n, wi, wo) }?;
-        let f = unsafe { slice_mut(f, n * b.names.len(), "f") }?;
+        let f = unsafe { slice_mut(f, times(n, b.names.len(), "f")?, "f") }?;
         b.brdf.eval_batch(wi, wo, f);
-        Ok(())
+        healthy(b)
     })
 }
 
@@ -296,7 +327,7 @@ pub unsafe extern "C" fn brdftab_pdf(
         for ((p, a), o) in pdf.iter_mut().zip(wi).zip(wo) {
             *p = b.brdf.pdf(*a, *o);
         }
-        Ok(())
+        healthy(b)
     })
 }
 
@@ -329,10 +360,16 @@ pub unsafe extern "C" fn brdftab_sample(
         let u = unsafe { slice(u as *const DVec2, n, "u") }?;
         let wi = unsafe { slice_mut(wi as *mut DVec3, n, "wi") }?;
         let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
-        let weight = unsafe { slice_mut(weight, n * c, "weight") }?;
+        let weight = unsafe { slice_mut(weight, times(n, c, "weight")?, "weight") }?;
         for k in 0..n {
             let w = &mut weight[k * c..(k + 1) * c];
-            match b.brdf.sample(wo[k], u[k], w) {
+            // Non-finite input has no sample (the NaN rule of the header), whatever the source.
+            let s = if wo[k].is_finite() && u[k].is_finite() {
+                b.brdf.sample(wo[k], u[k], w)
+            } else {
+                None
+            };
+            match s {
                 Some(s) => {
                     wi[k] = s.wi;
                     pdf[k] = s.pdf;
@@ -344,7 +381,7 @@ pub unsafe extern "C" fn brdftab_sample(
                 }
             }
         }
-        Ok(())
+        healthy(b)
     })
 }
 
@@ -368,8 +405,15 @@ pub unsafe extern "C" fn brdftab_albedo(
         }
         let wi = DVec3::new(theta.sin(), 0.0, theta.cos());
         b.brdf.albedo(wi, out);
-        Ok(())
+        healthy(b)
     })
+}
+
+/// Panics inside the boundary's guard and returns its result (-1): what a bug in the library
+/// would do. For the tests of the quiet panic hook only; not part of the C ABI (not exported).
+#[doc(hidden)]
+pub fn panic_for_tests() -> c_int {
+    guard(|| panic!("a deliberate panic (test)"))
 }
 
 /// The version of this ABI's crate (e.g. "0.1.0"), a static string.

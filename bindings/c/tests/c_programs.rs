@@ -268,3 +268,74 @@ fn the_header_declares_exactly_the_exported_functions() {
     assert_eq!(declared, exported);
     assert!(declared.len() >= 11, "{declared:?}");
 }
+
+/// A copy of table file `good` with one bit of chunk 0 flipped (its checksum then fails).
+fn corrupt_copy(good: &str, bad: &Path) {
+    use brdftab::store::{OpenOptions, Store};
+    let mut bytes = std::fs::read(good).unwrap();
+    let st = Store::from_bytes("t", bytes.clone(), OpenOptions::default()).unwrap();
+    let raw = st.single().unwrap().raw_chunk(0).unwrap().to_vec();
+    let at = bytes.windows(raw.len()).position(|w| w == raw).unwrap();
+    bytes[at + raw.len() / 2] ^= 0x10;
+    std::fs::write(bad, bytes).unwrap();
+}
+
+#[test]
+fn hostile_input_through_the_c_abi_is_an_error_or_zero_never_a_crash() {
+    let dir = tmp().join("hostile");
+    std::fs::create_dir_all(&dir).unwrap();
+    let exe = dir.join("hostile_test");
+    compile(
+        "cc",
+        &["-std=c11"],
+        &Path::new(CRATE).join("tests/hostile_test.c"),
+        &exe,
+    );
+    let table = bake_table(&dir);
+    let bad = dir.join("bad.btdb");
+    corrupt_copy(&table, &bad);
+    for good in [&table[..], r#"{"model":"ggx","alpha":0.3}"#] {
+        let out = Command::new(&exe).arg(good).arg(&bad).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{good}: {:?}\n{}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
+
+/// The child of the next test: a panic inside the C boundary's guard.
+#[test]
+fn quiet_panic_child() {
+    if std::env::var_os("BRDFTAB_QUIET_PANIC_CHILD").is_none() {
+        return; // only as the child of the test below
+    }
+    assert_eq!(brdftab_c::panic_for_tests(), -1);
+    // SAFETY: brdftab_last_error returns a NUL-terminated string valid until the next call.
+    let e = unsafe { std::ffi::CStr::from_ptr(brdftab_c::brdftab_last_error()) };
+    assert!(e.to_string_lossy().contains("deliberate panic"), "{e:?}");
+}
+
+#[test]
+fn a_panic_caught_at_the_boundary_prints_nothing_on_stderr() {
+    let out = Command::new(std::env::current_exe().unwrap())
+        .args([
+            "--exact",
+            "quiet_panic_child",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env("BRDFTAB_QUIET_PANIC_CHILD", "1")
+        .env("RUST_BACKTRACE", "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.contains("1 passed"), "{stdout}");
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("backtrace"),
+        "{stderr}"
+    );
+}

@@ -9,7 +9,6 @@
 //! The pure-Python side (`python/brdftab/__init__.py`) re-exports these names and adds
 //! `Database` and `brdftab.mitsuba`.
 
-use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
 
 use brdftab::bake::{BakeRequest, BakeTarget, GridChoice, SymmetryChoice};
@@ -43,29 +42,20 @@ fn lib_err(e: brdftab::Error) -> PyErr {
     }
 }
 
-fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
-    if let Some(s) = p.downcast_ref::<&str>() {
-        (*s).to_owned()
-    } else if let Some(s) = p.downcast_ref::<String>() {
-        s.clone()
-    } else {
-        "unknown panic".to_owned()
-    }
-}
-
-/// Runs `f`, turning a panic into `brdftab.Error` (no unwinding across the FFI boundary).
+/// Runs `f`, turning a panic into `brdftab.Error` (no unwinding across the FFI boundary, and
+/// nothing printed on stderr: [`brdftab::host::catch_quietly`]).
 fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
-    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| {
+    brdftab::host::catch_quietly(f).unwrap_or_else(|p| {
         Err(Error::new_err(format!(
-            "internal error in brdftab (please report): {}",
-            panic_message(p)
+            "internal error in brdftab (please report): {p}"
         )))
     })
 }
 
-/// [`guard`] for work done without the GIL: the panic message comes back as a `String`.
-fn no_panic<T>(f: impl FnOnce() -> T) -> Result<T, String> {
-    catch_unwind(AssertUnwindSafe(f)).map_err(panic_message)
+/// [`guard`] for work done without the GIL, on the library's fork-safe pool
+/// ([`brdftab::par`]): the panic message comes back as a `String`.
+fn no_panic<T: Send>(f: impl FnOnce() -> T + Send) -> Result<T, String> {
+    brdftab::host::catch_quietly(|| brdftab::par::install(f))
 }
 
 fn panic_err(m: String) -> PyErr {
@@ -118,7 +108,7 @@ fn f64_array<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonlyArr
         .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))
 }
 
-/// Rows of `width` finite numbers: (rows, true when the input was one row of shape (width,)).
+/// Rows of `width` numbers: (rows, true when the input was one row of shape (width,)).
 fn rows(obj: &Bound<'_, PyAny>, name: &str, width: usize) -> PyResult<(Vec<f64>, bool)> {
     let a = f64_array(obj, name)?;
     let shape = a.shape().to_vec();
@@ -137,12 +127,8 @@ fn rows(obj: &Bound<'_, PyAny>, name: &str, width: usize) -> PyResult<(Vec<f64>,
         Some(s) => s.to_vec(),
         None => v.iter().copied().collect(),
     };
-    if let Some(k) = flat.iter().position(|x| !x.is_finite()) {
-        return Err(PyValueError::new_err(format!(
-            "{name}: row {} holds a non-finite value (NaN or infinity)",
-            k / width
-        )));
-    }
+    // Non-finite numbers pass: a NaN or infinite direction gives 0 (the NaN rule of every host,
+    // README "Conventions"); `u` is range-checked by `sample`.
     Ok((flat, single))
 }
 
@@ -285,12 +271,12 @@ impl PyBrdf {
         self.inner.channels().len()
     }
 
-    /// A lazily decoded chunk that failed (corrupt data) is an error, not silent zeros.
+    /// A lazily decoded chunk that failed (corrupt data) is an error, not silent zeros
+    /// ([`Brdf::health`], sticky: the object stays failed).
     fn check_loaded(&self) -> PyResult<()> {
-        match self.table.as_ref().and_then(|t| t.load_error()) {
-            Some(e) => Err(Error::new_err(format!("{}: {e}", self.source))),
-            None => Ok(()),
-        }
+        self.inner
+            .health()
+            .map_err(|e| Error::new_err(format!("{}: {e}", self.source)))
     }
 }
 
@@ -365,7 +351,10 @@ impl PyBrdf {
     }
 
     /// f_r(wi, wo) in 1/sr (not times a cosine) as float32 of shape (n, c), or (c,) when both
-    /// wi and wo have shape (3,). Directions need not be normalized; below the horizon f_r = 0.
+    /// wi and wo have shape (3,). Directions need not be normalized; below the horizon, and
+    /// for a direction with a NaN or infinite component or a zero vector, f_r = 0 (as in the
+    /// library and the C ABI). A lazily opened table (`eager=False`) whose chunk fails its
+    /// checksum raises `brdftab.Error`, then and on every later call.
     fn eval(
         &self,
         py: Python<'_>,
@@ -465,7 +454,8 @@ impl PyBrdf {
     /// Draws wi for each wo from uniform numbers u in [0, 1)² (shape (n, 2)); returns
     /// (wi (n, 3) float64, pdf (n,) float64, weight (n, c) float32) with
     /// weight = f_r cos θi / pdf (`brdftab sample`'s conventions). Where no direction can be
-    /// drawn (wo below the horizon) wi, pdf and weight are 0.
+    /// drawn (wo below the horizon, NaN, infinite or zero) wi, pdf and weight are 0; `u`
+    /// outside [0, 1) (NaN included) is a `ValueError`.
     fn sample(
         &self,
         py: Python<'_>,
@@ -495,7 +485,12 @@ impl PyBrdf {
                     .enumerate()
                     .for_each(|(k, ((wi, p), w))| {
                         let u = DVec2::new(uu[2 * k], uu[2 * k + 1]);
-                        match brdf.sample(a[k], u, w) {
+                        // A non-finite wo has no sample (the NaN rule, whatever the source).
+                        let s = match a[k].is_finite() {
+                            true => brdf.sample(a[k], u, w),
+                            false => None,
+                        };
+                        match s {
                             Some(s) => {
                                 wi.copy_from_slice(&s.wi.to_array());
                                 *p = s.pdf;

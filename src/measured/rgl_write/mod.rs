@@ -425,12 +425,10 @@ pub fn write(
 ) -> Result<Written> {
     let path = path.as_ref();
     let fields = encode(brdf, opts, progress)?;
+    // A source that failed while it was read (a corrupt table chunk) gave zeros: write nothing.
+    brdf.health()?;
     let bytes = fields.to_bytes();
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = std::path::PathBuf::from(tmp);
-    std::fs::write(&tmp, &bytes).map_err(|e| Error::io(&tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))?;
+    crate::files::write_atomic(path, &bytes)?;
     Ok(Written {
         bytes: bytes.len(),
         fields,

@@ -207,19 +207,21 @@ fn retro(brdf: &dyn Brdf, nx: usize, ny: usize, isotropic: bool) -> Result<Vec<f
 /// σ at every node for the distribution `d_q` given at the quadrature points.
 fn project(q: &Quadrature, d_q: &[f64], nx: usize, ny: usize, isotropic: bool) -> Vec<f64> {
     let rows = if isotropic { 1 } else { ny };
-    let mut s: Vec<f64> = (0..nx * rows)
-        .into_par_iter()
-        .map(|k| {
-            let (ix, iy) = (k % nx, k / nx);
-            let (theta, phi) = node_dir(ix, nx, iy, ny);
-            let w = geometry::spherical(theta, if isotropic { 0.0 } else { phi });
-            let mut acc = 0.0;
-            for ((m, &wt), &d) in q.dirs.iter().zip(&q.weights).zip(d_q) {
-                acc += wt * d * m.dot(w).max(0.0);
-            }
-            acc
-        })
-        .collect();
+    let mut s: Vec<f64> = crate::par::install(|| {
+        (0..nx * rows)
+            .into_par_iter()
+            .map(|k| {
+                let (ix, iy) = (k % nx, k / nx);
+                let (theta, phi) = node_dir(ix, nx, iy, ny);
+                let w = geometry::spherical(theta, if isotropic { 0.0 } else { phi });
+                let mut acc = 0.0;
+                for ((m, &wt), &d) in q.dirs.iter().zip(&q.weights).zip(d_q) {
+                    acc += wt * d * m.dot(w).max(0.0);
+                }
+                acc
+            })
+            .collect()
+    });
     if isotropic {
         let first = s.clone();
         s.extend_from_slice(&first);

@@ -55,6 +55,9 @@ impl Brdf for CosO<'_> {
     fn describe(&self) -> String {
         format!("{} × cos θo", self.0.describe())
     }
+    fn health(&self) -> crate::Result<()> {
+        self.0.health()
+    }
 }
 
 /// Compares `written` (normally the file read back by [`RglBrdf`](crate::measured::RglBrdf))

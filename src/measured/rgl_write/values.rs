@@ -116,7 +116,8 @@ pub fn sample(
     let done = AtomicUsize::new(0);
     let plane = n * n;
     let _stage = crate::progress::Stage::begin(progress, "sampling", total as u64);
-    let slices: Vec<(Vec<f32>, Vec<bool>)> = (0..total)
+    let slices: Vec<(Vec<f32>, Vec<bool>)> = crate::par::install(|| {
+        (0..total)
         .into_par_iter()
         .map(|s| {
             let (p, t) = (s / nt, s % nt);
@@ -188,7 +189,8 @@ pub fn sample(
             progress.set((done.fetch_add(1, Ordering::Relaxed) + 1) as u64);
             Ok((data, valid))
         })
-        .collect::<Result<_>>()?;
+        .collect::<Result<_>>()
+    })?;
     let mut data = Vec::with_capacity(total * c * plane);
     let mut bits = Vec::with_capacity(total * plane);
     for (d, v) in slices {

@@ -29,7 +29,9 @@ class Brdf:
     def interp(self) -> str: ...
     def describe(self) -> str: ...
     def eval(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float32]:
-        """f_r(wi, wo) in 1/sr: (n, c) float32, or (c,) for one pair of shape (3,)."""
+        """f_r(wi, wo) in 1/sr: (n, c) float32, or (c,) for one pair of shape (3,).
+
+        NaN, infinite or zero directions give 0 (not an error), as in every host."""
     def eval_spectral(self, wi: ArrayLike, wo: ArrayLike, nm: ArrayLike) -> npt.NDArray[np.float32]:
         """f_r at wavelengths nm ((k,) or (n, k)): (n, k) float32."""
     def pdf(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float64]:

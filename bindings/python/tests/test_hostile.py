@@ -1,0 +1,128 @@
+"""Hostile input through the Python package: fork-started workers, corrupt tables read lazily,
+FIFOs as SOURCE, NaN directions, huge specs. Nothing hangs, nothing is silently wrong."""
+
+import multiprocessing
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import brdftab
+
+GGX = '{"model": "ggx", "alpha": 0.3, "ks": 0.8}'
+
+
+def upper(n, seed=0):
+    rng = np.random.default_rng(seed)
+    v = rng.normal(size=(n, 3))
+    v[:, 2] = np.abs(v[:, 2]) + 1e-3
+    return v
+
+
+def _work(args):
+    """A worker's batch: large enough (> 4096 pairs) to run on the library's thread pool."""
+    brdf, seed = args
+    wi, wo = upper(20000, seed), upper(20000, seed + 1)
+    u = np.random.default_rng(seed).random((20000, 2))
+    f = brdf.eval(wi, wo)
+    p = brdf.pdf(wi, wo)
+    _, sp, _ = brdf.sample(wo, u)
+    return float(f.sum()), float(p.sum()), float(sp.sum())
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="fork is the default start method on Linux only")
+def test_a_fork_started_pool_after_the_parent_opened_a_table(tmp_path):
+    table = tmp_path / "g.btdb"
+    brdftab.bake(GGX, str(table), preset="small")
+    b = brdftab.open(str(table))  # eager: decodes every chunk on the library's pool
+    expected = [_work((b, s)) for s in (1, 2, 3)]  # the parent uses the pool too
+    with multiprocessing.get_context("fork").Pool(2) as pool:
+        r = pool.map_async(_work, [(b, s) for s in (1, 2, 3)])
+        try:
+            got = r.get(timeout=120)
+        except multiprocessing.TimeoutError:
+            pool.terminate()
+            pytest.fail("a fork-started worker hung on the parent's thread pool")
+    assert got == expected
+    # A second fork generation (a worker's own child) works too.
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        assert pool.apply_async(_work, ((b, 4),)).get(timeout=120) == _work((b, 4))
+
+
+def _corrupt(path):
+    """Flips one bit in the middle of the file: inside the compressed chunks, which are most of
+    a single-table file."""
+    data = bytearray(path.read_bytes())
+    data[len(data) // 2] ^= 0x10
+    path.write_bytes(bytes(data))
+
+
+def test_a_lazily_opened_corrupt_table_stays_failed(tmp_path):
+    table = tmp_path / "c.btdb"
+    brdftab.bake(GGX, str(table), preset="small")
+    _corrupt(table)
+    with pytest.raises(brdftab.Error, match="checksum"):
+        brdftab.open(str(table))  # eager: the open checks every chunk
+    lazy = brdftab.open(str(table), eager=False)
+    with pytest.raises(brdftab.Error, match="checksum"):
+        lazy.eval(upper(5000), upper(5000, 1))
+    for _ in range(2):  # and stays failed, even for one pair
+        with pytest.raises(brdftab.Error, match="checksum"):
+            lazy.eval([0, 0, 1], [0, 0, 1])
+    with pytest.raises(brdftab.Error, match="checksum"):
+        lazy.pdf([0, 0, 1], [0, 0, 1])
+
+
+def test_a_fifo_as_source_is_refused_at_once(tmp_path):
+    fifo = tmp_path / "pipe.btdb"
+    os.mkfifo(fifo)
+    code = (
+        "import brdftab, sys\n"
+        "try:\n"
+        f"    brdftab.open({str(fifo)!r})\n"
+        "except brdftab.Error as e:\n"
+        "    print(e); sys.exit(0)\n"
+        "sys.exit(1)\n"
+    )
+    try:
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                           timeout=60)
+    except subprocess.TimeoutExpired:
+        pytest.fail("brdftab.open on a FIFO blocked")
+    assert r.returncode == 0, r.stderr
+    assert "not a regular file" in r.stdout
+    with pytest.raises(brdftab.Error, match="a directory"):
+        brdftab.open(str(tmp_path))
+
+
+@pytest.mark.parametrize("source", ["spec", "table"])
+def test_nan_directions_give_zero_as_in_every_host(tmp_path, source):
+    if source == "table":
+        brdftab.bake(GGX, str(tmp_path / "t.btdb"), preset="small")
+        b = brdftab.open(str(tmp_path / "t.btdb"))
+    else:
+        b = brdftab.open(GGX)
+    good = [0.2, 0.1, 0.9]
+    bad = [[np.nan, 0, 1], [0, np.inf, 1], [0, 0, 0], [0, 0, -np.inf]]
+    for d in bad:
+        assert b.eval(d, good).tolist() == [0, 0, 0]
+        assert b.eval(good, d).tolist() == [0, 0, 0]
+        assert b.pdf(d, good) == 0 and b.pdf(good, d) == 0
+        wi, pdf, w = b.sample(d, [0.3, 0.6])
+        assert wi.tolist() == [0, 0, 0] and pdf == 0 and w.tolist() == [0, 0, 0]
+    # A batch mixing good and bad rows: only the bad rows are 0.
+    wi = np.array([good, bad[0], good])
+    f = b.eval(wi, [good] * 3)
+    assert (f[1] == 0).all() and (f[0] > 0).all() and (f[0] == f[2]).all()
+    with pytest.raises(ValueError, match=r"\[0, 1\)"):
+        b.sample([0, 0, 1], [np.nan, 0.5])
+
+
+def test_an_error_about_a_huge_spec_is_short(tmp_path):
+    big = "x" * (10 << 20)
+    for spec in ('{"model": "%s"}' % big, '{"model": "lambert", "kd": "%s"}' % big):
+        with pytest.raises(brdftab.Error) as e:
+            brdftab.open(spec)
+        assert len(str(e.value)) < 2000

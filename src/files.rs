@@ -1,0 +1,231 @@
+//! Checks and helpers for the files a command reads and writes (a low room: it knows paths,
+//! not formats).
+//!
+//! - A SOURCE must be a regular file ([`require_regular`]): opening a FIFO blocks until a writer
+//!   appears, and a directory, socket or device is never a material. The file type is read with
+//!   `stat` (which does not open, and so cannot block) before any `open`; every reader of a
+//!   file (tables, databases, MERL, RGL, spec files) asks first.
+//! - An output must not be one of the command's inputs ([`refuse_input`]): `convert p.bsdf
+//!   p.bsdf` would replace a measurement with its lossy resample. Files are compared by device
+//!   and inode (a symlink, a hard link or another spelling of the same path is caught too).
+//! - Outputs are written atomically through a temporary file beside them ([`temp_path`],
+//!   [`write_atomic`]); an output directory that does not exist is reported with the user's
+//!   path, and temporary files that killed writers left behind are removed by the next write.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result, excerpt};
+
+/// Refuses `path` unless it is a regular file (after following symlinks). A path that does not
+/// exist passes: the open that follows reports it with its own error.
+pub fn require_regular(path: impl AsRef<Path>) -> Result<()> {
+    let path = path.as_ref();
+    let m = match std::fs::metadata(path) {
+        Ok(m) => m,
+        Err(_) => return Ok(()),
+    };
+    if m.is_file() {
+        return Ok(());
+    }
+    Err(Error::Unsupported(format!(
+        "{}: not a regular file ({}); a SOURCE must be a file",
+        excerpt(&path.display().to_string()),
+        kind_name(&m.file_type())
+    )))
+}
+
+/// True when `path` is a regular file (after following symlinks); checked without opening it.
+pub fn is_regular(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| m.is_file())
+}
+
+fn kind_name(t: &std::fs::FileType) -> &'static str {
+    if t.is_dir() {
+        return "a directory";
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_block_device() || t.is_char_device() {
+            return "a device";
+        }
+    }
+    "not a file"
+}
+
+/// True when `a` and `b` name the same existing file (same device and inode on Unix; equal
+/// canonical paths elsewhere).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (std::fs::metadata(a), std::fs::metadata(b)) {
+            (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        match (a.canonicalize(), b.canonicalize()) {
+            (Ok(x), Ok(y)) => x == y,
+            _ => false,
+        }
+    }
+}
+
+/// The file a SOURCE string reads, if it names one: the path of `FILE`, `DB#NAME`, a `.json`
+/// spec file, a MERL or RGL file; `None` for inline JSON.
+pub fn source_file(source: &str) -> Option<&str> {
+    if source.trim_start().starts_with('{') {
+        return None;
+    }
+    Some(split_source(source))
+}
+
+/// The path part of `DB#NAME` (as [`crate::store::db::split_source`] splits it).
+fn split_source(source: &str) -> &str {
+    match source.rsplit_once('#') {
+        Some((p, n)) if !n.is_empty() && !n.contains('/') => p,
+        _ => source,
+    }
+}
+
+/// Refuses to write `output` when it is the file one of `inputs` (SOURCE strings or paths)
+/// reads: the write would replace the input with a resample of itself.
+pub fn refuse_input(output: &Path, inputs: &[&str]) -> Result<()> {
+    for input in inputs {
+        if let Some(f) = source_file(input)
+            && same_file(output, Path::new(f))
+        {
+            return Err(Error::arg(
+                "output",
+                format!(
+                    "{} is the input {}: writing it would replace the source with its own \
+                     resample (write to another file)",
+                    output.display(),
+                    excerpt(input)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The temporary file an atomic write of `path` goes through: `.NAME.tmp.PID.NANOS` in the
+/// same directory (so the final rename stays on one file system).
+///
+/// Checks first that the directory exists, so that error names the user's path and not the
+/// temporary file, and removes the temporary files of `path` that earlier writers killed before
+/// they could clean up left behind (on Linux: those whose PID is no longer running).
+pub fn temp_path(path: &Path) -> Result<PathBuf> {
+    let dir = parent(path);
+    let fname = path
+        .file_name()
+        .ok_or_else(|| Error::arg("path", format!("{} has no file name", path.display())))?
+        .to_string_lossy()
+        .into_owned();
+    check_dir(path, &dir)?;
+    let prefix = format!(".{fname}.tmp.");
+    sweep_stale(&dir, &prefix);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    Ok(dir.join(format!("{prefix}{}.{nanos}", std::process::id())))
+}
+
+/// Writes `bytes` to `path` atomically (through [`temp_path`], renamed into place; the
+/// temporary file is removed on failure).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = temp_path(path)?;
+    let r = std::fs::write(&tmp, bytes)
+        .map_err(|e| Error::io(path, e))
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
+    if r.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    r
+}
+
+/// An output's directory must exist (checked up front: the error then names `path`).
+pub fn check_dir(path: &Path, dir: &Path) -> Result<()> {
+    match std::fs::metadata(dir) {
+        Ok(m) if m.is_dir() => Ok(()),
+        Ok(_) => Err(Error::Unsupported(format!(
+            "{}: {} is not a directory",
+            path.display(),
+            dir.display()
+        ))),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(Error::NotFound(format!(
+            "{}: directory {} does not exist",
+            path.display(),
+            dir.display()
+        ))),
+        Err(e) => Err(Error::io(path, e)),
+    }
+}
+
+/// Removes `dir/PREFIX<pid>.*` files whose writer process is gone (Linux, where `/proc` tells;
+/// elsewhere nothing is removed). Best effort: errors are ignored.
+fn sweep_stale(dir: &Path, prefix: &str) {
+    let proc = Path::new("/proc");
+    if !proc.join("self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let Some(rest) = name.to_str().and_then(|n| n.strip_prefix(prefix)) else {
+            continue;
+        };
+        let Some(pid) = rest.split('.').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        let is_file = e.file_type().is_ok_and(|t| t.is_file());
+        if is_file && pid != std::process::id() && !proc.join(pid.to_string()).exists() {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+fn parent(p: &Path) -> PathBuf {
+    match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn directories_are_refused_and_missing_files_pass() {
+        let d = std::env::temp_dir();
+        let e = require_regular(&d).unwrap_err().to_string();
+        assert!(e.contains("a directory"), "{e}");
+        assert!(require_regular(d.join("brdftab-no-such-file.btdb")).is_ok());
+    }
+
+    #[test]
+    fn the_same_file_under_two_names_is_caught() {
+        let d = std::env::temp_dir().join(format!("brdftab-paths-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let a = d.join("a.btdb");
+        std::fs::write(&a, b"x").unwrap();
+        let other = d.join(".").join("a.btdb");
+        assert!(same_file(&a, &other));
+        let src = format!("{}#t", other.display());
+        assert!(refuse_input(&a, &[&src]).is_err());
+        assert!(refuse_input(&d.join("b.btdb"), &[&src]).is_ok());
+        assert!(refuse_input(&a, &[r#"{"model": "lambert"}"#]).is_ok());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}
