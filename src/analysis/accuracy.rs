@@ -90,17 +90,80 @@ pub fn compare_weighted(
     max_theta: f64,
     weight: Weight,
 ) -> Result<Accuracy> {
-    if !(max_theta > 0.0 && max_theta <= std::f64::consts::FRAC_PI_2) {
-        return Err(Error::arg(
-            "max_theta",
-            format!("{max_theta} is not in (0, π/2]"),
-        ));
+    compare_region(
+        approx,
+        reference,
+        pairs,
+        seed,
+        Region::Cap(max_theta),
+        weight,
+    )
+}
+
+/// Where [`compare_region`] draws its pairs (uniformly over the region's solid angle).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Region {
+    /// Both directions within this angle of the normal (radians; π/2 = the whole hemisphere).
+    Cap(f64),
+    /// Pairs with at least one direction farther than this angle from the normal (radians): the
+    /// grazing band, where measured f_r grows like 1/cos θ and a cap hides every error.
+    Band(f64),
+}
+
+impl Region {
+    fn check(self) -> Result<()> {
+        let (name, t) = match self {
+            Region::Cap(t) => ("max_theta", t),
+            Region::Band(t) => ("min_theta", t),
+        };
+        let ok = match self {
+            Region::Cap(t) => t > 0.0 && t <= std::f64::consts::FRAC_PI_2,
+            Region::Band(t) => (0.0..std::f64::consts::FRAC_PI_2).contains(&t),
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(Error::arg(
+                name,
+                format!("{t} is not in the range of the region"),
+            ))
+        }
     }
+}
+
+/// Like [`compare_weighted`], over the pairs of `region`.
+pub fn compare_region(
+    approx: &dyn Brdf,
+    reference: &dyn Brdf,
+    pairs: usize,
+    seed: u64,
+    region: Region,
+    weight: Weight,
+) -> Result<Accuracy> {
+    region.check()?;
+    let max_theta = match region {
+        Region::Cap(t) => t,
+        Region::Band(_) => std::f64::consts::FRAC_PI_2,
+    };
     // Uniform on the cap: z uniform in [cos θmax, 1].
     let span = 1.0 - max_theta.cos();
     // (For θmax = π/2, span rounds to exactly 1 and z = u.x, the same pairs as before.)
     let cap = |u: glam::DVec2| {
         geometry::uniform_hemisphere(glam::DVec2::new((1.0 - span) + span * u.x, u.y))
+    };
+    // The band: pairs of the hemisphere drawn until one direction lies below cos θmin (a third
+    // of all pairs for 80°, so the rejection costs little).
+    let band_z = match region {
+        Region::Band(t) => t.cos(),
+        Region::Cap(_) => f64::INFINITY,
+    };
+    let draw = |rng: &mut Pcg32| loop {
+        let wi = cap(rng.next_dvec2());
+        let wo = cap(rng.next_dvec2());
+        if wi.z.min(wo.z) < band_z {
+            return (wi, wo);
+        }
     };
     let c = reference.channels().len();
     if approx.channels().len() != c || c > MAX_CHANNELS {
@@ -125,8 +188,7 @@ pub fn compare_weighted(
                 let mut fa = [0.0f32; MAX_CHANNELS];
                 let mut fr = [0.0f32; MAX_CHANNELS];
                 for _ in 0..n {
-                    let wi = cap(rng.next_dvec2());
-                    let wo = cap(rng.next_dvec2());
+                    let (wi, wo) = draw(&mut rng);
                     approx.eval(wi, wo, &mut fa[..c]);
                     reference.eval(wi, wo, &mut fr[..c]);
                     let w = match weight {

@@ -3,6 +3,7 @@
 pub mod accuracy;
 pub mod albedo;
 pub mod chi2;
+pub mod fidelity;
 pub mod plausibility;
 pub mod slice;
 pub mod timing;
