@@ -34,9 +34,10 @@ use crate::store::{TableHeader, Writer, db, tables};
 use crate::table::adaptive;
 use crate::table::presets::Preset;
 use crate::table::target::{self, TargetSearch};
+use crate::table::warp::WarpVar;
 use crate::table::{
-    BakeOptions, Grid, Interp, Mapping, Param, Symmetry, Table, TabulatedBrdf, bake_chunks,
-    symmetry,
+    BakeOptions, Grid, Interp, Mapping, Param, Quantity, Symmetry, Table, TabulatedBrdf,
+    bake_chunks, symmetry,
 };
 
 /// The grid a bake samples on.
@@ -267,6 +268,9 @@ pub struct BakeRequest {
     /// Applies to adaptive grids: RGL files by default, any isotropic bilateral source with
     /// [`GridChoice::Adaptive`]`(None)` or [`GridChoice::Default`].
     pub target_error: Option<f64>,
+    /// What the table stores (`None`: [`Quantity::FrCosCos`] for measured sources, RGL and
+    /// MERL files, [`Quantity::Fr`] otherwise; see [`Quantity`] for why).
+    pub quantity: Option<Quantity>,
 }
 
 impl BakeRequest {
@@ -286,7 +290,26 @@ impl BakeRequest {
             accuracy_pairs: 0,
             accuracy_interp: Interp::Linear,
             target_error: None,
+            quantity: None,
         }
+    }
+
+    /// Sets what the table stores (see [`BakeRequest::quantity`]).
+    pub fn quantity(mut self, q: Quantity) -> BakeRequest {
+        self.quantity = Some(q);
+        self
+    }
+
+    /// What the table stores: the request's own choice, or the default for its source.
+    pub fn effective_quantity(&self) -> Quantity {
+        self.quantity
+            .unwrap_or(match source::classify(&self.source) {
+                SourceKind::Rgl => Quantity::FrCosOut,
+                // Resampled onto an adaptive grid (an error target): bounded at the horizon
+                // like an RGL file's values. Its own cells are copied as they are (f_r).
+                SourceKind::Merl if self.adaptive() => Quantity::FrCosOut,
+                _ => Quantity::Fr,
+            })
     }
 
     /// Sets the error target (see [`BakeRequest::target_error`]).
@@ -390,6 +413,10 @@ impl BakeRequest {
     /// [`plan`](Self::plan), reporting an error-target search (about a second) on `progress`.
     pub fn plan_with(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<Plan> {
         let (mut sym, mut note) = self.resolve_symmetry(src);
+        if self.effective_quantity() == Quantity::FrCosOut && sym.reciprocal {
+            // f_r cos θo differs between a pair and its swap: the table cannot fold by it.
+            sym.reciprocal = false;
+        }
         let mut force = self.force || self.symmetry == SymmetryChoice::Declared;
         let mut assumed = false;
         if self.adaptive()
@@ -430,7 +457,7 @@ impl BakeRequest {
             },
         };
         Ok(Plan {
-            grid,
+            grid: grid.with_quantity(self.effective_quantity())?,
             note,
             force,
             assumed,
@@ -480,11 +507,28 @@ impl BakeRequest {
         target::search(
             src,
             sym,
-            &adaptive::AdaptiveOptions::default(),
+            &self.adaptive_options(adaptive::DEFAULT_NODES),
             &target::TargetOptions::new(e),
             force,
             progress,
         )
+    }
+
+    /// The options of this request's adaptive grids of `nodes`.
+    fn adaptive_options(&self, nodes: [usize; 3]) -> adaptive::AdaptiveOptions {
+        let quantity = self.effective_quantity();
+        adaptive::AdaptiveOptions {
+            nodes,
+            quantity,
+            // A projected table is judged to the horizon, with θh nodes up to it.
+            cap_deg: if quantity != Quantity::Fr { 90.0 } else { 85.0 },
+            h_var: if quantity != Quantity::Fr {
+                WarpVar::QuarterPower
+            } else {
+                WarpVar::SqrtSine
+            },
+            ..Default::default()
+        }
     }
 
     /// The grid this request bakes `src` on.
@@ -498,11 +542,7 @@ impl BakeRequest {
             if self.param.is_some_and(|p| p != Param::HalfDiff) {
                 return Err(Error::arg("grid", "an adaptive grid is halfdiff"));
             }
-            let opts = adaptive::AdaptiveOptions {
-                nodes,
-                ..Default::default()
-            };
-            return adaptive::adaptive_grid(src, sym, &opts);
+            return adaptive::adaptive_grid(src, sym, &self.adaptive_options(nodes));
         }
         match self.grid {
             GridChoice::Merl => Grid::merl(ch).with_symmetry(sym),
@@ -544,17 +584,20 @@ impl BakeRequest {
             let report = self.report_for(src, table.grid(), None, t0, true);
             return Ok((table, report));
         }
+        // What the bake samples ([`Brdf::bake_view`]); the report describes the source.
+        let view = src.bake_view();
+        let bake_src: &dyn Brdf = view.as_deref().unwrap_or(src);
         let Plan {
             grid,
             note,
             force,
             assumed,
             search,
-        } = self.plan_with(src, progress)?;
+        } = self.plan_with(bake_src, progress)?;
         let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
         let set = |done: u64, _total: u64| progress.set(done);
         let opts = self.bake_options(&set, force);
-        let (table, r) = crate::table::bake(src, &grid, &opts)?;
+        let (table, r) = crate::table::bake(bake_src, &grid, &opts)?;
         // A lazily read table source whose chunk failed gave zeros: refuse them.
         src.health()?;
         let mut report = self.report_for(src, &grid, note, t0, false);
@@ -697,20 +740,23 @@ impl BakeRequest {
         progress: &dyn Progress,
     ) -> Result<BakeReport> {
         let t0 = Instant::now();
+        // What the bake samples ([`Brdf::bake_view`]).
+        let view = src.bake_view();
+        let bake_src: &dyn Brdf = view.as_deref().unwrap_or(src);
         let Plan {
             grid,
             note,
             force,
             assumed,
             search,
-        } = self.plan_with(src, progress)?;
+        } = self.plan_with(bake_src, progress)?;
         let header = TableHeader::for_grid(name.to_owned(), provenance, &grid, self.codec);
         let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
         let set = |done: u64, _total: u64| progress.set(done);
         let opts = self.bake_options(&set, force);
         let mut baked = None;
         let mut write = |w: &mut Writer| -> Result<()> {
-            baked = Some(bake_chunks(src, &grid, &opts, |i, v| {
+            baked = Some(bake_chunks(bake_src, &grid, &opts, |i, v| {
                 src.health()?; // a failed table source: stop before its zeros are written
                 w.chunk_with(v, tables::chunk_layout(&grid, i))
             })?);

@@ -220,6 +220,15 @@ pub trait Brdf: Send + Sync {
     fn health(&self) -> crate::Result<()> {
         Ok(())
     }
+
+    /// What a bake of this BRDF samples, when that is not the BRDF itself: `None` (the
+    /// default) for every source except a measurement the table cannot follow as it is. An
+    /// isotropic RGL file's value at normal incidence depends on the direction from which wi
+    /// approaches the normal; its view replaces that by the continuous limit, keeping every
+    /// directional albedo ([`crate::measured::rgl_normal`]).
+    fn bake_view(&self) -> Option<Box<dyn Brdf + '_>> {
+        None
+    }
 }
 
 /// The length check of [`Brdf::eval_batch`]: returns the number of pairs, panics (with both
@@ -276,6 +285,9 @@ macro_rules! forward_brdf {
             }
             fn health(&self) -> crate::Result<()> {
                 (**self).health()
+            }
+            fn bake_view(&self) -> Option<Box<dyn Brdf + '_>> {
+                (**self).bake_view()
             }
         }
     };

@@ -45,12 +45,13 @@ impl F4 {
             )
         }
     }
-    /// The first four f16 values of `v` (bits), which must each be +0 or a positive normal f16
-    /// (as [`crate::table::kernel::Packed`] stores them), in SSE2 integer operations: the bits
-    /// shifted into an f32's exponent and mantissa, times 2^112 (the exponent bias difference);
-    /// exact for those values. `None` if `v` holds fewer than four.
+    /// The first four f16 values of `v` (bits), which must each be ±0 or a normal f16 (as
+    /// [`crate::table::kernel::Packed`] stores them), in SSE2 integer operations: the magnitude
+    /// bits shifted into an f32's exponent and mantissa, times 2^112 (the exponent bias
+    /// difference), the sign bit moved to the f32's; exact for those values. `None` if `v` holds
+    /// fewer than four.
     #[inline(always)]
-    pub fn from_f16_positive(v: &[u16]) -> Option<F4> {
+    pub fn from_f16_normal(v: &[u16]) -> Option<F4> {
         use std::arch::x86_64::*;
         if v.len() < 4 {
             return None;
@@ -58,12 +59,15 @@ impl F4 {
         // SAFETY: `v` holds at least four u16, the eight bytes read.
         unsafe {
             let h = _mm_loadl_epi64(v.as_ptr() as *const __m128i);
-            let w = _mm_slli_epi32::<13>(_mm_unpacklo_epi16(h, _mm_setzero_si128()));
-            Some(F4(_mm_mul_ps(_mm_castsi128_ps(w), _mm_set1_ps(F16_BIAS))))
+            let x = _mm_unpacklo_epi16(h, _mm_setzero_si128());
+            let mag = _mm_slli_epi32::<13>(_mm_and_si128(x, _mm_set1_epi32(0x7fff)));
+            let sign = _mm_slli_epi32::<16>(_mm_and_si128(x, _mm_set1_epi32(0x8000)));
+            let m = _mm_mul_ps(_mm_castsi128_ps(mag), _mm_set1_ps(F16_BIAS));
+            Some(F4(_mm_or_ps(m, _mm_castsi128_ps(sign))))
         }
     }
     /// The first four f16 values of `v` (bits; any f16) with the F16C instruction; for the
-    /// values [`F4::from_f16_positive`] takes, the same result. `None` if `v` holds fewer than
+    /// values [`F4::from_f16_normal`] takes, the same result. `None` if `v` holds fewer than
     /// four.
     ///
     /// # Safety
@@ -211,12 +215,14 @@ impl F4 {
     }
     /// See the x86-64 version.
     #[inline(always)]
-    pub fn from_f16_positive(v: &[u16]) -> Option<F4> {
+    pub fn from_f16_normal(v: &[u16]) -> Option<F4> {
         if v.len() < 4 {
             return None;
         }
         Some(F4(std::array::from_fn(|k| {
-            f32::from_bits((v[k] as u32) << 13) * F16_BIAS
+            let x = v[k] as u32;
+            let m = f32::from_bits((x & 0x7fff) << 13) * F16_BIAS;
+            f32::from_bits(m.to_bits() | ((x & 0x8000) << 16))
         })))
     }
     /// Every lane x.
@@ -357,7 +363,7 @@ mod tests {
         assert_eq!(n.max(F4::splat(0.0)).to_array(), [0.0; 4]);
         assert_eq!(n.min(F4::splat(1.0)).to_array(), [1.0; 4]);
         assert!(F4::load(&[1.0, 2.0, 3.0]).is_none());
-        assert!(F4::from_f16_positive(&[1, 2, 3]).is_none());
+        assert!(F4::from_f16_normal(&[1, 2, 3]).is_none());
         let (x, y) = F4::transpose_pairs(&[1.0, 2.0], &[3.0, 4.0], &[5.0, 6.0]);
         assert_eq!(
             (x.to_array(), y.to_array()),
@@ -379,7 +385,7 @@ mod tests {
                 .iter()
                 .map(|&b| half::f16::from_bits(b).to_f32())
                 .collect();
-            let got = F4::from_f16_positive(q).unwrap().to_array();
+            let got = F4::from_f16_normal(q).unwrap().to_array();
             assert_eq!(&got[..], &want[..], "{q:?}");
             #[cfg(target_arch = "x86_64")]
             if std::is_x86_feature_detected!("f16c") {

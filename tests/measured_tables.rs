@@ -51,10 +51,13 @@ fn rgl_defaults_meet_size_error_and_memory_bars() {
         );
         let native = source::open(&f.to_string_lossy()).unwrap();
         let table = source::open_table(&out, &OpenOptions::default()).unwrap();
+        // 100 000 pairs, as the search estimates it: on the near-mirror `cg_sunflower` one pair
+        // on the 0.4°-wide peak can carry most of a 20 000-pair figure (draws of 20 000 pairs
+        // on one table scatter from 0.3 % to 4.6 %; BENCHMARKS.md).
         let e = compare_weighted(
             &table,
             native.as_ref(),
-            20_000,
+            100_000,
             1,
             80f64.to_radians(),
             Weight::CosInCosOut,
@@ -71,6 +74,32 @@ fn rgl_defaults_meet_size_error_and_memory_bars() {
             table.resident_bytes()
         );
         assert!(table.resident_bytes() > 0, "{name}: evaluated, so loaded");
+    }
+}
+
+#[test]
+fn rgl_defaults_are_faithful_over_the_whole_hemisphere() {
+    // Issue #22's figures beyond the 80° cap, each file's default table against the native
+    // reader. The whole-hemisphere bar (1.5 %) is met; the grazing-band (3 %) and albedo (1 %)
+    // bars are not yet met on every file (see BENCHMARKS.md, "Measured tables at every angle"):
+    // until they are, this pins today's levels — far below where the defaults were before
+    // (grazing 6–186 %, albedo 3–19 %) — so that no change can slide back unnoticed.
+    let dir = measured::data::rgl_dir().expect("the shipped data/rgl");
+    for f in brdftab::report::measured::rgl_files(&dir).unwrap() {
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        let (out, _) = bake_default(&name);
+        let native = source::open(&f.to_string_lossy()).unwrap();
+        let table = source::open_table(&out, &OpenOptions::default()).unwrap();
+        let opts = brdftab::analysis::fidelity::FidelityOptions {
+            pairs: 100_000,
+            ..Default::default()
+        };
+        let fi = brdftab::analysis::fidelity::measure(&table, native.as_ref(), &opts).unwrap();
+        let s = fi.summary();
+        assert!(fi.cap <= 0.01, "{name}: {s}");
+        assert!(fi.whole <= 0.015, "{name}: {s}");
+        assert!(fi.grazing <= 0.06, "{name}: {s}");
+        assert!(fi.albedo.worst <= 0.05, "{name}: {s}");
     }
 }
 

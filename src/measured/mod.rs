@@ -5,6 +5,8 @@
 //! - [`rgl`]: RGL-EPFL `.bsdf` measurements evaluated natively by the published algorithm
 //!   ([`RglBrdf`], RGB or spectral, isotropic or anisotropic), with importance sampling by the
 //!   measurement's own warps;
+//! - [`rgl_normal`]: an isotropic RGL file made continuous at normal incidence, which is
+//!   what a bake samples (the reader's limit there depends on the approach direction);
 //! - [`rgl_write`]: any `Brdf` written as an RGL `.bsdf` file (the adaptive parameterization
 //!   rebuilt from the source: NDF by power iteration, warps, values), with its error report;
 //! - [`merl`]: MERL `.binary` files, read (the reference reader's nearest lookup, a validity
@@ -24,6 +26,7 @@ pub mod info;
 pub mod merl;
 pub mod merl_manifest;
 pub mod rgl;
+pub mod rgl_normal;
 pub mod rgl_write;
 pub mod tensor;
 

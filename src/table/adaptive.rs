@@ -19,7 +19,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
-use crate::table::grid::{Axis, Grid, Mapping, Nodes, Param};
+use crate::table::grid::{Axis, Grid, Mapping, Nodes, Param, Quantity};
 use crate::table::symmetry::Symmetry;
 use crate::table::warp::{Warp, WarpVar};
 
@@ -36,6 +36,12 @@ pub struct AdaptiveOptions {
     pub floor: f64,
     /// Directions beyond this angle from the normal do not count (degrees).
     pub cap_deg: f64,
+    /// What the grid's values are: the warps follow the variation of that quantity.
+    pub quantity: Quantity,
+    /// θh's warp variable: [`WarpVar::SqrtSine`] (the default), or [`WarpVar::QuarterPower`],
+    /// whose finite slope at 90° lets the warp place nodes up to the horizon (measured tables
+    /// judged over the whole hemisphere).
+    pub h_var: WarpVar,
 }
 
 impl Default for AdaptiveOptions {
@@ -46,6 +52,8 @@ impl Default for AdaptiveOptions {
             knots: 128,
             floor: 0.15,
             cap_deg: 85.0,
+            quantity: Quantity::Fr,
+            h_var: WarpVar::SqrtSine,
         }
     }
 }
@@ -56,8 +64,10 @@ impl Default for AdaptiveOptions {
 /// on average (BENCHMARKS.md, "Measured materials").
 pub const DEFAULT_NODES: [usize; 3] = [128, 48, 25];
 
-/// The warp variables of the three axes.
-pub const VARS: [WarpVar; 3] = [WarpVar::SqrtSine, WarpVar::HalfPower, WarpVar::PseudoAngle];
+/// The warp variables of the three axes, θh's as `opts` chooses.
+fn vars(opts: &AdaptiveOptions) -> [WarpVar; 3] {
+    [opts.h_var, WarpVar::HalfPower, WarpVar::PseudoAngle]
+}
 
 /// An adaptive grid for `src` (isotropic; `symmetry` must be isotropic and bilateral, and may
 /// be reciprocal): θh, θd and φd warped by the source's own variation (see the module docs).
@@ -76,7 +86,8 @@ pub fn adaptive_grid(src: &dyn Brdf, symmetry: Symmetry, opts: &AdaptiveOptions)
         ));
     }
     let warps = fit_warps(src, phi_hi(symmetry), opts)?;
-    grid_with_warps(src.channels().clone(), symmetry, opts.nodes, warps)
+    grid_with_warps(src.channels().clone(), symmetry, opts.nodes, warps)?
+        .with_quantity(opts.quantity)
 }
 
 /// The end of the stored φd axis: π, or π/2 with reciprocity.
@@ -137,8 +148,11 @@ pub fn fit_warps(src: &dyn Brdf, phi_hi: f64, opts: &AdaptiveOptions) -> Result<
     let his = [FRAC_PI_2, FRAC_PI_2, phi_hi];
     // Sample v at cell centres of the fine grids: f[((ih·md + id)·mp + ip)·c + k].
     let v = |a: usize, i: usize| (i as f64 + 0.5) / opts.fine[a] as f64;
-    let ang = |a: usize, i: usize| VARS[a].angle_of(v(a, i), his[a]);
+    let vars = vars(opts);
+    let ang = |a: usize, i: usize| vars[a].angle_of(v(a, i), his[a]);
     let cap = opts.cap_deg.to_radians().cos();
+    let quantity = opts.quantity;
+    let project = quantity != Quantity::Fr;
     let row = md * mp * c;
     let mut f = vec![0f32; mh * row];
     let mut w = vec![0f64; mh * md * mp];
@@ -154,7 +168,13 @@ pub fn fit_warps(src: &dyn Brdf, phi_hi: f64, opts: &AdaptiveOptions) -> Result<
                         let pd = ang(2, ip);
                         let (wi, wo) = crate::table::pair_of(Param::HalfDiff, [th, 0.0, td, pd]);
                         let o = id * mp + ip;
-                        src.eval(wi, wo, &mut fr[o * c..(o + 1) * c]);
+                        let out = &mut fr[o * c..(o + 1) * c];
+                        src.eval(wi, wo, out);
+                        if project {
+                            for x in out.iter_mut() {
+                                *x = (*x as f64 * quantity.factor(wi.z, wo.z)) as f32;
+                            }
+                        }
                         // Unlifted directions decide the cap (lifted ones sit at the horizon).
                         let (ri, ro) = crate::geometry::from_half_diff(crate::geometry::HalfDiff {
                             theta_h: th,
@@ -162,8 +182,11 @@ pub fn fit_warps(src: &dyn Brdf, phi_hi: f64, opts: &AdaptiveOptions) -> Result<
                             theta_d: td,
                             phi_d: pd,
                         });
-                        wr[o] = if ri.z >= cap && ro.z >= cap {
-                            (ri.z * ro.z).powi(2) * 4.0 * td.cos() * th.sin() * td.sin()
+                        // The metric's weight (cos θi cos θo)², divided by what the quantity
+                        // holds already.
+                        let cc2 = (ri.z * ro.z).powi(2) / quantity.factor(ri.z, ro.z).powi(2);
+                        wr[o] = if ri.z >= cap && ro.z >= cap && ri.z > 0.0 && ro.z > 0.0 {
+                            cc2 * 4.0 * td.cos() * th.sin() * td.sin()
                         } else {
                             0.0
                         };
@@ -187,7 +210,7 @@ pub fn fit_warps(src: &dyn Brdf, phi_hi: f64, opts: &AdaptiveOptions) -> Result<
             .map(|i| {
                 let h = 0.25 / m as f64;
                 let (v0, v1) = ((v(a, i) - h).max(0.0), (v(a, i) + h).min(1.0));
-                (VARS[a].angle_of(v1, his[a]) - VARS[a].angle_of(v0, his[a])) / (v1 - v0)
+                (vars[a].angle_of(v1, his[a]) - vars[a].angle_of(v0, his[a])) / (v1 - v0)
             })
             .collect();
         for ih in 0..mh {
@@ -215,7 +238,7 @@ pub fn fit_warps(src: &dyn Brdf, phi_hi: f64, opts: &AdaptiveOptions) -> Result<
         e[m - 1] = e[m - 2];
         let density: Vec<f64> = e.iter().map(|&x| x.max(0.0).powf(0.2)).collect();
         warps.push(Warp::from_density(
-            VARS[a], &density, opts.knots, opts.floor,
+            vars[a], &density, opts.knots, opts.floor,
         )?);
     }
     let [a, b, c] = <[Warp; 3]>::try_from(warps).expect("three warps");
@@ -263,10 +286,16 @@ mod tests {
         assert!(td.node(td.size - 1) < FRAC_PI_2 && td.node(0) > 0.0);
         // A Lambertian source has no variation: the warps are the identity in v.
         let lam = model(r#"{"model": "lambert", "kd": 0.5}"#);
-        let g = adaptive_grid(lam.as_ref(), sym, &opts).unwrap();
-        let th = &g.stored_axes()[0];
-        let v = WarpVar::SqrtSine.of_angle(th.node(16), FRAC_PI_2);
-        assert!((v - 16.0 / 63.0).abs() < 1e-5, "{v}");
+        for h_var in [WarpVar::SqrtSine, WarpVar::QuarterPower] {
+            let o = AdaptiveOptions {
+                h_var,
+                ..opts.clone()
+            };
+            let g = adaptive_grid(lam.as_ref(), sym, &o).unwrap();
+            let th = &g.stored_axes()[0];
+            let v = h_var.of_angle(th.node(16), FRAC_PI_2);
+            assert!((v - 16.0 / 63.0).abs() < 1e-5, "{h_var:?} {v}");
+        }
     }
 
     #[test]

@@ -26,7 +26,8 @@ use crate::error::{Error, Result};
 use crate::geometry::HalfDiff;
 use crate::rng::Pcg32;
 use crate::spectrum::MAX_CHANNELS;
-use crate::table::grid::{Grid, Nodes, Param, StoredAxis};
+use crate::table::grid::{Grid, Nodes, Param, Quantity, StoredAxis};
+use crate::table::horizon::HorizonFill;
 use crate::table::symmetry::{self, Symmetry};
 use crate::table::{Table, pair_of};
 
@@ -121,9 +122,12 @@ pub fn bake_chunks(
     // A source that stores this grid's first node stores them all (it is on the same grid):
     // its nodes are copied, not evaluated. Asked once, so other sources pay nothing.
     let native = grid.param() == Param::HalfDiff
+        && grid.quantity() == Quantity::Fr
         && opts.supersample <= 1
         && !layout.is_empty()
         && brdf.stored_node(half_diff(grid.node_angles([0; 4])), &mut vec![0.0; c]);
+    // Nodes beyond the horizon of f_r cos θi cos θo tables are extrapolated (`horizon`).
+    let mut horizon = HorizonFill::new(grid);
     let budget = (opts.memory_budget / 4).max(1);
     let mut buf: Vec<f32> = Vec::new();
     let mut a = 0;
@@ -175,6 +179,9 @@ pub fn bake_chunks(
         let mut done = layout.chunk_range(a).start as u64;
         for k in a..e {
             let l = layout.chunk_len(k);
+            if let Some(h) = horizon.as_mut() {
+                h.fill(k, &mut buf[off..off + l]);
+            }
             sink(k, &buf[off..off + l])?;
             off += l;
             done += l as u64;
@@ -221,13 +228,18 @@ fn eval_node(
     out: &mut [f32],
 ) {
     let param = grid.param();
+    // The factor of the stored quantity at a (lifted) pair.
+    let weight = |wi: glam::DVec3, wo: glam::DVec3| grid.quantity().factor(wi.z, wo.z);
     if k <= 1 {
         let (wi, wo) = pair_of(param, grid.node_angles(idx));
         brdf.eval(wi, wo, out);
+        let w = weight(wi, wo);
         for v in out.iter_mut() {
-            if !v.is_finite() {
-                *v = 0.0;
-            }
+            *v = if v.is_finite() {
+                (*v as f64 * w) as f32
+            } else {
+                0.0
+            };
         }
         return;
     }
@@ -269,9 +281,10 @@ fn eval_node(
         }
         let (wi, wo) = pair_of(param, coords);
         brdf.eval(wi, wo, &mut f[..c]);
+        let w = weight(wi, wo);
         for ch in 0..c {
             if f[ch].is_finite() {
-                acc[ch] += f[ch] as f64;
+                acc[ch] += f[ch] as f64 * w;
             }
         }
     }

@@ -420,8 +420,69 @@ pub struct Grid {
     axes: [Axis; 4],
     channels: Channels,
     symmetry: Symmetry,
+    quantity: Quantity,
     stored: [StoredAxis; 4],
     layout: Layout,
+}
+
+/// What a table's values are. A lookup always returns f_r; the quantity says what was
+/// interpolated to get it.
+///
+/// Measured reflectance is stored as f_r · cos θo (an RGL file) or f_r (MERL) and near the horizon
+/// grows like 1/cos θ: a piecewise-linear interpolant of f_r between a node at cos θ = 0.1 and
+/// one at 0.02 is off by 80 % halfway, and a node beyond the horizon (baked at a direction
+/// lifted to z = [`HORIZON_Z`](super::HORIZON_Z)) carries hundreds of times the value at 88°
+/// into the cells next to it. f_r cos θi cos θo is bounded and smooth there, and it is also
+/// what the light transport integrates, so an interpolation error in it is an error of the same
+/// size in the rendered radiance — at every angle, up to the horizon.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quantity {
+    /// f_r itself (analytic models; MERL cells copied verbatim).
+    #[default]
+    Fr,
+    /// f_r cos θi cos θo: the lookup divides by the two cosines of the pair.
+    FrCosCos,
+    /// f_r cos θo, what an RGL file stores: bounded where measured f_r grows like 1/cos θo,
+    /// and — unlike f_r cos θi cos θo — not vanishing as wi nears the horizon, so the albedo
+    /// a(θ′) = ∫ f_r cos θo dωo, the integral of this quantity, stays accurate at θ′ = 89°. Not
+    /// symmetric in the two directions: a table of it cannot fold by reciprocity.
+    FrCosOut,
+}
+
+impl Quantity {
+    /// True for [`Quantity::Fr`] (which the file header leaves out).
+    pub fn is_fr(&self) -> bool {
+        *self == Quantity::Fr
+    }
+
+    /// The name used in headers and summaries: `fr`, `fr_cos_cos` or `fr_cos_out`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::Fr => "fr",
+            Quantity::FrCosCos => "fr_cos_cos",
+            Quantity::FrCosOut => "fr_cos_out",
+        }
+    }
+
+    /// The factor of f_r in this quantity for a pair with cosines `cos_i`, `cos_o`.
+    #[inline(always)]
+    pub fn factor(self, cos_i: f64, cos_o: f64) -> f64 {
+        match self {
+            Quantity::Fr => 1.0,
+            Quantity::FrCosCos => cos_i * cos_o,
+            Quantity::FrCosOut => cos_o,
+        }
+    }
+
+    /// A one-line description: `f_r`, `f_r cos θi cos θo`, `f_r cos θo`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Quantity::Fr => "f_r",
+            Quantity::FrCosCos => "f_r cos θi cos θo",
+            Quantity::FrCosOut => "f_r cos θo",
+        }
+    }
 }
 
 #[derive(Serialize, Deserialize)]
@@ -434,6 +495,8 @@ struct GridRepr {
     phi2: Axis,
     channels: Channels,
     symmetry: Symmetry,
+    #[serde(default, skip_serializing_if = "Quantity::is_fr")]
+    quantity: Quantity,
 }
 
 impl TryFrom<GridRepr> for Grid {
@@ -444,7 +507,8 @@ impl TryFrom<GridRepr> for Grid {
             [r.theta1, r.phi1, r.theta2, r.phi2],
             r.channels,
             r.symmetry,
-        )
+        )?
+        .with_quantity(r.quantity)
     }
 }
 
@@ -458,6 +522,7 @@ impl From<Grid> for GridRepr {
             phi2: g.axes[3].clone(),
             channels: g.channels,
             symmetry: g.symmetry,
+            quantity: g.quantity,
         }
     }
 }
@@ -603,6 +668,7 @@ impl Grid {
             axes,
             channels,
             symmetry,
+            quantity: Quantity::Fr,
             stored,
             layout,
         };
@@ -674,6 +740,22 @@ impl Grid {
     pub fn symmetry(&self) -> Symmetry {
         self.symmetry
     }
+    /// What the values are ([`Quantity::Fr`] unless set with [`Grid::with_quantity`]).
+    pub fn quantity(&self) -> Quantity {
+        self.quantity
+    }
+    /// The same grid storing `quantity`. An error for [`Quantity::FrCosOut`] on a grid folded
+    /// by reciprocity (f_r cos θo differs between a pair and its swap).
+    pub fn with_quantity(mut self, quantity: Quantity) -> Result<Grid> {
+        if quantity == Quantity::FrCosOut && self.symmetry.reciprocal {
+            return Err(Error::arg(
+                "quantity",
+                "f_r cos θo is not reciprocal: a grid storing it cannot fold by reciprocity",
+            ));
+        }
+        self.quantity = quantity;
+        Ok(self)
+    }
     /// The stored (reduced) axes.
     pub fn stored_axes(&self) -> &[StoredAxis; 4] {
         &self.stored
@@ -705,11 +787,13 @@ impl Grid {
             self.channels.clone(),
             symmetry,
         )
+        .and_then(|g| g.with_quantity(self.quantity))
     }
 
     /// The same grid with other channels.
     pub fn with_channels(&self, channels: Channels) -> Result<Grid> {
         Grid::new(self.param, self.axes.clone(), channels, self.symmetry)
+            .and_then(|g| g.with_quantity(self.quantity))
     }
 
     /// The angles of stored node `idx` (in the stored domains; for isotropic `inout`, axis 3 is
@@ -746,6 +830,9 @@ impl Grid {
         ) + &match &self.axes[3].mapping {
             Mapping::Warp(_) => format!(", φ2 {}", self.axes[3].mapping.label()),
             _ => String::new(),
+        } + &match self.quantity {
+            Quantity::Fr => String::new(),
+            q => format!(", stores {}", q.label()),
         }
     }
 }

@@ -43,18 +43,20 @@ use crate::geometry;
 use crate::simd::F4;
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use crate::table::grid::{Grid, Mapping, Nodes, Param, StoredAxis};
+use crate::table::grid::{Grid, Mapping, Nodes, Param, Quantity, StoredAxis};
 use crate::table::warp::{Warp, WarpVar};
 
 /// A kernel table's values as its lookups read them: f16, scaled by a power of two.
 ///
 /// Half the bytes of f32, so a measured material's table (≈ 0.9 MB) stays in a core's L2
 /// cache, and a corner row (two φd corners × RGB) is 12 bytes. The scale 2^e puts the largest
-/// value in [2^14, 2^15), well inside f16's range; values below 2^-14 after scaling (2^-28 of
-/// the largest and less) are stored as 0, so every code is +0 or a positive normal f16 and
-/// expands exactly with [`F4::from_f16_positive`] (or F16C). The rounding costs at most
+/// magnitude in [2^14, 2^15), well inside f16's range; magnitudes below 2^-14 after scaling
+/// (2^-28 of the largest and less) are stored as 0, so every code is ±0 or a normal f16 and
+/// expands exactly with [`F4::from_f16_normal`] (or F16C). The rounding costs at most
 /// 2^-11 of a value (f16's half ulp), far below a measured table's interpolation error.
-/// Negative values (unmeasured cells, set aside by [`super::TabulatedBrdf`]) are stored as 0.
+/// Negative values are kept: a table of a [`Quantity`] other than f_r extrapolates its nodes beyond the
+/// horizon below 0 (`table::horizon`); an f_r table's negative values (unmeasured cells) are
+/// set aside by [`super::TabulatedBrdf`] before they reach here.
 ///
 /// Small tables whose kernel resamples a fixed mapping ([`Kernel::exact_values`]) keep f32
 /// values instead ([`Packed::exact`]): such a table is what a user baked on a grid of their own
@@ -75,12 +77,12 @@ pub struct Packed {
 const PACK_PAD: usize = 4;
 
 impl Packed {
-    /// Packs `values` (finite; negative and non-finite ones become 0).
+    /// Packs `values` (non-finite ones become 0).
     pub fn new(values: &[f32]) -> Packed {
         let max = values
             .iter()
             .filter(|x| x.is_finite())
-            .fold(0f32, |m, &x| m.max(x));
+            .fold(0f32, |m, &x| m.max(x.abs()));
         // max · 2^e ∈ [2^14, 2^15): e = 14 − ⌊log2 max⌋, read off max's exponent bits (exact);
         // within f32's normal exponents.
         let e = if max >= f32::MIN_POSITIVE {
@@ -97,7 +99,7 @@ impl Packed {
             .iter()
             .map(|&v| {
                 let x = v * scale;
-                if x >= min_normal && x.is_finite() {
+                if x.abs() >= min_normal && x.is_finite() {
                     half::f16::from_f32(x).to_bits()
                 } else {
                     0
@@ -112,11 +114,11 @@ impl Packed {
         }
     }
 
-    /// `values` as they are (f32; negative and non-finite ones become 0).
+    /// `values` as they are (f32; non-finite ones become 0).
     pub fn exact(values: &[f32]) -> Packed {
         let full = values
             .iter()
-            .map(|&v| if v >= 0.0 && v.is_finite() { v } else { 0.0 })
+            .map(|&v| if v.is_finite() { v } else { 0.0 })
             .chain(std::iter::repeat_n(0.0, PACK_PAD))
             .collect();
         Packed {
@@ -314,6 +316,9 @@ pub struct Kernel {
     axes: [Axis; 3],
     /// φd folded onto [0, π/2] (reciprocity) instead of [0, π].
     quarter: bool,
+    /// θh's variable is [`WarpVar::QuarterPower`] ((1 − cos θh)^¼) instead of
+    /// [`WarpVar::SqrtSine`].
+    h_quarter_power: bool,
     channels: usize,
     /// Values per θd row of a chunk (stored φd nodes × channels).
     row: usize,
@@ -329,14 +334,17 @@ pub struct Kernel {
     cut: F4,
     /// Some axis is resampled: RGB lookups check the cut.
     resampled: bool,
+    /// What the values are: lookups of a quantity other than f_r divide by its factor.
+    quantity: Quantity,
     /// Values are read exact ([`Packed::exact`]): resampled, and at most
     /// [`RESAMPLED_EXACT_MAX_VALUES`] of them.
     exact: bool,
 }
 
 impl Kernel {
-    /// The kernel of `grid` when it applies: `halfdiff`, isotropic and bilateral, θh, θd and φd
-    /// warped with their default variables on edge nodes. `None` otherwise (use the general
+    /// The kernel of `grid` when it applies: `halfdiff`, isotropic and bilateral, θh (by
+    /// [`WarpVar::SqrtSine`] or [`WarpVar::QuarterPower`]), θd and φd warped with their default
+    /// variables on edge nodes. `None` otherwise (use the general
     /// lookup).
     pub fn new(grid: &Grid) -> Option<Kernel> {
         let s = grid.symmetry();
@@ -353,6 +361,7 @@ impl Kernel {
         let mut axes = Vec::with_capacity(3);
         let mut cut = [2f32; 4];
         let mut resampled = false;
+        let mut h_quarter_power = false;
         for (i, (k, var, hi)) in want.into_iter().enumerate() {
             let a = &ax[k];
             let nodes_ok = match a.nodes {
@@ -366,6 +375,10 @@ impl Kernel {
             let centers = a.nodes == Nodes::Centers;
             match &a.mapping {
                 Mapping::Warp(w) if w.var() == var => axes.push(Axis::new(w, a.size, centers)),
+                Mapping::Warp(w) if k == 0 && w.var() == WarpVar::QuarterPower => {
+                    h_quarter_power = true;
+                    axes.push(Axis::new(w, a.size, centers));
+                }
                 // MERL-style fixed mappings (sqrt θh, uniform θd and φd), resampled.
                 m @ (Mapping::Sqrt | Mapping::Uniform)
                     if (k == 0) == (*m == Mapping::Sqrt)
@@ -396,11 +409,13 @@ impl Kernel {
             chunk: axes[1].n * axes[2].n * channels,
             axes,
             quarter: s.reciprocal,
+            h_quarter_power,
             channels,
             f16c: has_f16c(),
             cut: F4::new(cut[0], cut[1], cut[2], cut[3]),
             resampled,
             exact: resampled && grid.stored_values() <= RESAMPLED_EXACT_MAX_VALUES,
+            quantity: grid.quantity(),
         })
     }
 
@@ -434,7 +449,12 @@ impl Kernel {
         // cancellation near θh = 0 or θd = 0.
         let (ex, ey, ez) = (ix - ox, iy - oy, iz - oz);
         let vd = ((ex * ex + ey * ey + ez * ez) / (2.0 * (2.0 + hl))).sqrt();
-        let vh = (r2 / (r2 + hz * hz)).sqrt().sqrt();
+        // sin θh = r/|h|, or 1 − cos θh = r²/(|h|(|h| + hz)): no cancellation near θh = 0.
+        let vh = if self.h_quarter_power {
+            (r2 / (r2 + hz * hz + hl * hz)).sqrt().sqrt()
+        } else {
+            (r2 / (r2 + hz * hz)).sqrt().sqrt()
+        };
         let dx = hz * (hx * ix + hy * iy) - r2 * iz;
         let dy = (hl * (hx * iy - hy * ix)).abs();
         let den = dx.abs() + dy;
@@ -450,8 +470,10 @@ impl Kernel {
 
     /// [`Kernel::vars`] on four lanes: the three quotients in one division, the square roots
     /// in one (two for v_h); the same IEEE operations, so the same values (tested).
+    /// Lane 0 of the one division also gives 1 / (cos θi cos θo) (returned beside the variables;
+    /// the cosine product is kept at or above [`MIN_COS_PRODUCT`] so that it stays finite).
     #[inline(always)]
-    fn vars_lanes(&self, wi: DVec3, wo: DVec3) -> Option<F4> {
+    fn vars_lanes(&self, wi: DVec3, wo: DVec3) -> Option<(F4, f32)> {
         // One branch for the usual unit pair; anything else goes through `geometry::unit`.
         let unit =
             geometry::is_unit_l2(wi.length_squared()) & geometry::is_unit_l2(wo.length_squared());
@@ -464,9 +486,13 @@ impl Kernel {
         let (hx, hy, hz) = (ix + ox, iy + oy, iz + oz);
         let r2 = hx * hx + hy * hy;
         let hh = r2 + hz * hz;
-        // v_h's chain (a quotient, two roots) starts without waiting for |h|.
-        let vh = (r2 / hh).sqrt().sqrt();
         let hl = hh.sqrt();
+        // v_h's chain (a quotient, two roots); for SqrtSine it starts without waiting for |h|.
+        let vh = if self.h_quarter_power {
+            (r2 / (hh + hl * hz)).sqrt().sqrt()
+        } else {
+            (r2 / hh).sqrt().sqrt()
+        };
         let (ex, ey, ez) = (ix - ox, iy - oy, iz - oz);
         let e2 = ex * ex + ey * ey + ez * ez;
         let dx = hz * (hx * ix + hy * iy) - r2 * iz;
@@ -480,11 +506,16 @@ impl Kernel {
             (false, true) => (0.0, 1.0),
             (false, false) => (1.0, 1.0),
         };
-        let q = F4::new(1.0, e2, pn, 0.0) / F4::new(1.0, 2.0 * (2.0 + hl), pd, 1.0);
-        let [_, q1, q2, _] = q.to_array();
+        let cc = match self.quantity {
+            Quantity::FrCosOut => oz,
+            _ => iz * oz,
+        }
+        .max(MIN_COS_PRODUCT);
+        let q = F4::new(1.0, e2, pn, 0.0) / F4::new(cc, 2.0 * (2.0 + hl), pd, 1.0);
+        let [q0, q1, q2, _] = q.to_array();
         let p = if self.quarter { q2 } else { 0.5 - 0.5 * q2 };
         let v = F4::new(vh, q1.sqrt(), p, 0.0);
-        Some(v)
+        Some((v, q0))
     }
 
     /// Evaluates into `out[..channels]` from the table's `values` (all chunks, in order, as
@@ -525,6 +556,9 @@ impl Kernel {
             1 => self.blend::<1>(v, out, values),
             _ => self.blend::<0>(v, out, values),
         }
+        if self.quantity != Quantity::Fr {
+            project_out(self.quantity, wi, wo, &mut out[..self.channels]);
+        }
         true
     }
 
@@ -554,9 +588,15 @@ impl Kernel {
     ) -> bool {
         match self.vars_lanes(wi, wo) {
             // Only resampled axes have a cut (< 2).
-            Some(v) if CUT && v.any_ge(self.cut) => false,
-            Some(v) => {
+            Some((v, _)) if CUT && v.any_ge(self.cut) => false,
+            Some((v, inv_cc)) => {
                 self.eval_rgb::<F16C, EXACT>(v, out, values);
+                if self.quantity != Quantity::Fr {
+                    // Extrapolated nodes beyond the horizon may pull the blend below 0.
+                    for x in &mut out[..3] {
+                        *x = (*x * inv_cc).max(0.0);
+                    }
+                }
                 true
             }
             None => {
@@ -606,7 +646,7 @@ impl Kernel {
                 // SAFETY: `F16C` is true only in `rgb_f16c`, which runs when the CPU has F16C.
                 return unsafe { F4::from_f16_f16c(x) };
             }
-            F4::from_f16_positive(x)
+            F4::from_f16_normal(x)
         };
         // The four rows' values, all within o .. o + chunk + row + 7 (one bounds check; only
         // an empty table fails it). Each row's six values r..r+6: four at r (φd corner 0 in
@@ -674,6 +714,25 @@ impl Kernel {
     }
 }
 
+/// The smallest factor (cos θi cos θo, cos θo) a lookup of a [`Quantity`] divides by (a normal
+/// f32; pairs closer to the horizon keep a finite value).
+pub const MIN_COS_PRODUCT: f32 = 1e-30;
+
+/// f_r from an interpolated `quantity`: `out` divided by the quantity's factor for the pair
+/// (unit vectors made here) and clamped at 0 (extrapolated nodes beyond the horizon may pull
+/// the blend below 0); 0 for pairs below the horizon.
+pub fn project_out(quantity: Quantity, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+    match geometry::upper_pair(wi, wo) {
+        Some((wi, wo)) => {
+            let s = 1.0 / quantity.factor(wi.z, wo.z).max(MIN_COS_PRODUCT as f64);
+            for x in out {
+                *x = ((*x as f64 * s) as f32).max(0.0);
+            }
+        }
+        None => out.fill(0.0),
+    }
+}
+
 /// Whether the CPU has F16C (x86-64 only).
 fn has_f16c() -> bool {
     #[cfg(target_arch = "x86_64")]
@@ -695,7 +754,7 @@ fn unit_pair(wi: DVec3, wo: DVec3) -> Option<(DVec3, DVec3)> {
 
 /// The warp variables of a pair from its Rusinkiewicz angles (the reference for
 /// [`Kernel::vars`]): `None` below the horizon.
-pub fn reference_vars(wi: DVec3, wo: DVec3, quarter: bool) -> Option<[f64; 3]> {
+pub fn reference_vars(wi: DVec3, wo: DVec3, quarter: bool, h_var: WarpVar) -> Option<[f64; 3]> {
     let (wi, wo) = geometry::upper_pair(wi, wo)?;
     let hd = geometry::to_half_diff(wi, wo)?;
     // Bilateral symmetry folds φd onto [0, π]; reciprocity (φd → φd + π) onto [0, π/2].
@@ -709,7 +768,7 @@ pub fn reference_vars(wi: DVec3, wo: DVec3, quarter: bool) -> Option<[f64; 3]> {
         std::f64::consts::PI
     };
     Some([
-        WarpVar::SqrtSine.of_angle(hd.theta_h, std::f64::consts::FRAC_PI_2),
+        h_var.of_angle(hd.theta_h, std::f64::consts::FRAC_PI_2),
         WarpVar::HalfPower.of_angle(hd.theta_d, std::f64::consts::FRAC_PI_2),
         WarpVar::PseudoAngle.of_angle(p, hi),
     ])
@@ -737,13 +796,14 @@ mod tests {
         (d(r), d(r))
     }
 
-    fn test_kernel(quarter: bool) -> Kernel {
+    fn test_kernel(quarter: bool, h_quarter_power: bool) -> Kernel {
         let axes =
             std::array::from_fn(|_| Axis::new(&Warp::identity(WarpVar::HalfPower), 2, false));
         let per = |x: f32| F4::new(x, x, x, 0.0);
         Kernel {
             axes,
             quarter,
+            h_quarter_power,
             channels: 1,
             row: 2,
             chunk: 4,
@@ -752,6 +812,7 @@ mod tests {
             cut: F4::splat(2.0),
             resampled: false,
             exact: false,
+            quantity: Quantity::Fr,
         }
     }
 
@@ -762,7 +823,7 @@ mod tests {
             let v: Vec<f32> = (0..20_000)
                 .map(|i| match i {
                     0 => peak,
-                    1 => -1.0,
+                    1 => -0.5 * peak,
                     2 => f32::NAN,
                     // log-uniform over 2^-40 .. 1 of the peak
                     _ => peak * 2f32.powf(-40.0 * r.next_f64() as f32),
@@ -770,7 +831,10 @@ mod tests {
                 .collect();
             let p = Packed::new(&v);
             assert_eq!(p.len(), v.len());
-            assert_eq!((p.get(1), p.get(2), p.get(v.len())), (0.0, 0.0, 0.0));
+            // Negative values are kept (extrapolated nodes beyond the horizon), non-finite ones
+            // and those past the end read 0.
+            assert_eq!((p.get(2), p.get(v.len())), (0.0, 0.0));
+            assert!((p.get(1) + 0.5 * peak).abs() <= 0.5 * peak * 2f32.powi(-11));
             for (i, &x) in v.iter().enumerate().skip(3).chain([(0, &peak)]) {
                 let y = p.get(i);
                 if x >= peak * 2f32.powi(-28) {
@@ -787,19 +851,25 @@ mod tests {
 
     #[test]
     fn fast_variables_match_the_angles() {
-        for quarter in [false, true] {
+        for (quarter, hq) in [(false, false), (true, false), (false, true), (true, true)] {
             let mut r = Pcg32::new(71);
-            let k = test_kernel(quarter);
+            let k = test_kernel(quarter, hq);
+            let h_var = if hq {
+                WarpVar::QuarterPower
+            } else {
+                WarpVar::SqrtSine
+            };
             for _ in 0..100_000 {
                 let (wi, wo) = random_pair(&mut r);
                 let f = k.vars(wi, wo).unwrap();
-                let g = reference_vars(wi, wo, quarter).unwrap();
+                let g = reference_vars(wi, wo, quarter, h_var).unwrap();
                 // The lane version does the same IEEE operations.
-                let l = k.vars_lanes(wi, wo).unwrap().to_array();
+                let l = k.vars_lanes(wi, wo).unwrap().0.to_array();
                 assert_eq!(&l[..3], &f[..], "{wi} {wo}");
                 // f32 arithmetic without cancellation: a few ulps of v ≤ 1. φd itself is
                 // only as good as h = ωi + ωo in f32 relative to sin θh (it is undefined at
-                // θh = 0, where an isotropic BRDF does not depend on it).
+                // θh = 0, where an isotropic BRDF does not depend on it). v_h² ≤ sin θh for
+                // both variables (√2 sin(θh/2) ≤ sin θh up to 90°).
                 let sin_h = (g[0] * g[0]).max(1e-12);
                 assert!((f[0] as f64 - g[0]).abs() < 1e-5, "{wi} {wo}: {f:?} {g:?}");
                 assert!((f[1] as f64 - g[1]).abs() < 1e-5, "{wi} {wo}: {f:?} {g:?}");
@@ -817,7 +887,15 @@ mod tests {
             .unwrap()
             .build(&Channels::Rgb)
             .unwrap();
-        for reciprocal in [false, true] {
+        // f_r tables (θh by SqrtSine and QuarterPower) and tables of the other quantities, whose
+        // lookups divide by the cosines (and whose nodes beyond the horizon are extrapolated).
+        let cases = [
+            (false, Quantity::Fr, WarpVar::SqrtSine),
+            (true, Quantity::Fr, WarpVar::QuarterPower),
+            (false, Quantity::FrCosOut, WarpVar::QuarterPower),
+            (true, Quantity::FrCosCos, WarpVar::SqrtSine),
+        ];
+        for (reciprocal, quantity, h_var) in cases {
             let sym = Symmetry {
                 isotropic: true,
                 reciprocal,
@@ -826,6 +904,8 @@ mod tests {
             let opts = AdaptiveOptions {
                 nodes: [24, 16, 9],
                 fine: [64, 32, 16],
+                quantity,
+                h_var,
                 ..Default::default()
             };
             let grid = adaptive_grid(src.as_ref(), sym, &opts).unwrap();
@@ -837,29 +917,36 @@ mod tests {
             let mut r = Pcg32::new(32);
             let (mut a, mut b, mut c, mut d) = ([0f32; 3], [0f32; 3], [0f32; 3], [0f32; 3]);
             let mut soft = [0f32; 3];
-            let peak = t.values().iter().fold(0f32, |m, &x| m.max(x));
+            let peak = t.values().iter().fold(0f32, |m, &x| m.max(x.abs()));
             let mut worst = 0f32;
             for _ in 0..50_000 {
                 let (wi, wo) = random_pair(&mut r);
+                // What the lookup divides the interpolated quantity by.
+                let s = match geometry::upper_pair(wi, wo) {
+                    Some((i, o)) => 1.0 / quantity.factor(i.z, o.z) as f32,
+                    None => 0.0,
+                };
                 k.eval(wi, wo, &mut a, &packed);
                 // Without F16C (the integer expansion) exactly the same.
                 k.rgb::<false, false, false>(wi, wo, &mut soft, &packed);
                 assert_eq!(a, soft, "{wi} {wo}");
                 general.eval(Interp::Linear, wi, wo, &mut b, |i| t.chunk(i));
+                project_out(quantity, wi, wo, &mut b);
                 tb.eval(wi, wo, &mut c);
                 // The four-lane RGB path against its scalar reference, `blend::<3>`.
                 if let Some(v) = k.vars(wi, wo) {
                     k.blend::<3>(v, &mut d, &packed);
+                    project_out(quantity, wi, wo, &mut d);
                     for ch in 0..3 {
                         assert!((a[ch] - d[ch]).abs() <= 1e-6 * d[ch].abs(), "{a:?} {d:?}");
                     }
                 }
                 for ch in 0..3 {
                     // Both interpolate the same nodes; they differ by the values' f16
-                    // rounding (≤ 2^-11 of each, so of the blend of these positive values) and
-                    // the f32 variables (a few 1e-7) times the slope in node units: below 1e-3
-                    // of the value plus 1e-4 of the table's peak.
-                    let e = (a[ch] - b[ch]).abs() / (b[ch].abs() * 1e-3 + peak * 1e-4);
+                    // rounding (≤ 2^-11 of each, so of the blend) and the f32 variables (a few
+                    // 1e-7) times the slope in node units: below 1e-3 of the value plus 1e-4 of
+                    // the table's peak (both divided by the quantity's factor).
+                    let e = (a[ch] - b[ch]).abs() / (b[ch].abs() * 1e-3 + peak * 1e-4 * s);
                     worst = worst.max(e);
                     assert_eq!(a[ch], c[ch], "TabulatedBrdf uses the kernel");
                 }

@@ -20,6 +20,7 @@
 pub mod adaptive;
 pub mod bake;
 pub mod grid;
+mod horizon;
 pub mod kernel;
 pub mod lookup;
 pub mod param;
@@ -32,7 +33,7 @@ pub mod target;
 pub mod warp;
 
 pub use bake::{BakeOptions, BakeReport, bake, bake_chunks};
-pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, StoredAxis};
+pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, Quantity, StoredAxis};
 pub use lookup::Interp;
 pub use sampling::{SamplingResolution, TableSampler};
 pub use symmetry::Symmetry;

@@ -39,8 +39,8 @@ use crate::error::{Error, Result};
 use crate::geometry::HalfDiff;
 use crate::spectrum::Channels;
 use crate::table::Table;
-use crate::table::grid::{Grid, Param};
-use crate::table::kernel::{Kernel, Packed};
+use crate::table::grid::{Grid, Param, Quantity};
+use crate::table::kernel::{Kernel, Packed, project_out};
 use crate::table::lookup::{Interp, Lookup, Prepared};
 use crate::table::sampling::{SamplingResolution, TableSampler};
 
@@ -86,6 +86,9 @@ pub struct TabulatedBrdf {
     unmeasured: Box<[OnceLock<Unmeasured>]>,
     loader: Option<Box<dyn ChunkLoader>>,
     interp: Interp,
+    /// The values are not f_r ([`Quantity`]): general lookups divide by the quantity's factor
+    /// (the kernel does so itself).
+    project: bool,
     description: String,
     error: Mutex<Option<Error>>,
     /// Importance sampling distributions, built on first `sample`/`pdf` (see [`super::sampling`]).
@@ -110,11 +113,12 @@ impl TabulatedBrdf {
         let (grid, mut values, description) = table.into_parts();
         let l = grid.layout();
         let kernel = Kernel::new(&grid);
+        let project = grid.quantity() != Quantity::Fr;
         let mut unmeasured = Vec::with_capacity(l.chunk_count());
         let mut chunks = Vec::with_capacity(l.chunk_count());
         for i in 0..l.chunk_count() {
             let v = &mut values[l.chunk_range(i)];
-            unmeasured.push(OnceLock::from(set_aside_negatives(v)));
+            unmeasured.push(OnceLock::from(set_aside_negatives(v, project)));
             // An exact kernel's array serves as the chunks (`chunk`).
             chunks.push(match &kernel {
                 Some(k) if k.exact_values() => OnceLock::new(),
@@ -134,6 +138,7 @@ impl TabulatedBrdf {
             unmeasured: unmeasured.into(),
             loader: None,
             interp: Interp::Linear,
+            project,
             description,
             error: Mutex::new(None),
             failed: AtomicBool::new(false),
@@ -153,6 +158,7 @@ impl TabulatedBrdf {
         let unmeasured = (0..grid.layout().chunk_count())
             .map(|_| OnceLock::new())
             .collect();
+        let project = grid.quantity() != Quantity::Fr;
         TabulatedBrdf {
             lookup: Lookup::new(&grid),
             kernel: Kernel::new(&grid),
@@ -162,6 +168,7 @@ impl TabulatedBrdf {
             unmeasured,
             loader: Some(loader),
             interp: Interp::Linear,
+            project,
             description: description.into(),
             error: Mutex::new(None),
             failed: AtomicBool::new(false),
@@ -194,6 +201,8 @@ impl TabulatedBrdf {
             for (k, oc) in og.chunks_exact_mut(c).enumerate() {
                 if !prep[k].gather(c, oc) {
                     self.eval(wi[s + k], wo[s + k], oc);
+                } else if self.project {
+                    project_out(self.grid.quantity(), wi[s + k], wo[s + k], oc);
                 }
             }
         }
@@ -313,7 +322,7 @@ impl TabulatedBrdf {
             }
             match self.fetch(a) {
                 Ok(mut v) => {
-                    let _ = self.unmeasured[a].set(set_aside_negatives(&mut v));
+                    let _ = self.unmeasured[a].set(set_aside_negatives(&mut v, self.project));
                     all.extend_from_slice(&v);
                 }
                 Err(e) => {
@@ -380,7 +389,7 @@ impl TabulatedBrdf {
     fn load_chunk(&self, a: usize) -> &[f32] {
         self.chunks[a].get_or_init(|| match self.fetch(a) {
             Ok(mut v) => {
-                let _ = self.unmeasured[a].set(set_aside_negatives(&mut v));
+                let _ = self.unmeasured[a].set(set_aside_negatives(&mut v, self.project));
                 v.into()
             }
             Err(e) => {
@@ -447,7 +456,15 @@ impl Brdf for TabulatedBrdf {
         }
         // Not a kernel table, a nearest lookup, or a pair beyond a resampled axis's cut.
         self.lookup
-            .eval(self.interp, wi, wo, out, |a| self.chunk(a))
+            .eval(self.interp, wi, wo, out, |a| self.chunk(a));
+        if self.project {
+            project_out(
+                self.grid.quantity(),
+                wi,
+                wo,
+                &mut out[..self.lookup.channels()],
+            );
+        }
     }
 
     /// The first chunk-load error any lookup met (sticky, see the module docs); one atomic load
@@ -499,7 +516,8 @@ impl Brdf for TabulatedBrdf {
     /// The node at `hd` as stored, negative (unmeasured) values included, on `halfdiff` grids.
     fn stored_node(&self, hd: HalfDiff, out: &mut [f32]) -> bool {
         let c = self.lookup.channels();
-        if self.grid.param() != Param::HalfDiff || out.len() < c {
+        // A stored quantity other than f_r: such nodes are evaluated, not copied.
+        if self.grid.param() != Param::HalfDiff || out.len() < c || self.project {
             return false;
         }
         let x = crate::table::symmetry::canonical_half_diff(self.grid.symmetry(), hd);
@@ -542,9 +560,14 @@ impl Brdf for TabulatedBrdf {
     }
 }
 
-/// Replaces the negative values of `v` by 0 and returns them (offset, value), in order.
-fn set_aside_negatives(v: &mut [f32]) -> Unmeasured {
+/// Replaces the negative values of `v` by 0 and returns them (offset, value), in order; keeps
+/// them (and returns none) for values of another [`Quantity`] than f_r (`projected`), whose negative
+/// values are nodes beyond the horizon extrapolated below 0, not unmeasured cells.
+fn set_aside_negatives(v: &mut [f32], projected: bool) -> Unmeasured {
     let mut out = Vec::new();
+    if projected {
+        return out.into();
+    }
     for (k, x) in v.iter_mut().enumerate() {
         if *x < 0.0 {
             out.push((k as u32, *x));

@@ -131,8 +131,10 @@ pub fn search(
     let _stage = Stage::begin(progress, "searching grid", 0);
     progress.note("fitting warps");
     let warps = adaptive::fit_warps(src, adaptive::phi_hi(symmetry), adaptive_opts)?;
-    let grid_of =
-        |nodes| adaptive::grid_with_warps(src.channels().clone(), symmetry, nodes, warps.clone());
+    let grid_of = |nodes| {
+        adaptive::grid_with_warps(src.channels().clone(), symmetry, nodes, warps.clone())
+            .and_then(|g| g.with_quantity(adaptive_opts.quantity))
+    };
     let bake_opts = BakeOptions {
         force,
         ..BakeOptions::default()

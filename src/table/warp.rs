@@ -37,6 +37,11 @@ pub enum WarpVar {
     SqrtSine,
     /// v = (1 − cos θ)^½ = √2 sin(θ/2) on θ ∈ [0, π/2]: within 11% of uniform in θ.
     HalfPower,
+    /// v = (1 − cos θ)^¼ on θ ∈ [0, π/2]: about √θ near 0 like [`WarpVar::SqrtSine`], but
+    /// with a finite slope at π/2 (1/4 per radian), where (sin θ)^½ is flat — a θh axis in it
+    /// can place nodes at 89° and 90°, which the grazing near-mirror peak needs. From vectors:
+    /// 1 − cos θh = (hx² + hy²)/(|h|(|h| + hz)), a quotient and two square roots.
+    QuarterPower,
     /// The pseudo-angle of φ on a folded φ axis [0, hi], hi = π or π/2:
     /// p(φ) = ½ − ½ cos φ / (|cos φ| + |sin φ|), v = p(φ)/p(hi).
     PseudoAngle,
@@ -50,6 +55,7 @@ impl WarpVar {
             WarpVar::SqrtSine => x.sin().max(0.0).sqrt(),
             // 1 − cos x = 2 sin²(x/2), without cancellation near 0.
             WarpVar::HalfPower => (2.0f64.sqrt() * (0.5 * x).sin()).abs(),
+            WarpVar::QuarterPower => (2.0f64.sqrt() * (0.5 * x).sin()).abs().sqrt(),
             WarpVar::PseudoAngle => pseudo(x) / pseudo(hi),
         }
     }
@@ -61,6 +67,7 @@ impl WarpVar {
             WarpVar::SqrtSine => (v * v).asin(),
             // x = acos(1 − y) = 2 asin(√(y/2)), y = 1 − cos x.
             WarpVar::HalfPower => 2.0 * (v * std::f64::consts::FRAC_1_SQRT_2).asin(),
+            WarpVar::QuarterPower => 2.0 * (v * v * std::f64::consts::FRAC_1_SQRT_2).asin(),
             WarpVar::PseudoAngle => {
                 let p = v * pseudo(hi);
                 // p(φ) = sin/(2(cos + sin)) on [0, π/2]; p(π − φ) = 1 − p(φ).
@@ -77,7 +84,9 @@ impl WarpVar {
     /// The domain end the variable is normalized to on a θ axis (π/2) or the folded φ end.
     fn check_domain(self, hi: f64) -> Result<()> {
         let ok = match self {
-            WarpVar::SqrtSine | WarpVar::HalfPower => (hi - FRAC_PI_2).abs() < 1e-12,
+            WarpVar::SqrtSine | WarpVar::HalfPower | WarpVar::QuarterPower => {
+                (hi - FRAC_PI_2).abs() < 1e-12
+            }
             WarpVar::PseudoAngle => (hi - PI).abs() < 1e-12 || (hi - FRAC_PI_2).abs() < 1e-12,
         };
         if ok {
@@ -293,7 +302,7 @@ mod tests {
 
     #[test]
     fn variables_invert() {
-        for var in [WarpVar::SqrtSine, WarpVar::HalfPower] {
+        for var in [WarpVar::SqrtSine, WarpVar::HalfPower, WarpVar::QuarterPower] {
             for i in 0..=100 {
                 let x = i as f64 / 100.0 * FRAC_PI_2;
                 let v = var.of_angle(x, FRAC_PI_2);

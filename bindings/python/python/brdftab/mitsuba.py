@@ -267,6 +267,11 @@ class JitTable:
             raise brdftab.Error("packed inout reciprocal tables are not supported by the JIT path")
         self.param = grid["param"]
         self.sym = grid["symmetry"]
+        # What the values are (grid.rs, Quantity): "fr", "fr_cos_cos" or "fr_cos_out"; lookups
+        # of the last two divide by the cosines, as the Rust lookups do.
+        self.quantity = grid.get("quantity", "fr")
+        if self.quantity not in ("fr", "fr_cos_cos", "fr_cos_out"):
+            raise brdftab.Error(f"table quantity {self.quantity!r} is not supported by the JIT path")
         self.axes = [dict(ax) for ax in grid["stored_axes"]]
         self.shape = list(grid["stored_shape"])
         self.c = int(values.shape[-1])
@@ -286,11 +291,11 @@ class JitTable:
         # Adaptive grids: Rust looks them up with table/kernel.rs (float32 warp variables from
         # the vectors); mirror it, so that both compute the same node weights.
         self.kernel = None
-        want = {0: "sqrt_sine", 2: "half_power", 3: "pseudo_angle"}
+        want = {0: ("sqrt_sine", "quarter_power"), 2: ("half_power",), 3: ("pseudo_angle",)}
         if (interp == "linear" and self.param == "halfdiff" and self.sym["isotropic"]
                 and self.sym["bilateral"]
                 and all(isinstance(self.axes[k]["mapping"], dict)
-                        and self.axes[k]["mapping"].get("warp", {}).get("var") == v
+                        and self.axes[k]["mapping"].get("warp", {}).get("var") in v
                         and self.axes[k]["nodes"] in (("edges",) if k == 3 else ("edges", "centers"))
                         and self.axes[k]["size"] >= 2
                         for k, v in want.items())):
@@ -309,6 +314,7 @@ class JitTable:
                 ks.append((mi.Float(c.astype(np.float32)), mi.Float(d.astype(np.float32)),
                            float(len(knots) - 1), n))
             self.kernel = ks
+            self.h_quarter_power = self.axes[0]["mapping"]["warp"]["var"] == "quarter_power"
             # Packed::new in kernel.rs: the kernel reads f16 codes of the values scaled by 2^e.
             self.kernel_values = mi.Float(kernel_values(values).ravel())
             dr.eval(self.kernel_values)
@@ -429,6 +435,8 @@ class JitTable:
         var = w["var"]
         if var == "sqrt_sine":
             v = dr.sqrt(dr.maximum(dr.sin(x), 0.0))
+        elif var == "quarter_power":
+            v = dr.sqrt(math.sqrt(2.0) * dr.abs(dr.sin(0.5 * x)))
         elif var == "half_power":
             v = math.sqrt(2.0) * dr.abs(dr.sin(0.5 * x))
         elif var == "pseudo_angle":
@@ -508,7 +516,10 @@ class JitTable:
         if self.interp == "nearest":
             idx = [self._nearest(self.axes[k], x[k]) for k in range(4)]
             base = (((idx[0] * s1 + idx[1]) * n2 + idx[2]) * s3 + idx[3]) * c
-            return [dr.gather(Fl, self.values, base + k, valid) for k in range(c)]
+            out = [dr.gather(Fl, self.values, base + k, valid) for k in range(c)]
+            if self.quantity != "fr":
+                out = self._project(wi, wo, out)
+            return [dr.select(valid, o, 0.0) for o in out]
         lin = [self._linear(self.axes[k], x[k]) for k in range(4)]
         corners1 = [(lin[1][0], 1.0 - lin[1][2])]
         if s1 > 1:
@@ -523,7 +534,21 @@ class JitTable:
                         base = (row + q) * c
                         for k in range(c):
                             out[k] = dr.fma(wt, dr.gather(Fl, self.values, base + k, valid), out[k])
+        if self.quantity != "fr":
+            out = self._project(wi, wo, out)
         return [dr.select(valid, o, 0.0) for o in out]
+
+    def _project(self, wi, wo, out):
+        """f_r from an interpolated quantity (kernel.rs, ``project_out``): divided by cos θo
+        or cos θi cos θo of the unit directions (at least 1e-30), clamped at 0."""
+        import drjit as dr
+
+        F64 = self.Float64
+        iz = F64(wi.z) / dr.sqrt(dr.maximum(F64(wi.x) ** 2 + F64(wi.y) ** 2 + F64(wi.z) ** 2, 1e-300))
+        oz = F64(wo.z) / dr.sqrt(dr.maximum(F64(wo.x) ** 2 + F64(wo.y) ** 2 + F64(wo.z) ** 2, 1e-300))
+        f = oz if self.quantity == "fr_cos_out" else iz * oz
+        s = 1.0 / dr.maximum(f, 1e-30)
+        return [dr.maximum(type(o)(F64(o) * s), 0.0) for o in out]
 
 
     # -- kernel.rs (adaptive grids) -----------------------------------------------------------
@@ -546,8 +571,12 @@ class JitTable:
         hx, hy, hz = ix + ox, iy + oy, iz + oz
         r2 = hx * hx + hy * hy
         hh = r2 + hz * hz
-        vh = dr.sqrt(dr.sqrt(r2 / hh))
         hl = dr.sqrt(hh)
+        # sin θh = r/|h| (SqrtSine), or 1 − cos θh = r²/(|h|(|h| + hz)) (QuarterPower).
+        if self.h_quarter_power:
+            vh = dr.sqrt(dr.sqrt(r2 / (hh + hl * hz)))
+        else:
+            vh = dr.sqrt(dr.sqrt(r2 / hh))
         ex, ey, ez = ix - ox, iy - oy, iz - oz
         e2 = ex * ex + ey * ey + ez * ez
         dx = hz * (hx * ix + hy * iy) - r2 * iz
@@ -581,16 +610,23 @@ class JitTable:
                 x0 = dr.gather(Fl, self.kernel_values, r + ch, valid)
                 x1 = dr.gather(Fl, self.kernel_values, r + c + ch, valid)
                 out[ch] = out[ch] + (w0 * x0 + w1 * x1)
+        if self.quantity != "fr":
+            # The RGB kernel: times 1/(cos θo) or 1/(cos θi cos θo) in float32 (at least
+            # 1e-30), clamped at 0.
+            cc = oz if self.quantity == "fr_cos_out" else iz * oz
+            inv = 1.0 / dr.maximum(cc, 1e-30)
+            out = [dr.maximum(x * inv, 0.0) for x in out]
         return [dr.select(valid, x, 0.0) for x in out]
 
 
 def kernel_values(values):
     """The values as the Rust kernel (``Packed::new`` in ``src/table/kernel.rs``) reads them:
-    scaled by 2^e so that the largest finite one lies in [2^14, 2^15), rounded to float16 (to
-    nearest even), scaled values below 2^-14 (and negative or non-finite ones) set to 0, and
-    scaled back (exactly: a power of two). Returns float32 values of the same shape."""
+    scaled by 2^e so that the largest finite magnitude lies in [2^14, 2^15), rounded to float16
+    (to nearest even), scaled magnitudes below 2^-14 (and non-finite values) set to 0, and
+    scaled back (exactly: a power of two); negative values (extrapolated nodes beyond the
+    horizon) keep their sign. Returns float32 values of the same shape."""
     v = np.asarray(values, np.float32)
-    fin = v[np.isfinite(v)]
+    fin = np.abs(v[np.isfinite(v)])
     mx = max(float(fin.max()), 0.0) if fin.size else 0.0
     if mx >= float(np.finfo(np.float32).tiny):
         e = int(np.clip(14 - (int(np.frexp(np.float32(mx))[1]) - 1), -120, 120))
@@ -598,7 +634,7 @@ def kernel_values(values):
         e = 120 if mx > 0 else 0
     x = v * np.float32(2.0**e)
     with np.errstate(invalid="ignore"):
-        keep = np.isfinite(x) & (x >= np.float32(2.0**-14))
+        keep = np.isfinite(x) & (np.abs(x) >= np.float32(2.0**-14))
     q = np.where(keep, x, np.float32(0)).astype(np.float16).astype(np.float32)
     return q * np.float32(2.0**-e)
 
