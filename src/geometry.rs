@@ -83,6 +83,14 @@ pub fn reflect(w: DVec3, n: DVec3) -> DVec3 {
     2.0 * n.dot(w) * n - w
 }
 
+/// Elevation of a unit vector, 2·asin(|d − z| / 2): equal to acos(d.z) but accurate near the
+/// pole (the RGL reader's form).
+#[inline]
+pub fn elevation(d: DVec3) -> f64 {
+    let dist = (d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0)).sqrt();
+    2.0 * (0.5 * dist).min(1.0).asin()
+}
+
 /// Mirror reflection about the local normal z: (−x, −y, z).
 #[inline]
 pub fn reflect_z(w: DVec3) -> DVec3 {

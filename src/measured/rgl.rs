@@ -343,12 +343,7 @@ pub(crate) fn phi2u(phi: f64) -> f64 {
     (phi + PI) / (2.0 * PI)
 }
 
-/// Elevation of a unit vector, 2·asin(|d − z| / 2): equal to acos(d.z) but accurate near the pole.
-#[inline]
-pub(crate) fn elevation(d: DVec3) -> f64 {
-    let dist = (d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0)).sqrt();
-    2.0 * (0.5 * dist).min(1.0).asin()
-}
+pub(crate) use crate::geometry::elevation;
 
 /// `a` with the sign opposite to `b`'s sign bit (enoki's `mulsign_neg`).
 #[inline]

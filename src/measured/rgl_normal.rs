@@ -28,14 +28,8 @@
 use glam::DVec3;
 
 use crate::brdf::{Brdf, Flags};
+use crate::geometry::elevation;
 use crate::spectrum::{Channels, MAX_CHANNELS};
-
-/// Elevation of a unit vector, accurate near the pole (as the reader computes it).
-#[inline]
-fn elevation(d: DVec3) -> f64 {
-    let dist = (d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0)).sqrt();
-    2.0 * (0.5 * dist).min(1.0).asin()
-}
 
 /// Nodes of L's θo axis (θo = π/2 · t², t uniform: dense near the normal, where a film's peak
 /// is).
