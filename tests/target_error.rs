@@ -52,7 +52,11 @@ fn a_model_spec_gets_the_smallest_grid_within_the_target() {
     // The next smaller grid of the ladder was tried and missed (unless this is the smallest).
     let k = LADDER.iter().position(|&n| n == s.nodes).unwrap();
     if k > 0 {
-        let below = s.tried.iter().find(|(n, _)| *n == LADDER[k - 1]).unwrap();
+        let below = s
+            .tried
+            .iter()
+            .find(|(n, _, _)| *n == LADDER[k - 1])
+            .unwrap();
         assert!(below.1 > 0.005, "{}", s.summary());
     }
     // A looser target never picks a larger grid.

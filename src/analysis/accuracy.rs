@@ -112,7 +112,8 @@ pub enum Region {
 }
 
 impl Region {
-    fn check(self) -> Result<()> {
+    /// Checks the angle lies in the region kind's range.
+    pub fn check(self) -> Result<()> {
         let (name, t) = match self {
             Region::Cap(t) => ("max_theta", t),
             Region::Band(t) => ("min_theta", t),

@@ -69,6 +69,7 @@ use std::ops::Range;
 
 use crate::error::{Error, Result};
 use crate::spectrum::Channels;
+use crate::table::calibration::Calibration;
 pub use crate::table::param::Param;
 use crate::table::symmetry::Symmetry;
 pub use crate::table::warp::{Warp, WarpVar};
@@ -421,6 +422,7 @@ pub struct Grid {
     channels: Channels,
     symmetry: Symmetry,
     quantity: Quantity,
+    calibration: Option<Calibration>,
     stored: [StoredAxis; 4],
     layout: Layout,
 }
@@ -497,6 +499,8 @@ struct GridRepr {
     symmetry: Symmetry,
     #[serde(default, skip_serializing_if = "Quantity::is_fr")]
     quantity: Quantity,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    calibration: Option<Calibration>,
 }
 
 impl TryFrom<GridRepr> for Grid {
@@ -508,7 +512,8 @@ impl TryFrom<GridRepr> for Grid {
             r.channels,
             r.symmetry,
         )?
-        .with_quantity(r.quantity)
+        .with_quantity(r.quantity)?
+        .with_optional_calibration(r.calibration)
     }
 }
 
@@ -523,6 +528,7 @@ impl From<Grid> for GridRepr {
             channels: g.channels,
             symmetry: g.symmetry,
             quantity: g.quantity,
+            calibration: g.calibration,
         }
     }
 }
@@ -669,6 +675,7 @@ impl Grid {
             channels,
             symmetry,
             quantity: Quantity::Fr,
+            calibration: None,
             stored,
             layout,
         };
@@ -753,8 +760,53 @@ impl Grid {
                 "f_r cos θo is not reciprocal: a grid storing it cannot fold by reciprocity",
             ));
         }
+        if quantity == Quantity::Fr && self.calibration.is_some() {
+            return Err(Error::arg(
+                "quantity",
+                "an albedo calibration belongs to a table of a projected quantity",
+            ));
+        }
         self.quantity = quantity;
         Ok(self)
+    }
+    /// The albedo calibration the lookups apply, if any ([`Calibration`]).
+    pub fn calibration(&self) -> Option<&Calibration> {
+        self.calibration.as_ref()
+    }
+    /// The same grid with lookups multiplied by `calibration`'s k(θi). Only for a grid storing a
+    /// projected quantity (not f_r, so not folded by reciprocity, which a factor of θi alone
+    /// would break), with one factor per channel.
+    pub fn with_calibration(mut self, calibration: Calibration) -> Result<Grid> {
+        if self.quantity == Quantity::Fr || self.symmetry.reciprocal {
+            return Err(Error::arg(
+                "calibration",
+                "an albedo calibration needs a table of a projected quantity, not folded by \
+                 reciprocity",
+            ));
+        }
+        if calibration.channels() != self.channels.len() {
+            return Err(Error::arg(
+                "calibration",
+                format!(
+                    "{} factors per node for {} channels",
+                    calibration.channels(),
+                    self.channels.len()
+                ),
+            ));
+        }
+        self.calibration = Some(calibration);
+        Ok(self)
+    }
+    fn with_optional_calibration(self, calibration: Option<Calibration>) -> Result<Grid> {
+        match calibration {
+            Some(c) => self.with_calibration(c),
+            None => Ok(self),
+        }
+    }
+    /// The same grid without a calibration.
+    pub fn without_calibration(mut self) -> Grid {
+        self.calibration = None;
+        self
     }
     /// The stored (reduced) axes.
     pub fn stored_axes(&self) -> &[StoredAxis; 4] {
@@ -788,10 +840,12 @@ impl Grid {
             symmetry,
         )
         .and_then(|g| g.with_quantity(self.quantity))
+        .and_then(|g| g.with_optional_calibration(self.calibration.clone()))
     }
 
     /// The same grid with other channels.
     pub fn with_channels(&self, channels: Channels) -> Result<Grid> {
+        // A calibration is per channel: it does not carry over to other channels.
         Grid::new(self.param, self.axes.clone(), channels, self.symmetry)
             .and_then(|g| g.with_quantity(self.quantity))
     }
@@ -833,6 +887,15 @@ impl Grid {
         } + &match self.quantity {
             Quantity::Fr => String::new(),
             q => format!(", stores {}", q.label()),
+        } + &match &self.calibration {
+            Some(c) => {
+                let (lo, hi) = c.range();
+                format!(
+                    ", albedo calibrated over θi ({} nodes, factors {lo:.3}–{hi:.3})",
+                    c.nodes()
+                )
+            }
+            None => String::new(),
         }
     }
 }

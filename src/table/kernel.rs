@@ -43,6 +43,7 @@ use crate::geometry;
 use crate::simd::F4;
 use std::f64::consts::{FRAC_PI_2, PI};
 
+use crate::table::calibration::Calibration;
 use crate::table::grid::{Grid, Mapping, Nodes, Param, Quantity, StoredAxis};
 use crate::table::warp::{Warp, WarpVar};
 
@@ -336,6 +337,8 @@ pub struct Kernel {
     resampled: bool,
     /// What the values are: lookups of a quantity other than f_r divide by its factor.
     quantity: Quantity,
+    /// The albedo calibration lookups multiply by, if any.
+    calibration: Option<Calibration>,
     /// Values are read exact ([`Packed::exact`]): resampled, and at most
     /// [`RESAMPLED_EXACT_MAX_VALUES`] of them.
     exact: bool,
@@ -416,6 +419,7 @@ impl Kernel {
             resampled,
             exact: resampled && grid.stored_values() <= RESAMPLED_EXACT_MAX_VALUES,
             quantity: grid.quantity(),
+            calibration: grid.calibration().cloned(),
         })
     }
 
@@ -471,9 +475,10 @@ impl Kernel {
     /// [`Kernel::vars`] on four lanes: the three quotients in one division, the square roots
     /// in one (two for v_h); the same IEEE operations, so the same values (tested).
     /// Lane 0 of the one division also gives 1 / (cos θi cos θo) (returned beside the variables;
-    /// the cosine product is kept at or above [`MIN_COS_PRODUCT`] so that it stays finite).
+    /// the cosine product is kept at or above [`MIN_COS_PRODUCT`] so that it stays finite), and
+    /// cos θi comes last.
     #[inline(always)]
-    fn vars_lanes(&self, wi: DVec3, wo: DVec3) -> Option<(F4, f32)> {
+    fn vars_lanes(&self, wi: DVec3, wo: DVec3) -> Option<(F4, f32, f32)> {
         // One branch for the usual unit pair; anything else goes through `geometry::unit`.
         let unit =
             geometry::is_unit_l2(wi.length_squared()) & geometry::is_unit_l2(wo.length_squared());
@@ -515,7 +520,7 @@ impl Kernel {
         let [q0, q1, q2, _] = q.to_array();
         let p = if self.quarter { q2 } else { 0.5 - 0.5 * q2 };
         let v = F4::new(vh, q1.sqrt(), p, 0.0);
-        Some((v, q0))
+        Some((v, q0, iz))
     }
 
     /// Evaluates into `out[..channels]` from the table's `values` (all chunks, in order, as
@@ -557,7 +562,13 @@ impl Kernel {
             _ => self.blend::<0>(v, out, values),
         }
         if self.quantity != Quantity::Fr {
-            project_out(self.quantity, wi, wo, &mut out[..self.channels]);
+            project_out(
+                self.quantity,
+                self.calibration.as_ref(),
+                wi,
+                wo,
+                &mut out[..self.channels],
+            );
         }
         true
     }
@@ -588,14 +599,17 @@ impl Kernel {
     ) -> bool {
         match self.vars_lanes(wi, wo) {
             // Only resampled axes have a cut (< 2).
-            Some((v, _)) if CUT && v.any_ge(self.cut) => false,
-            Some((v, inv_cc)) => {
+            Some((v, _, _)) if CUT && v.any_ge(self.cut) => false,
+            Some((v, inv_cc, cos_i)) => {
                 self.eval_rgb::<F16C, EXACT>(v, out, values);
                 if self.quantity != Quantity::Fr {
                     // Extrapolated nodes beyond the horizon may pull the blend below 0.
                     for x in &mut out[..3] {
                         *x = (*x * inv_cc).max(0.0);
                     }
+                }
+                if let Some(c) = &self.calibration {
+                    c.apply(cos_i, &mut out[..3]);
                 }
                 true
             }
@@ -720,13 +734,23 @@ pub const MIN_COS_PRODUCT: f32 = 1e-30;
 
 /// f_r from an interpolated `quantity`: `out` divided by the quantity's factor for the pair
 /// (unit vectors made here) and clamped at 0 (extrapolated nodes beyond the horizon may pull
-/// the blend below 0); 0 for pairs below the horizon.
-pub fn project_out(quantity: Quantity, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+/// the blend below 0), then multiplied by the `calibration`'s k(θi) if there is one; 0 for
+/// pairs below the horizon.
+pub fn project_out(
+    quantity: Quantity,
+    calibration: Option<&Calibration>,
+    wi: DVec3,
+    wo: DVec3,
+    out: &mut [f32],
+) {
     match geometry::upper_pair(wi, wo) {
         Some((wi, wo)) => {
             let s = 1.0 / quantity.factor(wi.z, wo.z).max(MIN_COS_PRODUCT as f64);
-            for x in out {
+            for x in out.iter_mut() {
                 *x = ((*x as f64 * s) as f32).max(0.0);
+            }
+            if let Some(c) = calibration {
+                c.apply(wi.z as f32, out);
             }
         }
         None => out.fill(0.0),
@@ -813,6 +837,7 @@ mod tests {
             resampled: false,
             exact: false,
             quantity: Quantity::Fr,
+            calibration: None,
         }
     }
 
@@ -931,12 +956,12 @@ mod tests {
                 k.rgb::<false, false, false>(wi, wo, &mut soft, &packed);
                 assert_eq!(a, soft, "{wi} {wo}");
                 general.eval(Interp::Linear, wi, wo, &mut b, |i| t.chunk(i));
-                project_out(quantity, wi, wo, &mut b);
+                project_out(quantity, None, wi, wo, &mut b);
                 tb.eval(wi, wo, &mut c);
                 // The four-lane RGB path against its scalar reference, `blend::<3>`.
                 if let Some(v) = k.vars(wi, wo) {
                     k.blend::<3>(v, &mut d, &packed);
-                    project_out(quantity, wi, wo, &mut d);
+                    project_out(quantity, None, wi, wo, &mut d);
                     for ch in 0..3 {
                         assert!((a[ch] - d[ch]).abs() <= 1e-6 * d[ch].abs(), "{a:?} {d:?}");
                     }

@@ -19,6 +19,7 @@
 
 pub mod adaptive;
 pub mod bake;
+pub mod calibration;
 pub mod grid;
 mod horizon;
 pub mod kernel;

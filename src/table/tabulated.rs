@@ -202,7 +202,13 @@ impl TabulatedBrdf {
                 if !prep[k].gather(c, oc) {
                     self.eval(wi[s + k], wo[s + k], oc);
                 } else if self.project {
-                    project_out(self.grid.quantity(), wi[s + k], wo[s + k], oc);
+                    project_out(
+                        self.grid.quantity(),
+                        self.grid.calibration(),
+                        wi[s + k],
+                        wo[s + k],
+                        oc,
+                    );
                 }
             }
         }
@@ -460,6 +466,7 @@ impl Brdf for TabulatedBrdf {
         if self.project {
             project_out(
                 self.grid.quantity(),
+                self.grid.calibration(),
                 wi,
                 wo,
                 &mut out[..self.lookup.channels()],

@@ -272,6 +272,13 @@ class JitTable:
         self.quantity = grid.get("quantity", "fr")
         if self.quantity not in ("fr", "fr_cos_cos", "fr_cos_out"):
             raise brdftab.Error(f"table quantity {self.quantity!r} is not supported by the JIT path")
+        # The albedo calibration (table/calibration.rs): per-channel factors k(θi) on nodes
+        # uniform in t = sqrt(1 - cos θi), channels innermost; lookups multiply by them.
+        self.calibration = None
+        cal = grid.get("calibration")
+        if cal is not None:
+            f = np.asarray(cal["factors"], np.float32)
+            self.calibration = (mi.Float(f), int(cal["channels"]), f.size // int(cal["channels"]))
         self.axes = [dict(ax) for ax in grid["stored_axes"]]
         self.shape = list(grid["stored_shape"])
         self.c = int(values.shape[-1])
@@ -548,7 +555,28 @@ class JitTable:
         oz = F64(wo.z) / dr.sqrt(dr.maximum(F64(wo.x) ** 2 + F64(wo.y) ** 2 + F64(wo.z) ** 2, 1e-300))
         f = oz if self.quantity == "fr_cos_out" else iz * oz
         s = 1.0 / dr.maximum(f, 1e-30)
-        return [dr.maximum(type(o)(F64(o) * s), 0.0) for o in out]
+        out = [dr.maximum(type(o)(F64(o) * s), 0.0) for o in out]
+        return self._calibrate(type(out[0])(iz), out)
+
+    def _calibrate(self, iz, out):
+        """Times the calibration's k(θi) (calibration.rs, ``Calibration::apply``): t = sqrt(1 -
+        cos θi) in float32, linear between nodes ⌊t (n - 1)⌋ and the next."""
+        import drjit as dr
+
+        if self.calibration is None:
+            return out
+        fac, c, n = self.calibration
+        Fl = type(out[0])
+        t = dr.sqrt(dr.maximum(1.0 - Fl(iz), 0.0))
+        s = dr.minimum(t * float(n - 1), float(n - 1))
+        j = dr.minimum(self.UInt(dr.trunc(s)), n - 2)
+        f = s - Fl(j)
+        res = []
+        for k, o in enumerate(out):
+            a = dr.gather(Fl, fac, j * c + k)
+            b = dr.gather(Fl, fac, (j + 1) * c + k)
+            res.append(o * (a + f * (b - a)))
+        return res
 
 
     # -- kernel.rs (adaptive grids) -----------------------------------------------------------
@@ -616,6 +644,7 @@ class JitTable:
             cc = oz if self.quantity == "fr_cos_out" else iz * oz
             inv = 1.0 / dr.maximum(cc, 1e-30)
             out = [dr.maximum(x * inv, 0.0) for x in out]
+        out = self._calibrate(iz, out)
         return [dr.select(valid, x, 0.0) for x in out]
 
 
