@@ -10,24 +10,33 @@
 //! horizon, where a direction's cell holds little of the hemisphere, a few percent of bias
 //! remain too (`vch_golden_yellow` 3.9 % at 84°).
 //!
-//! A [`Calibration`] is a per-channel factor k(θi) on a fine axis of incidence angles: the table's
-//! value is multiplied by it, so that at every node of that axis the table's albedo equals the
-//! source's (computed on one quadrature for both, [`calibrate`]). Linear interpolation between
-//! nodes 0.2–0.45° apart follows a kink to a fraction of a percent. The factor depends on wi only,
-//! so it leaves the shape of every lobe alone and costs a square root and a blend per lookup; it
-//! is not reciprocal, which is why only tables that cannot fold by reciprocity anyway (the
-//! projected quantities of measured sources, [`super::Quantity::FrCosOut`]) carry one.
+//! A [`Calibration`] is a pair of per-channel factors on a fine axis of polar angles,
+//! k_in(θi) · k_out(θo), that the table's value is multiplied by, so that at every node of that
+//! axis the table's directional albedo equals the source's both ways: the light's
+//! a(θi) = ∫ f_r cos θo dωo (the energy a light at θi deposits) and the viewer's
+//! ∫ f_r cos θi dωi (what a view at θo sees in a white furnace). For a measured, non-reciprocal
+//! material the two differ, and a renderer meets both. [`calibrate`] fits them by alternating
+//! the two (each changes the other's integrals by the average of a factor within a percent or two
+//! of 1, so three rounds settle to 1e-4), every albedo on one quadrature for table and source.
+//! Linear interpolation between nodes 0.32–0.45° apart follows a kink to a fraction of a percent.
+//! The factors leave the shape of every lobe alone and cost two square roots and two blends per
+//! lookup; they are not reciprocal, which is why only tables that cannot fold by reciprocity
+//! anyway (the projected quantities of measured sources, [`super::Quantity::FrCosOut`]) carry
+//! one.
 //!
-//! The axis is uniform in t = √(1 − cos θi) = √2 sin(θi/2): nearly uniform in θi (node spacing
-//! 0.32° at the normal, 0.45° at the horizon for 257 nodes) and computed from cos θi with one
+//! The axis is uniform in t = √(1 − cos θ) = √2 sin(θ/2): nearly uniform in θ (node spacing
+//! 0.32° at the normal, 0.45° at the horizon for 257 nodes) and computed from cos θ with one
 //! square root — no `acos` in the lookup.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::fidelity::mirror_albedo;
+use crate::analysis::pair_rule::mirror_rule;
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
+use crate::quadrature::gauss_legendre;
+use crate::simd::F4;
 use crate::spectrum::MAX_CHANNELS;
 use crate::table::{Table, TabulatedBrdf};
 
@@ -35,15 +44,21 @@ use crate::table::{Table, TabulatedBrdf};
 /// albedo is off by more than this is broken, not biased.
 pub const MAX_FACTOR: f32 = 4.0;
 
-/// Per-channel albedo factors k(θi) over a uniform axis in t = √(1 − cos θi) (module docs).
+/// Per-channel albedo factors k_in(θi) · k_out(θo) over a uniform axis in t = √(1 − cos θ)
+/// (module docs).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "CalibrationRepr", into = "CalibrationRepr")]
 pub struct Calibration {
-    /// Nodes × channels, channels innermost; node i at t = i/(nodes − 1).
+    /// k_in: nodes × channels, channels innermost; node i at t = i/(nodes − 1).
     factors: Box<[f32]>,
+    /// k_out on the same nodes (1 where absent).
+    out_factors: Option<Box<[f32]>>,
     channels: usize,
     /// nodes − 1, as f32 (the lookup's scale).
     scale: f32,
+    /// For three channels, per node k_in RGB, 1, k_out RGB, 1 (k_out 1 where absent): the
+    /// four-lane form [`Calibration::apply_rgb`] loads.
+    lanes: Option<Box<[f32]>>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -51,14 +66,17 @@ pub struct Calibration {
 struct CalibrationRepr {
     /// Values per node.
     channels: usize,
-    /// Nodes × channels, channels innermost.
+    /// k_in: nodes × channels, channels innermost.
     factors: Vec<f32>,
+    /// k_out, as `factors`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    out_factors: Option<Vec<f32>>,
 }
 
 impl TryFrom<CalibrationRepr> for Calibration {
     type Error = Error;
     fn try_from(r: CalibrationRepr) -> Result<Calibration> {
-        Calibration::new(r.factors, r.channels)
+        Calibration::new(r.factors, r.out_factors, r.channels)
     }
 }
 
@@ -67,15 +85,21 @@ impl From<Calibration> for CalibrationRepr {
         CalibrationRepr {
             channels: c.channels,
             factors: c.factors.into_vec(),
+            out_factors: c.out_factors.map(|f| f.into_vec()),
         }
     }
 }
 
 impl Calibration {
-    /// A calibration from `factors` (nodes × `channels`, channels innermost). Checked: at least
-    /// two nodes, a whole number of them, every factor finite within [1/[`MAX_FACTOR`],
+    /// A calibration from `factors` k_in and optionally `out_factors` k_out (each nodes ×
+    /// `channels`, channels innermost). Checked: at least two nodes, a whole number of them,
+    /// as many of k_out as of k_in, every factor finite within [1/[`MAX_FACTOR`],
     /// [`MAX_FACTOR`]].
-    pub fn new(factors: Vec<f32>, channels: usize) -> Result<Calibration> {
+    pub fn new(
+        factors: Vec<f32>,
+        out_factors: Option<Vec<f32>>,
+        channels: usize,
+    ) -> Result<Calibration> {
         if channels == 0 || channels > MAX_CHANNELS || !factors.len().is_multiple_of(channels) {
             return Err(Error::arg(
                 "calibration",
@@ -89,8 +113,18 @@ impl Calibration {
         if nodes < 2 {
             return Err(Error::arg("calibration", "needs at least two nodes"));
         }
+        if out_factors
+            .as_ref()
+            .is_some_and(|o| o.len() != factors.len())
+        {
+            return Err(Error::arg(
+                "calibration",
+                "as many outgoing factors as incident ones",
+            ));
+        }
         if let Some(x) = factors
             .iter()
+            .chain(out_factors.iter().flatten())
             .find(|x| !(x.is_finite() && **x >= 1.0 / MAX_FACTOR && **x <= MAX_FACTOR))
         {
             return Err(Error::arg(
@@ -98,14 +132,27 @@ impl Calibration {
                 format!("factor {x} is outside [1/{MAX_FACTOR}, {MAX_FACTOR}]"),
             ));
         }
+        let lanes = (channels == 3).then(|| {
+            (0..nodes)
+                .flat_map(|i| {
+                    let kin = &factors[i * 3..i * 3 + 3];
+                    let kout = out_factors
+                        .as_ref()
+                        .map_or([1.0; 3], |o| [o[i * 3], o[i * 3 + 1], o[i * 3 + 2]]);
+                    [kin[0], kin[1], kin[2], 1.0, kout[0], kout[1], kout[2], 1.0]
+                })
+                .collect()
+        });
         Ok(Calibration {
             factors: factors.into(),
+            out_factors: out_factors.map(Into::into),
             channels,
             scale: (nodes - 1) as f32,
+            lanes,
         })
     }
 
-    /// Number of nodes of the θi axis.
+    /// Number of nodes of the axis.
     pub fn nodes(&self) -> usize {
         self.factors.len() / self.channels
     }
@@ -115,40 +162,76 @@ impl Calibration {
         self.channels
     }
 
-    /// The factors of node `i` (one per channel).
-    pub fn node_factors(&self, i: usize) -> &[f32] {
-        &self.factors[i * self.channels..(i + 1) * self.channels]
-    }
-
-    /// The incidence angle of node `i` of `nodes` (radians): cos θ = 1 − t², t = i/(nodes − 1).
+    /// The polar angle of node `i` of `nodes` (radians): cos θ = 1 − t², t = i/(nodes − 1).
     pub fn node_theta(i: usize, nodes: usize) -> f64 {
         let t = i as f64 / (nodes.max(2) - 1) as f64;
         (1.0 - t * t).clamp(-1.0, 1.0).acos()
     }
 
-    /// The smallest and largest factor.
+    /// The smallest and largest factor (of either kind).
     pub fn range(&self) -> (f32, f32) {
         self.factors
             .iter()
+            .chain(self.out_factors.iter().flat_map(|f| f.iter()))
             .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &x| {
                 (lo.min(x), hi.max(x))
             })
     }
 
-    /// Multiplies `out[..channels]` by k(θi) for a unit wi with z = `cos_i` (clamped to the
-    /// axis). The plain form of the lookup: t = √(1 − cos θi), s = t·(nodes − 1), linear
-    /// between the nodes ⌊s⌋ and ⌊s⌋ + 1.
+    /// The node and fraction of a unit direction with z = `cos`: t = √(1 − cos θ),
+    /// s = t·(nodes − 1), clamped to the axis (NaN: node 0).
     #[inline(always)]
-    pub fn apply(&self, cos_i: f32, out: &mut [f32]) {
-        let t = (1.0 - cos_i).max(0.0).sqrt();
+    fn cell(&self, cos: f32) -> (usize, f32) {
+        let t = (1.0 - cos).max(0.0).sqrt();
         let s = (t * self.scale).min(self.scale);
         // s ≥ 0 (NaN becomes 0 in the cast); the last cell ends at node `scale`.
         let j = (s as usize).min(self.factors.len() / self.channels - 2);
-        let f = s - j as f32;
+        (j, s - j as f32)
+    }
+
+    /// `x` (RGB in lanes 0..2) times k_in(θi) · k_out(θo) for unit directions with z =
+    /// `cos_i`, `cos_o`: [`Calibration::apply`] on four lanes (both axes' t in one square
+    /// root, each node's three factors in one load; the same operations lane by lane, tested
+    /// equal). `x` unchanged for a calibration of other than three channels.
+    #[inline(always)]
+    pub fn apply_rgb(&self, cos_i: f32, cos_o: f32, x: F4) -> F4 {
+        let Some(q) = &self.lanes else {
+            return x;
+        };
+        let zero = F4::splat(0.0);
+        let scale = F4::splat(self.scale);
+        let t = (F4::new(1.0 - cos_i, 1.0 - cos_o, 0.0, 0.0).max(zero)).sqrt();
+        let s = (t * scale).min(scale);
+        let (j, _) = s.trunc();
+        let last = self.factors.len() / 3 - 2;
+        // s ≥ 0 and not NaN (max and min above return the other operand for NaN lanes).
+        let (ji, jo) = ((j[0] as usize).min(last), (j[1] as usize).min(last));
+        let [si, so, _, _] = s.to_array();
+        let (fi, fo) = (F4::splat(si - ji as f32), F4::splat(so - jo as f32));
+        let lerp = |o: usize, f: F4| match (F4::load(&q[o..]), F4::load(&q[o + 8..])) {
+            (Some(a), Some(b)) => a + f * (b - a),
+            _ => F4::splat(1.0),
+        };
+        x * lerp(ji * 8, fi) * lerp(jo * 8 + 4, fo)
+    }
+
+    /// Multiplies `out[..channels]` by k_in(θi) · k_out(θo) for unit directions with z =
+    /// `cos_i`, `cos_o`: on each, linear between the nodes ⌊s⌋ and ⌊s⌋ + 1 (the plain form of
+    /// the lookup; the kernel calls it as it is).
+    #[inline(always)]
+    pub fn apply(&self, cos_i: f32, cos_o: f32, out: &mut [f32]) {
         let c = self.channels;
+        let (j, f) = self.cell(cos_i);
         let (a, b) = (&self.factors[j * c..], &self.factors[(j + 1) * c..]);
         for (k, x) in out.iter_mut().take(c).enumerate() {
             *x *= a[k] + f * (b[k] - a[k]);
+        }
+        if let Some(o) = &self.out_factors {
+            let (j, f) = self.cell(cos_o);
+            let (a, b) = (&o[j * c..], &o[(j + 1) * c..]);
+            for (k, x) in out.iter_mut().take(c).enumerate() {
+                *x *= a[k] + f * (b[k] - a[k]);
+            }
         }
     }
 }
@@ -156,44 +239,70 @@ impl Calibration {
 /// How [`calibrate`] integrates.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibrationOptions {
-    /// Nodes of the θi axis.
+    /// Nodes of the θ axis.
     pub nodes: usize,
     /// Azimuths of the albedo rule ([`mirror_albedo`]).
     pub nphi: usize,
     /// Gauss-Legendre nodes per segment of the albedo rule.
     pub order: usize,
-    /// The last node's albedo is taken this far above the horizon (radians): at θi = 90° the
-    /// incident direction lies in the surface, where measured data have no value.
+    /// The last node's albedo is taken this far above the horizon (radians): at θ = 90° the
+    /// direction lies in the surface, where measured data have no value.
     pub horizon_margin: f64,
+    /// Calibrate the viewer's albedo too (k_out); otherwise only the light's (k_in).
+    pub two_sided: bool,
+    /// Rounds of the alternating fit at most, in tens (it stops once no factor moves by 1e-6).
+    pub rounds: usize,
 }
 
 impl Default for CalibrationOptions {
-    /// 257 nodes (0.32–0.45° apart), 64 azimuths, 6 nodes per segment: the two albedos share
-    /// every node, so their ratio is far more accurate than either (about 4 000 evaluations of
-    /// each per node).
+    /// 257 nodes (0.32–0.45° apart), 64 azimuths, 6 nodes per segment (about 4 000
+    /// evaluations per albedo: table and source share every node, so their ratio is far more
+    /// accurate than either), both sides, at most 4 rounds.
     fn default() -> Self {
         CalibrationOptions {
             nodes: 257,
             nphi: 64,
             order: 6,
             horizon_margin: 0.1f64.to_radians(),
+            two_sided: true,
+            rounds: 4,
         }
     }
 }
 
-/// The source's directional albedo at the nodes of a calibration axis, computed once and used
-/// to calibrate any number of tables of that source ([`calibrate`]; the error-target search
-/// calibrates every candidate grid).
+/// `brdf` with its directions swapped: its directional albedo is the viewer's albedo of `brdf`.
+struct Reversed<'a>(&'a dyn Brdf);
+
+impl Brdf for Reversed<'_> {
+    fn channels(&self) -> &crate::spectrum::Channels {
+        self.0.channels()
+    }
+    fn eval(&self, wi: glam::DVec3, wo: glam::DVec3, out: &mut [f32]) {
+        self.0.eval(wo, wi, out)
+    }
+    fn flags(&self) -> crate::brdf::Flags {
+        self.0.flags()
+    }
+    fn describe(&self) -> String {
+        format!("{} (directions swapped)", self.0.describe())
+    }
+}
+
+/// The source's directional albedos (the light's and, when two-sided, the viewer's) at the
+/// nodes of a calibration axis, computed once and used to calibrate any number of tables of that
+/// source ([`calibrate`]; the error-target search calibrates every candidate grid).
 #[derive(Debug, Clone, PartialEq)]
 pub struct AlbedoReference {
     opts: CalibrationOptions,
     channels: usize,
-    /// Nodes × channels.
-    albedo: Vec<f64>,
+    /// The light's albedo, nodes × channels.
+    albedo_in: Vec<f64>,
+    /// The viewer's albedo (two-sided options only).
+    albedo_out: Vec<f64>,
 }
 
 impl AlbedoReference {
-    /// The albedo of `reference` at the nodes of `opts`.
+    /// The albedos of `reference` at the nodes of `opts`.
     pub fn new(reference: &dyn Brdf, opts: &CalibrationOptions) -> Result<AlbedoReference> {
         let c = reference.channels().len();
         if c == 0 || c > MAX_CHANNELS {
@@ -206,7 +315,12 @@ impl AlbedoReference {
             return Err(Error::arg("calibration", "needs at least two nodes"));
         }
         Ok(AlbedoReference {
-            albedo: node_albedos(reference, opts),
+            albedo_in: node_albedos(reference, opts),
+            albedo_out: if opts.two_sided {
+                node_albedos(&Reversed(reference), opts)
+            } else {
+                Vec::new()
+            },
             channels: c,
             opts: opts.clone(),
         })
@@ -229,10 +343,72 @@ fn node_albedos(brdf: &dyn Brdf, opts: &CalibrationOptions) -> Vec<f64> {
     rows.into_iter().flatten().collect()
 }
 
-/// `table` with a [`Calibration`] that pins its directional albedo to the albedo of
-/// `reference` at every node (module docs). A channel whose albedo is 0 in either keeps the
-/// factor 1 there; a ratio outside [1/[`MAX_FACTOR`], [`MAX_FACTOR`]] is an error (the table
-/// does not approximate its reference). Any calibration the table had is replaced.
+/// The transport of `brdf` from each node's direction onto the axis: `m[(i·nodes + j)·c + k]`
+/// = ∫ f_r cos θo · hat_j(t_o) dωo for wi at node i, where hat_j is node j's linear
+/// interpolation weight (what a factor on node j multiplies). Summed over j it is node i's
+/// albedo; with k_out applied, node i's albedo is Σ_j m[i][j] k_out[j].
+fn transport(brdf: &dyn Brdf, opts: &CalibrationOptions) -> Vec<f64> {
+    let c = brdf.channels().len();
+    let n = opts.nodes;
+    let max_theta = std::f64::consts::FRAC_PI_2 - opts.horizon_margin;
+    let (gx, gw) = gauss_legendre(opts.order.max(1));
+    let scale = (n - 1) as f64;
+    let rows: Vec<Vec<f64>> = crate::par::install(|| {
+        (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let theta = Calibration::node_theta(i, n).min(max_theta);
+                let mut row = vec![0.0f64; n * c];
+                let mut f = [0f32; MAX_CHANNELS];
+                mirror_rule(theta, opts.nphi.max(1), &gx, &gw, None, |wi, wo, w| {
+                    brdf.eval(wi, wo, &mut f[..c]);
+                    let s = ((1.0 - wo.z).max(0.0).sqrt() * scale).min(scale);
+                    let j = (s as usize).min(n - 2);
+                    let t = s - j as f64;
+                    let w = w * wo.z;
+                    for k in 0..c {
+                        let v = w * f[k] as f64;
+                        row[j * c + k] += (1.0 - t) * v;
+                        row[(j + 1) * c + k] += t * v;
+                    }
+                });
+                row
+            })
+            .collect()
+    });
+    rows.into_iter().flatten().collect()
+}
+
+/// One half step of the alternating fit: `k[i] = reference[i] / Σ_j m[i][j] other[j]` per
+/// channel (kept where either side is 0); returns the largest relative change.
+fn balance(k: &mut [f32], m: &[f64], other: &[f32], reference: &[f64], c: usize) -> f64 {
+    let n = k.len() / c;
+    let mut most = 0.0f64;
+    for i in 0..n {
+        for ch in 0..c {
+            let own: f64 = (0..n)
+                .map(|j| m[(i * n + j) * c + ch] * other[j * c + ch] as f64)
+                .sum();
+            let r = reference[i * c + ch];
+            if own > 0.0 && r > 0.0 {
+                let new = (r / own) as f32;
+                let old = &mut k[i * c + ch];
+                most = most.max(((new / *old) as f64 - 1.0).abs());
+                *old = new;
+            }
+        }
+    }
+    most
+}
+
+/// `table` with a [`Calibration`] that pins its directional albedos to those of `reference` at
+/// every node (module docs). The table is integrated once each way into a transport matrix
+/// ([`transport`]: what a factor on each node does to each node's albedo), and the factors are
+/// fitted on it by alternating k_in and k_out until neither moves by 1e-6 (at most
+/// [`CalibrationOptions::rounds`] × 10 rounds) — no further lookups. A channel whose albedo is 0
+/// in either keeps the factor 1 there; a factor outside [1/[`MAX_FACTOR`], [`MAX_FACTOR`]] is
+/// an error (the table does not approximate its reference). Any calibration the table had is
+/// replaced.
 pub fn calibrate(table: Table, reference: &AlbedoReference) -> Result<Table> {
     let c = table.grid().channels().len();
     if reference.channels != c {
@@ -244,22 +420,30 @@ pub fn calibrate(table: Table, reference: &AlbedoReference) -> Result<Table> {
             ),
         ));
     }
+    let opts = &reference.opts;
     let (grid, values, description) = table.into_parts();
     let grid = grid.without_calibration();
     let plain = TabulatedBrdf::from_table(Table::new(grid.clone(), values.clone(), "")?);
-    let own = node_albedos(&plain, &reference.opts);
-    let factors: Vec<f32> = own
-        .iter()
-        .zip(&reference.albedo)
-        .map(|(&a, &r)| {
-            if a > 0.0 && r > 0.0 {
-                (r / a) as f32
-            } else {
-                1.0
+    let n = opts.nodes * c;
+    let ones = vec![1.0f32; n];
+    let mut k_in = ones.clone();
+    let m_in = transport(&plain, opts);
+    let k_out = if opts.two_sided {
+        let m_out = transport(&Reversed(&plain), opts);
+        let mut k_out = ones;
+        for _ in 0..opts.rounds.max(1) * 10 {
+            let a = balance(&mut k_in, &m_in, &k_out, &reference.albedo_in, c);
+            let b = balance(&mut k_out, &m_out, &k_in, &reference.albedo_out, c);
+            if a.max(b) < 1e-6 {
+                break;
             }
-        })
-        .collect();
-    let cal = Calibration::new(factors, c).map_err(|e| {
+        }
+        Some(k_out)
+    } else {
+        balance(&mut k_in, &m_in, &ones, &reference.albedo_in, c);
+        None
+    };
+    let cal = Calibration::new(k_in, k_out, c).map_err(|e| {
         Error::arg(
             "calibration",
             format!("the table is too far from its reference to calibrate: {e}"),
@@ -275,11 +459,11 @@ mod tests {
     #[test]
     fn the_lookup_interpolates_linearly_in_t_and_clamps() {
         // Two channels, three nodes at t = 0, ½, 1 (θ = 0°, 41.4°, 90°).
-        let c = Calibration::new(vec![1.0, 2.0, 1.5, 1.0, 0.5, 3.0], 2).unwrap();
+        let c = Calibration::new(vec![1.0, 2.0, 1.5, 1.0, 0.5, 3.0], None, 2).unwrap();
         assert_eq!(c.nodes(), 3);
         let at = |cos_i: f32| {
             let mut v = [1.0f32, 1.0];
-            c.apply(cos_i, &mut v);
+            c.apply(cos_i, 0.3, &mut v);
             v
         };
         assert_eq!(at(1.0), [1.0, 2.0]);
@@ -295,6 +479,36 @@ mod tests {
             "{v:?}"
         );
         assert!((Calibration::node_theta(1, 3).to_degrees() - 41.409622).abs() < 1e-5);
+        // Two-sided: the product of the two blends.
+        let k_out = vec![2.0, 1.0, 1.0, 1.0, 1.0, 0.25];
+        let c = Calibration::new(vec![1.0, 2.0, 1.5, 1.0, 0.5, 3.0], Some(k_out), 2).unwrap();
+        let mut v = [1.0f32, 1.0];
+        c.apply(0.75, 0.0, &mut v); // k_in at node 1, k_out at node 2
+        assert_eq!(v, [1.5, 0.25]);
+        let mut v = [1.0f32, 1.0];
+        c.apply(0.0, 1.0 - 0.0625, &mut v); // k_in at node 2, k_out halfway to node 1
+        assert_eq!(v, [0.5 * 1.5, 3.0]);
+    }
+
+    #[test]
+    fn the_lane_form_equals_the_plain_one() {
+        let k_in: Vec<f32> = (0..33 * 3).map(|i| 0.9 + 0.002 * i as f32).collect();
+        let k_out: Vec<f32> = (0..33 * 3).map(|i| 1.1 - 0.003 * i as f32).collect();
+        for out in [None, Some(k_out)] {
+            let c = Calibration::new(k_in.clone(), out, 3).unwrap();
+            for (ci, co) in [
+                (1.0, 1.0),
+                (0.0, 0.0),
+                (0.37, 0.91),
+                (-0.2, 1.5),
+                (f32::NAN, 0.5),
+            ] {
+                let mut v = [0.3f32, 1.7, 0.01];
+                c.apply(ci, co, &mut v);
+                let w = c.apply_rgb(ci, co, F4::new(0.3, 1.7, 0.01, 0.0)).to_array();
+                assert_eq!(v, [w[0], w[1], w[2]], "{ci} {co}");
+            }
+        }
     }
 
     #[test]
@@ -307,8 +521,11 @@ mod tests {
             (vec![1.0, 0.2], 1),
             (vec![1.0, 1.0], 0),
         ] {
-            assert!(Calibration::new(f.clone(), c).is_err(), "{f:?} {c}");
+            assert!(Calibration::new(f.clone(), None, c).is_err(), "{f:?} {c}");
         }
+        // k_out: as many as k_in, in range.
+        assert!(Calibration::new(vec![1.0; 4], Some(vec![1.0; 2]), 1).is_err());
+        assert!(Calibration::new(vec![1.0; 2], Some(vec![1.0, 9.0]), 1).is_err());
         // Through the serialized form too.
         let e = serde_json::from_str::<Calibration>(r#"{"channels": 1, "factors": [1.0, -1.0]}"#);
         assert!(e.is_err());

@@ -476,9 +476,9 @@ impl Kernel {
     /// in one (two for v_h); the same IEEE operations, so the same values (tested).
     /// Lane 0 of the one division also gives 1 / (cos θi cos θo) (returned beside the variables;
     /// the cosine product is kept at or above [`MIN_COS_PRODUCT`] so that it stays finite), and
-    /// cos θi comes last.
+    /// (cos θi, cos θo) come last.
     #[inline(always)]
-    fn vars_lanes(&self, wi: DVec3, wo: DVec3) -> Option<(F4, f32, f32)> {
+    fn vars_lanes(&self, wi: DVec3, wo: DVec3) -> Option<(F4, f32, [f32; 2])> {
         // One branch for the usual unit pair; anything else goes through `geometry::unit`.
         let unit =
             geometry::is_unit_l2(wi.length_squared()) & geometry::is_unit_l2(wo.length_squared());
@@ -520,7 +520,7 @@ impl Kernel {
         let [q0, q1, q2, _] = q.to_array();
         let p = if self.quarter { q2 } else { 0.5 - 0.5 * q2 };
         let v = F4::new(vh, q1.sqrt(), p, 0.0);
-        Some((v, q0, iz))
+        Some((v, q0, [iz, oz]))
     }
 
     /// Evaluates into `out[..channels]` from the table's `values` (all chunks, in order, as
@@ -600,17 +600,17 @@ impl Kernel {
         match self.vars_lanes(wi, wo) {
             // Only resampled axes have a cut (< 2).
             Some((v, _, _)) if CUT && v.any_ge(self.cut) => false,
-            Some((v, inv_cc, cos_i)) => {
-                self.eval_rgb::<F16C, EXACT>(v, out, values);
+            Some((v, inv_cc, [cos_i, cos_o])) => {
+                let mut x = self.eval_rgb::<F16C, EXACT>(v, values);
                 if self.quantity != Quantity::Fr {
                     // Extrapolated nodes beyond the horizon may pull the blend below 0.
-                    for x in &mut out[..3] {
-                        *x = (*x * inv_cc).max(0.0);
-                    }
+                    x = (x * F4::splat(inv_cc)).max(F4::splat(0.0));
                 }
                 if let Some(c) = &self.calibration {
-                    c.apply(cos_i, &mut out[..3]);
+                    x = c.apply_rgb(cos_i, cos_o, x);
                 }
+                let [r, g, b, _] = x.to_array();
+                out[..3].copy_from_slice(&[r, g, b]);
                 true
             }
             None => {
@@ -625,12 +625,7 @@ impl Kernel {
     /// as two four-lane loads (RGB of the two φd corners; the fourth lane is ignored). Computes
     /// the same operations as `blend::<3>`, which stays as its reference (tested equal).
     #[inline(always)]
-    fn eval_rgb<const F16C: bool, const EXACT: bool>(
-        &self,
-        v: F4,
-        out: &mut [f32],
-        values: &Packed,
-    ) {
+    fn eval_rgb<const F16C: bool, const EXACT: bool>(&self, v: F4, values: &Packed) -> F4 {
         let [k, kcap, nmax, ncap] = self.lanes;
         let zero = F4::splat(0.0);
         // Knot interval j and its fraction per axis (lane 3: 0).
@@ -689,8 +684,7 @@ impl Kernel {
                 }
             }
         }
-        let [r, g, b, _] = (acc * F4::splat(values.unscale)).to_array();
-        out[..3].copy_from_slice(&[r, g, b]);
+        acc * F4::splat(values.unscale)
     }
 
     /// Trilinear blend of the eight corners; `N` > 0: exactly N channels in registers. The
@@ -750,7 +744,7 @@ pub fn project_out(
                 *x = ((*x as f64 * s) as f32).max(0.0);
             }
             if let Some(c) = calibration {
-                c.apply(wi.z as f32, out);
+                c.apply(wi.z as f32, wo.z as f32, out);
             }
         }
         None => out.fill(0.0),

@@ -272,13 +272,17 @@ class JitTable:
         self.quantity = grid.get("quantity", "fr")
         if self.quantity not in ("fr", "fr_cos_cos", "fr_cos_out"):
             raise brdftab.Error(f"table quantity {self.quantity!r} is not supported by the JIT path")
-        # The albedo calibration (table/calibration.rs): per-channel factors k(θi) on nodes
-        # uniform in t = sqrt(1 - cos θi), channels innermost; lookups multiply by them.
+        # The albedo calibration (table/calibration.rs): per-channel factors k_in(θi) and
+        # k_out(θo) on nodes uniform in t = sqrt(1 - cos θ), channels innermost; lookups
+        # multiply by them.
         self.calibration = None
         cal = grid.get("calibration")
         if cal is not None:
-            f = np.asarray(cal["factors"], np.float32)
-            self.calibration = (mi.Float(f), int(cal["channels"]), f.size // int(cal["channels"]))
+            c = int(cal["channels"])
+            f_in = np.asarray(cal["factors"], np.float32)
+            f_out = cal.get("out_factors")
+            f_out = None if f_out is None else mi.Float(np.asarray(f_out, np.float32))
+            self.calibration = (mi.Float(f_in), f_out, c, f_in.size // c)
         self.axes = [dict(ax) for ax in grid["stored_axes"]]
         self.shape = list(grid["stored_shape"])
         self.c = int(values.shape[-1])
@@ -556,27 +560,35 @@ class JitTable:
         f = oz if self.quantity == "fr_cos_out" else iz * oz
         s = 1.0 / dr.maximum(f, 1e-30)
         out = [dr.maximum(type(o)(F64(o) * s), 0.0) for o in out]
-        return self._calibrate(type(out[0])(iz), out)
+        Fl = type(out[0])
+        return self._calibrate(Fl(iz), Fl(oz), out)
 
-    def _calibrate(self, iz, out):
-        """Times the calibration's k(θi) (calibration.rs, ``Calibration::apply``): t = sqrt(1 -
-        cos θi) in float32, linear between nodes ⌊t (n - 1)⌋ and the next."""
+    def _calibrate(self, iz, oz, out):
+        """Times the calibration's k_in(θi) k_out(θo) (calibration.rs, ``Calibration::apply``):
+        on each, t = sqrt(1 - cos θ) in float32, linear between nodes ⌊t (n - 1)⌋ and the next."""
         import drjit as dr
 
         if self.calibration is None:
             return out
-        fac, c, n = self.calibration
+        f_in, f_out, c, n = self.calibration
         Fl = type(out[0])
-        t = dr.sqrt(dr.maximum(1.0 - Fl(iz), 0.0))
-        s = dr.minimum(t * float(n - 1), float(n - 1))
-        j = dr.minimum(self.UInt(dr.trunc(s)), n - 2)
-        f = s - Fl(j)
-        res = []
-        for k, o in enumerate(out):
-            a = dr.gather(Fl, fac, j * c + k)
-            b = dr.gather(Fl, fac, (j + 1) * c + k)
-            res.append(o * (a + f * (b - a)))
-        return res
+
+        def blend(fac, cos, out):
+            t = dr.sqrt(dr.maximum(1.0 - Fl(cos), 0.0))
+            s = dr.minimum(t * float(n - 1), float(n - 1))
+            j = dr.minimum(self.UInt(dr.trunc(s)), n - 2)
+            f = s - Fl(j)
+            res = []
+            for k, o in enumerate(out):
+                a = dr.gather(Fl, fac, j * c + k)
+                b = dr.gather(Fl, fac, (j + 1) * c + k)
+                res.append(o * (a + f * (b - a)))
+            return res
+
+        out = blend(f_in, iz, out)
+        if f_out is not None:
+            out = blend(f_out, oz, out)
+        return out
 
 
     # -- kernel.rs (adaptive grids) -----------------------------------------------------------
@@ -644,7 +656,7 @@ class JitTable:
             cc = oz if self.quantity == "fr_cos_out" else iz * oz
             inv = 1.0 / dr.maximum(cc, 1e-30)
             out = [dr.maximum(x * inv, 0.0) for x in out]
-        out = self._calibrate(iz, out)
+        out = self._calibrate(iz, oz, out)
         return [dr.select(valid, x, 0.0) for x in out]
 
 
