@@ -1,13 +1,19 @@
-//! Tables of measured materials with the defaults (issue: measured data in dense tables): an
-//! RGL file bakes on an adaptive grid, into a file no larger than the measurement, within 1%
-//! of the measurement's own evaluation, held in under 4 MB while evaluating — and the warps
+//! Tables of measured materials with the defaults: an RGL file bakes on an adaptive grid, into
+//! a file no larger than the measurement, within 1 % of the measurement's own evaluation inside
+//! 80°, faithful over the whole hemisphere, in the grazing band and in albedo, passing a white
+//! furnace, continuous at the normal, held in under 4 MB while evaluating — and the warps
 //! survive the file round trip.
 
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
 use brdftab::analysis::accuracy::{Weight, compare_weighted};
+use brdftab::analysis::fidelity::{self, FidelityOptions};
 use brdftab::bake::{BakeRequest, BakeTarget, GridChoice};
 use brdftab::source::{self, OpenOptions};
 use brdftab::table::{Mapping, kernel::Kernel};
 use brdftab::{Brdf, Error, measured};
+use glam::DVec3;
 
 fn tmp(name: &str) -> String {
     let d = std::env::temp_dir().join(format!("brdftab-measured-tables-{}", std::process::id()));
@@ -25,35 +31,77 @@ fn bake_default(file: &str) -> (String, brdftab::bake::BakeReport) {
     (out, r)
 }
 
+/// One shipped RGL file and its default table.
+struct Baked {
+    name: String,
+    rgl: PathBuf,
+    table: String,
+    report: brdftab::bake::BakeReport,
+}
+
+/// Every shipped RGL file baked with the defaults, once for all the tests of this file.
+fn baked() -> &'static [Baked] {
+    static BAKED: OnceLock<Vec<Baked>> = OnceLock::new();
+    BAKED.get_or_init(|| {
+        let dir = measured::data::rgl_dir().expect("the shipped data/rgl");
+        let files = brdftab::report::measured::rgl_files(&dir).unwrap();
+        assert_eq!(files.len(), 7, "the seven shipped RGL files");
+        files
+            .into_iter()
+            .map(|rgl| {
+                let name = rgl.file_name().unwrap().to_string_lossy().into_owned();
+                let (table, report) = bake_default(&name);
+                Baked {
+                    name,
+                    rgl,
+                    table,
+                    report,
+                }
+            })
+            .collect()
+    })
+}
+
+impl Baked {
+    fn native(&self) -> Box<dyn Brdf + Send + Sync> {
+        source::open(&self.rgl.to_string_lossy()).unwrap()
+    }
+    fn table(&self) -> brdftab::table::TabulatedBrdf {
+        source::open_table(&self.table, &OpenOptions::default()).unwrap()
+    }
+}
+
 #[test]
 fn rgl_defaults_meet_size_error_and_memory_bars() {
-    // Every shipped RGL file: the bars of the issue, on the metric it states.
-    let dir = measured::data::rgl_dir().expect("the shipped data/rgl");
-    let files = brdftab::report::measured::rgl_files(&dir).unwrap();
-    assert_eq!(files.len(), 7, "the seven shipped RGL files");
-    for f in files {
-        let name = f.file_name().unwrap().to_string_lossy().into_owned();
-        let (out, report) = bake_default(&name);
+    // Every shipped RGL file: the bars of the measured-table issue, on the metric it states.
+    for b in baked() {
+        let (name, report) = (&b.name, &b.report);
         assert!(
             matches!(report.grid.stored_axes()[0].mapping, Mapping::Warp(_)),
             "{name}: the default grid of an RGL file is adaptive"
         );
-        // Its node counts come from the default error target, which the search met.
+        // Its node counts come from the default error target, which the search met, in the
+        // grazing band too.
         let t = report.target.as_ref().expect("the default bake searched");
         assert_eq!(t.target, brdftab::bake::MEASURED_TARGET_ERROR);
-        assert!(t.met && t.error <= t.target, "{name}: {}", t.summary());
+        let band = t.grazing_target.expect("measured: the band is judged");
+        assert!(
+            t.met && t.error <= t.target && t.grazing <= band,
+            "{name}: {}",
+            t.summary()
+        );
         assert_eq!(report.grid.stored_shape()[0], t.nodes[0]);
-        let rgl_bytes = std::fs::metadata(&f).unwrap().len();
-        let table_bytes = std::fs::metadata(&out).unwrap().len();
+        assert!(report.grid.calibration().is_some(), "{name}: calibrated");
+        let rgl_bytes = std::fs::metadata(&b.rgl).unwrap().len();
+        let table_bytes = std::fs::metadata(&b.table).unwrap().len();
         assert!(
             table_bytes <= rgl_bytes,
             "{name}: {table_bytes} > {rgl_bytes} bytes"
         );
-        let native = source::open(&f.to_string_lossy()).unwrap();
-        let table = source::open_table(&out, &OpenOptions::default()).unwrap();
-        // 100 000 pairs, as the search estimates it: on the near-mirror `cg_sunflower` one pair
-        // on the 0.4°-wide peak can carry most of a 20 000-pair figure (draws of 20 000 pairs
-        // on one table scatter from 0.3 % to 4.6 %; BENCHMARKS.md).
+        let native = b.native();
+        let table = b.table();
+        // 100 000 pairs: on the near-mirror `cg_sunflower` one pair on the 0.4°-wide peak can
+        // carry most of a 20 000-pair figure (BENCHMARKS.md).
         let e = compare_weighted(
             &table,
             native.as_ref(),
@@ -78,28 +126,142 @@ fn rgl_defaults_meet_size_error_and_memory_bars() {
 }
 
 #[test]
-fn rgl_defaults_are_faithful_over_the_whole_hemisphere() {
-    // Issue #22's figures beyond the 80° cap, each file's default table against the native
-    // reader. The whole-hemisphere bar (1.5 %) is met; the grazing-band (3 %) and albedo (1 %)
-    // bars are not yet met on every file (see BENCHMARKS.md, "Measured tables at every angle"):
-    // until they are, this pins today's levels — far below where the defaults were before
-    // (grazing 6–186 %, albedo 3–19 %) — so that no change can slide back unnoticed.
-    let dir = measured::data::rgl_dir().expect("the shipped data/rgl");
-    for f in brdftab::report::measured::rgl_files(&dir).unwrap() {
-        let name = f.file_name().unwrap().to_string_lossy().into_owned();
-        let (out, _) = bake_default(&name);
-        let native = source::open(&f.to_string_lossy()).unwrap();
-        let table = source::open_table(&out, &OpenOptions::default()).unwrap();
-        let opts = brdftab::analysis::fidelity::FidelityOptions {
+fn rgl_defaults_are_faithful_at_every_angle() {
+    // The measured-fidelity issue's bars beyond the 80° cap, each file's default table against
+    // the native reader: relative RMSE of f_r cos θi cos θo within 80° ≤ 1 %, over the whole
+    // hemisphere ≤ 1.5 %, in the grazing band (a direction beyond 80°) ≤ 3 % — on 100 000
+    // random pairs and on the deterministic mirror-centred rule, which has no heavy tail — and
+    // the directional albedo within 1 % per channel at every θ′ = 1..89° (a channel darker than
+    // 0.02 judged against 0.02). Before the issue: grazing 6–186 %, albedo 3–19 %.
+    for b in baked() {
+        let opts = FidelityOptions {
             pairs: 100_000,
             ..Default::default()
         };
-        let fi = brdftab::analysis::fidelity::measure(&table, native.as_ref(), &opts).unwrap();
-        let s = fi.summary();
-        assert!(fi.cap <= 0.01, "{name}: {s}");
-        assert!(fi.whole <= 0.015, "{name}: {s}");
-        assert!(fi.grazing <= 0.06, "{name}: {s}");
-        assert!(fi.albedo.worst <= 0.05, "{name}: {s}");
+        let fi = fidelity::measure(&b.table(), b.native().as_ref(), &opts).unwrap();
+        let (name, s) = (&b.name, fi.summary());
+        assert!(fi.cap <= 0.01 && fi.rule.cap <= 0.01, "{name}: {s}");
+        assert!(fi.whole <= 0.015 && fi.rule.whole <= 0.015, "{name}: {s}");
+        assert!(fi.grazing <= 0.03 && fi.rule.grazing <= 0.03, "{name}: {s}");
+        assert!(fi.albedo.worst <= 0.01, "{name}: {s}");
+    }
+}
+
+#[test]
+fn rgl_defaults_pass_a_white_furnace() {
+    // Under uniform unit radiance a view at θo sees the viewer's albedo ∫ f_r cos θi dωi, and a
+    // light at θi deposits its albedo ∫ f_r cos θo dωo; a measurement is not reciprocal, so the
+    // two differ, and a renderer meets both. Each must equal the source's within 1 % (a channel
+    // darker than 0.02 judged against 0.02) at every angle up to 88°, both integrated on the same
+    // mirror-centred rule (it resolves `cg_sunflower`'s 0.4° peak, which random or tabulated
+    // importance sampling does not yet: that is the sampling issue's). The source is the one
+    // the table was baked from: the file made continuous at the normal (`Brdf::bake_view`; the
+    // native reader's own values near the normal depend on the azimuth from which wi nears it,
+    // README "Measured data"). At 89° the files' viewer albedo climbs steeply (satin_rosaline:
+    // 0.99 at 88°, 1.59 at 89°, as f_r ∝ 1/cos θo) and the table is within 1.5 % there.
+    let thetas: Vec<f64> = (0..=17)
+        .map(|k| (5 * k).max(1) as f64)
+        .chain([88.0])
+        .collect();
+    for b in baked() {
+        let native = b.native();
+        let view = native.bake_view();
+        let source: &dyn Brdf = view.as_deref().unwrap_or(native.as_ref());
+        let table = b.table();
+        let sides: [(&str, &dyn Brdf, &dyn Brdf); 2] = [
+            ("light", &table, source),
+            (
+                "viewer",
+                &fidelity::Reversed(&table),
+                &fidelity::Reversed(source),
+            ),
+        ];
+        for (side, t, src) in sides {
+            for &deg in &thetas {
+                let a = fidelity::mirror_albedo(t, deg.to_radians(), 128, 8);
+                let r = fidelity::mirror_albedo(src, deg.to_radians(), 128, 8);
+                for k in 0..3 {
+                    assert!(
+                        (a[k] - r[k]).abs() <= 0.01 * r[k].max(0.02),
+                        "{}: {side}'s albedo at {deg}°, channel {k}: table {:.5}, source {:.5}",
+                        b.name,
+                        a[k],
+                        r[k]
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn lookups_at_the_normal_give_the_continuous_limit() {
+    // Either direction at the normal, or within a hair of it from any azimuth: one value, the
+    // limit of the source made continuous there (the azimuthal mean of the file's normal
+    // slice; the native reader's own limit depends on the approach, README "Measured data").
+    for b in baked() {
+        let table = b.table();
+        let native = b.native();
+        let view = native.bake_view();
+        let source: &dyn Brdf = view.as_deref().unwrap_or(native.as_ref());
+        // The limit: the whole slice at the normal — each side's albedo at exactly θ = 0, which
+        // evaluates the table at the normal itself — within 1 % of the source's (a channel
+        // darker than 0.02 judged against 0.02).
+        let sides: [(&dyn Brdf, &dyn Brdf); 2] = [
+            (&table, source),
+            (&fidelity::Reversed(&table), &fidelity::Reversed(source)),
+        ];
+        for (t, s) in sides {
+            let a = fidelity::mirror_albedo(t, 0.0, 128, 8);
+            let r = fidelity::mirror_albedo(s, 0.0, 128, 8);
+            for k in 0..3 {
+                assert!(
+                    (a[k] - r[k]).abs() <= 0.01 * r[k].max(0.02),
+                    "{}: {} at the normal, channel {k}: table {:.5}, source {:.5}",
+                    b.name,
+                    t.describe(),
+                    a[k],
+                    r[k]
+                );
+            }
+        }
+        for deg in [10.0f64, 25.0, 50.0] {
+            let t = deg.to_radians();
+            let other = DVec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos());
+            let (mut at, mut near) = ([0f32; 3], [0f32; 3]);
+            for incident_at_normal in [true, false] {
+                let pair = |n: DVec3| {
+                    if incident_at_normal {
+                        (n, other)
+                    } else {
+                        (other, n)
+                    }
+                };
+                let (wi, wo) = pair(DVec3::Z);
+                table.eval(wi, wo, &mut at);
+                for k in 0..8 {
+                    let phi = k as f64 * std::f64::consts::TAU / 8.0;
+                    for eps in [1e-9, 1e-6, 1e-4] {
+                        let n = DVec3::new(eps * phi.cos(), eps * phi.sin(), 1.0).normalize();
+                        let (wi, wo) = pair(n);
+                        table.eval(wi, wo, &mut near);
+                        let top = at.iter().fold(1e-3f32, |m, &x| m.max(x));
+                        for c in 0..3 {
+                            // Continuous: the change vanishes with the distance (a cell of the
+                            // table is ≥ 0.5° wide and a value changes by less than the pair's
+                            // brightest channel across one: below 120 per radian), plus f32
+                            // rounding.
+                            let bound = (120.0 * eps as f32 + 1e-5) * top;
+                            assert!(
+                                (near[c] - at[c]).abs() <= bound,
+                                "{}: {deg}° {incident_at_normal} {eps}: {near:?} vs {at:?}",
+                                b.name
+                            );
+                        }
+                    }
+                }
+            }
+        }
     }
 }
 

@@ -216,6 +216,26 @@ pub fn mirror_albedo(
     s
 }
 
+/// `brdf` with its directions swapped: its directional albedo ([`mirror_albedo`]) is the
+/// viewer's albedo of `brdf`, ∫ f_r(wi, wo) cos θi dωi for a view wo — what a white furnace
+/// shows at that view. For a reciprocal BRDF the two albedos agree; measured data are not.
+pub struct Reversed<'a>(pub &'a dyn Brdf);
+
+impl Brdf for Reversed<'_> {
+    fn channels(&self) -> &crate::spectrum::Channels {
+        self.0.channels()
+    }
+    fn eval(&self, wi: glam::DVec3, wo: glam::DVec3, out: &mut [f32]) {
+        self.0.eval(wo, wi, out)
+    }
+    fn flags(&self) -> crate::brdf::Flags {
+        self.0.flags()
+    }
+    fn describe(&self) -> String {
+        format!("{} (directions swapped)", self.0.describe())
+    }
+}
+
 /// The worst albedo error of `approx` against `reference` (see the module docs).
 pub fn albedo_error(
     approx: &dyn Brdf,

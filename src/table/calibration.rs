@@ -31,7 +31,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::fidelity::mirror_albedo;
+use crate::analysis::fidelity::{Reversed, mirror_albedo};
 use crate::analysis::pair_rule::mirror_rule;
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
@@ -267,24 +267,6 @@ impl Default for CalibrationOptions {
             two_sided: true,
             rounds: 4,
         }
-    }
-}
-
-/// `brdf` with its directions swapped: its directional albedo is the viewer's albedo of `brdf`.
-struct Reversed<'a>(&'a dyn Brdf);
-
-impl Brdf for Reversed<'_> {
-    fn channels(&self) -> &crate::spectrum::Channels {
-        self.0.channels()
-    }
-    fn eval(&self, wi: glam::DVec3, wo: glam::DVec3, out: &mut [f32]) {
-        self.0.eval(wo, wi, out)
-    }
-    fn flags(&self) -> crate::brdf::Flags {
-        self.0.flags()
-    }
-    fn describe(&self) -> String {
-        format!("{} (directions swapped)", self.0.describe())
     }
 }
 
