@@ -15,6 +15,9 @@ fn main() -> brdftab::Result<()> {
         if let Ok(g) = std::env::var("GRID") {
             req = req.grid(brdftab::bake::GridChoice::parse(&g)?);
         }
+        if std::env::var("COSCOS").is_ok() {
+            req = req.quantity(brdftab::table::Quantity::FrCosCos);
+        }
         let src = req.open_source()?;
         let t0 = std::time::Instant::now();
         let (t, rep) = req.table_of(src.as_ref(), &brdftab::progress::Silent)?;

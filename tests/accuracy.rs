@@ -67,7 +67,7 @@ fn parse_csv(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
     (header, rows)
 }
 
-const METRICS: [&str; 8] = [
+const METRICS: [&str; 13] = [
     "values",
     "bytes",
     "ratio_f32",
@@ -75,6 +75,11 @@ const METRICS: [&str; 8] = [
     "rel_rmse",
     "max_rel",
     "albedo_err",
+    "rmse_80",
+    "rmse_whole",
+    "rmse_grazing",
+    "albedo_worst",
+    "albedo_worst_deg",
     "render_rel_rmse",
 ];
 
@@ -128,10 +133,22 @@ fn lambert_table_has_no_error() {
     assert!(f32.max_rel < 1e-6, "{f32:?}");
     assert!(f32.albedo_err < 1e-6, "{f32:?}");
     assert!(f32.render_rel_rmse < 1e-5, "{f32:?}");
+    // The whole-domain figures too: a constant is exact everywhere, up to the horizon.
+    for x in [
+        f32.rmse_80,
+        f32.rmse_whole,
+        f32.rmse_grazing,
+        f32.albedo_worst,
+    ] {
+        assert!(x < 1e-6, "{f32:?}");
+    }
     // log16 keeps its bound: every error within the tolerance.
     let l = &report.rows[1];
     assert!(l.max_rel <= 1.01e-3, "{l:?}");
     assert!(l.rel_rmse <= 1.01e-3 && l.albedo_err <= 1.01e-3, "{l:?}");
+    for x in [l.rmse_80, l.rmse_whole, l.rmse_grazing, l.albedo_worst] {
+        assert!(x <= 1.01e-3, "{l:?}");
+    }
 }
 
 #[test]
@@ -261,12 +278,16 @@ fn quick_suite_has_the_lecture_phong_variants_with_finite_rows() {
             r.rel_rmse,
             r.max_rel,
             r.albedo_err,
+            r.rmse_80,
+            r.rmse_whole,
+            r.rmse_grazing,
+            r.albedo_worst,
             r.render_rel_rmse,
         ];
         assert!(m.iter().all(|x| x.is_finite()), "{}: {m:?}", r.csv());
         // Either measured (≥ 0) or not measured and said so.
         if r.status == "ok" {
-            assert!(m[..5].iter().all(|&x| x >= 0.0), "{}", r.csv());
+            assert!(m[..9].iter().all(|&x| x >= 0.0), "{}", r.csv());
         } else {
             assert!(m[2] == NOT_MEASURED, "{}", r.csv());
         }

@@ -117,23 +117,69 @@ pub fn measure(
     reference: &dyn Brdf,
     opts: &FidelityOptions,
 ) -> Result<Fidelity> {
-    let cap = opts.cap_deg.to_radians();
-    let w = Weight::CosInCosOut;
-    let rmse = |r: Region| -> Result<f64> {
-        Ok(compare_region(approx, reference, opts.pairs, opts.seed, r, w)?.rel_rmse)
-    };
-    let in_cap = rmse(Region::Cap(cap))?;
-    let whole = rmse(Region::Cap(std::f64::consts::FRAC_PI_2))?;
-    let grazing = rmse(Region::Band(cap))?;
-    let albedo = albedo_error(approx, reference, opts)?;
-    let rule = PairRule::new(reference, cap, &PairRuleOptions::default())?.error(approx)?;
-    Ok(Fidelity {
-        cap: in_cap,
-        whole,
-        grazing,
-        albedo,
-        rule,
-    })
+    FidelityReference::new(reference, opts)?.measure(approx)
+}
+
+/// What [`measure`] needs of the source, computed once for several tables of it (the accuracy
+/// suite measures every preset and codec against one source): its values on the product rule
+/// and its albedo curve.
+pub struct FidelityReference<'a> {
+    reference: &'a dyn Brdf,
+    opts: FidelityOptions,
+    rule: PairRule,
+    albedo: AlbedoCurve,
+}
+
+impl<'a> FidelityReference<'a> {
+    /// The source's side of the figures of `opts`.
+    pub fn new(reference: &'a dyn Brdf, opts: &FidelityOptions) -> Result<FidelityReference<'a>> {
+        let cap = opts.cap_deg.to_radians();
+        Ok(FidelityReference {
+            reference,
+            rule: PairRule::new(reference, cap, &PairRuleOptions::default())?,
+            albedo: albedo_curve(reference, opts)?,
+            opts: opts.clone(),
+        })
+    }
+
+    /// The figures of `approx` against the source.
+    pub fn measure(&self, approx: &dyn Brdf) -> Result<Fidelity> {
+        let opts = &self.opts;
+        let cap = opts.cap_deg.to_radians();
+        let w = Weight::CosInCosOut;
+        let rmse = |r: Region| -> Result<f64> {
+            Ok(compare_region(approx, self.reference, opts.pairs, opts.seed, r, w)?.rel_rmse)
+        };
+        let in_cap = rmse(Region::Cap(cap))?;
+        let whole = rmse(Region::Cap(std::f64::consts::FRAC_PI_2))?;
+        let grazing = rmse(Region::Band(cap))?;
+        let albedo = worst_albedo(&albedo_curve(approx, opts)?, &self.albedo, opts);
+        Ok(Fidelity {
+            cap: in_cap,
+            whole,
+            grazing,
+            albedo,
+            rule: self.rule.error(approx)?,
+        })
+    }
+}
+
+/// The albedo curve of `brdf` at [`FidelityOptions::albedo_thetas_deg`] ([`mirror_albedo`]).
+pub fn albedo_curve(brdf: &dyn Brdf, opts: &FidelityOptions) -> Result<AlbedoCurve> {
+    let c = brdf.channels().len();
+    if c > MAX_CHANNELS {
+        return Err(Error::arg("channels", format!("{c} channels")));
+    }
+    if opts.albedo_phi == 0 || opts.albedo_order == 0 {
+        return Err(Error::arg("albedo_phi", "needs at least one node"));
+    }
+    Ok(opts
+        .albedo_thetas_deg
+        .par_iter()
+        .map(|&t| {
+            mirror_albedo(brdf, t.to_radians(), opts.albedo_phi, opts.albedo_order)[..c].to_vec()
+        })
+        .collect())
 }
 
 /// Directional albedo per θ′ of [`FidelityOptions::albedo_thetas_deg`], per channel.
@@ -243,6 +289,12 @@ pub fn albedo_error(
     opts: &FidelityOptions,
 ) -> Result<AlbedoError> {
     let (a, r) = albedo_pair(approx, reference, opts)?;
+    Ok(worst_albedo(&a, &r, opts))
+}
+
+/// The worst relative difference of albedo curve `a` from `r` (a channel darker than
+/// [`FidelityOptions::dark_floor`] judged against the floor).
+pub fn worst_albedo(a: &AlbedoCurve, r: &AlbedoCurve, opts: &FidelityOptions) -> AlbedoError {
     let mut worst = AlbedoError {
         worst: 0.0,
         theta_deg: opts.albedo_thetas_deg.first().copied().unwrap_or(0.0),
@@ -250,7 +302,7 @@ pub fn albedo_error(
         approx: 0.0,
         reference: 0.0,
     };
-    for (k, (ak, rk)) in a.iter().zip(&r).enumerate() {
+    for (k, (ak, rk)) in a.iter().zip(r).enumerate() {
         for (ch, (&x, &y)) in ak.iter().zip(rk).enumerate() {
             let e = (x - y).abs() / y.abs().max(opts.dark_floor);
             if e > worst.worst || e.is_nan() {
@@ -264,7 +316,7 @@ pub fn albedo_error(
             }
         }
     }
-    Ok(worst)
+    worst
 }
 
 #[cfg(test)]

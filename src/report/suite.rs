@@ -38,7 +38,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use crate::analysis::{accuracy, albedo};
+use crate::analysis::{accuracy, albedo, fidelity};
 use crate::bake::{BakeRequest, SymmetryChoice};
 use crate::brdf::Brdf;
 use crate::codec::{self, Codec, Quant};
@@ -375,6 +375,18 @@ pub struct Row {
     pub max_rel: f64,
     /// Max relative albedo error.
     pub albedo_err: f64,
+    /// Relative RMSE of f_r cos θi cos θo with both directions within 80°, on the mirror-centred
+    /// product rule ([`fidelity`]: no heavy tail on near-mirror materials).
+    pub rmse_80: f64,
+    /// The same over the whole hemisphere of both directions.
+    pub rmse_whole: f64,
+    /// The same over the grazing band (a direction beyond 80°).
+    pub rmse_grazing: f64,
+    /// The worst directional-albedo error over θ′ = 1..89° (odd degrees and 89°) and the
+    /// channels, a channel darker than 0.02 judged against 0.02.
+    pub albedo_worst: f64,
+    /// Where that is (degrees).
+    pub albedo_worst_deg: f64,
     /// Relative RMSE of the preview render.
     pub render_rel_rmse: f64,
     /// `ok` or `skipped`.
@@ -387,7 +399,7 @@ pub struct Row {
 }
 
 /// The CSV header (column names of [`Row`], in order).
-pub const CSV_HEADER: &str = "source,kind,preset,param,symmetry,codec,values,bytes,ratio_f32,bits_per_value,rel_rmse,max_rel,albedo_err,render_rel_rmse,render,status,seconds";
+pub const CSV_HEADER: &str = "source,kind,preset,param,symmetry,codec,values,bytes,ratio_f32,bits_per_value,rel_rmse,max_rel,albedo_err,rmse_80,rmse_whole,rmse_grazing,albedo_worst,albedo_worst_deg,render_rel_rmse,render,status,seconds";
 
 fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {
@@ -422,6 +434,11 @@ impl Row {
             num(self.rel_rmse),
             num(self.max_rel),
             num(self.albedo_err),
+            num(self.rmse_80),
+            num(self.rmse_whole),
+            num(self.rmse_grazing),
+            num(self.albedo_worst),
+            num(self.albedo_worst_deg),
             num(self.render_rel_rmse),
             csv_field(&self.render),
             csv_field(&self.status),
@@ -461,15 +478,18 @@ impl Report {
             "{}\n\nRun time: {:.1} s, {} rows. Metrics are measured on the decoded table \
              (quantization included) against the source; `-1` = not measured (see the `render` \
              and `status` columns). rel RMSE is cosine-weighted; albedo error is the max \
-             relative error over the incidence angles; render error is the relative RMSE of a \
-             lit-sphere preview (fixed sampling, same seed).\n\n",
+             relative error over the incidence angles; 80° / whole / grazing are relative RMSEs \
+             of f_r cos θi cos θo within 80°, over the whole hemisphere and in the band beyond \
+             80°, on a mirror-centred product rule; albedo worst is the largest albedo error over \
+             θ′ = 1..89°; render error is the relative RMSE of a lit-sphere preview (fixed \
+             sampling, same seed).\n\n",
             self.config,
             self.seconds,
             self.rows.len()
         ));
         s.push_str(
-            "| source | preset | param | sym | codec | bytes | ×f32 | bits/value | rel RMSE | max rel | albedo err | render err | status |\n\
-             |---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|\n",
+            "| source | preset | param | sym | codec | bytes | ×f32 | bits/value | rel RMSE | max rel | albedo err | 80° / whole / grazing | albedo worst (θ′) | render err | status |\n\
+             |---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
         );
         let md = |x: f64| {
             if x == NOT_MEASURED {
@@ -480,7 +500,7 @@ impl Report {
         };
         for r in &self.rows {
             s.push_str(&format!(
-                "| {} | {} | {} | {} | {} | {} | {:.3} | {:.2} | {} | {} | {} | {} | {} |\n",
+                "| {} | {} | {} | {} | {} | {} | {:.3} | {:.2} | {} | {} | {} | {} / {} / {} | {} ({}°) | {} | {} |\n",
                 r.source,
                 r.preset,
                 r.param,
@@ -492,6 +512,11 @@ impl Report {
                 md(r.rel_rmse),
                 md(r.max_rel),
                 md(r.albedo_err),
+                md(r.rmse_80),
+                md(r.rmse_whole),
+                md(r.rmse_grazing),
+                md(r.albedo_worst),
+                r.albedo_worst_deg,
                 if r.render == "ok" {
                     md(r.render_rel_rmse)
                 } else {
@@ -657,6 +682,18 @@ pub fn metrics(
     })
 }
 
+/// The suite's whole-domain figures ([`fidelity::FidelityReference`]): `pairs` random pairs,
+/// the albedo at odd degrees 1..89° and 89° on a 64-azimuth rule.
+fn fidelity_options(pairs: usize) -> fidelity::FidelityOptions {
+    fidelity::FidelityOptions {
+        pairs,
+        albedo_thetas_deg: (0..45).map(|k| (2 * k + 1) as f64).chain([89.0]).collect(),
+        albedo_phi: 64,
+        albedo_order: 6,
+        ..Default::default()
+    }
+}
+
 fn finite_or(x: f64, alt: f64) -> f64 {
     if x.is_finite() { x } else { alt }
 }
@@ -690,6 +727,8 @@ pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
             .as_ref()
             .filter(|_| !measured || cfg.render_measured);
         let src_albedo = albedos(src.as_ref(), &cfg.albedo_thetas);
+        let fid_opts = fidelity_options(cfg.pairs);
+        let fid_ref = fidelity::FidelityReference::new(src.as_ref(), &fid_opts)?;
         let src_image = match render_opts {
             Some(o) => Some(render::render(src.as_ref(), o, &Silent)?),
             None => None,
@@ -710,6 +749,11 @@ pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
                     rel_rmse: NOT_MEASURED,
                     max_rel: NOT_MEASURED,
                     albedo_err: NOT_MEASURED,
+                    rmse_80: NOT_MEASURED,
+                    rmse_whole: NOT_MEASURED,
+                    rmse_grazing: NOT_MEASURED,
+                    albedo_worst: NOT_MEASURED,
+                    albedo_worst_deg: NOT_MEASURED,
                     render_rel_rmse: NOT_MEASURED,
                     render: "skipped".to_owned(),
                     status: "ok".to_owned(),
@@ -756,6 +800,16 @@ pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
                                     row.albedo_err = m.albedo_err;
                                 }
                                 Err(e) => row.status = format!("accuracy failed: {e}"),
+                            }
+                            match fid_ref.measure(&tab) {
+                                Ok(f) => {
+                                    row.rmse_80 = finite_or(f.rule.cap, NOT_MEASURED);
+                                    row.rmse_whole = finite_or(f.rule.whole, NOT_MEASURED);
+                                    row.rmse_grazing = finite_or(f.rule.grazing, NOT_MEASURED);
+                                    row.albedo_worst = finite_or(f.albedo.worst, NOT_MEASURED);
+                                    row.albedo_worst_deg = f.albedo.theta_deg;
+                                }
+                                Err(e) => row.status = format!("fidelity failed: {e}"),
                             }
                             if let (Some(o), Some(reference)) = (render_opts, &src_image) {
                                 match render::render(&tab, o, &Silent)

@@ -64,8 +64,9 @@ pub struct BakeFlags {
     #[arg(long, default_value_t = 1)]
     pub supersample: usize,
     /// Pick the smallest adaptive grid whose table meets this error: relative RMSE of
-    /// f_r cos θi cos θo, both directions within 80°, on 100 000 random pairs (e.g. `0.5%` or
-    /// `0.005`). Isotropic bilateral sources; not with given node counts.
+    /// f_r cos θi cos θo, both directions within 80°, on a mirror-centred product rule (e.g.
+    /// `0.5%` or `0.005`); measured sources also within 3× it in the grazing band beyond 80°.
+    /// Isotropic bilateral sources; not with given node counts.
     #[arg(long)]
     pub target_error: Option<String>,
 }

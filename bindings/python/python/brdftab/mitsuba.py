@@ -282,7 +282,7 @@ class JitTable:
             f_in = np.asarray(cal["factors"], np.float32)
             f_out = cal.get("out_factors")
             f_out = None if f_out is None else mi.Float(np.asarray(f_out, np.float32))
-            self.calibration = (mi.Float(f_in), f_out, c, f_in.size // c)
+            self.calibration = (mi.Float(f_in), f_out, c, f_in.size // c, float(cal["t_end"]))
         self.axes = [dict(ax) for ax in grid["stored_axes"]]
         self.shape = list(grid["stored_shape"])
         self.c = int(values.shape[-1])
@@ -565,17 +565,19 @@ class JitTable:
 
     def _calibrate(self, iz, oz, out):
         """Times the calibration's k_in(θi) k_out(θo) (calibration.rs, ``Calibration::apply``):
-        on each, t = sqrt(1 - cos θ) in float32, linear between nodes ⌊t (n - 1)⌋ and the next."""
+        on each, t = sqrt(1 - cos θ) in float32, s = min(t (n - 1)/t_end, n - 1), linear between
+        nodes ⌊s⌋ and the next."""
         import drjit as dr
 
         if self.calibration is None:
             return out
-        f_in, f_out, c, n = self.calibration
+        f_in, f_out, c, n, t_end = self.calibration
         Fl = type(out[0])
+        scale = float(np.float32(n - 1) / np.float32(t_end))
 
         def blend(fac, cos, out):
             t = dr.sqrt(dr.maximum(1.0 - Fl(cos), 0.0))
-            s = dr.minimum(t * float(n - 1), float(n - 1))
+            s = dr.minimum(t * scale, float(n - 1))
             j = dr.minimum(self.UInt(dr.trunc(s)), n - 2)
             f = s - Fl(j)
             res = []
