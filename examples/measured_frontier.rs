@@ -31,7 +31,7 @@ fn main() -> brdftab::Result<()> {
     }
     let dir = brdftab::measured::data::rgl_dir()
         .ok_or_else(|| brdftab::Error::NotFound("no RGL directory".into()))?;
-    let files = brdftab::report::measured::rgl_files(&dir)?;
+    let files = brdftab::measured::data::rgl_files(&dir)?;
     let sym = Symmetry {
         isotropic: true,
         reciprocal: false,

@@ -7,7 +7,9 @@
 //! [`spec::ModelSpec`]) or a measurement ([`measured`]) — is baked on a grid into a dense table
 //! ([`table`]); the table is split into chunks that the [`codec`] turns into bytes; the [`store`]
 //! writes chunks and metadata; opening gives back a `TabulatedBrdf` that implements `Brdf` again.
-//! Every consumer — [`analysis`], [`render`], the `brdftab` CLI — sees only `Brdf`.
+//! Every consumer — [`analysis`], the hosts (the C ABI, the Python package), and the application
+//! in `tools/brdftab` (the `brdftab` CLI, its preview renderer and reports, a crate of its own
+//! that no host compiles) — sees only `Brdf`.
 //!
 //! ```
 //! use brdftab::{Brdf, spec::ModelSpec, spectrum::Channels};
@@ -41,8 +43,6 @@ pub mod models;
 pub mod par;
 pub mod progress;
 pub mod quadrature;
-pub mod render;
-pub mod report;
 pub mod rng;
 pub mod simd;
 pub mod source;
@@ -50,7 +50,6 @@ pub mod spec;
 pub mod spectrum;
 pub mod store;
 pub mod table;
-pub mod text;
 
 pub use bake::{BakeReport, BakeRequest, BakeTarget};
 pub use brdf::{Brdf, BrdfSample, Flags};

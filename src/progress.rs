@@ -50,33 +50,13 @@ impl<P: Progress + ?Sized> Progress for &P {
     }
 }
 
-/// Turns increments from several threads into [`Progress::set`] calls with the running total.
-pub(crate) struct Counter<'a> {
-    progress: &'a dyn Progress,
-    done: std::sync::atomic::AtomicU64,
-}
-
-impl<'a> Counter<'a> {
-    pub(crate) fn new(progress: &'a dyn Progress) -> Counter<'a> {
-        Counter {
-            progress,
-            done: std::sync::atomic::AtomicU64::new(0),
-        }
-    }
-
-    /// `k` more units are done.
-    pub(crate) fn add(&self, k: u64) {
-        let done = self.done.fetch_add(k, std::sync::atomic::Ordering::Relaxed) + k;
-        self.progress.set(done);
-    }
-}
-
-/// Ends the stage when dropped, so an early return through `?` still ends it.
-pub(crate) struct Stage<'a>(pub(crate) &'a dyn Progress);
+/// A stage of a [`Progress`] that ends when dropped, so an early return through `?` still ends
+/// it (for long operations built on the library, e.g. the CLI's renders and reports).
+pub struct Stage<'a>(&'a dyn Progress);
 
 impl<'a> Stage<'a> {
     /// Begins a stage on `p`.
-    pub(crate) fn begin(p: &'a dyn Progress, what: &str, total: u64) -> Stage<'a> {
+    pub fn begin(p: &'a dyn Progress, what: &str, total: u64) -> Stage<'a> {
         p.begin(what, total);
         Stage(p)
     }

@@ -44,7 +44,7 @@ fn baked() -> &'static [Baked] {
     static BAKED: OnceLock<Vec<Baked>> = OnceLock::new();
     BAKED.get_or_init(|| {
         let dir = measured::data::rgl_dir().expect("the shipped data/rgl");
-        let files = brdftab::report::measured::rgl_files(&dir).unwrap();
+        let files = brdftab::measured::data::rgl_files(&dir).unwrap();
         assert_eq!(files.len(), 7, "the seven shipped RGL files");
         files
             .into_iter()

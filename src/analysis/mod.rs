@@ -6,5 +6,4 @@ pub mod chi2;
 pub mod fidelity;
 pub mod pair_rule;
 pub mod plausibility;
-pub mod slice;
 pub mod timing;

@@ -33,8 +33,8 @@ const ALPHA_EDGES_DEG: [f64; 12] = [
 /// The nodes and weights of a rule over wo for wi at polar angle `theta` (azimuth 0): polar
 /// coordinates (α, φ) about the mirror direction m, wo = cos α m + sin α (cos φ e₁ + sin φ e₂),
 /// dω = sin α dα dφ; for each of `nphi` azimuths (trapezoidal, periodic) a Gauss-Legendre rule
-/// (`gx`, `gw` on [−1, 1]) on each segment of [`ALPHA_EDGES_DEG`] up to the horizon α_max(φ),
-/// which is an integration limit, not a jump inside a segment. With `split_z`, the angles where
+/// (`gx`, `gw` on [−1, 1]) on each segment between the α edges 0, ¼, ½, 1, 2, 4, … 128, 180°
+/// up to the horizon α_max(φ), which is an integration limit, not a jump inside a segment. With `split_z`, the angles where
 /// wo.z = `split_z` are segment edges too (a region's boundary). `visit(wi, wo, weight)` gets
 /// every node above the horizon, its weight dωo (no cosine).
 pub fn mirror_rule(

@@ -85,6 +85,23 @@ fn find(name: &str, dirs: Vec<PathBuf>) -> Result<PathBuf> {
     )))
 }
 
+/// The `.bsdf` files of `dir`, sorted.
+pub fn rgl_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let rd = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+    let mut v: Vec<PathBuf> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "bsdf"))
+        .collect();
+    v.sort();
+    if v.is_empty() {
+        return Err(Error::NotFound(format!(
+            "{}: no .bsdf files",
+            dir.display()
+        )));
+    }
+    Ok(v)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

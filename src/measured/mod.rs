@@ -19,7 +19,7 @@
 //!
 //! Both readers load a file completely at open (MERL: 35 MB in ≈ 0.1 s; RGL: < 1 MB) and never
 //! allocate in `eval`. Slice images of any source live in
-//! [`analysis::slice`](crate::analysis::slice).
+//! `brdftab_tools::preview::slice`.
 
 pub mod data;
 pub mod info;

@@ -421,7 +421,7 @@ fn balance(k: &mut [f32], m: &[f64], other: &[f32], reference: &[f64], c: usize)
 
 /// `table` with a [`Calibration`] that pins its directional albedos to those of `reference` at
 /// every node (module docs). The table is integrated once each way into a transport matrix
-/// ([`transport`]: what a factor on each node does to each node's albedo), and the factors are
+/// (what a factor on each node does to each node's albedo), and the factors are
 /// fitted on it by alternating k_in and k_out until neither moves by 1e-7 (at most
 /// [`CalibrationOptions::rounds`] rounds) — no further lookups. A channel whose albedo is 0
 /// in either keeps the factor 1 there; factors stay within [1/[`FIT_LIMIT`], [`FIT_LIMIT`]].

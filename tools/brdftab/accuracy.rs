@@ -2,10 +2,10 @@
 
 use std::path::PathBuf;
 
-use brdftab::report::suite::{self, SuiteConfig};
 use brdftab::table::Param;
 use brdftab::table::presets::Preset;
 use brdftab::{Error, Result};
+use brdftab_tools::report::suite::{self, SuiteConfig};
 use clap::Args;
 
 use crate::bake::flag;

@@ -38,7 +38,7 @@ pub struct BenchArgs {
 
 /// `brdftab bench --measured`.
 fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
-    use brdftab::report::measured;
+    use brdftab_tools::report::measured;
     let dir = match dir {
         "" => brdftab::measured::data::rgl_dir().ok_or_else(|| {
             brdftab::Error::NotFound(format!(

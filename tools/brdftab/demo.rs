@@ -18,11 +18,11 @@ use std::time::Instant;
 use brdftab::analysis::accuracy::Weight;
 use brdftab::analysis::{fidelity, plausibility};
 use brdftab::bake::{BakeRequest, BakeTarget, SymmetryChoice};
-use brdftab::report::suite::{self, MetricOptions};
 use brdftab::store;
 use brdftab::table::TabulatedBrdf;
 use brdftab::table::presets::Preset;
 use brdftab::{Brdf, Channels, Error, Result};
+use brdftab_tools::report::suite::{self, MetricOptions};
 use clap::Args;
 
 use crate::analysis::emit;

@@ -5,11 +5,11 @@ use std::path::{Path, PathBuf};
 
 use brdftab::analysis::plausibility;
 use brdftab::progress::Silent;
-use brdftab::render::{self, EnvChoice, RenderOptions};
-use brdftab::report::{plot, suite};
 use brdftab::table::presets::Preset;
 use brdftab::table::{Param, TabulatedBrdf};
 use brdftab::{Brdf, Error, Result};
+use brdftab_tools::preview::{self, EnvChoice, RenderOptions};
+use brdftab_tools::report::{plot, suite};
 
 use crate::analysis::emit;
 
@@ -32,7 +32,7 @@ pub fn preview_renders(
         spp: 16,
         max_depth: 3,
         // Material-independent directions: the difference shows the materials, not the noise.
-        sampling: render::Sampling::Fixed,
+        sampling: preview::Sampling::Fixed,
         env: EnvChoice::Sky,
         ..Default::default()
     };
@@ -42,13 +42,13 @@ pub fn preview_renders(
     ))?;
     let mut files = Vec::new();
     for (name, src, tab) in previews {
-        let a = render::render(*src, &opts, &Silent)?;
-        let b = render::render(tab, &opts, &Silent)?;
-        let cmp = render::compare(&b, &a)?;
-        let (diff, _legend) = render::difference_image(&b, &a)?;
-        let side = render::image::Image::hstack(&[&a, &b, &diff.to_rgb()?], 4, 0.0)?;
+        let a = preview::render(*src, &opts, &Silent)?;
+        let b = preview::render(tab, &opts, &Silent)?;
+        let cmp = preview::compare(&b, &a)?;
+        let (diff, _legend) = preview::difference_image(&b, &a)?;
+        let side = preview::image::Image::hstack(&[&a, &b, &diff.to_rgb()?], 4, 0.0)?;
         let path = out.join(format!("render_{name}.png"));
-        render::image::write_png(&side, &path, 0.0)?;
+        preview::image::write_png(&side, &path, 0.0)?;
         emit(&format!(
             "  {:<24} rendered rel RMSE table vs source {:.3}%\n",
             name,

@@ -11,13 +11,14 @@ mod demo;
 mod demo_extra;
 mod export;
 mod fit;
-mod measured;
 mod models;
 mod progress;
 mod render;
 mod sample;
+mod slice;
 mod source;
 mod table;
+mod text;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -49,7 +50,7 @@ enum Command {
     /// Render SOURCE on a sphere (path tracer or lit sphere); --compare renders two side by side.
     Render(render::RenderArgs),
     /// Render a slice image (MERL-style θh × θd, or polar f_r·cos θo) to EXR or PNG.
-    Slice(measured::SliceArgs),
+    Slice(slice::SliceArgs),
     /// Convert between formats (MERL .binary, RGL .bsdf, tables).
     Convert(convert::ConvertArgs),
     /// Directional albedo a(θ′) per channel: one line `theta a_1 a_2 ...` per angle.
@@ -82,7 +83,7 @@ fn main() -> ExitCode {
         Command::Export(a) => export::run(a),
         Command::Bench(a) => bench::bench(a),
         Command::Render(a) => render::run(a),
-        Command::Slice(a) => measured::slice(a),
+        Command::Slice(a) => slice::slice(a),
         Command::Convert(a) => convert::convert(a),
         Command::Albedo(a) => analysis::albedo(a),
         Command::Check(a) => analysis::check(a),

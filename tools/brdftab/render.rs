@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use brdftab::render::{self, EnvChoice, Image, LightChoice, Mode, RenderOptions, Sampling};
 use brdftab::{Error, Result};
+use brdftab_tools::preview::{self, EnvChoice, Image, LightChoice, Mode, RenderOptions, Sampling};
 use clap::Args;
 
 use crate::bake::flag;
@@ -105,7 +105,7 @@ fn render_one(brdf: &dyn brdftab::Brdf, opts: &RenderOptions, label: &str) -> Re
     let start = Instant::now();
     let bar = crate::progress::Bar::new("{msg} [{bar:40}] {percent}% eta {eta}");
     bar.prefix(label);
-    let img = render::render(brdf, opts, &bar)?;
+    let img = preview::render(brdf, opts, &bar)?;
     eprintln!(
         "{label}: {}×{} at {} spp in {:.2} s",
         opts.width,
@@ -132,7 +132,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let brdf = source::open(&a.source, &channels)?;
     let img = render_one(brdf.as_ref(), &opts, &a.source)?;
     let Some(other) = &a.compare else {
-        return render::write_auto(&img, &a.output, opts.exposure);
+        return preview::write_auto(&img, &a.output, opts.exposure);
     };
     let brdf_b = source::open(other, &channels)?;
     let opts_b = RenderOptions {
@@ -140,12 +140,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
         ..opts.clone()
     };
     let img_b = render_one(brdf_b.as_ref(), &opts_b, other)?;
-    let r = render::compare(&img, &img_b)?;
+    let r = preview::compare(&img, &img_b)?;
     let pair = Image::hstack(&[&img, &img_b], 4, 0.0)?;
-    render::write_auto(&pair, &a.output, opts.exposure)?;
-    let (diff, legend) = render::difference_image(&img, &img_b)?;
+    preview::write_auto(&pair, &a.output, opts.exposure)?;
+    let (diff, legend) = preview::difference_image(&img, &img_b)?;
     let dp = diff_path(&a.output);
-    render::write_png(&diff, &dp, 0.0)?;
+    preview::write_png(&diff, &dp, 0.0)?;
     println!(
         "relative RMSE: {:.6} ({:.4}%)",
         r.rel_rmse,

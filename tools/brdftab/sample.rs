@@ -9,8 +9,8 @@
 
 use std::io::Write;
 
-use brdftab::rng::Pcg32;
 use brdftab::{Error, Result};
+use brdftab_tools::rng::Rng;
 use clap::Args;
 use glam::DVec3;
 
@@ -71,7 +71,7 @@ pub fn sample(a: SampleArgs) -> Result<()> {
     let wo = parse_wo(&a.wo)?;
     let c = brdf.channels().len();
     let mut w = vec![0.0f32; c];
-    let mut rng = Pcg32::new(a.seed);
+    let mut rng = Rng::new(a.seed);
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     for _ in 0..a.count {
         let u = rng.next_dvec2();
@@ -94,7 +94,7 @@ pub fn pdf(a: PdfArgs) -> Result<()> {
     let channels = source::channels(a.wavelengths.as_deref())?;
     let brdf = source::open(&a.source, &channels)?;
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-    brdftab::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
+    crate::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
         let p = brdf.pdf(wi, wo);
         brdf.health()?;
         writeln!(out, "{p}").map_err(out_err)

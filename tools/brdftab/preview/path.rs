@@ -28,11 +28,11 @@ use rayon::prelude::*;
 use super::image::Image;
 use super::sampler::PixelSampler;
 use super::scene::{Environment, Hit, Light, Scene};
-use crate::brdf::Brdf;
-use crate::error::{Error, Result};
-use crate::geometry::{self, Frame};
-use crate::progress::{Counter, Progress, Stage};
-use crate::spectrum::{Channels, MAX_CHANNELS, RGB_WAVELENGTHS};
+use brdftab::brdf::Brdf;
+use brdftab::error::{Error, Result};
+use brdftab::geometry::{self, Frame};
+use brdftab::progress::{Progress, Stage};
+use brdftab::spectrum::{Channels, MAX_CHANNELS, RGB_WAVELENGTHS};
 
 /// What to compute.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -570,7 +570,7 @@ const TILE: usize = 16;
 /// Renders `brdf` on the sphere of the preview scene. Returns a linear RGB image (radiance).
 ///
 /// `progress` sees one stage, `"rendering"`, counting pixels up to width × height
-/// ([`Silent`](crate::progress::Silent) for none).
+/// ([`Silent`](brdftab::progress::Silent) for none).
 pub fn render(brdf: &dyn Brdf, opts: &RenderOptions, progress: &dyn Progress) -> Result<Image> {
     opts.validate()?;
     let _stage = Stage::begin(progress, "rendering", (opts.width * opts.height) as u64);
@@ -621,7 +621,7 @@ pub fn render(brdf: &dyn Brdf, opts: &RenderOptions, progress: &dyn Progress) ->
         out
     };
     let results: Vec<Vec<f32>> = match opts.threads {
-        None => crate::par::install(|| tiles.par_iter().map(render_tile).collect()),
+        None => brdftab::par::install(|| tiles.par_iter().map(render_tile).collect()),
         Some(n) => {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(n)
@@ -642,14 +642,35 @@ pub fn render(brdf: &dyn Brdf, opts: &RenderOptions, progress: &dyn Progress) ->
     Ok(img)
 }
 
+/// Turns increments from several threads into [`Progress::set`] calls with the running total.
+struct Counter<'a> {
+    progress: &'a dyn Progress,
+    done: std::sync::atomic::AtomicU64,
+}
+
+impl<'a> Counter<'a> {
+    fn new(progress: &'a dyn Progress) -> Counter<'a> {
+        Counter {
+            progress,
+            done: std::sync::atomic::AtomicU64::new(0),
+        }
+    }
+
+    /// `k` more units are done.
+    fn add(&self, k: u64) {
+        let done = self.done.fetch_add(k, std::sync::atomic::Ordering::Relaxed) + k;
+        self.progress.set(done);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brdf::{BrdfSample, Flags};
-    use crate::models::lambert::Lambert;
-    use crate::progress::Silent;
-    use crate::render::compare::compare;
-    use crate::spectrum::Value;
+    use crate::preview::compare::compare;
+    use brdftab::brdf::{BrdfSample, Flags};
+    use brdftab::models::lambert::Lambert;
+    use brdftab::progress::Silent;
+    use brdftab::spectrum::Value;
 
     fn lambert(kd: f64) -> Lambert {
         Lambert::new(Value::Grey(kd), &Channels::Rgb).unwrap()

@@ -1,7 +1,7 @@
 //! `slice`: a slice image of any SOURCE.
 
-use brdftab::analysis::slice;
 use brdftab::{Brdf, Error, Result};
+use brdftab_tools::preview::slice;
 use clap::{Args, ValueEnum};
 
 use crate::source;

@@ -9,7 +9,7 @@
 //!
 //! ```
 //! use brdftab::{spec::ModelSpec, spectrum::Channels};
-//! use brdftab::render::{RenderOptions, Mode, render};
+//! use brdftab_tools::preview::{RenderOptions, Mode, render};
 //!
 //! let brdf = ModelSpec::parse(r#"{"model": "lambert", "kd": 0.2}"#)?.build(&Channels::Rgb)?;
 //! let opts = RenderOptions { width: 16, height: 16, spp: 4, mode: Mode::Lit, ..Default::default() };
@@ -23,6 +23,7 @@ pub mod image;
 pub mod path;
 pub mod sampler;
 pub mod scene;
+pub mod slice;
 
 pub use compare::{CompareResult, compare, difference_image};
 pub use image::{

@@ -2,12 +2,12 @@
 
 use std::process::Command;
 
-use brdftab::render::{LightChoice, Mode, RenderOptions, Sampling};
-use brdftab::report::suite::{
-    self, CSV_HEADER, CodecDef, NOT_MEASURED, SourceDef, SuiteConfig, default_codecs,
-};
 use brdftab::table::Param;
 use brdftab::table::presets::Preset;
+use brdftab_tools::preview::{LightChoice, Mode, RenderOptions, Sampling};
+use brdftab_tools::report::suite::{
+    self, CSV_HEADER, CodecDef, NOT_MEASURED, SourceDef, SuiteConfig, default_codecs,
+};
 
 fn tmp(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("brdftab-accuracy-{}-{name}", std::process::id()));

@@ -12,20 +12,20 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::accuracy::{Weight, compare_weighted};
-use crate::analysis::fidelity::{self, Fidelity, FidelityOptions};
-use crate::analysis::timing;
+use brdftab::analysis::accuracy::{Weight, compare_weighted};
+use brdftab::analysis::fidelity::{self, Fidelity, FidelityOptions};
+use brdftab::analysis::timing;
 use std::time::Instant;
 
 use glam::DVec3;
 
-use crate::bake::{BakeRequest, BakeTarget};
-use crate::brdf::Brdf;
-use crate::error::{Error, Result};
-use crate::geometry;
-use crate::progress::{Progress, Stage};
-use crate::rng::Pcg32;
-use crate::source::{self, OpenOptions};
+use crate::rng::Rng;
+use brdftab::bake::{BakeRequest, BakeTarget};
+use brdftab::brdf::Brdf;
+use brdftab::error::{Error, Result};
+use brdftab::geometry;
+use brdftab::progress::{Progress, Stage};
+use brdftab::source::{self, OpenOptions};
 
 /// How [`run`] measures.
 #[derive(Debug, Clone)]
@@ -97,22 +97,7 @@ pub struct MeasuredRow {
     pub bake_seconds: f64,
 }
 
-/// The `.bsdf` files of `dir`, sorted.
-pub fn rgl_files(dir: &Path) -> Result<Vec<PathBuf>> {
-    let rd = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
-    let mut v: Vec<PathBuf> = rd
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "bsdf"))
-        .collect();
-    v.sort();
-    if v.is_empty() {
-        return Err(Error::NotFound(format!(
-            "{}: no .bsdf files",
-            dir.display()
-        )));
-    }
-    Ok(v)
-}
+pub use brdftab::measured::data::rgl_files;
 
 /// Bakes every file with the defaults and measures it against its native evaluation.
 pub fn run(
@@ -191,7 +176,7 @@ fn row(f: &Path, opts: &MeasuredOptions) -> Result<MeasuredRow> {
 /// a then b (wall clock: CPU-time clocks tick too coarsely for ~70 ns lookups): medians of a,
 /// b and of the per-round ratio a/b.
 fn paired(a: &dyn Brdf, b: &dyn Brdf, pairs: usize, rounds: usize) -> (f64, f64, f64) {
-    let mut rng = Pcg32::new(2024);
+    let mut rng = Rng::new(2024);
     let p: Vec<(DVec3, DVec3)> = (0..pairs.max(1))
         .map(|_| {
             (

@@ -13,7 +13,7 @@ pub use suite::{CodecDef, Report, Row, SourceDef, SuiteConfig, run};
 
 use std::path::{Path, PathBuf};
 
-use crate::error::{Error, Result};
+use brdftab::error::{Error, Result};
 
 // Here rather than in `suite`, so that `plot` (which draws suite rows) and `suite` do not import
 // each other.

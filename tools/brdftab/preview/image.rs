@@ -20,7 +20,7 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
 
-use crate::error::{Error, Result};
+use brdftab::error::{Error, Result};
 
 /// A floating-point image: `channels` samples per pixel, row-major, top row first.
 #[derive(Debug, Clone, PartialEq)]

@@ -20,7 +20,7 @@ use std::path::Path;
 use glam::{DVec2, DVec3};
 
 use super::image::{Image, read_exr};
-use crate::error::{Error, Result};
+use brdftab::error::{Error, Result};
 
 /// A piecewise-constant 1D distribution on [0, 1) with `func.len()` bins.
 #[derive(Debug, Clone)]
@@ -196,7 +196,7 @@ impl Environment {
             let theta = PI * (y as f64 + 0.5) / h as f64;
             for x in 0..w {
                 let phi = 2.0 * PI * (x as f64 + 0.5) / w as f64;
-                let d = crate::geometry::spherical(theta, phi);
+                let d = brdftab::geometry::spherical(theta, phi);
                 texels.push(sky_radiance(d, sun));
             }
         }
@@ -214,7 +214,7 @@ impl Environment {
     }
 
     fn texel_index(&self, dir: DVec3) -> Option<(usize, usize)> {
-        let d = crate::geometry::normalize(dir)?;
+        let d = brdftab::geometry::normalize(dir)?;
         let theta = d.z.clamp(-1.0, 1.0).acos();
         let mut phi = d.y.atan2(d.x);
         if phi < 0.0 {
@@ -245,7 +245,7 @@ impl Environment {
         if sin_theta <= 0.0 {
             return None;
         }
-        let dir = crate::geometry::spherical(theta, 2.0 * PI * uu);
+        let dir = brdftab::geometry::spherical(theta, 2.0 * PI * uu);
         let pdf = pdf_u * pdf_v / (2.0 * PI * PI * sin_theta);
         if !(pdf > 0.0 && pdf.is_finite()) {
             return None;
@@ -258,7 +258,7 @@ impl Environment {
         if self.black {
             return 0.0;
         }
-        let Some(d) = crate::geometry::normalize(dir) else {
+        let Some(d) = brdftab::geometry::normalize(dir) else {
             return 0.0;
         };
         let Some((x, y)) = self.texel_index(d) else {
@@ -515,7 +515,7 @@ impl Scene {
         let cos_t = 1.0 - u.x * one_minus;
         let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
         let phi = 2.0 * PI * u.y;
-        let frame = crate::geometry::Frame::from_normal(axis);
+        let frame = brdftab::geometry::Frame::from_normal(axis);
         let dir = frame.to_world(DVec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t));
         Some((dir, 1.0 / (2.0 * PI * one_minus), radiance))
     }
@@ -551,18 +551,18 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::Pcg32;
+    use crate::rng::Rng;
 
     /// ∫ pdf dω = 1 and E[L/pdf] = ∫ L dω for the sky (against a direct quadrature).
     #[test]
     fn env_sampling_is_normalized_and_unbiased() {
         let env = Environment::sky();
-        let mut rng = Pcg32::new(7);
+        let mut rng = Rng::new(7);
         let n = 200_000;
         // Uniform-sphere estimate of ∫ pdf dω.
         let mut s = 0.0;
         for _ in 0..n {
-            let d = crate::geometry::uniform_sphere(rng.next_dvec2());
+            let d = brdftab::geometry::uniform_sphere(rng.next_dvec2());
             s += env.pdf(d) * 4.0 * PI;
         }
         let norm = s / n as f64;
@@ -595,7 +595,7 @@ mod tests {
     fn sphere_light_pdf_matches_sampling() {
         let scene = Scene::new(Environment::black(), Some(Light::default_area()), false);
         let p = DVec3::new(0.0, 0.0, 2.0);
-        let mut rng = Pcg32::new(3);
+        let mut rng = Rng::new(3);
         for _ in 0..1000 {
             let (d, pdf, _) = scene.sample_sphere_light(p, rng.next_dvec2()).unwrap();
             assert!((scene.sphere_light_pdf(p, d) - pdf).abs() < 1e-9 * pdf);
@@ -628,7 +628,8 @@ mod exr_env_tests {
         // Bright top half (sky), dark bottom half: the zenith is bright, the nadir dark.
         let img = Image::from_fn(16, 8, 3, |_, y, o| o.fill(if y < 4 { 2.0 } else { 0.5 }));
         let p = std::env::temp_dir().join(format!("brdftab-env-{}.exr", std::process::id()));
-        crate::render::image::write_exr(&img, &p, crate::render::image::ExrPrecision::F16).unwrap();
+        crate::preview::image::write_exr(&img, &p, crate::preview::image::ExrPrecision::F16)
+            .unwrap();
         let env = Environment::from_exr(&p).unwrap();
         assert_eq!(env.eval(DVec3::Z), DVec3::splat(2.0));
         assert_eq!(env.eval(-DVec3::Z), DVec3::splat(0.5));

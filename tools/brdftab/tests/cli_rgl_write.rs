@@ -14,17 +14,11 @@ fn brdftab(args: &[&str]) -> (bool, String, String) {
     )
 }
 
-/// The shipped RGL files: `data/rgl` under the crate, else `../shared/data/measured/rgl`;
-/// fails when neither exists.
+/// The shipped RGL files (the library's search: `$BRDFTAB_RGL_DIR`, `data/rgl`, `../shared`);
+/// fails when none exists.
 fn rgl_dir() -> std::path::PathBuf {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    [
-        root.join("data/rgl"),
-        root.join("../shared/data/measured/rgl"),
-    ]
-    .into_iter()
-    .find(|d| d.is_dir())
-    .expect("no RGL data: neither data/rgl nor ../shared/data/measured/rgl exists")
+    brdftab::measured::data::rgl_dir()
+        .expect("no RGL data directory: data/rgl ships with the crate")
 }
 
 #[test]

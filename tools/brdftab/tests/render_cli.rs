@@ -33,7 +33,7 @@ fn render_writes_png_and_exr() {
         assert!(st.success());
         assert!(std::fs::metadata(&out).unwrap().len() > 0);
     }
-    let img = brdftab::render::read_exr(tmp("a.exr")).unwrap();
+    let img = brdftab_tools::preview::read_exr(tmp("a.exr")).unwrap();
     assert_eq!((img.width, img.height, img.channels), (16, 12, 3));
 }
 

@@ -7,7 +7,7 @@
 //! can only resolve material differences well above it.
 
 use super::image::{FalseColor, Image, false_color};
-use crate::error::{Error, Result};
+use brdftab::error::{Error, Result};
 
 /// The result of [`compare`].
 #[derive(Debug, Clone, Copy, PartialEq)]

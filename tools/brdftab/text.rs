@@ -8,7 +8,7 @@ use std::io::BufRead;
 
 use glam::DVec3;
 
-use crate::error::{Error, Result};
+use brdftab::{Error, Result};
 
 /// Parses a line of exactly `N` numbers; `None` for blank and `#` lines. `name` and `lineno`
 /// go into the error.
@@ -32,9 +32,12 @@ pub fn parse_numbers<const N: usize>(
         if k == N {
             return Err(err(format!("expected {N} numbers, got more")));
         }
-        v[k] = tok
-            .parse()
-            .map_err(|_| err(format!("`{}` is not a number", crate::error::excerpt(tok))))?;
+        v[k] = tok.parse().map_err(|_| {
+            err(format!(
+                "`{}` is not a number",
+                brdftab::error::excerpt(tok)
+            ))
+        })?;
         k += 1;
     }
     if k < N {

@@ -8,10 +8,10 @@
 //!   azimuthal-equidistant projection (radius ∝ θo, angle = φo; +x to the right, +y up). Pixels
 //!   outside the disk are NaN in the data and the darkest colour in PNGs.
 //!
-//! Images are [`render::image::Image`](crate::render::image::Image)s: linear f32, one channel per
+//! Images are [`render::image::Image`](crate::preview::image::Image)s: linear f32, one channel per
 //! BRDF channel, named after them. [`write()`] stores them as EXR (as they are) or as PNG (one
 //! channel or the luminance, log scale through viridis with a colorbar strip below, via
-//! [`false_color`](crate::render::image::false_color)) and returns the legend line.
+//! [`false_color`](crate::preview::image::false_color)) and returns the legend line.
 
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::Path;
@@ -19,11 +19,11 @@ use std::path::Path;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::brdf::Brdf;
-use crate::error::{Error, Result};
-use crate::geometry;
-use crate::render::image::{self, ExrPrecision, FalseColor, Image};
-use crate::spectrum::MAX_CHANNELS;
+use crate::preview::image::{self, ExrPrecision, FalseColor, Image};
+use brdftab::brdf::Brdf;
+use brdftab::error::{Error, Result};
+use brdftab::geometry;
+use brdftab::spectrum::MAX_CHANNELS;
 
 fn render(
     brdf: &dyn Brdf,
@@ -33,7 +33,7 @@ fn render(
 ) -> Image {
     let c = brdf.channels().len().min(MAX_CHANNELS);
     let mut data = vec![0.0f32; width * height * c];
-    crate::par::install(|| {
+    brdftab::par::install(|| {
         data.par_chunks_mut(width * c)
             .enumerate()
             .for_each(|(y, row)| {
@@ -160,8 +160,8 @@ pub fn incident(theta: f64, phi: f64) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::lambert::Lambert;
-    use crate::spectrum::{Channels, Value};
+    use brdftab::models::lambert::Lambert;
+    use brdftab::spectrum::{Channels, Value};
 
     #[test]
     fn lambert_slices() {

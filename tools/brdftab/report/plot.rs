@@ -16,7 +16,7 @@ use std::sync::Once;
 use plotters::prelude::*;
 
 use super::suite::Row;
-use crate::error::{Error, Result};
+use brdftab::error::{Error, Result};
 
 /// Smallest error drawn (log axes cannot show 0).
 pub const FLOOR: f64 = 1e-7;

@@ -14,7 +14,7 @@
 
 use glam::DVec2;
 
-use crate::rng::Pcg32;
+use crate::rng::Rng;
 
 /// Number of stratified 2D pairs; further pairs fall back to independent random numbers.
 pub const STRATIFIED_PAIRS: usize = 1 + 4 * 3;
@@ -40,7 +40,7 @@ fn sobol2(mut i: u32, mut scramble: u32) -> u32 {
 }
 
 #[inline]
-fn unit(x: u32, rng: &mut Pcg32) -> f64 {
+fn unit(x: u32, rng: &mut Rng) -> f64 {
     // 32 stratified bits plus 21 random low bits, so values are not confined to a 2^-32 lattice.
     let lo = (rng.next_u32() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
     ((x as f64) * (1.0 / 4294967296.0) + lo).min(1.0 - f64::EPSILON)
@@ -51,7 +51,7 @@ fn unit(x: u32, rng: &mut Pcg32) -> f64 {
 pub struct PixelSampler {
     spp: usize,
     pairs: Vec<DVec2>,
-    rng: Pcg32,
+    rng: Rng,
     sample: usize,
 }
 
@@ -61,7 +61,7 @@ impl PixelSampler {
         let mut s = PixelSampler {
             spp,
             pairs: Vec::new(),
-            rng: Pcg32::new(0),
+            rng: Rng::new(0),
             sample: 0,
         };
         s.reset(seed, pixel);
@@ -71,7 +71,7 @@ impl PixelSampler {
     /// Re-initialises for another pixel, reusing the buffer.
     pub fn reset(&mut self, seed: u64, pixel: u64) {
         // Different pixels = different PCG streams; different seeds = different states.
-        self.rng = Pcg32::with_stream(seed ^ 0x9e37_79b9_7f4a_7c15, pixel);
+        self.rng = Rng::with_stream(seed ^ 0x9e37_79b9_7f4a_7c15, pixel);
         let spp = self.spp;
         self.pairs.clear();
         self.pairs.reserve(spp * STRATIFIED_PAIRS);

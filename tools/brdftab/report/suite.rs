@@ -5,19 +5,19 @@
 //! 1. bakes the source on the preset grid (symmetry reduced as the source's flags declare; the
 //!    bake verifies it, and a source that fails the check is baked without reduction);
 //! 2. encodes every chunk with the codec exactly as the store writer does (same per-chunk
-//!    predictor layout, [`store::tables::chunk_layout`](crate::store::tables::chunk_layout),
+//!    predictor layout, [`store::tables::chunk_layout`](brdftab::store::tables::chunk_layout),
 //!    zstd level 3) and counts the bytes — the sum of the chunk sizes, which is what a `.btdb`
 //!    file holds for the table apart from its small JSON header and chunk index;
 //! 3. decodes those bytes back into a [`TabulatedBrdf`] (linear interpolation): every metric is
 //!    measured on the *decoded* table, quantization error included;
 //! 4. measures, against the source:
-//!    - `rel_rmse`, `max_rel`: [`analysis::accuracy::compare`](crate::analysis::accuracy::compare) over `pairs` uniform random pairs
+//!    - `rel_rmse`, `max_rel`: [`analysis::accuracy::compare`](brdftab::analysis::accuracy::compare) over `pairs` uniform random pairs
 //!      (cosine-weighted relative RMSE; max relative error with a 1 %-of-RMS floor);
 //!    - `albedo_err`: max over the incidence angles `albedo_thetas` and channels of
 //!      |a_table − a_source| / a_source (denominator floored at 1e-3 × the largest source
 //!      albedo), both albedos by the same adaptive quadrature ([`albedo::integrate`]) with
 //!      [`ALBEDO_OPTIONS`], so quadrature error cancels as far as possible;
-//!    - `render_rel_rmse`: [`render::compare`](fn@crate::render::compare) of a small lit-sphere render of the table against
+//!    - `render_rel_rmse`: [`render::compare`](fn@crate::preview::compare) of a small lit-sphere render of the table against
 //!      the same render of the source, both with [`Sampling::Fixed`] and the same seed, so the
 //!      sampled directions coincide and the difference is (nearly) free of Monte Carlo noise.
 //!
@@ -38,18 +38,18 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use crate::analysis::{accuracy, albedo, fidelity};
-use crate::bake::{BakeRequest, SymmetryChoice};
-use crate::brdf::Brdf;
-use crate::codec::{self, Codec, Quant};
-use crate::error::{Error, Result};
-use crate::geometry;
-use crate::progress::{Progress, Silent, Stage};
-use crate::render::{self, LightChoice, Mode, RenderOptions, Sampling};
-use crate::spec::ModelSpec;
-use crate::spectrum::{Channels, MAX_CHANNELS};
-use crate::table::presets::Preset;
-use crate::table::{Param, Symmetry, Table, TabulatedBrdf};
+use crate::preview::{self, LightChoice, Mode, RenderOptions, Sampling};
+use brdftab::analysis::{accuracy, albedo, fidelity};
+use brdftab::bake::{BakeRequest, SymmetryChoice};
+use brdftab::brdf::Brdf;
+use brdftab::codec::{self, Codec, Quant};
+use brdftab::error::{Error, Result};
+use brdftab::geometry;
+use brdftab::progress::{Progress, Silent, Stage};
+use brdftab::spec::ModelSpec;
+use brdftab::spectrum::{Channels, MAX_CHANNELS};
+use brdftab::table::presets::Preset;
+use brdftab::table::{Param, Symmetry, Table, TabulatedBrdf};
 
 /// Quadrature settings of the albedo metric: a 1e-4 target with bounded interval counts, so a
 /// piecewise-linear table (whose kinks defeat a 1e-6 target) costs at most ~30 000 evaluations
@@ -98,7 +98,7 @@ impl SourceDef {
         }
     }
 
-    /// The source as a SOURCE string ([`crate::source`]): the spec's JSON or the file's path.
+    /// The source as a SOURCE string ([`brdftab::source`]): the spec's JSON or the file's path.
     pub fn source(&self) -> String {
         match &self.kind {
             SourceKind::Model(spec) => spec.to_json(),
@@ -110,7 +110,7 @@ impl SourceDef {
     pub fn open(&self) -> Result<Box<dyn Brdf + Send + Sync>> {
         match &self.kind {
             SourceKind::Model(spec) => spec.build(&Channels::Rgb),
-            SourceKind::Rgl(path) => Ok(Box::new(crate::measured::RglBrdf::open(path)?)),
+            SourceKind::Rgl(path) => Ok(Box::new(brdftab::measured::RglBrdf::open(path)?)),
         }
     }
 }
@@ -544,7 +544,7 @@ pub fn file_safe(s: &str) -> String {
 
 /// Albedo per θ and channel by [`albedo::integrate`] with [`ALBEDO_OPTIONS`].
 pub fn albedos(brdf: &dyn Brdf, thetas: &[f64]) -> Vec<Vec<f64>> {
-    crate::par::install(|| {
+    brdftab::par::install(|| {
         thetas
             .par_iter()
             .map(|&t| albedo::integrate(brdf, geometry::spherical(t, 0.0), &ALBEDO_OPTIONS).value)
@@ -576,13 +576,13 @@ pub fn albedo_error(a: &[Vec<f64>], reference: &[Vec<f64>]) -> f64 {
 pub fn round_trip(table: &Table, codec: &Codec) -> Result<(u64, Table)> {
     let grid = table.grid();
     let n = grid.layout().chunk_count();
-    let parts: Vec<(usize, Vec<f32>)> = crate::par::install(|| {
+    let parts: Vec<(usize, Vec<f32>)> = brdftab::par::install(|| {
         (0..n)
             .into_par_iter()
             .map(|a| {
                 let bytes = codec::encode(
                     table.chunk(a),
-                    crate::store::tables::chunk_layout(grid, a),
+                    brdftab::store::tables::chunk_layout(grid, a),
                     codec,
                 )?;
                 let back = codec::decode(&bytes, grid.layout().chunk_len(a))?;
@@ -730,7 +730,7 @@ pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
         let fid_opts = fidelity_options(cfg.pairs);
         let fid_ref = fidelity::FidelityReference::new(src.as_ref(), &fid_opts)?;
         let src_image = match render_opts {
-            Some(o) => Some(render::render(src.as_ref(), o, &Silent)?),
+            Some(o) => Some(preview::render(src.as_ref(), o, &Silent)?),
             None => None,
         };
         for &preset in &cfg.presets {
@@ -773,7 +773,7 @@ pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
                 };
                 let sym = table.grid().symmetry().to_string();
                 let values = table.grid().stored_values() as u64;
-                let mut group: Vec<Row> = crate::par::install(|| {
+                let mut group: Vec<Row> = brdftab::par::install(|| {
                     cfg.codecs
                         .par_iter()
                         .map(|cd| {
@@ -812,8 +812,8 @@ pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
                                 Err(e) => row.status = format!("fidelity failed: {e}"),
                             }
                             if let (Some(o), Some(reference)) = (render_opts, &src_image) {
-                                match render::render(&tab, o, &Silent)
-                                    .and_then(|img| render::compare(&img, reference))
+                                match preview::render(&tab, o, &Silent)
+                                    .and_then(|img| preview::compare(&img, reference))
                                 {
                                     Ok(r) if r.rel_rmse.is_finite() => {
                                         row.render_rel_rmse = r.rel_rmse;

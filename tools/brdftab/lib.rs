@@ -1,0 +1,15 @@
+//! The brdftab application's library: what the `brdftab` CLI needs beyond the core library
+//! `brdftab`, kept out of it so that a renderer linking brdftab (the C ABI, the Python
+//! extension) compiles none of it.
+//!
+//! - [`preview`]: the preview renderer (path tracer and lit sphere), images (EXR, PNG), false
+//!   colour, and slice images of any `Brdf`;
+//! - [`report`]: the accuracy suite, the measured-table benchmark and their plots;
+//! - [`rng`]: the tools' random numbers.
+
+// `!(x > 0.0)` rejects NaN together with non-positive values, as in the core library.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod preview;
+pub mod report;
+pub mod rng;
