@@ -13,7 +13,7 @@ fn main() -> brdftab::Result<()> {
     for f in files {
         let mut req = BakeRequest::new(f.as_str());
         if let Ok(g) = std::env::var("GRID") {
-            req = req.grid(brdftab::bake::GridChoice::parse(&g)?);
+            req = req.grid(g.parse::<brdftab::bake::GridChoice>()?);
         }
         if std::env::var("COSCOS").is_ok() {
             req = req.quantity(brdftab::table::Quantity::FrCosCos);

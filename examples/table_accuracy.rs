@@ -48,7 +48,7 @@ fn main() -> brdftab::Result<()> {
             "--pairs" => pairs = it.next().and_then(|s| s.parse().ok()).unwrap_or(pairs),
             "--only" => only = it.next().cloned(),
             "--seeds" => seeds = it.next().and_then(|s| s.parse().ok()).unwrap_or(1),
-            p => presets.push(Preset::parse(p)?),
+            p => presets.push(p.parse::<Preset>()?),
         }
     }
     if presets.is_empty() {

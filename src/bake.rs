@@ -64,10 +64,12 @@ pub enum GridChoice {
     Adaptive(Option<[usize; 3]>),
 }
 
-impl GridChoice {
+impl std::str::FromStr for GridChoice {
+    type Err = crate::Error;
+
     /// Parses `small`/`medium`/`large`, `merl`, sizes `θ1xφ1xθ2xφ2`, `adaptive` or
     /// `adaptive:NHxNDxNP` (θh, θd and stored φd nodes).
-    pub fn parse(s: &str) -> Result<GridChoice> {
+    fn from_str(s: &str) -> std::result::Result<Self, crate::Error> {
         let t = s.trim().to_ascii_lowercase();
         if let Some(rest) = t.strip_prefix("adaptive") {
             let Some(n) = rest.strip_prefix(':') else {
@@ -92,7 +94,7 @@ impl GridChoice {
         match t.as_str() {
             "merl" => Ok(GridChoice::Merl),
             "default" => Ok(GridChoice::Default),
-            "small" | "medium" | "large" => Ok(GridChoice::Preset(Preset::parse(&t)?)),
+            "small" | "medium" | "large" => Ok(GridChoice::Preset(t.parse::<Preset>()?)),
             _ => {
                 let v = sizes(&t)?;
                 let sizes: [usize; 4] = v.try_into().map_err(|_| {
@@ -170,13 +172,15 @@ pub enum SymmetryChoice {
     Declared,
 }
 
-impl SymmetryChoice {
+impl std::str::FromStr for SymmetryChoice {
+    type Err = crate::Error;
+
     /// Parses `auto`, `declared`, `none`, `all` or a list of `isotropic,reciprocal,bilateral`.
-    pub fn parse(s: &str) -> Result<SymmetryChoice> {
+    fn from_str(s: &str) -> std::result::Result<Self, crate::Error> {
         match s.trim() {
             "auto" => Ok(SymmetryChoice::Auto),
             "declared" => Ok(SymmetryChoice::Declared),
-            s => Ok(SymmetryChoice::Exactly(Symmetry::parse(s)?)),
+            s => Ok(SymmetryChoice::Exactly(s.parse::<Symmetry>()?)),
         }
     }
 }
@@ -653,7 +657,7 @@ impl BakeRequest {
 
     fn bake_options<'a>(
         &self,
-        set: crate::table::bake::Progress<'a>,
+        set: crate::table::fill::Progress<'a>,
         force: bool,
     ) -> BakeOptions<'a> {
         BakeOptions {
@@ -1057,30 +1061,33 @@ mod tests {
 
     #[test]
     fn grid_choice_parses() {
-        assert_eq!(GridChoice::parse("merl").unwrap(), GridChoice::Merl);
+        assert_eq!("merl".parse::<GridChoice>().unwrap(), GridChoice::Merl);
         assert_eq!(
-            GridChoice::parse("90x1x90x180").unwrap(),
+            "90x1x90x180".parse::<GridChoice>().unwrap(),
             GridChoice::Sizes([90, 1, 90, 180])
         );
         assert_eq!(
-            GridChoice::parse("small").unwrap(),
+            "small".parse::<GridChoice>().unwrap(),
             GridChoice::Preset(Preset::Small)
         );
         assert!(matches!(
-            GridChoice::parse("90x1x90"),
+            "90x1x90".parse::<GridChoice>(),
             Err(Error::InvalidArgument { .. })
         ));
         assert_eq!(
-            GridChoice::parse("adaptive").unwrap(),
+            "adaptive".parse::<GridChoice>().unwrap(),
             GridChoice::Adaptive(None)
         );
         assert_eq!(
-            GridChoice::parse("Adaptive:96x48x25").unwrap(),
+            "Adaptive:96x48x25".parse::<GridChoice>().unwrap(),
             GridChoice::Adaptive(Some([96, 48, 25]))
         );
         for bad in ["adaptive:96x48", "adaptivex", "adaptive:", "adaptive:axbxc"] {
             assert!(
-                matches!(GridChoice::parse(bad), Err(Error::InvalidArgument { .. })),
+                matches!(
+                    bad.parse::<GridChoice>(),
+                    Err(Error::InvalidArgument { .. })
+                ),
                 "{bad}"
             );
         }
@@ -1171,7 +1178,7 @@ mod tests {
         let out = d.join("p.btdb").to_str().unwrap().to_owned();
         let req = BakeRequest::new(spec)
             .preset(Preset::Small)
-            .symmetry(SymmetryChoice::parse("isotropic,reciprocal").unwrap());
+            .symmetry("isotropic,reciprocal".parse::<SymmetryChoice>().unwrap());
         assert!(matches!(
             req.run(&BakeTarget::file(&out)),
             Err(Error::Symmetry { .. })

@@ -43,6 +43,7 @@ pub mod models;
 pub mod par;
 pub mod progress;
 pub mod quadrature;
+pub mod request;
 pub mod rng;
 pub mod simd;
 pub mod source;

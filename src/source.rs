@@ -90,8 +90,10 @@ pub fn classify(source: &str) -> SourceKind {
 /// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct OpenOptions {
-    /// Interpolation of tables (default linear). Measured and analytic sources ignore it.
-    pub interp: Interp,
+    /// Interpolation of tables; `None` (the default) chooses per table
+    /// ([`TabulatedBrdf::default_interp`]: nearest on tables of MERL cells, linear otherwise).
+    /// Measured and analytic sources ignore it.
+    pub interp: Option<Interp>,
     /// Channels to evaluate: `None` keeps the source's own (RGB for model specs, the file's for
     /// RGL files). Model specs evaluate their spectral data at these wavelengths; RGL files
     /// resample their spectra. Tables and MERL files have fixed channels: asking them for other
@@ -104,14 +106,14 @@ pub struct OpenOptions {
 }
 
 impl OpenOptions {
-    /// The defaults: linear interpolation, the source's own channels, lazy decoding.
+    /// The defaults: interpolation chosen per table, the source's own channels, lazy decoding.
     pub fn new() -> OpenOptions {
         OpenOptions::default()
     }
 
     /// Sets the interpolation of tables.
     pub fn interp(mut self, interp: Interp) -> OpenOptions {
-        self.interp = interp;
+        self.interp = Some(interp);
         self
     }
 
@@ -133,8 +135,8 @@ impl OpenOptions {
     }
 }
 
-/// Opens SOURCE with the default [`OpenOptions`] (linear interpolation, the source's own
-/// channels).
+/// Opens SOURCE with the default [`OpenOptions`] (interpolation chosen per table, the
+/// source's own channels).
 ///
 /// An analytic model, inline:
 /// ```
@@ -238,7 +240,8 @@ pub fn open_table(source: &str, opts: &OpenOptions) -> Result<TabulatedBrdf> {
             excerpt(path)
         )));
     };
-    Ok(brdf.with_interp(opts.interp))
+    let interp = opts.interp.unwrap_or_else(|| brdf.default_interp());
+    Ok(brdf.with_interp(interp))
 }
 
 /// Parses a spec SOURCE: inline JSON (starting with `{`) or a `.json` file.

@@ -506,6 +506,15 @@ fn prefix_field(e: Error, i: usize) -> Error {
     }
 }
 
+impl std::str::FromStr for ModelSpec {
+    type Err = Error;
+
+    /// [`ModelSpec::parse`]: `r#"{"model": "lambert", "kd": 0.5}"#.parse::<ModelSpec>()`.
+    fn from_str(json: &str) -> Result<Self> {
+        ModelSpec::parse(json)
+    }
+}
+
 impl ModelSpec {
     /// Parses a spec from JSON text; errors name the field path.
     pub fn parse(json: &str) -> Result<Self> {

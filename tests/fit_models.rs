@@ -112,7 +112,7 @@ fn a_subset_of_parameters_keeps_the_others_fixed() {
     let src = build(r#"{"model": "cook_torrance", "m": 0.25, "ks": 0.8}"#);
     let init = ModelSpec::parse(r#"{"model": "cook_torrance", "m": 0.5, "ks": 0.8}"#).unwrap();
     let opts = FitOptions {
-        params: vec![ParamRequest::parse("m=0.1:0.2").unwrap()],
+        params: vec!["m=0.1:0.2".parse::<ParamRequest>().unwrap()],
         ..grey(2)
     };
     let r = fit::fit(src.as_ref(), &init, &opts).unwrap();

@@ -94,9 +94,9 @@ fn a_taken_name_is_a_duplicate_error_naming_no_flag() {
 #[test]
 fn library_argument_errors_name_settings_not_flags() {
     let errors = [
-        Preset::parse("huge").unwrap_err(),
-        brdftab::table::Param::parse("polar").unwrap_err(),
-        brdftab::table::Interp::parse("cubic").unwrap_err(),
+        "huge".parse::<Preset>().unwrap_err(),
+        "polar".parse::<brdftab::table::Param>().unwrap_err(),
+        "cubic".parse::<brdftab::table::Interp>().unwrap_err(),
     ];
     for e in errors {
         assert!(matches!(e, Error::InvalidArgument { .. }), "{e}");
@@ -130,7 +130,7 @@ fn the_lecture_table_has_a_row_per_model() {
 fn declared_symmetry_is_taken_unverified() {
     use brdftab::bake::SymmetryChoice;
     assert_eq!(
-        SymmetryChoice::parse("declared").unwrap(),
+        "declared".parse::<SymmetryChoice>().unwrap(),
         SymmetryChoice::Declared
     );
     let src = lambert();

@@ -279,7 +279,7 @@ fn the_warps_survive_the_file_and_select_the_fast_lookup() {
     let near = source::open_table(
         &out,
         &OpenOptions {
-            interp: brdftab::table::Interp::Nearest,
+            interp: Some(brdftab::table::Interp::Nearest),
             ..Default::default()
         },
     )

@@ -698,7 +698,7 @@ mod tests {
     fn bounds_are_respected() {
         let src = build(r#"{"model": "lambert", "kd": 0.25}"#);
         let opts = FitOptions {
-            params: vec![ParamRequest::parse("kd=0.01:0.05").unwrap()],
+            params: vec!["kd=0.01:0.05".parse::<ParamRequest>().unwrap()],
             ..quick()
         };
         let r = fit(src.as_ref(), &preset("lambert").unwrap(), &opts).unwrap();

@@ -251,9 +251,13 @@ impl ParamRequest {
             bounds: None,
         }
     }
+}
+
+impl std::str::FromStr for ParamRequest {
+    type Err = crate::Error;
 
     /// Parses `path` or `path=lo:hi` (linear) or `path=lo:hi:log`.
-    pub fn parse(s: &str) -> Result<Self> {
+    fn from_str(s: &str) -> std::result::Result<Self, crate::Error> {
         let s = s.trim();
         let Some((path, b)) = s.split_once('=') else {
             parse_path(s)?;
@@ -485,15 +489,15 @@ mod tests {
 
     #[test]
     fn paths_and_bounds_parse() {
-        let r = ParamRequest::parse("terms[1].m=0.05:0.5").unwrap();
+        let r = "terms[1].m=0.05:0.5".parse::<ParamRequest>().unwrap();
         assert_eq!(r.path, "terms[1].m");
         assert_eq!(r.bounds, Some(Bounds::linear(0.05, 0.5)));
-        let r = ParamRequest::parse("n=2:100:log").unwrap();
+        let r = "n=2:100:log".parse::<ParamRequest>().unwrap();
         assert_eq!(r.bounds.unwrap().scale, Scale::Log);
-        assert!(ParamRequest::parse("n=100:2").is_err());
-        assert!(ParamRequest::parse("n=0:2:log").is_err());
-        assert!(ParamRequest::parse("terms[x].m").is_err());
-        assert!(ParamRequest::parse("").is_err());
+        assert!("n=100:2".parse::<ParamRequest>().is_err());
+        assert!("n=0:2:log".parse::<ParamRequest>().is_err());
+        assert!("terms[x].m".parse::<ParamRequest>().is_err());
+        assert!("".parse::<ParamRequest>().is_err());
     }
 
     #[test]

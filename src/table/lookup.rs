@@ -28,9 +28,11 @@ pub enum Interp {
     Linear,
 }
 
-impl Interp {
+impl std::str::FromStr for Interp {
+    type Err = crate::Error;
+
     /// Parses `nearest` or `linear`.
-    pub fn parse(s: &str) -> crate::Result<Interp> {
+    fn from_str(s: &str) -> std::result::Result<Self, crate::Error> {
         match s.trim().to_ascii_lowercase().as_str() {
             "nearest" => Ok(Interp::Nearest),
             "linear" => Ok(Interp::Linear),

@@ -5,7 +5,7 @@
 //! - [`symmetry`]: [`Symmetry`], the canonical maps, [`symmetry::verify`] and
 //!   [`symmetry::detect`];
 //! - [`Table`]: a grid plus its stored values, in memory;
-//! - [`bake`](mod@bake): any `Brdf` → values, chunk by chunk ([`bake_chunks`], for streaming
+//! - [`fill`]: any `Brdf` → values, chunk by chunk ([`bake_chunks`], for streaming
 //!   writers) or into a [`Table`];
 //! - [`lookup`]: nearest and multilinear interpolation ([`Interp`]);
 //! - [`tabulated`]: [`TabulatedBrdf`], the `Brdf` over a table — every chunk in memory, or loaded
@@ -18,8 +18,8 @@
 //! one set of angular interpolation weights serves all channels.
 
 pub mod adaptive;
-pub mod bake;
 pub mod calibration;
+pub mod fill;
 pub mod grid;
 mod horizon;
 pub mod kernel;
@@ -33,7 +33,7 @@ pub mod tabulated;
 pub mod target;
 pub mod warp;
 
-pub use bake::{BakeOptions, BakeReport, bake, bake_chunks};
+pub use fill::{BakeOptions, BakeStats, bake, bake_chunks};
 pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, Quantity, StoredAxis};
 pub use lookup::Interp;
 pub use sampling::{SamplingResolution, TableSampler};

@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::Error;
 
 /// The angular parameterization of a table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
@@ -28,16 +28,20 @@ impl Param {
         }
     }
 
-    /// `inout` or `halfdiff`: the name [`Param::parse`] reads and tables store.
+    /// `inout` or `halfdiff`: the name [`str::parse`] reads and tables store.
     pub fn name(self) -> &'static str {
         match self {
             Param::InOut => "inout",
             Param::HalfDiff => "halfdiff",
         }
     }
+}
+
+impl std::str::FromStr for Param {
+    type Err = crate::Error;
 
     /// Parses `inout` or `halfdiff`.
-    pub fn parse(s: &str) -> Result<Self> {
+    fn from_str(s: &str) -> std::result::Result<Self, crate::Error> {
         match s.trim().to_ascii_lowercase().as_str() {
             "inout" | "in_out" => Ok(Param::InOut),
             "halfdiff" | "half_diff" => Ok(Param::HalfDiff),

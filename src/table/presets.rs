@@ -58,25 +58,12 @@ pub enum Preset {
 }
 
 impl Preset {
-    /// `small`, `medium` or `large`: the name [`Preset::parse`] reads.
+    /// `small`, `medium` or `large`: the name [`str::parse`] reads.
     pub fn name(self) -> &'static str {
         match self {
             Preset::Small => "small",
             Preset::Medium => "medium",
             Preset::Large => "large",
-        }
-    }
-
-    /// Parses `small`, `medium` or `large`.
-    pub fn parse(s: &str) -> Result<Preset> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "small" => Ok(Preset::Small),
-            "medium" => Ok(Preset::Medium),
-            "large" => Ok(Preset::Large),
-            o => Err(Error::arg(
-                "preset",
-                format!("`{o}`: expected small, medium or large"),
-            )),
         }
     }
 
@@ -122,5 +109,22 @@ impl Preset {
             channels,
             symmetry,
         )
+    }
+}
+
+impl std::str::FromStr for Preset {
+    type Err = crate::Error;
+
+    /// Parses `small`, `medium` or `large`.
+    fn from_str(s: &str) -> std::result::Result<Self, crate::Error> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "small" => Ok(Preset::Small),
+            "medium" => Ok(Preset::Medium),
+            "large" => Ok(Preset::Large),
+            o => Err(Error::arg(
+                "preset",
+                format!("`{o}`: expected small, medium or large"),
+            )),
+        }
     }
 }

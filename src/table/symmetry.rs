@@ -68,9 +68,22 @@ impl Symmetry {
         }
     }
 
+    /// The symmetries present in both.
+    pub fn intersect(self, o: Symmetry) -> Symmetry {
+        Symmetry {
+            isotropic: self.isotropic && o.isotropic,
+            reciprocal: self.reciprocal && o.reciprocal,
+            bilateral: self.bilateral && o.bilateral,
+        }
+    }
+}
+
+impl std::str::FromStr for Symmetry {
+    type Err = crate::Error;
+
     /// Parses a comma-separated list: `isotropic,reciprocal,bilateral` (also `iso`, `recip`,
     /// `bilat`), `none` or `all`.
-    pub fn parse(s: &str) -> Result<Symmetry> {
+    fn from_str(s: &str) -> std::result::Result<Self, crate::Error> {
         let mut out = Symmetry::NONE;
         for w in s.split(',').map(|w| w.trim().to_ascii_lowercase()) {
             match w.as_str() {
@@ -90,15 +103,6 @@ impl Symmetry {
             }
         }
         Ok(out)
-    }
-
-    /// The symmetries present in both.
-    pub fn intersect(self, o: Symmetry) -> Symmetry {
-        Symmetry {
-            isotropic: self.isotropic && o.isotropic,
-            reciprocal: self.reciprocal && o.reciprocal,
-            bilateral: self.bilateral && o.bilateral,
-        }
     }
 }
 

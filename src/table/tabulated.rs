@@ -246,6 +246,22 @@ impl TabulatedBrdf {
         self.sampler = OnceLock::from(s);
     }
 
+    /// The interpolation a table opens with unless told otherwise: nearest when an axis holds
+    /// cells rather than nodes ([`Nodes::CellStart`](super::Nodes), the MERL grid: a MERL reader
+    /// looks such values up by cell, so nearest reproduces the source), linear otherwise.
+    pub fn default_interp(&self) -> Interp {
+        let cells = self
+            .grid()
+            .axes()
+            .iter()
+            .any(|a| a.nodes == super::Nodes::CellStart);
+        if cells {
+            Interp::Nearest
+        } else {
+            Interp::Linear
+        }
+    }
+
     /// The interpolation in use.
     pub fn interp(&self) -> Interp {
         self.interp

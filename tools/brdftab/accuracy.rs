@@ -8,7 +8,7 @@ use brdftab::{Error, Result};
 use brdftab_tools::report::suite::{self, SuiteConfig};
 use clap::Args;
 
-use crate::bake::flag;
+use crate::bake::flag_named;
 
 /// Arguments of `brdftab accuracy`.
 #[derive(Args)]
@@ -66,12 +66,12 @@ pub fn accuracy(a: AccuracyArgs) -> Result<()> {
     };
     if let Some(p) = &a.presets {
         cfg.presets = list(p)
-            .map(|p| Preset::parse(p).map_err(|e| flag(e, "--presets")))
+            .map(|p| p.parse::<Preset>().map_err(|e| flag_named(e, "--presets")))
             .collect::<Result<_>>()?;
     }
     if let Some(p) = &a.params {
         cfg.params = list(p)
-            .map(|p| Param::parse(p).map_err(|e| flag(e, "--params")))
+            .map(|p| p.parse::<Param>().map_err(|e| flag_named(e, "--params")))
             .collect::<Result<_>>()?;
     }
     if let Some(o) = &a.only {

@@ -4,8 +4,6 @@ use brdftab::analysis::{albedo, plausibility};
 use brdftab::{Error, Result};
 use clap::Args;
 
-use crate::source;
-
 /// Arguments of `brdftab albedo`.
 #[derive(Args)]
 pub struct AlbedoArgs {
@@ -19,9 +17,8 @@ pub struct AlbedoArgs {
         allow_hyphen_values = true
     )]
     theta: String,
-    /// Compute at these wavelengths in nm (comma separated) instead of RGB.
-    #[arg(long)]
-    wavelengths: Option<String>,
+    #[command(flatten)]
+    open: brdftab::request::OpenSettings,
 }
 
 /// Arguments of `brdftab check`.
@@ -32,16 +29,14 @@ pub struct CheckArgs {
     /// Print the report as one JSON object.
     #[arg(long)]
     json: bool,
-    /// Check at these wavelengths in nm (comma separated) instead of RGB.
-    #[arg(long)]
-    wavelengths: Option<String>,
+    #[command(flatten)]
+    open: brdftab::request::OpenSettings,
 }
 
 /// Prints `theta a_1 a_2 ...` per requested angle.
 pub fn albedo(a: AlbedoArgs) -> Result<()> {
     let thetas = parse_degrees(&a.theta)?;
-    let channels = source::channels(a.wavelengths.as_deref())?;
-    let brdf = source::open(&a.source, &channels)?;
+    let brdf = brdftab::request::open(&a.source, &a.open)?;
     let radians: Vec<f64> = thetas.iter().map(|t| t.to_radians()).collect();
     let curve = albedo::albedo_curve(&*brdf, &radians);
     brdf.health()?;
@@ -55,8 +50,7 @@ pub fn albedo(a: AlbedoArgs) -> Result<()> {
 
 /// Prints the plausibility report (text or JSON).
 pub fn check(a: CheckArgs) -> Result<()> {
-    let channels = source::channels(a.wavelengths.as_deref())?;
-    let brdf = source::open(&a.source, &channels)?;
+    let brdf = brdftab::request::open(&a.source, &a.open)?;
     let report = plausibility::check(&*brdf, &plausibility::Options::default());
     brdf.health()?;
     if a.json {

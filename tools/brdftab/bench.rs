@@ -4,11 +4,9 @@ use std::fmt::Write as _;
 
 use brdftab::Result;
 use brdftab::analysis::timing;
-use brdftab::table::Interp;
 use clap::Args;
 
-use crate::bake::flag;
-use crate::source;
+use crate::bake::flag_named;
 use crate::table::print_out;
 
 /// Arguments of `brdftab bench`.
@@ -25,12 +23,8 @@ pub struct BenchArgs {
     /// Number of random pairs.
     #[arg(long, default_value_t = 1_000_000)]
     pairs: usize,
-    /// Interpolation for tables: nearest or linear.
-    #[arg(long, default_value = "linear")]
-    interp: String,
-    /// Wavelengths (model specs only).
-    #[arg(long)]
-    wavelengths: Option<String>,
+    #[command(flatten)]
+    open: brdftab::request::OpenSettings,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -91,10 +85,9 @@ pub fn bench(a: BenchArgs) -> Result<()> {
     if let Some(d) = &a.measured {
         return measured(d, &a);
     }
-    let interp = Interp::parse(&a.interp).map_err(|e| flag(e, "--interp"))?;
-    let channels = source::channels(a.wavelengths.as_deref())?;
-    let src = source::open_with(a.source.as_deref().unwrap_or_default(), &channels, interp)?;
-    let t = timing::lookups(src.as_ref(), a.pairs, 5).map_err(|e| flag(e, "--pairs"))?;
+    let interp = a.open.interp.as_deref().unwrap_or("auto");
+    let src = brdftab::request::open(a.source.as_deref().unwrap_or_default(), &a.open)?;
+    let t = timing::lookups(src.as_ref(), a.pairs, 5).map_err(|e| flag_named(e, "--pairs"))?;
     let mut o = String::new();
     if a.json {
         let mut v = serde_json::to_value(&t).unwrap_or_default();
@@ -113,7 +106,7 @@ pub fn bench(a: BenchArgs) -> Result<()> {
         let _ = writeln!(o, "source:  {}", t.source);
         let _ = writeln!(
             o,
-            "pairs:   {} ({} channels, {interp:?})",
+            "pairs:   {} ({} channels, interpolation {interp})",
             t.pairs, t.channels
         );
         let _ = writeln!(

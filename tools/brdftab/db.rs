@@ -5,7 +5,7 @@ use brdftab::store::{self, db};
 use brdftab::{Error, Result};
 use clap::{Args, Subcommand};
 
-use crate::bake::BakeFlags;
+use brdftab::request::BakeSettings;
 
 /// Arguments of `brdftab db`.
 #[derive(Args)]
@@ -30,13 +30,10 @@ enum DbCommand {
 struct AddArgs {
     /// The database file.
     db: String,
-    /// Replace an existing table of the same name.
-    #[arg(long)]
-    replace: bool,
     /// The source: a model spec (inline JSON or .json), a table, a MERL or RGL file.
     source: String,
     #[command(flatten)]
-    bake: Box<BakeFlags>,
+    bake: Box<BakeSettings>,
 }
 
 #[derive(Args)]
@@ -71,11 +68,11 @@ pub fn run(a: DbArgs) -> Result<()> {
                 .name
                 .clone()
                 .ok_or_else(|| Error::arg("--name", "db add needs --name NAME"))?;
-            let req = a.bake.request(&a.source)?;
+            let req = a.bake.request(&a.source).map_err(crate::bake::flag)?;
             let target = BakeTarget::Db {
                 path: a.db.clone(),
                 name,
-                replace: a.replace,
+                replace: a.bake.replace,
             };
             crate::bake::run(&req, &target).map(drop)
         }

@@ -26,7 +26,7 @@ use brdftab_tools::report::suite::{self, MetricOptions};
 use clap::Args;
 
 use crate::analysis::emit;
-use crate::bake::flag;
+use crate::bake::flag_named;
 use crate::demo_extra::{plausibility_table, preview_renders, rate_distortion};
 
 /// Arguments of `brdftab demo`.
@@ -97,8 +97,8 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     if a.plausibility {
         return Ok(());
     }
-    let preset = a.preset.as_deref().map(Preset::parse).transpose();
-    let preset = preset.map_err(|e| flag(e, "--preset"))?;
+    let preset = a.preset.as_deref().map(str::parse::<Preset>).transpose();
+    let preset = preset.map_err(|e| flag_named(e, "--preset"))?;
     std::fs::create_dir_all(&a.out).map_err(|e| Error::io(&a.out, e))?;
     let out = a.out.canonicalize().map_err(|e| Error::io(&a.out, e))?;
     let db = out.join("demo.btdb");

@@ -6,19 +6,13 @@ use brdftab::spec::MODELS;
 use brdftab::{Error, Result};
 use clap::Args;
 
-use crate::source;
-
 /// Arguments of `brdftab eval`.
 #[derive(Args)]
 pub struct EvalArgs {
     /// A model spec (inline JSON starting with `{`, or a .json file), or a table file.
     source: String,
-    /// Evaluate at these wavelengths in nm (comma separated) instead of RGB.
-    #[arg(long)]
-    wavelengths: Option<String>,
-    /// Interpolation for table sources: nearest or linear.
-    #[arg(long, default_value = "linear")]
-    interp: String,
+    #[command(flatten)]
+    open: brdftab::request::OpenSettings,
 }
 
 /// Arguments of `brdftab models`.
@@ -31,9 +25,7 @@ pub struct ModelsArgs {
 
 /// Reads `wix wiy wiz wox woy woz` lines from stdin, prints f_r per channel.
 pub fn eval(a: EvalArgs) -> Result<()> {
-    let channels = source::channels(a.wavelengths.as_deref())?;
-    let interp = brdftab::table::Interp::parse(&a.interp)?;
-    let brdf = source::open_with(&a.source, &channels, interp)?;
+    let brdf = brdftab::request::open(&a.source, &a.open)?;
     let c = brdf.channels().len();
     let mut f = vec![0.0f32; c];
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());

@@ -7,8 +7,7 @@ use brdftab::{Error, Result};
 use brdftab_tools::preview::{self, EnvChoice, Image, LightChoice, Mode, RenderOptions, Sampling};
 use clap::Args;
 
-use crate::bake::flag;
-use crate::source;
+use crate::bake::flag_named;
 
 /// Arguments of `brdftab render`.
 #[derive(Args)]
@@ -60,9 +59,8 @@ pub struct RenderArgs {
     /// under another seed measures the noise floor.
     #[arg(long)]
     compare_seed: Option<u64>,
-    /// Evaluate spectral sources at these wavelengths in nm (comma separated).
-    #[arg(long)]
-    wavelengths: Option<String>,
+    #[command(flatten)]
+    open: brdftab::request::OpenSettings,
     /// Number of threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -78,12 +76,12 @@ fn parse_size(s: &str) -> Result<(usize, usize)> {
 
 fn options(a: &RenderArgs) -> Result<RenderOptions> {
     let (width, height) = parse_size(&a.size)?;
-    let mode = Mode::parse(&a.mode).map_err(|e| flag(e, "--mode"))?;
-    let env = EnvChoice::parse(&a.env).map_err(|e| flag(e, "--env"))?;
-    let light = LightChoice::parse(&a.light).map_err(|e| flag(e, "--light"))?;
+    let mode = Mode::parse(&a.mode).map_err(|e| flag_named(e, "--mode"))?;
+    let env = EnvChoice::parse(&a.env).map_err(|e| flag_named(e, "--env"))?;
+    let light = LightChoice::parse(&a.light).map_err(|e| flag_named(e, "--light"))?;
     let default_sampling = if a.compare.is_some() { "fixed" } else { "mis" };
     let sampling = Sampling::parse(a.sampling.as_deref().unwrap_or(default_sampling))
-        .map_err(|e| flag(e, "--sampling"))?;
+        .map_err(|e| flag_named(e, "--sampling"))?;
     Ok(RenderOptions {
         width,
         height,
@@ -128,13 +126,12 @@ fn diff_path(out: &Path) -> PathBuf {
 /// Runs `brdftab render`.
 pub fn run(a: RenderArgs) -> Result<()> {
     let opts = options(&a)?;
-    let channels = source::channels(a.wavelengths.as_deref())?;
-    let brdf = source::open(&a.source, &channels)?;
+    let brdf = brdftab::request::open(&a.source, &a.open)?;
     let img = render_one(brdf.as_ref(), &opts, &a.source)?;
     let Some(other) = &a.compare else {
         return preview::write_auto(&img, &a.output, opts.exposure);
     };
-    let brdf_b = source::open(other, &channels)?;
+    let brdf_b = brdftab::request::open(other, &a.open)?;
     let opts_b = RenderOptions {
         seed: a.compare_seed.unwrap_or(opts.seed),
         ..opts.clone()

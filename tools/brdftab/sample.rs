@@ -14,8 +14,6 @@ use brdftab_tools::rng::Rng;
 use clap::Args;
 use glam::DVec3;
 
-use crate::source;
-
 /// Arguments of `brdftab sample`.
 #[derive(Args)]
 pub struct SampleArgs {
@@ -30,9 +28,8 @@ pub struct SampleArgs {
     /// Seed of the uniform numbers (PCG32).
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Wavelengths in nm (comma separated) for a spec SOURCE instead of RGB.
-    #[arg(long)]
-    wavelengths: Option<String>,
+    #[command(flatten)]
+    open: brdftab::request::OpenSettings,
 }
 
 /// Arguments of `brdftab pdf`.
@@ -40,9 +37,8 @@ pub struct SampleArgs {
 pub struct PdfArgs {
     /// A spec, table, MERL or RGL SOURCE.
     source: String,
-    /// Wavelengths in nm (comma separated) for a spec SOURCE instead of RGB.
-    #[arg(long)]
-    wavelengths: Option<String>,
+    #[command(flatten)]
+    open: brdftab::request::OpenSettings,
 }
 
 fn parse_wo(s: &str) -> Result<DVec3> {
@@ -66,8 +62,7 @@ fn out_err(e: std::io::Error) -> Error {
 
 /// Draws `count` directions for `wo` and prints `wix wiy wiz pdf w_1 .. w_c`.
 pub fn sample(a: SampleArgs) -> Result<()> {
-    let channels = source::channels(a.wavelengths.as_deref())?;
-    let brdf = source::open(&a.source, &channels)?;
+    let brdf = brdftab::request::open(&a.source, &a.open)?;
     let wo = parse_wo(&a.wo)?;
     let c = brdf.channels().len();
     let mut w = vec![0.0f32; c];
@@ -91,8 +86,7 @@ pub fn sample(a: SampleArgs) -> Result<()> {
 
 /// Reads `wix wiy wiz wox woy woz` lines from stdin, prints pdf(wi | wo) per line.
 pub fn pdf(a: PdfArgs) -> Result<()> {
-    let channels = source::channels(a.wavelengths.as_deref())?;
-    let brdf = source::open(&a.source, &channels)?;
+    let brdf = brdftab::request::open(&a.source, &a.open)?;
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     crate::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
         let p = brdf.pdf(wi, wo);

@@ -4,8 +4,6 @@ use brdftab::{Brdf, Error, Result};
 use brdftab_tools::preview::slice;
 use clap::{Args, ValueEnum};
 
-use crate::source;
-
 /// Which slice to draw.
 #[derive(Clone, Copy, ValueEnum)]
 pub enum SliceKind {
@@ -42,9 +40,8 @@ pub struct SliceArgs {
     /// Image size in pixels.
     #[arg(long, default_value_t = 256)]
     size: usize,
-    /// Evaluate at these wavelengths in nm (comma separated) instead of RGB.
-    #[arg(long)]
-    wavelengths: Option<String>,
+    #[command(flatten)]
+    open: brdftab::request::OpenSettings,
 }
 
 /// Renders a slice image.
@@ -52,8 +49,7 @@ pub fn slice(a: SliceArgs) -> Result<()> {
     if a.size == 0 || a.size > 8192 {
         return Err(Error::arg("--size", "must be 1..=8192"));
     }
-    let channels = source::channels(a.wavelengths.as_deref())?;
-    let brdf = source::open(&a.source, &channels)?;
+    let brdf = brdftab::request::open(&a.source, &a.open)?;
     let names = brdf.channels().names();
     let channel = match &a.channel {
         None => None,

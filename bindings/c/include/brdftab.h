@@ -43,7 +43,8 @@ typedef struct brdftab_brdf brdftab_brdf;
 
 /* Options of brdftab_open_with; zero-initialized means the defaults. */
 typedef struct brdftab_open_options {
-    int interp;               /* tables: 0 linear (default), 1 nearest */
+    int interp;               /* tables: 0 auto (default: nearest on tables of MERL cells,
+                                 linear otherwise), 1 nearest, 2 linear */
     size_t n_wavelengths;     /* 0 keeps the source's channels */
     const double *wavelengths; /* nm, strictly increasing (model specs, RGL files) */
     int eager;                /* non-zero: decode every table chunk at open */
@@ -72,6 +73,21 @@ int brdftab_sample(const brdftab_brdf *b, size_t n, const double *wo, const doub
                    double *wi, double *pdf, float *weight);
 /* Directional albedo for light at polar angle theta (radians): one double per channel. */
 int brdftab_albedo(const brdftab_brdf *b, double theta, double *albedo);
+/* The request layer: settings as a JSON object with the field names of the CLI's flags and
+ * Python's keywords (e.g. {"target_error": 0.005, "codec": "f16"}); NULL or "" = defaults; an
+ * unknown field is an error. */
+/* Opens SOURCE with {"interp": "auto"|"nearest"|"linear", "wavelengths": [..], "eager": bool}. */
+brdftab_brdf *brdftab_open_json(const char *source, const char *settings_json);
+/* Bakes SOURCE into OUTPUT (.btdb file, DB#NAME, raw table) like `brdftab bake`. 0 or -1. */
+int brdftab_bake(const char *source, const char *output, const char *settings_json);
+/* Converts SOURCE into OUTPUT (.bsdf, MERL .binary, DB#NAME, .btdb, raw table, by its name)
+ * like `brdftab convert`. 0 or -1. */
+int brdftab_convert(const char *source, const char *output, const char *settings_json);
+/* Fits MODEL ("ggx", "lambert+ggx" or a JSON spec) to SOURCE; the result as JSON (as
+ * `brdftab fit --json`), freed with brdftab_free_string; NULL on failure. */
+char *brdftab_fit(const char *source, const char *model, const char *settings_json);
+/* Frees a string returned by brdftab; NULL is a no-op. */
+void brdftab_free_string(char *s);
 /* The version of the library, e.g. "0.1.0" (static). */
 const char *brdftab_version(void);
 

@@ -38,6 +38,9 @@ use brdftab::table::Interp;
 use brdftab::{Brdf, Channels};
 use glam::{DVec2, DVec3};
 
+mod request;
+pub use request::*;
+
 // `double[n][3]` is read as `[DVec3; n]`: glam's DVec3 is `#[repr(C)] {x, y, z}` of f64.
 const _: () = assert!(std::mem::size_of::<DVec3>() == 24 && std::mem::align_of::<DVec3>() == 8);
 const _: () = assert!(std::mem::size_of::<DVec2>() == 16 && std::mem::align_of::<DVec2>() == 8);
@@ -52,7 +55,8 @@ pub struct brdftab_brdf {
 /// Options of [`brdftab_open_with`]. Zero-initialized means the defaults.
 #[repr(C)]
 pub struct brdftab_open_options {
-    /// Table interpolation: 0 linear (default), 1 nearest.
+    /// Table interpolation: 0 auto (default: nearest on tables of MERL cells, linear otherwise),
+    /// 1 nearest, 2 linear.
     pub interp: c_int,
     /// Number of wavelengths in `wavelengths`; 0 keeps the source's own channels.
     pub n_wavelengths: usize,
@@ -178,31 +182,56 @@ unsafe fn pair_args<'a>(
     Ok((b, wi, wo))
 }
 
-fn open_impl(source: *const c_char, opts: Option<&brdftab_open_options>) -> *mut brdftab_brdf {
+/// A caller's string argument as UTF-8 (`what` names it in errors).
+///
+/// # Safety
+/// `p` is NULL or a NUL-terminated string.
+unsafe fn text<'a>(p: *const c_char, what: &str) -> Result<&'a str, String> {
+    if p.is_null() {
+        return Err(format!("`{what}` is NULL"));
+    }
+    // SAFETY: a non-NULL pointer is a NUL-terminated string (the caller's contract).
+    unsafe { CStr::from_ptr(p) }
+        .to_str()
+        .map_err(|_| format!("`{what}` is not valid UTF-8"))
+}
+
+/// The library's open options of a C options struct.
+fn open_options(opts: &brdftab_open_options) -> Result<OpenOptions, String> {
+    let interp = match opts.interp {
+        0 => None,
+        1 => Some(Interp::Nearest),
+        2 => Some(Interp::Linear),
+        i => {
+            return Err(format!(
+                "interp {i}: expected 0 (auto), 1 (nearest) or 2 (linear)"
+            ));
+        }
+    };
+    let channels = if opts.n_wavelengths > 0 {
+        // SAFETY: the caller promises `n_wavelengths` readable doubles.
+        let nm = unsafe { slice(opts.wavelengths, opts.n_wavelengths, "wavelengths") }?;
+        Some(Channels::wavelengths(nm.to_vec()).map_err(|e| e.to_string())?)
+    } else {
+        None
+    };
+    Ok(OpenOptions {
+        interp,
+        channels,
+        eager: opts.eager != 0,
+    })
+}
+
+/// Opens `source` with the options `opts` makes, as a new handle (NULL on failure).
+fn open_impl(
+    source: *const c_char,
+    opts: impl FnOnce() -> Result<OpenOptions, String>,
+) -> *mut brdftab_brdf {
     let mut out = std::ptr::null_mut();
     guard(|| {
-        if source.is_null() {
-            return Err("`source` is NULL".into());
-        }
-        // SAFETY: a non-NULL `source` is a NUL-terminated string (the header's contract).
-        let source = unsafe { CStr::from_ptr(source) }
-            .to_str()
-            .map_err(|_| "`source` is not valid UTF-8".to_string())?;
-        let mut o = OpenOptions::default();
-        if let Some(opts) = opts {
-            o.interp = match opts.interp {
-                0 => Interp::Linear,
-                1 => Interp::Nearest,
-                i => return Err(format!("interp {i}: expected 0 (linear) or 1 (nearest)")),
-            };
-            if opts.n_wavelengths > 0 {
-                // SAFETY: the caller promises `n_wavelengths` readable doubles.
-                let nm = unsafe { slice(opts.wavelengths, opts.n_wavelengths, "wavelengths") }?;
-                o.channels = Some(Channels::wavelengths(nm.to_vec()).map_err(|e| e.to_string())?);
-            }
-            o.eager = opts.eager != 0;
-        }
-        let brdf = brdftab::open_with(source, &o).map_err(|e| e.to_string())?;
+        // SAFETY: the header's contract: NULL or a NUL-terminated string.
+        let source = unsafe { text(source, "source") }?;
+        let brdf = brdftab::open_with(source, &opts()?).map_err(|e| e.to_string())?;
         let names = brdf
             .channels()
             .names()
@@ -223,7 +252,7 @@ fn open_impl(source: *const c_char, opts: Option<&brdftab_open_options>) -> *mut
 /// `source` is NULL or a NUL-terminated string.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn brdftab_open(source: *const c_char) -> *mut brdftab_brdf {
-    open_impl(source, None)
+    open_impl(source, || Ok(OpenOptions::default()))
 }
 
 /// Opens SOURCE with options (`opts` NULL = defaults). NULL on failure.
@@ -236,7 +265,10 @@ pub unsafe extern "C" fn brdftab_open_with(
     opts: *const brdftab_open_options,
 ) -> *mut brdftab_brdf {
     // SAFETY: the caller promises NULL or a valid struct.
-    open_impl(source, unsafe { opts.as_ref() })
+    let opts = unsafe { opts.as_ref() };
+    open_impl(source, || {
+        opts.map_or(Ok(OpenOptions::default()), open_options)
+    })
 }
 
 /// This thread's last failure, `""` if the last call succeeded. Valid until this thread's next

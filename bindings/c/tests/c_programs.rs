@@ -175,6 +175,74 @@ fn the_c_test_program_agrees_with_the_rust_api() {
 }
 
 #[test]
+fn requests_with_json_settings_do_what_the_rust_request_layer_does() {
+    use brdftab::request;
+    let dir = tmp().join("request");
+    std::fs::create_dir_all(&dir).unwrap();
+    let exe = dir.join("request_test");
+    compile(
+        "cc",
+        &["-std=c11"],
+        &Path::new(CRATE).join("tests/request_test.c"),
+        &exe,
+    );
+    let out = run(Command::new(&exe).arg(&dir));
+    let line = |label: &str| {
+        out.lines()
+            .find_map(|l| l.strip_prefix(&format!("{label} ")))
+            .unwrap_or_else(|| panic!("no `{label}` line in\n{out}"))
+    };
+    // The table: the Lambert's kd, stored as f32 (exact to f32 rounding) under either interp.
+    for label in ["table", "table-default"] {
+        for (got, want) in nums(line(label)).iter().zip([0.1, 0.2, 0.3]) {
+            assert!(
+                (got - want).abs() <= want * f32::EPSILON as f64,
+                "{label}: {got} vs {want}"
+            );
+        }
+    }
+    // Errors name the field at fault.
+    for (label, field) in [
+        ("error unknown:", "gird"),
+        ("error bad-value:", "supersample"),
+        ("error fit-unknown:", "strats"),
+        ("error open-interp:", "interp"),
+    ] {
+        assert!(line(label).contains(field), "{label} {}", line(label));
+    }
+    // The .bsdf is the one the Rust request layer writes with the same settings.
+    let settings: request::ConvertSettings =
+        request::from_json(r#"{"theta_i": 4, "resolution": 16, "ndf_resolution": 32, "pairs": 0}"#)
+            .unwrap();
+    let rust = dir.join("rust.bsdf");
+    let lambert = r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#;
+    request::convert(
+        lambert,
+        rust.to_str().unwrap(),
+        &settings,
+        &brdftab::progress::Silent,
+    )
+    .unwrap();
+    assert_eq!(
+        std::fs::read(dir.join("c.bsdf")).unwrap(),
+        std::fs::read(&rust).unwrap()
+    );
+    // The fit: the Rust layer's result, as JSON.
+    let fit: serde_json::Value = serde_json::from_str(line("fit")).unwrap();
+    let settings: request::FitSettings =
+        request::from_json(r#"{"pairs": 300, "starts": 2}"#).unwrap();
+    let want = request::fit(
+        r#"{"model":"lambert","kd":0.3}"#,
+        "lambert",
+        &settings,
+        &brdftab::progress::Silent,
+    )
+    .unwrap();
+    assert_eq!(fit["spec"], serde_json::to_value(&want).unwrap()["spec"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn the_examples_build_and_print_what_the_library_computes() {
     let dir = tmp().join("examples");
     std::fs::create_dir_all(&dir).unwrap();

@@ -1,7 +1,8 @@
 //! `brdftab._native`: the PyO3 extension behind the Python package `brdftab`.
 //!
-//! Thin over the library's two doors ([`brdftab::open_with`] and [`BakeRequest`]): this module
-//! converts numpy arrays and keyword arguments, releases the GIL around batch work (which runs on
+//! Thin over the library's request layer ([`brdftab::request`]: keyword arguments are its
+//! settings' fields, validated there as for the CLI and the C ABI): this module converts numpy
+//! arrays and Python values, releases the GIL around batch work (which runs on
 //! rayon, as `eval_batch` does), and maps errors — `brdftab::Error` to `brdftab.Error` (argument
 //! errors to `ValueError`), wrong shapes and dtypes to `ValueError`/`TypeError`. Every call runs
 //! under `catch_unwind`: a panic becomes `brdftab.Error`, never an abort of the interpreter.
@@ -11,9 +12,11 @@
 
 use std::sync::Arc;
 
-use brdftab::bake::{BakeRequest, BakeTarget, GridChoice, SymmetryChoice};
+use brdftab::request::{
+    self, BakeSettings, ConvertOutput, ConvertSettings, FitSettings, OpenSettings,
+};
 use brdftab::source::{self, OpenOptions, SourceKind};
-use brdftab::table::{Interp, Param, TabulatedBrdf};
+use brdftab::table::TabulatedBrdf;
 use brdftab::{Brdf, Channels};
 use glam::{DVec2, DVec3};
 use numpy::ndarray::{Array1, Array2, ArrayD, IxDyn};
@@ -182,12 +185,6 @@ fn pair_rows(
     Ok((x, y, n, xs && ys))
 }
 
-fn interp_of(s: &str) -> PyResult<Interp> {
-    Interp::parse(s).map_err(|_| {
-        PyValueError::new_err(format!("interp: `{s}`: expected \"linear\" or \"nearest\""))
-    })
-}
-
 /// `wavelengths=`: None, a comma-separated string, or a sequence of numbers (nm).
 fn channels_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Channels>> {
     let Some(o) = obj else { return Ok(None) };
@@ -230,6 +227,7 @@ struct PyBrdf {
     inner: Arc<dyn Brdf + Send + Sync>,
     table: Option<Arc<TabulatedBrdf>>,
     source: String,
+    /// The interpolation asked for: auto, nearest or linear.
     interp: String,
     wavelengths: Option<Vec<f64>>,
     eager: bool,
@@ -242,10 +240,14 @@ impl PyBrdf {
         channels: Option<Channels>,
         eager: bool,
     ) -> PyResult<PyBrdf> {
+        let settings = OpenSettings {
+            interp: Some(interp.to_owned()),
+            wavelengths: None,
+            eager: Some(eager),
+        };
         let opts = OpenOptions {
-            interp: interp_of(interp)?,
             channels: channels.clone(),
-            eager,
+            ..settings.options().map_err(lib_err)?
         };
         let (inner, table): (Arc<dyn Brdf + Send + Sync>, _) =
             if source::classify(source) == SourceKind::Table && channels.is_none() {
@@ -331,10 +333,14 @@ impl PyBrdf {
         self.source.clone()
     }
 
-    /// The interpolation of tables ("linear" or "nearest").
+    /// The interpolation of a table ("linear" or "nearest"; with `interp="auto"`, the one the
+    /// table's grid chose), or the interpolation asked for when the source is no table.
     #[getter]
     fn interp(&self) -> String {
-        self.interp.clone()
+        match &self.table {
+            Some(t) => format!("{:?}", t.interp()).to_ascii_lowercase(),
+            None => self.interp.clone(),
+        }
     }
 
     /// A one-line description (model and parameters, or table and source).
@@ -557,11 +563,11 @@ impl PyBrdf {
                     run_batch(py, PARALLEL, move || t.to_table())?.map_err(lib_err)?
                 }
                 _ => {
-                    let mut req = BakeRequest::new(self.source.clone());
-                    if let Some(w) = &self.wavelengths {
+                    let settings: BakeSettings = settings_of(options)?;
+                    let mut req = settings.request(&self.source).map_err(lib_err)?;
+                    if let (Some(w), None) = (&self.wavelengths, &settings.wavelengths) {
                         req.channels = Some(Channels::wavelengths(w.clone()).map_err(lib_err)?);
                     }
-                    let (_, _) = apply_bake_options(&mut req, options, &[])?;
                     run_batch(py, PARALLEL, || req.table(&brdftab::progress::Silent))?
                         .map_err(lib_err)?
                         .0
@@ -604,99 +610,98 @@ impl PyBrdf {
     }
 }
 
-/// Reads the bake keywords into `req`; returns (replace, accuracy interp given) and leaves the
-/// keys listed in `extra` to the caller. Unknown keywords are a `TypeError`.
-fn apply_bake_options(
-    req: &mut BakeRequest,
-    options: Option<&Bound<'_, PyDict>>,
-    extra: &[&str],
-) -> PyResult<(bool, bool)> {
-    let mut replace = false;
-    let mut interp_given = false;
+/// A Python value as JSON for the request layer: None, bools, ints, floats, strings, and lists,
+/// tuples, dicts and numpy arrays or scalars of those (through `tolist`).
+fn json_of(key: &str, v: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
+    use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyString};
+    use serde_json::Value;
+    if v.is_none() {
+        return Ok(Value::Null);
+    }
+    if v.is_instance_of::<PyBool>() {
+        return Ok(Value::Bool(v.extract()?));
+    }
+    if v.is_instance_of::<PyInt>() {
+        return match v.extract::<i64>() {
+            Ok(i) => Ok(Value::from(i)),
+            Err(_) => Ok(Value::from(v.extract::<u64>().map_err(|_| {
+                PyValueError::new_err(format!("{key}: integer out of range"))
+            })?)),
+        };
+    }
+    if v.is_instance_of::<PyFloat>() {
+        let x: f64 = v.extract()?;
+        return serde_json::Number::from_f64(x)
+            .map(Value::Number)
+            .ok_or_else(|| PyValueError::new_err(format!("{key}: {x}: expected a finite number")));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(Value::String(v.extract()?));
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        let mut m = serde_json::Map::new();
+        for (k, x) in d.iter() {
+            let k: String = k
+                .extract()
+                .map_err(|_| PyTypeError::new_err(format!("{key}: keys must be strings")))?;
+            let inner = json_of(&format!("{key}.{k}"), &x)?;
+            m.insert(k, inner);
+        }
+        return Ok(Value::Object(m));
+    }
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        return v
+            .try_iter()?
+            .enumerate()
+            .map(|(i, x)| json_of(&format!("{key}[{i}]"), &x?))
+            .collect::<PyResult<Vec<_>>>()
+            .map(Value::Array);
+    }
+    if v.hasattr("tolist")? {
+        let t = v.call_method0("tolist")?;
+        if !t.is(v) {
+            return json_of(key, &t);
+        }
+    }
+    Err(PyTypeError::new_err(format!(
+        "{key}: unsupported type {}",
+        v.get_type().name()?
+    )))
+}
+
+/// Keyword arguments as settings of the request layer ([`brdftab::request`]): the same field
+/// names and the same validation as the CLI's flags and the C ABI's JSON. An unknown keyword is
+/// a `TypeError`, as Python's own; a value of the wrong type a `TypeError` naming the field,
+/// any other bad value a `ValueError` naming it.
+fn settings_of<T>(options: Option<&Bound<'_, PyDict>>) -> PyResult<T>
+where
+    T: serde::de::DeserializeOwned + serde::Serialize + Default,
+{
     let Some(opts) = options else {
-        return Ok((replace, interp_given));
+        return Ok(T::default());
     };
-    let (mut codec, mut tol, mut floor, mut level, mut exhaustive) =
-        ("log16".to_owned(), None, None, None, false);
-    let mut codec_given = false;
+    let known = brdftab::request::field_names::<T>();
+    let mut map = serde_json::Map::new();
     for (k, v) in opts.iter() {
         let key: String = k.extract()?;
-        if v.is_none() {
-            continue;
+        if !known.contains(&key) {
+            return Err(PyTypeError::new_err(format!(
+                "unexpected keyword argument '{key}'"
+            )));
         }
-        let bad = |what: &str| PyTypeError::new_err(format!("{key}: expected {what}"));
-        match key.as_str() {
-            "preset" | "grid" => {
-                let s: String = v.extract().map_err(|_| bad("a string"))?;
-                req.grid = GridChoice::parse(&s).map_err(lib_err)?;
-            }
-            "param" => {
-                let s: String = v.extract().map_err(|_| bad("\"halfdiff\" or \"inout\""))?;
-                req.param = Some(Param::parse(&s).map_err(lib_err)?);
-            }
-            "symmetry" => {
-                let s: String = v.extract().map_err(|_| bad("a string"))?;
-                req.symmetry = SymmetryChoice::parse(&s).map_err(lib_err)?;
-            }
-            "symmetry_tolerance" => {
-                req.symmetry_tolerance = v.extract().map_err(|_| bad("a number"))?
-            }
-            "force" => req.force = v.extract().map_err(|_| bad("a bool"))?,
-            "codec" => {
-                codec = v
-                    .extract()
-                    .map_err(|_| bad("\"f32\", \"f16\" or \"log16\""))?;
-                codec_given = true;
-            }
-            "codec_tolerance" => {
-                tol = Some(v.extract().map_err(|_| bad("a number"))?);
-                codec_given = true;
-            }
-            "floor" | "codec_floor" => {
-                floor = Some(v.extract().map_err(|_| bad("a number"))?);
-                codec_given = true;
-            }
-            "level" => {
-                level = Some(v.extract().map_err(|_| bad("an int"))?);
-                codec_given = true;
-            }
-            "exhaustive" => {
-                exhaustive = v.extract().map_err(|_| bad("a bool"))?;
-                codec_given = true;
-            }
-            "name" => req.name = Some(v.extract().map_err(|_| bad("a string"))?),
-            "supersample" => req.supersample = v.extract().map_err(|_| bad("an int"))?,
-            "target_error" => req.target_error = Some(v.extract().map_err(|_| bad("a number"))?),
-            "wavelengths" => req.channels = channels_of(Some(&v))?,
-            "accuracy_pairs" | "pairs" => {
-                req.accuracy_pairs = v.extract().map_err(|_| bad("an int"))?
-            }
-            "accuracy_interp" | "interp" => {
-                let s: String = v.extract().map_err(|_| bad("a string"))?;
-                req.accuracy_interp = interp_of(&s)?;
-                interp_given = true;
-            }
-            "replace" => replace = v.extract().map_err(|_| bad("a bool"))?,
-            k if extra.contains(&k) => {}
-            _ => {
-                return Err(PyTypeError::new_err(format!(
-                    "unexpected keyword argument '{key}'"
-                )));
-            }
+        map.insert(key.clone(), json_of(&key, &v)?);
+    }
+    brdftab::request::from_value(serde_json::Value::Object(map)).map_err(|e| match e {
+        brdftab::Error::InvalidArgument { ref msg, .. } if msg.starts_with("invalid type") => {
+            PyTypeError::new_err(e.to_string())
         }
-    }
-    if req.supersample == 0 {
-        return Err(PyValueError::new_err("supersample: must be at least 1"));
-    }
-    if codec_given {
-        req.codec = brdftab::bake::codec(&codec, tol, floor, level, exhaustive).map_err(lib_err)?;
-    }
-    Ok((replace, interp_given))
+        e => lib_err(e),
+    })
 }
 
 /// Opens SOURCE (a spec, table, `DB#NAME`, MERL `.binary` or RGL `.bsdf`) as a `Brdf`.
 #[pyfunction]
-#[pyo3(signature = (source, *, interp = "linear", wavelengths = None, eager = true))]
+#[pyo3(signature = (source, *, interp = "auto", wavelengths = None, eager = true))]
 fn open(
     source: &str,
     interp: &str,
@@ -795,11 +800,9 @@ fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyA
     to_py(py, &info)
 }
 
-/// Bakes SOURCE into OUTPUT: a `.btdb` file, `DB#NAME` (a table of a database), or a raw table
-/// file. Keywords: preset, grid, param, symmetry, symmetry_tolerance, force, codec,
-/// codec_tolerance, floor, level, exhaustive, name, supersample, wavelengths, target_error (the
-/// smallest adaptive grid within this error, e.g. 0.005), replace. Returns what
-/// `brdftab info --json OUTPUT` reports.
+/// Bakes SOURCE into OUTPUT: a `.btdb` file, or `DB#NAME` (a table of a database). The
+/// keywords are the fields of [`BakeSettings`] (the CLI's `bake` flags, snake_cased). Returns
+/// what `brdftab info --json OUTPUT` reports.
 #[pyfunction]
 #[pyo3(signature = (source, output, **options))]
 fn bake(
@@ -809,21 +812,18 @@ fn bake(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let mut req = BakeRequest::new(source);
-        let (replace, _) = apply_bake_options(&mut req, options, &[])?;
-        let target = BakeTarget::parse(output, None, replace);
+        let settings: BakeSettings = settings_of(options)?;
         let r = run_batch(py, PARALLEL, || {
-            req.run_with(&target, &brdftab::progress::Silent)
+            request::bake(source, output, &settings, &brdftab::progress::Silent)
         })?
         .map_err(lib_err)?;
         report_dict(py, &r)
     })
 }
 
-/// Converts SOURCE into OUTPUT like `brdftab convert`: a MERL `.binary` (resampled on the MERL
-/// cells), `DB#NAME`, a `.btdb` file (a table named after the input) or a raw table. Takes the
-/// bake keywords plus `pairs` (accuracy pairs, default 200 000; 0 skips) and `interp`. Returns
-/// {"output", "source", "grid", "values", "seconds", "accuracy", "info"}.
+/// Converts SOURCE into OUTPUT as `brdftab convert` does ([`request::convert`]): an RGL
+/// `.bsdf`, a MERL `.binary`, `DB#NAME`, a `.btdb` file (a table named after the input) or a raw
+/// table. The keywords are the fields of [`ConvertSettings`].
 #[pyfunction]
 #[pyo3(signature = (source, output, **options))]
 fn convert(
@@ -833,68 +833,59 @@ fn convert(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let mut req = BakeRequest::new(source);
-        req.accuracy_pairs = 200_000;
-        let (replace, _) = apply_bake_options(&mut req, options, &[])?;
-        match source::classify(output) {
-            SourceKind::Merl => {
-                let brdf = req.open_source().map_err(lib_err)?;
-                let t = std::time::Instant::now();
-                run_batch(py, PARALLEL, || {
-                    brdftab::measured::MerlBrdf::from_brdf(brdf.as_ref()).write(output)
-                })?
-                .map_err(lib_err)?;
-                return to_py(
-                    py,
-                    &serde_json::json!({
-                        "output": output,
-                        "source": brdf.describe(),
-                        "grid": "merl 90x90x180 cell centres",
-                        "seconds": t.elapsed().as_secs_f64(),
-                    }),
-                );
-            }
-            SourceKind::Rgl => {
-                return Err(Error::new_err(
-                    "writing RGL .bsdf files is not supported (they are read only)",
-                ));
-            }
-            _ => {}
-        }
-        let name = req
-            .name
-            .clone()
-            .unwrap_or_else(|| brdftab::bake::stem(source));
-        let target = match BakeTarget::parse(output, None, replace) {
-            BakeTarget::File(p) => BakeTarget::Db {
-                path: p,
-                name,
-                replace,
-            },
-            t => t,
-        };
-        let r = run_batch(py, PARALLEL, || {
-            req.run_with(&target, &brdftab::progress::Silent)
+        let settings: ConvertSettings = settings_of(options)?;
+        let out = run_batch(py, PARALLEL, || {
+            request::convert(source, output, &settings, &brdftab::progress::Silent)
         })?
         .map_err(lib_err)?;
-        let d = serde_json::json!({
-            "output": r.output,
-            "source": r.source,
-            "grid": r.grid.summary(),
-            "values": r.values,
-            "seconds": r.seconds,
-            "accuracy": r.accuracy,
-        });
-        let d = to_py(py, &d)?;
-        d.bind(py).set_item("info", report_dict(py, &r)?)?;
-        Ok(d)
+        let d = match out {
+            ConvertOutput::Merl(r) => serde_json::json!({
+                "output": r.output,
+                "format": "merl",
+                "source": r.source,
+                "grid": "merl 90x90x180 cell centres",
+                "seconds": r.seconds,
+            }),
+            ConvertOutput::Rgl(r) => {
+                let f = &r.written.fields;
+                serde_json::json!({
+                    "output": output,
+                    "format": "rgl",
+                    "source": r.source,
+                    "bytes": r.written.bytes,
+                    "resolution": f.n,
+                    "theta_i": f.theta_i.len(),
+                    "phi_i": f.phi_i.len(),
+                    "seconds": r.seconds,
+                    "error": r.error.map(|e| serde_json::json!({
+                        "pairs": e.pairs,
+                        "rel_rmse": e.rel_rmse,
+                        "per_channel": e.per_channel,
+                        "max_rel": e.max_rel,
+                    })),
+                })
+            }
+            ConvertOutput::Table { report: r, .. } => {
+                let d = serde_json::json!({
+                    "output": r.output,
+                    "format": "table",
+                    "source": r.source,
+                    "grid": r.grid.summary(),
+                    "values": r.values,
+                    "seconds": r.seconds,
+                    "accuracy": r.accuracy,
+                });
+                let d = to_py(py, &d)?;
+                d.bind(py).set_item("info", report_dict(py, &r)?)?;
+                return Ok(d);
+            }
+        };
+        to_py(py, &d)
     })
 }
 
 /// Fits `model` (a name such as "ggx", a sum "lambert+ggx", or a JSON spec) to SOURCE; returns
-/// the dict of `brdftab fit --json`. Keywords: params (str or list), log, starts, pairs,
-/// max_theta (radians), seed, fresnel ("none"/"schlick"/"dielectric"), grey, wavelengths,
-/// specular_fraction, max_iterations.
+/// the dict of `brdftab fit --json`. The keywords are the fields of [`FitSettings`].
 #[pyfunction]
 #[pyo3(signature = (source, model, **options))]
 fn fit(
@@ -903,96 +894,10 @@ fn fit(
     model: &str,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
-    use brdftab::fit::{ColorMode, FitOptions, ParamRequest};
-    use brdftab::fresnel::FresnelSpec;
     guard(|| {
-        let mut opts = FitOptions::default();
-        let mut channels = None;
-        let mut fresnel = None;
-        if let Some(o) = options {
-            for (k, v) in o.iter() {
-                let key: String = k.extract()?;
-                if v.is_none() {
-                    continue;
-                }
-                let bad = |what: &str| PyTypeError::new_err(format!("{key}: expected {what}"));
-                match key.as_str() {
-                    "params" => {
-                        let list: Vec<String> = match v.extract::<String>() {
-                            Ok(s) => s.split(',').map(str::to_owned).collect(),
-                            Err(_) => v
-                                .extract()
-                                .map_err(|_| bad("a string or a list of strings"))?,
-                        };
-                        opts.params = list
-                            .iter()
-                            .filter(|x| !x.trim().is_empty())
-                            .map(|x| ParamRequest::parse(x))
-                            .collect::<brdftab::Result<Vec<_>>>()
-                            .map_err(lib_err)?;
-                    }
-                    "log" => opts.log = v.extract().map_err(|_| bad("a bool"))?,
-                    "starts" => opts.starts = v.extract().map_err(|_| bad("an int"))?,
-                    "pairs" => opts.pairs = v.extract().map_err(|_| bad("an int"))?,
-                    "max_theta" => {
-                        opts.max_theta = v.extract().map_err(|_| bad("a number (radians)"))?
-                    }
-                    "seed" => opts.seed = v.extract().map_err(|_| bad("an int"))?,
-                    "specular_fraction" => {
-                        opts.specular_fraction = v.extract().map_err(|_| bad("a number"))?
-                    }
-                    "max_iterations" => {
-                        opts.max_iterations = v.extract().map_err(|_| bad("an int"))?
-                    }
-                    "grey" => {
-                        let g: bool = v.extract().map_err(|_| bad("a bool"))?;
-                        opts.color = if g {
-                            ColorMode::Grey
-                        } else {
-                            ColorMode::PerChannel
-                        };
-                    }
-                    "fresnel" => {
-                        let s: String = v.extract().map_err(|_| bad("a string"))?;
-                        fresnel = Some(match s.as_str() {
-                            "schlick" => FresnelSpec::Schlick(brdftab::Value::Grey(0.04)),
-                            "dielectric" => FresnelSpec::Dielectric(brdftab::Value::Grey(1.5)),
-                            "none" => FresnelSpec::None,
-                            o => {
-                                return Err(PyValueError::new_err(format!(
-                                    "fresnel: `{o}`: expected none, schlick or dielectric"
-                                )));
-                            }
-                        });
-                    }
-                    "wavelengths" => channels = channels_of(Some(&v))?,
-                    _ => {
-                        return Err(PyTypeError::new_err(format!(
-                            "unexpected keyword argument '{key}'"
-                        )));
-                    }
-                }
-            }
-        }
-        if opts.starts == 0 || opts.pairs == 0 {
-            return Err(PyValueError::new_err(
-                "starts and pairs: must be at least 1",
-            ));
-        }
-        let brdf = brdftab::open_with(
-            source,
-            &OpenOptions {
-                channels,
-                ..OpenOptions::default()
-            },
-        )
-        .map_err(lib_err)?;
-        let mut init = brdftab::fit::preset(model).map_err(lib_err)?;
-        if let Some(f) = &fresnel {
-            init = brdftab::fit::with_fresnel(&init, f).map_err(lib_err)?;
-        }
+        let settings: FitSettings = settings_of(options)?;
         let result = run_batch(py, PARALLEL, || {
-            brdftab::fit::fit(brdf.as_ref(), &init, &opts)
+            request::fit(source, model, &settings, &brdftab::progress::Silent)
         })?
         .map_err(lib_err)?;
         ser(py, &result)

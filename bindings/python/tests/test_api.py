@@ -2,6 +2,7 @@
 
 import json
 import multiprocessing
+import pathlib
 import pickle
 
 import numpy as np
@@ -203,8 +204,18 @@ def test_convert(tmp_path, paper):
     merl = str(tmp_path / "lambert.binary")
     brdftab.convert(LAMBERT, merl)
     np.testing.assert_allclose(brdftab.open(merl).eval([0, 0.1, 1], [0.2, 0, 1]), [0.1, 0.2, 0.3], rtol=1e-3)
-    with pytest.raises(brdftab.Error, match="read only"):
-        brdftab.convert(LAMBERT, str(tmp_path / "x.bsdf"))
+
+
+def test_convert_writes_bsdf_like_the_cli(tmp_path, cli):
+    # one request layer: Python's convert writes the same .bsdf file as the CLI's
+    a, b = str(tmp_path / "a.bsdf"), str(tmp_path / "b.bsdf")
+    r = brdftab.convert(LAMBERT, a, theta_i=4, resolution=16, ndf_resolution=32, pairs=500)
+    cli("convert", LAMBERT, b, "--theta-i", "4", "--resolution", "16", "--ndf-resolution", "32",
+        "--pairs", "500")
+    assert r["format"] == "rgl" and r["theta_i"] == 4 and r["resolution"] == 16
+    assert r["error"]["pairs"] == 500
+    assert pathlib.Path(a).read_bytes() == pathlib.Path(b).read_bytes()
+    assert brdftab.open(a).channels == ["R", "G", "B"]
 
 
 def test_fit_is_cli_json(cli):
@@ -321,5 +332,11 @@ def test_bad_arguments():
         brdftab.bake(LAMBERT, "/tmp/never.btdb", grid="1x2x3")
     with pytest.raises(TypeError, match="unexpected keyword"):
         brdftab.fit(LAMBERT, "lambert", colour=True)
+    with pytest.raises(TypeError, match="supersample"):
+        brdftab.bake(LAMBERT, "/tmp/never.btdb", supersample="two")
+    with pytest.raises(ValueError, match="supersample"):
+        brdftab.bake(LAMBERT, "/tmp/never.btdb", supersample=65)
+    with pytest.raises(ValueError, match="max_theta_deg"):
+        brdftab.fit(LAMBERT, "lambert", max_theta_deg=100)
     # one-pair evaluation does not leak state between bad and good calls
     assert b.eval([0, 0, 1], [0, 0, 1]).tolist() == pytest.approx([0.1, 0.2, 0.3])

@@ -47,8 +47,10 @@ class Brdf:
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
 
 def open(
-    source: str, *, interp: str = "linear", wavelengths: Wavelengths = None, eager: bool = True
-) -> Brdf: ...
+    source: str, *, interp: str = "auto", wavelengths: Wavelengths = None, eager: bool = True
+) -> Brdf:
+    """Opens SOURCE. interp: "auto" (nearest on tables of MERL cells, linear otherwise),
+    "nearest" or "linear"."""
 def check(source: str, *, wavelengths: Wavelengths = None) -> dict[str, Any]: ...
 def info(source: str) -> dict[str, Any]: ...
 def bake(
@@ -69,10 +71,27 @@ def bake(
     name: str | None = ...,
     supersample: int = ...,
     wavelengths: Wavelengths = ...,
-    target_error: float | None = ...,
+    target_error: float | str | None = ...,
+    calibrate: bool | None = ...,
     replace: bool = ...,
-) -> dict[str, Any]: ...
-def convert(source: str, output: str, **options: Any) -> dict[str, Any]: ...
+) -> dict[str, Any]:
+    """Bakes SOURCE into OUTPUT (a .btdb file or DB#NAME); the keywords are the CLI's bake flags,
+    snake_cased, validated by the library's request layer. Returns `brdftab info --json`."""
+def convert(
+    source: str,
+    output: str,
+    *,
+    pairs: int | None = ...,
+    interp: str | None = ...,
+    resolution: int | None = ...,
+    theta_i: int | None = ...,
+    phi_i: int | None = ...,
+    ndf_resolution: int | None = ...,
+    **bake_options: Any,
+) -> dict[str, Any]:
+    """Converts SOURCE into OUTPUT, whose name says its kind: an RGL .bsdf (pbrt-v4 and
+    Mitsuba 3 load it), a MERL .binary, DB#NAME, a .btdb file or a raw table. Takes the keywords
+    of `bake` plus these; returns {"output", "format", "source", ...}."""
 def fit(
     source: str,
     model: str,
@@ -81,7 +100,7 @@ def fit(
     log: bool = ...,
     starts: int = ...,
     pairs: int = ...,
-    max_theta: float = ...,
+    max_theta_deg: float = ...,
     seed: int = ...,
     fresnel: str | None = ...,
     grey: bool = ...,

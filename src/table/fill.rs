@@ -34,6 +34,10 @@ use crate::table::{Table, pair_of};
 /// Progress callback: (values done, values total).
 pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
 
+/// The largest `supersample` of a bake: 64^d samples per node is already far past what any
+/// lobe needs.
+pub const MAX_SUPERSAMPLE: usize = 64;
+
 /// Options of [`bake_chunks`] and [`bake`].
 #[derive(Clone, Copy)]
 pub struct BakeOptions<'a> {
@@ -63,7 +67,7 @@ impl Default for BakeOptions<'_> {
 
 /// What a bake did.
 #[derive(Debug, Clone, Default)]
-pub struct BakeReport {
+pub struct BakeStats {
     /// Stored values produced.
     pub values: u64,
     /// Wall-clock seconds (excluding the symmetry check).
@@ -89,8 +93,11 @@ fn check(brdf: &dyn Brdf, grid: &Grid, opts: &BakeOptions) -> Result<Option<Stri
             "a delta (mirror/refractor) BRDF cannot be tabulated".into(),
         ));
     }
-    if opts.supersample == 0 || opts.supersample > 64 {
-        return Err(Error::arg("supersample", "must be in 1..=64"));
+    if !(1..=MAX_SUPERSAMPLE).contains(&opts.supersample) {
+        return Err(Error::arg(
+            "supersample",
+            format!("{}: must be in 1..={MAX_SUPERSAMPLE}", opts.supersample),
+        ));
     }
     if grid.symmetry() == Symmetry::NONE {
         return Ok(None);
@@ -110,7 +117,7 @@ pub fn bake_chunks(
     grid: &Grid,
     opts: &BakeOptions,
     mut sink: impl FnMut(usize, &[f32]) -> Result<()>,
-) -> Result<BakeReport> {
+) -> Result<BakeStats> {
     let forced = check(brdf, grid, opts)?;
     let start = Instant::now();
     let layout = grid.layout();
@@ -191,7 +198,7 @@ pub fn bake_chunks(
         }
         a = e;
     }
-    Ok(BakeReport {
+    Ok(BakeStats {
         values: total,
         seconds: start.elapsed().as_secs_f64(),
         forced,
@@ -199,7 +206,7 @@ pub fn bake_chunks(
 }
 
 /// Bakes `brdf` on `grid` into an in-memory [`Table`].
-pub fn bake(brdf: &dyn Brdf, grid: &Grid, opts: &BakeOptions) -> Result<(Table, BakeReport)> {
+pub fn bake(brdf: &dyn Brdf, grid: &Grid, opts: &BakeOptions) -> Result<(Table, BakeStats)> {
     let mut values = Vec::with_capacity(grid.stored_values());
     let report = bake_chunks(brdf, grid, opts, |_, v| {
         values.extend_from_slice(v);

@@ -1,0 +1,121 @@
+//! [`ConvertSettings`] and [`convert`]: any SOURCE into a MERL file, an RGL `.bsdf` file or a
+//! table, the output's kind chosen by its name — the one conversion every host runs.
+
+use serde::{Deserialize, Serialize};
+
+use super::bake::BakeSettings;
+use crate::bake::{self, BakeReport, BakeTarget, Converted};
+use crate::error::Result;
+use crate::measured::rgl_write;
+use crate::progress::Progress;
+use crate::source::{SourceKind, classify};
+use crate::table::Interp;
+
+/// The settings of a conversion: a bake's (for table and MERL outputs; `wavelengths` for every
+/// output) plus the accuracy report and the `.bsdf` writer's layout.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+#[cfg_attr(feature = "clap", derive(clap::Args))]
+pub struct ConvertSettings {
+    /// The bake's settings.
+    #[serde(flatten)]
+    #[cfg_attr(feature = "clap", command(flatten))]
+    pub bake: BakeSettings,
+    /// Random pairs for the reported accuracy (default 200 000; 0 skips it).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub pairs: Option<usize>,
+    /// Interpolation for the reported accuracy of a table: nearest or linear (default).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub interp: Option<String>,
+    /// .bsdf output: reflectance table resolution N (default 64, a .bsdf input's own).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub resolution: Option<usize>,
+    /// .bsdf output: number of incident elevations θi (default 16; 8 = the RGL database's
+    /// spacing).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub theta_i: Option<usize>,
+    /// .bsdf output: number of incident azimuths φi (default 1 if isotropic, else 17).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub phi_i: Option<usize>,
+    /// .bsdf output: NDF, σ and VNDF grid resolution (default 128).
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub ndf_resolution: Option<usize>,
+}
+
+/// The accuracy pairs of a conversion unless told otherwise.
+pub const DEFAULT_PAIRS: usize = 200_000;
+
+/// What [`convert`] wrote.
+#[derive(Debug, Clone)]
+pub enum ConvertOutput {
+    /// A MERL `.binary`: the source resampled at the MERL cell centres.
+    Merl(BakeReport),
+    /// An RGL `.bsdf` file, with the error of the file read back.
+    Rgl(Converted),
+    /// A table (`DB#NAME`, a `.btdb` file holding one table named after the input, or a raw
+    /// table), with its accuracy against the source under `interp`.
+    Table {
+        /// What the bake did.
+        report: BakeReport,
+        /// The interpolation of the accuracy report.
+        interp: Interp,
+    },
+}
+
+/// Converts SOURCE into `output`, whose kind its name says: a MERL `.binary`, an RGL `.bsdf`,
+/// `DB#NAME`, a `.btdb` file (a table named after the input) or a raw table file.
+///
+/// # Errors
+/// Invalid settings ([`crate::Error::InvalidArgument`] naming the field), and whatever opening
+/// the source and writing the output fail with.
+pub fn convert(
+    source: &str,
+    output: &str,
+    settings: &ConvertSettings,
+    progress: &dyn Progress,
+) -> Result<ConvertOutput> {
+    let mut req = settings.bake.request(source)?;
+    let pairs = settings.pairs.unwrap_or(DEFAULT_PAIRS);
+    match classify(output) {
+        SourceKind::Merl => Ok(ConvertOutput::Merl(
+            req.run_with(&BakeTarget::Merl(output.to_owned()), progress)?,
+        )),
+        SourceKind::Rgl => {
+            let opts = rgl_write::Options {
+                resolution: settings.resolution,
+                theta_i: settings.theta_i,
+                phi_i: settings.phi_i,
+                ndf_resolution: settings.ndf_resolution,
+                ..Default::default()
+            };
+            Ok(ConvertOutput::Rgl(bake::to_rgl(
+                source,
+                req.channels.clone(),
+                output,
+                &opts,
+                pairs,
+                progress,
+            )?))
+        }
+        _ => {
+            req.accuracy_pairs = pairs;
+            if let Some(i) = &settings.interp {
+                req.accuracy_interp = i.parse()?;
+            }
+            let replace = settings.bake.replace;
+            let target = match BakeTarget::parse(output, None, replace) {
+                BakeTarget::File(path) => BakeTarget::Db {
+                    path,
+                    name: req.name.clone().unwrap_or_else(|| bake::stem(source)),
+                    replace,
+                },
+                t => t,
+            };
+            let report = req.run_with(&target, progress)?;
+            Ok(ConvertOutput::Table {
+                report,
+                interp: req.accuracy_interp,
+            })
+        }
+    }
+}
