@@ -11,8 +11,8 @@ use brdftab::Brdf;
 use brdftab::bake::BakeRequest;
 use brdftab::geometry::uniform_hemisphere;
 use brdftab::progress::Silent;
-use brdftab::rng::Pcg32;
 use brdftab::table::TabulatedBrdf;
+use brdftab::testkit::Pcg32;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 

@@ -14,8 +14,8 @@ use std::hint::black_box;
 
 use brdftab::Channels;
 use brdftab::geometry;
-use brdftab::rng::Pcg32;
 use brdftab::spec::{MODELS, ModelSpec};
+use brdftab::testkit::Pcg32;
 use criterion::measurement::WallTime;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec3;

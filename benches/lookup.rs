@@ -11,8 +11,8 @@
 use std::hint::black_box;
 
 use brdftab::geometry::uniform_hemisphere;
-use brdftab::rng::Pcg32;
 use brdftab::table::{Grid, Interp, Table, TabulatedBrdf};
+use brdftab::testkit::Pcg32;
 use brdftab::{Brdf, Channels};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;

@@ -12,7 +12,7 @@ use std::time::Instant;
 use brdftab::Brdf;
 use brdftab::geometry::uniform_hemisphere;
 use brdftab::measured::{MerlBrdf, RglBrdf, merl};
-use brdftab::rng::Pcg32;
+use brdftab::testkit::Pcg32;
 use glam::DVec3;
 
 /// The shipped RGL file `name` (`data/rgl`, see `brdftab::measured::data`); a missing file

@@ -16,9 +16,9 @@
 use std::hint::black_box;
 
 use brdftab::geometry;
-use brdftab::rng::Pcg32;
 use brdftab::spec::ModelSpec;
 use brdftab::table::{BakeOptions, Grid, Mapping, Param, Symmetry, TabulatedBrdf, bake};
+use brdftab::testkit::Pcg32;
 use brdftab::{Brdf, Channels};
 use criterion::measurement::{Measurement, WallTime};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};

@@ -65,7 +65,7 @@ fn main() -> Result<()> {
         return Err(Error::Unsupported(format!("{cc} could not build {src}")));
     }
     let pairs = 1_000_000;
-    let mut rng = brdftab::rng::Pcg32::new(2024);
+    let mut rng = brdftab::testkit::Pcg32::new(2024);
     let p: Vec<(DVec3, DVec3)> = (0..pairs)
         .map(|_| {
             (

@@ -4,7 +4,7 @@
 //! `cargo run --release --example table_diag -- SPEC [u|c] [n_theta_d]` (θd uniform or uniform in cos)
 use brdftab::analysis::accuracy;
 use brdftab::table::{BakeOptions, Grid, Mapping, Param, TabulatedBrdf, bake, symmetry};
-use brdftab::{Brdf, Channels, ModelSpec, geometry, rng::Pcg32};
+use brdftab::{Brdf, Channels, ModelSpec, geometry, testkit::Pcg32};
 
 fn main() -> brdftab::Result<()> {
     let Some(spec) = std::env::args().nth(1) else {

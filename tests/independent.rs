@@ -6,7 +6,7 @@
 //! complex Fresnel equations with complex arithmetic), in f64. Every model is compared on 2 000
 //! random direction pairs at 1e-4 relative.
 
-use brdftab::rng::Pcg32;
+use brdftab::testkit::Pcg32;
 use brdftab::{Brdf, Channels, ModelSpec};
 use glam::DVec3;
 use std::f64::consts::PI;

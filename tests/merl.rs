@@ -4,7 +4,7 @@
 
 use brdftab::measured::MerlBrdf;
 use brdftab::measured::merl::{self, FILE_SIZE, SAMPLES};
-use brdftab::rng::Pcg32;
+use brdftab::testkit::Pcg32;
 use brdftab::{Brdf, Error};
 use std::f64::consts::PI;
 use std::path::PathBuf;

@@ -5,8 +5,8 @@
 use brdftab::analysis::albedo::quadrature;
 use brdftab::analysis::chi2::{self, Chi2Options};
 use brdftab::geometry;
-use brdftab::rng::Pcg32;
 use brdftab::spec::ModelSpec;
+use brdftab::testkit::Pcg32;
 use brdftab::{Brdf, Channels};
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;

@@ -315,7 +315,7 @@ fn corrupted_headers_never_panic() {
     // Flip random header bytes (names, dtypes, offsets, shapes) of a real file: every outcome must
     // be Ok or a typed error, never a panic or a huge allocation.
     let orig = std::fs::read(rgl("paper_white_rgb.bsdf")).unwrap();
-    let mut rng = brdftab::rng::Pcg32::new(5);
+    let mut rng = brdftab::testkit::Pcg32::new(5);
     for _ in 0..3000 {
         let mut b = orig.clone();
         for _ in 0..1 + rng.below(3) {
@@ -334,7 +334,7 @@ fn corrupted_headers_never_panic() {
 
 #[test]
 fn random_pairs_are_finite_and_non_negative() {
-    let mut rng = brdftab::rng::Pcg32::new(8);
+    let mut rng = brdftab::testkit::Pcg32::new(8);
     for file in ["cg_sunflower_rgb.bsdf", "satin_rosaline_rgb.bsdf"] {
         let b = RglBrdf::open(rgl(file)).unwrap();
         let mut f = [0f32; 3];

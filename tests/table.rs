@@ -3,11 +3,11 @@
 use brdftab::analysis::accuracy;
 use brdftab::geometry::{self, spherical};
 use brdftab::models::lambert::Lambert;
-use brdftab::rng::Pcg32;
 use brdftab::table::{
     Axis, BakeOptions, ChunkLoader, Grid, Interp, Mapping, Nodes, Param, Symmetry, Table,
     TabulatedBrdf, bake, bake_chunks, pair_of, symmetry,
 };
+use brdftab::testkit::Pcg32;
 use brdftab::{Brdf, Channels, Error, Flags, Result, Value};
 use glam::DVec3;
 use proptest::prelude::*;

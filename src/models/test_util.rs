@@ -82,28 +82,10 @@ pub fn check_reciprocity<B: Brdf + ?Sized>(
 }
 
 /// Below-horizon, NaN, infinite and zero directions give 0 from eval, eval_wavelength and pdf,
-/// and no sample.
+/// and no sample (the contract's check, [`crate::testkit`]).
+#[track_caller]
 pub fn check_invalid_inputs_give_zero<B: Brdf + ?Sized>(brdf: &B) {
-    let up = DVec3::new(0.2, 0.1, 1.0);
-    let bad = [
-        DVec3::new(0.0, 0.3, -1.0),
-        DVec3::new(1.0, 0.0, 0.0),
-        DVec3::new(f64::NAN, 0.0, 1.0),
-        DVec3::new(0.0, f64::INFINITY, 1.0),
-        DVec3::ZERO,
-    ];
-    let c = brdf.channels().len();
-    for b in bad {
-        for (wi, wo) in [(b, up), (up, b), (b, b)] {
-            let mut f = [1.0f32; MAX_CHANNELS];
-            brdf.eval(wi, wo, &mut f[..c]);
-            assert!(f[..c].iter().all(|&x| x == 0.0), "eval({wi}, {wo}) = {f:?}");
-            assert_eq!(brdf.eval_wavelength(wi, wo, 550.0), 0.0);
-            assert_eq!(brdf.pdf(wi, wo), 0.0, "pdf({wi}, {wo})");
-        }
-        let mut w = [0.0f32; MAX_CHANNELS];
-        assert!(brdf.sample(b, DVec2::new(0.3, 0.6), &mut w[..c]).is_none());
-    }
+    crate::testkit::contract::assert_bad_input_gives_zero(brdf);
 }
 
 /// eval_wavelength at each channel's wavelength equals eval's value for that channel.
@@ -126,61 +108,12 @@ pub fn check_eval_wavelength_matches_channels<B: Brdf + ?Sized>(brdf: &B) {
     }
 }
 
-/// For `n` random samples at each `wo`: the returned pdf equals `pdf(wi, wo)` and the weight
-/// equals f_r cos θi / pdf per channel (both to f32-level relative accuracy); sampled directions
-/// are unit and above the horizon.
+/// For `n` random samples at each `wo`: the returned pdf equals `pdf(wi, wo)`, the weight
+/// equals f_r cos θi / pdf per channel, `eval_pdf` agrees, sampled directions are unit and above
+/// the horizon (the contract's check, [`crate::testkit`]).
+#[track_caller]
 pub fn check_sampling_consistency<B: Brdf + ?Sized>(brdf: &B, wos: &[DVec3], n: usize) {
-    let mut rng = Pcg32::new(5);
-    let c = brdf.channels().len();
-    for &wo in wos {
-        let mut got = 0;
-        for _ in 0..n {
-            let mut w = [0.0f32; MAX_CHANNELS];
-            let Some(s) = brdf.sample(wo, rng.next_dvec2(), &mut w[..c]) else {
-                continue;
-            };
-            got += 1;
-            assert!(!s.delta);
-            assert!(
-                (s.wi.length() - 1.0).abs() < 1e-12 && s.wi.z > 0.0,
-                "{}",
-                s.wi
-            );
-            let pdf = brdf.pdf(s.wi, wo);
-            assert!(
-                (s.pdf - pdf).abs() <= 1e-7 * pdf,
-                "wo {wo}: sampled pdf {} vs pdf() {pdf}",
-                s.pdf
-            );
-            let mut f = [0.0f32; MAX_CHANNELS];
-            brdf.eval(s.wi, wo, &mut f[..c]);
-            // The fused eval_pdf agrees with eval and pdf.
-            let mut f2 = [0.0f32; MAX_CHANNELS];
-            let p2 = brdf.eval_pdf(s.wi, wo, &mut f2[..c]);
-            assert!(
-                (p2 - pdf).abs() <= 1e-12 * pdf,
-                "eval_pdf pdf {p2} vs {pdf}"
-            );
-            for k in 0..c {
-                assert!(
-                    (f2[k] - f[k]).abs() <= 1e-6 * f[k].abs(),
-                    "eval_pdf f {} vs {}",
-                    f2[k],
-                    f[k]
-                );
-            }
-            for k in 0..c {
-                let expect = f[k] as f64 * s.wi.z / s.pdf;
-                assert!(
-                    (w[k] as f64 - expect).abs() <= 1e-5 * expect + 1e-30,
-                    "wo {wo} wi {}: weight {} vs f cos/pdf {expect}",
-                    s.wi,
-                    w[k]
-                );
-            }
-        }
-        assert!(got > n / 4, "wo {wo}: only {got} of {n} samples succeeded");
-    }
+    crate::testkit::contract::assert_sampling_consistent(brdf, wos, n);
 }
 
 /// Chi-square tests of each model's sampler at every [`test_wos`] direction (see [`chi2_cases`]).

@@ -10,7 +10,7 @@ use std::ffi::CString;
 use std::time::Instant;
 
 use brdftab::bake::{BakeRequest, BakeTarget};
-use brdftab::rng::Pcg32;
+use brdftab::testkit::Pcg32;
 use brdftab::{Brdf, geometry};
 use brdftab_c::*;
 use glam::DVec3;

@@ -6,7 +6,7 @@ use std::io::Write;
 use std::process::{Command, Stdio};
 
 use brdftab::geometry::uniform_hemisphere;
-use brdftab::rng::Pcg32;
+use brdftab::testkit::Pcg32;
 
 #[test]
 fn default_lambert_table_evaluates_to_kd() {

@@ -11,8 +11,8 @@ use std::process::Command;
 
 use brdftab::measured::MerlBrdf;
 use brdftab::measured::merl::{self, RES_PHI_D, RES_THETA_D, RES_THETA_H, SAMPLES, SCALE};
-use brdftab::rng::Pcg32;
 use brdftab::store::Store;
+use brdftab::testkit::Pcg32;
 
 fn tmpdir(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("brdftab-merlrt-{tag}-{}", std::process::id()));

@@ -1,0 +1,505 @@
+//! [`check_contract`]: the `Brdf` contract, checked on one value (module docs of
+//! [`crate::testkit`]).
+
+use glam::{DVec2, DVec3};
+
+use crate::brdf::Brdf;
+use crate::geometry;
+use crate::rng::Pcg32;
+use crate::spectrum::MAX_CHANNELS;
+
+/// How hard [`check_contract`] looks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Contract {
+    /// Random direction pairs for positivity, symmetry and batches.
+    pub pairs: usize,
+    /// Samples drawn at each view direction of the sampling checks (0 skips them).
+    pub samples: usize,
+    /// Relative tolerance of the declared symmetries: f32 rounding of the two values plus the
+    /// rounding of two different computations of the same coordinates (default 1e-5).
+    pub symmetry_tolerance: f64,
+    /// Absolute tolerance of the declared symmetries, as a fraction of the channel's largest
+    /// value over the pairs (default 1e-6). A table's linear lookup computes its angles with
+    /// polynomial `atan2`/`acos` (error ≤ 2e-7 rad), so two pairs related by a symmetry land
+    /// up to that far apart: |Δf| ≤ |∂f/∂φ| · 2e-7, which is large relative to f only where f
+    /// is tiny and steep — negligible against the material's own scale.
+    pub symmetry_floor: f64,
+    /// Angular resolution of the declared symmetries, in radians (default 4e-7): a table's
+    /// linear lookup computes its angles with polynomial `atan2`/`acos` (error ≤ 2e-7 rad each),
+    /// so two pairs related by a symmetry may be looked up that far apart. Where f differs by
+    /// more than the tolerances above, the difference must stay within f's own change when a
+    /// direction turns by this angle about the normal.
+    pub symmetry_angle: f64,
+    /// Relative tolerance between a sample's pdf and `pdf(wi, wo)` (default 1e-7: both from
+    /// f64 arithmetic; a sampler whose warps are f32 data, as an RGL file's, agrees to f32
+    /// rounding through the warp, ~1e-6).
+    pub pdf_tolerance: f64,
+    /// Relative tolerance of `eval_batch` against `eval` (default 1e-6: a batch path may
+    /// reorder the same f32 arithmetic, not approximate it differently).
+    pub batch_tolerance: f64,
+    /// Seed of the pairs and samples.
+    pub seed: u64,
+}
+
+impl Default for Contract {
+    fn default() -> Self {
+        Contract {
+            pairs: 2000,
+            samples: 200,
+            symmetry_tolerance: 1e-5,
+            symmetry_floor: 1e-6,
+            symmetry_angle: 4e-7,
+            pdf_tolerance: 1e-7,
+            batch_tolerance: 1e-6,
+            seed: 1,
+        }
+    }
+}
+
+/// The view directions of the sampling checks: normal, moderate, steep and near-grazing, at
+/// azimuths off the axes so anisotropic lobes are exercised.
+pub(crate) fn views() -> [DVec3; 5] {
+    [
+        (0.0f64, 0.0f64),
+        (30.0, 0.4),
+        (60.0, 2.0),
+        (80.0, -1.1),
+        (88.0, 0.9),
+    ]
+    .map(|(t, p)| geometry::spherical(t.to_radians(), p))
+}
+
+/// At most this many violations are reported per check (one failure mode usually repeats).
+const PER_CHECK: usize = 5;
+
+/// Collects violations, `PER_CHECK` per check.
+struct Log {
+    all: Vec<String>,
+    counts: Vec<(&'static str, usize)>,
+}
+
+impl Log {
+    fn new() -> Log {
+        Log {
+            all: Vec::new(),
+            counts: Vec::new(),
+        }
+    }
+
+    #[cfg(test)]
+    #[track_caller]
+    fn assert_empty(self, what: &str) {
+        assert!(self.all.is_empty(), "{what}:\n{}", self.all.join("\n"));
+    }
+
+    fn fail(&mut self, check: &'static str, msg: impl FnOnce() -> String) {
+        let n = match self.counts.iter_mut().find(|(c, _)| *c == check) {
+            Some((_, n)) => n,
+            None => {
+                self.counts.push((check, 0));
+                &mut self.counts.last_mut().expect("just pushed").1
+            }
+        };
+        *n += 1;
+        if *n <= PER_CHECK {
+            self.all.push(format!("{check}: {}", msg()));
+        }
+    }
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    close_abs(a, b, rel, 1e-30)
+}
+
+fn close_abs(a: f64, b: f64, rel: f64, abs: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()) + abs
+}
+
+/// Checks the whole `Brdf` contract on `brdf` (module docs); `Err` lists the violations found
+/// (at most five per check, each naming its check and the directions).
+pub fn check_contract(brdf: &dyn Brdf, opts: &Contract) -> Result<(), Vec<String>> {
+    let mut log = Log::new();
+    let c = brdf.channels().len();
+    if c == 0 || c > MAX_CHANNELS {
+        return Err(vec![format!("channels: {c} (expected 1..={MAX_CHANNELS})")]);
+    }
+    let mut rng = Pcg32::new(opts.seed);
+    let pairs: Vec<(DVec3, DVec3)> = (0..opts.pairs)
+        .map(|_| {
+            (
+                geometry::uniform_hemisphere(rng.next_dvec2()),
+                geometry::uniform_hemisphere(rng.next_dvec2()),
+            )
+        })
+        .collect();
+    values_and_symmetry(brdf, opts, &pairs, &mut log);
+    batches(brdf, opts, &pairs, &mut log);
+    bad_input(brdf, &mut log);
+    if opts.samples > 0 {
+        sampling(brdf, opts, &views(), &mut rng, &mut log);
+    }
+    if let Err(e) = brdf.health() {
+        log.fail("health", || e.to_string());
+    }
+    if log.all.is_empty() {
+        Ok(())
+    } else {
+        let hidden: usize = log
+            .counts
+            .iter()
+            .map(|(_, n)| n.saturating_sub(PER_CHECK))
+            .sum();
+        if hidden > 0 {
+            log.all.push(format!("... and {hidden} more"));
+        }
+        Err(log.all)
+    }
+}
+
+fn eval<B: Brdf + ?Sized>(brdf: &B, wi: DVec3, wo: DVec3) -> [f32; MAX_CHANNELS] {
+    let mut f = [0.0f32; MAX_CHANNELS];
+    brdf.eval(wi, wo, &mut f[..brdf.channels().len()]);
+    f
+}
+
+/// Positivity, and the symmetries the flags declare.
+fn values_and_symmetry(brdf: &dyn Brdf, opts: &Contract, pairs: &[(DVec3, DVec3)], log: &mut Log) {
+    let c = brdf.channels().len();
+    let flags = brdf.flags();
+    let tol = opts.symmetry_tolerance;
+    let mirror = |v: DVec3| DVec3::new(v.x, -v.y, v.z);
+    let mut scale = [0.0f64; MAX_CHANNELS];
+    for &(wi, wo) in pairs {
+        let f = eval(brdf, wi, wo);
+        for ch in 0..c {
+            if f[ch].is_finite() {
+                scale[ch] = scale[ch].max(f[ch] as f64 * opts.symmetry_floor);
+            }
+        }
+    }
+    for (k, &(wi, wo)) in pairs.iter().enumerate() {
+        let f = eval(brdf, wi, wo);
+        if let Some(x) = f[..c].iter().find(|x| !(x.is_finite() && **x >= 0.0)) {
+            log.fail("positive", || format!("f({wi}, {wo}) = {x}"));
+        }
+        let mut same = |check: &'static str, a: DVec3, b: DVec3| {
+            let g = eval(brdf, a, b);
+            for ch in 0..c {
+                let slack = scale[ch] + 1e-30;
+                if !close_abs(f[ch] as f64, g[ch] as f64, tol, slack)
+                    && !close_abs(
+                        f[ch] as f64,
+                        g[ch] as f64,
+                        tol,
+                        slack + sensitivity(brdf, wi, wo, ch, opts.symmetry_angle),
+                    )
+                {
+                    log.fail(check, || {
+                        format!(
+                            "channel {ch}: f({wi}, {wo}) = {} but f({a}, {b}) = {}",
+                            f[ch], g[ch]
+                        )
+                    });
+                    break;
+                }
+            }
+        };
+        if flags.reciprocal {
+            same("reciprocal", wo, wi);
+        }
+        if flags.isotropic {
+            // A rotation about the normal by an angle drawn from the pair's index.
+            let a = 0.7 + k as f64 * 2.399963;
+            let rot = |v: DVec3| {
+                let (s, co) = a.sin_cos();
+                DVec3::new(co * v.x - s * v.y, s * v.x + co * v.y, v.z)
+            };
+            same("isotropic", rot(wi), rot(wo));
+        }
+        if flags.bilateral {
+            same("bilateral", mirror(wi), mirror(wo));
+        }
+    }
+}
+
+/// How much f's channel `ch` changes when either direction turns by ±`angle` about the normal.
+fn sensitivity(brdf: &dyn Brdf, wi: DVec3, wo: DVec3, ch: usize, angle: f64) -> f64 {
+    let f = eval(brdf, wi, wo)[ch] as f64;
+    let turn = |v: DVec3, a: f64| {
+        let (s, c) = a.sin_cos();
+        DVec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z)
+    };
+    [
+        (turn(wi, angle), wo),
+        (turn(wi, -angle), wo),
+        (wi, turn(wo, angle)),
+        (wi, turn(wo, -angle)),
+    ]
+    .iter()
+    .map(|&(a, b)| (eval(brdf, a, b)[ch] as f64 - f).abs())
+    .fold(0.0, f64::max)
+}
+
+/// `eval_batch` against `eval`, pair by pair (unnormalized and below-horizon pairs included).
+fn batches(brdf: &dyn Brdf, opts: &Contract, pairs: &[(DVec3, DVec3)], log: &mut Log) {
+    let c = brdf.channels().len();
+    let (wi, wo): (Vec<DVec3>, Vec<DVec3>) = pairs
+        .iter()
+        .enumerate()
+        .map(|(k, &(a, b))| match k % 13 {
+            0 => (a, DVec3::new(b.x, b.y, -b.z)),
+            1 => (a * 3.5, b * 0.25),
+            _ => (a, b),
+        })
+        .unzip();
+    let mut out = vec![0.0f32; wi.len() * c];
+    brdf.eval_batch(&wi, &wo, &mut out);
+    for (k, got) in out.chunks_exact(c).enumerate() {
+        let want = eval(brdf, wi[k], wo[k]);
+        if (0..c).any(|ch| !close(got[ch] as f64, want[ch] as f64, opts.batch_tolerance)) {
+            log.fail("eval_batch", || {
+                format!(
+                    "pair ({}, {}): batch {got:?} vs eval {:?}",
+                    wi[k],
+                    wo[k],
+                    &want[..c]
+                )
+            });
+        }
+    }
+}
+
+/// Below the horizon, NaN, infinite and zero directions: f = 0, pdf = 0, no sample.
+fn bad_input<B: Brdf + ?Sized>(brdf: &B, log: &mut Log) {
+    let c = brdf.channels().len();
+    let up = DVec3::new(0.2, 0.1, 1.0);
+    let bad = [
+        DVec3::new(0.0, 0.3, -1.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(f64::NAN, 0.0, 1.0),
+        DVec3::new(0.0, f64::INFINITY, 1.0),
+        DVec3::ZERO,
+    ];
+    let transmits = brdf.flags().transmission;
+    for b in bad {
+        // A refractor is non-zero across the horizon; the non-finite and zero ones still give 0.
+        if transmits && b.is_finite() && b != DVec3::ZERO && b.z != 0.0 {
+            continue;
+        }
+        for (wi, wo) in [(b, up), (up, b), (b, b)] {
+            let mut f = [1.0f32; MAX_CHANNELS];
+            brdf.eval(wi, wo, &mut f[..c]);
+            if f[..c].iter().any(|&x| x != 0.0) {
+                log.fail("horizon", || format!("eval({wi}, {wo}) = {:?}", &f[..c]));
+            }
+            let nm = brdf.channels().wavelength(0);
+            if brdf.eval_wavelength(wi, wo, nm) != 0.0 {
+                log.fail("horizon", || format!("eval_wavelength({wi}, {wo}) ≠ 0"));
+            }
+            if brdf.pdf(wi, wo) != 0.0 {
+                log.fail("horizon", || format!("pdf({wi}, {wo}) ≠ 0"));
+            }
+        }
+        let mut w = [0.0f32; MAX_CHANNELS];
+        if let Some(s) = brdf.sample(b, DVec2::new(0.3, 0.6), &mut w[..c]) {
+            log.fail("horizon", || format!("sample(wo = {b}) gave {s:?}"));
+        }
+    }
+}
+
+/// The bad-input part of the contract alone, panicking with the violations (the crate's model
+/// tests).
+#[cfg(test)]
+#[track_caller]
+pub(crate) fn assert_bad_input_gives_zero<B: Brdf + ?Sized>(brdf: &B) {
+    let mut log = Log::new();
+    bad_input(brdf, &mut log);
+    log.assert_empty(&brdf.describe());
+}
+
+/// The sampling part of the contract alone, `n` samples at each of `wos`, panicking with the
+/// violations (the crate's model tests).
+#[cfg(test)]
+#[track_caller]
+pub(crate) fn assert_sampling_consistent<B: Brdf + ?Sized>(brdf: &B, wos: &[DVec3], n: usize) {
+    let opts = Contract {
+        samples: n,
+        ..Contract::default()
+    };
+    let mut log = Log::new();
+    sampling(brdf, &opts, wos, &mut Pcg32::new(5), &mut log);
+    log.assert_empty(&brdf.describe());
+}
+
+/// Samples against pdf and eval at each of [`views`].
+fn sampling<B: Brdf + ?Sized>(
+    brdf: &B,
+    opts: &Contract,
+    wos: &[DVec3],
+    rng: &mut Pcg32,
+    log: &mut Log,
+) {
+    let c = brdf.channels().len();
+    let delta = brdf.flags().delta;
+    for &wo in wos {
+        let mut got = 0;
+        for _ in 0..opts.samples {
+            let mut w = [0.0f32; MAX_CHANNELS];
+            let Some(s) = brdf.sample(wo, rng.next_dvec2(), &mut w[..c]) else {
+                continue;
+            };
+            got += 1;
+            if !((s.wi.length() - 1.0).abs() < 1e-9 && s.wi.is_finite()) {
+                log.fail("sample", || format!("wo {wo}: wi {} not unit", s.wi));
+                continue;
+            }
+            if w[..c].iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+                log.fail("sample", || format!("wo {wo}: weight {:?}", &w[..c]));
+            }
+            if s.delta || delta {
+                if !s.delta {
+                    log.fail("sample", || {
+                        format!("wo {wo}: a delta BRDF's sample not delta")
+                    });
+                }
+                continue;
+            }
+            if !brdf.flags().transmission && s.wi.z <= 0.0 {
+                log.fail("sample", || {
+                    format!("wo {wo}: wi {} below the horizon", s.wi)
+                });
+            }
+            let pdf = brdf.pdf(s.wi, wo);
+            if !close(s.pdf, pdf, opts.pdf_tolerance) || !(pdf > 0.0) {
+                log.fail("pdf", || {
+                    format!(
+                        "wo {wo}, wi {}: sample's pdf {} vs pdf() {pdf}",
+                        s.wi, s.pdf
+                    )
+                });
+            }
+            let f = eval(brdf, s.wi, wo);
+            let mut f2 = [0.0f32; MAX_CHANNELS];
+            let p2 = brdf.eval_pdf(s.wi, wo, &mut f2[..c]);
+            if !close(p2, pdf, 1e-12) || (0..c).any(|k| !close(f2[k] as f64, f[k] as f64, 1e-6)) {
+                log.fail("eval_pdf", || {
+                    format!(
+                        "wo {wo}, wi {}: eval_pdf ({p2}, {:?}) vs pdf {pdf}, eval {:?}",
+                        s.wi,
+                        &f2[..c],
+                        &f[..c]
+                    )
+                });
+            }
+            for k in 0..c {
+                let want = f[k] as f64 * s.wi.z.abs() / s.pdf;
+                if !close(w[k] as f64, want, 1e-5) {
+                    log.fail("weight", || {
+                        format!(
+                            "wo {wo}, wi {}: channel {k} weight {} vs f cos θi / pdf {want}",
+                            s.wi, w[k]
+                        )
+                    });
+                }
+            }
+        }
+        if got * 4 < opts.samples {
+            log.fail("sample", || {
+                format!("wo {wo}: only {got} of {} samples drawn", opts.samples)
+            });
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brdf::{BrdfSample, Flags};
+    use crate::spectrum::Channels;
+
+    /// Lambert (kd = 0.3) with one flaw.
+    struct Flawed(&'static str);
+
+    impl Brdf for Flawed {
+        fn channels(&self) -> &Channels {
+            &Channels::Rgb
+        }
+        fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+            let ok = |v: DVec3| v.is_finite() && v.z > 0.0;
+            let v = if !(ok(wi) && ok(wo)) && self.0 != "horizon" {
+                0.0
+            } else {
+                match self.0 {
+                    "negative" if wi.x > 0.5 => -0.1,
+                    "reciprocal" => 0.3 + 0.1 * wi.z as f32,
+                    "isotropic" => 0.3 + 0.1 * wi.x as f32,
+                    _ => 0.3,
+                }
+            };
+            out.fill(v);
+        }
+        fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
+            for ((a, b), o) in wi.iter().zip(wo).zip(out.chunks_exact_mut(3)) {
+                self.eval(*a, *b, o);
+                if self.0 == "batch" {
+                    o[0] *= 1.001;
+                }
+            }
+        }
+        fn flags(&self) -> Flags {
+            Flags::SMOOTH_SYMMETRIC
+        }
+        fn describe(&self) -> String {
+            self.0.into()
+        }
+        fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+            let p = match (geometry::unit(wi), geometry::unit(wo)) {
+                (Some(i), Some(o)) if i.z > 0.0 && o.z > 0.0 => i.z / std::f64::consts::PI,
+                _ => 0.0,
+            };
+            if self.0 == "pdf" { p * 1.01 } else { p }
+        }
+        fn sample(&self, wo: DVec3, u: DVec2, w: &mut [f32]) -> Option<BrdfSample> {
+            let o = geometry::unit(wo)?;
+            if o.z <= 0.0 {
+                return None;
+            }
+            let wi = geometry::cosine_hemisphere(u);
+            let pdf = wi.z / std::f64::consts::PI;
+            let k = if self.0 == "weight" { 1.1 } else { 1.0 };
+            w.fill((0.3 * std::f64::consts::PI * k) as f32);
+            Some(BrdfSample {
+                wi,
+                pdf,
+                delta: false,
+            })
+        }
+    }
+
+    #[test]
+    fn each_flaw_is_caught_by_its_check_and_lambert_passes() {
+        let quick = Contract {
+            pairs: 300,
+            samples: 50,
+            ..Contract::default()
+        };
+        assert_eq!(check_contract(&Flawed("none"), &quick), Ok(()));
+        for flaw in [
+            "negative",
+            "reciprocal",
+            "isotropic",
+            "batch",
+            "horizon",
+            "pdf",
+            "weight",
+        ] {
+            let v = check_contract(&Flawed(flaw), &quick).expect_err(flaw);
+            let check = match flaw {
+                "negative" => "positive",
+                "batch" => "eval_batch",
+                f => f,
+            };
+            assert!(v.iter().any(|m| m.starts_with(check)), "{flaw}: {v:?}");
+        }
+    }
+}
