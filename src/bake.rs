@@ -624,8 +624,8 @@ impl BakeRequest {
             let report = self.report_for(src, table.grid(), None, t0, true);
             return Ok((table, report));
         }
-        // What the bake samples ([`Brdf::bake_view`]); the report describes the source.
-        let view = src.bake_view();
+        // What the bake samples ([`BakeSource::bake_view`](crate::brdf::BakeSource::bake_view)); the report describes the source.
+        let view = src.bake_source().and_then(|b| b.bake_view());
         let bake_src: &dyn Brdf = view.as_deref().unwrap_or(src);
         let Plan {
             grid,
@@ -791,8 +791,8 @@ impl BakeRequest {
         progress: &dyn Progress,
     ) -> Result<BakeReport> {
         let t0 = Instant::now();
-        // What the bake samples ([`Brdf::bake_view`]).
-        let view = src.bake_view();
+        // What the bake samples ([`BakeSource::bake_view`](crate::brdf::BakeSource::bake_view)).
+        let view = src.bake_source().and_then(|b| b.bake_view());
         let bake_src: &dyn Brdf = view.as_deref().unwrap_or(src);
         let Plan {
             grid,

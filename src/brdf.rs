@@ -36,17 +36,63 @@ pub struct Flags {
     pub bilateral: bool,
     /// Transmits light to the other side of the surface (refraction).
     pub transmission: bool,
+    /// The kinds of lobe the BRDF has, for hosts to map to their own flags (Mitsuba's
+    /// `DiffuseReflection`/`GlossyReflection`/`DeltaReflection`, pbrt-v4's `BxDFFlags`).
+    pub lobes: Lobes,
+}
+
+/// The kinds of lobe a BRDF has; a sum has the union of its terms'. Tables and measured data
+/// are glossy (whatever they hold, a renderer must sample them as such).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct Lobes {
+    /// A constant or slowly varying lobe (Lambert, Oren-Nayar): cosine sampling is near ideal.
+    pub diffuse: bool,
+    /// A lobe with a peak (the Phong family, microfacet models, tables, measurements).
+    pub glossy: bool,
+    /// A Dirac delta (ideal mirror, ideal refraction): `eval` cannot see it.
+    pub delta: bool,
+}
+
+impl Lobes {
+    /// Diffuse only.
+    pub const DIFFUSE: Lobes = Lobes {
+        diffuse: true,
+        glossy: false,
+        delta: false,
+    };
+    /// Glossy only.
+    pub const GLOSSY: Lobes = Lobes {
+        diffuse: false,
+        glossy: true,
+        delta: false,
+    };
+    /// Delta only.
+    pub const DELTA: Lobes = Lobes {
+        diffuse: false,
+        glossy: false,
+        delta: true,
+    };
+
+    /// The lobes of either.
+    pub fn union(self, o: Lobes) -> Lobes {
+        Lobes {
+            diffuse: self.diffuse || o.diffuse,
+            glossy: self.glossy || o.glossy,
+            delta: self.delta || o.delta,
+        }
+    }
 }
 
 impl Flags {
-    /// Flags of a smooth, reciprocal, isotropic, bilaterally symmetric reflection model — the
-    /// common case.
+    /// Flags of a smooth, reciprocal, isotropic, bilaterally symmetric glossy reflection model
+    /// — the common case.
     pub const SMOOTH_SYMMETRIC: Flags = Flags {
         delta: false,
         reciprocal: true,
         isotropic: true,
         bilateral: true,
         transmission: false,
+        lobes: Lobes::GLOSSY,
     };
 }
 
@@ -195,6 +241,29 @@ pub trait Brdf: Send + Sync {
         self.pdf(wi, wo)
     }
 
+    /// What a bake needs of this source beyond its values ([`BakeSource`]): `None` (the
+    /// default) for the analytic models; a MERL file and a table give their stored nodes, an
+    /// RGL file the view a bake samples.
+    fn bake_source(&self) -> Option<&dyn BakeSource> {
+        None
+    }
+
+    /// Whether every value this BRDF has returned so far was real. `eval` cannot return an
+    /// error, so a source whose data can fail while it is read — a lazily decoded table whose
+    /// chunk fails its checksum — returns 0 for the lookups it cannot serve and reports the
+    /// failure here from then on (sticky: a failed source stays failed). Call it after a batch
+    /// of lookups (a tile, a frame) and discard the batch on an error; it is one atomic load
+    /// for a healthy table. Always `Ok` for analytic models and measured files (read whole at
+    /// open).
+    fn health(&self) -> crate::Result<()> {
+        Ok(())
+    }
+}
+
+/// What a bake asks of a source besides `eval`: the nodes it stores, and what to sample when
+/// the source itself is not what a table should follow. Reached through
+/// [`Brdf::bake_source`], so the core trait carries one hook instead of the bake's concerns.
+pub trait BakeSource {
     /// For sources that are themselves values on nodes in the Rusinkiewicz angles — a MERL
     /// measurement (cell centres), a `halfdiff` table (its nodes): when `hd` is one of those
     /// nodes (to rounding), writes its value **as stored** into `out[..channels]` and returns
@@ -208,17 +277,6 @@ pub trait Brdf: Send + Sync {
     fn stored_node(&self, hd: geometry::HalfDiff, out: &mut [f32]) -> bool {
         let _ = (hd, out);
         false
-    }
-
-    /// Whether every value this BRDF has returned so far was real. `eval` cannot return an
-    /// error, so a source whose data can fail while it is read — a lazily decoded table whose
-    /// chunk fails its checksum — returns 0 for the lookups it cannot serve and reports the
-    /// failure here from then on (sticky: a failed source stays failed). Call it after a batch
-    /// of lookups (a tile, a frame) and discard the batch on an error; it is one atomic load
-    /// for a healthy table. Always `Ok` for analytic models and measured files (read whole at
-    /// open).
-    fn health(&self) -> crate::Result<()> {
-        Ok(())
     }
 
     /// What a bake of this BRDF samples, when that is not the BRDF itself: `None` (the
@@ -280,14 +338,11 @@ macro_rules! forward_brdf {
             fn eval_pdf(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) -> f64 {
                 (**self).eval_pdf(wi, wo, out)
             }
-            fn stored_node(&self, hd: geometry::HalfDiff, out: &mut [f32]) -> bool {
-                (**self).stored_node(hd, out)
+            fn bake_source(&self) -> Option<&dyn BakeSource> {
+                (**self).bake_source()
             }
             fn health(&self) -> crate::Result<()> {
                 (**self).health()
-            }
-            fn bake_view(&self) -> Option<Box<dyn Brdf + '_>> {
-                (**self).bake_view()
             }
         }
     };

@@ -55,7 +55,7 @@ pub mod table;
 pub mod testkit;
 
 pub use bake::{BakeReport, BakeRequest, BakeTarget};
-pub use brdf::{Brdf, BrdfSample, Flags};
+pub use brdf::{BakeSource, Brdf, BrdfSample, Flags, Lobes};
 pub use error::{Error, Result};
 pub use progress::Progress;
 pub use source::{OpenOptions, SourceKind, classify, open, open_with};

@@ -155,7 +155,7 @@ fn rgl_defaults_pass_a_white_furnace() {
     // darker than 0.02 judged against 0.02) at every angle up to 88°, both integrated on the same
     // mirror-centred rule (it resolves `cg_sunflower`'s 0.4° peak, which random or tabulated
     // importance sampling does not yet: that is the sampling issue's). The source is the one
-    // the table was baked from: the file made continuous at the normal (`Brdf::bake_view`; the
+    // the table was baked from: the file made continuous at the normal (`BakeSource::bake_view`; the
     // native reader's own values near the normal depend on the azimuth from which wi nears it,
     // README "Measured data"). At 89° the files' viewer albedo climbs steeply (satin_rosaline:
     // 0.99 at 88°, 1.59 at 89°, as f_r ∝ 1/cos θo) and the table is within 1.5 % there.
@@ -165,7 +165,7 @@ fn rgl_defaults_pass_a_white_furnace() {
         .collect();
     for b in baked() {
         let native = b.native();
-        let view = native.bake_view();
+        let view = native.bake_source().and_then(|b| b.bake_view());
         let source: &dyn Brdf = view.as_deref().unwrap_or(native.as_ref());
         let table = b.table();
         let sides: [(&str, &dyn Brdf, &dyn Brdf); 2] = [
@@ -202,7 +202,7 @@ fn lookups_at_the_normal_give_the_continuous_limit() {
     for b in baked() {
         let table = b.table();
         let native = b.native();
-        let view = native.bake_view();
+        let view = native.bake_source().and_then(|b| b.bake_view());
         let source: &dyn Brdf = view.as_deref().unwrap_or(native.as_ref());
         // The limit: the whole slice at the normal — each side's albedo at exactly θ = 0, which
         // evaluates the table at the normal itself — within 1 % of the source's (a channel

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use brdftab::codec::{Codec, Layout, Quant};
 use brdftab::store::format::{self, Superblock, Toc};
-use brdftab::store::{OpenOptions, Source, Store, TableHeader, Writer, db, export};
+use brdftab::store::{Source, Store, StoreOptions, TableHeader, Writer, db, export};
 use brdftab::{Channels, Error};
 
 fn tmpdir(name: &str) -> PathBuf {
@@ -181,7 +181,7 @@ fn cache_respects_its_memory_bound_and_eager_decodes_everything() {
     let chunk_bytes = 10 * 20 * 3 * 4;
     let s = Store::open_with(
         &p,
-        OpenOptions {
+        StoreOptions {
             cache_bytes: 2 * chunk_bytes,
             eager: false,
         },
@@ -194,7 +194,7 @@ fn cache_respects_its_memory_bound_and_eager_decodes_everything() {
     assert!(format!("{s:?}").contains("tables"));
     let s = Store::open_with(
         &p,
-        OpenOptions {
+        StoreOptions {
             cache_bytes: 1 << 30,
             eager: true,
         },
@@ -278,7 +278,7 @@ fn sample_file(d: &Path) -> (PathBuf, Vec<u8>) {
 /// Opens bytes as a file and verifies everything; returns the error (panics if it succeeds).
 fn open_err(d: &Path, bytes: &[u8]) -> Error {
     let _ = d;
-    match Store::from_bytes("bad.btdb", bytes.to_vec(), OpenOptions::default())
+    match Store::from_bytes("bad.btdb", bytes.to_vec(), StoreOptions::default())
         .and_then(|s| s.verify())
     {
         Ok(_) => panic!("damaged file accepted"),
@@ -479,7 +479,7 @@ fn random_mutations_never_panic_or_pass() {
             continue;
         }
         let r = std::panic::catch_unwind(|| {
-            Store::from_bytes("m", m.clone(), OpenOptions::default()).and_then(|s| s.verify())
+            Store::from_bytes("m", m.clone(), StoreOptions::default()).and_then(|s| s.verify())
         });
         match r {
             Err(_) => panic!("mutation {it} panicked"),
@@ -656,14 +656,14 @@ fn a_damaged_chunk_read_lazily_stays_a_checksum_error() {
         .run(&brdftab::BakeTarget::file(p.to_str().unwrap()))
         .unwrap();
     let mut b = std::fs::read(&p).unwrap();
-    let st = Store::from_bytes("x.btdb", b.clone(), OpenOptions::default()).unwrap();
+    let st = Store::from_bytes("x.btdb", b.clone(), StoreOptions::default()).unwrap();
     let raw = st.table("l").unwrap().raw_chunk(0).unwrap().to_vec();
     let at = b
         .windows(raw.len())
         .position(|w| w == raw.as_slice())
         .unwrap();
     b[at + raw.len() / 2] ^= 0x10;
-    let st = Store::from_bytes("x.btdb", b, OpenOptions::default()).unwrap();
+    let st = Store::from_bytes("x.btdb", b, StoreOptions::default()).unwrap();
     let tab = st.table("l").unwrap().brdf().unwrap();
     let e = tab.load_all().unwrap_err();
     assert!(

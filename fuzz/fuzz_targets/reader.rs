@@ -2,11 +2,11 @@
 //! slice — must return errors, never panic, never allocate beyond what the input justifies.
 #![no_main]
 
-use brdftab::store::{OpenOptions, Store};
+use brdftab::store::{StoreOptions, Store};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let opts = OpenOptions { cache_bytes: 1 << 20, eager: false };
+    let opts = StoreOptions { cache_bytes: 1 << 20, eager: false };
     let Ok(s) = Store::from_bytes("fuzz", data.to_vec(), opts) else { return };
     for e in s.tables().to_vec() {
         let Ok(t) = s.table(&e.name) else { continue };

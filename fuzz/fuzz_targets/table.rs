@@ -6,11 +6,11 @@
 #[path = "common.rs"]
 mod common;
 
-use brdftab::store::{OpenOptions, Store};
+use brdftab::store::{StoreOptions, Store};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let opts = OpenOptions { cache_bytes: 1 << 20, eager: false };
+    let opts = StoreOptions { cache_bytes: 1 << 20, eager: false };
     let Ok(s) = Store::from_bytes("fuzz.btdb", data.to_vec(), opts) else { return };
     let Ok(t) = s.single() else { return };
     let Ok(b) = t.brdf() else { return };

@@ -30,7 +30,7 @@
 //! does.
 //!
 //! A table of the file on [`Grid::merl`](crate::table::Grid::merl) ([`MerlBrdf::to_table`], or
-//! a bake on that grid, which copies the cells through [`Brdf::stored_node`]) keeps them too, as
+//! a bake on that grid, which copies the cells through [`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node)) keeps them too, as
 //! negative values (−1 × scale), so MERL → table → MERL gives the file back (to f32 precision,
 //! and within the codec's bound for lossy codecs, which keep the sign). Lookups in such a table
 //! see them as 0 ([`TabulatedBrdf`](crate::table::TabulatedBrdf)): a *nearest* lookup gives the
@@ -60,7 +60,7 @@ use std::path::Path;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::brdf::{Brdf, Flags};
+use crate::brdf::{BakeSource, Brdf, Flags};
 use crate::error::{Error, Result};
 use crate::geometry::{self, HalfDiff};
 use crate::spectrum::{Channels, RGB_WAVELENGTHS};
@@ -305,10 +305,10 @@ impl MerlBrdf {
 
     /// Resamples any BRDF at the cell centres of the MERL grid and stores f_r / scale.
     ///
-    /// A source that stores a value at the cell centre ([`Brdf::stored_node`]: a MERL
+    /// A source that stores a value at the cell centre ([`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node): a MERL
     /// measurement, a `halfdiff` table on the MERL grid) gives it as stored, so MERL → MERL and
     /// MERL → table → MERL keep every cell — to f32 precision, the precision of
-    /// [`Brdf::stored_node`] — and every unmeasured cell: a negative stored value is written as
+    /// [`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node) — and every unmeasured cell: a negative stored value is written as
     /// the database's −1. Any other source is evaluated at the cell centre (RGB channels: `eval`;
     /// other channel sets: [`Brdf::eval_wavelength`] at the representative RGB wavelengths);
     /// there cells whose centre puts a direction below the horizon are stored as −1
@@ -328,7 +328,11 @@ impl MerlBrdf {
                             let hd = cell_center(ith, itd, ipd);
                             let cell = &mut chunk[ipd + RES_PHI_D * itd];
                             let mut f = [0.0f32; 3];
-                            if stored && brdf.stored_node(hd, &mut f) {
+                            if stored
+                                && brdf
+                                    .bake_source()
+                                    .is_some_and(|b| b.stored_node(hd, &mut f))
+                            {
                                 for c in 0..3 {
                                     cell[c] = if f[c] < 0.0 {
                                         -1.0
@@ -465,6 +469,10 @@ fn dims(h: &[u8]) -> [i32; 3] {
 }
 
 impl Brdf for MerlBrdf {
+    fn bake_source(&self) -> Option<&dyn BakeSource> {
+        Some(self)
+    }
+
     fn channels(&self) -> &Channels {
         &self.channels
     }
@@ -492,6 +500,7 @@ impl Brdf for MerlBrdf {
         Flags {
             reciprocal: true,
             isotropic: true,
+            lobes: crate::brdf::Lobes::GLOSSY,
             ..Flags::default()
         }
     }
@@ -499,7 +508,9 @@ impl Brdf for MerlBrdf {
     fn describe(&self) -> String {
         format!("MERL measured BRDF ({})", self.name)
     }
+}
 
+impl BakeSource for MerlBrdf {
     /// The stored cell whose centre is `hd` ([`cell_at_center`]), unmeasured cells negative.
     fn stored_node(&self, hd: HalfDiff, out: &mut [f32]) -> bool {
         match cell_at_center(hd) {

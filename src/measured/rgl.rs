@@ -40,7 +40,7 @@ use glam::DVec3;
 
 use super::rgl_normal::{ContinuousAtNormal, NormalLimit};
 use super::tensor::{Dtype, Field, TensorFile};
-use crate::brdf::{Brdf, Flags};
+use crate::brdf::{BakeSource, Brdf, Flags};
 use crate::error::{Error, Result};
 use crate::geometry;
 use crate::spectrum::{Channels, MAX_CHANNELS};
@@ -822,6 +822,10 @@ impl std::fmt::Debug for RglBrdf {
 }
 
 impl Brdf for RglBrdf {
+    fn bake_source(&self) -> Option<&dyn BakeSource> {
+        Some(self)
+    }
+
     fn channels(&self) -> &Channels {
         &self.channels
     }
@@ -890,20 +894,9 @@ impl Brdf for RglBrdf {
     fn flags(&self) -> Flags {
         Flags {
             isotropic: self.isotropic,
+            lobes: crate::brdf::Lobes::GLOSSY,
             ..Flags::default()
         }
-    }
-
-    fn bake_view(&self) -> Option<Box<dyn Brdf + '_>> {
-        // Anisotropic files store the normal slice once per φi and interpolate between them:
-        // their limit is the reader's own (left as it is).
-        if !self.isotropic || self.theta_i.len() < 2 {
-            return None;
-        }
-        let limit = self.normal_limit.get_or_init(|| NormalLimit::new(self));
-        let t0 = self.theta_i[0] as f64;
-        let slice = [t0, (self.theta_i[1] as f64).min(t0 + NORMAL_BAND)];
-        Some(Box::new(ContinuousAtNormal::new(self, limit, slice)))
     }
 
     fn describe(&self) -> String {
@@ -926,5 +919,19 @@ impl Brdf for RglBrdf {
                 format!(", reduction {}", s.reduction)
             }
         )
+    }
+}
+
+impl BakeSource for RglBrdf {
+    fn bake_view(&self) -> Option<Box<dyn Brdf + '_>> {
+        // Anisotropic files store the normal slice once per φi and interpolate between them:
+        // their limit is the reader's own (left as it is).
+        if !self.isotropic || self.theta_i.len() < 2 {
+            return None;
+        }
+        let limit = self.normal_limit.get_or_init(|| NormalLimit::new(self));
+        let t0 = self.theta_i[0] as f64;
+        let slice = [t0, (self.theta_i[1] as f64).min(t0 + NORMAL_BAND)];
+        Some(Box::new(ContinuousAtNormal::new(self, limit, slice)))
     }
 }

@@ -193,7 +193,10 @@ mod tests {
     #[test]
     fn the_view_is_continuous_at_the_normal_and_the_file_is_not() {
         let rgl = file("cc_iris_purple_gem_rgb.bsdf");
-        let view = rgl.bake_view().expect("an isotropic file has a view");
+        let view = rgl
+            .bake_source()
+            .and_then(|b| b.bake_view())
+            .expect("an isotropic file has a view");
         let wo = spherical(30f64.to_radians(), 0.7);
         let (mut a, mut b) = ([0f32; 3], [0f32; 3]);
         let mut spread = |brdf: &dyn Brdf| {
@@ -232,7 +235,7 @@ mod tests {
     #[test]
     fn the_view_keeps_every_directional_albedo() {
         let rgl = file("vch_golden_yellow_rgb.bsdf");
-        let view = rgl.bake_view().unwrap();
+        let view = rgl.bake_source().and_then(|b| b.bake_view()).unwrap();
         let opts = crate::analysis::fidelity::FidelityOptions {
             albedo_thetas_deg: vec![0.0, 0.05, 0.5, 1.0, 2.0, 4.0],
             ..Default::default()

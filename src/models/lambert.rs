@@ -59,7 +59,10 @@ impl Brdf for Lambert {
     }
 
     fn flags(&self) -> Flags {
-        Flags::SMOOTH_SYMMETRIC
+        Flags {
+            lobes: crate::brdf::Lobes::DIFFUSE,
+            ..Flags::SMOOTH_SYMMETRIC
+        }
     }
 
     fn describe(&self) -> String {

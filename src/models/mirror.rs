@@ -81,6 +81,7 @@ impl Brdf for Mirror {
     fn flags(&self) -> Flags {
         Flags {
             delta: true,
+            lobes: crate::brdf::Lobes::DELTA,
             ..Flags::SMOOTH_SYMMETRIC
         }
     }
@@ -209,6 +210,7 @@ impl Brdf for Refractor {
             isotropic: true,
             bilateral: true,
             transmission: true,
+            lobes: crate::brdf::Lobes::DELTA,
         }
     }
 

@@ -104,7 +104,10 @@ impl Brdf for OrenNayar {
     }
 
     fn flags(&self) -> Flags {
-        Flags::SMOOTH_SYMMETRIC
+        Flags {
+            lobes: crate::brdf::Lobes::DIFFUSE,
+            ..Flags::SMOOTH_SYMMETRIC
+        }
     }
 
     /// Cosine-weighted sampling (pdf cos θi / π), so the weight is k_d π (A + B …): the

@@ -123,6 +123,9 @@ impl Sum {
             isotropic: fl.iter().all(|f| f.isotropic),
             bilateral: fl.iter().all(|f| f.bilateral),
             transmission: fl.iter().any(|f| f.transmission),
+            lobes: fl
+                .iter()
+                .fold(crate::brdf::Lobes::default(), |a, f| a.union(f.lobes)),
         };
         let select = normalized(
             terms
@@ -666,6 +669,7 @@ mod tests {
         fn flags(&self) -> Flags {
             Flags {
                 delta: true,
+                lobes: crate::brdf::Lobes::DELTA,
                 ..Flags::SMOOTH_SYMMETRIC
             }
         }
@@ -729,8 +733,15 @@ mod tests {
     }
 
     #[test]
-    fn flags_are_the_and_of_terms() {
-        assert_eq!(plastic().flags(), Flags::SMOOTH_SYMMETRIC);
+    fn flags_are_the_and_of_terms_and_lobes_their_union() {
+        let both = crate::brdf::Lobes::DIFFUSE.union(crate::brdf::Lobes::GLOSSY);
+        assert_eq!(
+            plastic().flags(),
+            Flags {
+                lobes: both,
+                ..Flags::SMOOTH_SYMMETRIC
+            }
+        );
         let aniso = Sum::new(vec![lambert(0.2), ggx(0.1, 0.3)], None, &Channels::Rgb).unwrap();
         assert!(!aniso.flags().isotropic && aniso.flags().reciprocal && !aniso.flags().delta);
         let mirror = || -> Box<dyn Brdf + Send + Sync> { Box::new(TestMirror(Channels::Rgb, 0.5)) };
@@ -738,6 +749,8 @@ mod tests {
         assert!(!mixed.flags().delta);
         let all = Sum::new(vec![mirror(), mirror()], None, &Channels::Rgb).unwrap();
         assert!(all.flags().delta);
+        let lobes = mixed.flags().lobes;
+        assert!(lobes.diffuse && lobes.delta && !lobes.glossy);
     }
 
     #[test]

@@ -8,14 +8,14 @@
 //! - [`Store::open`] maps the file and checks its superblock and table of contents; nothing else
 //!   is read. [`Store::table`] reads and checks one table's header and chunk index.
 //! - [`StoredTable::chunk`] decodes a chunk on first touch into a thread-safe cache bounded in
-//!   memory ([`OpenOptions::cache_bytes`]), or every chunk up front with [`OpenOptions::eager`].
+//!   memory ([`StoreOptions::cache_bytes`]), or every chunk up front with [`StoreOptions::eager`].
 //! - [`Writer`] streams chunks into a new file and replaces the destination atomically;
 //!   [`db`] builds add / replace / remove / verify on it.
 //! - [`tables`] connects the store to [`crate::table`]: headers from a `Grid`, saving a `Table`,
 //!   streaming `bake_chunks` into a [`Writer`] (`chunk_with` + [`tables::chunk_layout`]), and
 //!   [`tables::open_brdf`] (`FILE` or `DB#NAME`) giving a `TabulatedBrdf` whose
 //!   `ChunkLoader` is the [`StoredTable`] (chunks decoded, checksum checked, on first touch; the
-//!   `TabulatedBrdf` keeps what it loaded, so the memory bound of [`OpenOptions::cache_bytes`]
+//!   `TabulatedBrdf` keeps what it loaded, so the memory bound of [`StoreOptions::cache_bytes`]
 //!   applies to [`StoredTable::chunk`] users such as the exports, not to a `TabulatedBrdf`).
 //! - [`export`]: `.npy` of the dense table, EXR of 2D slices.
 //!
@@ -67,7 +67,7 @@ use crate::error::{Error, Result, Section};
 
 /// Options for [`Store::open_with`].
 #[derive(Debug, Clone, Copy)]
-pub struct OpenOptions {
+pub struct StoreOptions {
     /// Memory bound of the decoded-chunk cache, in bytes (default 512 MiB). The least recently
     /// used chunks are dropped beyond it (chunks still referenced by a caller stay alive).
     pub cache_bytes: usize,
@@ -75,9 +75,9 @@ pub struct OpenOptions {
     pub eager: bool,
 }
 
-impl Default for OpenOptions {
+impl Default for StoreOptions {
     fn default() -> Self {
-        OpenOptions {
+        StoreOptions {
             cache_bytes: 512 << 20,
             eager: false,
         }
@@ -91,7 +91,7 @@ pub struct Store {
     map: Arc<Backing>,
     toc: Toc,
     cache: Arc<ChunkCache>,
-    opts: OpenOptions,
+    opts: StoreOptions,
 }
 
 impl std::fmt::Debug for Store {
@@ -106,11 +106,11 @@ impl std::fmt::Debug for Store {
 impl Store {
     /// Opens a file with default options.
     pub fn open(path: impl AsRef<Path>) -> Result<Store> {
-        Self::open_with(path, OpenOptions::default())
+        Self::open_with(path, StoreOptions::default())
     }
 
     /// Opens a file: maps it and checks the superblock and table of contents.
-    pub fn open_with(path: impl AsRef<Path>, opts: OpenOptions) -> Result<Store> {
+    pub fn open_with(path: impl AsRef<Path>, opts: StoreOptions) -> Result<Store> {
         let path = path.as_ref().to_path_buf();
         let name = path.display().to_string();
         crate::files::require_regular(&path)?; // before the open: a FIFO would block it
@@ -132,7 +132,7 @@ impl Store {
     }
 
     /// Opens a file held in memory (`name` is used in error messages). Used by the fuzz target.
-    pub fn from_bytes(name: &str, bytes: Vec<u8>, opts: OpenOptions) -> Result<Store> {
+    pub fn from_bytes(name: &str, bytes: Vec<u8>, opts: StoreOptions) -> Result<Store> {
         Self::from_backing(
             PathBuf::from(name),
             name.to_owned(),
@@ -141,7 +141,12 @@ impl Store {
         )
     }
 
-    fn from_backing(path: PathBuf, name: String, map: Backing, opts: OpenOptions) -> Result<Store> {
+    fn from_backing(
+        path: PathBuf,
+        name: String,
+        map: Backing,
+        opts: StoreOptions,
+    ) -> Result<Store> {
         let sb = Superblock::parse(&name, &map)?;
         let toc_bytes = format::block(&name, &map, &sb.toc, &Section::Toc, format::MAX_JSON_LEN)?;
         let toc: Toc = format::json(&name, "table of contents", toc_bytes)?;

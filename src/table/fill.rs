@@ -11,7 +11,7 @@
 //! ([`symmetry::verify`]); a violation is an error unless [`BakeOptions::force`] is set.
 //!
 //! A node's value is f at the node's representative pair ([`pair_of`]) — or, on
-//! a `halfdiff` grid whose nodes the source itself stores ([`Brdf::stored_node`]: a MERL file
+//! a `halfdiff` grid whose nodes the source itself stores ([`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node): a MERL file
 //! on [`Grid::merl`], a table on its own grid), the stored value verbatim, including cells whose
 //! centre lies below the horizon and negative markers of unmeasured cells; with
 //! `supersample = k > 1` it is the mean of k^d stratified, jittered samples over the node's cell
@@ -132,7 +132,9 @@ pub fn bake_chunks(
         && grid.quantity() == Quantity::Fr
         && opts.supersample <= 1
         && !layout.is_empty()
-        && brdf.stored_node(half_diff(grid.node_angles([0; 4])), &mut vec![0.0; c]);
+        && brdf
+            .bake_source()
+            .is_some_and(|b| b.stored_node(half_diff(grid.node_angles([0; 4])), &mut vec![0.0; c]));
     // Nodes beyond the horizon of f_r cos θi cos θo tables are extrapolated (`horizon`).
     let mut horizon = HorizonFill::new(grid);
     let budget = (opts.memory_budget / 4).max(1);
@@ -169,7 +171,11 @@ pub fn bake_chunks(
                         for q in 0..s3 {
                             let out = &mut row[q * c..(q + 1) * c];
                             let idx = [chunk, p, b, q];
-                            if native && brdf.stored_node(half_diff(grid.node_angles(idx)), out) {
+                            if native
+                                && brdf.bake_source().is_some_and(|b| {
+                                    b.stored_node(half_diff(grid.node_angles(idx)), out)
+                                })
+                            {
                                 for v in out.iter_mut() {
                                     if !v.is_finite() {
                                         *v = 0.0;

@@ -24,7 +24,7 @@
 //! the lookup sees 0 there: a *nearest* lookup of an unmeasured cell gives 0, and a *linear*
 //! lookup next to one blends towards 0 over the half cell between the nodes (measured values
 //! near the unmeasured region are darkened, none is made up). The set-aside values stay with
-//! the table: [`Brdf::stored_node`] and [`TabulatedBrdf::to_table`] give them back, so a table
+//! the table: [`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node) and [`TabulatedBrdf::to_table`] give them back, so a table
 //! converts back to the MERL file it came from. Below the horizon `eval` is 0 as for every
 //! `Brdf`; a node whose centre pair has a direction below the horizon still holds its stored
 //! value and is interpolated with its neighbours for pairs above it.
@@ -34,7 +34,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use crate::brdf::{Brdf, BrdfSample, Flags};
+use crate::brdf::{BakeSource, Brdf, BrdfSample, Flags};
 use crate::error::{Error, Result};
 use crate::geometry::HalfDiff;
 use crate::spectrum::Channels;
@@ -75,7 +75,7 @@ pub struct TabulatedBrdf {
     /// The fast linear lookup ([`super::kernel`]) of adaptive grids and of small MERL-style
     /// fixed grids, when it applies. Its lookups read `packed`, all chunks in one array loaded
     /// at first use: f16 codes for adaptive grids, whose `chunks` are then loaded only for other
-    /// readers (nearest lookups, [`TabulatedBrdf::to_table`], [`Brdf::stored_node`]), or the
+    /// readers (nearest lookups, [`TabulatedBrdf::to_table`], [`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node)), or the
     /// exact values, which `chunk` then serves instead of `chunks`.
     kernel: Option<Kernel>,
     /// Every chunk, contiguous and packed (tables with a kernel only), loaded on first use.
@@ -464,6 +464,10 @@ impl TabulatedBrdf {
 }
 
 impl Brdf for TabulatedBrdf {
+    fn bake_source(&self) -> Option<&dyn BakeSource> {
+        Some(self)
+    }
+
     fn channels(&self) -> &Channels {
         self.grid.channels()
     }
@@ -515,6 +519,7 @@ impl Brdf for TabulatedBrdf {
             isotropic: s.isotropic,
             bilateral: s.bilateral,
             transmission: false,
+            lobes: crate::brdf::Lobes::GLOSSY,
         }
     }
 
@@ -536,6 +541,28 @@ impl Brdf for TabulatedBrdf {
         self.sampler().pdf(wi, wo)
     }
 
+    /// Parallel (rayon) above 16384 pairs, sequential below.
+    fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
+        let c = self.lookup.channels();
+        let n = crate::brdf::check_batch(wi, wo, out, c.max(1));
+        const BLOCK: usize = 4096;
+        if n >= 4 * BLOCK {
+            crate::par::install(|| {
+                out[..n * c]
+                    .par_chunks_mut(BLOCK * c)
+                    .enumerate()
+                    .for_each(|(b, o)| {
+                        let s = b * BLOCK;
+                        self.eval_block(&wi[s..], &wo[s..], o);
+                    })
+            });
+        } else {
+            self.eval_block(wi, wo, &mut out[..n * c]);
+        }
+    }
+}
+
+impl BakeSource for TabulatedBrdf {
     /// The node at `hd` as stored, negative (unmeasured) values included, on `halfdiff` grids.
     fn stored_node(&self, hd: HalfDiff, out: &mut [f32]) -> bool {
         let c = self.lookup.channels();
@@ -560,26 +587,6 @@ impl Brdf for TabulatedBrdf {
             out[k as usize - off] = x;
         }
         true
-    }
-
-    /// Parallel (rayon) above 16384 pairs, sequential below.
-    fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
-        let c = self.lookup.channels();
-        let n = crate::brdf::check_batch(wi, wo, out, c.max(1));
-        const BLOCK: usize = 4096;
-        if n >= 4 * BLOCK {
-            crate::par::install(|| {
-                out[..n * c]
-                    .par_chunks_mut(BLOCK * c)
-                    .enumerate()
-                    .for_each(|(b, o)| {
-                        let s = b * BLOCK;
-                        self.eval_block(&wi[s..], &wo[s..], o);
-                    })
-            });
-        } else {
-            self.eval_block(wi, wo, &mut out[..n * c]);
-        }
     }
 }
 

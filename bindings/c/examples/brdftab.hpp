@@ -67,6 +67,8 @@ public:
 
     /// Channels per value (3 for RGB).
     std::size_t channels() const { return brdftab_channels(h_); }
+    /// What the BRDF declares: a bit set of BRDFTAB_DIFFUSE, _GLOSSY, _DELTA, ... (brdftab.h).
+    unsigned flags() const { return brdftab_flags(h_); }
     /// Channel names ("R", "G", "B" or "550nm", ...).
     std::vector<std::string> channel_names() const {
         std::vector<std::string> v;

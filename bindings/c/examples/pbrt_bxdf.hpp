@@ -47,7 +47,16 @@ public:
         if (b.channels() != 3) throw brdftab::Error("BrdftabBxDF expects an RGB source");
     }
 
-    BxDFFlags Flags() const { return BxDFFlags::Reflection | BxDFFlags::Glossy; }
+    /// pbrt's flags from the lobes the library declares (glossy when it declares none).
+    BxDFFlags Flags() const {
+        unsigned f = b_->flags();
+        BxDFFlags out = BxDFFlags::Reflection;
+        if (f & BRDFTAB_DIFFUSE) out = out | BxDFFlags::Diffuse;
+        if (f & BRDFTAB_DELTA) out = out | BxDFFlags::Specular;
+        if ((f & BRDFTAB_GLOSSY) || !(f & (BRDFTAB_DIFFUSE | BRDFTAB_DELTA)))
+            out = out | BxDFFlags::Glossy;
+        return out;
+    }
 
     SampledSpectrum f(Vector3f wo, Vector3f wi) const {
         if (wo.z <= 0 || wi.z <= 0) return {};  // front side only, as pbrt's measured BxDF

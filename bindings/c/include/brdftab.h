@@ -61,6 +61,16 @@ const char *brdftab_last_error(void);
 void brdftab_close(brdftab_brdf *b);
 /* Number of channels (3 for RGB); 0 for NULL. */
 size_t brdftab_channels(const brdftab_brdf *b);
+/* What the BRDF declares, a bit set of the BRDFTAB_* values below (0 for NULL): the kinds of
+ * lobe it has (a renderer maps them to its own flags) and its symmetries. */
+#define BRDFTAB_DIFFUSE 1u
+#define BRDFTAB_GLOSSY 2u
+#define BRDFTAB_DELTA 4u
+#define BRDFTAB_TRANSMISSION 8u
+#define BRDFTAB_RECIPROCAL 16u
+#define BRDFTAB_ISOTROPIC 32u
+#define BRDFTAB_BILATERAL 64u
+unsigned brdftab_flags(const brdftab_brdf *b);
 /* Name of channel i ("R", "G", "B" or e.g. "550nm"); NULL if out of range. Valid while open. */
 const char *brdftab_channel_name(const brdftab_brdf *b, size_t i);
 /* f_r for n pairs into f (n x channels). */

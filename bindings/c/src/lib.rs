@@ -300,6 +300,33 @@ pub unsafe extern "C" fn brdftab_channels(b: *const brdftab_brdf) -> usize {
     unsafe { b.as_ref() }.map_or(0, |b| b.names.len())
 }
 
+/// What the BRDF declares, as a bit set: lobes diffuse 1, glossy 2, delta 4 (`BRDFTAB_DIFFUSE`,
+/// `_GLOSSY`, `_DELTA`), then transmission 8, reciprocal 16, isotropic 32, bilateral 64; 0 for
+/// a NULL handle. A renderer maps the lobes to its own flags (pbrt's `BxDFFlags`).
+///
+/// # Safety
+/// `b` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_flags(b: *const brdftab_brdf) -> std::ffi::c_uint {
+    // SAFETY: the caller promises NULL or a live handle.
+    let Some(b) = (unsafe { b.as_ref() }) else {
+        return 0;
+    };
+    let f = b.brdf.flags();
+    [
+        f.lobes.diffuse,
+        f.lobes.glossy,
+        f.lobes.delta,
+        f.transmission,
+        f.reciprocal,
+        f.isotropic,
+        f.bilateral,
+    ]
+    .iter()
+    .enumerate()
+    .fold(0, |acc, (i, &on)| acc | (std::ffi::c_uint::from(on) << i))
+}
+
 /// The name of channel `i` ("R", "G", "B", or e.g. "550nm"); NULL when `i` is out of range or
 /// the handle is NULL. Valid while the handle is open.
 ///

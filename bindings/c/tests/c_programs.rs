@@ -201,6 +201,32 @@ fn requests_with_json_settings_do_what_the_rust_request_layer_does() {
             );
         }
     }
+    // Flags: a Lambert is diffuse, reciprocal, isotropic and bilateral; its table glossy.
+    let bits = |f: brdftab::Flags| {
+        [
+            f.lobes.diffuse,
+            f.lobes.glossy,
+            f.lobes.delta,
+            f.transmission,
+            f.reciprocal,
+            f.isotropic,
+            f.bilateral,
+        ]
+        .iter()
+        .enumerate()
+        .map(|(i, &on)| u32::from(on) << i)
+        .sum::<u32>()
+    };
+    let lambert_flags = brdftab::open(r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#)
+        .unwrap()
+        .flags();
+    assert_eq!(line("lambert-flags"), (1 + 16 + 32 + 64).to_string());
+    assert_eq!(line("lambert-flags"), bits(lambert_flags).to_string());
+    let table_flags = brdftab::open(dir.join("c.btdb").to_str().unwrap())
+        .unwrap()
+        .flags();
+    assert_eq!(line("table-flags"), bits(table_flags).to_string());
+    assert!(table_flags.lobes.glossy);
     // Errors name the field at fault.
     for (label, field) in [
         ("error unknown:", "gird"),
@@ -339,9 +365,9 @@ fn the_header_declares_exactly_the_exported_functions() {
 
 /// A copy of table file `good` with one bit of chunk 0 flipped (its checksum then fails).
 fn corrupt_copy(good: &str, bad: &Path) {
-    use brdftab::store::{OpenOptions, Store};
+    use brdftab::store::{Store, StoreOptions};
     let mut bytes = std::fs::read(good).unwrap();
-    let st = Store::from_bytes("t", bytes.clone(), OpenOptions::default()).unwrap();
+    let st = Store::from_bytes("t", bytes.clone(), StoreOptions::default()).unwrap();
     let raw = st.single().unwrap().raw_chunk(0).unwrap().to_vec();
     let at = bytes.windows(raw.len()).position(|w| w == raw).unwrap();
     bytes[at + raw.len() / 2] ^= 0x10;

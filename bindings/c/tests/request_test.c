@@ -33,6 +33,7 @@ static void print_normal(const char *label, const char *source, const char *sett
         failures++;
     }
     printf("%s %.9g %.9g %.9g\n", label, f[0], f[1], f[2]);
+    printf("%s-flags %u\n", label, brdftab_flags(b));
     brdftab_close(b);
 }
 
@@ -73,6 +74,8 @@ int main(int argc, char **argv) {
     if (brdftab_fit(LAMBERT, "lambert", "{\"strats\": 2}") != NULL) failures++;
     expect_error(-1, "fit-unknown", "strats");
     brdftab_free_string(NULL);
+    print_normal("lambert", LAMBERT, NULL);
+    if (brdftab_flags(NULL) != 0) failures++;
 
     if (brdftab_open_json(LAMBERT, "{\"interp\": \"cubic\"}") != NULL) failures++;
     expect_error(-1, "open-interp", "interp");

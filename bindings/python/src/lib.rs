@@ -321,7 +321,8 @@ impl PyBrdf {
         }
     }
 
-    /// What the BRDF declares: {"delta", "reciprocal", "isotropic", "bilateral", "transmission"}.
+    /// What the BRDF declares: {"delta", "reciprocal", "isotropic", "bilateral", "transmission",
+    /// "lobes": {"diffuse", "glossy", "delta"}} (hosts map the lobes to their own flags).
     #[getter]
     fn flags(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         ser(py, &self.inner.flags())

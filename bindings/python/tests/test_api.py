@@ -113,7 +113,9 @@ def test_channels_flags_wavelengths(paper):
     b = brdftab.open(LAMBERT)
     assert b.channels == ["R", "G", "B"]
     assert b.flags == {"delta": False, "reciprocal": True, "isotropic": True,
-                       "bilateral": True, "transmission": False}
+                       "bilateral": True, "transmission": False,
+                       "lobes": {"diffuse": True, "glossy": False, "delta": False}}
+    assert brdftab.open(GGX).flags["lobes"] == {"diffuse": False, "glossy": True, "delta": False}
     s = brdftab.open(LAMBERT.replace("[0.1, 0.2, 0.3]", "0.5"), wavelengths=[450, 550, 650.5])
     assert s.channels == ["450nm", "550nm", "650.5nm"]
     assert s.wavelengths == [450, 550, 650.5]

@@ -268,8 +268,14 @@ def test_scalar_flags_and_delta():
     assert np.all(np.array(m.eval(mi.BSDFContext(), si, bs.wo)) == 0)
     lam = mi.load_dict({"type": "brdftab", "source": '{"model": "lambert", "kd": 0.5}'})
     assert lam.flags() & F.DiffuseReflection
+    assert not lam.flags() & F.GlossyReflection
     ggx = mi.load_dict({"type": "brdftab", "source": '{"model": "ggx", "alpha": 0.3}'})
-    assert ggx.flags() & F.GlossyReflection
+    assert ggx.flags() & F.GlossyReflection and not ggx.flags() & F.DiffuseReflection
+    # the library's lobes, not a guess from the model's name: a sum has both, a spec file too
+    plastic = ('{"model": "sum", "terms": [{"model": "oren_nayar", "kd": 0.3, "sigma": 0.2},'
+               ' {"model": "ggx", "alpha": 0.2}]}')
+    both = mi.load_dict({"type": "brdftab", "source": plastic})
+    assert both.flags() & F.GlossyReflection and both.flags() & F.DiffuseReflection
     # back side: zero
     si.wi = mi.Vector3f(0, 0, -1)
     assert np.all(np.array(ggx.eval(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1))) == 0)

@@ -65,7 +65,7 @@ pub const NOT_MEASURED: f64 = -1.0;
 
 /// Where a source comes from.
 #[derive(Debug, Clone, PartialEq)]
-pub enum SourceKind {
+pub enum Origin {
     /// An analytic model (evaluated in RGB).
     Model(ModelSpec),
     /// An RGL-EPFL `.bsdf` file.
@@ -78,7 +78,7 @@ pub struct SourceDef {
     /// Short name, e.g. `reciprocal_phong_n100`.
     pub name: String,
     /// The model spec or measured file.
-    pub kind: SourceKind,
+    pub kind: Origin,
 }
 
 impl SourceDef {
@@ -86,31 +86,31 @@ impl SourceDef {
     pub fn model(name: &str, json: &str) -> Result<SourceDef> {
         Ok(SourceDef {
             name: name.to_owned(),
-            kind: SourceKind::Model(ModelSpec::parse(json)?),
+            kind: Origin::Model(ModelSpec::parse(json)?),
         })
     }
 
     /// `model` or `measured`.
     pub fn kind_name(&self) -> &'static str {
         match self.kind {
-            SourceKind::Model(_) => "model",
-            SourceKind::Rgl(_) => "measured",
+            Origin::Model(_) => "model",
+            Origin::Rgl(_) => "measured",
         }
     }
 
     /// The source as a SOURCE string ([`brdftab::source`]): the spec's JSON or the file's path.
     pub fn source(&self) -> String {
         match &self.kind {
-            SourceKind::Model(spec) => spec.to_json(),
-            SourceKind::Rgl(path) => path.display().to_string(),
+            Origin::Model(spec) => spec.to_json(),
+            Origin::Rgl(path) => path.display().to_string(),
         }
     }
 
     /// Opens the source as a `Brdf` (RGB).
     pub fn open(&self) -> Result<Box<dyn Brdf + Send + Sync>> {
         match &self.kind {
-            SourceKind::Model(spec) => spec.build(&Channels::Rgb),
-            SourceKind::Rgl(path) => Ok(Box::new(brdftab::measured::RglBrdf::open(path)?)),
+            Origin::Model(spec) => spec.build(&Channels::Rgb),
+            Origin::Rgl(path) => Ok(Box::new(brdftab::measured::RglBrdf::open(path)?)),
         }
     }
 }
@@ -183,7 +183,7 @@ pub fn rgl_sources(dir: impl AsRef<Path>) -> Result<Vec<SourceDef>> {
             name: p
                 .file_stem()
                 .map_or_else(String::new, |s| s.to_string_lossy().into_owned()),
-            kind: SourceKind::Rgl(p),
+            kind: Origin::Rgl(p),
         })
         .collect();
     v.sort_by(|a, b| a.name.cmp(&b.name));
@@ -721,7 +721,7 @@ pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
         if c == 0 || c > MAX_CHANNELS {
             return Err(Error::arg("source", format!("{}: {c} channels", sd.name)));
         }
-        let measured = matches!(sd.kind, SourceKind::Rgl(_));
+        let measured = matches!(sd.kind, Origin::Rgl(_));
         let render_opts = cfg
             .render
             .as_ref()

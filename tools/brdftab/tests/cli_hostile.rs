@@ -50,12 +50,12 @@ const CT: &str = r#"{"model": "cook_torrance", "m": 0.3}"#;
 
 /// Bakes a small table to `good` and writes a copy with one bit of chunk 0 flipped to `bad`.
 fn good_and_bad(d: &Path) -> (PathBuf, PathBuf) {
-    use brdftab::store::{OpenOptions, Store};
+    use brdftab::store::{Store, StoreOptions};
     let good = d.join("good.btdb");
     let (ok, _, e) = brdftab(&["bake", CT, "-o", s(&good), "--preset", "small"], "");
     assert!(ok, "{e}");
     let mut b = std::fs::read(&good).unwrap();
-    let st = Store::from_bytes("t", b.clone(), OpenOptions::default()).unwrap();
+    let st = Store::from_bytes("t", b.clone(), StoreOptions::default()).unwrap();
     let raw = st.single().unwrap().raw_chunk(0).unwrap().to_vec();
     let at = b.windows(raw.len()).position(|w| w == raw).unwrap();
     b[at + raw.len() / 2] ^= 0x10;

@@ -22,7 +22,9 @@ class Brdf:
     @property
     def wavelengths(self) -> list[float] | None: ...
     @property
-    def flags(self) -> dict[str, bool]: ...
+    def flags(self) -> dict[str, Any]:
+        """{"delta", "reciprocal", "isotropic", "bilateral", "transmission": bool,
+        "lobes": {"diffuse", "glossy", "delta": bool}}."""
     @property
     def source(self) -> str: ...
     @property

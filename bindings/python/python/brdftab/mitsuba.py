@@ -81,16 +81,19 @@ def _prop(props, name, default=None):
 
 
 def _flags(brdf, source):
+    """Mitsuba's BSDF flags from the lobes the library declares (`Brdf.flags["lobes"]`)."""
     import mitsuba as mi
 
     F = mi.BSDFFlags
-    if brdf.flags["delta"]:
-        lobe = F.DeltaReflection
-    elif brdftab_kind(source) == "spec" and _is_diffuse_spec(source):
-        lobe = F.DiffuseReflection
-    else:
-        lobe = F.GlossyReflection
-    return lobe | F.FrontSide
+    lobes = brdf.flags["lobes"]
+    flags = F.FrontSide
+    if lobes["delta"]:
+        flags |= F.DeltaTransmission if brdf.flags["transmission"] else F.DeltaReflection
+    if lobes["diffuse"]:
+        flags |= F.DiffuseReflection
+    if lobes["glossy"] or not (lobes["delta"] or lobes["diffuse"]):
+        flags |= F.GlossyReflection
+    return flags
 
 
 def brdftab_kind(source):
@@ -103,16 +106,6 @@ def brdftab_kind(source):
     if low.endswith(".bsdf"):
         return "rgl"
     return "table"
-
-
-def _is_diffuse_spec(source):
-    import json
-
-    try:
-        spec = json.loads(source) if source.strip().startswith("{") else json.load(open(source))
-    except Exception:
-        return False
-    return spec.get("model") in ("lambert", "oren_nayar")
 
 
 class _Common:
