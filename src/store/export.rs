@@ -188,32 +188,35 @@ pub fn slice(
         }
     }
     let (w, ht) = (axes[s.x] as usize, axes[s.y] as usize);
-    // Strides of the flat array (values).
-    let mut stride = vec![0u64; axes.len()];
-    let mut acc = nc as u64;
-    for a in (0..axes.len()).rev() {
-        stride[a] = acc;
-        acc *= axes[a];
-    }
     let mut out = vec![f32::NAN; w * ht * nc];
     let mut idx: Vec<usize> = s.fixed.iter().map(|&i| i as usize).collect();
+    // A dense table: chunk i is the C-order slab i of axis 0, an array over the other axes and
+    // the channels (the same view `Table::view` gives of a whole table).
+    let slab: Vec<usize> = axes[1..]
+        .iter()
+        .map(|&d| d as usize)
+        .chain([nc])
+        .collect();
+    let mut node = vec![0usize; slab.len()];
     for yy in 0..ht {
         for xx in 0..w {
             idx[s.x] = xx;
             idx[s.y] = yy;
-            let flat = match offset {
-                Some(f) => f(&idx),
-                None => Some(
-                    idx.iter()
-                        .zip(&stride)
-                        .map(|(&i, &st)| i as u64 * st)
-                        .sum::<u64>() as usize,
-                ),
+            let o = (yy * w + xx) * nc;
+            let Some(f) = offset else {
+                let c = table.chunk(idx[0])?;
+                let v = ndarray::ArrayViewD::from_shape(ndarray::IxDyn(&slab), &c[..])
+                    .map_err(|e| Error::Unsupported(format!("chunk {} as an array: {e}", idx[0])))?;
+                node[..idx.len() - 1].copy_from_slice(&idx[1..]);
+                for (ch, x) in out[o..o + nc].iter_mut().enumerate() {
+                    node[slab.len() - 1] = ch;
+                    *x = v[ndarray::IxDyn(&node)];
+                }
+                continue;
             };
-            let Some(flat) = flat else { continue };
+            let Some(flat) = f(&idx) else { continue };
             let (ci, off) = table.locate(flat as u64)?;
             let c = table.chunk(ci)?;
-            let o = (yy * w + xx) * nc;
             out[o..o + nc].copy_from_slice(&c[off..off + nc]);
         }
     }

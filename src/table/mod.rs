@@ -115,6 +115,55 @@ impl Table {
         &mut self.values
     }
 
+    /// The array shape of the stored values: the stored axes and the channels
+    /// (`stored_shape + [c]`, λ innermost); `None` for a packed layout (an `inout` reciprocal
+    /// table stores a triangle of its θ axes, no rectangle).
+    pub fn shape(&self) -> Option<[usize; 5]> {
+        let l = self.grid.layout();
+        let [a, b, c, d] = self.grid.stored_shape();
+        (!l.packed).then_some([a, b, c, d, l.channels])
+    }
+
+    /// The stored values as an `ndarray` view shaped by [`Table::shape`], without a copy: what
+    /// hosts hand to numpy and what exports slice.
+    ///
+    /// ```
+    /// use brdftab::bake::BakeRequest;
+    /// let (table, _) = BakeRequest::new(r#"{"model": "lambert", "kd": 0.5}"#)
+    ///     .grid("8x1x8x16".parse()?)
+    ///     .table(&brdftab::progress::Silent)?;
+    /// let v = table.view()?;
+    /// assert_eq!(v.shape(), &table.shape().unwrap()[..]);
+    /// assert_eq!(v[[0, 0, 0, 0, 2]], table.values()[2]);
+    /// # Ok::<(), brdftab::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::Unsupported`] for a packed layout (use [`Table::values`]).
+    pub fn view(&self) -> Result<ndarray::ArrayView5<'_, f32>> {
+        let shape = self.shape().ok_or_else(|| self.packed_error())?;
+        ndarray::ArrayView5::from_shape(shape, &self.values)
+            .map_err(|e| Error::Unsupported(format!("table values as an array: {e}")))
+    }
+
+    /// The stored values as an owned array shaped by [`Table::shape`] (no copy: the vector
+    /// moves into it).
+    ///
+    /// # Errors
+    /// [`Error::Unsupported`] for a packed layout.
+    pub fn into_array(self) -> Result<ndarray::Array5<f32>> {
+        let shape = self.shape().ok_or_else(|| self.packed_error())?;
+        ndarray::Array5::from_shape_vec(shape, self.values)
+            .map_err(|e| Error::Unsupported(format!("table values as an array: {e}")))
+    }
+
+    fn packed_error(&self) -> Error {
+        Error::Unsupported(format!(
+            "a packed {} table has no rectangular array of values (use the flat values)",
+            self.grid.summary()
+        ))
+    }
+
     /// The values of chunk `i` (a slab of stored axis 0).
     pub fn chunk(&self, i: usize) -> &[f32] {
         &self.values[self.grid.layout().chunk_range(i)]

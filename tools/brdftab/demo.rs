@@ -27,7 +27,7 @@ use clap::Args;
 
 use crate::analysis::emit;
 use crate::bake::flag_named;
-use crate::demo_extra::{plausibility_table, preview_renders, rate_distortion};
+use crate::demo_extra::{BAKED_MODELS, plausibility_table, preview_renders, rate_distortion};
 
 /// Arguments of `brdftab demo`.
 #[derive(Args)]
@@ -50,33 +50,6 @@ pub struct DemoArgs {
     #[arg(long)]
     quick: bool,
 }
-
-/// The models the demo bakes, as (table name, spec). Delta models (the mirror) cannot be
-/// tabulated and are left out.
-pub const BAKED_MODELS: &[(&str, &str)] = &[
-    ("lambert", r#"{"model": "lambert", "kd": 0.5}"#),
-    (
-        "reciprocal_phong_n50",
-        r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 50}"#,
-    ),
-    (
-        "max_phong_n50",
-        r#"{"model": "max_phong", "ks": 0.5, "n": 50}"#,
-    ),
-    ("cook_torrance_gold", crate::demo_extra::CT_GOLD),
-    (
-        "ggx_0.1_copper",
-        r#"{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}"#,
-    ),
-    (
-        "ward_aniso",
-        r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}"#,
-    ),
-    (
-        "oren_nayar",
-        r#"{"model": "oren_nayar", "kd": 0.5, "sigma": 0.3}"#,
-    ),
-];
 
 /// Pairs of the accuracy comparison (per source).
 const ACCURACY_PAIRS: usize = 50_000;

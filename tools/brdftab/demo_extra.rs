@@ -13,6 +13,33 @@ use brdftab_tools::report::{plot, suite};
 
 use crate::analysis::emit;
 
+/// The models the demo bakes, as (table name, spec). Delta models (the mirror) cannot be
+/// tabulated and are left out.
+pub const BAKED_MODELS: &[(&str, &str)] = &[
+    ("lambert", r#"{"model": "lambert", "kd": 0.5}"#),
+    (
+        "reciprocal_phong_n50",
+        r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 50}"#,
+    ),
+    (
+        "max_phong_n50",
+        r#"{"model": "max_phong", "ks": 0.5, "n": 50}"#,
+    ),
+    ("cook_torrance_gold", CT_GOLD),
+    (
+        "ggx_0.1_copper",
+        r#"{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}"#,
+    ),
+    (
+        "ward_aniso",
+        r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}"#,
+    ),
+    (
+        "oren_nayar",
+        r#"{"model": "oren_nayar", "kd": 0.5, "sigma": 0.3}"#,
+    ),
+];
+
 /// The spec of the rate–distortion sweep and of the render acceptance figure.
 pub const CT_GOLD: &str = r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#;
 

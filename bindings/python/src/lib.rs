@@ -207,6 +207,61 @@ fn wavelengths_of(c: &Option<Channels>) -> Option<Vec<f64>> {
     }
 }
 
+/// A decoded table (`Brdf.table()`): its values as a numpy array sharing the table's memory,
+/// and its grid.
+#[pyclass(name = "Table", module = "brdftab", frozen)]
+struct PyTable {
+    table: brdftab::table::Table,
+    grid: Py<PyAny>,
+}
+
+#[pymethods]
+impl PyTable {
+    /// float32 values shaped by the stored axes and the channels (`grid["stored_shape"] +
+    /// [c]`, λ innermost), or flat for a packed layout; read-only, no copy (the array keeps
+    /// this table alive).
+    #[getter]
+    fn values<'py>(slf: Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        let t = &slf.get().table;
+        let shape: Vec<usize> = match t.shape() {
+            Some(s) => s.to_vec(),
+            None => vec![t.values().len()],
+        };
+        let view = numpy::ndarray::ArrayViewD::from_shape(IxDyn(&shape), t.values())
+            .map_err(|e| Error::new_err(e.to_string()))?;
+        // SAFETY: the array borrows the values of `slf`'s table, which is frozen (never mutated)
+        // and kept alive by the array's base object, `slf` itself.
+        let arr = unsafe { PyArrayDyn::borrow_from_array(&view, slf.clone().into_any()) };
+        let kw = PyDict::new(slf.py());
+        kw.set_item("write", false)?;
+        arr.call_method("setflags", (), Some(&kw))?;
+        Ok(arr.into_any())
+    }
+
+    /// The grid: parameterization, full axes, symmetry, stored axes with their mappings and
+    /// node placement, stored_shape, packed, channel_names, description.
+    #[getter]
+    fn grid(&self, py: Python<'_>) -> Py<PyAny> {
+        self.grid.clone_ref(py)
+    }
+
+    /// `values, grid = table`.
+    fn __iter__<'py>(slf: Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        let py = slf.py();
+        let grid = slf.get().grid.clone_ref(py);
+        let pair = PyTuple::new(py, [PyTable::values(slf)?.unbind(), grid])?;
+        pair.into_any().try_iter().map(Bound::into_any)
+    }
+
+    fn __len__(&self) -> usize {
+        2
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<brdftab.Table {}: {}>", self.table.grid().summary(), self.table.description())
+    }
+}
+
 /// A serde_json value as a Python object (through `json.loads`: dicts, lists, floats, ...).
 fn to_py(py: Python<'_>, v: &serde_json::Value) -> PyResult<Py<PyAny>> {
     let s = serde_json::to_string(v).map_err(|e| Error::new_err(e.to_string()))?;
@@ -550,13 +605,13 @@ impl PyBrdf {
         })
     }
 
-    /// The decoded table: (values, grid). `values` is float32 of shape stored_shape + (c,)
-    /// (λ innermost; a packed `inout` reciprocal table comes flat, chunk a holding axis-2
-    /// indices a..n); `grid` describes it (parameterization, full axes, symmetry, stored axes
-    /// with their mappings and node placement, packing). A table SOURCE gives its stored table;
-    /// any other source is baked in memory with `options` (the keywords of `brdftab.bake`).
+    /// The decoded table as a `brdftab.Table`: `values` (float32, shaped by the stored axes
+    /// and the channels, λ innermost; flat for a packed `inout` reciprocal table) shares the
+    /// table's memory, read-only; `grid` describes it. Unpacks as `values, grid = b.table()`.
+    /// A table SOURCE gives its stored table; any other source is baked in memory with
+    /// `options` (the keywords of `brdftab.bake`).
     #[pyo3(signature = (**options))]
-    fn table(&self, py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<Py<PyTuple>> {
+    fn table(&self, py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<PyTable> {
         guard(|| {
             let table = match (&self.table, options.is_some_and(|o| !o.is_empty())) {
                 (Some(t), false) => {
@@ -582,18 +637,10 @@ impl PyBrdf {
             g["packed"] = serde_json::json!(grid.layout().packed);
             g["channel_names"] = serde_json::json!(grid.channels().names());
             g["description"] = serde_json::json!(table.description());
-            let mut shape = grid.stored_shape().to_vec();
-            shape.push(grid.channels().len());
-            let packed = grid.layout().packed;
-            let (_, values, _) = table.into_parts();
-            if packed {
-                // Packed inout reciprocity (chunk a holds axis-2 indices a..n): flat values.
-                shape = vec![values.len()];
-            }
-            let arr = ArrayD::from_shape_vec(IxDyn(&shape), values)
-                .map_err(|e| Error::new_err(e.to_string()))?;
-            let arr: Bound<'_, PyArrayDyn<f32>> = arr.into_pyarray(py);
-            Ok(PyTuple::new(py, [arr.into_any().unbind(), to_py(py, &g)?])?.unbind())
+            Ok(PyTable {
+                grid: to_py(py, &g)?,
+                table,
+            })
         })
     }
 
@@ -910,6 +957,7 @@ fn fit(
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("Error", m.py().get_type::<Error>())?;
     m.add_class::<PyBrdf>()?;
+    m.add_class::<PyTable>()?;
     m.add_function(wrap_pyfunction!(open, m)?)?;
     m.add_function(wrap_pyfunction!(_reopen, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;

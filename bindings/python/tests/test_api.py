@@ -240,6 +240,15 @@ def test_table_values_and_grid(tmp_path):
     assert grid["param"] == "halfdiff" and len(grid["stored_axes"]) == 4
     v2, g2 = brdftab.open(GGX).table(preset="small")
     np.testing.assert_allclose(v2, values, rtol=2e-3, atol=1e-6)
+    # Table.values is a view of the table's memory: no copy per access, read-only, kept alive
+    t = brdftab.open(out).table()
+    v = t.values
+    assert v.base is t and not v.flags.writeable and v.flags.c_contiguous
+    assert np.shares_memory(v, t.values)
+    with pytest.raises(ValueError):
+        v[0, 0, 0, 0, 0] = 1.0
+    del t
+    assert np.isfinite(v).all()  # the array keeps its table alive
 
 
 # ---- pickling and workers ------------------------------------------------------------------

@@ -22,6 +22,7 @@ from __future__ import annotations
 from ._native import (  # noqa: F401
     Brdf,
     Error,
+    Table,
     __version__,
     bake,
     check,
@@ -36,6 +37,7 @@ __all__ = [
     "Brdf",
     "Database",
     "Error",
+    "Table",
     "bake",
     "check",
     "convert",

@@ -1,7 +1,7 @@
 """Type stubs of the brdftab package (the Rust extension `brdftab._native` and its wrappers)."""
 
 from os import PathLike
-from typing import Any, Sequence, Union
+from typing import Any, Iterator, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -44,9 +44,20 @@ class Brdf:
         """(wi (n, 3), pdf (n,), weight = f cos θi / pdf (n, c)) for u in [0, 1)² of shape (n, 2)."""
     def albedo(self, theta: ArrayLike) -> npt.NDArray[np.float64]:
         """Directional albedo at θ′ in radians: (k, c) float64."""
-    def table(self, **options: Any) -> tuple[npt.NDArray[np.float32], dict[str, Any]]:
-        """The decoded table (values λ innermost, grid description); other sources are baked."""
+    def table(self, **options: Any) -> Table:
+        """The decoded table (other sources are baked with the keywords of `bake`); unpacks as
+        `values, grid = b.table()`."""
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+
+class Table:
+    """A decoded table: `values` shares its memory (read-only float32, stored axes + channels,
+    λ innermost; flat when packed), `grid` describes it."""
+    @property
+    def values(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def grid(self) -> dict[str, Any]: ...
+    def __iter__(self) -> Iterator[Any]: ...
+    def __len__(self) -> int: ...
 
 def open(
     source: str, *, interp: str = "auto", wavelengths: Wavelengths = None, eager: bool = True
