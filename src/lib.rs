@@ -3,7 +3,7 @@
 //! A library of BRDF models behind one [`Brdf`] trait, dense symmetry-reduced compressed tables
 //! that sample any `Brdf` or load measured data, and the tools around them.
 //!
-//! Data flows one way (see `DESIGN.md`): a source — an analytic model ([`models`], described by a
+//! Data flows one way (see DESIGN.md in the repository): a source — an analytic model ([`models`], described by a
 //! [`spec::ModelSpec`]) or a measurement ([`measured`]) — is baked on a grid into a dense table
 //! ([`table`]); the table is split into chunks that the [`codec`] turns into bytes; the [`store`]
 //! writes chunks and metadata; opening gives back a `TabulatedBrdf` that implements `Brdf` again.

@@ -192,11 +192,7 @@ pub fn slice(
     let mut idx: Vec<usize> = s.fixed.iter().map(|&i| i as usize).collect();
     // A dense table: chunk i is the C-order slab i of axis 0, an array over the other axes and
     // the channels (the same view `Table::view` gives of a whole table).
-    let slab: Vec<usize> = axes[1..]
-        .iter()
-        .map(|&d| d as usize)
-        .chain([nc])
-        .collect();
+    let slab: Vec<usize> = axes[1..].iter().map(|&d| d as usize).chain([nc]).collect();
     let mut node = vec![0usize; slab.len()];
     for yy in 0..ht {
         for xx in 0..w {
@@ -205,8 +201,9 @@ pub fn slice(
             let o = (yy * w + xx) * nc;
             let Some(f) = offset else {
                 let c = table.chunk(idx[0])?;
-                let v = ndarray::ArrayViewD::from_shape(ndarray::IxDyn(&slab), &c[..])
-                    .map_err(|e| Error::Unsupported(format!("chunk {} as an array: {e}", idx[0])))?;
+                let v = ndarray::ArrayViewD::from_shape(ndarray::IxDyn(&slab), &c[..]).map_err(
+                    |e| Error::Unsupported(format!("chunk {} as an array: {e}", idx[0])),
+                )?;
                 node[..idx.len() - 1].copy_from_slice(&idx[1..]);
                 for (ch, x) in out[o..o + nc].iter_mut().enumerate() {
                     node[slab.len() - 1] = ch;

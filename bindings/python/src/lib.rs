@@ -258,7 +258,11 @@ impl PyTable {
     }
 
     fn __repr__(&self) -> String {
-        format!("<brdftab.Table {}: {}>", self.table.grid().summary(), self.table.description())
+        format!(
+            "<brdftab.Table {}: {}>",
+            self.table.grid().summary(),
+            self.table.description()
+        )
     }
 }
 
