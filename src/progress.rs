@@ -71,21 +71,8 @@ impl Drop for Stage<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::sync::Mutex;
 
-    #[derive(Default)]
-    struct Log(Mutex<Vec<String>>);
-    impl Progress for Log {
-        fn begin(&self, what: &str, total: u64) {
-            self.0.lock().unwrap().push(format!("begin {what} {total}"));
-        }
-        fn set(&self, done: u64) {
-            self.0.lock().unwrap().push(format!("set {done}"));
-        }
-        fn end(&self) {
-            self.0.lock().unwrap().push("end".into());
-        }
-    }
+    use crate::testkit::ProgressLog as Log;
 
     #[test]
     fn a_stage_ends_on_early_return() {
@@ -100,6 +87,6 @@ mod tests {
             Ok(())
         };
         assert!(run(true).is_err());
-        assert_eq!(*log.0.lock().unwrap(), ["begin x 2", "set 1", "end"]);
+        assert_eq!(log.calls(), ["begin x 2", "set 1", "end"]);
     }
 }

@@ -96,18 +96,34 @@ impl Fidelity {
     /// One line: `within 80° 0.41 %, whole hemisphere 0.62 %, grazing band 1.3 % (rule 0.40 /
     /// 0.60 / 1.5 %), albedo 0.55 % (worst at 34°, channel 2)`.
     pub fn summary(&self) -> String {
+        let [
+            cap,
+            whole,
+            grazing,
+            rule_cap,
+            rule_whole,
+            rule_grazing,
+            albedo,
+        ] = self.percents();
         format!(
-            "within 80° {:.2} %, whole hemisphere {:.2} %, grazing band {:.2} % (rule {:.2} / {:.2} / {:.2} %), albedo {:.2} % (worst at {}°, channel {})",
-            self.cap * 100.0,
-            self.whole * 100.0,
-            self.grazing * 100.0,
-            self.rule.cap * 100.0,
-            self.rule.whole * 100.0,
-            self.rule.grazing * 100.0,
-            self.albedo.worst * 100.0,
-            self.albedo.theta_deg,
-            self.albedo.channel
+            "within 80° {cap:.2} %, whole hemisphere {whole:.2} %, grazing band {grazing:.2} % (rule {rule_cap:.2} / {rule_whole:.2} / {rule_grazing:.2} %), albedo {albedo:.2} % (worst at {}°, channel {})",
+            self.albedo.theta_deg, self.albedo.channel
         )
+    }
+
+    /// The errors in percent, in the order every report prints them: within the cap, whole
+    /// hemisphere, grazing band (random pairs), the same three on the rule, worst albedo.
+    pub fn percents(&self) -> [f64; 7] {
+        [
+            self.cap,
+            self.whole,
+            self.grazing,
+            self.rule.cap,
+            self.rule.whole,
+            self.rule.grazing,
+            self.albedo.worst,
+        ]
+        .map(|x| x * 100.0)
     }
 }
 

@@ -27,8 +27,10 @@
 //! ```
 
 pub(crate) mod contract;
+mod progress_log;
 mod tempdir;
 
 pub use crate::rng::Pcg32;
 pub use contract::{Contract, check_contract};
+pub use progress_log::ProgressLog;
 pub use tempdir::TempDir;

@@ -227,18 +227,10 @@ pub fn fidelity_markdown(rows: &[MeasuredRow]) -> String {
             .get(f.albedo.channel)
             .copied()
             .unwrap_or("?");
+        let [cap, whole, grazing, r_cap, r_whole, r_grazing, albedo] = f.percents();
         s += &format!(
-            "| {} | {} | {:.2} % | {:.2} % | {:.2} % | {:.2} / {:.2} / {:.2} % | {:.2} % at {}°, {ch} |\n",
-            r.file,
-            r.nodes,
-            f.cap * 100.0,
-            f.whole * 100.0,
-            f.grazing * 100.0,
-            f.rule.cap * 100.0,
-            f.rule.whole * 100.0,
-            f.rule.grazing * 100.0,
-            f.albedo.worst * 100.0,
-            f.albedo.theta_deg,
+            "| {} | {} | {cap:.2} % | {whole:.2} % | {grazing:.2} % | {r_cap:.2} / {r_whole:.2} / {r_grazing:.2} % | {albedo:.2} % at {}°, {ch} |\n",
+            r.file, r.nodes, f.albedo.theta_deg,
         );
     }
     s

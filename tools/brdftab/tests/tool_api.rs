@@ -2,8 +2,6 @@
 //! preview renderer and the reports): one progress type through renders and the suite, the
 //! suite's metrics.
 
-use std::sync::Mutex;
-
 use brdftab::Error;
 use brdftab::bake::BakeRequest;
 use brdftab::progress::{Progress, Silent};
@@ -24,27 +22,7 @@ fn lambert() -> Box<dyn brdftab::Brdf + Send + Sync> {
         .unwrap()
 }
 
-/// Records every call, so tests can check what a long operation reported.
-#[derive(Default)]
-struct Log(Mutex<Vec<String>>);
-
-impl Progress for Log {
-    fn begin(&self, what: &str, total: u64) {
-        self.0.lock().unwrap().push(format!("begin {what} {total}"));
-    }
-    fn set(&self, done: u64) {
-        self.0.lock().unwrap().push(format!("set {done}"));
-    }
-    fn end(&self) {
-        self.0.lock().unwrap().push("end".into());
-    }
-}
-
-impl Log {
-    fn calls(&self) -> Vec<String> {
-        self.0.lock().unwrap().clone()
-    }
-}
+use brdftab::testkit::ProgressLog as Log;
 
 #[test]
 fn render_reports_one_stage_counting_every_pixel() {
