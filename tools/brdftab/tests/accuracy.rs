@@ -1,6 +1,6 @@
 //! The accuracy suite: a tiny configuration end to end (library and CLI).
 
-use std::process::Command;
+mod common;
 
 use brdftab::table::Param;
 use brdftab::table::presets::Preset;
@@ -196,39 +196,35 @@ fn write_all_writes_csv_markdown_and_valid_pngs() {
 #[test]
 fn cli_writes_the_files() {
     let dir = tmp("cli");
-    let out = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args([
-            "accuracy",
-            "--quick",
-            "--only",
-            "lambert",
-            "--params",
-            "inout",
-            "--pairs",
-            "1000",
-            "--no-render",
-            "--out",
-        ])
-        .arg(&dir)
-        .env_remove("BRDFTAB_RGL_DIR")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let mut cmd = common::command(&[
+        "accuracy",
+        "--quick",
+        "--only",
+        "lambert",
+        "--params",
+        "inout",
+        "--pairs",
+        "1000",
+        "--no-render",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    cmd.env_remove("BRDFTAB_RGL_DIR");
+    let out = common::run(cmd, "");
+    assert!(out.ok, "{}", out.stderr);
     let csv = std::fs::read_to_string(dir.join("accuracy.csv")).unwrap();
     let (header, rows) = parse_csv(&csv);
     assert_eq!(header.join(","), CSV_HEADER);
     assert_eq!(rows.len(), 4); // lambert × small × inout × 4 codecs
     assert!(dir.join("accuracy.md").is_file() && dir.join("rd_lambert.png").is_file());
-    let bad = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args(["accuracy", "--presets", "huge", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert_eq!(bad.status.code(), Some(1));
+    let bad = common::brdftab(&[
+        "accuracy",
+        "--presets",
+        "huge",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(bad.code, 1);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -6,8 +6,9 @@
 //! pair with a direction below the horizon (e.g. θh 83, θd 15, φd 145), which resampling at
 //! directions cannot reach.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use brdftab::measured::MerlBrdf;
 use brdftab::measured::merl::{self, RES_PHI_D, RES_THETA_D, RES_THETA_H, SAMPLES, SCALE};
@@ -52,16 +53,10 @@ fn issue_file(path: &Path) -> Vec<f64> {
     data
 }
 
-fn brdftab(args: &[&str]) {
-    let o = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "brdftab {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+/// Runs `brdftab ARGS`, which must succeed.
+fn brdftab_ok(args: &[&str]) {
+    let o = common::brdftab(args);
+    assert!(o.ok, "brdftab {args:?}: {}", o.stderr);
 }
 
 /// f32 rounding of the scaled value (relative 2^-24) and two f64 operations.
@@ -88,7 +83,7 @@ fn merl_to_merl_keeps_every_cell() {
     let dir = tmpdir("m2m");
     let (a, b) = (dir.join("a.binary"), dir.join("b.binary"));
     let data = issue_file(&a);
-    brdftab(&["convert", a.to_str().unwrap(), b.to_str().unwrap()]);
+    brdftab_ok(&["convert", a.to_str().unwrap(), b.to_str().unwrap()]);
     assert_same_file(&data, &b, F32_REL);
     // The cell of the issue: (θh 83, θd 15, φd 145), channel R, measured, centre pair below the
     // horizon.
@@ -105,7 +100,7 @@ fn bake_on_the_merl_grid_holds_the_cells_verbatim() {
     let a = dir.join("a.binary");
     let t = dir.join("t.btdb");
     let data = issue_file(&a);
-    brdftab(&[
+    brdftab_ok(&[
         "bake",
         a.to_str().unwrap(),
         "--grid",
@@ -139,7 +134,7 @@ fn bake_on_the_merl_grid_holds_the_cells_verbatim() {
     }
     // And back to MERL from the baked table.
     let b = dir.join("b.binary");
-    brdftab(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
+    brdftab_ok(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
     assert_same_file(&data, &b, F32_REL);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -155,7 +150,7 @@ fn merl_to_table_to_merl_keeps_every_cell() {
     for (codec, rel) in [("f32", F32_REL), ("log16", 1e-3 * (1.0 + 1e-6) + F32_REL)] {
         let t = dir.join(format!("t-{codec}.btdb"));
         let b = dir.join(format!("b-{codec}.binary"));
-        brdftab(&[
+        brdftab_ok(&[
             "convert",
             a.to_str().unwrap(),
             t.to_str().unwrap(),
@@ -164,20 +159,20 @@ fn merl_to_table_to_merl_keeps_every_cell() {
             "--pairs",
             "0",
         ]);
-        brdftab(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
+        brdftab_ok(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
         assert_same_file(&data, &b, rel);
     }
     // A raw table file too.
     let t = dir.join("t.tbl");
     let b = dir.join("b-raw.binary");
-    brdftab(&[
+    brdftab_ok(&[
         "convert",
         a.to_str().unwrap(),
         t.to_str().unwrap(),
         "--pairs",
         "0",
     ]);
-    brdftab(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
+    brdftab_ok(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
     assert_same_file(&data, &b, F32_REL);
     let _ = std::fs::remove_dir_all(&dir);
 }
