@@ -4,16 +4,11 @@ mod common;
 
 use brdftab::table::Param;
 use brdftab::table::presets::Preset;
+use brdftab::testkit::TempDir;
 use brdftab_tools::preview::{LightChoice, Mode, RenderOptions, Sampling};
 use brdftab_tools::report::suite::{
     self, CSV_HEADER, CodecDef, NOT_MEASURED, SourceDef, SuiteConfig, default_codecs,
 };
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("brdftab-accuracy-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
 
 fn codecs(names: &[&str]) -> Vec<CodecDef> {
     default_codecs()
@@ -174,7 +169,9 @@ fn unmeasured_render_is_minus_one_and_said_so() {
 #[test]
 fn write_all_writes_csv_markdown_and_valid_pngs() {
     let report = suite::run(&tiny(), &brdftab::progress::Silent).unwrap();
-    let dir = tmp("lib");
+    // A directory that does not exist yet: `write_all` creates it.
+    let tmp = TempDir::new("accuracy-lib");
+    let dir = tmp.join("report");
     let files = report.write_all(&dir).unwrap();
     assert_eq!(files.len(), 4, "{files:?}");
     let md = std::fs::read_to_string(dir.join("accuracy.md")).unwrap();
@@ -190,12 +187,12 @@ fn write_all_writes_csv_markdown_and_valid_pngs() {
         // Not blank: the figure has dark pixels (text, axes) and white background.
         assert!(buf.iter().any(|&b| b < 64) && buf.contains(&255));
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn cli_writes_the_files() {
-    let dir = tmp("cli");
+    let tmp = TempDir::new("accuracy-cli");
+    let dir = tmp.join("report");
     let mut cmd = common::command(&[
         "accuracy",
         "--quick",
@@ -225,7 +222,6 @@ fn cli_writes_the_files() {
         dir.to_str().unwrap(),
     ]);
     assert_eq!(bad.code, 1);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The lecture's Phong variants run in the quick suite, each named by its model so a reader of

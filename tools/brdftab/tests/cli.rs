@@ -2,6 +2,7 @@
 
 mod common;
 
+use brdftab::testkit::TempDir;
 use common::{Run, brdftab, brdftab_with_stdin};
 
 /// Asserts the error contract: exit 1, stderr starts with `error:`, no panic, nothing on stdout.
@@ -60,8 +61,7 @@ fn eval_wavelengths_gives_one_column_per_wavelength() {
 
 #[test]
 fn eval_reads_a_spec_file() {
-    let dir = std::env::temp_dir().join(format!("brdftab-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("cli-spec");
     let path = dir.join("lambert.json");
     std::fs::write(&path, r#"{"model": "lambert", "kd": 0.2}"#).unwrap();
     let o = brdftab_with_stdin(&["eval", path.to_str().unwrap()], "0 0 1 0 0 1\n");
@@ -75,7 +75,6 @@ fn eval_reads_a_spec_file() {
     let bad = dir.join("bad.json");
     std::fs::write(&bad, "{\"model\": ").unwrap();
     assert_error(&brdftab(&["eval", bad.to_str().unwrap()]), "bad.json");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -127,8 +126,8 @@ fn bad_arguments_are_errors() {
 
 #[test]
 fn bake_target_error_reports_the_search_and_names_its_flag() {
-    let out = std::env::temp_dir().join(format!("brdftab-cli-target-{}.btdb", std::process::id()));
-    let out = out.to_string_lossy().into_owned();
+    let dir = TempDir::new("cli-target");
+    let out = dir.file("t.btdb");
     let ggx = r#"{"model": "ggx", "alpha": 0.3}"#;
     let o = brdftab(&["bake", ggx, "-o", &out, "--target-error", "1%"]);
     assert_eq!(o.code, 0, "{}", o.stderr);
@@ -157,7 +156,6 @@ fn bake_target_error_reports_the_search_and_names_its_flag() {
         "1%",
     ]);
     assert_error(&o, "--target-error");
-    let _ = std::fs::remove_file(&out);
 }
 
 #[test]
@@ -236,13 +234,12 @@ fn check_text_and_models_and_demo_run() {
 
 #[test]
 fn demo_bakes_into_a_database_and_prints_where() {
-    let dir = std::env::temp_dir().join(format!("brdftab-demo-test-{}", std::process::id()));
-    let out = dir.to_str().unwrap();
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("cli-demo");
+    let out = dir.path().to_str().unwrap();
     // As a user of a checkout standing alone: no `$BRDFTAB_RGL_DIR`, run from elsewhere (no
     // `data/` or `../shared` beside the working directory); the shipped `data/rgl` is found.
     let mut cmd = common::command(&["demo", "--quick", "--preset", "small", "--out", out]);
-    cmd.env_remove("BRDFTAB_RGL_DIR").current_dir(&dir);
+    cmd.env_remove("BRDFTAB_RGL_DIR").current_dir(dir.path());
     let o = common::run(cmd, "");
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(o.stdout.contains("cook_torrance_gold"), "{}", o.stdout);
@@ -261,5 +258,4 @@ fn demo_bakes_into_a_database_and_prints_where() {
     }
     assert!(o.stdout.contains("demo.btdb"), "{}", o.stdout);
     assert!(dir.join("demo.btdb").is_file());
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -8,14 +8,8 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use brdftab::testkit::TempDir;
 use common::{brdftab, brdftab_with_stdin};
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("brdftab-hostile-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -41,8 +35,8 @@ fn good_and_bad(d: &Path) -> (PathBuf, PathBuf) {
 
 #[test]
 fn a_corrupt_chunk_read_lazily_is_an_error_everywhere() {
-    let d = tmpdir("corrupt");
-    let (good, bad) = good_and_bad(&d);
+    let d = TempDir::new("hostile-corrupt");
+    let (good, bad) = good_and_bad(d.path());
     let pair = "0 0 1 0 0 1\n";
     let r = brdftab_with_stdin(&["eval", s(&good)], pair);
     assert!(r.ok && r.stdout.trim() != "0e0 0e0 0e0", "{}", r.stdout);
@@ -80,12 +74,11 @@ fn a_corrupt_chunk_read_lazily_is_an_error_everywhere() {
     assert!(!npy.exists(), "export left a partial .npy");
     let r = brdftab(&["db", "verify", s(&bad)]);
     assert!(!r.ok && r.stderr.contains("checksum"), "{}", r.stderr);
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn a_fifo_or_a_directory_as_source_is_refused_at_once() {
-    let d = tmpdir("fifo");
+    let d = TempDir::new("hostile-fifo");
     let fifo = d.join("pipe.btdb");
     let c = std::ffi::CString::new(s(&fifo)).unwrap();
     // SAFETY: a valid NUL-terminated path.
@@ -114,12 +107,11 @@ fn a_fifo_or_a_directory_as_source_is_refused_at_once() {
     assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
     let r = brdftab(&["eval", s(&fifo_json)]);
     assert!(!r.ok && r.stderr.contains("a FIFO"), "{}", r.stderr);
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn an_output_that_is_the_input_is_refused_and_the_input_kept() {
-    let d = tmpdir("same");
+    let d = TempDir::new("hostile-same");
     let rgl = brdftab::measured::data::rgl_dir().expect("data/rgl ships");
     let p = d.join("p.bsdf");
     std::fs::copy(rgl.join("paper_white_rgb.bsdf"), &p).unwrap();
@@ -137,7 +129,7 @@ fn an_output_that_is_the_input_is_refused_and_the_input_kept() {
         before,
         "the measurement changed"
     );
-    let (good, _) = good_and_bad(&d);
+    let (good, _) = good_and_bad(d.path());
     let before = std::fs::read(&good).unwrap();
     let r = brdftab(&["bake", s(&good), "-o", s(&good)]);
     assert!(!r.ok && r.stderr.contains("is the input"), "{}", r.stderr);
@@ -172,12 +164,11 @@ fn an_output_that_is_the_input_is_refused_and_the_input_kept() {
         "small",
     ]);
     assert!(!r.ok && r.stderr.contains("is the input"), "{}", r.stderr);
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn a_missing_output_directory_is_named_not_an_internal_file() {
-    let d = tmpdir("missing");
+    let d = TempDir::new("hostile-missing");
     let gone = d.join("no-such-dir");
     for (args, out) in [
         (vec!["bake", CT, "--preset", "small", "-o"], "x.btdb"),
@@ -208,12 +199,11 @@ fn a_missing_output_directory_is_named_not_an_internal_file() {
             r.stderr
         );
     }
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn temporary_files_of_killed_writers_are_removed_by_the_next_write() {
-    let d = tmpdir("stale");
+    let d = TempDir::new("hostile-stale");
     // PID 4194305 is above Linux's largest pid_max: that writer is certainly gone.
     let stale = d.join(".x.btdb.tmp.4194305.123456");
     let live = d.join(format!(".x.btdb.tmp.{}.1", std::process::id()));
@@ -229,12 +219,11 @@ fn temporary_files_of_killed_writers_are_removed_by_the_next_write() {
     );
     assert!(live.exists(), "a live process's temporary file was removed");
     assert!(other.exists(), "another file's temporary file was removed");
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn errors_quote_huge_inputs_in_part() {
-    let d = tmpdir("huge");
+    let d = TempDir::new("hostile-huge");
     let big = "x".repeat(10 << 20);
     for (name, spec) in [
         ("model.json", format!(r#"{{"model": "{big}"}}"#)),
@@ -263,13 +252,12 @@ fn errors_quote_huge_inputs_in_part() {
         "a {} byte error",
         r.stderr.len()
     );
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn nan_directions_give_zero() {
-    let d = tmpdir("nan");
-    let (good, _) = good_and_bad(&d);
+    let d = TempDir::new("hostile-nan");
+    let (good, _) = good_and_bad(d.path());
     let rgl = brdftab::measured::data::rgl_dir().expect("data/rgl ships");
     let paper = rgl.join("paper_white_rgb.bsdf");
     for src in [CT, s(&good), s(&paper)] {
@@ -283,5 +271,4 @@ fn nan_directions_give_zero() {
         assert!(r.ok, "{src}: {}", r.stderr);
         assert_eq!(r.stdout, "0\n0\n", "{src}");
     }
-    std::fs::remove_dir_all(&d).unwrap();
 }

@@ -2,6 +2,7 @@
 
 mod common;
 
+use brdftab::testkit::TempDir;
 use common::{brdftab, brdftab_with_stdin};
 
 /// The shipped RGL file `name` (`data/rgl`, see `brdftab::measured::data`); a missing file
@@ -39,8 +40,7 @@ fn info_eval_slice_convert() {
     assert_eq!(v.len(), 3);
     assert!((v[1] - 0.2853).abs() < 1e-3, "{}", r.stdout);
 
-    let dir = std::env::temp_dir().join(format!("brdftab-cli-measured-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("cli-measured");
     let png = dir.join("s.png");
     let r = brdftab(&[
         "slice",
@@ -73,5 +73,4 @@ fn info_eval_slice_convert() {
         "{}",
         r.stderr
     );
-    std::fs::remove_dir_all(&dir).ok();
 }

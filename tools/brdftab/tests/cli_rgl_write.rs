@@ -2,6 +2,7 @@
 
 mod common;
 
+use brdftab::testkit::TempDir;
 use common::brdftab;
 
 /// The shipped RGL files (the library's search: `$BRDFTAB_RGL_DIR`, `data/rgl`, `../shared`);
@@ -13,8 +14,7 @@ fn rgl_dir() -> std::path::PathBuf {
 
 #[test]
 fn convert_writes_bsdf_files_and_reports_their_error() {
-    let dir = std::env::temp_dir().join(format!("brdftab-cli-rglw-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("cli-rglw");
     let out = dir.join("ct.bsdf");
     let out_s = out.to_str().unwrap();
     let spec = r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#;
@@ -89,5 +89,4 @@ fn convert_writes_bsdf_files_and_reports_their_error() {
     assert!(!zero.exists());
     let r = brdftab(&["convert", spec, out_s, "--phi-i", "2"]);
     assert!(!r.ok && r.stderr.contains("azimuths"), "{}", r.stderr);
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -3,14 +3,13 @@
 
 mod common;
 
+use brdftab::testkit::TempDir;
 use common::{brdftab, brdftab_with_stdin};
 
 #[test]
 fn bake_info_db_eval_export() {
-    let d = std::env::temp_dir().join(format!("brdftab-cli-store-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    let p = |f: &str| d.join(f).display().to_string();
+    let d = TempDir::new("cli-store");
+    let p = |f: &str| d.file(f);
     let ct = r#"{"model": "cook_torrance", "m": 0.3}"#;
 
     let r = brdftab(&[
@@ -89,5 +88,4 @@ fn bake_info_db_eval_export() {
         "{}",
         r.stderr
     );
-    let _ = std::fs::remove_dir_all(&d);
 }

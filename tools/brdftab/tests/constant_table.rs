@@ -5,12 +5,11 @@
 mod common;
 
 use brdftab::geometry::uniform_hemisphere;
-use brdftab::testkit::Pcg32;
+use brdftab::testkit::{Pcg32, TempDir};
 
 #[test]
 fn default_lambert_table_evaluates_to_kd() {
-    let dir = std::env::temp_dir().join(format!("brdftab-constant-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("constant");
     let table = dir.join("lam.btdb");
     let kd = [0.1f64, 0.2, 0.3];
     let spec = r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#;
@@ -56,5 +55,4 @@ fn default_lambert_table_evaluates_to_kd() {
         n += 1;
     }
     assert_eq!(n, pairs.lines().count());
-    let _ = std::fs::remove_dir_all(&dir);
 }

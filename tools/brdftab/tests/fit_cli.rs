@@ -2,6 +2,7 @@
 
 mod common;
 
+use brdftab::testkit::TempDir;
 use common::{brdftab, brdftab_with_stdin};
 
 const LAMBERT: &str = r#"{"model": "lambert", "kd": [0.1, 0.2, 0.3]}"#;
@@ -131,8 +132,7 @@ fn sample_rejects_a_bad_wo() {
 
 #[test]
 fn fit_through_a_baked_table_file_recovers_cook_torrance() {
-    let dir = std::env::temp_dir().join(format!("brdftab-fit-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("fit-cli");
     let table = dir.join("ct.brdftab");
     let table = table.to_str().unwrap();
     let ct = r#"{"model": "cook_torrance", "m": 0.25, "ks": 0.8, "fresnel": "none"}"#;
@@ -149,7 +149,6 @@ fn fit_through_a_baked_table_file_recovers_cook_torrance() {
         "--starts",
         "3",
     ]);
-    std::fs::remove_dir_all(&dir).ok();
     assert_eq!(r.code, 0, "{}", r.stderr);
     let j: serde_json::Value = serde_json::from_str(r.stdout.trim()).unwrap();
     let (m, ks) = (j["m"].as_f64().unwrap(), j["ks"].as_f64().unwrap());

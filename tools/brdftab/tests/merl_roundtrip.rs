@@ -8,18 +8,12 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use brdftab::measured::MerlBrdf;
 use brdftab::measured::merl::{self, RES_PHI_D, RES_THETA_D, RES_THETA_H, SAMPLES, SCALE};
 use brdftab::store::Store;
-use brdftab::testkit::Pcg32;
-
-fn tmpdir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("brdftab-merlrt-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use brdftab::testkit::{Pcg32, TempDir};
 
 fn unmeasured(ith: usize, itd: usize) -> bool {
     ith >= 80 && itd >= 85
@@ -80,7 +74,7 @@ fn assert_same_file(a: &[f64], path: &Path, rel: f64) {
 
 #[test]
 fn merl_to_merl_keeps_every_cell() {
-    let dir = tmpdir("m2m");
+    let dir = TempDir::new("merlrt-m2m");
     let (a, b) = (dir.join("a.binary"), dir.join("b.binary"));
     let data = issue_file(&a);
     brdftab_ok(&["convert", a.to_str().unwrap(), b.to_str().unwrap()]);
@@ -89,14 +83,13 @@ fn merl_to_merl_keeps_every_cell() {
     // horizon.
     let k = merl::sample_index(83, 15, 145);
     assert!(MerlBrdf::open(&b).unwrap().raw()[k] > 0.0);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `bake --grid merl` stores cell (i, j, k) at node (i, 0, j, k) as the f32 of its f_r, the
 /// sentinels as −1 × scale; the store's f32 codec is lossless, so the check is bit for bit.
 #[test]
 fn bake_on_the_merl_grid_holds_the_cells_verbatim() {
-    let dir = tmpdir("bake");
+    let dir = TempDir::new("merlrt-bake");
     let a = dir.join("a.binary");
     let t = dir.join("t.btdb");
     let data = issue_file(&a);
@@ -136,7 +129,6 @@ fn bake_on_the_merl_grid_holds_the_cells_verbatim() {
     let b = dir.join("b.binary");
     brdftab_ok(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
     assert_same_file(&data, &b, F32_REL);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// MERL → table → MERL through `convert` (the file's own cells, no resampling): with the f32
@@ -144,7 +136,7 @@ fn bake_on_the_merl_grid_holds_the_cells_verbatim() {
 /// sentinel in both (log16 keeps the sign).
 #[test]
 fn merl_to_table_to_merl_keeps_every_cell() {
-    let dir = tmpdir("m2t2m");
+    let dir = TempDir::new("merlrt-m2t2m");
     let a = dir.join("a.binary");
     let data = issue_file(&a);
     for (codec, rel) in [("f32", F32_REL), ("log16", 1e-3 * (1.0 + 1e-6) + F32_REL)] {
@@ -174,7 +166,6 @@ fn merl_to_table_to_merl_keeps_every_cell() {
     ]);
     brdftab_ok(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
     assert_same_file(&data, &b, F32_REL);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// What a lookup makes of the unmeasured cells: 0 at them (nearest), a blend towards 0 next to

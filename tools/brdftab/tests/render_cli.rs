@@ -3,18 +3,14 @@
 
 mod common;
 
+use brdftab::testkit::TempDir;
 use common::brdftab;
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("brdftab-render-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
 
 #[test]
 fn render_writes_png_and_exr() {
+    let dir = TempDir::new("render-cli");
     for name in ["a.png", "a.exr"] {
-        let out = tmp(name);
+        let out = dir.join(name);
         let r = brdftab(&[
             "render",
             r#"{"model":"lambert","kd":0.2}"#,
@@ -28,13 +24,14 @@ fn render_writes_png_and_exr() {
         assert!(r.ok, "{}", r.stderr);
         assert!(std::fs::metadata(&out).unwrap().len() > 0);
     }
-    let img = brdftab_tools::preview::read_exr(tmp("a.exr")).unwrap();
+    let img = brdftab_tools::preview::read_exr(dir.join("a.exr")).unwrap();
     assert_eq!((img.width, img.height, img.channels), (16, 12, 3));
 }
 
 #[test]
 fn compare_with_itself_is_zero_and_writes_diff() {
-    let out = tmp("cmp.png");
+    let dir = TempDir::new("render-cli-compare");
+    let out = dir.join("cmp.png");
     let o = brdftab(&[
         "render",
         r#"{"model":"lambert","kd":0.2}"#,
@@ -49,11 +46,12 @@ fn compare_with_itself_is_zero_and_writes_diff() {
     ]);
     assert!(o.ok, "{}", o.stderr);
     assert!(o.stdout.contains("relative RMSE: 0.000000"), "{}", o.stdout);
-    assert!(tmp("cmp-diff.png").exists());
+    assert!(dir.join("cmp-diff.png").exists());
 }
 
 #[test]
 fn bad_arguments_are_errors() {
+    let dir = TempDir::new("render-cli-bad");
     for args in [
         vec!["--size", "16"],
         vec!["--mode", "fast"],
@@ -61,7 +59,7 @@ fn bad_arguments_are_errors() {
         vec!["--light", "sun"],
         vec!["--spp", "0"],
     ] {
-        let x = tmp("x.png");
+        let x = dir.join("x.png");
         let mut all = vec![
             "render",
             r#"{"model":"lambert","kd":0.2}"#,
