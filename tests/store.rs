@@ -440,10 +440,16 @@ fn absurd_dimensions_and_invalid_json_are_refused_before_allocating() {
 fn random_mutations_never_panic_or_pass() {
     let d = TempDir::new("store-mutate");
     let (_, b) = sample_file(d.path());
-    let iters: usize = std::env::var("BRDFTAB_MUTATIONS")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(3000);
+    // `BRDFTAB_MUTATIONS` asks for more (or fewer) mutations; a value that is not a positive
+    // count is refused rather than run as the default or as no test at all.
+    let iters: usize = match std::env::var("BRDFTAB_MUTATIONS") {
+        Ok(s) => s
+            .parse()
+            .ok()
+            .filter(|&n| n > 0)
+            .unwrap_or_else(|| panic!("BRDFTAB_MUTATIONS={s:?}: not a positive count")),
+        Err(_) => 3000,
+    };
     let mut rng = 0x9E3779B97F4A7C15u64;
     let mut next = move || {
         rng ^= rng << 13;
@@ -451,6 +457,7 @@ fn random_mutations_never_panic_or_pass() {
         rng ^= rng << 17;
         rng
     };
+    let mut tried = 0;
     for it in 0..iters {
         let mut m = b.clone();
         for _ in 0..1 + next() % 4 {
@@ -472,6 +479,7 @@ fn random_mutations_never_panic_or_pass() {
         if m == b {
             continue;
         }
+        tried += 1;
         let r = std::panic::catch_unwind(|| {
             Store::from_bytes("m", m.clone(), StoreOptions::default()).and_then(|s| s.verify())
         });
@@ -481,6 +489,7 @@ fn random_mutations_never_panic_or_pass() {
             Ok(Err(_)) => {}
         }
     }
+    assert!(tried > 0, "no mutation changed the file");
 }
 
 // ---------------------------------------------------------------------------------------------
