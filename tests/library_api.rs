@@ -7,15 +7,10 @@ use brdftab::bake::{BakeRequest, BakeTarget};
 use brdftab::progress::{Progress, Silent};
 use brdftab::store::info;
 use brdftab::table::presets::Preset;
+use brdftab::testkit::TempDir;
 use brdftab::{Channels, Error, ModelSpec};
 
 const LAMBERT: &str = r#"{"model": "lambert", "kd": 0.25}"#;
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("brdftab-api-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn lambert() -> Box<dyn brdftab::Brdf + Send + Sync> {
     ModelSpec::parse(LAMBERT)
@@ -48,7 +43,7 @@ impl Log {
 
 #[test]
 fn bake_reports_its_values_and_the_report_reads_as_text() {
-    let d = tmp("bake");
+    let d = TempDir::new("api-bake");
     let out = d.join("l.btdb");
     let log = Log::default();
     let req = BakeRequest::new(LAMBERT).preset(Preset::Small);
@@ -73,12 +68,11 @@ fn bake_reports_its_values_and_the_report_reads_as_text() {
         l.lines().count() == 2 && l.lines().nth(1).unwrap().starts_with('l'),
         "{l}"
     );
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
 fn a_taken_name_is_a_duplicate_error_naming_no_flag() {
-    let d = tmp("dup");
+    let d = TempDir::new("api-dup");
     let db = d.join("x.btdb").display().to_string();
     let req = BakeRequest::new(LAMBERT).preset(Preset::Small);
     req.run(&BakeTarget::db(&db, "a")).unwrap();
@@ -88,7 +82,6 @@ fn a_taken_name_is_a_duplicate_error_naming_no_flag() {
         "{e}"
     );
     assert!(!e.to_string().contains("--"), "{e}");
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]

@@ -4,7 +4,7 @@
 //! furnace, continuous at the normal, held in under 4 MB while evaluating — and the warps
 //! survive the file round trip.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use brdftab::analysis::accuracy::{Weight, compare_weighted};
@@ -12,19 +12,17 @@ use brdftab::analysis::fidelity::{self, FidelityOptions};
 use brdftab::bake::{BakeRequest, BakeTarget, GridChoice};
 use brdftab::source::{self, OpenOptions};
 use brdftab::table::{Mapping, kernel::Kernel};
+use brdftab::testkit::TempDir;
 use brdftab::{Brdf, Error, measured};
 use glam::DVec3;
 
-fn tmp(name: &str) -> String {
-    let d = std::env::temp_dir().join(format!("brdftab-measured-tables-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name).to_string_lossy().into_owned()
-}
-
-/// Bakes `file` with the defaults; returns (table path, report).
-fn bake_default(file: &str) -> (String, brdftab::bake::BakeReport) {
+/// Bakes `file` with the defaults into `dir`; returns (table path, report).
+fn bake_default(dir: &Path, file: &str) -> (String, brdftab::bake::BakeReport) {
     let rgl = measured::data::rgl_file(file).unwrap_or_else(|e| panic!("{e}"));
-    let out = tmp(&format!("{file}.btdb"));
+    let out = dir
+        .join(format!("{file}.btdb"))
+        .to_string_lossy()
+        .into_owned();
     let r = BakeRequest::new(rgl.to_string_lossy())
         .run(&BakeTarget::File(out.clone()))
         .unwrap();
@@ -41,8 +39,21 @@ struct Baked {
 
 /// Every shipped RGL file baked with the defaults, once for all the tests of this file.
 fn baked() -> &'static [Baked] {
+    // The tests open the tables by path, so the directory outlives each of them: a static is
+    // never dropped, so it is removed when the test process exits.
+    static DIR: OnceLock<TempDir> = OnceLock::new();
     static BAKED: OnceLock<Vec<Baked>> = OnceLock::new();
+    extern "C" fn remove_dir() {
+        if let Some(d) = DIR.get() {
+            let _ = std::fs::remove_dir_all(d.path());
+        }
+    }
     BAKED.get_or_init(|| {
+        let out = DIR.get_or_init(|| {
+            // SAFETY: registers a function that takes nothing and returns nothing.
+            assert_eq!(unsafe { libc::atexit(remove_dir) }, 0, "atexit");
+            TempDir::new("measured-tables")
+        });
         let dir = measured::data::rgl_dir().expect("the shipped data/rgl");
         let files = brdftab::measured::data::rgl_files(&dir).unwrap();
         assert_eq!(files.len(), 7, "the seven shipped RGL files");
@@ -50,7 +61,7 @@ fn baked() -> &'static [Baked] {
             .into_iter()
             .map(|rgl| {
                 let name = rgl.file_name().unwrap().to_string_lossy().into_owned();
-                let (table, report) = bake_default(&name);
+                let (table, report) = bake_default(out.path(), &name);
                 Baked {
                     name,
                     rgl,
@@ -267,7 +278,8 @@ fn lookups_at_the_normal_give_the_continuous_limit() {
 
 #[test]
 fn the_warps_survive_the_file_and_select_the_fast_lookup() {
-    let (out, report) = bake_default("paper_white_rgb.bsdf");
+    let dir = TempDir::new("measured-tables-warps");
+    let (out, report) = bake_default(dir.path(), "paper_white_rgb.bsdf");
     let table = source::open_table(&out, &OpenOptions::default()).unwrap();
     assert_eq!(
         table.grid(),

@@ -4,16 +4,9 @@
 
 use brdftab::measured::MerlBrdf;
 use brdftab::measured::merl::{self, FILE_SIZE, SAMPLES};
-use brdftab::testkit::Pcg32;
+use brdftab::testkit::{Pcg32, TempDir};
 use brdftab::{Brdf, Error};
 use std::f64::consts::PI;
-use std::path::PathBuf;
-
-fn tmpdir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("brdftab-merl-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// Writes a MERL file by hand: header then planes.
 fn write_file(path: &std::path::Path, dims: [i32; 3], data: &[f64]) {
@@ -96,7 +89,7 @@ fn ref_lookup(data: &[f64], ti: f64, pi: f64, to: f64, po: f64) -> [f64; 3] {
 
 #[test]
 fn nearest_lookup_matches_reference_reader() {
-    let dir = tmpdir("lookup");
+    let dir = TempDir::new("merl-lookup");
     let path = dir.join("random.binary");
     let data = random_data(1);
     write_file(&path, [90, 90, 180], &data);
@@ -139,12 +132,11 @@ fn nearest_lookup_matches_reference_reader() {
         }
     }
     assert!(invalid_seen > 30);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn write_read_is_bit_exact() {
-    let dir = tmpdir("rw");
+    let dir = TempDir::new("merl-rw");
     let (a, b) = (dir.join("a.binary"), dir.join("b.binary"));
     let data = random_data(3);
     write_file(&a, [90, 90, 180], &data);
@@ -157,7 +149,6 @@ fn write_read_is_bit_exact() {
         .filter(|&k| (0..3).any(|c| data[c * SAMPLES + k] < 0.0))
         .count();
     assert_eq!(m.invalid_cells(), invalid);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -168,7 +159,7 @@ fn resampled_lambert_round_trips() {
         .build(&brdftab::Channels::Rgb)
         .unwrap();
     let m = MerlBrdf::from_brdf(&*brdf);
-    let dir = tmpdir("lambert");
+    let dir = TempDir::new("merl-lambert");
     let p = dir.join("lambert.binary");
     m.write(&p).unwrap();
     let back = MerlBrdf::open(&p).unwrap();
@@ -196,12 +187,11 @@ fn resampled_lambert_round_trips() {
     }
     assert_eq!(back.invalid_cells(), below);
     assert!(below > 0);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn wrong_size_and_dims_are_typed_errors() {
-    let dir = tmpdir("bad");
+    let dir = TempDir::new("merl-bad");
     let p = dir.join("bad.binary");
     // Right size, wrong dimensions.
     let data = vec![0.0; 3 * SAMPLES];
@@ -227,7 +217,6 @@ fn wrong_size_and_dims_are_typed_errors() {
         MerlBrdf::open(dir.join("none.binary")),
         Err(Error::Io { .. })
     ));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

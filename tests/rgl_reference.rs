@@ -8,6 +8,7 @@ use brdftab::Brdf;
 use brdftab::geometry::spherical;
 use brdftab::measured::RglBrdf;
 use brdftab::measured::tensor::{Dtype, TensorFile, TensorWriter};
+use brdftab::testkit::TempDir;
 use std::collections::BTreeMap;
 
 /// The shipped RGL file `name` (`data/rgl`, see `brdftab::measured::data`); a missing file
@@ -138,8 +139,7 @@ fn rebuilt_file_evaluates_identically() {
 
 #[test]
 fn bad_files_are_typed_errors() {
-    let tmp = std::env::temp_dir().join(format!("brdftab-rgl-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
+    let tmp = TempDir::new("rgl-bad");
     let orig = std::fs::read(rgl("paper_white_rgb.bsdf")).unwrap();
     // Truncated copies: every cut must be an error, never a panic.
     for cut in [0, 10, 17, 100, 1000, orig.len() / 2, orig.len() - 1] {
@@ -212,7 +212,6 @@ fn bad_files_are_typed_errors() {
         }),
         "strictly increasing",
     );
-    std::fs::remove_dir_all(&tmp).ok();
 }
 
 #[test]

@@ -6,14 +6,8 @@ use std::path::{Path, PathBuf};
 use brdftab::codec::{Codec, Layout, Quant};
 use brdftab::store::format::{self, Superblock, Toc};
 use brdftab::store::{Source, Store, StoreOptions, TableHeader, Writer, db, export};
+use brdftab::testkit::TempDir;
 use brdftab::{Channels, Error};
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("brdftab-store-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// A smooth specular-lobe-like table of shape [a, b, c, 3], chunks = slabs of axis 0.
 fn lobe(shape: [usize; 3], seed: f32) -> Vec<f32> {
@@ -67,7 +61,7 @@ fn add(path: &Path, name: &str, quant: Quant, seed: f32) {
 
 #[test]
 fn every_codec_round_trips_through_a_file() {
-    let d = tmpdir("roundtrip");
+    let d = TempDir::new("store-roundtrip");
     let data = lobe(SHAPE, 0.0);
     for (k, q) in [
         Quant::F32,
@@ -111,7 +105,7 @@ fn every_codec_round_trips_through_a_file() {
 
 #[test]
 fn database_add_replace_remove_list_verify() {
-    let d = tmpdir("db");
+    let d = TempDir::new("store-db");
     let p = d.join("db.btdb");
     add(&p, "a", Quant::F16, 0.0);
     add(&p, "b", Quant::F32, 1.0);
@@ -165,7 +159,7 @@ fn database_add_replace_remove_list_verify() {
     .unwrap_err();
     assert!(e.to_string().contains("index 0"), "{e}");
     assert_eq!(names(&p), ["b", "c"]);
-    let stray: Vec<_> = std::fs::read_dir(&d)
+    let stray: Vec<_> = std::fs::read_dir(d.path())
         .unwrap()
         .filter_map(|e| e.ok())
         .filter(|e| e.file_name().to_string_lossy().contains(".tmp."))
@@ -175,7 +169,7 @@ fn database_add_replace_remove_list_verify() {
 
 #[test]
 fn cache_respects_its_memory_bound_and_eager_decodes_everything() {
-    let d = tmpdir("cache");
+    let d = TempDir::new("store-cache");
     let p = d.join("t.btdb");
     add(&p, "a", Quant::F16, 0.0);
     let chunk_bytes = 10 * 20 * 3 * 4;
@@ -205,7 +199,7 @@ fn cache_respects_its_memory_bound_and_eager_decodes_everything() {
 
 #[test]
 fn nan_in_data_names_the_chunk_and_index() {
-    let d = tmpdir("nan");
+    let d = TempDir::new("store-nan");
     let mut w = Writer::create(d.join("x.btdb")).unwrap();
     w.begin_table(header("x", SHAPE, Quant::F32)).unwrap();
     let mut v = lobe(SHAPE, 0.0)[..600].to_vec();
@@ -219,7 +213,7 @@ fn nan_in_data_names_the_chunk_and_index() {
 
 #[test]
 fn npy_and_exr_exports() {
-    let d = tmpdir("export");
+    let d = TempDir::new("store-export");
     let p = d.join("t.btdb");
     add(&p, "a", Quant::F32, 0.0);
     let s = Store::open(&p).unwrap();
@@ -314,8 +308,8 @@ fn reseal(bytes: &[u8], extra: &[u8], edit: impl FnOnce(&mut Toc, u64)) -> Vec<u
 
 #[test]
 fn truncation_anywhere_is_a_typed_error() {
-    let d = tmpdir("trunc");
-    let (_, b) = sample_file(&d);
+    let d = TempDir::new("store-trunc");
+    let (_, b) = sample_file(d.path());
     // Through real files for a few lengths (the path goes through the mmap), in memory for all.
     for len in [0, 5, 63, 64, 100, b.len() - 1] {
         let p = d.join("trunc.btdb");
@@ -327,7 +321,7 @@ fn truncation_anywhere_is_a_typed_error() {
         );
     }
     for len in 0..b.len() {
-        let e = open_err(&d, &b[..len]);
+        let e = open_err(d.path(), &b[..len]);
         assert!(
             matches!(e, Error::Format { .. } | Error::Checksum { .. }),
             "{len}: {e}"
@@ -337,27 +331,27 @@ fn truncation_anywhere_is_a_typed_error() {
 
 #[test]
 fn wrong_magic_and_newer_version() {
-    let d = tmpdir("magic");
-    let (_, b) = sample_file(&d);
+    let d = TempDir::new("store-magic");
+    let (_, b) = sample_file(d.path());
     let mut m = b.clone();
     m[1] = b'X';
-    assert!(open_err(&d, &m).to_string().contains("wrong magic"));
+    assert!(open_err(d.path(), &m).to_string().contains("wrong magic"));
     let mut v = b.clone();
     let mut sb = Superblock::parse("x", &b).unwrap();
     sb.version = format::VERSION + 1;
     v[..64].copy_from_slice(&sb.to_bytes());
-    let e = open_err(&d, &v).to_string();
+    let e = open_err(d.path(), &v).to_string();
     assert!(e.contains("newer"), "{e}");
 }
 
 #[test]
 fn every_flipped_byte_is_caught() {
-    let d = tmpdir("flip");
-    let (_, b) = sample_file(&d);
+    let d = TempDir::new("store-flip");
+    let (_, b) = sample_file(d.path());
     for i in 0..b.len() {
         let mut m = b.clone();
         m[i] ^= 0x10;
-        let e = open_err(&d, &m);
+        let e = open_err(d.path(), &m);
         assert!(
             matches!(
                 e,
@@ -370,8 +364,8 @@ fn every_flipped_byte_is_caught() {
 
 #[test]
 fn overflowing_chunk_ranges_are_refused() {
-    let d = tmpdir("overflow");
-    let (_, b) = sample_file(&d);
+    let d = TempDir::new("store-overflow");
+    let (_, b) = sample_file(d.path());
     let sb = Superblock::parse("x", &b).unwrap();
     let toc: Toc =
         serde_json::from_slice(&b[sb.toc.offset as usize..][..sb.toc.len as usize]).unwrap();
@@ -392,7 +386,7 @@ fn overflowing_chunk_ranges_are_refused() {
                 xxh3: format::xxh3(&ib),
             };
         });
-        let e = open_err(&d, &m);
+        let e = open_err(d.path(), &m);
         assert!(
             matches!(e, Error::Format { .. }),
             "field {field} = {val}: {e}"
@@ -402,8 +396,8 @@ fn overflowing_chunk_ranges_are_refused() {
 
 #[test]
 fn absurd_dimensions_and_invalid_json_are_refused_before_allocating() {
-    let d = tmpdir("bomb");
-    let (_, b) = sample_file(&d);
+    let d = TempDir::new("store-bomb");
+    let (_, b) = sample_file(d.path());
     let mut h = header("a", SHAPE, Quant::F16);
     for (shape, values) in [
         (vec![1u64 << 20, 1 << 20, 1 << 20, 3], 1u64 << 62),
@@ -421,7 +415,7 @@ fn absurd_dimensions_and_invalid_json_are_refused_before_allocating() {
                 xxh3: format::xxh3(&j),
             };
         });
-        let e = open_err(&d, &m);
+        let e = open_err(d.path(), &m);
         assert!(matches!(e, Error::Format { .. }), "{e}");
     }
     // Invalid JSON in a header and in the TOC itself.
@@ -433,10 +427,10 @@ fn absurd_dimensions_and_invalid_json_are_refused_before_allocating() {
             xxh3: format::xxh3(&j),
         };
     });
-    assert!(matches!(open_err(&d, &m), Error::Json { .. }));
+    assert!(matches!(open_err(d.path(), &m), Error::Json { .. }));
     // A TOC claiming a huge index count.
     let m = reseal(&b, &[], |t, _| t.tables[0].chunks = u64::MAX / 2);
-    assert!(matches!(open_err(&d, &m), Error::Format { .. }));
+    assert!(matches!(open_err(d.path(), &m), Error::Format { .. }));
 }
 
 /// The in-repo substitute for a fuzzer (nightly is not available for `cargo fuzz`): thousands of
@@ -444,12 +438,18 @@ fn absurd_dimensions_and_invalid_json_are_refused_before_allocating() {
 /// each give an error, never a panic or an accepted file.
 #[test]
 fn random_mutations_never_panic_or_pass() {
-    let d = tmpdir("mutate");
-    let (_, b) = sample_file(&d);
-    let iters: usize = std::env::var("BRDFTAB_MUTATIONS")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(3000);
+    let d = TempDir::new("store-mutate");
+    let (_, b) = sample_file(d.path());
+    // `BRDFTAB_MUTATIONS` asks for more (or fewer) mutations; a value that is not a positive
+    // count is refused rather than run as the default or as no test at all.
+    let iters: usize = match std::env::var("BRDFTAB_MUTATIONS") {
+        Ok(s) => s
+            .parse()
+            .ok()
+            .filter(|&n| n > 0)
+            .unwrap_or_else(|| panic!("BRDFTAB_MUTATIONS={s:?}: not a positive count")),
+        Err(_) => 3000,
+    };
     let mut rng = 0x9E3779B97F4A7C15u64;
     let mut next = move || {
         rng ^= rng << 13;
@@ -457,6 +457,7 @@ fn random_mutations_never_panic_or_pass() {
         rng ^= rng << 17;
         rng
     };
+    let mut tried = 0;
     for it in 0..iters {
         let mut m = b.clone();
         for _ in 0..1 + next() % 4 {
@@ -478,6 +479,7 @@ fn random_mutations_never_panic_or_pass() {
         if m == b {
             continue;
         }
+        tried += 1;
         let r = std::panic::catch_unwind(|| {
             Store::from_bytes("m", m.clone(), StoreOptions::default()).and_then(|s| s.verify())
         });
@@ -487,6 +489,7 @@ fn random_mutations_never_panic_or_pass() {
             Ok(Err(_)) => {}
         }
     }
+    assert!(tried > 0, "no mutation changed the file");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -496,7 +499,7 @@ fn random_mutations_never_panic_or_pass() {
 fn grid_tables_round_trip_including_packed_layouts() {
     use brdftab::store::tables;
     use brdftab::table::{Grid, Mapping, Param, Symmetry, Table};
-    let d = tmpdir("grid");
+    let d = TempDir::new("store-grid");
     let p = d.join("g.btdb");
     for (k, (param, sizes, sym)) in [
         (
@@ -572,7 +575,7 @@ fn stored_tables_evaluate_like_the_table_they_came_from() {
     use brdftab::store::tables;
     use brdftab::table::{Grid, Mapping, Param, Symmetry, Table, TabulatedBrdf};
     use glam::DVec3;
-    let d = tmpdir("brdf");
+    let d = TempDir::new("store-brdf");
     let p = d.join("g.btdb");
     let g = Grid::with_sizes(
         Param::HalfDiff,
@@ -649,7 +652,7 @@ fn stored_tables_evaluate_like_the_table_they_came_from() {
 
 #[test]
 fn a_damaged_chunk_read_lazily_stays_a_checksum_error() {
-    let d = tmpdir("lazy-checksum");
+    let d = TempDir::new("store-lazy-checksum");
     let p = d.join("l.btdb");
     brdftab::BakeRequest::new(r#"{"model": "lambert", "kd": 0.3}"#)
         .preset(brdftab::table::presets::Preset::Small)

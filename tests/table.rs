@@ -7,7 +7,7 @@ use brdftab::table::{
     Axis, BakeOptions, ChunkLoader, Grid, Interp, Mapping, Nodes, Param, Symmetry, Table,
     TabulatedBrdf, bake, bake_chunks, pair_of, symmetry,
 };
-use brdftab::testkit::Pcg32;
+use brdftab::testkit::{Pcg32, TempDir};
 use brdftab::{Brdf, Channels, Error, Flags, Result, Value};
 use glam::DVec3;
 use proptest::prelude::*;
@@ -635,8 +635,7 @@ fn lazy_chunks_load_on_first_touch_and_failures_read_as_zero() {
 fn raw_file_round_trips() {
     let g = grid(Param::InOut, [6, 8, 6, 8], Symmetry::ALL);
     let (t, _) = bake(&Symmetric, &g, &BakeOptions::default()).unwrap();
-    let dir = std::env::temp_dir().join(format!("brdftab-raw-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("table-raw");
     let p = dir.join("t.brdftab");
     t.save_raw(&p).unwrap();
     assert!(Table::is_raw(&p));
@@ -646,7 +645,6 @@ fn raw_file_round_trips() {
     let bytes = std::fs::read(&p).unwrap();
     std::fs::write(&p, &bytes[..bytes.len() - 3]).unwrap();
     assert!(matches!(Table::open_raw(&p), Err(Error::Format { .. })));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The two-phase batch path (prepare, prefetch, gather) is bit-identical to single lookups for

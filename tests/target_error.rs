@@ -8,13 +8,8 @@ use brdftab::progress::Silent;
 use brdftab::table::presets::Preset;
 use brdftab::table::target::LADDER;
 use brdftab::table::{Mapping, TabulatedBrdf};
+use brdftab::testkit::TempDir;
 use brdftab::{Error, source};
-
-fn tmp(name: &str) -> String {
-    let d = std::env::temp_dir().join(format!("brdftab-target-error-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name).to_string_lossy().into_owned()
-}
 
 fn error_of(t: &TabulatedBrdf, src: &dyn brdftab::Brdf, seed: u64) -> f64 {
     compare_weighted(
@@ -71,7 +66,8 @@ fn a_model_spec_gets_the_smallest_grid_within_the_target() {
 
 #[test]
 fn a_merl_file_with_a_target_is_resampled_onto_an_adaptive_grid() {
-    let path = tmp("ct.binary");
+    let dir = TempDir::new("target-error-merl");
+    let path = dir.file("ct.binary");
     let model = source::open(r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.2}, {"model": "cook_torrance", "m": 0.2}]}"#).unwrap();
     MerlBrdf::from_brdf(model.as_ref()).write(&path).unwrap();
     // Without a target the file keeps its own cells...
@@ -80,7 +76,7 @@ fn a_merl_file_with_a_target_is_resampled_onto_an_adaptive_grid() {
     // ...with one, it gets the adaptive grid that meets it, against the MERL evaluation. That
     // is the reader's nearest lookup, a staircase over its cells: a smooth (linear) table of
     // any size stays about 2 % from it on this material, so the target here is 3 %.
-    let out = tmp("ct.btdb");
+    let out = dir.file("ct.btdb");
     let r = BakeRequest::new(path.as_str())
         .target_error(0.03)
         .run(&BakeTarget::file(&out))

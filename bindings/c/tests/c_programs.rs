@@ -6,7 +6,7 @@ use std::process::Command;
 
 use brdftab::bake::{BakeRequest, BakeTarget};
 use brdftab::table::presets::Preset;
-use brdftab::testkit::Pcg32;
+use brdftab::testkit::{Pcg32, TempDir};
 use brdftab::{Brdf, geometry};
 use glam::{DVec2, DVec3};
 
@@ -29,12 +29,6 @@ fn lib_dir() -> PathBuf {
                 profile.display()
             )
         })
-}
-
-fn tmp() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("brdftab-c-tests-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 fn run(cmd: &mut Command) -> String {
@@ -154,8 +148,7 @@ fn check_source(exe: &Path, dir: &Path, source: &str) {
 
 #[test]
 fn the_c_test_program_agrees_with_the_rust_api() {
-    let dir = tmp().join("abi");
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("c-abi");
     let exe = dir.join("abi_test");
     compile(
         "cc",
@@ -163,13 +156,17 @@ fn the_c_test_program_agrees_with_the_rust_api() {
         &Path::new(CRATE).join("tests/abi_test.c"),
         &exe,
     );
-    let table = bake_table(&dir);
-    check_source(&exe, &dir, &table);
-    check_source(&exe, &dir, r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#);
+    let table = bake_table(dir.path());
+    check_source(&exe, dir.path(), &table);
+    check_source(
+        &exe,
+        dir.path(),
+        r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#,
+    );
     let rgl = brdftab::measured::data::rgl_dir().expect("the RGL files ship in data/rgl");
     check_source(
         &exe,
-        &dir,
+        dir.path(),
         rgl.join("paper_white_rgb.bsdf").to_str().unwrap(),
     );
 }
@@ -177,8 +174,7 @@ fn the_c_test_program_agrees_with_the_rust_api() {
 #[test]
 fn requests_with_json_settings_do_what_the_rust_request_layer_does() {
     use brdftab::request;
-    let dir = tmp().join("request");
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("c-request");
     let exe = dir.join("request_test");
     compile(
         "cc",
@@ -186,7 +182,7 @@ fn requests_with_json_settings_do_what_the_rust_request_layer_does() {
         &Path::new(CRATE).join("tests/request_test.c"),
         &exe,
     );
-    let out = run(Command::new(&exe).arg(&dir));
+    let out = run(Command::new(&exe).arg(dir.path()));
     let line = |label: &str| {
         out.lines()
             .find_map(|l| l.strip_prefix(&format!("{label} ")))
@@ -265,14 +261,12 @@ fn requests_with_json_settings_do_what_the_rust_request_layer_does() {
     )
     .unwrap();
     assert_eq!(fit["spec"], serde_json::to_value(&want).unwrap()["spec"]);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn the_examples_build_and_print_what_the_library_computes() {
-    let dir = tmp().join("examples");
-    std::fs::create_dir_all(&dir).unwrap();
-    let table = bake_table(&dir);
+    let dir = TempDir::new("c-examples");
+    let table = bake_table(dir.path());
     let ex = Path::new(CRATE).join("examples");
 
     // slice.c, against the shared and against the static library.
@@ -376,8 +370,7 @@ fn corrupt_copy(good: &str, bad: &Path) {
 
 #[test]
 fn hostile_input_through_the_c_abi_is_an_error_or_zero_never_a_crash() {
-    let dir = tmp().join("hostile");
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("c-hostile");
     let exe = dir.join("hostile_test");
     compile(
         "cc",
@@ -385,7 +378,7 @@ fn hostile_input_through_the_c_abi_is_an_error_or_zero_never_a_crash() {
         &Path::new(CRATE).join("tests/hostile_test.c"),
         &exe,
     );
-    let table = bake_table(&dir);
+    let table = bake_table(dir.path());
     let bad = dir.join("bad.btdb");
     corrupt_copy(&table, &bad);
     for good in [&table[..], r#"{"model":"ggx","alpha":0.3}"#] {

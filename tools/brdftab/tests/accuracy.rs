@@ -1,19 +1,14 @@
 //! The accuracy suite: a tiny configuration end to end (library and CLI).
 
-use std::process::Command;
+mod common;
 
 use brdftab::table::Param;
 use brdftab::table::presets::Preset;
+use brdftab::testkit::TempDir;
 use brdftab_tools::preview::{LightChoice, Mode, RenderOptions, Sampling};
 use brdftab_tools::report::suite::{
     self, CSV_HEADER, CodecDef, NOT_MEASURED, SourceDef, SuiteConfig, default_codecs,
 };
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("brdftab-accuracy-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
 
 fn codecs(names: &[&str]) -> Vec<CodecDef> {
     default_codecs()
@@ -174,7 +169,9 @@ fn unmeasured_render_is_minus_one_and_said_so() {
 #[test]
 fn write_all_writes_csv_markdown_and_valid_pngs() {
     let report = suite::run(&tiny(), &brdftab::progress::Silent).unwrap();
-    let dir = tmp("lib");
+    // A directory that does not exist yet: `write_all` creates it.
+    let tmp = TempDir::new("accuracy-lib");
+    let dir = tmp.join("report");
     let files = report.write_all(&dir).unwrap();
     assert_eq!(files.len(), 4, "{files:?}");
     let md = std::fs::read_to_string(dir.join("accuracy.md")).unwrap();
@@ -190,46 +187,41 @@ fn write_all_writes_csv_markdown_and_valid_pngs() {
         // Not blank: the figure has dark pixels (text, axes) and white background.
         assert!(buf.iter().any(|&b| b < 64) && buf.contains(&255));
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn cli_writes_the_files() {
-    let dir = tmp("cli");
-    let out = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args([
-            "accuracy",
-            "--quick",
-            "--only",
-            "lambert",
-            "--params",
-            "inout",
-            "--pairs",
-            "1000",
-            "--no-render",
-            "--out",
-        ])
-        .arg(&dir)
-        .env_remove("BRDFTAB_RGL_DIR")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let tmp = TempDir::new("accuracy-cli");
+    let dir = tmp.join("report");
+    let mut cmd = common::command(&[
+        "accuracy",
+        "--quick",
+        "--only",
+        "lambert",
+        "--params",
+        "inout",
+        "--pairs",
+        "1000",
+        "--no-render",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    cmd.env_remove("BRDFTAB_RGL_DIR");
+    let out = common::run(cmd, "");
+    assert!(out.ok, "{}", out.stderr);
     let csv = std::fs::read_to_string(dir.join("accuracy.csv")).unwrap();
     let (header, rows) = parse_csv(&csv);
     assert_eq!(header.join(","), CSV_HEADER);
     assert_eq!(rows.len(), 4); // lambert × small × inout × 4 codecs
     assert!(dir.join("accuracy.md").is_file() && dir.join("rd_lambert.png").is_file());
-    let bad = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args(["accuracy", "--presets", "huge", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert_eq!(bad.status.code(), Some(1));
-    let _ = std::fs::remove_dir_all(&dir);
+    let bad = common::brdftab(&[
+        "accuracy",
+        "--presets",
+        "huge",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(bad.code, 1);
 }
 
 /// The lecture's Phong variants run in the quick suite, each named by its model so a reader of

@@ -1,34 +1,12 @@
 //! The `brdftab` command line as a user sees it: output contracts and error behaviour.
 
-use std::io::Write;
-use std::process::{Command, Stdio};
+mod common;
 
-struct Out {
-    code: i32,
-    stdout: String,
-    stderr: String,
-}
-
-fn run(args: &[&str], stdin: &str) -> Out {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the binary runs");
-    // A failing command may exit before reading stdin: ignore a broken pipe.
-    let _ = child.stdin.take().unwrap().write_all(stdin.as_bytes());
-    let out = child.wait_with_output().unwrap();
-    Out {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8(out.stdout).unwrap(),
-        stderr: String::from_utf8(out.stderr).unwrap(),
-    }
-}
+use brdftab::testkit::TempDir;
+use common::{Run, brdftab, brdftab_with_stdin};
 
 /// Asserts the error contract: exit 1, stderr starts with `error:`, no panic, nothing on stdout.
-fn assert_error(o: &Out, needle: &str) {
+fn assert_error(o: &Run, needle: &str) {
     assert_eq!(o.code, 1, "stderr: {}", o.stderr);
     assert!(o.stderr.starts_with("error:"), "stderr: {}", o.stderr);
     assert!(!o.stderr.contains("panicked"), "stderr: {}", o.stderr);
@@ -50,7 +28,7 @@ const LAMBERT: &str = r#"{"model": "lambert", "kd": [0.1, 0.123456789, 0.3]}"#;
 #[test]
 fn eval_skips_blank_and_comment_lines_and_prints_one_line_per_pair() {
     let input = "# wi then wo\n0 0 1 0 0 1\n\n   \n0.3 0.1 1  -0.2 0.4 0.9\n# below the horizon:\n0 0 -1 0 0 1\n";
-    let o = run(&["eval", LAMBERT], input);
+    let o = brdftab_with_stdin(&["eval", LAMBERT], input);
     assert_eq!(o.code, 0, "{}", o.stderr);
     let lines: Vec<&str> = o.stdout.lines().collect();
     assert_eq!(lines.len(), 3, "{}", o.stdout);
@@ -64,7 +42,7 @@ fn eval_skips_blank_and_comment_lines_and_prints_one_line_per_pair() {
 
 #[test]
 fn eval_wavelengths_gives_one_column_per_wavelength() {
-    let o = run(
+    let o = brdftab_with_stdin(
         &[
             "eval",
             r#"{"model": "lambert", "kd": 0.25}"#,
@@ -83,11 +61,10 @@ fn eval_wavelengths_gives_one_column_per_wavelength() {
 
 #[test]
 fn eval_reads_a_spec_file() {
-    let dir = std::env::temp_dir().join(format!("brdftab-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("cli-spec");
     let path = dir.join("lambert.json");
     std::fs::write(&path, r#"{"model": "lambert", "kd": 0.2}"#).unwrap();
-    let o = run(&["eval", path.to_str().unwrap()], "0 0 1 0 0 1\n");
+    let o = brdftab_with_stdin(&["eval", path.to_str().unwrap()], "0 0 1 0 0 1\n");
     assert_eq!(o.code, 0, "{}", o.stderr);
     let v: Vec<f32> = o
         .stdout
@@ -97,63 +74,62 @@ fn eval_reads_a_spec_file() {
     assert_eq!(v, [0.2f32; 3]);
     let bad = dir.join("bad.json");
     std::fs::write(&bad, "{\"model\": ").unwrap();
-    assert_error(&run(&["eval", bad.to_str().unwrap()], ""), "bad.json");
-    std::fs::remove_dir_all(&dir).ok();
+    assert_error(&brdftab(&["eval", bad.to_str().unwrap()]), "bad.json");
 }
 
 #[test]
 fn malformed_stdin_line_names_the_line() {
-    let o = run(&["eval", LAMBERT], "0 0 1 0 0 1\n\n0 0 1 0 zero 1\n");
+    let o = brdftab_with_stdin(&["eval", LAMBERT], "0 0 1 0 0 1\n\n0 0 1 0 zero 1\n");
     assert_error(&o, "line 3");
-    let o = run(&["eval", LAMBERT], "0 0 1 0 0\n");
+    let o = brdftab_with_stdin(&["eval", LAMBERT], "0 0 1 0 0\n");
     assert_error(&o, "line 1");
-    let o = run(&["eval", LAMBERT], "0 0 1 0 0 1 7\n");
+    let o = brdftab_with_stdin(&["eval", LAMBERT], "0 0 1 0 0 1 7\n");
     assert_error(&o, "line 1");
 }
 
 #[test]
 fn bad_specs_are_errors_naming_the_problem() {
-    assert_error(&run(&["eval", r#"{"model": "bogus"}"#], ""), "bogus");
+    assert_error(&brdftab(&["eval", r#"{"model": "bogus"}"#]), "bogus");
     assert_error(
-        &run(&["eval", r#"{"model": "lambert", "kd": 0.3, "kx": 1}"#], ""),
+        &brdftab(&["eval", r#"{"model": "lambert", "kd": 0.3, "kx": 1}"#]),
         "kx",
     );
     assert_error(
-        &run(&["eval", r#"{"model": "lambert", "kd": -0.3}"#], ""),
+        &brdftab(&["eval", r#"{"model": "lambert", "kd": -0.3}"#]),
         "kd",
     );
     assert_error(
-        &run(&["eval", r#"{"model": "lambert", "kd": "#], ""),
+        &brdftab(&["eval", r#"{"model": "lambert", "kd": "#]),
         "json",
     );
-    assert_error(&run(&["check", r#"{"model": "lambert"}"#], ""), "kd");
+    assert_error(&brdftab(&["check", r#"{"model": "lambert"}"#]), "kd");
     assert_error(
-        &run(&["albedo", "/no/such/file.json"], ""),
+        &brdftab(&["albedo", "/no/such/file.json"]),
         "/no/such/file.json",
     );
 }
 
 #[test]
 fn bad_arguments_are_errors() {
-    assert_error(&run(&["eval", LAMBERT, "--bogus"], ""), "--bogus");
-    assert_error(&run(&["frobnicate"], ""), "frobnicate");
-    assert_error(&run(&[], ""), "subcommand");
-    assert_error(&run(&["check"], ""), "SOURCE");
+    assert_error(&brdftab(&["eval", LAMBERT, "--bogus"]), "--bogus");
+    assert_error(&brdftab(&["frobnicate"]), "frobnicate");
+    assert_error(&brdftab(&[]), "subcommand");
+    assert_error(&brdftab(&["check"]), "SOURCE");
     assert_error(
-        &run(&["eval", LAMBERT, "--wavelengths", "400,blue"], ""),
+        &brdftab(&["eval", LAMBERT, "--wavelengths", "400,blue"]),
         "--wavelengths",
     );
-    assert_error(&run(&["albedo", LAMBERT, "--theta", "10,x"], ""), "--theta");
-    assert_error(&run(&["albedo", LAMBERT, "--theta", "-5"], ""), "--theta");
-    assert_error(&run(&["albedo", LAMBERT, "--theta", "95"], ""), "--theta");
+    assert_error(&brdftab(&["albedo", LAMBERT, "--theta", "10,x"]), "--theta");
+    assert_error(&brdftab(&["albedo", LAMBERT, "--theta", "-5"]), "--theta");
+    assert_error(&brdftab(&["albedo", LAMBERT, "--theta", "95"]), "--theta");
 }
 
 #[test]
 fn bake_target_error_reports_the_search_and_names_its_flag() {
-    let out = std::env::temp_dir().join(format!("brdftab-cli-target-{}.btdb", std::process::id()));
-    let out = out.to_string_lossy().into_owned();
+    let dir = TempDir::new("cli-target");
+    let out = dir.file("t.btdb");
     let ggx = r#"{"model": "ggx", "alpha": 0.3}"#;
-    let o = run(&["bake", ggx, "-o", &out, "--target-error", "1%"], "");
+    let o = brdftab(&["bake", ggx, "-o", &out, "--target-error", "1%"]);
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(
         o.stderr.contains("note: target error 1.00%: met by"),
@@ -165,40 +141,36 @@ fn bake_target_error_reports_the_search_and_names_its_flag() {
         "--target-error=0",
         "--target-error=-1%",
     ] {
-        let o = run(&["bake", ggx, "-o", &out, bad], "");
+        let o = brdftab(&["bake", ggx, "-o", &out, bad]);
         assert_error(&o, "--target-error");
     }
     // A fixed grid cannot take a target: the library's refusal names the flag.
-    let o = run(
-        &[
-            "bake",
-            ggx,
-            "-o",
-            &out,
-            "--preset",
-            "small",
-            "--target-error",
-            "1%",
-        ],
-        "",
-    );
+    let o = brdftab(&[
+        "bake",
+        ggx,
+        "-o",
+        &out,
+        "--preset",
+        "small",
+        "--target-error",
+        "1%",
+    ]);
     assert_error(&o, "--target-error");
-    let _ = std::fs::remove_file(&out);
 }
 
 #[test]
 fn help_and_version_succeed() {
-    let o = run(&["--help"], "");
+    let o = brdftab(&["--help"]);
     assert_eq!(o.code, 0);
     assert!(o.stdout.contains("albedo") && o.stdout.contains("check"));
-    let o = run(&["--version"], "");
+    let o = brdftab(&["--version"]);
     assert_eq!(o.code, 0);
     assert!(o.stdout.starts_with("brdftab "));
 }
 
 #[test]
 fn albedo_prints_theta_and_one_column_per_channel() {
-    let o = run(&["albedo", LAMBERT, "--theta", "0,45,89"], "");
+    let o = brdftab(&["albedo", LAMBERT, "--theta", "0,45,89"]);
     assert_eq!(o.code, 0, "{}", o.stderr);
     let rows: Vec<Vec<f64>> = o.stdout.lines().map(numbers).collect();
     assert_eq!(rows.len(), 3);
@@ -210,27 +182,21 @@ fn albedo_prints_theta_and_one_column_per_channel() {
             assert!((a - expect).abs() < 1e-6 * expect, "{a} vs {expect}");
         }
     }
-    let o = run(
-        &[
-            "albedo",
-            r#"{"model": "lambert", "kd": 0.1}"#,
-            "--theta",
-            "30",
-            "--wavelengths",
-            "450,550",
-        ],
-        "",
-    );
+    let o = brdftab(&[
+        "albedo",
+        r#"{"model": "lambert", "kd": 0.1}"#,
+        "--theta",
+        "30",
+        "--wavelengths",
+        "450,550",
+    ]);
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert_eq!(numbers(o.stdout.trim()).len(), 3);
 }
 
 #[test]
 fn check_json_has_the_documented_fields() {
-    let o = run(
-        &["check", r#"{"model": "lambert", "kd": 0.5}"#, "--json"],
-        "",
-    );
+    let o = brdftab(&["check", r#"{"model": "lambert", "kd": 0.5}"#, "--json"]);
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert_eq!(o.stdout.lines().count(), 1, "one JSON object on one line");
     let v: serde_json::Value = serde_json::from_str(&o.stdout).unwrap();
@@ -247,16 +213,16 @@ fn check_json_has_the_documented_fields() {
 
 #[test]
 fn check_text_and_models_and_demo_run() {
-    let o = run(&["check", r#"{"model": "lambert", "kd": 0.3}"#], "");
+    let o = brdftab(&["check", r#"{"model": "lambert", "kd": 0.3}"#]);
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(o.stdout.contains("energy conserving:  yes"), "{}", o.stdout);
-    let o = run(&["models"], "");
+    let o = brdftab(&["models"]);
     assert_eq!(o.code, 0);
     assert!(o.stdout.contains("reciprocal_phong"));
-    let o = run(&["models", "--json"], "");
+    let o = brdftab(&["models", "--json"]);
     let v: serde_json::Value = serde_json::from_str(&o.stdout).unwrap();
     assert!(v.as_array().unwrap().len() >= 10);
-    let o = run(&["demo", "--plausibility"], "");
+    let o = brdftab(&["demo", "--plausibility"]);
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(o.stdout.contains("lambert kd=0.3"), "{}", o.stdout);
     assert!(
@@ -268,22 +234,13 @@ fn check_text_and_models_and_demo_run() {
 
 #[test]
 fn demo_bakes_into_a_database_and_prints_where() {
-    let dir = std::env::temp_dir().join(format!("brdftab-demo-test-{}", std::process::id()));
-    let out = dir.to_str().unwrap();
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("cli-demo");
+    let out = dir.path().to_str().unwrap();
     // As a user of a checkout standing alone: no `$BRDFTAB_RGL_DIR`, run from elsewhere (no
     // `data/` or `../shared` beside the working directory); the shipped `data/rgl` is found.
-    let o = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args(["demo", "--quick", "--preset", "small", "--out", out])
-        .env_remove("BRDFTAB_RGL_DIR")
-        .current_dir(&dir)
-        .output()
-        .unwrap();
-    let o = Out {
-        code: o.status.code().unwrap_or(-1),
-        stdout: String::from_utf8(o.stdout).unwrap(),
-        stderr: String::from_utf8(o.stderr).unwrap(),
-    };
+    let mut cmd = common::command(&["demo", "--quick", "--preset", "small", "--out", out]);
+    cmd.env_remove("BRDFTAB_RGL_DIR").current_dir(dir.path());
+    let o = common::run(cmd, "");
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(o.stdout.contains("cook_torrance_gold"), "{}", o.stdout);
     assert!(!o.stderr.contains("no RGL directory"), "{}", o.stderr);
@@ -301,5 +258,4 @@ fn demo_bakes_into_a_database_and_prints_where() {
     }
     assert!(o.stdout.contains("demo.btdb"), "{}", o.stdout);
     assert!(dir.join("demo.btdb").is_file());
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -3,44 +3,13 @@
 //! errors, NaN directions. Every case ends in a correct answer or `error: ...` with status 1 —
 //! never a hang, a silent zero or a lost file.
 
-use std::io::Write;
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// Runs brdftab with `stdin`; kills it and fails after 60 s (a hang is a failure, not a wait).
-fn brdftab(args: &[&str], stdin: &str) -> (bool, String, String) {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // A process that refuses its input at once may exit before reading it: a broken pipe here
-    // is its answer, not a failure of the test.
-    if let Err(e) = c.stdin.take().unwrap().write_all(stdin.as_bytes()) {
-        assert_eq!(e.kind(), std::io::ErrorKind::BrokenPipe, "{e}");
-    }
-    let t0 = Instant::now();
-    while c.try_wait().unwrap().is_none() {
-        if t0.elapsed() > Duration::from_secs(60) {
-            c.kill().unwrap();
-            panic!("brdftab {args:?} hung (killed after 60 s)");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let o = c.wait_with_output().unwrap();
-    let s = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
-    (o.status.success(), s(&o.stdout), s(&o.stderr))
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("brdftab-hostile-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use brdftab::testkit::TempDir;
+use common::{brdftab, brdftab_with_stdin};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -52,8 +21,8 @@ const CT: &str = r#"{"model": "cook_torrance", "m": 0.3}"#;
 fn good_and_bad(d: &Path) -> (PathBuf, PathBuf) {
     use brdftab::store::{Store, StoreOptions};
     let good = d.join("good.btdb");
-    let (ok, _, e) = brdftab(&["bake", CT, "-o", s(&good), "--preset", "small"], "");
-    assert!(ok, "{e}");
+    let r = brdftab(&["bake", CT, "-o", s(&good), "--preset", "small"]);
+    assert!(r.ok, "{}", r.stderr);
     let mut b = std::fs::read(&good).unwrap();
     let st = Store::from_bytes("t", b.clone(), StoreOptions::default()).unwrap();
     let raw = st.single().unwrap().raw_chunk(0).unwrap().to_vec();
@@ -66,42 +35,50 @@ fn good_and_bad(d: &Path) -> (PathBuf, PathBuf) {
 
 #[test]
 fn a_corrupt_chunk_read_lazily_is_an_error_everywhere() {
-    let d = tmpdir("corrupt");
-    let (good, bad) = good_and_bad(&d);
+    let d = TempDir::new("hostile-corrupt");
+    let (good, bad) = good_and_bad(d.path());
     let pair = "0 0 1 0 0 1\n";
-    let (ok, out, _) = brdftab(&["eval", s(&good)], pair);
-    assert!(ok && out.trim() != "0e0 0e0 0e0", "{out}");
+    let r = brdftab_with_stdin(&["eval", s(&good)], pair);
+    assert!(r.ok && r.stdout.trim() != "0e0 0e0 0e0", "{}", r.stdout);
     // (0, 0, 1), (0, 0, 1) is θh = 0: chunk 0, the corrupt one.
-    let (ok, out, e) = brdftab(&["eval", s(&bad)], &format!("0.1 0 1 0 0 1\n{pair}{pair}"));
-    assert!(!ok, "{out}");
-    assert!(e.starts_with("error: ") && e.contains("checksum"), "{e}");
+    let r = brdftab_with_stdin(&["eval", s(&bad)], &format!("0.1 0 1 0 0 1\n{pair}{pair}"));
+    assert!(!r.ok, "{}", r.stdout);
     assert!(
-        !out.contains("0e0"),
-        "eval printed the corrupt chunk's zero: {out}"
+        r.stderr.starts_with("error: ") && r.stderr.contains("checksum"),
+        "{}",
+        r.stderr
+    );
+    assert!(
+        !r.stdout.contains("0e0"),
+        "eval printed the corrupt chunk's zero: {}",
+        r.stdout
     );
     // (pdf and sample read the sampler, built from pairs that may miss chunk 0: they fail only
     // when they touched it.) The albedo at normal incidence integrates over θh = 0.
-    let (ok, _, e) = brdftab(&["albedo", s(&bad), "--theta", "0"], "");
-    assert!(!ok && e.contains("checksum"), "{e}");
+    let r = brdftab(&["albedo", s(&bad), "--theta", "0"]);
+    assert!(!r.ok && r.stderr.contains("checksum"), "{}", r.stderr);
     // Writers refuse and leave no file.
     for out in ["out.bsdf", "out.binary", "out.btdb", "out.tbl"] {
         let o = d.join(out);
-        let (ok, _, e) = brdftab(&["convert", s(&bad), s(&o), "--pairs", "0"], "");
-        assert!(!ok && e.contains("checksum"), "convert to {out}: {e}");
+        let r = brdftab(&["convert", s(&bad), s(&o), "--pairs", "0"]);
+        assert!(
+            !r.ok && r.stderr.contains("checksum"),
+            "convert to {out}: {}",
+            r.stderr
+        );
         assert!(!o.exists(), "convert wrote {out} from a corrupt table");
     }
     let npy = d.join("t.npy");
-    let (ok, _, e) = brdftab(&["export", s(&bad), "--npy", s(&npy)], "");
-    assert!(!ok && e.contains("checksum"), "{e}");
+    let r = brdftab(&["export", s(&bad), "--npy", s(&npy)]);
+    assert!(!r.ok && r.stderr.contains("checksum"), "{}", r.stderr);
     assert!(!npy.exists(), "export left a partial .npy");
-    let (ok, _, e) = brdftab(&["db", "verify", s(&bad)], "");
-    assert!(!ok && e.contains("checksum"), "{e}");
-    std::fs::remove_dir_all(&d).unwrap();
+    let r = brdftab(&["db", "verify", s(&bad)]);
+    assert!(!r.ok && r.stderr.contains("checksum"), "{}", r.stderr);
 }
 
 #[test]
 fn a_fifo_or_a_directory_as_source_is_refused_at_once() {
-    let d = tmpdir("fifo");
+    let d = TempDir::new("hostile-fifo");
     let fifo = d.join("pipe.btdb");
     let c = std::ffi::CString::new(s(&fifo)).unwrap();
     // SAFETY: a valid NUL-terminated path.
@@ -115,8 +92,12 @@ fn a_fifo_or_a_directory_as_source_is_refused_at_once() {
             vec!["db", "list", s(src)],
         ] {
             let t0 = Instant::now();
-            let (ok, _, e) = brdftab(&args, "0 0 1 0 0 1\n");
-            assert!(!ok && e.contains("not a regular file"), "{args:?}: {e}");
+            let r = brdftab_with_stdin(&args, "0 0 1 0 0 1\n");
+            assert!(
+                !r.ok && r.stderr.contains("not a regular file"),
+                "{args:?}: {}",
+                r.stderr
+            );
             assert!(t0.elapsed() < Duration::from_secs(20), "{args:?} was slow");
         }
     }
@@ -124,14 +105,13 @@ fn a_fifo_or_a_directory_as_source_is_refused_at_once() {
     let c = std::ffi::CString::new(s(&fifo_json)).unwrap();
     // SAFETY: as above.
     assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
-    let (ok, _, e) = brdftab(&["eval", s(&fifo_json)], "");
-    assert!(!ok && e.contains("a FIFO"), "{e}");
-    std::fs::remove_dir_all(&d).unwrap();
+    let r = brdftab(&["eval", s(&fifo_json)]);
+    assert!(!r.ok && r.stderr.contains("a FIFO"), "{}", r.stderr);
 }
 
 #[test]
 fn an_output_that_is_the_input_is_refused_and_the_input_kept() {
-    let d = tmpdir("same");
+    let d = TempDir::new("hostile-same");
     let rgl = brdftab::measured::data::rgl_dir().expect("data/rgl ships");
     let p = d.join("p.bsdf");
     std::fs::copy(rgl.join("paper_white_rgb.bsdf"), &p).unwrap();
@@ -141,64 +121,54 @@ fn an_output_that_is_the_input_is_refused_and_the_input_kept() {
     std::os::unix::fs::symlink(&p, &link).unwrap();
     let dotted = d.join(".").join("p.bsdf");
     for out in [&p, &dotted, &link] {
-        let (ok, _, e) = brdftab(&["convert", s(&p), s(out), "--pairs", "0"], "");
-        assert!(!ok && e.contains("is the input"), "{e}");
+        let r = brdftab(&["convert", s(&p), s(out), "--pairs", "0"]);
+        assert!(!r.ok && r.stderr.contains("is the input"), "{}", r.stderr);
     }
     assert_eq!(
         std::fs::read(&p).unwrap(),
         before,
         "the measurement changed"
     );
-    let (good, _) = good_and_bad(&d);
+    let (good, _) = good_and_bad(d.path());
     let before = std::fs::read(&good).unwrap();
-    let (ok, _, e) = brdftab(&["bake", s(&good), "-o", s(&good)], "");
-    assert!(!ok && e.contains("is the input"), "{e}");
-    let (ok, _, e) = brdftab(&["export", s(&good), "--npy", s(&good)], "");
-    assert!(!ok && e.contains("is the input"), "{e}");
+    let r = brdftab(&["bake", s(&good), "-o", s(&good)]);
+    assert!(!r.ok && r.stderr.contains("is the input"), "{}", r.stderr);
+    let r = brdftab(&["export", s(&good), "--npy", s(&good)]);
+    assert!(!r.ok && r.stderr.contains("is the input"), "{}", r.stderr);
     assert_eq!(std::fs::read(&good).unwrap(), before);
     // Another entry of the database the source reads is fine.
     let db = d.join("lib.btdb");
-    let (ok, _, e) = brdftab(
-        &["db", "add", s(&db), CT, "--name", "a", "--preset", "small"],
-        "",
-    );
-    assert!(ok, "{e}");
+    let r = brdftab(&["db", "add", s(&db), CT, "--name", "a", "--preset", "small"]);
+    assert!(r.ok, "{}", r.stderr);
     let entry = format!("{}#a", s(&db));
-    let (ok, _, e) = brdftab(
-        &[
-            "db",
-            "add",
-            s(&db),
-            &entry,
-            "--name",
-            "b",
-            "--preset",
-            "small",
-        ],
-        "",
-    );
-    assert!(ok, "{e}");
-    let (ok, _, e) = brdftab(
-        &[
-            "db",
-            "add",
-            s(&db),
-            &entry,
-            "--name",
-            "a",
-            "--replace",
-            "--preset",
-            "small",
-        ],
-        "",
-    );
-    assert!(!ok && e.contains("is the input"), "{e}");
-    std::fs::remove_dir_all(&d).unwrap();
+    let r = brdftab(&[
+        "db",
+        "add",
+        s(&db),
+        &entry,
+        "--name",
+        "b",
+        "--preset",
+        "small",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let r = brdftab(&[
+        "db",
+        "add",
+        s(&db),
+        &entry,
+        "--name",
+        "a",
+        "--replace",
+        "--preset",
+        "small",
+    ]);
+    assert!(!r.ok && r.stderr.contains("is the input"), "{}", r.stderr);
 }
 
 #[test]
 fn a_missing_output_directory_is_named_not_an_internal_file() {
-    let d = tmpdir("missing");
+    let d = TempDir::new("hostile-missing");
     let gone = d.join("no-such-dir");
     for (args, out) in [
         (vec!["bake", CT, "--preset", "small", "-o"], "x.btdb"),
@@ -216,20 +186,24 @@ fn a_missing_output_directory_is_named_not_an_internal_file() {
             "convert" => drop(args.splice(2..2, [s(&o)])),
             _ => args.push(s(&o)),
         }
-        let (ok, _, e) = brdftab(&args, "");
-        assert!(!ok, "{args:?}");
+        let r = brdftab(&args);
+        assert!(!r.ok, "{args:?}");
         assert!(
-            e.contains(s(&o)) && e.contains("does not exist"),
-            "{args:?}: {e}"
+            r.stderr.contains(s(&o)) && r.stderr.contains("does not exist"),
+            "{args:?}: {}",
+            r.stderr
         );
-        assert!(!e.contains(".tmp") && !e.contains(".lock"), "{args:?}: {e}");
+        assert!(
+            !r.stderr.contains(".tmp") && !r.stderr.contains(".lock"),
+            "{args:?}: {}",
+            r.stderr
+        );
     }
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn temporary_files_of_killed_writers_are_removed_by_the_next_write() {
-    let d = tmpdir("stale");
+    let d = TempDir::new("hostile-stale");
     // PID 4194305 is above Linux's largest pid_max: that writer is certainly gone.
     let stale = d.join(".x.btdb.tmp.4194305.123456");
     let live = d.join(format!(".x.btdb.tmp.{}.1", std::process::id()));
@@ -237,23 +211,19 @@ fn temporary_files_of_killed_writers_are_removed_by_the_next_write() {
     for f in [&stale, &live, &other] {
         std::fs::write(f, b"").unwrap();
     }
-    let (ok, _, e) = brdftab(
-        &["bake", CT, "--preset", "small", "-o", s(&d.join("x.btdb"))],
-        "",
-    );
-    assert!(ok, "{e}");
+    let r = brdftab(&["bake", CT, "--preset", "small", "-o", s(&d.join("x.btdb"))]);
+    assert!(r.ok, "{}", r.stderr);
     assert!(
         !stale.exists(),
         "the dead writer's temporary file is still there"
     );
     assert!(live.exists(), "a live process's temporary file was removed");
     assert!(other.exists(), "another file's temporary file was removed");
-    std::fs::remove_dir_all(&d).unwrap();
 }
 
 #[test]
 fn errors_quote_huge_inputs_in_part() {
-    let d = tmpdir("huge");
+    let d = TempDir::new("hostile-huge");
     let big = "x".repeat(10 << 20);
     for (name, spec) in [
         ("model.json", format!(r#"{{"model": "{big}"}}"#)),
@@ -268,31 +238,37 @@ fn errors_quote_huge_inputs_in_part() {
     ] {
         let f = d.join(name);
         std::fs::write(&f, spec).unwrap();
-        let (ok, _, e) = brdftab(&["eval", s(&f)], "");
-        assert!(!ok && e.starts_with("error: "), "{name}");
-        assert!(e.len() < 2000, "{name}: a {} byte error", e.len());
+        let r = brdftab(&["eval", s(&f)]);
+        assert!(!r.ok && r.stderr.starts_with("error: "), "{name}");
+        assert!(
+            r.stderr.len() < 2000,
+            "{name}: a {} byte error",
+            r.stderr.len()
+        );
     }
-    let (ok, _, e) = brdftab(&["eval", CT], &format!("0 0 1 0 0 {big}\n"));
-    assert!(!ok && e.len() < 2000, "a {} byte error", e.len());
-    std::fs::remove_dir_all(&d).unwrap();
+    let r = brdftab_with_stdin(&["eval", CT], &format!("0 0 1 0 0 {big}\n"));
+    assert!(
+        !r.ok && r.stderr.len() < 2000,
+        "a {} byte error",
+        r.stderr.len()
+    );
 }
 
 #[test]
 fn nan_directions_give_zero() {
-    let d = tmpdir("nan");
-    let (good, _) = good_and_bad(&d);
+    let d = TempDir::new("hostile-nan");
+    let (good, _) = good_and_bad(d.path());
     let rgl = brdftab::measured::data::rgl_dir().expect("data/rgl ships");
     let paper = rgl.join("paper_white_rgb.bsdf");
     for src in [CT, s(&good), s(&paper)] {
-        let (ok, out, e) = brdftab(
+        let r = brdftab_with_stdin(
             &["eval", src],
             "nan 0 1 0 0 1\n0 0 1 0 inf 1\n0 0 0 0 0 1\n",
         );
-        assert!(ok, "{src}: {e}");
-        assert_eq!(out, "0e0 0e0 0e0\n".repeat(3), "{src}");
-        let (ok, out, e) = brdftab(&["pdf", src], "nan 0 1 0 0 1\n0 0 1 0 0 NaN\n");
-        assert!(ok, "{src}: {e}");
-        assert_eq!(out, "0\n0\n", "{src}");
+        assert!(r.ok, "{src}: {}", r.stderr);
+        assert_eq!(r.stdout, "0e0 0e0 0e0\n".repeat(3), "{src}");
+        let r = brdftab_with_stdin(&["pdf", src], "nan 0 1 0 0 1\n0 0 1 0 0 NaN\n");
+        assert!(r.ok, "{src}: {}", r.stderr);
+        assert_eq!(r.stdout, "0\n0\n", "{src}");
     }
-    std::fs::remove_dir_all(&d).unwrap();
 }

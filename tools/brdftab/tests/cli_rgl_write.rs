@@ -1,18 +1,9 @@
 //! `brdftab convert SOURCE out.bsdf`: the CLI call site of the RGL writer.
 
-use std::process::Command;
+mod common;
 
-fn brdftab(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args(args)
-        .output()
-        .expect("run brdftab");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use brdftab::testkit::TempDir;
+use common::brdftab;
 
 /// The shipped RGL files (the library's search: `$BRDFTAB_RGL_DIR`, `data/rgl`, `../shared`);
 /// fails when none exists.
@@ -23,29 +14,34 @@ fn rgl_dir() -> std::path::PathBuf {
 
 #[test]
 fn convert_writes_bsdf_files_and_reports_their_error() {
-    let dir = std::env::temp_dir().join(format!("brdftab-cli-rglw-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("cli-rglw");
     let out = dir.join("ct.bsdf");
     let out_s = out.to_str().unwrap();
     let spec = r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#;
-    let (ok, stdout, stderr) = brdftab(&["convert", spec, out_s, "--pairs", "20000"]);
-    assert!(ok, "{stderr}");
-    assert!(stdout.contains("1 φi × 16 θi, 64×64 table"), "{stdout}");
-    let rmse: f64 = stdout
+    let r = brdftab(&["convert", spec, out_s, "--pairs", "20000"]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(
+        r.stdout.contains("1 φi × 16 θi, 64×64 table"),
+        "{}",
+        r.stdout
+    );
+    let rmse: f64 = r
+        .stdout
         .split("cos θi cos θo ")
         .nth(1)
         .and_then(|t| t.split(',').next())
         .and_then(|t| t.trim().parse().ok())
-        .unwrap_or_else(|| panic!("no error figure in {stdout}"));
-    assert!(rmse < 0.02, "{stdout}");
-    let (ok, info, _) = brdftab(&["info", out_s]);
+        .unwrap_or_else(|| panic!("no error figure in {}", r.stdout));
+    assert!(rmse < 0.02, "{}", r.stdout);
+    let r = brdftab(&["info", out_s]);
     assert!(
-        ok && info.contains("rgb") && info.contains("φi 1 × θi 16"),
-        "{info}"
+        r.ok && r.stdout.contains("rgb") && r.stdout.contains("φi 1 × θi 16"),
+        "{}",
+        r.stdout
     );
 
     // Layout options, and a re-encoded RGL file keeping its own layout.
-    let (ok, stdout, stderr) = brdftab(&[
+    let r = brdftab(&[
         "convert",
         spec,
         out_s,
@@ -57,12 +53,14 @@ fn convert_writes_bsdf_files_and_reports_their_error() {
         "0",
     ]);
     assert!(
-        ok && stdout.contains("1 φi × 8 θi, 32×32 table"),
-        "{stdout}{stderr}"
+        r.ok && r.stdout.contains("1 φi × 8 θi, 32×32 table"),
+        "{}{}",
+        r.stdout,
+        r.stderr
     );
     let paper = rgl_dir().join("paper_white_rgb.bsdf");
     let re = dir.join("paper.bsdf");
-    let (ok, stdout, stderr) = brdftab(&[
+    let r = brdftab(&[
         "convert",
         paper.to_str().unwrap(),
         re.to_str().unwrap(),
@@ -70,23 +68,25 @@ fn convert_writes_bsdf_files_and_reports_their_error() {
         "20000",
     ]);
     assert!(
-        ok && stdout.contains("1 φi × 8 θi, 32×32 table"),
-        "{stdout}{stderr}"
+        r.ok && r.stdout.contains("1 φi × 8 θi, 32×32 table"),
+        "{}{}",
+        r.stdout,
+        r.stderr
     );
 
     // Bad input: a clear error, no file.
     let zero = dir.join("zero.bsdf");
-    let (ok, _, stderr) = brdftab(&[
+    let r = brdftab(&[
         "convert",
         r#"{"model": "lambert", "kd": 0}"#,
         zero.to_str().unwrap(),
     ]);
     assert!(
-        !ok && stderr.starts_with("error: ") && stderr.contains("retro-reflection"),
-        "{stderr}"
+        !r.ok && r.stderr.starts_with("error: ") && r.stderr.contains("retro-reflection"),
+        "{}",
+        r.stderr
     );
     assert!(!zero.exists());
-    let (ok, _, stderr) = brdftab(&["convert", spec, out_s, "--phi-i", "2"]);
-    assert!(!ok && stderr.contains("azimuths"), "{stderr}");
-    std::fs::remove_dir_all(&dir).ok();
+    let r = brdftab(&["convert", spec, out_s, "--phi-i", "2"]);
+    assert!(!r.ok && r.stderr.contains("azimuths"), "{}", r.stderr);
 }

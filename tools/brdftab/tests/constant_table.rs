@@ -2,29 +2,23 @@
 //! log16 at 1e-3) of a Lambert BRDF evaluates to kd — the codec stores constant chunks exactly
 //! (chunk version 3 anchors each channel's log16 grid at its most common value).
 
-use std::io::Write;
-use std::process::{Command, Stdio};
+mod common;
 
 use brdftab::geometry::uniform_hemisphere;
-use brdftab::testkit::Pcg32;
+use brdftab::testkit::{Pcg32, TempDir};
 
 #[test]
 fn default_lambert_table_evaluates_to_kd() {
-    let dir = std::env::temp_dir().join(format!("brdftab-constant-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("constant");
     let table = dir.join("lam.btdb");
     let kd = [0.1f64, 0.2, 0.3];
     let spec = r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#;
-    let o = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args(["bake", spec, "-o"])
-        .arg(&table)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = common::brdftab(&["bake", spec, "-o", table.to_str().unwrap()]);
+    assert!(o.ok, "{}", o.stderr);
     assert!(
-        String::from_utf8_lossy(&o.stderr).contains("log16"),
+        o.stderr.contains("log16"),
         "the default codec is log16: {}",
-        String::from_utf8_lossy(&o.stderr)
+        o.stderr
     );
 
     // Random pairs over both hemispheres' interiors, plus near-normal and near-grazing ones.
@@ -40,22 +34,11 @@ fn default_lambert_table_evaluates_to_kd() {
         }
     }
     pairs += "0 0 1 0 0 1\n0.9999 0 0.0141 -0.9999 0 0.0141\n";
-    let mut child = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .arg("eval")
-        .arg(&table)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // Feed stdin from a thread: the output would fill its pipe before the input is written.
-    let mut stdin = child.stdin.take().unwrap();
-    let input = pairs.clone();
-    let feeder = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
-    let o = child.wait_with_output().unwrap();
-    feeder.join().unwrap().unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let out = String::from_utf8(o.stdout).unwrap();
+    // (The runner feeds stdin from a thread: the output would fill its pipe before the input
+    // is written.)
+    let o = common::brdftab_with_stdin(&["eval", table.to_str().unwrap()], &pairs);
+    assert!(o.ok, "{}", o.stderr);
+    let out = o.stdout;
     let mut n = 0;
     for line in out.lines() {
         let v: Vec<f64> = line
@@ -72,5 +55,4 @@ fn default_lambert_table_evaluates_to_kd() {
         n += 1;
     }
     assert_eq!(n, pairs.lines().count());
-    let _ = std::fs::remove_dir_all(&dir);
 }

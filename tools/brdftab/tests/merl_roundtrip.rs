@@ -6,19 +6,14 @@
 //! pair with a direction below the horizon (e.g. θh 83, θd 15, φd 145), which resampling at
 //! directions cannot reach.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
+
+use std::path::Path;
 
 use brdftab::measured::MerlBrdf;
 use brdftab::measured::merl::{self, RES_PHI_D, RES_THETA_D, RES_THETA_H, SAMPLES, SCALE};
 use brdftab::store::Store;
-use brdftab::testkit::Pcg32;
-
-fn tmpdir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("brdftab-merlrt-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use brdftab::testkit::{Pcg32, TempDir};
 
 fn unmeasured(ith: usize, itd: usize) -> bool {
     ith >= 80 && itd >= 85
@@ -52,16 +47,10 @@ fn issue_file(path: &Path) -> Vec<f64> {
     data
 }
 
-fn brdftab(args: &[&str]) {
-    let o = Command::new(env!("CARGO_BIN_EXE_brdftab"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "brdftab {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+/// Runs `brdftab ARGS`, which must succeed.
+fn brdftab_ok(args: &[&str]) {
+    let o = common::brdftab(args);
+    assert!(o.ok, "brdftab {args:?}: {}", o.stderr);
 }
 
 /// f32 rounding of the scaled value (relative 2^-24) and two f64 operations.
@@ -85,27 +74,26 @@ fn assert_same_file(a: &[f64], path: &Path, rel: f64) {
 
 #[test]
 fn merl_to_merl_keeps_every_cell() {
-    let dir = tmpdir("m2m");
+    let dir = TempDir::new("merlrt-m2m");
     let (a, b) = (dir.join("a.binary"), dir.join("b.binary"));
     let data = issue_file(&a);
-    brdftab(&["convert", a.to_str().unwrap(), b.to_str().unwrap()]);
+    brdftab_ok(&["convert", a.to_str().unwrap(), b.to_str().unwrap()]);
     assert_same_file(&data, &b, F32_REL);
     // The cell of the issue: (θh 83, θd 15, φd 145), channel R, measured, centre pair below the
     // horizon.
     let k = merl::sample_index(83, 15, 145);
     assert!(MerlBrdf::open(&b).unwrap().raw()[k] > 0.0);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `bake --grid merl` stores cell (i, j, k) at node (i, 0, j, k) as the f32 of its f_r, the
 /// sentinels as −1 × scale; the store's f32 codec is lossless, so the check is bit for bit.
 #[test]
 fn bake_on_the_merl_grid_holds_the_cells_verbatim() {
-    let dir = tmpdir("bake");
+    let dir = TempDir::new("merlrt-bake");
     let a = dir.join("a.binary");
     let t = dir.join("t.btdb");
     let data = issue_file(&a);
-    brdftab(&[
+    brdftab_ok(&[
         "bake",
         a.to_str().unwrap(),
         "--grid",
@@ -139,9 +127,8 @@ fn bake_on_the_merl_grid_holds_the_cells_verbatim() {
     }
     // And back to MERL from the baked table.
     let b = dir.join("b.binary");
-    brdftab(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
+    brdftab_ok(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
     assert_same_file(&data, &b, F32_REL);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// MERL → table → MERL through `convert` (the file's own cells, no resampling): with the f32
@@ -149,13 +136,13 @@ fn bake_on_the_merl_grid_holds_the_cells_verbatim() {
 /// sentinel in both (log16 keeps the sign).
 #[test]
 fn merl_to_table_to_merl_keeps_every_cell() {
-    let dir = tmpdir("m2t2m");
+    let dir = TempDir::new("merlrt-m2t2m");
     let a = dir.join("a.binary");
     let data = issue_file(&a);
     for (codec, rel) in [("f32", F32_REL), ("log16", 1e-3 * (1.0 + 1e-6) + F32_REL)] {
         let t = dir.join(format!("t-{codec}.btdb"));
         let b = dir.join(format!("b-{codec}.binary"));
-        brdftab(&[
+        brdftab_ok(&[
             "convert",
             a.to_str().unwrap(),
             t.to_str().unwrap(),
@@ -164,22 +151,21 @@ fn merl_to_table_to_merl_keeps_every_cell() {
             "--pairs",
             "0",
         ]);
-        brdftab(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
+        brdftab_ok(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
         assert_same_file(&data, &b, rel);
     }
     // A raw table file too.
     let t = dir.join("t.tbl");
     let b = dir.join("b-raw.binary");
-    brdftab(&[
+    brdftab_ok(&[
         "convert",
         a.to_str().unwrap(),
         t.to_str().unwrap(),
         "--pairs",
         "0",
     ]);
-    brdftab(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
+    brdftab_ok(&["convert", t.to_str().unwrap(), b.to_str().unwrap()]);
     assert_same_file(&data, &b, F32_REL);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// What a lookup makes of the unmeasured cells: 0 at them (nearest), a blend towards 0 next to

@@ -1,68 +1,57 @@
 //! `brdftab render` end to end: a tiny render, and --compare writing the pair, the difference
 //! image and the relative RMSE.
 
-use std::process::Command;
+mod common;
 
-fn brdftab() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_brdftab"))
-}
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("brdftab-render-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
+use brdftab::testkit::TempDir;
+use common::brdftab;
 
 #[test]
 fn render_writes_png_and_exr() {
+    let dir = TempDir::new("render-cli");
     for name in ["a.png", "a.exr"] {
-        let out = tmp(name);
-        let st = brdftab()
-            .args([
-                "render",
-                r#"{"model":"lambert","kd":0.2}"#,
-                "--size",
-                "16x12",
-                "--spp",
-                "2",
-                "-o",
-            ])
-            .arg(&out)
-            .status()
-            .unwrap();
-        assert!(st.success());
+        let out = dir.join(name);
+        let r = brdftab(&[
+            "render",
+            r#"{"model":"lambert","kd":0.2}"#,
+            "--size",
+            "16x12",
+            "--spp",
+            "2",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(r.ok, "{}", r.stderr);
         assert!(std::fs::metadata(&out).unwrap().len() > 0);
     }
-    let img = brdftab_tools::preview::read_exr(tmp("a.exr")).unwrap();
+    let img = brdftab_tools::preview::read_exr(dir.join("a.exr")).unwrap();
     assert_eq!((img.width, img.height, img.channels), (16, 12, 3));
 }
 
 #[test]
 fn compare_with_itself_is_zero_and_writes_diff() {
-    let out = tmp("cmp.png");
-    let o = brdftab()
-        .args([
-            "render",
-            r#"{"model":"lambert","kd":0.2}"#,
-            "--size",
-            "16x16",
-            "--spp",
-            "2",
-            "--compare",
-            r#"{"model":"lambert","kd":0.2}"#,
-            "-o",
-        ])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(stdout.contains("relative RMSE: 0.000000"), "{stdout}");
-    assert!(tmp("cmp-diff.png").exists());
+    let dir = TempDir::new("render-cli-compare");
+    let out = dir.join("cmp.png");
+    let o = brdftab(&[
+        "render",
+        r#"{"model":"lambert","kd":0.2}"#,
+        "--size",
+        "16x16",
+        "--spp",
+        "2",
+        "--compare",
+        r#"{"model":"lambert","kd":0.2}"#,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.ok, "{}", o.stderr);
+    assert!(o.stdout.contains("relative RMSE: 0.000000"), "{}", o.stdout);
+    assert!(dir.join("cmp-diff.png").exists());
 }
 
 #[test]
 fn bad_arguments_are_errors() {
+    let dir = TempDir::new("render-cli-bad");
     for args in [
         vec!["--size", "16"],
         vec!["--mode", "fast"],
@@ -70,13 +59,16 @@ fn bad_arguments_are_errors() {
         vec!["--light", "sun"],
         vec!["--spp", "0"],
     ] {
-        let o = brdftab()
-            .args(["render", r#"{"model":"lambert","kd":0.2}"#, "-o"])
-            .arg(tmp("x.png"))
-            .args(&args)
-            .output()
-            .unwrap();
-        assert_eq!(o.status.code(), Some(1), "{args:?}");
-        assert!(String::from_utf8_lossy(&o.stderr).starts_with("error:"));
+        let x = dir.join("x.png");
+        let mut all = vec![
+            "render",
+            r#"{"model":"lambert","kd":0.2}"#,
+            "-o",
+            x.to_str().unwrap(),
+        ];
+        all.extend(&args);
+        let o = brdftab(&all);
+        assert_eq!(o.code, 1, "{args:?}");
+        assert!(o.stderr.starts_with("error:"));
     }
 }
