@@ -4,7 +4,7 @@
 
 use brdftab::Error;
 use brdftab::bake::BakeRequest;
-use brdftab::progress::{Progress, Silent};
+use brdftab::progress::Silent;
 use brdftab::table::TabulatedBrdf;
 use brdftab::table::presets::Preset;
 use brdftab::{Channels, ModelSpec};
