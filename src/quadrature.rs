@@ -10,7 +10,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use crate::geometry;
 use crate::spectrum::MAX_CHANNELS;
 
-/// Accuracy settings of [`hemisphere`].
+/// Accuracy settings of `hemisphere`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
     /// Target relative error of the albedo (of its largest channel).
@@ -31,7 +31,7 @@ impl Default for Options {
     }
 }
 
-/// The result of [`hemisphere`].
+/// The result of `hemisphere`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Estimate {
     /// The albedo per channel.

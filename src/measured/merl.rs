@@ -30,7 +30,7 @@
 //! does.
 //!
 //! A table of the file on [`Grid::merl`](crate::table::Grid::merl) ([`MerlBrdf::to_table`], or
-//! a bake on that grid, which copies the cells through [`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node)) keeps them too, as
+//! a bake on that grid, which copies the cells through [`BakeSource::stored_node`]) keeps them too, as
 //! negative values (−1 × scale), so MERL → table → MERL gives the file back (to f32 precision,
 //! and within the codec's bound for lossy codecs, which keep the sign). Lookups in such a table
 //! see them as 0 ([`TabulatedBrdf`](crate::table::TabulatedBrdf)): a *nearest* lookup gives the
@@ -305,10 +305,10 @@ impl MerlBrdf {
 
     /// Resamples any BRDF at the cell centres of the MERL grid and stores f_r / scale.
     ///
-    /// A source that stores a value at the cell centre ([`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node): a MERL
+    /// A source that stores a value at the cell centre ([`BakeSource::stored_node`]: a MERL
     /// measurement, a `halfdiff` table on the MERL grid) gives it as stored, so MERL → MERL and
     /// MERL → table → MERL keep every cell — to f32 precision, the precision of
-    /// [`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node) — and every unmeasured cell: a negative stored value is written as
+    /// [`BakeSource::stored_node`] — and every unmeasured cell: a negative stored value is written as
     /// the database's −1. Any other source is evaluated at the cell centre (RGB channels: `eval`;
     /// other channel sets: [`Brdf::eval_wavelength`] at the representative RGB wavelengths);
     /// there cells whose centre puts a direction below the horizon are stored as −1

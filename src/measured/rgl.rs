@@ -322,7 +322,7 @@ const NO_PARAMS: Corners = Corners {
     w: [1.0, 0.0, 0.0, 0.0],
 };
 
-/// Where a bake's view of an isotropic file ([`Brdf::bake_view`]) replaces the normal slice's
+/// Where a bake's view of an isotropic file ([`BakeSource::bake_view`]) replaces the normal slice's
 /// pattern by its azimuthal mean: from θi = 0, fading out linearly by θi = 5° (or the file's
 /// second θi sample, if nearer). The files' second sample is near 30°, but the pattern matters
 /// only where a table cannot follow it — within a few degrees of the normal, where it turns
@@ -375,7 +375,7 @@ pub struct RglBrdf {
     /// Per output channel: file channels (c0, c1) and weight of c1.
     out_map: Vec<(usize, usize, f64)>,
     /// The azimuthal mean of the θi = 0 slice (isotropic files; made on the first
-    /// [`Brdf::bake_view`]).
+    /// [`BakeSource::bake_view`]).
     normal_limit: std::sync::OnceLock<NormalLimit>,
 }
 

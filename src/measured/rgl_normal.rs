@@ -91,7 +91,7 @@ impl NormalLimit {
 }
 
 /// An isotropic RGL file as a bake samples it: continuous at normal incidence (see the module
-/// docs). Made by [`RglBrdf`](crate::measured::RglBrdf)'s [`Brdf::bake_view`]; sampling and
+/// docs). Made by [`RglBrdf`](crate::measured::RglBrdf)'s [`BakeSource::bake_view`](crate::brdf::BakeSource::bake_view); sampling and
 /// the pdf are the file's own.
 pub struct ContinuousAtNormal<'a> {
     rgl: &'a dyn Brdf,

@@ -53,7 +53,7 @@ use crate::table::warp::{Warp, WarpVar};
 /// cache, and a corner row (two φd corners × RGB) is 12 bytes. The scale 2^e puts the largest
 /// magnitude in [2^14, 2^15), well inside f16's range; magnitudes below 2^-14 after scaling
 /// (2^-28 of the largest and less) are stored as 0, so every code is ±0 or a normal f16 and
-/// expands exactly with [`F4::from_f16_normal`] (or F16C). The rounding costs at most
+/// expands exactly with `F4::from_f16_normal` (or F16C). The rounding costs at most
 /// 2^-11 of a value (f16's half ulp), far below a measured table's interpolation error.
 /// Negative values are kept: a table of a [`Quantity`] other than f_r extrapolates its nodes beyond the
 /// horizon below 0 (`table::horizon`); an f_r table's negative values (unmeasured cells) are

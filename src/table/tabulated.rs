@@ -24,7 +24,7 @@
 //! the lookup sees 0 there: a *nearest* lookup of an unmeasured cell gives 0, and a *linear*
 //! lookup next to one blends towards 0 over the half cell between the nodes (measured values
 //! near the unmeasured region are darkened, none is made up). The set-aside values stay with
-//! the table: [`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node) and [`TabulatedBrdf::to_table`] give them back, so a table
+//! the table: [`BakeSource::stored_node`] and [`TabulatedBrdf::to_table`] give them back, so a table
 //! converts back to the MERL file it came from. Below the horizon `eval` is 0 as for every
 //! `Brdf`; a node whose centre pair has a direction below the horizon still holds its stored
 //! value and is interpolated with its neighbours for pairs above it.
@@ -75,7 +75,7 @@ pub struct TabulatedBrdf {
     /// The fast linear lookup ([`super::kernel`]) of adaptive grids and of small MERL-style
     /// fixed grids, when it applies. Its lookups read `packed`, all chunks in one array loaded
     /// at first use: f16 codes for adaptive grids, whose `chunks` are then loaded only for other
-    /// readers (nearest lookups, [`TabulatedBrdf::to_table`], [`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node)), or the
+    /// readers (nearest lookups, [`TabulatedBrdf::to_table`], [`BakeSource::stored_node`]), or the
     /// exact values, which `chunk` then serves instead of `chunks`.
     kernel: Option<Kernel>,
     /// Every chunk, contiguous and packed (tables with a kernel only), loaded on first use.
