@@ -44,6 +44,7 @@ use crate::brdf::{BakeSource, Brdf, Flags};
 use crate::error::{Error, Result};
 use crate::geometry;
 use crate::spectrum::{Channels, MAX_CHANNELS};
+use crate::table::sampling::{SamplingResolution, TableSampler};
 pub(crate) use crate::table::warp2d::{Corners, Planes, Warp};
 use crate::table::warp2d::{NO_PARAMS, bilinear};
 
@@ -129,6 +130,8 @@ pub struct RglBrdf {
     /// The azimuthal mean of the θi = 0 slice (isotropic files; made on the first
     /// [`Brdf::bake_view`]).
     normal_limit: std::sync::OnceLock<NormalLimit>,
+    /// Importance sampling of f_r cos θi given `wo`, built on first `sample`/`pdf`.
+    sampler: std::sync::OnceLock<TableSampler>,
 }
 
 /// What [`RglBrdf::summary`] reports about a file.
@@ -371,6 +374,7 @@ impl RglBrdf {
             wavelengths,
             out_map,
             normal_limit: std::sync::OnceLock::new(),
+            sampler: std::sync::OnceLock::new(),
         })
     }
 
@@ -550,6 +554,18 @@ impl RglBrdf {
         Some((Self::flip(out, signs), pdf))
     }
 
+    /// The sampler of [`Brdf::sample`] and [`Brdf::pdf`] (built on first use).
+    pub fn sampler(&self) -> &TableSampler {
+        self.sampler.get_or_init(|| {
+            let res = if self.isotropic {
+                SamplingResolution::default()
+            } else {
+                SamplingResolution::anisotropic()
+            };
+            TableSampler::build(self, self.isotropic, &res)
+        })
+    }
+
     /// The reference reader's value, f_r · cos θo, per channel (for tests and comparisons).
     pub fn eval_cos(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
         self.eval(wi, wo, out);
@@ -614,33 +630,25 @@ impl Brdf for RglBrdf {
         if f.is_finite() && f > 0.0 { f } else { 0.0 }
     }
 
-    /// Importance sampling by the measurement's own warps. The tensor is conditioned on the
-    /// incident direction `wi`, but `sample` must draw `wi` given `wo`; it therefore runs the
-    /// tensor's sampler with the roles swapped (tensor-incident = `wo`). That is exact — `pdf`
-    /// reports the density of this very procedure and the weight uses the true f_r(wi, wo) — and
-    /// efficient because measured reflectance is close to reciprocal.
+    /// Importance sampling by conditional half-vector warps of f_r cos θi given `wo`
+    /// ([`TableSampler`], built from this reader on first use: 131 k evaluations).
+    ///
+    /// The file's own warps ([`RglBrdf::tensor_sample`]) are conditioned on the tensor's
+    /// incident direction, our `wi`, while `sample` must draw `wi` given `wo`; run with the
+    /// roles swapped they are exact but follow f_r(wo, wi) cos θo rather than f_r(wi, wo) cos θi,
+    /// and measured reflectance is not reciprocal enough for that: the weights' coefficient of
+    /// variation was 0.1–0.6 over views 3–75°, against ≤ 0.06 with the table sampler.
     fn sample(
         &self,
         wo: DVec3,
         u: glam::DVec2,
         weight: &mut [f32],
     ) -> Option<crate::brdf::BrdfSample> {
-        let (wi, pdf) = self.tensor_sample(wo, u)?;
-        let c = self.channels.len();
-        self.eval(wi, wo, &mut weight[..c]);
-        let cos_i = wi.z;
-        for w in &mut weight[..c] {
-            *w = (*w as f64 * cos_i / pdf) as f32;
-        }
-        Some(crate::brdf::BrdfSample {
-            wi,
-            pdf,
-            delta: false,
-        })
+        self.sampler().sample(self, wo, u, weight)
     }
 
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        self.tensor_pdf(wo, wi)
+        self.sampler().pdf(wi, wo)
     }
 
     fn flags(&self) -> Flags {
