@@ -18,13 +18,19 @@
 //!   g(s, y) = f_r·cos θi · 4 (wo·h) · sin θh · π s · 2π (f_r the channel mean), sampled at
 //!   `theta_h` × `phi_h` nodes and interpolated bilinearly — the RGL format's `Marginal2D`
 //!   ([`super::warp2d`]), sampled exactly by inverting its CDFs (one quadratic per axis).
-//! - **Floor**: every node whose mirror image lies above the horizon also gets `floor` × the
-//!   mean of those nodes, and every node a tenth of that, so the density is positive wherever
-//!   f_r may be (a lobe narrower than the nodes, cells across the horizon) and the estimate is
-//!   unbiased. A draw whose mirror image falls below the horizon is refused (`None`, weight 0).
-//!   The floor's share of the samples lands where f_r cos θi may be near 0, so it costs up to
-//!   about √(1.1 floor) in the coefficient of variation of the weights (0.074 at the default
-//!   0.005; far less where the floor overlaps the lobe).
+//! - **Floor**: the nodes whose mirror image lies above the horizon also share `floor` × the
+//!   node's mass, and every node a tenth of that, so the density is positive wherever f_r may
+//!   be (a lobe narrower than the nodes, cells across the horizon) and the estimate unbiased.
+//!   Its share of the samples lands where f_r cos θi may be near 0: it costs up to about
+//!   √(1.1 floor) in the coefficient of variation of the weights (0.074 at the default 0.005,
+//!   far less where the floor overlaps the lobe).
+//! - **Fold at the horizon**: a draw whose mirror image falls below the horizon is reflected
+//!   above it (z → −z) rather than refused, so the mass that bilinear interpolation puts across
+//!   the horizon (cells with valid and invalid corners, where f_r cos θi is cut off) is not
+//!   wasted; the density of `wi` is then the sum over both preimages, h(wi) and h(wi mirrored
+//!   below the horizon) — one more density lookup per sample and per `pdf`. (Giving invalid
+//!   nodes their neighbours' values instead was tried: it put mass where f_r cos θi vanishes at
+//!   the horizon and doubled the CV of diffuse files.)
 //! - **Conditioning nodes**: `theta_o` nodes uniform in t = sqrt(1 − cos θo) ∈ [0, 1] (within
 //!   10 % of uniform in θo; needs no `acos`); anisotropic sources also `phi_o` periodic nodes
 //!   over φo. Isotropic sources rotate a query into the nodes' frame (φo = 0) by vector algebra.
@@ -33,8 +39,8 @@
 //!   again a normalized distribution that is sampled exactly, so [`TableSampler::pdf`] is the
 //!   density of [`TableSampler::sample`] for every `wo`, not only at the nodes.
 //! - **Cost**: a sample is two binary searches over interpolated CDFs, two quadratics, two
-//!   `sin_cos`, a reflection and one evaluation of the source for the weight; it never
-//!   allocates. `pdf` adds an `asin` and an `atan2` (the inverse map).
+//!   `sin_cos`, a reflection, the density of the other preimage (an `asin`, an `atan2` and a
+//!   bilinear lookup) and one evaluation of the source for the weight; it never allocates.
 //!
 //! # Resolution and memory
 //!
@@ -132,6 +138,12 @@ fn square_of(h: DVec3) -> [f64; 2] {
     [s, y]
 }
 
+/// (x, y, −z).
+#[inline]
+fn mirror_z(v: DVec3) -> DVec3 {
+    DVec3::new(v.x, v.y, -v.z)
+}
+
 impl TableSampler {
     /// Builds the distributions of `brdf` (f_r·cos θi, channel mean). `isotropic`: condition on
     /// θo only and rotate by φo.
@@ -184,16 +196,23 @@ impl TableSampler {
                         sum += g;
                     }
                 }
-                let mean = sum / valid.max(1) as f64;
-                // A node with nothing measured is uniform on the square. Otherwise the floor goes
-                // to the valid nodes, and a tenth of it everywhere (cells across the horizon).
-                let (on_valid, everywhere) = if mean > 0.0 && mean.is_finite() {
-                    ((floor * mean) as f32, (0.1 * floor * mean) as f32)
+                // A node with nothing measured is uniform on the square. Otherwise the valid
+                // nodes share `floor` × the node's mass, and every node `floor` / 10 of it
+                // (cells across the horizon).
+                let (on_valid, everywhere) = if sum > 0.0 && sum.is_finite() {
+                    (
+                        (floor * sum / valid.max(1) as f64) as f32,
+                        (0.1 * floor * sum / plane as f64) as f32,
+                    )
                 } else {
                     (1.0, 1.0)
                 };
                 for v in d.iter_mut() {
-                    *v = if *v < 0.0 { everywhere } else { *v + on_valid + everywhere };
+                    *v = if *v < 0.0 {
+                        everywhere
+                    } else {
+                        *v + on_valid + everywhere
+                    };
                 }
             }
         }
@@ -290,18 +309,31 @@ impl TableSampler {
         let (c, s) = self.frame(wo);
         let rot = |v: DVec3| DVec3::new(c * v.x + s * v.y, -s * v.x + c * v.y, v.z);
         let (wil, wol) = (rot(wi), rot(wo));
-        let Some(h) = geometry::normalize(wil + wol) else {
-            return 0.0;
-        };
-        let u = square_of(h);
-        let sin_th = (h.x * h.x + h.y * h.y).sqrt();
-        let jac = 4.0 * wol.dot(h) * half_jacobian(u[0], sin_th);
-        let pdf = self.square_pdf(u, &self.corners(wo)) / jac;
+        let k = self.corners(wo);
+        let pdf = self.density_at(wil, wol, &k) + self.density_at(mirror_z(wil), wol, &k);
         if pdf.is_finite() && pdf > 0.0 {
             pdf
         } else {
             0.0
         }
+    }
+
+    /// The density of drawing the half vector of (`wil`, `wol`) (nodes' frame; `wil` may be
+    /// below the horizon), per solid angle of `wil`; 0 when the half vector is below the
+    /// horizon or undefined.
+    #[inline]
+    fn density_at(&self, wil: DVec3, wol: DVec3, k: &Corners) -> f64 {
+        let Some(h) = geometry::normalize(wil + wol) else {
+            return 0.0;
+        };
+        let dot = wol.dot(h);
+        if h.z <= 0.0 || dot <= 0.0 {
+            return 0.0;
+        }
+        let u = square_of(h);
+        let sin_th = (h.x * h.x + h.y * h.y).sqrt();
+        let d = self.square_pdf(u, k) / (4.0 * dot * half_jacobian(u[0], sin_th));
+        if d.is_finite() { d } else { 0.0 }
     }
 
     /// Draws `wi` for `wo` from `u` ∈ [0,1)²; evaluates `brdf` for the weight f_r cos θi / pdf.
@@ -318,15 +350,23 @@ impl TableSampler {
         }
         let (c, s) = self.frame(wo);
         let wol = DVec3::new(c * wo.x + s * wo.y, -s * wo.x + c * wo.y, wo.z);
-        let (p, pdf_square) = self.warp.sample([u.x, u.y], &self.corners(wo));
+        let k = self.corners(wo);
+        let (p, pdf_square) = self.warp.sample([u.x, u.y], &k);
         let (h, sin_th) = half_of(p);
         let dot = wol.dot(h);
-        let wil = 2.0 * dot * h - wol;
-        if dot <= 0.0 || wil.z <= 0.0 {
+        if dot <= 0.0 {
             return None;
         }
-        let pdf = pdf_square / (4.0 * dot * half_jacobian(p[0], sin_th));
-        if !(pdf > 0.0) || !pdf.is_finite() {
+        let drawn = 2.0 * dot * h - wol;
+        let here = pdf_square / (4.0 * dot * half_jacobian(p[0], sin_th));
+        // Folded at the horizon: the other preimage of `wil` is its mirror image below it.
+        let (wil, pdf) = if drawn.z > 0.0 {
+            (drawn, here + self.density_at(mirror_z(drawn), wol, &k))
+        } else {
+            let wil = mirror_z(drawn);
+            (wil, here + self.density_at(wil, wol, &k))
+        };
+        if !(wil.z > 0.0) || !(pdf > 0.0) || !pdf.is_finite() {
             return None;
         }
         // Back from the nodes' frame; renormalized against rounding.
