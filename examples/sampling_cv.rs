@@ -2,7 +2,8 @@
 //! SOURCE, natively (RGL files: the native reader) and as the default table that
 //! `brdftab bake SOURCE` makes, at views θo = 3, 15, 30, 45, 60, 75, 85°. Each figure is the
 //! largest CV over four view azimuths (0.3, 1.9, 3.4, 5.0 rad), 40 000 samples each; a draw
-//! without a direction counts as weight 0.
+//! without a direction counts as weight 0. The last column is the cost of one `sample`
+//! (direction, pdf and weight) against one `eval`, single thread, on random views.
 //!
 //! `cargo run --release --example sampling_cv -- data/rgl/*.bsdf`
 //! (`--samples N` per view; `--native-only`, `--table-only`; `--wrap` samples a native source with
@@ -69,16 +70,52 @@ fn row(label: &str, b: &dyn Brdf, samples: usize) {
         for (k, &phi) in PHIS.iter().enumerate() {
             let wo = geometry::spherical(v.to_radians(), phi);
             let s = weight_stats(b, wo, samples, 1000 + k as u64);
-            cv = if s.cv.is_nan() { f64::NAN } else { cv.max(s.cv) };
+            cv = if s.cv.is_nan() {
+                f64::NAN
+            } else {
+                cv.max(s.cv)
+            };
             worst_max = worst_max.max(s.max_over_mean);
             worst_refused = worst_refused.max(s.refused);
         }
         cells.push(format!("{cv:6.3}"));
     }
+    // Cost: one sample (direction, pdf, weight) against one evaluation, on the same views and
+    // uniforms, single thread, wall time (best of three runs of 200 000 each).
+    let mut rng = brdftab::rng::Pcg32::new(5);
+    let n = 200_000;
+    let pairs: Vec<(glam::DVec3, glam::DVec2, glam::DVec3)> = (0..n)
+        .map(|_| {
+            let wo = geometry::uniform_hemisphere(rng.next_dvec2());
+            let u = rng.next_dvec2();
+            let wi = geometry::uniform_hemisphere(rng.next_dvec2());
+            (wo, u, wi)
+        })
+        .collect();
+    let mut w = [0.0f32; 64];
+    let c = b.channels().len();
+    let mut best = [f64::INFINITY; 2];
+    for _ in 0..3 {
+        let t = Instant::now();
+        for &(wo, u, _) in &pairs {
+            std::hint::black_box(b.sample(wo, u, &mut w[..c]));
+        }
+        best[0] = best[0].min(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        for &(wo, _, wi) in &pairs {
+            b.eval(wi, wo, &mut w[..c]);
+            std::hint::black_box(w[0]);
+        }
+        best[1] = best[1].min(t.elapsed().as_secs_f64());
+    }
+    let ns = |s: f64| s / n as f64 * 1e9;
     println!(
-        "| {label:<34} | {} | {worst_max:7.1} | {:5.1} % | {build:5.2} |",
+        "| {label:<34} | {} | {worst_max:7.1} | {:5.1} % | {build:5.2} | {:.0} / {:.0} ns = {:.2} |",
         cells.join(" | "),
-        100.0 * worst_refused
+        100.0 * worst_refused,
+        ns(best[0]),
+        ns(best[1]),
+        best[0] / best[1]
     );
 }
 
@@ -118,10 +155,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     println!(
-        "| source | {} | max w/mean | refused | build s |",
+        "| source | {} | max w/mean | refused | build s | sample / eval |",
         VIEWS.map(|v| format!("{v}°")).join(" | ")
     );
-    println!("|---|{}---|---|---|", "---|".repeat(VIEWS.len()));
+    println!("|---|{}---|---|---|---|", "---|".repeat(VIEWS.len()));
     let dir = std::env::temp_dir().join(format!("brdftab-sampling-cv-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     for (i, s) in sources.iter().enumerate() {

@@ -58,7 +58,6 @@ fn warp_of(planes: Planes, file: &TensorFile, field: &Field) -> Result<Warp> {
     })
 }
 
-
 /// Interval index `i` (clamped to [0, n−2]) with values[i] ≤ x, and the weight of `i + 1`
 /// (clamped to [0, 1]). A single value gives (0, 0) — no interpolation.
 #[inline]
@@ -73,7 +72,6 @@ fn param_weight(values: &[f32], x: f64) -> (usize, usize, f64) {
     let w = ((x - p0) / (p1 - p0)).clamp(0.0, 1.0);
     (i, i + 1, w)
 }
-
 
 /// Where a bake's view of an isotropic file ([`Brdf::bake_view`]) replaces the normal slice's
 /// pattern by its azimuthal mean: from θi = 0, fading out linearly by θi = 5° (or the file's
@@ -557,11 +555,7 @@ impl RglBrdf {
     /// The sampler of [`Brdf::sample`] and [`Brdf::pdf`] (built on first use).
     pub fn sampler(&self) -> &TableSampler {
         self.sampler.get_or_init(|| {
-            let res = if self.isotropic {
-                SamplingResolution::default()
-            } else {
-                SamplingResolution::anisotropic()
-            };
+            let res = SamplingResolution::for_isotropy(self.isotropic);
             TableSampler::build(self, self.isotropic, &res)
         })
     }

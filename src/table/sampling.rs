@@ -12,10 +12,12 @@
 //!   h, wi = 2 (wo·h) h − wo (dωi = 4 (wo·h) dωh). Reflectance concentrates around h = n (the
 //!   specular peak) for every view, so the distributions of neighbouring views look alike and
 //!   interpolate well, and one fixed, pole-dense parameterization resolves sharp peaks: the unit
-//!   square (s, y) maps to θh = (π/2) s² (the RGL format's u(θ) = √(2θ/π)) and φh = 2π y − π
-//!   (relative to φo for isotropic sources, absolute otherwise).
+//!   square (s, y) maps to θh = (π/2)(0.1 s + 0.9 s²) (nearly the RGL format's u(θ) = √(2θ/π),
+//!   but with a Jacobian that vanishes at the pole as the bilinear density does, so the density
+//!   of `wi` stays finite at the mirror direction) and φh = 2π y − π (relative to φo for
+//!   isotropic sources, absolute otherwise).
 //! - **Per conditioning node** (a view `wo`): the target density on the square,
-//!   g(s, y) = f_r·cos θi · 4 (wo·h) · sin θh · π s · 2π (f_r the channel mean), sampled at
+//!   g(s, y) = f_r·cos θi · 4 (wo·h) · sin θh · dθh/ds · 2π (f_r the channel mean), sampled at
 //!   `theta_h` × `phi_h` nodes and interpolated bilinearly — the RGL format's `Marginal2D`
 //!   ([`super::warp2d`]), sampled exactly by inverting its CDFs (one quadratic per axis).
 //! - **Floor**: the nodes whose mirror image lies above the horizon also share `floor` × the
@@ -88,6 +90,23 @@ impl Default for SamplingResolution {
 }
 
 impl SamplingResolution {
+    /// The default for a source: [`SamplingResolution::default`] when `isotropic`, else
+    /// [`SamplingResolution::anisotropic`].
+    pub fn for_isotropy(isotropic: bool) -> Self {
+        if isotropic {
+            Self::default()
+        } else {
+            Self::anisotropic()
+        }
+    }
+
+    /// Bytes a [`TableSampler`] of this resolution holds (`isotropic`: one node per θo).
+    pub fn memory_bytes(&self, isotropic: bool) -> usize {
+        let (nx, ny) = (self.theta_h.max(2), self.phi_h.max(2));
+        let views = self.theta_o.max(1) * if isotropic { 1 } else { self.phi_o.max(1) };
+        4 * views * (2 * nx * ny + ny)
+    }
+
     /// The default for anisotropic sources (fewer nodes per view, 12 × 16 views).
     pub fn anisotropic() -> Self {
         SamplingResolution {
@@ -109,16 +128,32 @@ pub struct TableSampler {
     warp: Warp,
 }
 
-/// θh of the square's first coordinate s: (π/2) s².
+/// Share of the θh map that is linear in s: θh = (π/2)(a s + (1 − a) s²), a = `LINEAR`.
+/// The quadratic part puts the nodes close together at the pole (the RGL format's u(θ) = √(2θ/π)
+/// is the pure quadratic); the linear part keeps dθh/ds > 0 there, so that the Jacobian
+/// vanishes like s at the pole, as the bilinear density does — with the pure quadratic it
+/// vanishes like s³ and the density of `wi` would be infinite at the mirror direction.
+const LINEAR: f64 = 0.1;
+
+/// θh of the square's first coordinate s.
 #[inline]
 fn theta_of_s(s: f64) -> f64 {
-    FRAC_PI_2 * s * s
+    FRAC_PI_2 * s * (LINEAR + (1.0 - LINEAR) * s)
 }
 
-/// |dωi / d(s, y)| / (4 (wo·h)) = sin θh · dθh/ds · dφh/dy = sin θh · π s · 2π.
+/// s of θh (inverse of [`theta_of_s`]): the positive root of (1 − a) s² + a s − 2θh/π = 0.
+#[inline]
+fn s_of_theta(theta: f64) -> f64 {
+    let q = theta / FRAC_PI_2;
+    // 2q / (a + √(a² + 4(1 − a) q)): the root without cancellation.
+    let s = 2.0 * q / (LINEAR + (LINEAR * LINEAR + 4.0 * (1.0 - LINEAR) * q).sqrt());
+    s.clamp(0.0, 1.0)
+}
+
+/// |dωi / d(s, y)| / (4 (wo·h)) = sin θh · dθh/ds · dφh/dy.
 #[inline]
 fn half_jacobian(s: f64, sin_th: f64) -> f64 {
-    sin_th * PI * s * TAU
+    sin_th * FRAC_PI_2 * (LINEAR + 2.0 * (1.0 - LINEAR) * s) * TAU
 }
 
 /// The half vector of square point `u` = (s, y) in the frame of the nodes, with sin θh.
@@ -132,7 +167,7 @@ fn half_of(u: [f64; 2]) -> (DVec3, f64) {
 /// The square point (s, y) of a unit half vector `h` (inverse of [`half_of`]).
 #[inline]
 fn square_of(h: DVec3) -> [f64; 2] {
-    let s = (geometry::elevation(h) / FRAC_PI_2).min(1.0).sqrt();
+    let s = s_of_theta(geometry::elevation(h));
     let mut y = (h.y.atan2(h.x) + PI) / TAU;
     y -= y.floor();
     [s, y]
@@ -207,8 +242,12 @@ impl TableSampler {
                 } else {
                     (1.0, 1.0)
                 };
-                for v in d.iter_mut() {
-                    *v = if *v < 0.0 {
+                for (k, v) in d.iter_mut().enumerate() {
+                    *v = if k % nx == 0 {
+                        // The pole (s = 0), where the Jacobian vanishes: no floor, so the
+                        // density of `wi` stays finite there.
+                        0.0
+                    } else if *v < 0.0 {
                         everywhere
                     } else {
                         *v + on_valid + everywhere
@@ -403,7 +442,10 @@ mod tests {
             assert!((h.length() - 1.0).abs() < 1e-12 && h.z >= 0.0);
             assert!((sin_th - (h.x * h.x + h.y * h.y).sqrt()).abs() < 1e-12);
             let q = square_of(h);
-            assert!((p.x - q[0]).abs() < 1e-9 && (p.y - q[1]).abs() < 1e-9, "{p} -> {h} -> {q:?}");
+            assert!(
+                (p.x - q[0]).abs() < 1e-9 && (p.y - q[1]).abs() < 1e-9,
+                "{p} -> {h} -> {q:?}"
+            );
         }
     }
 
@@ -421,12 +463,13 @@ mod tests {
             let p = rng.next_dvec2() * 0.98 + DVec2::splat(0.01);
             let u = [p.x, p.y];
             let a = wi_of(u);
-            let bx = wi_of([u[0] + e, u[1]]) - a;
-            let by = wi_of([u[0], u[1] + e]) - a;
-            let area = bx.cross(by).length() / (e * e);
+            let bx = wi_of([u[0] + e, u[1]]) - wi_of([u[0] - e, u[1]]);
+            let by = wi_of([u[0], u[1] + e]) - wi_of([u[0], u[1] - e]);
+            let area = bx.cross(by).length() / (4.0 * e * e);
+            let _ = a;
             let (h, st) = half_of(u);
             let j = 4.0 * wo.dot(h).abs() * half_jacobian(u[0], st);
-            assert!((area - j).abs() <= 1e-4 * j + 1e-9, "{u:?}: {area} vs {j}");
+            assert!((area - j).abs() <= 1e-6 * j + 1e-9, "{u:?}: {area} vs {j}");
         }
     }
 }

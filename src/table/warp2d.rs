@@ -15,7 +15,6 @@
 //! the RGL writer to build them, and the table sampler ([`super::sampling`]) for its conditional
 //! distributions of f_r cos θi.
 
-
 /// A bilinearly interpolated grid of `slices` planes of `ny` rows × `nx` columns on [0, 1]².
 #[derive(Debug, Clone)]
 pub(crate) struct Planes {
@@ -257,7 +256,13 @@ pub(crate) fn solve_linear_cdf(a: f64, b: f64, y: f64) -> f64 {
 
 /// Bilinear interpolation of plane `plane` (within slice stride `stride`) at unit point `u`.
 #[inline]
-pub(crate) fn bilinear(p: &Planes, k: &Corners, stride: usize, plane_off: usize, u: [f64; 2]) -> f64 {
+pub(crate) fn bilinear(
+    p: &Planes,
+    k: &Corners,
+    stride: usize,
+    plane_off: usize,
+    u: [f64; 2],
+) -> f64 {
     let (ix, fx) = Planes::locate(u[0], p.nx);
     let (iy, fy) = Planes::locate(u[1], p.ny);
     let o = plane_off + ix + iy * p.nx;
