@@ -82,13 +82,22 @@ fn row(label: &str, b: &dyn Brdf, samples: usize) {
     }
     // Cost: one sample (direction, pdf, weight) against one evaluation, on the same views and
     // uniforms, single thread, wall time (best of three runs of 200 000 each).
-    let mut rng = brdftab::rng::Pcg32::new(5);
+    // A splitmix64 stream (the crate's generator is private).
+    let mut state = 5u64;
+    let mut next = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut pair = move || glam::DVec2::new(next(), next());
     let n = 200_000;
     let pairs: Vec<(glam::DVec3, glam::DVec2, glam::DVec3)> = (0..n)
         .map(|_| {
-            let wo = geometry::uniform_hemisphere(rng.next_dvec2());
-            let u = rng.next_dvec2();
-            let wi = geometry::uniform_hemisphere(rng.next_dvec2());
+            let wo = geometry::uniform_hemisphere(pair());
+            let u = pair();
+            let wi = geometry::uniform_hemisphere(pair());
             (wo, u, wi)
         })
         .collect();

@@ -58,6 +58,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use super::warp2d::{Corners, Planes, Warp};
 use crate::brdf::{Brdf, BrdfSample};
+use crate::fastmath;
 use crate::geometry;
 use crate::spectrum::MAX_CHANNELS;
 
@@ -159,9 +160,10 @@ fn half_jacobian(s: f64, sin_th: f64) -> f64 {
 /// The half vector of square point `u` = (s, y) in the frame of the nodes, with sin θh.
 #[inline]
 fn half_of(u: [f64; 2]) -> (DVec3, f64) {
-    let (st, ct) = theta_of_s(u[0]).sin_cos();
-    let (sp, cp) = (TAU * u[1] - PI).sin_cos();
-    (DVec3::new(st * cp, st * sp, ct), st)
+    let (st, ct) = fastmath::sin_cos_2pi(theta_of_s(u[0]) * (1.0 / TAU));
+    // φh = 2π y − π: (sin, cos) of 2π y, negated.
+    let (sp, cp) = fastmath::sin_cos_2pi(u[1]);
+    (DVec3::new(-st * cp, -st * sp, ct), st)
 }
 
 /// The square point (s, y) of a unit half vector `h` (inverse of [`half_of`]).
@@ -399,9 +401,17 @@ impl TableSampler {
         let drawn = 2.0 * dot * h - wol;
         let here = pdf_square / (4.0 * dot * half_jacobian(p[0], sin_th));
         // Folded at the horizon: the other preimage of `wil` is its mirror image below it.
+        // The mirror image of `drawn` below the horizon has its half vector (∝ wo + mirror)
+        // above the horizon only when drawn.z < wo.z; otherwise its density is 0.
         let (wil, pdf) = if drawn.z > 0.0 {
-            (drawn, here + self.density_at(mirror_z(drawn), wol, &k))
+            let other = if drawn.z < wol.z {
+                self.density_at(mirror_z(drawn), wol, &k)
+            } else {
+                0.0
+            };
+            (drawn, here + other)
         } else {
+            // The other preimage is `wil` itself, whose half vector is always above.
             let wil = mirror_z(drawn);
             (wil, here + self.density_at(wil, wol, &k))
         };
