@@ -331,3 +331,34 @@ fn adaptive_grids_need_bilateral_isotropy_and_model_specs_keep_the_preset() {
         .unwrap_err();
     assert!(matches!(e, Error::InvalidArgument { .. }), "{e}");
 }
+
+/// Importance sampling as good as the measurement's own (#24): the coefficient of variation of
+/// the weights f_r cos θi / pdf stays ≤ 0.10 at views 3–75° and ≤ 0.2 at 85°, natively and for
+/// the default tables (the figures of `examples/sampling_cv`, on 20 000 samples at two view
+/// azimuths; the measured CVs are at most 0.09 at 3–75° and 0.18 at 85°, and the estimate of a
+/// CV near 0.1 on 20 000 samples has a standard error near 0.001).
+#[test]
+fn rgl_sampling_weights_are_near_constant() {
+    use brdftab::analysis::weights::weight_stats;
+    let mut failures = Vec::new();
+    for b in baked() {
+        let native = b.native();
+        let table = b.table();
+        for (kind, brdf) in [("native", native.as_ref()), ("table", &table as &dyn Brdf)] {
+            for deg in [3.0f64, 15.0, 30.0, 45.0, 60.0, 75.0, 85.0] {
+                let bar = if deg <= 75.0 { 0.10 } else { 0.2 };
+                for (k, phi) in [0.3f64, 3.4].into_iter().enumerate() {
+                    let wo = brdftab::geometry::spherical(deg.to_radians(), phi);
+                    let s = weight_stats(brdf, wo, 20_000, 50 + k as u64);
+                    if s.cv.is_nan() || s.cv > bar {
+                        failures.push(format!(
+                            "{} {kind} at {deg}°, φ {phi}: CV {:.3}",
+                            b.name, s.cv
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

@@ -7,3 +7,4 @@ pub mod fidelity;
 pub mod pair_rule;
 pub mod plausibility;
 pub mod timing;
+pub mod weights;

@@ -3,7 +3,8 @@
 //! The CLI prints these (as JSON with `--json`, as text otherwise), the bake request returns the
 //! entry of the table it wrote, and the Python package hands them out as dicts — so the keys are
 //! an interface: `name`, `source`, `parameterization`, `symmetry`, `channels`, `units`, `codec`,
-//! `tool`, `shape`, `values`, `chunks`, `bytes`, `ratio_to_f32` per table; `file`, `format`,
+//! `tool`, `shape`, `values`, `chunks`, `bytes`, `ratio_to_f32`, `sampling_bytes` (the importance
+//! sampler's structure, built in memory on the first `sample`/`pdf`) per table; `file`, `format`,
 //! `bytes`, `ratio_to_f32`, `tables` per file.
 
 use std::fmt::Write as _;
@@ -12,13 +13,14 @@ use serde_json::{Value, json};
 
 use super::{Store, db};
 use crate::error::{Error, Result};
-use crate::table::Table;
+use crate::table::{SamplingResolution, Table};
 
 /// The summary of table `name` of an open store.
 pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
     let t = s.table(name)?;
     let h = t.header();
     let bytes = t.compressed_bytes();
+    let isotropic = h.symmetry.split('+').any(|p| p == "isotropic");
     Ok(json!({
         "name": h.name,
         "source": h.source,
@@ -33,6 +35,7 @@ pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
         "chunks": t.chunk_count(),
         "bytes": bytes,
         "ratio_to_f32": (h.values as f64 * 4.0) / (bytes.max(1) as f64),
+        "sampling_bytes": SamplingResolution::for_isotropy(isotropic).memory_bytes(isotropic),
     }))
 }
 
@@ -186,6 +189,11 @@ pub fn file_text(v: &Value) -> String {
             t["chunks"],
             t["bytes"],
             t["ratio_to_f32"].as_f64().unwrap_or(0.0)
+        );
+        let _ = writeln!(
+            o,
+            "  sampling: {} bytes in memory once sampled",
+            t["sampling_bytes"]
         );
         let _ = writeln!(
             o,

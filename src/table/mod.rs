@@ -32,6 +32,7 @@ pub mod symmetry;
 pub mod tabulated;
 pub mod target;
 pub mod warp;
+pub(crate) mod warp2d;
 
 pub use fill::{BakeOptions, BakeStats, bake, bake_chunks};
 pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, Quantity, StoredAxis};

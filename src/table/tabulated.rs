@@ -231,12 +231,7 @@ impl TabulatedBrdf {
     pub fn sampler(&self) -> &TableSampler {
         self.sampler.get_or_init(|| {
             let iso = self.grid.symmetry().isotropic;
-            let res = if iso {
-                SamplingResolution::default()
-            } else {
-                SamplingResolution::anisotropic()
-            };
-            TableSampler::build(self, iso, &res)
+            TableSampler::build(self, iso, &SamplingResolution::for_isotropy(iso))
         })
     }
 
@@ -307,7 +302,8 @@ impl TabulatedBrdf {
         self.chunks.iter().filter(|c| c.get().is_some()).count()
     }
 
-    /// Bytes of decoded values this table holds in memory now (what a lookup reads).
+    /// Bytes this table holds in memory now: decoded values (what a lookup reads) and, once
+    /// built, the importance sampler's structure.
     pub fn resident_bytes(&self) -> usize {
         let f = std::mem::size_of::<f32>();
         let packed = self.packed.get().map_or(0, |p| p.bytes());
@@ -323,7 +319,8 @@ impl TabulatedBrdf {
             .filter_map(|u| u.get())
             .map(|u| u.len() * std::mem::size_of::<(u32, f32)>())
             .sum();
-        packed + chunks + unmeasured
+        let sampler = self.sampler.get().map_or(0, |s| s.memory_bytes());
+        packed + chunks + unmeasured + sampler
     }
 
     /// All chunks in one packed array (tables with a kernel), decoded on first use (without
