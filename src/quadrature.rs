@@ -31,6 +31,37 @@ impl Default for Options {
     }
 }
 
+impl Options {
+    /// The most times `hemisphere` calls `eval` with these options, whatever the integrand:
+    /// the lobe search, then every G7/K15 rule the outer (φ) rule may apply (the 4 quadrants,
+    /// then two per bisection up to `max_outer` intervals) times 15 nodes, each node an inner
+    /// (α) integration of at most as many rules (1 to 5 initial intervals, two per bisection
+    /// up to `max_inner`) times 15. With the default options 28,974,085: reached only by an
+    /// integrand no tolerance can be met on (noise); smooth models take about 5 000.
+    pub fn max_evals(&self) -> usize {
+        let rules = |initial: &[usize], max: usize| {
+            initial
+                .iter()
+                .map(|&k| k + 2 * max.saturating_sub(k))
+                .max()
+                .unwrap_or(0)
+        };
+        let outer = rules(&[4], self.max_outer);
+        let inner = rules(&[1, 2, 3, 4, 5], self.max_inner);
+        LOBE_EVALS.saturating_add(
+            outer
+                .saturating_mul(15)
+                .saturating_mul(inner.saturating_mul(15)),
+        )
+    }
+}
+
+/// Evaluations of the lobe search ([`lobe_centre`]): the mirror direction, the probe grid and
+/// 24 rounds of a 4-point pattern search.
+const LOBE_EVALS: usize = 1 + LOBE_NT * LOBE_NP + 24 * 4;
+const LOBE_NT: usize = 12;
+const LOBE_NP: usize = 24;
+
 /// The result of `hemisphere`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Estimate {
@@ -87,10 +118,15 @@ pub fn hemisphere(
     let e1 = e2.cross(centre);
 
     // Absolute floors from the coarse estimate of the albedo, so directions far from the lobe
-    // are not integrated to a pointless relative accuracy.
-    let outer_abs = opts.rel_tol * 0.1 * scale;
+    // are not integrated to a pointless relative accuracy; and never below what f32 values
+    // resolve: f below f32::MIN_POSITIVE is subnormal, its relative precision falls to nothing
+    // and a relative tolerance would bisect f32 rounding noise to the last interval allowed
+    // (a GGX with α = 1e14, f ≈ 1e-43, made 28.7 M evaluations before this floor). So an
+    // albedo is accurate to max(tolerance, f32::MIN_POSITIVE ≈ 1.2e-38) absolute.
+    let floor = f32::MIN_POSITIVE as f64;
+    let outer_abs = (opts.rel_tol * 0.1 * scale).max(floor);
     let inner_rel = opts.rel_tol * 0.01;
-    let inner_abs = opts.rel_tol * 0.01 * scale / TAU;
+    let inner_abs = (opts.rel_tol * 0.01 * scale).max(floor) / TAU;
 
     let mut inner_out = [0.0f64; MAX_CHANNELS];
     let mut inner = |phi: f64, out: &mut [f64], evals: &mut usize| {
@@ -156,8 +192,8 @@ fn lobe_centre(
     wi: DVec3,
     evals: &mut usize,
 ) -> (DVec3, f64) {
-    const NT: usize = 12;
-    const NP: usize = 24;
+    const NT: usize = LOBE_NT;
+    const NP: usize = LOBE_NP;
     let mirror = geometry::reflect_z(wi);
     let g_mirror = g(mirror, evals);
     let (mut best, mut best_t, mut best_p) = (f64::NEG_INFINITY, 0.0, 0.0);

@@ -24,7 +24,10 @@
 //!
 //! With the default [`Options`] the result is accurate to about 1e-6 relative for smooth models
 //! and well below 1e-4 for the sharp lobes above (see the tests), at a cost of roughly 5 000
-//! evaluations for smooth models and a few 10 000 for sharp lobes.
+//! evaluations for smooth models and a few 10 000 for sharp lobes. The absolute error is never
+//! asked below f32::MIN_POSITIVE (f32 values smaller than that are subnormal and their rounding
+//! noise would be refined forever), and the work is bounded whatever the integrand by
+//! [`Options::max_evals`] (29 M evaluations with the defaults, reached only by noise).
 
 use glam::DVec3;
 
@@ -280,6 +283,149 @@ mod tests {
         };
         let t = integrate(&*b, wi, &tight).value[0];
         assert!(rel(a, t) < 1e-5, "{a} vs {t}");
+    }
+
+    /// Counts the evaluations of the BRDF it wraps, through any path (the trait's default
+    /// `albedo`, the plausibility check).
+    struct Counting {
+        inner: Box<dyn Brdf + Send + Sync>,
+        evals: std::sync::atomic::AtomicUsize,
+    }
+
+    impl Brdf for Counting {
+        fn channels(&self) -> &Channels {
+            self.inner.channels()
+        }
+        fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+            self.evals
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            self.inner.eval(wi, wo, out)
+        }
+        fn flags(&self) -> Flags {
+            self.inner.flags()
+        }
+        fn describe(&self) -> String {
+            self.inner.describe()
+        }
+    }
+
+    #[test]
+    fn subnormal_values_take_one_pass_not_the_interval_limit() {
+        // Issue #23 (found by the `spec` fuzz target): GGX with α = 1.1e14 has f ≈ 2.5e-43, an
+        // f32 subnormal whose rounding noise no relative tolerance can meet, so every rule was
+        // bisected to its interval limit — 28,747,285 evaluations for one albedo (the bound,
+        // `Options::max_evals()`, is 28,974,085), 90 times over in a plausibility check. Now
+        // the work is bounded by a run that may not bisect at all: the lobe search and one
+        // G7/K15 pass.
+        let first_pass = Options {
+            max_outer: 4,
+            max_inner: 1,
+            ..Options::default()
+        }
+        .max_evals();
+        assert_eq!(first_pass, 385 + 4 * 15 * 5 * 15);
+        assert_eq!(Options::default().max_evals(), 28_974_085);
+        for alpha in ["1.1e14", "1e15", "3e20"] {
+            let spec = format!(r#"{{"model": "ggx", "alpha": {alpha}}}"#);
+            let b = Counting {
+                inner: model(&spec),
+                evals: Default::default(),
+            };
+            let mut f = [0.0f32; 3];
+            b.eval(DVec3::Z, DVec3::new(0.6, 0.0, 0.8), &mut f);
+            assert!(f[0] < f32::MIN_POSITIVE, "{alpha}: {f:?} is not subnormal");
+            for deg in [0.0f64, 30.0, 60.0, 85.0] {
+                let wi = geometry::spherical(deg.to_radians(), 0.0);
+                let est = integrate(&b, wi, &Options::default());
+                assert!(
+                    est.evals <= first_pass,
+                    "{alpha} at {deg}°: {} evals",
+                    est.evals
+                );
+                for a in &est.value {
+                    assert!((0.0..f32::MIN_POSITIVE as f64).contains(a), "{alpha}: {a}");
+                }
+                // The same through the trait's default albedo.
+                b.evals.store(0, std::sync::atomic::Ordering::Relaxed);
+                let mut a = [1.0; 3];
+                b.albedo(wi, &mut a);
+                let n = b.evals.load(std::sync::atomic::Ordering::Relaxed);
+                assert!(
+                    n <= first_pass,
+                    "{alpha} at {deg}°: albedo() made {n} evals"
+                );
+                assert_eq!(a.to_vec(), est.value);
+            }
+            // Near grazing the albedo is above f32::MIN_POSITIVE and is refined (to an absolute
+            // error below it), still far from the limit.
+            let est = integrate(&b, geometry::spherical(1.569, 0.0), &Options::default());
+            assert!(
+                est.evals < 100 * first_pass,
+                "{alpha} at 89.9°: {} evals",
+                est.evals
+            );
+            // And the plausibility check that found it: 90 angles of albedo.
+            b.evals.store(0, std::sync::atomic::Ordering::Relaxed);
+            let opts = crate::analysis::plausibility::Options {
+                pairs: 100,
+                ..Default::default()
+            };
+            let r = crate::analysis::plausibility::check(&b, &opts);
+            let n = b.evals.load(std::sync::atomic::Ordering::Relaxed);
+            assert!(
+                n <= 2 * opts.pairs + 2 * 90 * first_pass,
+                "{alpha}: {n} evals"
+            );
+            assert!(r.energy_conserving && r.positive, "{alpha}: {r}");
+        }
+    }
+
+    #[test]
+    fn noise_is_bounded_by_max_evals() {
+        // An integrand no tolerance can be met on (a hash of the direction): every rule is
+        // bisected to the limit, and no further.
+        struct Noise(Channels);
+        impl Brdf for Noise {
+            fn channels(&self) -> &Channels {
+                &self.0
+            }
+            fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+                let h = (wi + wo)
+                    .to_array()
+                    .iter()
+                    .fold(0x9e37_79b9_7f4a_7c15u64, |h, x| {
+                        (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3)
+                    });
+                out[..3].fill((h >> 40) as f32 / (1u64 << 24) as f32);
+            }
+            fn flags(&self) -> Flags {
+                Flags::SMOOTH_SYMMETRIC
+            }
+            fn describe(&self) -> String {
+                "test noise".into()
+            }
+        }
+        let b = Noise(Channels::Rgb);
+        for (max_outer, max_inner) in [(4, 1), (8, 16), (16, 8), (2, 40)] {
+            let opts = Options {
+                max_outer,
+                max_inner,
+                ..Options::default()
+            };
+            for deg in [0.0f64, 60.0, 89.5] {
+                let est = integrate(&b, geometry::spherical(deg.to_radians(), 0.2), &opts);
+                assert!(
+                    est.evals <= opts.max_evals(),
+                    "{max_outer}×{max_inner} at {deg}°: {} > {}",
+                    est.evals,
+                    opts.max_evals()
+                );
+                assert!(
+                    est.evals * 2 > opts.max_evals(),
+                    "{deg}°: the noise converged?"
+                );
+            }
+        }
     }
 
     #[test]
