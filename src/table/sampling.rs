@@ -19,7 +19,7 @@
 //! - **Per conditioning node** (a view `wo`): the target density on the square,
 //!   g(s, y) = f_r·cos θi · 4 (wo·h) · sin θh · dθh/ds · 2π (f_r the channel mean), sampled at
 //!   `theta_h` × `phi_h` nodes and interpolated bilinearly — the RGL format's `Marginal2D`
-//!   ([`super::warp2d`]), sampled exactly by inverting its CDFs (one quadratic per axis).
+//!   (`table::warp2d`), sampled exactly by inverting its CDFs (one quadratic per axis).
 //! - **Floor**: the nodes whose mirror image lies above the horizon also share `floor` × the
 //!   node's mass, and every node a tenth of that, so the density is positive wherever f_r may
 //!   be (a lobe narrower than the nodes, cells across the horizon) and the estimate unbiased.
