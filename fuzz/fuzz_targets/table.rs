@@ -3,11 +3,12 @@
 //! in `health()` = Err, never a panic.
 //!
 //! Cost: the importance sampler behind `pdf`/`sample` evaluates the table at a fixed grid of
-//! 221,184 (isotropic) or 262,144 (anisotropic) points whatever the table's size — 94 % of
-//! this target's time when built on every input (103 exec/s). So the sampler is built at a
-//! small resolution picked by the input's hash (1–8 cells a side, 1–3 θo and φo nodes,
-//! supersample 1–2, cosine fractions 0.1, 0, 1 and NaN: the same `TableSampler::build`, `Node::from_mass`,
-//! `sample` and `pdf` code, resolutions the library's defaults never reach included), and at
+//! points whatever the table's size (64 × 64 half-vector nodes at 32 θo nodes, and 16 φo
+//! nodes when anisotropic) — most of this target's time when built on every input. So the
+//! sampler is built at a small resolution picked by the input's hash (0–8 nodes over θh and
+//! 1–8 over φh, which `build` raises to 2; 0–3 θo and 1–3 φo nodes; floors 0.005, 0.05, 0, 1
+//! and NaN: the same `TableSampler::build`, `sample` and `pdf` code, resolutions and floors
+//! the library's defaults never reach included), and at
 //! the default resolution, lazily as hosts build it, on 1 input in 256. The albedo is
 //! integrated on 1 input in 16 (coarse options, `common::coarse_albedo`).
 #![no_main]
@@ -15,12 +16,8 @@
 #[path = "common.rs"]
 mod common;
 
-<<<<<<< HEAD
-use brdftab::store::{StoreOptions, Store};
-=======
-use brdftab::store::{OpenOptions, Store};
+use brdftab::store::{Store, StoreOptions};
 use brdftab::table::SamplingResolution;
->>>>>>> fuzz-counts
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
@@ -36,11 +33,11 @@ fuzz_target!(|data: &[u8]| {
     if h & 0xff != 0 {
         let pick = |shift: u32, n: u64| ((h >> shift) % n) as usize;
         b.set_sampling_resolution(&SamplingResolution {
-            square: [1, 2, 3, 5, 8][pick(8, 5)],
-            theta_o: 1 + pick(16, 3),
+            theta_h: [0, 2, 3, 5, 8][pick(8, 5)],
+            phi_h: [1, 2, 3, 5, 8][pick(12, 5)],
+            theta_o: pick(16, 4),
             phi_o: 1 + pick(24, 3),
-            supersample: 1 + pick(32, 2),
-            cosine_fraction: [0.1, 0.1, 0.0, 1.0, f64::NAN][pick(40, 5)],
+            floor: [0.005, 0.05, 0.0, 1.0, f64::NAN][pick(40, 5)],
         });
     }
     common::exercise(&b);
