@@ -161,25 +161,35 @@ pub trait Brdf: Send + Sync {
     /// included) checks this with [`check_batch`]; hosts that take user arrays (the Python and
     /// C bindings) check the lengths before calling.
     fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
-        use rayon::prelude::*;
         let c = self.channels().len().max(1);
         let n = check_batch(wi, wo, out, c);
-        const BLOCK: usize = 4096;
-        let run = |s: usize, o: &mut [f32]| {
+        crate::batch::blocks(&mut out[..n * c], c, |s, o| {
             for ((a, b), o) in wi[s..].iter().zip(&wo[s..]).zip(o.chunks_exact_mut(c)) {
                 self.eval(*a, *b, o);
             }
-        };
-        if n >= 4 * BLOCK {
-            crate::par::install(|| {
-                out[..n * c]
-                    .par_chunks_mut(BLOCK * c)
-                    .enumerate()
-                    .for_each(|(b, o)| run(b * BLOCK, o))
-            });
-        } else {
-            run(0, &mut out[..n * c]);
-        }
+        });
+    }
+
+    /// Densities of many pairs: `out[k] = pdf(wi[k], wo[k])`, on the library's pool from
+    /// [`crate::batch::PARALLEL`] pairs on (what the hosts call on their callers' arrays).
+    ///
+    /// # Panics
+    ///
+    /// If the three lengths differ (a caller's bug, as for [`Brdf::eval_batch`]).
+    fn pdf_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f64]) {
+        crate::batch::pdf(self, wi, wo, out)
+    }
+
+    /// Draws `wi` for every `wo[k]` from `u[k]` into `out` (wi, pdf, and `c` weights per pair).
+    /// A pair with no sample — `wo` below the horizon, a non-finite `wo` or `u`, a zero lobe —
+    /// gets wi = 0, pdf = 0 and weights 0. On the library's pool from
+    /// [`crate::batch::PARALLEL`] pairs on.
+    ///
+    /// # Panics
+    ///
+    /// If the lengths do not match `wo.len()` pairs.
+    fn sample_batch(&self, wo: &[DVec3], u: &[DVec2], out: crate::batch::SampleOut<'_>) {
+        crate::batch::sample(self, wo, u, out)
     }
 
     /// Directional albedo a(wi) = ∫ f_r(wi, wo) cos θo dωo for every channel into `out`.
@@ -328,6 +338,12 @@ macro_rules! forward_brdf {
             }
             fn albedo(&self, wi: DVec3, out: &mut [f64]) {
                 (**self).albedo(wi, out)
+            }
+            fn pdf_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f64]) {
+                (**self).pdf_batch(wi, wo, out)
+            }
+            fn sample_batch(&self, wo: &[DVec3], u: &[DVec2], out: crate::batch::SampleOut<'_>) {
+                (**self).sample_batch(wo, u, out)
             }
             fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
                 (**self).sample(wo, u, weight)

@@ -28,7 +28,9 @@
 
 pub mod analysis;
 pub mod bake;
+pub mod batch;
 pub mod brdf;
+pub mod cache;
 pub mod codec;
 pub mod error;
 pub(crate) mod fastmath;

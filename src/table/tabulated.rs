@@ -30,7 +30,6 @@
 //! value and is interpolated with its neighbours for pairs above it.
 
 use glam::{DVec2, DVec3};
-use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -542,20 +541,9 @@ impl Brdf for TabulatedBrdf {
     fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
         let c = self.lookup.channels();
         let n = crate::brdf::check_batch(wi, wo, out, c.max(1));
-        const BLOCK: usize = 4096;
-        if n >= 4 * BLOCK {
-            crate::par::install(|| {
-                out[..n * c]
-                    .par_chunks_mut(BLOCK * c)
-                    .enumerate()
-                    .for_each(|(b, o)| {
-                        let s = b * BLOCK;
-                        self.eval_block(&wi[s..], &wo[s..], o);
-                    })
-            });
-        } else {
-            self.eval_block(wi, wo, &mut out[..n * c]);
-        }
+        crate::batch::blocks(&mut out[..n * c], c, |s, o| {
+            self.eval_block(&wi[s..], &wo[s..], o)
+        });
     }
 }
 

@@ -383,9 +383,7 @@ pub unsafe extern "C" fn brdftab_pdf(
         // SAFETY (both): the header's contract on sizes; NULL and alignment are checked.
         let (b, wi, wo) = unsafe { pair_args(b, n, wi, wo) }?;
         let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
-        for ((p, a), o) in pdf.iter_mut().zip(wi).zip(wo) {
-            *p = b.brdf.pdf(*a, *o);
-        }
+        b.brdf.pdf_batch(wi, wo, pdf);
         healthy(b)
     })
 }
@@ -420,26 +418,9 @@ pub unsafe extern "C" fn brdftab_sample(
         let wi = unsafe { slice_mut(wi as *mut DVec3, n, "wi") }?;
         let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
         let weight = unsafe { slice_mut(weight, times(n, c, "weight")?, "weight") }?;
-        for k in 0..n {
-            let w = &mut weight[k * c..(k + 1) * c];
-            // Non-finite input has no sample (the NaN rule of the header), whatever the source.
-            let s = if wo[k].is_finite() && u[k].is_finite() {
-                b.brdf.sample(wo[k], u[k], w)
-            } else {
-                None
-            };
-            match s {
-                Some(s) => {
-                    wi[k] = s.wi;
-                    pdf[k] = s.pdf;
-                }
-                None => {
-                    wi[k] = DVec3::ZERO;
-                    pdf[k] = 0.0;
-                    w.fill(0.0);
-                }
-            }
-        }
+        // Non-finite input has no sample (the NaN rule of the header): `sample_batch`'s rule.
+        let out = brdftab::batch::SampleOut { wi, pdf, weight };
+        b.brdf.sample_batch(wo, u, out);
         healthy(b)
     })
 }

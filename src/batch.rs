@@ -1,0 +1,169 @@
+//! Many pairs at once: the batch forms of `pdf` and `sample` that every host calls.
+//!
+//! Why a module: the C ABI and the Python package both take arrays of directions from their
+//! caller and used to loop over them each in its own way (the C ABI sequentially, Python on
+//! rayon after copying the arrays). One implementation here — blocks of [`BLOCK`] pairs, on
+//! the library's fork-safe pool ([`crate::par`]) from [`PARALLEL`] pairs on, the NaN rule of
+//! every host applied once — makes a host's rate the library's rate. [`Brdf::eval_batch`] is
+//! the third batch entry; tables override it, these two are plain loops over the trait's
+//! one-pair methods.
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+
+use crate::brdf::Brdf;
+
+/// Pairs per block handed to one rayon task.
+pub const BLOCK: usize = 4096;
+
+/// Batches at least this large run on the library's pool; smaller ones on the calling thread.
+pub const PARALLEL: usize = 4 * BLOCK;
+
+/// Runs `f(start, block)` over consecutive blocks of at most [`BLOCK`] pairs of `out`
+/// (`width` values per pair), in parallel from [`PARALLEL`] pairs on.
+pub fn blocks<T: Send>(out: &mut [T], width: usize, f: impl Fn(usize, &mut [T]) + Sync + Send) {
+    let width = width.max(1);
+    let n = out.len() / width;
+    let go = |(b, o): (usize, &mut [T])| f(b * BLOCK, o);
+    if n >= PARALLEL {
+        crate::par::install(|| out.par_chunks_mut(BLOCK * width).enumerate().for_each(go));
+    } else {
+        out.chunks_mut(BLOCK * width).enumerate().for_each(go);
+    }
+}
+
+/// `out[k] = brdf.pdf(wi[k], wo[k])`; see [`Brdf::pdf_batch`].
+///
+/// # Panics
+///
+/// If the three lengths differ (a caller's bug, as in [`crate::brdf::check_batch`]).
+pub fn pdf<B: Brdf + ?Sized>(brdf: &B, wi: &[DVec3], wo: &[DVec3], out: &mut [f64]) {
+    assert!(
+        wi.len() == wo.len() && out.len() == wi.len(),
+        "pdf_batch: {} wi, {} wo and {} outputs do not match",
+        wi.len(),
+        wo.len(),
+        out.len()
+    );
+    blocks(out, 1, |s, o| {
+        for ((p, a), b) in o.iter_mut().zip(&wi[s..]).zip(&wo[s..]) {
+            *p = brdf.pdf(*a, *b);
+        }
+    });
+}
+
+/// The outputs of [`sample`]: one row per pair.
+pub struct SampleOut<'a> {
+    /// Drawn incident directions (0 where there is no sample).
+    pub wi: &'a mut [DVec3],
+    /// Their densities (solid angle; 0 where there is no sample).
+    pub pdf: &'a mut [f64],
+    /// `c` weights per pair, f_r cos θi / pdf (0 where there is no sample).
+    pub weight: &'a mut [f32],
+}
+
+/// Draws `wi` for every `wo[k]` from `u[k]`; see [`Brdf::sample_batch`].
+///
+/// # Panics
+///
+/// If the lengths do not match `wo.len()` pairs of `c = brdf.channels().len()` weights.
+pub fn sample<B: Brdf + ?Sized>(brdf: &B, wo: &[DVec3], u: &[DVec2], out: SampleOut<'_>) {
+    let n = wo.len();
+    let c = brdf.channels().len().max(1);
+    let SampleOut { wi, pdf, weight } = out;
+    assert!(
+        u.len() == n && wi.len() == n && pdf.len() == n && weight.len() == n * c,
+        "sample_batch: {n} wo, {} u, {} wi, {} pdf and {} weights do not match ({c} channels)",
+        u.len(),
+        wi.len(),
+        pdf.len(),
+        weight.len()
+    );
+    // One parallel pass over the three outputs, zipped block by block.
+    let run = |s: usize, wi: &mut [DVec3], pdf: &mut [f64], w: &mut [f32]| {
+        for (k, ((wi, p), w)) in wi
+            .iter_mut()
+            .zip(pdf.iter_mut())
+            .zip(w.chunks_exact_mut(c))
+            .enumerate()
+        {
+            let (o, u) = (wo[s + k], u[s + k]);
+            // Non-finite input has no sample (the NaN rule of every host), whatever the source.
+            let drawn = match o.is_finite() && u.is_finite() {
+                true => brdf.sample(o, u, w),
+                false => None,
+            };
+            match drawn {
+                Some(d) => {
+                    *wi = d.wi;
+                    *p = d.pdf;
+                }
+                None => {
+                    *wi = DVec3::ZERO;
+                    *p = 0.0;
+                    w.fill(0.0);
+                }
+            }
+        }
+    };
+    if n >= PARALLEL {
+        crate::par::install(|| {
+            wi.par_chunks_mut(BLOCK)
+                .zip(pdf.par_chunks_mut(BLOCK))
+                .zip(weight.par_chunks_mut(BLOCK * c))
+                .enumerate()
+                .for_each(|(b, ((wi, p), w))| run(b * BLOCK, wi, p, w))
+        });
+    } else {
+        run(0, wi, pdf, weight);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::lambert::Lambert;
+    use crate::spectrum::{Channels, Value};
+
+    fn dirs(n: usize) -> Vec<DVec3> {
+        (0..n)
+            .map(|k| {
+                let t = k as f64 * 0.618;
+                DVec3::new(t.sin() * 0.7, t.cos() * 0.5, 0.2 + (k % 7) as f64 * 0.1)
+            })
+            .collect()
+    }
+
+    /// The parallel path (≥ PARALLEL pairs, blocks straddled) equals the one-pair methods.
+    #[test]
+    fn batches_equal_one_pair_calls() {
+        let b = Lambert::new(Value::Grey(0.5), &Channels::Rgb).unwrap();
+        let n = PARALLEL + 3 * BLOCK / 2 + 5;
+        let (wi, wo) = (dirs(n), dirs(n + 9)[9..].to_vec());
+        let mut p = vec![-1.0; n];
+        pdf(&b, &wi, &wo, &mut p);
+        for k in [0, BLOCK - 1, BLOCK, n - 1] {
+            assert_eq!(p[k], b.pdf(wi[k], wo[k]));
+        }
+        let u: Vec<DVec2> = (0..n)
+            .map(|k| DVec2::new((k % 97) as f64 / 97.0, (k % 89) as f64 / 89.0))
+            .collect();
+        let (mut si, mut sp, mut sw) = (vec![DVec3::NAN; n], vec![-1.0; n], vec![-1.0; 3 * n]);
+        let mut nan_wo = wo.clone();
+        nan_wo[BLOCK] = DVec3::new(f64::NAN, 0.0, 1.0);
+        let out = SampleOut {
+            wi: &mut si,
+            pdf: &mut sp,
+            weight: &mut sw,
+        };
+        sample(&b, &nan_wo, &u, out);
+        for k in [0, BLOCK - 1, BLOCK + 1, n - 1] {
+            let mut w = [0.0f32; 3];
+            let s = b.sample(nan_wo[k], u[k], &mut w).unwrap();
+            assert_eq!((si[k], sp[k]), (s.wi, s.pdf));
+            assert_eq!(&sw[3 * k..3 * k + 3], &w);
+        }
+        assert_eq!((si[BLOCK], sp[BLOCK]), (DVec3::ZERO, 0.0));
+        assert_eq!(&sw[3 * BLOCK..3 * BLOCK + 3], &[0.0; 3]);
+    }
+}
