@@ -10,7 +10,12 @@
 //! The pure-Python side (`python/brdftab/__init__.py`) re-exports these names and adds
 //! `Database` and `brdftab.mitsuba`.
 
+mod arrays;
+
 use std::sync::Arc;
+
+use arrays::{Pairs, Rows};
+use brdftab::batch::{BLOCK, SampleOut};
 
 use brdftab::request::{
     self, BakeSettings, ConvertOutput, ConvertSettings, FitSettings, OpenSettings,
@@ -19,8 +24,8 @@ use brdftab::source::{self, OpenOptions, SourceKind};
 use brdftab::table::TabulatedBrdf;
 use brdftab::{Brdf, Channels};
 use glam::{DVec2, DVec3};
-use numpy::ndarray::{Array1, Array2, ArrayD, IxDyn};
-use numpy::{IntoPyArray, PyArrayDyn, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::ndarray::{ArrayD, IxDyn};
+use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyException, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -33,9 +38,6 @@ pyo3::create_exception!(
     "An error reported by the brdftab library (missing file, unknown model, corrupt table, ...); \
      the message is the library's."
 );
-
-/// Batches at least this large release the GIL and run on rayon.
-const PARALLEL: usize = 4096;
 
 /// Maps a library error: argument errors are `ValueError`, everything else `brdftab.Error`.
 fn lib_err(e: brdftab::Error) -> PyErr {
@@ -55,134 +57,26 @@ fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
     })
 }
 
-/// [`guard`] for work done without the GIL, on the library's fork-safe pool
-/// ([`brdftab::par`]): the panic message comes back as a `String`.
-fn no_panic<T: Send>(f: impl FnOnce() -> T + Send) -> Result<T, String> {
-    brdftab::host::catch_quietly(|| brdftab::par::install(f))
+/// Runs long work (a bake, a fit, an albedo curve) with the GIL released, on the library's
+/// fork-safe pool ([`brdftab::par`]), a panic becoming `brdftab.Error`.
+fn unlocked<T: Send>(py: Python<'_>, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    py.detach(|| brdftab::host::catch_quietly(|| brdftab::par::install(f)))
+        .map_err(panic_err)
 }
 
-fn panic_err(m: String) -> PyErr {
-    Error::new_err(format!("internal error in brdftab (please report): {m}"))
-}
-
-/// Runs `f` with the GIL released when `n` is large enough to be worth it.
-fn run_batch<T: Send>(py: Python<'_>, n: usize, f: impl FnOnce() -> T + Send) -> PyResult<T> {
-    let r = if n >= PARALLEL {
-        py.detach(|| no_panic(f))
-    } else {
-        no_panic(f)
+/// Runs a batch call of `n` pairs: with the GIL released for the whole call unless it is one
+/// pair (where releasing costs more than the lookup). The library's batch functions go to its
+/// pool themselves.
+fn batch<T: Send>(py: Python<'_>, n: usize, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+    let r = match n > 1 {
+        true => py.detach(|| brdftab::host::catch_quietly(f)),
+        false => brdftab::host::catch_quietly(f),
     };
     r.map_err(panic_err)
 }
 
-/// A float64 view of an array-like (numpy array, list, tuple); non-numeric dtypes are a
-/// `TypeError`.
-fn f64_array<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
-    if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'py, f64>>() {
-        return Ok(a);
-    }
-    let py = obj.py();
-    if obj.is_none() || obj.is_instance_of::<pyo3::types::PyString>() {
-        return Err(PyTypeError::new_err(format!(
-            "{name}: expected an array of real numbers, got {}",
-            obj.get_type()
-                .name()
-                .map(|n| n.to_string())
-                .unwrap_or_default()
-        )));
-    }
-    if let Ok(dt) = obj.getattr("dtype") {
-        let kind: String = dt
-            .getattr("kind")
-            .and_then(|k| k.extract())
-            .unwrap_or_default();
-        if !matches!(kind.as_str(), "b" | "i" | "u" | "f") {
-            return Err(PyTypeError::new_err(format!(
-                "{name}: expected real numbers, got an array of dtype {}",
-                dt.str().map(|s| s.to_string()).unwrap_or_default()
-            )));
-        }
-    }
-    let np = py.import("numpy")?;
-    let arr = np
-        .call_method1("asarray", (obj, "float64"))
-        .map_err(|e| PyTypeError::new_err(format!("{name}: not an array of real numbers ({e})")))?;
-    arr.extract::<PyReadonlyArrayDyn<'py, f64>>()
-        .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))
-}
-
-/// Rows of `width` numbers: (rows, true when the input was one row of shape (width,)).
-fn rows(obj: &Bound<'_, PyAny>, name: &str, width: usize) -> PyResult<(Vec<f64>, bool)> {
-    let a = f64_array(obj, name)?;
-    let shape = a.shape().to_vec();
-    let single = match shape.as_slice() {
-        [w] if *w == width => true,
-        [_, w] if *w == width => false,
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "{name}: expected shape (n, {width}) or ({width},), got {}",
-                shape_str(&shape)
-            )));
-        }
-    };
-    let v = a.as_array();
-    let flat: Vec<f64> = match v.as_slice() {
-        Some(s) => s.to_vec(),
-        None => v.iter().copied().collect(),
-    };
-    // Non-finite numbers pass: a NaN or infinite direction gives 0 (the NaN rule of every host,
-    // README "Conventions"); `u` is range-checked by `sample`.
-    Ok((flat, single))
-}
-
-fn shape_str(shape: &[usize]) -> String {
-    match shape {
-        [a] => format!("({a},)"),
-        s => format!(
-            "({})",
-            s.iter()
-                .map(|x| x.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    }
-}
-
-fn vec3s(flat: &[f64]) -> Vec<DVec3> {
-    flat.chunks_exact(3)
-        .map(|r| DVec3::new(r[0], r[1], r[2]))
-        .collect()
-}
-
-/// Two row sets of the same count; a single row broadcasts against many.
-fn pair_rows(
-    a: &Bound<'_, PyAny>,
-    an: &str,
-    aw: usize,
-    b: &Bound<'_, PyAny>,
-    bn: &str,
-    bw: usize,
-) -> PyResult<(Vec<f64>, Vec<f64>, usize, bool)> {
-    let (mut x, xs) = rows(a, an, aw)?;
-    let (mut y, ys) = rows(b, bn, bw)?;
-    let (nx, ny) = (x.len() / aw, y.len() / bw);
-    let n = match (xs, ys) {
-        (true, false) => {
-            x = x.repeat(ny);
-            ny
-        }
-        (false, true) => {
-            y = y.repeat(nx);
-            nx
-        }
-        _ if nx == ny => nx,
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "{an} and {bn}: {nx} and {ny} rows; expected the same number (or one row)"
-            )));
-        }
-    };
-    Ok((x, y, n, xs && ys))
+fn panic_err(m: String) -> PyErr {
+    Error::new_err(format!("internal error in brdftab (please report): {m}"))
 }
 
 /// `wavelengths=`: None, a comma-separated string, or a sequence of numbers (nm).
@@ -341,23 +235,6 @@ impl PyBrdf {
     }
 }
 
-fn shaped_f32(
-    py: Python<'_>,
-    v: Vec<f32>,
-    n: usize,
-    c: usize,
-    single: bool,
-) -> PyResult<Py<PyAny>> {
-    let a = if single {
-        Array1::from_vec(v).into_dyn()
-    } else {
-        Array2::from_shape_vec((n, c), v)
-            .map_err(|e| Error::new_err(e.to_string()))?
-            .into_dyn()
-    };
-    Ok(a.into_pyarray(py).into_any().unbind())
-}
-
 fn shaped_f64(py: Python<'_>, v: Vec<f64>, shape: &[usize]) -> PyResult<Py<PyAny>> {
     let a = ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| Error::new_err(e.to_string()))?;
     Ok(a.into_pyarray(py).into_any().unbind())
@@ -428,17 +305,20 @@ impl PyBrdf {
         wo: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyAny>> {
         guard(|| {
-            let (a, b, n, single) = pair_rows(wi, "wi", 3, wo, "wo", 3)?;
+            let (a, b) = (Rows::<DVec3>::new(wi, "wi")?, Rows::<DVec3>::new(wo, "wo")?);
+            let p = Pairs::new(&a, "wi", &b, "wo")?;
             let c = self.c();
+            let shape: &[usize] = if p.single { &[c] } else { &[p.n, c] };
+            let out = arrays::zeros::<f32>(py, shape);
+            let mut w = out.readwrite();
+            let o = w
+                .as_slice_mut()
+                .map_err(|e| Error::new_err(e.to_string()))?;
             let brdf = &self.inner;
-            let out = run_batch(py, n, || {
-                let (a, b) = (vec3s(&a), vec3s(&b));
-                let mut out = vec![0.0f32; n * c];
-                brdf.eval_batch(&a, &b, &mut out);
-                out
-            })?;
+            batch(py, p.n, || p.run(o, c, |a, b, o| brdf.eval_batch(a, b, o)))?;
+            drop(w);
             self.check_loaded()?;
-            shaped_f32(py, out, n, c, single)
+            Ok(out.into_any().unbind())
         })
     }
 
@@ -452,15 +332,17 @@ impl PyBrdf {
         nm: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyAny>> {
         guard(|| {
-            let (a, b, n, single) = pair_rows(wi, "wi", 3, wo, "wo", 3)?;
-            let l = f64_array(nm, "nm")?;
+            let (a, b) = (Rows::<DVec3>::new(wi, "wi")?, Rows::<DVec3>::new(wo, "wo")?);
+            let p = Pairs::new(&a, "wi", &b, "wo")?;
+            let n = p.n;
+            let l = arrays::f64_array(nm, "nm")?;
             let (k, per_row) = match l.shape() {
                 [k] => (*k, false),
                 [m, k] if *m == n => (*k, true),
                 s => {
                     return Err(PyValueError::new_err(format!(
                         "nm: expected shape (k,) or ({n}, k), got {}",
-                        shape_str(s)
+                        arrays::shape_str(s)
                     )));
                 }
             };
@@ -468,27 +350,30 @@ impl PyBrdf {
             if nm.iter().any(|x| !x.is_finite()) {
                 return Err(PyValueError::new_err("nm: non-finite wavelength"));
             }
+            let shape: &[usize] = if p.single { &[k] } else { &[n, k] };
+            let out = arrays::zeros::<f32>(py, shape);
+            let mut w = out.readwrite();
+            let o = w
+                .as_slice_mut()
+                .map_err(|e| Error::new_err(e.to_string()))?;
             let brdf = &self.inner;
-            let out = run_batch(py, n * k, || {
-                let (a, b) = (vec3s(&a), vec3s(&b));
-                let mut out = vec![0.0f32; n * k];
-                out.par_chunks_mut(k.max(1))
-                    .with_min_len(256)
-                    .enumerate()
-                    .for_each(|(r, o)| {
-                        let l = if per_row {
-                            &nm[r * k..(r + 1) * k]
-                        } else {
-                            &nm[..]
+            batch(py, n * k, || {
+                brdftab::batch::blocks(o, k, |s, o| {
+                    let (a, b) = p.block(s, o.len() / k.max(1));
+                    for (r, o) in o.chunks_exact_mut(k.max(1)).enumerate() {
+                        let l = match per_row {
+                            true => &nm[(s + r) * k..(s + r + 1) * k],
+                            false => &nm[..],
                         };
                         for (o, &x) in o.iter_mut().zip(l) {
                             *o = brdf.eval_wavelength(a[r], b[r], x) as f32;
                         }
-                    });
-                out
+                    }
+                })
             })?;
+            drop(w);
             self.check_loaded()?;
-            shaped_f32(py, out, n, k, single)
+            Ok(out.into_any().unbind())
         })
     }
 
@@ -500,20 +385,19 @@ impl PyBrdf {
         wo: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyAny>> {
         guard(|| {
-            let (a, b, n, single) = pair_rows(wi, "wi", 3, wo, "wo", 3)?;
+            let (a, b) = (Rows::<DVec3>::new(wi, "wi")?, Rows::<DVec3>::new(wo, "wo")?);
+            let p = Pairs::new(&a, "wi", &b, "wo")?;
+            let shape: &[usize] = if p.single { &[] } else { &[p.n] };
+            let out = arrays::zeros::<f64>(py, shape);
+            let mut w = out.readwrite();
+            let o = w
+                .as_slice_mut()
+                .map_err(|e| Error::new_err(e.to_string()))?;
             let brdf = &self.inner;
-            let out = run_batch(py, n, || {
-                let (a, b) = (vec3s(&a), vec3s(&b));
-                let mut out = vec![0.0f64; n];
-                out.par_iter_mut()
-                    .with_min_len(1024)
-                    .enumerate()
-                    .for_each(|(k, o)| *o = brdf.pdf(a[k], b[k]));
-                out
-            })?;
+            batch(py, p.n, || p.run(o, 1, |a, b, o| brdf.pdf_batch(a, b, o)))?;
+            drop(w);
             self.check_loaded()?;
-            let shape: &[usize] = if single { &[] } else { &[n] };
-            shaped_f64(py, out, shape)
+            Ok(out.into_any().unbind())
         })
     }
 
@@ -529,49 +413,80 @@ impl PyBrdf {
         u: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyTuple>> {
         guard(|| {
-            let (a, uu, n, single) = pair_rows(wo, "wo", 3, u, "u", 2)?;
-            if let Some(k) = uu.iter().position(|x| !(0.0..1.0).contains(x)) {
-                return Err(PyValueError::new_err(format!(
-                    "u: row {}: {} is outside [0, 1)",
-                    k / 2,
-                    uu[k]
-                )));
+            let (a, b) = (Rows::<DVec3>::new(wo, "wo")?, Rows::<DVec2>::new(u, "u")?);
+            let uu = b.as_slice();
+            for (k, u) in uu.iter().enumerate() {
+                if let Some(x) = [u.x, u.y].into_iter().find(|x| !(0.0..1.0).contains(x)) {
+                    return Err(PyValueError::new_err(format!(
+                        "u: row {k}: {x} is outside [0, 1)"
+                    )));
+                }
             }
-            let c = self.c();
+            let p = Pairs::new(&a, "wo", &b, "u")?;
+            let (n, c) = (p.n, self.c());
+            let (s3, s1, sc): (&[usize], &[usize], &[usize]) = match p.single {
+                true => (&[3], &[], &[c]),
+                false => (&[n, 3], &[n], &[n, c]),
+            };
+            let (wi, pdf, weight) = (
+                arrays::zeros::<f64>(py, s3),
+                arrays::zeros::<f64>(py, s1),
+                arrays::zeros::<f32>(py, sc),
+            );
+            let (mut wi_w, mut pdf_w, mut w_w) =
+                (wi.readwrite(), pdf.readwrite(), weight.readwrite());
+            let slice_err = |e: numpy::NotContiguousError| Error::new_err(e.to_string());
+            let wi_s = wi_w.as_slice_mut().map_err(slice_err)?;
+            let pdf_s = pdf_w.as_slice_mut().map_err(slice_err)?;
+            let w_s = w_w.as_slice_mut().map_err(slice_err)?;
+            // wi as rows: a fresh C-contiguous float64 array, aligned by numpy's allocator.
+            let wi_s = arrays::as_rows_mut(wi_s)?;
             let brdf = &self.inner;
-            let (wi, pdf, w) = run_batch(py, n, || {
-                let a = vec3s(&a);
-                let mut wi = vec![0.0f64; n * 3];
-                let mut pdf = vec![0.0f64; n];
-                let mut w = vec![0.0f32; n * c.max(1)];
-                wi.par_chunks_mut(3)
-                    .zip(pdf.par_iter_mut())
-                    .zip(w.par_chunks_mut(c.max(1)))
-                    .with_min_len(1024)
-                    .enumerate()
-                    .for_each(|(k, ((wi, p), w))| {
-                        let u = DVec2::new(uu[2 * k], uu[2 * k + 1]);
-                        // A non-finite wo has no sample (the NaN rule, whatever the source).
-                        let s = match a[k].is_finite() {
-                            true => brdf.sample(a[k], u, w),
-                            false => None,
+            batch(py, n, || match p.whole() {
+                Some((a, b)) => brdf.sample_batch(
+                    a,
+                    b,
+                    SampleOut {
+                        wi: wi_s,
+                        pdf: pdf_s,
+                        weight: w_s,
+                    },
+                ),
+                None => {
+                    let cw = c.max(1);
+                    let go =
+                        |(k, ((wi, pd), w)): (usize, ((&mut [DVec3], &mut [f64]), &mut [f32]))| {
+                            let (a, b) = p.block(k * BLOCK, pd.len());
+                            brdf.sample_batch(
+                                a,
+                                b,
+                                SampleOut {
+                                    wi,
+                                    pdf: pd,
+                                    weight: w,
+                                },
+                            )
                         };
-                        match s {
-                            Some(s) => {
-                                wi.copy_from_slice(&s.wi.to_array());
-                                *p = s.pdf;
-                            }
-                            None => w.fill(0.0),
-                        }
-                    });
-                (wi, pdf, w)
+                    if n >= brdftab::batch::PARALLEL {
+                        brdftab::par::install(|| {
+                            wi_s.par_chunks_mut(BLOCK)
+                                .zip(pdf_s.par_chunks_mut(BLOCK))
+                                .zip(w_s.par_chunks_mut(BLOCK * cw))
+                                .enumerate()
+                                .for_each(go)
+                        })
+                    } else {
+                        wi_s.chunks_mut(BLOCK)
+                            .zip(pdf_s.chunks_mut(BLOCK))
+                            .zip(w_s.chunks_mut(BLOCK * cw))
+                            .enumerate()
+                            .for_each(go)
+                    }
+                }
             })?;
+            drop((wi_w, pdf_w, w_w));
             self.check_loaded()?;
-            let (s3, s1): (&[usize], &[usize]) = if single { (&[3], &[]) } else { (&[n, 3], &[n]) };
-            let wi = shaped_f64(py, wi, s3)?;
-            let pdf = shaped_f64(py, pdf, s1)?;
-            let w = shaped_f32(py, w, n, c, single)?;
-            Ok(PyTuple::new(py, [wi, pdf, w])?.unbind())
+            Ok(PyTuple::new(py, [wi.into_any(), pdf.into_any(), weight.into_any()])?.unbind())
         })
     }
 
@@ -579,12 +494,12 @@ impl PyBrdf {
     /// float64 (k, c) (or (c,) for a scalar θ′).
     fn albedo(&self, py: Python<'_>, theta: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
         guard(|| {
-            let a = f64_array(theta, "theta")?;
+            let a = arrays::f64_array(theta, "theta")?;
             let single = a.ndim() == 0;
             if a.ndim() > 1 {
                 return Err(PyValueError::new_err(format!(
                     "theta: expected a number or a 1-d array, got shape {}",
-                    shape_str(a.shape())
+                    arrays::shape_str(a.shape())
                 )));
             }
             let t: Vec<f64> = a.as_array().iter().copied().collect();
@@ -598,7 +513,7 @@ impl PyBrdf {
             }
             let brdf = &self.inner;
             let k = t.len();
-            let curve = run_batch(py, PARALLEL, || {
+            let curve = unlocked(py, || {
                 brdftab::analysis::albedo::albedo_curve(brdf.as_ref(), &t)
             })?;
             self.check_loaded()?;
@@ -620,7 +535,7 @@ impl PyBrdf {
             let table = match (&self.table, options.is_some_and(|o| !o.is_empty())) {
                 (Some(t), false) => {
                     let t = t.clone();
-                    run_batch(py, PARALLEL, move || t.to_table())?.map_err(lib_err)?
+                    unlocked(py, move || t.to_table())?.map_err(lib_err)?
                 }
                 _ => {
                     let settings: BakeSettings = settings_of(options)?;
@@ -628,7 +543,7 @@ impl PyBrdf {
                     if let (Some(w), None) = (&self.wavelengths, &settings.wavelengths) {
                         req.channels = Some(Channels::wavelengths(w.clone()).map_err(lib_err)?);
                     }
-                    run_batch(py, PARALLEL, || req.table(&brdftab::progress::Silent))?
+                    unlocked(py, || req.table(&brdftab::progress::Silent))?
                         .map_err(lib_err)?
                         .0
                 }
@@ -795,7 +710,7 @@ fn check(
             ..OpenOptions::default()
         };
         let brdf = brdftab::open_with(source, &opts).map_err(lib_err)?;
-        let report = run_batch(py, PARALLEL, || {
+        let report = unlocked(py, || {
             brdftab::analysis::plausibility::check(
                 brdf.as_ref(),
                 &brdftab::analysis::plausibility::Options::default(),
@@ -834,6 +749,25 @@ fn db_remove(path: &str, name: &str) -> PyResult<()> {
     guard(|| brdftab::store::db::remove(path, name).map_err(lib_err))
 }
 
+/// Adds the table of a single-table file's bytes (what `bake` writes to a `.btdb` path) to
+/// database `path` as `name`, copying its encoded chunks (no re-encoding; checksums checked).
+#[pyfunction]
+#[pyo3(signature = (path, name, data, replace=false))]
+fn db_import(py: Python<'_>, path: &str, name: &str, data: Vec<u8>, replace: bool) -> PyResult<()> {
+    guard(|| {
+        let opts = brdftab::store::StoreOptions {
+            eager: false,
+            ..Default::default()
+        };
+        unlocked(py, || {
+            let s = brdftab::store::Store::from_bytes("<bytes>", data, opts)?;
+            let from = s.single()?.header().name.clone();
+            brdftab::store::db::import(path, &s, &from, name, replace)
+        })?
+        .map_err(lib_err)
+    })
+}
+
 fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyAny>> {
     let info = if r.info.is_null() {
         serde_json::json!({
@@ -865,11 +799,37 @@ fn bake(
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
         let settings: BakeSettings = settings_of(options)?;
-        let r = run_batch(py, PARALLEL, || {
+        let r = unlocked(py, || {
             request::bake(source, output, &settings, &brdftab::progress::Silent)
         })?
         .map_err(lib_err)?;
         report_dict(py, &r)
+    })
+}
+
+/// The table of SOURCE baked with `options` (the keywords of `bake`), from the cache of baked
+/// tables or baked into it now ([`brdftab::cache`]): keyed by the source's content, the
+/// settings and the library's version, in `cache_dir` (default `$BRDFTAB_CACHE_DIR`, else
+/// `$XDG_CACHE_HOME/brdftab`, else `~/.cache/brdftab`). Safe under concurrent calls from many
+/// processes. `refresh=True` bakes again (for a cached file that failed to open). Returns
+/// `{"path": str, "hit": bool}`; open the table with `brdftab.open(path)`.
+#[pyfunction]
+#[pyo3(signature = (source, cache_dir=None, refresh=false, **options))]
+fn bake_cached(
+    py: Python<'_>,
+    source: &str,
+    cache_dir: Option<std::path::PathBuf>,
+    refresh: bool,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        let settings: BakeSettings = settings_of(options)?;
+        let c = unlocked(py, || {
+            brdftab::cache::bake_cached(source, &settings, cache_dir.as_deref(), refresh)
+        })?
+        .map_err(lib_err)?;
+        let v = serde_json::json!({"path": c.path.to_string_lossy(), "hit": c.hit});
+        to_py(py, &v)
     })
 }
 
@@ -886,7 +846,7 @@ fn convert(
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
         let settings: ConvertSettings = settings_of(options)?;
-        let out = run_batch(py, PARALLEL, || {
+        let out = unlocked(py, || {
             request::convert(source, output, &settings, &brdftab::progress::Silent)
         })?
         .map_err(lib_err)?;
@@ -948,7 +908,7 @@ fn fit(
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
         let settings: FitSettings = settings_of(options)?;
-        let result = run_batch(py, PARALLEL, || {
+        let result = unlocked(py, || {
             request::fit(source, model, &settings, &brdftab::progress::Silent)
         })?
         .map_err(lib_err)?;
@@ -968,7 +928,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(db_names, m)?)?;
     m.add_function(wrap_pyfunction!(db_remove, m)?)?;
+    m.add_function(wrap_pyfunction!(db_import, m)?)?;
     m.add_function(wrap_pyfunction!(bake, m)?)?;
+    m.add_function(wrap_pyfunction!(bake_cached, m)?)?;
     m.add_function(wrap_pyfunction!(convert, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -1,0 +1,276 @@
+//! numpy arrays in and out of batch calls without copies.
+//!
+//! Why a module: a batch call's cost should be the library's. Directions arrive as `(n, 3)`
+//! arrays; a C-contiguous, aligned float64 array is read in place as `[DVec3]` (glam's `DVec3`
+//! is `#[repr(C)]` of three f64, as the C ABI reads `double[n][3]`); anything else — float32,
+//! a strided view, a list — is converted by numpy once. Results are written straight into the
+//! numpy arrays returned, with the GIL released, so a large call's memory is its output.
+
+use brdftab::batch::{BLOCK, blocks};
+use glam::{DVec2, DVec3};
+use numpy::ndarray::IxDyn;
+use numpy::{Element, PyArrayDyn, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+// `[f64; 3k]` is read as `[DVec3; k]` and `[f64; 2k]` as `[DVec2; k]`.
+const _: () = assert!(std::mem::size_of::<DVec3>() == 24 && std::mem::align_of::<DVec3>() == 8);
+const _: () = assert!(std::mem::size_of::<DVec2>() == 16 && std::mem::align_of::<DVec2>() == 8);
+
+/// A float64 view of an array-like (numpy array, list, tuple); non-numeric dtypes are a
+/// `TypeError`. A float64 array is borrowed as it is; anything else is converted once.
+pub(crate) fn f64_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+    if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'py, f64>>() {
+        return Ok(a);
+    }
+    let py = obj.py();
+    if obj.is_none() || obj.is_instance_of::<pyo3::types::PyString>() {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: expected an array of real numbers, got {}",
+            obj.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        )));
+    }
+    if let Ok(dt) = obj.getattr("dtype") {
+        let kind: String = dt
+            .getattr("kind")
+            .and_then(|k| k.extract())
+            .unwrap_or_default();
+        if !matches!(kind.as_str(), "b" | "i" | "u" | "f") {
+            return Err(PyTypeError::new_err(format!(
+                "{name}: expected real numbers, got an array of dtype {}",
+                dt.str().map(|s| s.to_string()).unwrap_or_default()
+            )));
+        }
+    }
+    let np = py.import("numpy")?;
+    let arr = np
+        .call_method1("asarray", (obj, "float64"))
+        .map_err(|e| PyTypeError::new_err(format!("{name}: not an array of real numbers ({e})")))?;
+    arr.extract::<PyReadonlyArrayDyn<'py, f64>>()
+        .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))
+}
+
+/// `(a,)` or `(a, b, ...)` as Python prints a shape.
+pub(crate) fn shape_str(shape: &[usize]) -> String {
+    match shape {
+        [a] => format!("({a},)"),
+        s => format!(
+            "({})",
+            s.iter()
+                .map(|x| x.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// Rows of `W` float64 numbers, `(n, W)` or one row `(W,)`, as `[T]` (`T` = `DVec3` or
+/// `DVec2`): borrowed in place when C-contiguous and aligned, else copied once.
+pub(crate) struct Rows<'py, T> {
+    /// Keeps the numpy array (and its read borrow) alive while `ptr` is used.
+    _array: PyReadonlyArrayDyn<'py, f64>,
+    owned: Vec<T>,
+    ptr: *const T,
+    len: usize,
+    /// The input was one row of shape `(W,)`.
+    pub single: bool,
+}
+
+/// Row types read from float64 arrays: `W` numbers, `#[repr(C)]` of f64.
+pub(crate) trait Row: Copy + Send + Sync {
+    /// Numbers per row.
+    const W: usize;
+    /// A row from its `W` numbers.
+    fn from(s: &[f64]) -> Self;
+}
+
+impl Row for DVec3 {
+    const W: usize = 3;
+    fn from(s: &[f64]) -> Self {
+        DVec3::new(s[0], s[1], s[2])
+    }
+}
+
+impl Row for DVec2 {
+    const W: usize = 2;
+    fn from(s: &[f64]) -> Self {
+        DVec2::new(s[0], s[1])
+    }
+}
+
+impl<'py, T: Row> Rows<'py, T> {
+    /// Reads `obj` as rows of `T::W` numbers; wrong shapes are a `ValueError` naming `name`.
+    pub(crate) fn new(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Self> {
+        let w = T::W;
+        let mut a = f64_array(obj, name)?;
+        let single = match a.shape() {
+            [x] if *x == w => true,
+            [_, x] if *x == w => false,
+            s => {
+                return Err(PyValueError::new_err(format!(
+                    "{name}: expected shape (n, {w}) or ({w},), got {}",
+                    shape_str(s)
+                )));
+            }
+        };
+        if !a.is_c_contiguous() {
+            // A strided view (or Fortran order): one copy, by numpy.
+            let np = obj.py().import("numpy")?;
+            a = np
+                .call_method1("ascontiguousarray", (a.as_any(),))?
+                .extract::<PyReadonlyArrayDyn<'py, f64>>()?;
+        }
+        let flat = a
+            .as_slice()
+            .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
+        let len = flat.len() / w;
+        let aligned = (flat.as_ptr() as usize) % std::mem::align_of::<T>() == 0;
+        let (owned, ptr) = if aligned {
+            (Vec::new(), flat.as_ptr() as *const T)
+        } else {
+            // A misaligned buffer (e.g. a view into bytes): copied, once.
+            let v: Vec<T> = flat.chunks_exact(w).map(T::from).collect();
+            let p = v.as_ptr();
+            (v, p)
+        };
+        Ok(Rows {
+            _array: a,
+            owned,
+            ptr,
+            len,
+            single,
+        })
+    }
+
+    /// Number of rows.
+    pub(crate) fn len(&self) -> usize {
+        self.len
+    }
+
+    /// The rows, in place.
+    pub(crate) fn as_slice(&self) -> &[T] {
+        if !self.owned.is_empty() {
+            return &self.owned;
+        }
+        // SAFETY: `ptr` points to `len * W` f64 of the C-contiguous, aligned array kept alive
+        // (and read-borrowed) by `_array`; `T` is `#[repr(C)]` of `W` f64 (asserted above).
+        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+    }
+}
+
+/// Two row sets paired for a call: the same count, or one row against many (broadcast, the
+/// single row repeated into a block-sized buffer: no n-sized copy).
+pub(crate) struct Pairs<'a, A, B> {
+    a: &'a [A],
+    b: &'a [B],
+    /// `a`'s single row repeated `min(n, BLOCK)` times when it broadcasts, else empty.
+    ra: Vec<A>,
+    /// The same for `b`.
+    rb: Vec<B>,
+    /// Number of pairs.
+    pub n: usize,
+    /// Both inputs were single rows: results drop their leading axis.
+    pub single: bool,
+}
+
+impl<'a, A: Row, B: Row> Pairs<'a, A, B> {
+    /// Pairs `a` (named `an`) with `b` (named `bn`).
+    pub(crate) fn new(
+        a: &'a Rows<'_, A>,
+        an: &str,
+        b: &'a Rows<'_, B>,
+        bn: &str,
+    ) -> PyResult<Self> {
+        let (na, nb) = (a.len(), b.len());
+        let n = match (a.single, b.single) {
+            (true, false) => nb,
+            (false, true) => na,
+            _ if na == nb => na,
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "{an} and {bn}: {na} and {nb} rows; expected the same number (or one row)"
+                )));
+            }
+        };
+        let single = a.single && b.single;
+        let (a, b) = (a.as_slice(), b.as_slice());
+        let m = n.min(BLOCK);
+        Ok(Pairs {
+            ra: if a.len() == n {
+                Vec::new()
+            } else {
+                vec![a[0]; m]
+            },
+            rb: if b.len() == n {
+                Vec::new()
+            } else {
+                vec![b[0]; m]
+            },
+            a,
+            b,
+            n,
+            single,
+        })
+    }
+
+    /// Both sides whole (no broadcast): the arrays as they are.
+    pub(crate) fn whole(&self) -> Option<(&[A], &[B])> {
+        (self.a.len() == self.n && self.b.len() == self.n).then_some((self.a, self.b))
+    }
+
+    /// The `k` pairs from `s` on (`k` ≤ [`BLOCK`] when a side broadcasts).
+    pub(crate) fn block(&self, s: usize, k: usize) -> (&[A], &[B]) {
+        let a = match self.a.len() == self.n {
+            true => &self.a[s..s + k],
+            false => &self.ra[..k],
+        };
+        let b = match self.b.len() == self.n {
+            true => &self.b[s..s + k],
+            false => &self.rb[..k],
+        };
+        (a, b)
+    }
+
+    /// Runs `f(a, b, out)` over all pairs: once on the whole arrays (the library
+    /// parallelizes), or block by block on the library's pool when a side broadcasts.
+    /// `width` = outputs per pair.
+    pub(crate) fn run<T: Send>(
+        &self,
+        out: &mut [T],
+        width: usize,
+        f: impl Fn(&[A], &[B], &mut [T]) + Sync + Send,
+    ) {
+        if let Some((a, b)) = self.whole() {
+            return f(a, b, out);
+        }
+        blocks(out, width, |s, o| {
+            let (a, b) = self.block(s, o.len() / width.max(1));
+            f(a, b, o)
+        });
+    }
+}
+
+/// A new zero-filled numpy array of `shape` (numpy's `zeros`: calloc'ed pages).
+pub(crate) fn zeros<'py, T: Element>(
+    py: Python<'py>,
+    shape: &[usize],
+) -> Bound<'py, PyArrayDyn<T>> {
+    PyArrayDyn::<T>::zeros(py, IxDyn(shape), false)
+}
+
+/// A fresh `(n, 3)` float64 output array's numbers as `[DVec3]` (numpy's allocations are
+/// aligned; a misaligned one is an error, not undefined behaviour).
+pub(crate) fn as_rows_mut(flat: &mut [f64]) -> PyResult<&mut [DVec3]> {
+    if (flat.as_ptr() as usize) % std::mem::align_of::<DVec3>() != 0 || flat.len() % 3 != 0 {
+        return Err(PyValueError::new_err("internal: misaligned output array"));
+    }
+    // SAFETY: aligned (checked), `len / 3` rows of three f64 = `DVec3` (`#[repr(C)]`, asserted
+    // above); the borrow of `flat` is moved into the result.
+    Ok(unsafe { std::slice::from_raw_parts_mut(flat.as_mut_ptr() as *mut DVec3, flat.len() / 3) })
+}

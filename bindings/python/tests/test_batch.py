@@ -1,0 +1,158 @@
+"""Batch calls at the library's cost (issue 26, item 1): arrays read in place, results written
+into the returned arrays, the GIL released, every input layout giving the same numbers."""
+
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import brdftab
+
+GGX = '{"model": "ggx", "alpha": 0.3, "fresnel": {"conductor": "Cu"}}'
+# Larger than the library's parallel threshold (4 blocks of 4096 pairs), not a multiple of it.
+N = 4 * 4096 + 4096 // 2 + 7
+
+
+def upper(n, seed):
+    rng = np.random.default_rng(seed)
+    v = rng.normal(size=(n, 3))
+    v[:, 2] = np.abs(v[:, 2]) + 0.05
+    return v / np.linalg.norm(v, axis=1)[:, None]
+
+
+@pytest.fixture(scope="module")
+def table(tmp_path_factory):
+    p = tmp_path_factory.mktemp("batch") / "ggx.btdb"
+    brdftab.bake(GGX, str(p), preset="small")
+    return brdftab.open(str(p))
+
+
+@pytest.mark.parametrize("layout", ["fortran", "strided", "float32", "misaligned", "list"])
+def test_every_layout_gives_the_contiguous_result(table, layout):
+    wi, wo = upper(N, 1), upper(N, 2)
+    ref = table.eval(wi, wo)
+
+    def convert(a):
+        if layout == "fortran":
+            return np.asfortranarray(a)
+        if layout == "strided":
+            b = np.zeros((a.shape[0], 5))
+            b[:, 1:4] = a
+            return b[:, 1:4]
+        if layout == "float32":
+            return a.astype(np.float32)
+        if layout == "misaligned":
+            raw = np.zeros(a.nbytes + 1, np.uint8)
+            b = np.frombuffer(raw.data, dtype=np.float64, count=a.size, offset=1).reshape(a.shape)
+            b[...] = a
+            assert b.ctypes.data % 8 != 0
+            return b
+        return a.tolist()
+
+    got = table.eval(convert(wi), convert(wo))
+    if layout == "float32":
+        np.testing.assert_array_equal(got, table.eval(wi.astype(np.float32).astype(np.float64),
+                                                      wo.astype(np.float32).astype(np.float64)))
+    else:
+        np.testing.assert_array_equal(got, ref)
+    np.testing.assert_array_equal(table.pdf(convert(wi), convert(wo)), table.pdf(
+        np.asarray(convert(wi), np.float64), np.asarray(convert(wo), np.float64)))
+
+
+def test_a_single_row_broadcasts_like_its_repeat(table):
+    """One row against many, past the block size and the parallel threshold: the same numbers
+    as the row repeated (the binding repeats it per block, never n times)."""
+    wi, wo = upper(N, 3), upper(N, 4)
+    one = wo[17]
+    rep = np.repeat(one[None, :], N, axis=0)
+    np.testing.assert_array_equal(table.eval(wi, one), table.eval(wi, rep))
+    np.testing.assert_array_equal(table.eval(one, wi), table.eval(rep, wi))
+    np.testing.assert_array_equal(table.pdf(wi, one), table.pdf(wi, rep))
+    u = np.random.default_rng(5).random((N, 2))
+    for a, b in zip(table.sample(one, u), table.sample(rep, u)):
+        np.testing.assert_array_equal(a, b)
+    for a, b in zip(table.sample(wo, u[3]), table.sample(wo, np.repeat(u[3:4], N, axis=0))):
+        np.testing.assert_array_equal(a, b)
+    nm = np.array([450.0, 550.0, 650.0])
+    np.testing.assert_array_equal(table.eval_spectral(wi, one, nm),
+                                  table.eval_spectral(wi, rep, nm))
+
+
+def test_batches_equal_one_pair_calls(table):
+    wi, wo = upper(N, 6), upper(N, 7)
+    u = np.random.default_rng(8).random((N, 2))
+    f, p = table.eval(wi, wo), table.pdf(wi, wo)
+    s_wi, s_pdf, s_w = table.sample(wo, u)
+    for k in [0, 4095, 4096, N - 1]:
+        np.testing.assert_array_equal(f[k], table.eval(wi[k], wo[k]))
+        assert p[k] == table.pdf(wi[k], wo[k])
+        one = table.sample(wo[k], u[k])
+        np.testing.assert_array_equal(s_wi[k], one[0])
+        assert s_pdf[k] == one[1]
+        np.testing.assert_array_equal(s_w[k], one[2])
+
+
+def test_results_are_fresh_writable_arrays(table):
+    wi = upper(8, 9)
+    f = table.eval(wi, wi)
+    assert f.flags.c_contiguous and f.flags.writeable and f.flags.owndata
+    f[:] = 0  # the caller's to keep or change
+    assert table.eval(wi, wi).any()
+
+
+def test_the_gil_is_released_during_a_batch(table):
+    """A Python thread keeps running while a long eval runs (it could not if the call held
+    the GIL)."""
+    wi, wo = upper(2_000_000, 10), upper(2_000_000, 11)
+    ticks = []
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+
+    t = threading.Thread(target=count)
+    t.start()
+    time.sleep(0.01)
+    t0 = time.perf_counter()
+    table.eval(wi, wo)
+    t1 = time.perf_counter()
+    stop.set()
+    t.join()
+    inside = [x for x in ticks if t0 < x < t1]
+    # The counting thread ran during the call: many ticks spread over it, not one burst at
+    # a GIL switch interval (5 ms) boundary.
+    assert t1 - t0 > 0.02, "the call was too short to tell"
+    assert len(inside) > 1000, (len(inside), t1 - t0)
+    assert inside[-1] - inside[0] > 0.5 * (t1 - t0)
+
+
+MEMORY = r"""
+import resource, sys, numpy as np, brdftab
+b = brdftab.open(sys.argv[1], eager=True)  # decoded whole: the eval's own memory only
+n = 4_000_000
+rng = np.random.default_rng(1)
+wi = rng.normal(size=(n, 3)); wi[:, 2] = abs(wi[:, 2])
+wo = rng.normal(size=(n, 3)); wo[:, 2] = abs(wo[:, 2])
+b.eval(wi[:10], wo[:10])
+rss = int(open("/proc/self/statm").read().split()[1]) * resource.getpagesize()
+f = b.eval(wi, wo)
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+print(peak - rss, f.nbytes)
+"""
+
+
+def test_a_large_eval_needs_about_its_output(tmp_path):
+    """4e6 pairs (inputs 192 MB, result 48 MB): the process grows by the result, not by
+    copies of the inputs (432 MB before the inputs were read in place)."""
+    p = tmp_path / "ggx.btdb"
+    brdftab.bake(GGX, str(p), preset="small")
+    r = subprocess.run([sys.executable, "-c", MEMORY, str(p)], capture_output=True, text=True,
+                       check=True)
+    growth, out = map(int, r.stdout.split())
+    # The result, plus slack for the allocator and the rayon threads' stacks (a copy of one
+    # input alone would be 96 MB).
+    assert growth < out + 24e6, (growth, out)
