@@ -53,10 +53,33 @@ fn existing(path: &Path) -> Result<Option<Store>> {
 fn copy_table(from: &Store, e: &TocEntry, w: &mut Writer) -> Result<()> {
     let t = from.table(&e.name)?;
     w.begin_table(t.header().clone())?;
+    copy_chunks(&t, w)?;
+    w.end_table()
+}
+
+/// The encoded chunks of `t`, checksums checked, into the table `w` has begun.
+fn copy_chunks(t: &super::StoredTable, w: &mut Writer) -> Result<()> {
     for i in 0..t.chunk_count() {
         w.encoded_chunk(t.raw_chunk(i)?, t.chunk_values(i) as u64)?;
     }
-    w.end_table()
+    Ok(())
+}
+
+/// Adds table `name` of `from` (another database, or a single-table file's bytes opened with
+/// [`Store::from_bytes`]) to the database at `path` as `as_name`, without decoding or
+/// re-encoding: what gathers tables baked elsewhere (other processes, other machines) into
+/// one database. Every chunk's checksum is checked on the way; `replace` as in [`put`].
+pub fn import(
+    path: impl AsRef<Path>,
+    from: &Store,
+    name: &str,
+    as_name: &str,
+    replace: bool,
+) -> Result<()> {
+    let t = from.table(name)?;
+    let mut header = t.header().clone();
+    header.name = as_name.to_owned();
+    put(path, header, replace, |w| copy_chunks(&t, w))
 }
 
 /// Adds a table to the database at `path` (created if absent). `write` receives the writer with

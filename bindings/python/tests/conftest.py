@@ -62,3 +62,16 @@ def cli():
         return r.stdout
 
     return run
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _cache_dir(tmp_path_factory):
+    """The cache of baked tables (brdftab.bake_cached, the Mitsuba plugin) in a temporary
+    directory: tests never write to the user's ~/.cache."""
+    old = os.environ.get("BRDFTAB_CACHE_DIR")
+    os.environ["BRDFTAB_CACHE_DIR"] = str(tmp_path_factory.mktemp("bake-cache"))
+    yield
+    if old is None:
+        os.environ.pop("BRDFTAB_CACHE_DIR", None)
+    else:
+        os.environ["BRDFTAB_CACHE_DIR"] = old

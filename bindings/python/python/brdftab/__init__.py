@@ -25,6 +25,7 @@ from ._native import (  # noqa: F401
     Table,
     __version__,
     bake,
+    bake_cached,
     check,
     convert,
     fit,
@@ -39,6 +40,7 @@ __all__ = [
     "Error",
     "Table",
     "bake",
+    "bake_cached",
     "check",
     "convert",
     "fit",
@@ -76,6 +78,15 @@ class Database:
         of :func:`bake`. Returns what ``brdftab info --json DB#NAME`` reports."""
         _check_name(name)
         return _native.bake(source, f"{self.path}#{name}", replace=replace, **options)
+
+    def add_bytes(self, name, data, *, replace=False):
+        """Adds the table in ``data`` — the bytes of a single-table ``.btdb`` file, as
+        :func:`bake` writes one — as table NAME, copying its compressed chunks unchanged
+        (checksums checked). This is how tables baked elsewhere (worker processes, other
+        machines: see ``bindings/python/examples/dask_bake.py``) are gathered into one
+        database; without ``replace`` an existing NAME is an error, so nothing is duplicated."""
+        _check_name(name)
+        _native.db_import(self.path, name, bytes(data), replace)
 
     def remove(self, name):
         """Removes table NAME."""

@@ -90,6 +90,15 @@ def bake(
 ) -> dict[str, Any]:
     """Bakes SOURCE into OUTPUT (a .btdb file or DB#NAME); the keywords are the CLI's bake flags,
     snake_cased, validated by the library's request layer. Returns `brdftab info --json`."""
+def bake_cached(
+    source: str,
+    cache_dir: str | PathLike[str] | None = None,
+    refresh: bool = False,
+    **options: Any,
+) -> dict[str, Any]:
+    """The table of SOURCE baked with `options` (the keywords of `bake`), from the cache of
+    baked tables (keyed by the source's content, the settings and the library's version) or
+    baked into it now. Returns {"path": str, "hit": bool}."""
 def convert(
     source: str,
     output: str,
@@ -128,6 +137,9 @@ class Database:
     def names(self) -> list[str]: ...
     def __contains__(self, name: str) -> bool: ...
     def add(self, source: str, name: str, *, replace: bool = False, **options: Any) -> dict[str, Any]: ...
+    def add_bytes(self, name: str, data: bytes, *, replace: bool = False) -> None:
+        """Adds the table in a single-table .btdb file's bytes as NAME (chunks copied as they
+        are); an existing NAME is an error unless replace."""
     def remove(self, name: str) -> None: ...
     def open(self, name: str, **options: Any) -> Brdf: ...
     def source(self, name: str) -> str: ...

@@ -8,8 +8,10 @@
 Properties: ``source`` (string, any SOURCE: spec, table, ``DB#NAME``, MERL, RGL), optional
 ``interp`` (``"linear"`` or ``"nearest"``), and for JIT variants optional ``preset`` / ``grid``
 (the table a non-table source is baked on, default ``medium``; RGL files: the library's
-adaptive grid, MERL files: their own cells) and ``sampling_res`` (the
-resolution of the tabulated sampling distributions, default 64).
+adaptive grid, MERL files: their own cells), ``sampling_res`` (the
+resolution of the tabulated sampling distributions, default 64), ``cache`` (bool, default
+true: baked tables are kept in the cache of baked tables, :func:`brdftab.bake_cached`, so a
+material is baked once, not at every scene load) and ``cache_dir``.
 
 Conventions are those of Mitsuba's ``measured`` plugin: ``si.wi`` is brdftab's ``wi`` (towards
 the light in brdftab's words; the tensor's incident axes for RGL data), Mitsuba's ``wo`` is
@@ -689,6 +691,10 @@ class JitBrdftabBSDF(_Common):
                 f"{self.source}: a delta (mirror/refractor) source has no table; the JIT "
                 "variants of the plugin do not support it (use a scalar variant)"
             )
+        # The cache of baked tables: property `cache` (default true), `cache_dir` (default
+        # $BRDFTAB_CACHE_DIR, $XDG_CACHE_HOME/brdftab or ~/.cache/brdftab).
+        self.cache = bool(_prop(props, "cache", True))
+        self.cache_dir = _prop(props, "cache_dir")
         options = {}
         for key in ("preset", "grid"):
             v = _prop(props, key)
@@ -706,6 +712,9 @@ class JitBrdftabBSDF(_Common):
         dr.eval()
 
     def _table(self, options):
+        # What the sampling distributions are built from: the table when it is at hand as a
+        # Brdf, else the source.
+        self._sampled = self.brdf
         if brdftab_kind(self.source) == "table" and not options:
             values, grid = self.brdf.table()
             if not grid.get("packed"):
@@ -716,6 +725,20 @@ class JitBrdftabBSDF(_Common):
             options.setdefault("preset", "medium")
         if options.get("preset") and options.get("grid"):
             options.pop("preset")
+        if self.cache:
+            # The baked table from the cache of baked tables (brdftab.bake_cached), lossless
+            # (f32: the values an in-memory bake gives), so a scene loads a material's table
+            # from disk after its first bake.
+            options = {"param": "halfdiff", "codec": "f32", **options}
+            for refresh in (False, True):
+                hit = brdftab.bake_cached(self.source, self.cache_dir, refresh, **options)
+                try:
+                    t = brdftab.open(hit["path"], interp=self.interp)
+                    self._sampled = t
+                    return t.table()
+                except brdftab.Error:
+                    if refresh:  # a fresh bake that does not open is the library's error
+                        raise
         b = self.brdf
         if "wavelengths" in options:
             b = brdftab.open(self.source, interp=self.interp, wavelengths=options.pop("wavelengths"))
@@ -739,22 +762,16 @@ class JitBrdftabBSDF(_Common):
         data = np.empty((n_t, n, 2 * n), dtype=np.float32)
         for j, ti in enumerate(thetas):
             wi = np.array([math.sin(ti), 0.0, math.cos(ti)])
-            # the table itself is what is sampled (values as the JIT lookup sees them)
-            f = self._eval_table_np(np.tile(wi, (len(wo), 1)), wo)
+            # The table (or its source) through the library: the same values as the JIT lookup
+            # to its float rounding, without compiling a kernel at every scene load. Any
+            # density is consistent: `pdf` reads the same distribution `sample` draws from.
+            f = self._sampled.eval(wi, wo)
             lum = f.mean(axis=1).reshape(n, 2 * n)
             g = lum * np.cos(T) * np.sin(T)
             g = np.maximum(g, 0) + 1e-3 * max(g.mean(), 1e-12) * np.sin(T)
             data[j] = g
         self.warp_thetas = thetas
         return mi.MarginalContinuous2D1(data, [thetas.tolist()], normalize=True)
-
-    def _eval_table_np(self, wi, wo):
-        import mitsuba as mi
-
-        vi = mi.Vector3f(wi[:, 0], wi[:, 1], wi[:, 2])
-        vo = mi.Vector3f(wo[:, 0], wo[:, 1], wo[:, 2])
-        f = self.table.lookup(vi, vo)
-        return np.stack([np.array(x) for x in f], -1)
 
     def _f(self, wi, wo, si, active):
         import drjit as dr

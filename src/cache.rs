@@ -1,0 +1,240 @@
+//! Baked tables kept on disk, keyed by what they were baked from.
+//!
+//! Why a module: a host that needs a table of a non-table SOURCE (the Mitsuba plugin's JIT
+//! variants, a renderer that uploads tables to a device) would bake it on every scene load —
+//! 0.7–1.1 s per RGL file. [`bake_cached`] bakes once per (source content, bake settings,
+//! library version) and returns the file of the table; later loads open that file.
+//!
+//! - The key is an xxh3-128 of the library's version, the source's kind and content (the bytes
+//!   of a file or database, the text of an inline spec) and the settings as JSON (`replace`
+//!   and `name` left out: they do not change the table). Editing a file in place changes its
+//!   key; a model spec is keyed by its text.
+//! - The directory is [`default_dir`] unless given: `$BRDFTAB_CACHE_DIR`, else
+//!   `$XDG_CACHE_HOME/brdftab`, else `$HOME/.cache/brdftab`.
+//! - Concurrent loads are safe: a bake writes a temporary file and renames it into place
+//!   (the library's atomic write, under a writer lock whose empty `.<key>.btdb.lock` file
+//!   stays beside the table), so a reader sees no file or a whole one; processes baking the
+//!   same key at once all succeed and leave one file.
+//! - A cached file that no longer opens (truncated, a chunk failing its checksum when read)
+//!   is re-baked by asking again with `refresh`.
+//!
+//! ```no_run
+//! use brdftab::cache;
+//! use brdftab::request::BakeSettings;
+//! let hit = cache::bake_cached("paper_white_rgb.bsdf", &BakeSettings::default(), None, false)?;
+//! let table = brdftab::open(&hit.path.to_string_lossy())?;
+//! # Ok::<(), brdftab::Error>(())
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use xxhash_rust::xxh3::Xxh3;
+
+use crate::error::{Error, Result};
+use crate::request::BakeSettings;
+use crate::source::{self, SourceKind};
+
+/// Where a table was found or put.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cached {
+    /// The table file (`<dir>/<key>.btdb`).
+    pub path: PathBuf,
+    /// It was there already (no bake ran).
+    pub hit: bool,
+}
+
+/// The cache directory used when none is given: `$BRDFTAB_CACHE_DIR`, else
+/// `$XDG_CACHE_HOME/brdftab`, else `$HOME/.cache/brdftab`.
+///
+/// # Errors
+/// [`Error::InvalidArgument`] (field `cache_dir`) when none of the three is set.
+pub fn default_dir() -> Result<PathBuf> {
+    let var = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    if let Some(d) = var("BRDFTAB_CACHE_DIR") {
+        return Ok(d);
+    }
+    if let Some(d) = var("XDG_CACHE_HOME") {
+        return Ok(d.join("brdftab"));
+    }
+    if let Some(h) = var("HOME") {
+        return Ok(h.join(".cache").join("brdftab"));
+    }
+    Err(Error::arg(
+        "cache_dir",
+        "no cache directory: set BRDFTAB_CACHE_DIR (or XDG_CACHE_HOME or HOME)",
+    ))
+}
+
+/// The cache key of baking `source` with `settings`: 32 hex digits.
+///
+/// # Errors
+/// A source file that cannot be read ([`Error::Io`] naming it).
+pub fn key(source: &str, settings: &BakeSettings) -> Result<String> {
+    let mut h = Xxh3::new();
+    let mut part = |b: &[u8]| {
+        h.update(&(b.len() as u64).to_le_bytes());
+        h.update(b);
+    };
+    part(b"brdftab bake cache 1");
+    part(env!("CARGO_PKG_VERSION").as_bytes());
+    let kind = source::classify(source);
+    part(kind.name().as_bytes());
+    let inline = kind == SourceKind::Spec && source.trim_start().starts_with('{');
+    if inline {
+        part(source.trim().as_bytes());
+    } else {
+        let (file, name) = match kind {
+            SourceKind::Table => crate::store::db::split_source(source),
+            _ => (source, None),
+        };
+        part(&content_hash(Path::new(file))?.to_le_bytes());
+        part(name.unwrap_or("").as_bytes());
+    }
+    let mut s = settings.clone();
+    s.replace = false;
+    s.name = None;
+    let json = serde_json::to_string(&s).map_err(|e| Error::arg("settings", e.to_string()))?;
+    part(json.as_bytes());
+    Ok(format!("{:032x}", h.digest128()))
+}
+
+/// xxh3-128 of a file's bytes, read through a memory map (RGL files are tens of MB).
+fn content_hash(path: &Path) -> Result<u128> {
+    let f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let meta = f.metadata().map_err(|e| Error::io(path, e))?;
+    if !meta.is_file() {
+        return Err(Error::arg(
+            "source",
+            format!("{}: not a regular file", path.display()),
+        ));
+    }
+    if meta.len() == 0 {
+        return Ok(xxhash_rust::xxh3::xxh3_128(&[]));
+    }
+    // SAFETY: read-only map of a regular file for the duration of the hash; a file truncated
+    // meanwhile by another process is the documented hazard of memory maps (SIGBUS), the same
+    // as for the library's lazily mapped tables.
+    let map = unsafe { memmap2::Mmap::map(&f) }.map_err(|e| Error::io(path, e))?;
+    Ok(xxhash_rust::xxh3::xxh3_128(&map))
+}
+
+/// The table of `source` baked with `settings`, from the cache in `dir` (default:
+/// [`default_dir`]) or baked into it now. `refresh` bakes again even when the file is there
+/// (for a cached file that failed to open).
+///
+/// # Errors
+/// No cache directory, a directory that cannot be created, and whatever the bake fails with.
+pub fn bake_cached(
+    source: &str,
+    settings: &BakeSettings,
+    dir: Option<&Path>,
+    refresh: bool,
+) -> Result<Cached> {
+    let dir = match dir {
+        Some(d) => d.to_path_buf(),
+        None => default_dir()?,
+    };
+    // Settings are checked before any file is read or written.
+    settings.request(source)?;
+    let path = dir.join(format!("{}.btdb", key(source, settings)?));
+    if !refresh && path.is_file() {
+        return Ok(Cached { path, hit: true });
+    }
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let mut s = settings.clone();
+    s.replace = true;
+    let out = path.to_string_lossy();
+    crate::request::bake(source, &out, &s, &crate::progress::Silent)?;
+    Ok(Cached { path, hit: false })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testkit::TempDir;
+
+    const SPEC: &str = r#"{"model": "lambert", "kd": 0.5}"#;
+
+    fn small() -> BakeSettings {
+        BakeSettings {
+            preset: Some("small".into()),
+            ..BakeSettings::default()
+        }
+    }
+
+    #[test]
+    fn the_key_follows_content_and_settings_not_names() {
+        let d = TempDir::new("cache-key");
+        let f = d.path().join("m.json");
+        std::fs::write(&f, SPEC).unwrap();
+        let fs = f.to_string_lossy().to_string();
+        let k = key(&fs, &small()).unwrap();
+        assert_eq!(k.len(), 32);
+        assert_eq!(k, key(&fs, &small()).unwrap());
+        let named = BakeSettings {
+            name: Some("x".into()),
+            replace: true,
+            ..small()
+        };
+        assert_eq!(
+            k,
+            key(&fs, &named).unwrap(),
+            "name and replace do not change a table"
+        );
+        assert_ne!(k, key(&fs, &BakeSettings::default()).unwrap());
+        std::fs::write(&f, r#"{"model": "lambert", "kd": 0.6}"#).unwrap();
+        assert_ne!(k, key(&fs, &small()).unwrap(), "edited in place: a new key");
+        assert_ne!(key(SPEC, &small()).unwrap(), key(&fs, &small()).unwrap());
+        assert!(key(&d.path().join("nope.bsdf").to_string_lossy(), &small()).is_err());
+    }
+
+    #[test]
+    fn a_second_call_is_a_hit_and_refresh_bakes_again() {
+        let d = TempDir::new("cache-hit");
+        let a = bake_cached(SPEC, &small(), Some(d.path()), false).unwrap();
+        assert!(!a.hit && a.path.is_file());
+        let b = bake_cached(SPEC, &small(), Some(d.path()), false).unwrap();
+        assert_eq!(
+            b,
+            Cached {
+                path: a.path.clone(),
+                hit: true
+            }
+        );
+        let t = crate::open(&b.path.to_string_lossy()).unwrap();
+        let mut f = [0.0f32; 3];
+        t.eval(glam::DVec3::Z, glam::DVec3::Z, &mut f);
+        assert!((f[0] - 0.5).abs() < 1e-3, "Lambert: f_r = kd, {f:?}");
+        std::fs::write(&a.path, b"not a table").unwrap();
+        let c = bake_cached(SPEC, &small(), Some(d.path()), true).unwrap();
+        assert!(!c.hit);
+        assert!(crate::open(&c.path.to_string_lossy()).is_ok());
+        // One table; beside it only the writer's lock file, no temporary file.
+        let names: Vec<String> = std::fs::read_dir(d.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert!(names.iter().all(|n| !n.contains(".tmp")), "{names:?}");
+        assert_eq!(
+            names.iter().filter(|n| n.ends_with(".btdb")).count(),
+            1,
+            "{names:?}"
+        );
+    }
+
+    #[test]
+    fn bad_settings_fail_before_anything_is_written() {
+        let d = TempDir::new("cache-bad");
+        let bad = BakeSettings {
+            preset: Some("huge".into()),
+            ..BakeSettings::default()
+        };
+        let e = bake_cached(SPEC, &bad, Some(&d.path().join("sub")), false).unwrap_err();
+        assert!(e.to_string().contains("preset"), "{e}");
+        assert!(!d.path().join("sub").exists());
+    }
+}
