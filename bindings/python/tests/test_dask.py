@@ -1,0 +1,75 @@
+"""The distributed bake (issue 26, item 4): the shipped materials and a parameter sweep baked on
+a Dask LocalCluster and gathered into one database, nothing lost or duplicated, every table the
+one a local bake makes."""
+
+import importlib.util
+import pathlib
+
+import numpy as np
+import pytest
+
+import brdftab
+
+from conftest import unavailable
+
+EXAMPLE = pathlib.Path(__file__).resolve().parents[1] / "examples" / "dask_bake.py"
+
+
+@pytest.fixture(scope="module")
+def example():
+    spec = importlib.util.spec_from_file_location("dask_bake", EXAMPLE)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.fixture(scope="module")
+def client():
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        unavailable("dask.distributed is not installed (pip install 'dask[distributed]')")
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                           dashboard_address=None)
+    with Client(cluster) as c:
+        yield c
+    cluster.close()
+
+
+def test_a_local_cluster_bakes_every_material_once(example, client, rgl, tmp_path):
+    jobs = example.jobs(rgl, sweep=4, preset="small")
+    names = [n for n, _, _ in jobs]
+    assert len(names) == 7 + 4
+    db = tmp_path / "all.btdb"
+    added = example.bake_all(client, jobs, str(db))
+    assert sorted(added) == sorted(names)
+    d = brdftab.Database(db)
+    assert sorted(d.names()) == sorted(names), "each table once"
+    rng = np.random.default_rng(1)
+    wi = rng.normal(size=(64, 3))
+    wi[:, 2] = np.abs(wi[:, 2])
+    wo = wi[::-1].copy()
+    for name, source, options in [jobs[0], jobs[-1]]:
+        local = tmp_path / f"{name}.btdb"
+        brdftab.bake(source, str(local), **options)
+        np.testing.assert_array_equal(d.open(name).eval(wi, wo),
+                                      brdftab.open(str(local)).eval(wi, wo))
+    # Gathering again does not duplicate: an existing name is an error unless replace.
+    with pytest.raises(brdftab.Error):
+        example.bake_all(client, jobs[-1:], str(db))
+    example.bake_all(client, jobs[-1:], str(db), replace=True)
+    assert sorted(d.names()) == sorted(names)
+
+
+def test_add_bytes_refuses_a_damaged_table(tmp_path):
+    t = tmp_path / "t.btdb"
+    brdftab.bake('{"model": "lambert", "kd": 0.5}', str(t), preset="small")
+    data = bytearray(t.read_bytes())
+    db = brdftab.Database(tmp_path / "db.btdb")
+    db.add_bytes("ok", bytes(data))
+    data[len(data) // 2] ^= 0x40
+    with pytest.raises(brdftab.Error):
+        db.add_bytes("bad", bytes(data))
+    assert db.names() == ["ok"]
+    with pytest.raises(ValueError):
+        db.add_bytes("a#b", t.read_bytes())
