@@ -54,6 +54,7 @@ def main():
         res = {"file": pathlib.Path(a.file).name, "first_load_s": first,
                "cached_load_s": statistics.median(cached), "cached_loads_s": cached,
                "measured_load_s": statistics.median(measured)}
+        print(json.dumps(res), flush=True)
         if not a.no_render:
             sys.path.insert(0, str(pathlib.Path(__file__).parent))
             import os
@@ -64,8 +65,8 @@ def main():
             # The plugin on the file itself (its default table, from the cache) vs measured.
             times, diff = bench.render_times(a.file, a.file, None)
             res["render_s"] = times
-            res["render_ratio_plugin_over_measured"] = times["plugin"] / times["measured"]
-            res["mean_image_difference"] = diff
+            res["render_ratio_plugin_over_measured"] = float(times["plugin"] / times["measured"])
+            res["mean_image_difference"] = float(diff)
     print(json.dumps(res, indent=1))
 
 

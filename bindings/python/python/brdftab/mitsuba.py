@@ -759,17 +759,17 @@ class JitBrdftabBSDF(_Common):
         T, P = np.meshgrid(to, po, indexing="ij")
         wo = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], -1).reshape(-1, 3)
         wo[:, 2] = np.maximum(wo[:, 2], 1e-4)
-        data = np.empty((n_t, n, 2 * n), dtype=np.float32)
-        for j, ti in enumerate(thetas):
-            wi = np.array([math.sin(ti), 0.0, math.cos(ti)])
-            # The table (or its source) through the library: the same values as the JIT lookup
-            # to its float rounding, without compiling a kernel at every scene load. Any
-            # density is consistent: `pdf` reads the same distribution `sample` draws from.
-            f = self._sampled.eval(wi, wo)
-            lum = f.mean(axis=1).reshape(n, 2 * n)
-            g = lum * np.cos(T) * np.sin(T)
-            g = np.maximum(g, 0) + 1e-3 * max(g.mean(), 1e-12) * np.sin(T)
-            data[j] = g
+        wi = np.stack([np.sin(thetas), np.zeros(n_t), np.cos(thetas)], -1)
+        # The table (or its source) through the library: the same values as the JIT lookup to
+        # its float rounding, without compiling a kernel at every scene load. Any density is
+        # consistent: `pdf` reads the same distribution `sample` draws from. One row of wi
+        # against all wo nodes: broadcast by the binding, no copies.
+        f = np.stack([self._sampled.eval(w, wo) for w in wi])
+        lum = f.mean(axis=2).reshape(n_t, n, 2 * n)
+        jac = (np.cos(T) * np.sin(T))[None]
+        g = lum * jac
+        floor = 1e-3 * np.maximum(g.mean(axis=(1, 2)), 1e-12)[:, None, None]
+        data = (np.maximum(g, 0) + floor * np.sin(T)[None]).astype(np.float32)
         self.warp_thetas = thetas
         return mi.MarginalContinuous2D1(data, [thetas.tolist()], normalize=True)
 
