@@ -37,7 +37,7 @@ pub(crate) mod warp2d;
 pub use fill::{BakeOptions, BakeStats, bake, bake_chunks};
 pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, Quantity, StoredAxis};
 pub use lookup::Interp;
-pub use sampling::{SamplingResolution, TableSampler};
+pub use sampling::{Adjoint, SamplingNodes, SamplingResolution, TableSampler};
 pub use symmetry::Symmetry;
 pub use tabulated::{ChunkLoader, TabulatedBrdf};
 

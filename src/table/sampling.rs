@@ -181,10 +181,35 @@ fn mirror_z(v: DVec3) -> DVec3 {
     DVec3::new(v.x, v.y, -v.z)
 }
 
-impl TableSampler {
-    /// Builds the distributions of `brdf` (f_r·cos θi, channel mean). `isotropic`: condition on
-    /// θo only and rotate by φo.
-    pub fn build(brdf: &dyn Brdf, isotropic: bool, res: &SamplingResolution) -> TableSampler {
+/// The densities a [`TableSampler`] is built from: g(s, y) at `nx` × `ny` nodes of the unit
+/// square (s → θh = (π/2)(0.1 s + 0.9 s²), y → φh = 2π y − π relative to φo for isotropic
+/// sources) for each conditioning node, `nt` over t = sqrt(1 − cos θo) ∈ [0, 1] (uniform; one
+/// node: t = ½) times `np` over φo ∈ [0, 2π) (periodic; 1 for isotropic sources), the floor
+/// included (see the module docs), not normalized.
+///
+/// Hosts that sample on a device build the same warps from these (the Mitsuba plugin: one
+/// `MarginalContinuous2D1` over t, after the square, the half-vector map and the fold at the
+/// horizon of [`TableSampler::sample`]).
+#[derive(Debug, Clone)]
+pub struct SamplingNodes {
+    /// Nodes over s (the inner axis of `data`).
+    pub nx: usize,
+    /// Nodes over y.
+    pub ny: usize,
+    /// Conditioning nodes over t.
+    pub nt: usize,
+    /// Conditioning nodes over φo.
+    pub np: usize,
+    /// Conditioned on θo only (the view rotated to φo = 0).
+    pub isotropic: bool,
+    /// `nt` × `np` planes of `ny` × `nx` densities (t outermost, s innermost).
+    pub data: Vec<f32>,
+}
+
+impl SamplingNodes {
+    /// The node densities of `brdf` (f_r·cos θi, channel mean) at resolution `res`.
+    /// `isotropic`: one conditioning node over φo.
+    pub fn build(brdf: &dyn Brdf, isotropic: bool, res: &SamplingResolution) -> SamplingNodes {
         let nx = res.theta_h.max(2);
         let ny = res.phi_h.max(2);
         let nt = res.theta_o.max(1);
@@ -257,6 +282,50 @@ impl TableSampler {
                 }
             }
         }
+        SamplingNodes {
+            nx,
+            ny,
+            nt,
+            np,
+            isotropic,
+            data,
+        }
+    }
+}
+
+/// `f_r` with its directions exchanged: A(wi, wo) = f_r(wo, wi). Nodes or a sampler built from
+/// it draw `wo` given `wi`, ∝ f_r(wi, wo) cos θo — what a host that conditions on the light
+/// direction needs (Mitsuba samples its `wo` given `si.wi`, brdftab's `wi`).
+pub struct Adjoint<'a>(pub &'a dyn Brdf);
+
+impl Brdf for Adjoint<'_> {
+    fn channels(&self) -> &crate::spectrum::Channels {
+        self.0.channels()
+    }
+    fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
+        self.0.eval(wo, wi, out)
+    }
+    fn flags(&self) -> crate::brdf::Flags {
+        self.0.flags()
+    }
+    fn describe(&self) -> String {
+        format!("adjoint of {}", self.0.describe())
+    }
+}
+
+impl TableSampler {
+    /// Builds the distributions of `brdf` (f_r·cos θi, channel mean). `isotropic`: condition on
+    /// θo only and rotate by φo.
+    pub fn build(brdf: &dyn Brdf, isotropic: bool, res: &SamplingResolution) -> TableSampler {
+        let SamplingNodes {
+            nx,
+            ny,
+            nt,
+            np,
+            data,
+            ..
+        } = SamplingNodes::build(brdf, isotropic, res);
+        let plane = nx * ny;
         let warp = match Warp::build(Planes { nx, ny, data }) {
             Ok(w) => w,
             // Unreachable (every node is positive), but never panic: fall back to uniform.
@@ -585,5 +654,48 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The exported nodes are the sampler's own, and the adjoint exchanges the directions:
+    /// for a reciprocal model it gives the same nodes, for a non-reciprocal one others.
+    #[test]
+    fn nodes_and_their_adjoint() {
+        use crate::spec::ModelSpec;
+        let res = SamplingResolution {
+            theta_h: 12,
+            phi_h: 10,
+            theta_o: 5,
+            ..SamplingResolution::default()
+        };
+        let open = |json: &str| {
+            ModelSpec::parse(json)
+                .unwrap()
+                .build(&crate::spectrum::Channels::Rgb)
+                .unwrap()
+        };
+        let ggx = open(r#"{"model": "ggx", "alpha": 0.3}"#);
+        let n = SamplingNodes::build(ggx.as_ref(), true, &res);
+        assert_eq!((n.nx, n.ny, n.nt, n.np), (12, 10, 5, 1));
+        assert_eq!(n.data.len(), 12 * 10 * 5);
+        let a = SamplingNodes::build(&Adjoint(ggx.as_ref()), true, &res);
+        for (x, y) in n.data.iter().zip(&a.data) {
+            assert!((x - y).abs() <= 1e-5 * x.abs().max(1e-6), "{x} vs {y}");
+        }
+        // Original Phong divides by cos θi: not reciprocal, so its adjoint differs.
+        let phong = open(r#"{"model": "phong", "ks": 0.5, "n": 20}"#);
+        let p = SamplingNodes::build(phong.as_ref(), true, &res);
+        let q = SamplingNodes::build(&Adjoint(phong.as_ref()), true, &res);
+        let diff = p
+            .data
+            .iter()
+            .zip(&q.data)
+            .filter(|(x, y)| (*x - *y).abs() > 1e-3 * x.abs());
+        assert!(diff.count() > 10);
+        let mut f = [0.0f32; 3];
+        let mut g = [0.0f32; 3];
+        let (wi, wo) = (DVec3::new(0.3, 0.1, 0.9), DVec3::new(-0.5, 0.2, 0.6));
+        phong.eval(wo, wi, &mut f);
+        Adjoint(phong.as_ref()).eval(wi, wo, &mut g);
+        assert_eq!(f, g);
     }
 }

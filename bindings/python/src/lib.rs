@@ -524,6 +524,63 @@ impl PyBrdf {
         })
     }
 
+    /// The node densities of the library's importance sampler (`brdftab.table.SamplingNodes`
+    /// in Rust): {"version": 1, "nx", "ny", "nt", "np", "isotropic", "data": float32 array
+    /// (nt·np, ny, nx)} — g(s, y) of f_r cos θ over the half-vector square (s → θh = (π/2)(0.1 s
+    /// + 0.9 s²), y → φh = 2π y − π relative to the conditioning direction's azimuth) at nt
+    /// conditioning nodes uniform in t = sqrt(1 − cos θ) (times np over φ for anisotropic
+    /// sources). `adjoint=True` conditions on wi and weights by cos θo (Mitsuba's convention:
+    /// draw wo given wi). For hosts that sample on a device (the Mitsuba plugin).
+    #[pyo3(signature = (adjoint=false, theta_h=64, phi_h=64, theta_o=32, phi_o=16))]
+    fn sampling_nodes(
+        &self,
+        py: Python<'_>,
+        adjoint: bool,
+        theta_h: usize,
+        phi_h: usize,
+        theta_o: usize,
+        phi_o: usize,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| {
+            use brdftab::table::{Adjoint, SamplingNodes, SamplingResolution};
+            let nodes = [theta_h, phi_h, theta_o, phi_o]
+                .iter()
+                .try_fold(1usize, |a, &x| a.checked_mul(x.max(1)));
+            if !nodes.is_some_and(|n| n <= 1 << 26) {
+                return Err(PyValueError::new_err(
+                    "theta_h·phi_h·theta_o·phi_o: at most 2^26 nodes",
+                ));
+            }
+            let res = SamplingResolution {
+                theta_h,
+                phi_h,
+                theta_o,
+                phi_o,
+                ..SamplingResolution::default()
+            };
+            let iso = self.inner.flags().isotropic;
+            let brdf: &dyn Brdf = self.inner.as_ref();
+            let n = unlocked(py, || match adjoint {
+                true => SamplingNodes::build(&Adjoint(brdf), iso, &res),
+                false => SamplingNodes::build(brdf, iso, &res),
+            })?;
+            self.check_loaded()?;
+            let shape = [n.nt * n.np, n.ny, n.nx];
+            let data = ArrayD::from_shape_vec(IxDyn(&shape), n.data)
+                .map_err(|e| Error::new_err(e.to_string()))?
+                .into_pyarray(py);
+            let d = PyDict::new(py);
+            d.set_item("version", 1)?;
+            d.set_item("nx", n.nx)?;
+            d.set_item("ny", n.ny)?;
+            d.set_item("nt", n.nt)?;
+            d.set_item("np", n.np)?;
+            d.set_item("isotropic", n.isotropic)?;
+            d.set_item("data", data)?;
+            Ok(d.into_any().unbind())
+        })
+    }
+
     /// The decoded table as a `brdftab.Table`: `values` (float32, shaped by the stored axes
     /// and the channels, λ innermost; flat for a packed `inout` reciprocal table) shares the
     /// table's memory, read-only; `grid` describes it. Unpacks as `values, grid = b.table()`.

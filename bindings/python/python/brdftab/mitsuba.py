@@ -9,7 +9,8 @@ Properties: ``source`` (string, any SOURCE: spec, table, ``DB#NAME``, MERL, RGL)
 ``interp`` (``"linear"`` or ``"nearest"``), and for JIT variants optional ``preset`` / ``grid``
 (the table a non-table source is baked on, default ``medium``; RGL files: the library's
 adaptive grid, MERL files: their own cells), ``sampling_res`` (the
-resolution of the tabulated sampling distributions, default 64), ``cache`` (bool, default
+resolution of the sampling distributions: half-vector nodes per axis, default 64, 48 for
+anisotropic tables), ``cache`` (bool, default
 true: baked tables are kept in the cache of baked tables, :func:`brdftab.bake_cached`, so a
 material is baked once, not at every scene load) and ``cache_dir``.
 
@@ -23,9 +24,11 @@ brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only.
   the plugin bakes (or loads) a table, uploads its decoded values once, and evaluates it in
   Dr.Jit operations that mirror the Rust lookup (``src/table/{grid,symmetry,lookup}.rs``):
   half/difference coordinates, symmetry folds, axis mappings and multilinear interpolation.
-  Sampling draws wo from tabulated 2D distributions of f_r cos θo conditioned on θ(wi)
-  (isotropic tables; Mitsuba's ``MarginalContinuous2D1``) with the exactly consistent pdf, mixed
-  with cosine-weighted sampling; anisotropic tables sample cosine-weighted only.
+  Sampling is the library's (``src/table/sampling.rs``): wo is drawn as the mirror image of
+  wi about a half vector from conditional 2D warps of f_r cos θo over the half vector, on the
+  node densities the library exports (``Brdf.sampling_nodes``), conditioned on θi (and φi for
+  anisotropic tables) with Mitsuba's ``MarginalContinuous2D1``/``2D2``, with the exactly
+  consistent pdf (``brdftab._halfwarp``).
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ import math
 import numpy as np
 
 import brdftab
+from brdftab._halfwarp import HalfVectorSampler
 
 _REGISTERED = set()
 
@@ -704,11 +708,13 @@ class JitBrdftabBSDF(_Common):
             options.setdefault("wavelengths", list(range(380, 781, 20)))
         values, grid = self._table(options)
         self.table = JitTable(values, grid, self.interp)
-        self.sampling_res = int(_prop(props, "sampling_res", 64))
-        self.cos_fraction = float(_prop(props, "cosine_fraction", 0.1))
-        self.warp = None
-        if grid["symmetry"]["isotropic"] and not self.delta:
-            self.warp = self._build_warp()
+        # The library's importance sampler (conditional half-vector warps of f_r cos θo given
+        # wi), on the densities it exports for the table (or the source): brdftab._halfwarp.
+        iso = grid["symmetry"]["isotropic"]
+        res = int(_prop(props, "sampling_res", 64 if iso else 48))
+        nodes = self._sampled.sampling_nodes(adjoint=True, theta_h=res, phi_h=res,
+                                             theta_o=32 if iso else 12)
+        self.sampler = HalfVectorSampler(nodes)
         dr.eval()
 
     def _table(self, options):
@@ -744,35 +750,6 @@ class JitBrdftabBSDF(_Common):
             b = brdftab.open(self.source, interp=self.interp, wavelengths=options.pop("wavelengths"))
         return b.table(param="halfdiff", **options)
 
-    # -- tabulated sampling: wo ~ f(wi, wo) cos θo, conditioned on θi ---------------------------
-    def _build_warp(self):
-        import mitsuba as mi
-
-        n = self.sampling_res
-        n_t = 16
-        thetas = np.linspace(0, math.pi / 2, n_t) * 0.999
-        # node grid over the unit square: x → φo (relative to φi = 0), y → θo (uniform)
-        ys = np.linspace(0, 1, n)
-        xs = np.linspace(0, 1, 2 * n)
-        to = ys * (math.pi / 2)
-        po = xs * (2 * math.pi)
-        T, P = np.meshgrid(to, po, indexing="ij")
-        wo = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], -1).reshape(-1, 3)
-        wo[:, 2] = np.maximum(wo[:, 2], 1e-4)
-        wi = np.stack([np.sin(thetas), np.zeros(n_t), np.cos(thetas)], -1)
-        # The table (or its source) through the library: the same values as the JIT lookup to
-        # its float rounding, without compiling a kernel at every scene load. Any density is
-        # consistent: `pdf` reads the same distribution `sample` draws from. One row of wi
-        # against all wo nodes: broadcast by the binding, no copies.
-        f = np.stack([self._sampled.eval(w, wo) for w in wi])
-        lum = f.mean(axis=2).reshape(n_t, n, 2 * n)
-        jac = (np.cos(T) * np.sin(T))[None]
-        g = lum * jac
-        floor = 1e-3 * np.maximum(g.mean(axis=(1, 2)), 1e-12)[:, None, None]
-        data = (np.maximum(g, 0) + floor * np.sin(T)[None]).astype(np.float32)
-        self.warp_thetas = thetas
-        return mi.MarginalContinuous2D1(data, [thetas.tolist()], normalize=True)
-
     def _f(self, wi, wo, si, active):
         import drjit as dr
         import mitsuba as mi
@@ -794,20 +771,6 @@ class JitBrdftabBSDF(_Common):
             out.append(v)
         return mi.Spectrum(out)
 
-    def _polar(self, wi, wo):
-        """(frame-relative unit coordinates of wo, θi, ok): x = (φo − φi)/2π, y = θo/(π/2)."""
-        import drjit as dr
-        import mitsuba as mi
-
-        ti = dr.acos(dr.clip(dr.normalize(wi).z, -1, 1))
-        phi_i = dr.atan2(wi.y, wi.x)
-        won = dr.normalize(wo)
-        to = dr.acos(dr.clip(won.z, -1, 1))
-        po = dr.atan2(won.y, won.x) - phi_i
-        x = po * (0.5 / math.pi)
-        x = x - dr.floor(x)
-        return mi.Point2f(x, to * (2 / math.pi)), ti, phi_i, to
-
     def eval(self, ctx, si, wo, active=True):
         import drjit as dr
         import mitsuba as mi
@@ -820,18 +783,8 @@ class JitBrdftabBSDF(_Common):
 
     def _pdf(self, si, wo, active):
         import drjit as dr
-        import mitsuba as mi
 
-        cos_o = dr.normalize(wo).z
-        p_cos = dr.maximum(cos_o, 0.0) / math.pi
-        if self.warp is None:
-            return dr.select(active, p_cos, 0.0)
-        pos, ti, _, to = self._polar(si.wi, wo)
-        ti = dr.minimum(ti, float(self.warp_thetas[-1]))
-        p_pos = self.warp.eval(pos, [ti], active)
-        p_w = p_pos / dr.maximum(math.pi * math.pi * dr.sin(to), 1e-12)
-        c = self.cos_fraction
-        return dr.select(active, c * p_cos + (1 - c) * p_w, 0.0)
+        return self.sampler.pdf(dr.normalize(si.wi), dr.normalize(wo), active)
 
     def pdf(self, ctx, si, wo, active=True):
         import mitsuba as mi
@@ -850,21 +803,9 @@ class JitBrdftabBSDF(_Common):
 
         active = mi.Bool(active) & (si.wi.z > 0)
         bs = dr.zeros(mi.BSDFSample3f)
-        wo_cos = mi.warp.square_to_cosine_hemisphere(sample2)
-        if self.warp is None:
-            wo = wo_cos
-        else:
-            _, ti, phi_i, _ = self._polar(si.wi, si.wi)
-            ti = dr.minimum(ti, float(self.warp_thetas[-1]))
-            use_cos = sample1 < self.cos_fraction
-            pos, _ = self.warp.sample(sample2, [ti], active & ~use_cos)
-            to = pos.y * (math.pi / 2)
-            po = pos.x * (2 * math.pi) + phi_i
-            st, ct = dr.sincos(to)
-            sp, cp = dr.sincos(po)
-            wo = dr.select(use_cos, wo_cos, mi.Vector3f(st * cp, st * sp, ct))
+        wo, pdf = self.sampler.sample(dr.normalize(si.wi), sample2, active)
         bs.wo = wo
-        bs.pdf = self._pdf(si, wo, active & (wo.z > 0))
+        bs.pdf = pdf
         bs.eta = 1.0
         bs.sampled_type = mi.UInt32(+self.m_flags & ~int(mi.BSDFFlags.FrontSide))
         bs.sampled_component = mi.UInt32(0)
