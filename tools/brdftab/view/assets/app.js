@@ -1,0 +1,365 @@
+// brdftab view: the page. State lives in the URL hash; every view is fetched from the local
+// server as JSON arrays and drawn as SVG by plots.js.
+"use strict";
+
+const $ = (id) => document.getElementById(id);
+const state = { sel: [], ti: 30, scale: "linear", cos: false, src: false, lt: 40, lp: 135, ev: 0, spec: "", on: false, yaw: -0.7, pitch: 1.05 };
+let materials = [], models = [];
+const gen = {}; // newest request per view: older answers are dropped
+const data = { polar: [], lobe: [] };
+
+async function getJSON(path) {
+  const r = await fetch(path);
+  const v = await r.json();
+  if (!r.ok) throw new Error(v.error || r.statusText);
+  return v;
+}
+
+// ---- the URL hash ----
+function readHash() {
+  const h = new URLSearchParams(location.hash.slice(1));
+  if (h.get("m")) state.sel = h.get("m").split(",").map(Number).filter((i) => i >= 0 && i < materials.length).slice(0, 4);
+  for (const k of ["ti", "lt", "lp", "ev", "yaw", "pitch"]) if (h.has(k) && Number.isFinite(+h.get(k))) state[k] = +h.get(k);
+  if (h.has("scale")) state.scale = h.get("scale") === "log" ? "log" : "linear";
+  state.cos = h.get("cos") === "1";
+  state.src = h.get("src") === "1";
+  if (h.has("spec")) state.spec = h.get("spec");
+  state.on = h.get("on") === "1" && state.spec !== "";
+}
+
+function writeHash() {
+  const h = new URLSearchParams();
+  h.set("m", state.sel.join(","));
+  for (const k of ["ti", "scale", "lt", "lp", "ev"]) h.set(k, state[k]);
+  h.set("yaw", state.yaw.toFixed(2));
+  h.set("pitch", state.pitch.toFixed(2));
+  if (state.cos) h.set("cos", "1");
+  if (state.src) h.set("src", "1");
+  if (state.spec) h.set("spec", state.spec);
+  if (state.on) h.set("on", "1");
+  history.replaceState(null, "", "#" + h.toString());
+}
+
+// ---- what is drawn: the selected materials, their sources, the spec ----
+function entries() {
+  const out = [];
+  state.sel.forEach((id, k) => {
+    const m = materials[id];
+    out.push({ q: `m=${id}`, label: m.name, color: COLORS[k], id });
+    if (state.src && m.has_source) out.push({ q: `m=${id}&of=source`, label: `${m.name} (source)`, color: COLORS[k], dash: "5 3", sourceOf: id });
+  });
+  if (state.on && state.spec) out.push({ q: "spec=" + encodeURIComponent(state.spec), label: "spec", color: "#7f3fbf", spec: true });
+  return out;
+}
+
+async function view(name, params, draw) {
+  const g = (gen[name] = (gen[name] || 0) + 1);
+  const list = entries();
+  try {
+    const got = await Promise.all(list.map((e) => getJSON(`/api/${name}?${e.q}&${params}`)));
+    if (g !== gen[name]) return false;
+    draw(list, got);
+    $("spec-error").textContent = "";
+    return true;
+  } catch (err) {
+    if (g === gen[name]) $("spec-error").textContent = String(err.message || err);
+    return false;
+  }
+}
+
+// ---- the views ----
+function polarSeries() {
+  const series = [];
+  data.polar.forEach(({ e, v }) => {
+    const y = v.y.map((f, k) => (state.cos ? f * Math.cos((v.theta_o[k] * Math.PI) / 180) : f));
+    series.push({ x: v.theta_o, y, color: e.color, dash: e.dash });
+  });
+  // The difference of each table and its source, thin.
+  for (const a of data.polar) {
+    const b = data.polar.find((o) => o.e.sourceOf === a.e.id && !a.e.dash);
+    if (!b) continue;
+    const y = a.v.y.map((f, k) => Math.abs(f - b.v.y[k]) * (state.cos ? Math.cos((a.v.theta_o[k] * Math.PI) / 180) : 1));
+    series.push({ x: a.v.theta_o, y, color: a.e.color, dash: "1 2", width: 1 });
+  }
+  return series;
+}
+
+function drawPolar() {
+  polarPlot($("polar"), polarSeries(), { log: state.scale === "log", thetaI: state.ti, label: state.cos ? "f_r cos θo" : "f_r (1/sr)" });
+}
+
+function drawLobe() {
+  lobePlot($("lobe"), data.lobe.map(({ e, v }) => ({
+    nt: v.nt, np: v.np, color: e.color, dash: e.dash,
+    r: v.y.map((f, k) => {
+      const t = (Math.PI / 2) * Math.floor(k / v.np) / (v.nt - 1);
+      const x = state.cos ? f * Math.cos(t) : f;
+      return state.scale === "log" ? x : x;
+    }),
+  })), { yaw: state.yaw, pitch: state.pitch });
+}
+
+async function fastViews() {
+  const t0 = performance.now();
+  const p = view("polar", `theta_i=${state.ti}&n=181`, (list, got) => {
+    data.polar = list.map((e, k) => ({ e, v: got[k] }));
+    drawPolar();
+  });
+  const l = view("lobe", `theta_i=${state.ti}&nt=19&np=36`, (list, got) => {
+    data.lobe = list.map((e, k) => ({ e, v: got[k] }));
+    drawLobe();
+  });
+  const [ok] = await Promise.all([p, l]);
+  if (ok) {
+    const ms = performance.now() - t0;
+    window.brdftabRedrawMs = ms;
+    $("timing").textContent = `redraw ${ms.toFixed(0)} ms`;
+  }
+}
+
+function sphereView(size) {
+  const q = `lt=${state.lt}&lp=${state.lp}&size=${size}&exposure=${Math.pow(2, state.ev)}`;
+  return view("sphere", q, (list, got) => {
+    const images = list.map((e, k) => ({ ...got[k], color: e.color, label: e.label }));
+    for (const a of list.keys()) {
+      const s = list.findIndex((o) => o.sourceOf === list[a].id && !list[a].dash);
+      if (s < 0) continue;
+      const diff = images[a].rgb.map((x, i) => Math.min(255, 4 * Math.abs(x - images[s].rgb[i])));
+      images.push({ size, rgb: diff, color: list[a].color, label: "|diff| ×4" });
+    }
+    spherePanel($("sphere"), images.slice(0, 4));
+  });
+}
+
+function sliceView() {
+  return view("slice", "n=64", (list, got) => {
+    const log = state.scale === "log";
+    if (!got.length) return clear($("slice"));
+    const a = list[0], s = list.findIndex((o) => o.sourceOf === a.id && !a.dash);
+    if (s > 0) {
+      const d = got[0].y.map((v, k) => v - got[s].y[k]);
+      heatmap($("slice"), got[0].n, d, { signed: true, label: `${a.label}: table − source` });
+    } else heatmap($("slice"), got[0].n, got[0].y, { log, label: a.label });
+  });
+}
+
+function albedoView() {
+  return view("albedo", "", (list, got) => {
+    const series = got.map((v, k) => ({ x: v.theta, y: v.y, color: list[k].color, dash: list[k].dash }));
+    linePlot($("albedo"), series, { x0: 0, x1: 90, dx: 15, xlabel: "θ′ (luminance)" });
+  });
+}
+
+async function report() {
+  const list = entries().filter((e) => !e.sourceOf && e.sourceOf !== 0);
+  const rows = await Promise.all(list.map(async (e) => {
+    const p = await getJSON(`/api/plausibility?${e.q}`).catch(() => null);
+    const m = e.id !== undefined && materials[e.id].has_source ? await getJSON(`/api/compare?m=${e.id}`).catch(() => null) : null;
+    return { e, p, m };
+  }));
+  const yn = (b) => (b ? '<span class="ok">yes</span>' : '<span class="bad">no</span>');
+  let html = "<table><tr><th></th><th>positive</th><th>reciprocal</th><th>energy (max a)</th><th>cos-weighted err</th><th>albedo err</th></tr>";
+  for (const { e, p, m } of rows) {
+    html += `<tr><td style="color:${e.color}">${escapeHtml(e.label)}</td>`;
+    html += p ? `<td>${yn(p.positive)}</td><td>${yn(p.reciprocal)} (${p.max_reciprocity_error.toExponential(1)})</td><td>${yn(p.energy_conserving)} (${p.max_albedo.toFixed(3)})</td>` : "<td colspan=3>…</td>";
+    html += m && !m.error ? `<td>${(100 * m.rel_rmse).toFixed(3)} %</td><td>${(100 * m.albedo_err).toFixed(3)} %</td>` : "<td>–</td><td>–</td>";
+    html += "</tr>";
+  }
+  $("report").innerHTML = html + "</table>";
+}
+
+function escapeHtml(s) {
+  return s.replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(0)};`);
+}
+
+let slowTimer = null;
+function slowViews(delay) {
+  clearTimeout(slowTimer);
+  slowTimer = setTimeout(() => { sliceView(); albedoView(); report(); }, delay || 0);
+}
+
+function redrawAll() {
+  writeHash();
+  renderList();
+  fastViews();
+  sphereView(128);
+  slowViews(0);
+}
+
+// ---- the material list ----
+function renderList() {
+  const ul = $("materials");
+  if (!ul.children.length) {
+    materials.forEach((m) => {
+      const li = document.createElement("li");
+      li.dataset.id = m.id;
+      const c = document.createElement("canvas");
+      c.width = c.height = 48;
+      const meta = document.createElement("div");
+      meta.className = "meta";
+      const kb = m.bytes !== undefined ? `${(m.bytes / 1024).toFixed(1)} KiB, ${m.ratio.toFixed(1)}× vs f32, ${m.codec.quant}` : "";
+      meta.innerHTML = `<div class="name">${escapeHtml(m.name)}</div>${m.kind} · ${m.channels.join(" ")}` +
+        (m.grid ? `<br>${escapeHtml(m.grid)}<br>${kb}` : "") + (m.has_source ? "<br>source: opens" : "");
+      li.append(c, meta);
+      li.addEventListener("click", () => toggle(m.id));
+      ul.appendChild(li);
+    });
+    thumbnails();
+  }
+  for (const li of ul.children) {
+    const k = state.sel.indexOf(+li.dataset.id);
+    li.classList.toggle("selected", k >= 0);
+    li.style.borderLeftColor = k >= 0 ? COLORS[k] : "transparent";
+  }
+}
+
+async function thumbnails() {
+  for (const m of materials) {
+    const v = await getJSON(`/api/sphere?m=${m.id}&size=48&lt=40&lp=135`).catch(() => null);
+    if (!v) continue;
+    const c = document.querySelector(`#materials li[data-id="${m.id}"] canvas`);
+    const img = new ImageData(v.size, v.size);
+    for (let p = 0; p < v.size * v.size; p++) img.data.set([v.rgb[3 * p], v.rgb[3 * p + 1], v.rgb[3 * p + 2], 255], 4 * p);
+    c.getContext("2d").putImageData(img, 0, 0);
+  }
+}
+
+function toggle(id) {
+  const k = state.sel.indexOf(id);
+  if (k >= 0) state.sel.splice(k, 1);
+  else if (state.sel.length + (state.on ? 1 : 0) < 4) state.sel.push(id);
+  const m = materials[id];
+  if (k < 0 && m.spec) loadSpec(JSON.stringify(m.spec));
+  redrawAll();
+}
+
+// ---- the analytic spec editor ----
+const FRESNEL = ['"none"', '{"conductor":"Au"}', '{"conductor":"Ag"}', '{"conductor":"Cu"}', '{"conductor":"Al"}', '{"eta":1.5}', '{"schlick":0.04}'];
+
+function sliderRange(name, kind) {
+  if (kind === "radians") return { min: 0, max: 1.5, log: false };
+  if (name === "n") return { min: 0, max: 4, log: true };
+  if (/^(m|alpha)/.test(name)) return { min: 0.005, max: 1, log: false };
+  if (name === "eta") return { min: 1, max: 3, log: false };
+  return { min: 0, max: 1, log: false };
+}
+
+function loadSpec(json) {
+  let spec;
+  try { spec = JSON.parse(json); } catch { return; }
+  state.spec = JSON.stringify(spec);
+  $("spec-json").value = state.spec;
+  $("model").value = spec.model;
+  buildParams(spec);
+}
+
+function buildParams(spec) {
+  const box = $("params");
+  box.innerHTML = "";
+  const info = models.find((m) => m.name === spec.model);
+  if (!info) return;
+  for (const p of info.params) {
+    const label = document.createElement("label");
+    label.textContent = p.name;
+    if (["number", "radians", "value"].includes(p.kind)) {
+      const r = sliderRange(p.name, p.kind);
+      let v = spec[p.name];
+      if (Array.isArray(v)) v = v[0];
+      if (typeof v !== "number") v = p.default !== null && Number.isFinite(+p.default) ? +p.default : r.min;
+      const input = Object.assign(document.createElement("input"), { type: "range", min: r.min, max: r.max, step: (r.max - r.min) / 400 });
+      input.value = r.log ? Math.log10(Math.max(v, 1)) : v;
+      const out = document.createElement("span");
+      out.textContent = (+v).toPrecision(3);
+      input.addEventListener("input", () => {
+        const x = r.log ? Math.round(Math.pow(10, +input.value)) : +input.value;
+        out.textContent = x.toPrecision(3);
+        specChanged(Object.assign(JSON.parse(state.spec), { [p.name]: x }));
+      });
+      label.append(input, out);
+    } else if (p.kind === "fresnel" || (p.kind && p.kind.choice)) {
+      const sel = document.createElement("select");
+      const options = p.kind === "fresnel" ? FRESNEL : p.kind.choice.map((c) => JSON.stringify(c));
+      const cur = JSON.stringify(spec[p.name] === undefined ? JSON.parse(options[0]) : spec[p.name]);
+      for (const o of options.includes(cur) ? options : [cur, ...options]) sel.add(new Option(o, o, false, o === cur));
+      sel.addEventListener("change", () => specChanged(Object.assign(JSON.parse(state.spec), { [p.name]: JSON.parse(sel.value) })));
+      label.append(sel);
+    } else continue;
+    box.appendChild(label);
+  }
+}
+
+function specChanged(spec) {
+  state.spec = JSON.stringify(spec);
+  $("spec-json").value = state.spec;
+  writeHash();
+  if (!state.on) return;
+  fastViews();
+  sphereView(64);
+  slowViews(300);
+}
+
+// ---- controls ----
+function bind() {
+  const range = (id, key, fast) => {
+    $(id).value = state[key];
+    $(id).addEventListener("input", () => { state[key] = +$(id).value; writeHash(); fast(true); });
+    $(id).addEventListener("change", () => fast(false));
+  };
+  range("theta-i", "ti", () => { $("theta-i-val").textContent = `${state.ti}°`; fastViews(); });
+  range("light-theta", "lt", (drag) => sphereView(drag ? 48 : 128));
+  range("light-phi", "lp", (drag) => sphereView(drag ? 48 : 128));
+  range("exposure", "ev", (drag) => sphereView(drag ? 48 : 128));
+  $("theta-i-val").textContent = `${state.ti}°`;
+  $("scale").value = state.scale;
+  $("scale").addEventListener("change", () => { state.scale = $("scale").value; writeHash(); drawPolar(); drawLobe(); sliceView(); });
+  $("cosine").checked = state.cos;
+  $("cosine").addEventListener("change", () => { state.cos = $("cosine").checked; writeHash(); drawPolar(); drawLobe(); });
+  $("vs-source").checked = state.src;
+  $("vs-source").addEventListener("change", () => { state.src = $("vs-source").checked; redrawAll(); });
+  $("spec-on").checked = state.on;
+  $("spec-on").addEventListener("change", () => { state.on = $("spec-on").checked && state.spec !== ""; redrawAll(); });
+  $("model").addEventListener("change", () => {
+    const m = models.find((x) => x.name === $("model").value);
+    loadSpec(m.example);
+    specChanged(JSON.parse(state.spec));
+  });
+  $("spec-json").addEventListener("input", () => {
+    try { const s = JSON.parse($("spec-json").value); state.spec = JSON.stringify(s); buildParams(s); specChanged(s); }
+    catch { $("spec-error").textContent = "not JSON yet"; }
+  });
+  // Drag on the lobe rotates it; drag on the sphere moves the light.
+  drag($("lobe"), (dx, dy) => { state.yaw += dx * 0.01; state.pitch = Math.min(Math.PI, Math.max(0, state.pitch + dy * 0.01)); drawLobe(); }, writeHash);
+  drag($("sphere"), (dx, dy) => {
+    state.lp = Math.round(((state.lp + dx + 540) % 360) - 180);
+    state.lt = Math.min(90, Math.max(0, state.lt + dy * 0.5));
+    $("light-theta").value = state.lt; $("light-phi").value = state.lp;
+    sphereView(48);
+  }, () => { writeHash(); sphereView(128); });
+  for (const panel of document.querySelectorAll(".panel[data-plot]")) {
+    addDownloads(panel, panel.querySelector("svg"), "brdftab-" + panel.dataset.plot);
+  }
+}
+
+function drag(target, move, end) {
+  let last = null;
+  target.addEventListener("pointerdown", (e) => { last = [e.clientX, e.clientY]; target.setPointerCapture(e.pointerId); });
+  target.addEventListener("pointermove", (e) => {
+    if (!last) return;
+    move(e.clientX - last[0], e.clientY - last[1]);
+    last = [e.clientX, e.clientY];
+  });
+  target.addEventListener("pointerup", () => { last = null; end(); });
+}
+
+async function main() {
+  [materials, models] = await Promise.all([getJSON("/api/materials"), getJSON("/api/models")]);
+  for (const m of models) $("model").add(new Option(m.name, m.name));
+  readHash();
+  if (!location.hash) state.sel = [0];
+  loadSpec(state.spec || models.find((m) => m.name === "cook_torrance").example);
+  bind();
+  redrawAll();
+  window.addEventListener("hashchange", () => { readHash(); redrawAll(); });
+}
+
+main();
