@@ -28,16 +28,14 @@ function readHash() {
 }
 
 function writeHash() {
-  const h = new URLSearchParams();
-  h.set("m", state.sel.join(","));
-  for (const k of ["ti", "scale", "lt", "lp", "ev"]) h.set(k, state[k]);
-  h.set("yaw", state.yaw.toFixed(2));
-  h.set("pitch", state.pitch.toFixed(2));
-  if (state.cos) h.set("cos", "1");
-  if (state.src) h.set("src", "1");
-  if (state.spec) h.set("spec", state.spec);
-  if (state.on) h.set("on", "1");
-  history.replaceState(null, "", "#" + h.toString());
+  const h = [`m=${state.sel.join(",")}`];
+  for (const k of ["ti", "scale", "lt", "lp", "ev"]) h.push(`${k}=${state[k]}`);
+  h.push(`yaw=${state.yaw.toFixed(2)}`, `pitch=${state.pitch.toFixed(2)}`);
+  if (state.cos) h.push("cos=1");
+  if (state.src) h.push("src=1");
+  if (state.spec) h.push("spec=" + encodeURIComponent(state.spec));
+  if (state.on) h.push("on=1");
+  history.replaceState(null, "", "#" + h.join("&"));
 }
 
 // ---- what is drawn: the selected materials, their sources, the spec ----
@@ -76,7 +74,8 @@ function polarSeries() {
   });
   // The difference of each table and its source, thin.
   for (const a of data.polar) {
-    const b = data.polar.find((o) => o.e.sourceOf === a.e.id && !a.e.dash);
+    if (a.e.id === undefined || a.e.sourceOf !== undefined) continue;
+    const b = data.polar.find((o) => o.e.sourceOf === a.e.id);
     if (!b) continue;
     const y = a.v.y.map((f, k) => Math.abs(f - b.v.y[k]) * (state.cos ? Math.cos((a.v.theta_o[k] * Math.PI) / 180) : 1));
     series.push({ x: a.v.theta_o, y, color: a.e.color, dash: "1 2", width: 1 });
@@ -93,10 +92,9 @@ function drawLobe() {
     nt: v.nt, np: v.np, color: e.color, dash: e.dash,
     r: v.y.map((f, k) => {
       const t = (Math.PI / 2) * Math.floor(k / v.np) / (v.nt - 1);
-      const x = state.cos ? f * Math.cos(t) : f;
-      return state.scale === "log" ? x : x;
+      return state.cos ? f * Math.cos(t) : f;
     }),
-  })), { yaw: state.yaw, pitch: state.pitch });
+  })), { yaw: state.yaw, pitch: state.pitch, log: state.scale === "log" });
 }
 
 async function fastViews() {
@@ -120,14 +118,18 @@ async function fastViews() {
 function sphereView(size) {
   const q = `lt=${state.lt}&lp=${state.lp}&size=${size}&exposure=${Math.pow(2, state.ev)}`;
   return view("sphere", q, (list, got) => {
-    const images = list.map((e, k) => ({ ...got[k], color: e.color, label: e.label }));
-    for (const a of list.keys()) {
-      const s = list.findIndex((o) => o.sourceOf === list[a].id && !list[a].dash);
-      if (s < 0) continue;
-      const diff = images[a].rgb.map((x, i) => Math.min(255, 4 * Math.abs(x - images[s].rgb[i])));
-      images.push({ size, rgb: diff, color: list[a].color, label: "|diff| ×4" });
-    }
-    spherePanel($("sphere"), images.slice(0, 4));
+    // Each material, then its source and their difference when shown.
+    const images = [];
+    list.forEach((e, k) => {
+      if (e.sourceOf !== undefined) return;
+      images.push({ ...got[k], color: e.color, label: e.label });
+      const s = e.id === undefined ? -1 : list.findIndex((o) => o.sourceOf === e.id);
+      if (s < 0) return;
+      images.push({ ...got[s], color: e.color, label: list[s].label });
+      const diff = got[k].rgb.map((x, i) => Math.min(255, 4 * Math.abs(x - got[s].rgb[i])));
+      images.push({ size, rgb: diff, color: e.color, label: "|table − source| ×4" });
+    });
+    spherePanel($("sphere"), images.slice(0, 6));
   });
 }
 
@@ -135,7 +137,7 @@ function sliceView() {
   return view("slice", "n=64", (list, got) => {
     const log = state.scale === "log";
     if (!got.length) return clear($("slice"));
-    const a = list[0], s = list.findIndex((o) => o.sourceOf === a.id && !a.dash);
+    const a = list[0], s = a.id === undefined ? -1 : list.findIndex((o) => o.sourceOf === a.id);
     if (s > 0) {
       const d = got[0].y.map((v, k) => v - got[s].y[k]);
       heatmap($("slice"), got[0].n, d, { signed: true, label: `${a.label}: table − source` });
@@ -151,21 +153,34 @@ function albedoView() {
 }
 
 async function report() {
-  const list = entries().filter((e) => !e.sourceOf && e.sourceOf !== 0);
+  const list = entries().filter((e) => e.sourceOf === undefined);
   const rows = await Promise.all(list.map(async (e) => {
     const p = await getJSON(`/api/plausibility?${e.q}`).catch(() => null);
     const m = e.id !== undefined && materials[e.id].has_source ? await getJSON(`/api/compare?m=${e.id}`).catch(() => null) : null;
     return { e, p, m };
   }));
-  const yn = (b) => (b ? '<span class="ok">yes</span>' : '<span class="bad">no</span>');
-  let html = "<table><tr><th></th><th>positive</th><th>reciprocal</th><th>energy (max a)</th><th>cos-weighted err</th><th>albedo err</th></tr>";
+  // Built as DOM nodes, not HTML text: the page's CSP allows no inline style attributes.
+  const table = document.createElement("table");
+  const row = (cells, head) => {
+    const tr = table.insertRow();
+    for (const c of cells) {
+      const td = document.createElement(head ? "th" : "td");
+      if (typeof c === "string") td.textContent = c;
+      else { td.textContent = c.text; if (c.cls) td.className = c.cls; if (c.color) td.style.color = c.color; }
+      tr.appendChild(td);
+    }
+  };
+  const yn = (b, x) => ({ text: (b ? "yes" : "no") + (x ? ` (${x})` : ""), cls: b ? "ok" : "bad" });
+  row(["", "positive", "reciprocal", "energy (max a)", "cos-weighted err", "albedo err"], true);
   for (const { e, p, m } of rows) {
-    html += `<tr><td style="color:${e.color}">${escapeHtml(e.label)}</td>`;
-    html += p ? `<td>${yn(p.positive)}</td><td>${yn(p.reciprocal)} (${p.max_reciprocity_error.toExponential(1)})</td><td>${yn(p.energy_conserving)} (${p.max_albedo.toFixed(3)})</td>` : "<td colspan=3>…</td>";
-    html += m && !m.error ? `<td>${(100 * m.rel_rmse).toFixed(3)} %</td><td>${(100 * m.albedo_err).toFixed(3)} %</td>` : "<td>–</td><td>–</td>";
-    html += "</tr>";
+    const cells = [{ text: e.label, color: e.color }];
+    if (p) cells.push(yn(p.positive), yn(p.reciprocal, p.max_reciprocity_error.toExponential(1)), yn(p.energy_conserving, p.max_albedo.toFixed(3)));
+    else cells.push("…", "…", "…");
+    if (m && !m.error) cells.push(`${(100 * m.rel_rmse).toFixed(3)} %`, `${(100 * m.albedo_err).toFixed(3)} %`);
+    else cells.push("–", "–");
+    row(cells);
   }
-  $("report").innerHTML = html + "</table>";
+  $("report").replaceChildren(table);
 }
 
 function escapeHtml(s) {

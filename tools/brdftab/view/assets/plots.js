@@ -94,10 +94,11 @@ function ramp(t) {
 // An n × n map (row = θd, column = θh) as rectangles; signed data uses a red/blue ramp.
 function heatmap(svg, n, y, opts) {
   clear(svg);
-  const S = 210, L = 40, T = 8, cell = S / n;
-  let max = 0;
-  for (const v of y) if (Number.isFinite(v)) max = Math.max(max, Math.abs(v));
-  max = max || 1;
+  const S = 200, L = 34, T = 6, cell = S / n;
+  // Signed maps (differences) scale by the 99th percentile, so one grazing outlier does not
+  // wash the rest out; others by their maximum.
+  const mags = y.filter(Number.isFinite).map(Math.abs).sort((a, b) => a - b);
+  const max = (opts.signed ? mags[Math.floor(0.99 * (mags.length - 1))] : mags[mags.length - 1]) || 1;
   const s = scaler(max, opts.log);
   const g = el("g", { "shape-rendering": "crispEdges" }, svg);
   for (let d = 0; d < n; d++) {
@@ -111,11 +112,11 @@ function heatmap(svg, n, y, opts) {
       el("rect", { x: (L + h * cell).toFixed(2), y: (T + S - (d + 1) * cell).toFixed(2), width: (cell + 0.3).toFixed(2), height: (cell + 0.3).toFixed(2), fill }, g);
     }
   }
-  text(svg, L + S / 2 - 10, T + S + 14, "θh →");
+  text(svg, L + S / 2 - 10, T + S + 12, "θh →");
   text(svg, 2, T + S / 2, "θd ↑");
-  text(svg, L + S + 8, T + 12, opts.label);
-  text(svg, L + S + 8, T + 26, `max ${max.toPrecision(3)}`);
-  if (opts.log) text(svg, L + S + 8, T + 40, "log, 4 decades");
+  text(svg, L, T + S + 26, opts.label);
+  const scale = opts.signed ? `±${max.toPrecision(3)} (red +, blue −)` : `max ${max.toPrecision(3)}`;
+  text(svg, L, T + S + 39, scale + (opts.log ? ", log over 4 decades" : ""));
 }
 
 // The 3D lobe: r(θo, φo) along each outgoing direction, rotated by yaw/pitch, projected.
@@ -124,7 +125,7 @@ function lobePlot(svg, lobes, view) {
   const cx = 160, cy = 150, R = 120;
   let max = 0;
   for (const l of lobes) for (const v of l.r) max = Math.max(max, v);
-  max = max || 1;
+  const s = scaler(max || 1, view.log);
   const cy_ = Math.cos(view.yaw), sy = Math.sin(view.yaw), cp = Math.cos(view.pitch), sp = Math.sin(view.pitch);
   const project = (x, y, z) => {
     const x1 = cy_ * x - sy * y, y1 = sy * x + cy_ * y;
@@ -139,7 +140,7 @@ function lobePlot(svg, lobes, view) {
   axis(1, 0, 0, "x"); axis(0, 1, 0, "y"); axis(0, 0, 1, "n");
   for (const l of lobes) {
     const pt = (i, j) => {
-      const t = (Math.PI / 2) * i / (l.nt - 1), p = (2 * Math.PI * j) / l.np, r = l.r[i * l.np + j] / max;
+      const t = (Math.PI / 2) * i / (l.nt - 1), p = (2 * Math.PI * j) / l.np, r = s(l.r[i * l.np + j]);
       return project(r * Math.sin(t) * Math.cos(p), r * Math.sin(t) * Math.sin(p), r * Math.cos(t));
     };
     const lines = [];
@@ -169,10 +170,11 @@ function spherePanel(svg, images) {
       data.data.set([im.rgb[3 * p], im.rgb[3 * p + 1], im.rgb[3 * p + 2], 255], 4 * p);
     }
     c.getContext("2d").putImageData(data, 0, 0);
-    const x = 4 + k * 79;
-    el("image", { x, y: 4, width: 76, height: 76, href: c.toDataURL() }, svg);
-    el("rect", { x, y: 84, width: 76, height: 4, fill: im.color }, svg);
-    text(svg, x, 100, im.label.slice(0, 14));
+    // Up to three a row: a table, its source, their difference.
+    const x = 4 + (k % 3) * 145, y = 4 + Math.floor(k / 3) * 118;
+    el("image", { x, y, width: 100, height: 100, href: c.toDataURL() }, svg);
+    el("rect", { x, y: y + 102, width: 100, height: 3, fill: im.color }, svg);
+    text(svg, x, y + 114, im.label.slice(0, 24));
   });
 }
 
