@@ -18,7 +18,7 @@ use super::security::inline_spec;
 use crate::report::suite::{self, MetricOptions};
 
 /// A request's decoded query parameters.
-pub struct Query(pub Vec<(String, String)>);
+pub struct Query(pub super::security::Params);
 
 impl Query {
     /// The value of parameter `k`, if given.

@@ -37,8 +37,11 @@ pub fn host_allowed(host: Option<&str>, allowed: &[String]) -> bool {
     host.is_some_and(|h| allowed.iter().any(|a| a.eq_ignore_ascii_case(h)))
 }
 
+/// Decoded query parameters, in request order.
+pub type Params = Vec<(String, String)>;
+
 /// A request target split into its path and decoded query parameters, or why it is refused.
-pub fn split_target(target: &str) -> Result<(&str, Vec<(String, String)>), &'static str> {
+pub fn split_target(target: &str) -> Result<(&str, Params), &'static str> {
     let (path, query) = target.split_once('?').unwrap_or((target, ""));
     if !path.starts_with('/')
         || path.contains('%')

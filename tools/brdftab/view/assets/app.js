@@ -139,8 +139,11 @@ function sliceView() {
     if (!got.length) return clear($("slice"));
     const a = list[0], s = a.id === undefined ? -1 : list.findIndex((o) => o.sourceOf === a.id);
     if (s > 0) {
-      const d = got[0].y.map((v, k) => v - got[s].y[k]);
-      heatmap($("slice"), got[0].n, d, { signed: true, label: `${a.label}: table − source` });
+      // Relative to the source (floored at 1e-5 /sr): absolute differences would show only the
+      // grazing row, where analytic lobes reach 1e5.
+      const src = got[s].y;
+      const d = got[0].y.map((v, k) => (v - src[k]) / Math.max(Math.abs(src[k]), 1e-5));
+      heatmap($("slice"), got[0].n, d, { signed: true, label: `${a.label}: (table − source) / source` });
     } else heatmap($("slice"), got[0].n, got[0].y, { log, label: a.label });
   });
 }

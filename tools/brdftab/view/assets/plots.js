@@ -97,7 +97,7 @@ function heatmap(svg, n, y, opts) {
   const S = 200, L = 34, T = 6, cell = S / n;
   // Signed maps (differences) scale by the 99th percentile, so one grazing outlier does not
   // wash the rest out; others by their maximum.
-  const mags = y.filter(Number.isFinite).map(Math.abs).sort((a, b) => a - b);
+  const mags = y.filter((v) => Number.isFinite(v) && v !== 0).map(Math.abs).sort((a, b) => a - b);
   const max = (opts.signed ? mags[Math.floor(0.99 * (mags.length - 1))] : mags[mags.length - 1]) || 1;
   const s = scaler(max, opts.log);
   const g = el("g", { "shape-rendering": "crispEdges" }, svg);
