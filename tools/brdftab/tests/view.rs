@@ -208,7 +208,7 @@ fn materials_and_views_of_a_database() {
     // The page and its assets are served from the binary.
     let (status, page) = get(&v, "/");
     assert!(status == 200 && page.contains("/app.js"), "{status}");
-    for asset in ["/app.js", "/plots.js", "/style.css"] {
+    for asset in ["/app.js", "/list.js", "/spec.js", "/plots.js", "/style.css"] {
         assert_eq!(get(&v, asset).0, 200, "{asset}");
     }
 }

@@ -6,23 +6,20 @@ use super::http::{Request, Response};
 use super::registry::Registry;
 use super::security;
 
-/// The page, its script and its style, embedded in the binary: the viewer works offline.
+/// The content type of the scripts.
+const JS: &str = "text/javascript; charset=utf-8";
+
+/// The page, its scripts and its style, embedded in the binary: the viewer works offline.
 const ASSETS: &[(&str, &str, &str)] = &[
     (
         "/",
         "text/html; charset=utf-8",
         include_str!("assets/index.html"),
     ),
-    (
-        "/app.js",
-        "text/javascript; charset=utf-8",
-        include_str!("assets/app.js"),
-    ),
-    (
-        "/plots.js",
-        "text/javascript; charset=utf-8",
-        include_str!("assets/plots.js"),
-    ),
+    ("/app.js", JS, include_str!("assets/app.js")),
+    ("/list.js", JS, include_str!("assets/list.js")),
+    ("/spec.js", JS, include_str!("assets/spec.js")),
+    ("/plots.js", JS, include_str!("assets/plots.js")),
     (
         "/style.css",
         "text/css; charset=utf-8",

@@ -113,12 +113,37 @@ def check(driver, url, screenshot):
     assert not errors, f"console errors: {errors}"
     os.makedirs(os.path.dirname(screenshot), exist_ok=True)
     driver.save_screenshot(screenshot)
+    check_spec_and_shared_url(driver, wait)
+    errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+    assert not errors, f"console errors: {errors}"
     median = statistics.median(times)
     print(f"redraw after a θi step: median {median:.1f} ms, max {max(times):.1f} ms "
           f"over {len(times)} steps (budget {BUDGET_MS:.0f} ms)")
     assert median <= BUDGET_MS, f"median redraw {median:.1f} ms > {BUDGET_MS} ms"
     print(f"screenshot: {screenshot}")
     print("1 passed, 0 failed")
+
+
+def check_spec_and_shared_url(driver, wait):
+    """An analytic spec's slider re-evaluates it; the URL restores the whole view."""
+    polar = lambda d: d.find_element(By.ID, "polar").get_attribute("innerHTML")
+    lines = len(driver.find_elements(By.CSS_SELECTOR, "#polar polyline"))
+    driver.find_element(By.ID, "spec-on").click()
+    wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#polar polyline")) > lines)
+    before = polar(driver)
+    slider = driver.find_element(By.CSS_SELECTOR, "#params input[type=range]")
+    for _ in range(20):
+        slider.send_keys(Keys.ARROW_RIGHT)
+    wait.until(lambda d: polar(d) != before)
+    url = driver.current_url
+    assert "on=1" in url and "spec=" in url, url
+    driver.get("about:blank")
+    driver.get(url)
+    wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#materials li.selected")) == 2)
+    assert driver.find_element(By.ID, "theta-i").get_attribute("value") == "42"
+    assert driver.find_element(By.ID, "spec-on").is_selected()
+    assert driver.find_element(By.ID, "vs-source").is_selected()
+    wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#polar polyline")) == lines + 1)
 
 
 if __name__ == "__main__":
