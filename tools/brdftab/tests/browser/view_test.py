@@ -8,7 +8,7 @@ measures from the slider's input event to the redrawn plots), and that the conso
 errors. Saves a screenshot (docs/view.png by default).
 
     python3 tools/brdftab/tests/browser/view_test.py [--brdftab target/release/brdftab]
-        [--screenshot docs/view.png]
+        [--screenshot docs/view.png] [--preset medium]
 
 Needs Debian's `chromium` and `chromium-driver` and the `selenium` package.
 """
@@ -64,11 +64,12 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--brdftab", default=os.path.join(ROOT, "target", "release", "brdftab"))
     ap.add_argument("--screenshot", default=os.path.join(ROOT, "docs", "view.png"))
+    ap.add_argument("--preset", default="medium", help="grid preset of the baked tables")
     a = ap.parse_args()
     with tempfile.TemporaryDirectory(prefix="brdftab-view-test-") as tmp:
         db = os.path.join(tmp, "lib.btdb")
         for name, spec in [("gold", GOLD), ("plastic", PLASTIC)]:
-            run([a.brdftab, "db", "add", db, spec, "--name", name, "--preset", "small"])
+            run([a.brdftab, "db", "add", db, spec, "--name", name, "--preset", a.preset])
         server, url = start_server(a.brdftab, db)
         driver = None
         try:
