@@ -16,13 +16,24 @@ pub struct ViewArgs {
     /// The port (0: any free port; the URL printed says which).
     #[arg(long, default_value_t = 8127)]
     port: u16,
-    /// The address to bind. Anything but loopback exposes the materials to the network.
+    /// The address to bind (not 0.0.0.0: requests must name it as their Host). Anything but
+    /// loopback exposes the materials to the network.
     #[arg(long, default_value_t = IpAddr::V4(Ipv4Addr::LOCALHOST))]
     bind: IpAddr,
 }
 
 /// Opens the materials, binds, prints the URL on stdout and serves until killed.
 pub fn run(a: ViewArgs) -> Result<()> {
+    if a.bind.is_unspecified() {
+        // The Host check answers only to the bound address: name the one clients will use.
+        return Err(Error::arg(
+            "--bind",
+            format!(
+                "{} is not an address clients can name; give this machine's address",
+                a.bind
+            ),
+        ));
+    }
     if !a.bind.is_loopback() {
         eprintln!(
             "warning: --bind {} serves the materials beyond this machine",

@@ -344,3 +344,18 @@ fn a_slider_step_is_answered_within_the_redraw_budget() {
     };
     assert!(median < budget, "median {median:.1} ms");
 }
+
+#[test]
+fn it_binds_loopback_by_default_and_refuses_an_unnameable_bind_address() {
+    let d = TempDir::new("view-bind");
+    let db = database(&d);
+    // `start` reads the URL: the default bind is 127.0.0.1.
+    let v = start(&[&db]);
+    assert_eq!(get_json(&v, "/api/materials").as_array().unwrap().len(), 2);
+    let r = brdftab(&["view", &db, "--bind", "0.0.0.0", "--port", "0"]);
+    assert!(
+        !r.ok && r.stderr.starts_with("error: ") && r.stderr.contains("--bind"),
+        "{}",
+        r.stderr
+    );
+}

@@ -25,6 +25,7 @@ function readHash() {
   state.src = h.get("src") === "1";
   if (h.has("spec")) state.spec = h.get("spec");
   state.on = h.get("on") === "1" && state.spec !== "";
+  if (state.on) state.sel = state.sel.slice(0, 3);
 }
 
 function writeHash() {
@@ -223,7 +224,11 @@ function bind() {
   $("vs-source").checked = state.src;
   $("vs-source").addEventListener("change", () => { state.src = $("vs-source").checked; redrawAll(); });
   $("spec-on").checked = state.on;
-  $("spec-on").addEventListener("change", () => { state.on = $("spec-on").checked && state.spec !== ""; redrawAll(); });
+  $("spec-on").addEventListener("change", () => {
+    state.on = $("spec-on").checked && state.spec !== "";
+    if (state.on) state.sel = state.sel.slice(0, 3); // four curves at most
+    redrawAll();
+  });
   $("model").addEventListener("change", () => {
     const m = models.find((x) => x.name === $("model").value);
     loadSpec(m.example);
