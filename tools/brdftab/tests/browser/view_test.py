@@ -114,6 +114,7 @@ def check(driver, url, screenshot):
     assert not errors, f"console errors: {errors}"
     os.makedirs(os.path.dirname(screenshot), exist_ok=True)
     driver.save_screenshot(screenshot)
+    check_downloads(driver, wait)
     check_spec_and_shared_url(driver, wait)
     errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
     assert not errors, f"console errors: {errors}"
@@ -123,6 +124,20 @@ def check(driver, url, screenshot):
     assert median <= BUDGET_MS, f"median redraw {median:.1f} ms > {BUDGET_MS} ms"
     print(f"screenshot: {screenshot}")
     print("1 passed, 0 failed")
+
+
+def check_downloads(driver, wait):
+    """Every plot's SVG and PNG buttons produce a file (PNG through a canvas, untainted)."""
+    driver.execute_script(
+        "window.savedFiles = []; window.save = (url, file) => window.savedFiles.push([url.slice(0, 15), file]);")
+    buttons = driver.find_elements(By.CSS_SELECTOR, ".panel .dl button")
+    assert len(buttons) == 10, len(buttons)
+    for b in buttons:
+        b.click()
+    wait.until(lambda d: len(d.execute_script("return window.savedFiles;")) == len(buttons))
+    for url, name in driver.execute_script("return window.savedFiles;"):
+        want = "data:image/png" if name.endswith(".png") else "blob:"
+        assert url.startswith(want) and name.startswith("brdftab-"), (url, name)
 
 
 def check_spec_and_shared_url(driver, wait):
