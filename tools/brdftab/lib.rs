@@ -5,7 +5,8 @@
 //! - [`preview`]: the preview renderer (path tracer and lit sphere), images (EXR, PNG), false
 //!   colour, and slice images of any `Brdf`;
 //! - [`report`]: the accuracy suite, the measured-table benchmark and their plots;
-//! - [`rng`]: the tools' random numbers.
+//! - [`rng`]: the tools' random numbers;
+//! - [`view`]: the `brdftab view` server (the BRDF explorer in the browser).
 
 // `!(x > 0.0)` rejects NaN together with non-positive values, as in the core library.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -13,3 +14,6 @@
 pub mod preview;
 pub mod report;
 pub mod rng;
+// The directory holds both `view.rs` (the binary's command) and `view/` (this module).
+#[path = "view/mod.rs"]
+pub mod view;

@@ -19,6 +19,9 @@ mod slice;
 mod source;
 mod table;
 mod text;
+// `view/` beside it is the library's server module (`brdftab_tools::view`).
+#[path = "view.rs"]
+mod view;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -67,6 +70,8 @@ enum Command {
     Sample(sample::SampleArgs),
     /// Print pdf(wi | wo) for `wix wiy wiz wox woy woz` lines read from stdin.
     Pdf(sample::PdfArgs),
+    /// Explore materials in the browser: serves a local web app and prints its URL.
+    View(view::ViewArgs),
 }
 
 fn main() -> ExitCode {
@@ -92,6 +97,7 @@ fn main() -> ExitCode {
         Command::Fit(a) => fit::fit(a),
         Command::Sample(a) => sample::sample(a),
         Command::Pdf(a) => sample::pdf(a),
+        Command::View(a) => view::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

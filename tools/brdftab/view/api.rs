@@ -1,0 +1,232 @@
+//! The JSON API: one handler per view, each taking its material by index (`m=ID`, with
+//! `of=source` for a table's source) or as an inline analytic spec (`spec={...}`).
+//!
+//! Handlers validate every number against a range before use, so no request can ask for an
+//! unbounded amount of work; the slow figures of a material (error figures, plausibility,
+//! albedo) are computed once and cached.
+
+use std::sync::Arc;
+
+use brdftab::analysis::{accuracy::Weight, plausibility};
+use brdftab::spectrum::Channels;
+use serde_json::json;
+
+use super::eval;
+use super::http::Response;
+use super::registry::{Registry, Shared};
+use super::security::inline_spec;
+use crate::report::suite::{self, MetricOptions};
+
+/// A request's decoded query parameters.
+pub struct Query(pub super::security::Params);
+
+impl Query {
+    /// The value of parameter `k`, if given.
+    pub fn get(&self, k: &str) -> Option<&str> {
+        self.0.iter().find(|(n, _)| n == k).map(|(_, v)| v.as_str())
+    }
+
+    /// Number `k` in [lo, hi] (`default` when absent).
+    fn num(&self, k: &str, default: f64, lo: f64, hi: f64) -> Result<f64, Response> {
+        let Some(v) = self.get(k) else {
+            return Ok(default);
+        };
+        match v.parse::<f64>() {
+            Ok(x) if (lo..=hi).contains(&x) => Ok(x),
+            _ => Err(Response::error(
+                400,
+                &format!("{k}: expected a number in [{lo}, {hi}]"),
+            )),
+        }
+    }
+
+    /// Count `k` in [lo, hi] (`default` when absent).
+    fn count(&self, k: &str, default: usize, lo: usize, hi: usize) -> Result<usize, Response> {
+        Ok(self.num(k, default as f64, lo as f64, hi as f64)?.round() as usize)
+    }
+}
+
+/// What a view request evaluates: the BRDF, and the cache key of a registered material (`None`
+/// for an inline spec, which is never cached).
+struct Target {
+    brdf: Shared,
+    key: Option<String>,
+}
+
+/// The BRDF a request names: `spec=` (inline specs only), else `m=ID` with optional `of=source`.
+fn target(reg: &Registry, q: &Query) -> Result<Target, Response> {
+    if let Some(s) = q.get("spec") {
+        let spec = inline_spec(s).map_err(|e| Response::error(400, &e))?;
+        let brdf = spec
+            .build(&Channels::Rgb)
+            .map_err(|e| Response::error(400, &e.to_string()))?;
+        return Ok(Target {
+            brdf: Arc::from(brdf),
+            key: None,
+        });
+    }
+    let id: usize = q
+        .get("m")
+        .ok_or_else(|| Response::error(400, "m=ID or spec=JSON is required"))?
+        .parse()
+        .map_err(|_| Response::error(400, "m: expected a material index"))?;
+    let m = reg
+        .get(id)
+        .ok_or_else(|| Response::error(404, "no such material"))?;
+    match q.get("of") {
+        None | Some("table") => Ok(Target {
+            brdf: m.brdf.clone(),
+            key: Some(id.to_string()),
+        }),
+        Some("source") => match &m.source {
+            Some(s) => Ok(Target {
+                brdf: s.clone(),
+                key: Some(format!("{id}:source")),
+            }),
+            None => Err(Response::error(
+                404,
+                "this material has no source that opens",
+            )),
+        },
+        Some(_) => Err(Response::error(400, "of: expected table or source")),
+    }
+}
+
+/// `/api/materials`: every material's description.
+pub fn materials(reg: &Registry) -> Response {
+    let list: Vec<&serde_json::Value> = reg.materials.iter().map(|m| &m.info).collect();
+    Response::json(json!(list).to_string())
+}
+
+/// `/api/models`: the model catalogue (parameters, bounds, defaults) the spec sliders use.
+pub fn models() -> Response {
+    Response::json(serde_json::to_string(brdftab::spec::MODELS).unwrap_or_default())
+}
+
+/// `/api/polar?theta_i=DEG&n=N`.
+pub fn polar(reg: &Registry, q: &Query) -> Result<Response, Response> {
+    let t = target(reg, q)?;
+    let ti = q.num("theta_i", 30.0, 0.0, 89.9)?;
+    let n = q.count("n", 181, 2, 2001)?;
+    Ok(Response::json(
+        eval::polar(t.brdf.as_ref(), ti, n).to_string(),
+    ))
+}
+
+/// `/api/lobe?theta_i=DEG&nt=N&np=N`.
+pub fn lobe(reg: &Registry, q: &Query) -> Result<Response, Response> {
+    let t = target(reg, q)?;
+    let ti = q.num("theta_i", 30.0, 0.0, 89.9)?;
+    let nt = q.count("nt", 24, 2, 96)?;
+    let np = q.count("np", 48, 3, 192)?;
+    Ok(Response::json(
+        eval::lobe(t.brdf.as_ref(), ti, nt, np).to_string(),
+    ))
+}
+
+/// `/api/slice?n=N`.
+pub fn slice(reg: &Registry, q: &Query) -> Result<Response, Response> {
+    let t = target(reg, q)?;
+    let n = q.count("n", 64, 2, 256)?;
+    Ok(Response::json(eval::slice(t.brdf.as_ref(), n).to_string()))
+}
+
+/// `/api/sphere?lt=DEG&lp=DEG&size=N&exposure=X`.
+pub fn sphere(reg: &Registry, q: &Query) -> Result<Response, Response> {
+    let t = target(reg, q)?;
+    let lt = q.num("lt", 40.0, 0.0, 90.0)?;
+    let lp = q.num("lp", 135.0, -360.0, 360.0)?;
+    let size = q.count("size", 128, 8, 256)?;
+    let exposure = q.num("exposure", 1.0, 1e-3, 1e3)?;
+    let v = eval::sphere(t.brdf.as_ref(), lt, lp, size, exposure);
+    Ok(Response::json(v.to_string()))
+}
+
+/// The value of `f` on the target, cached under `what` for registered materials.
+fn cached_view(
+    reg: &Registry,
+    q: &Query,
+    what: &str,
+    f: fn(&dyn brdftab::Brdf) -> String,
+) -> Result<Response, Response> {
+    let t = target(reg, q)?;
+    let body = match t.key {
+        Some(k) => reg
+            .cached(format!("{what}:{k}"), || f(t.brdf.as_ref()))
+            .to_string(),
+        None => f(t.brdf.as_ref()),
+    };
+    Ok(Response::json(body))
+}
+
+/// `/api/albedo`: the albedo curve.
+pub fn albedo(reg: &Registry, q: &Query) -> Result<Response, Response> {
+    cached_view(reg, q, "albedo", |b| eval::albedo(b).to_string())
+}
+
+/// `/api/plausibility`: positivity, reciprocity and energy conservation (the demo's quick
+/// settings: 4000 pairs, albedo at 0°, 30°, 60°, 85°).
+pub fn plausibility(reg: &Registry, q: &Query) -> Result<Response, Response> {
+    cached_view(reg, q, "plausibility", |b| {
+        let opts = plausibility::Options {
+            pairs: 4000,
+            thetas_deg: vec![0.0, 30.0, 60.0, 85.0],
+            albedo: Some(suite::ALBEDO_OPTIONS),
+            ..Default::default()
+        };
+        let r = plausibility::check(b, &opts);
+        let mut v = serde_json::to_value(&r).unwrap_or_default();
+        v["plausible"] = json!(r.plausible());
+        v.to_string()
+    })
+}
+
+/// `/api/compare?m=ID`: a table against its source, as the demo measures it (cos-weighted
+/// relative RMSE over 20 000 random pairs, and the largest relative albedo error).
+pub fn compare(reg: &Registry, q: &Query) -> Result<Response, Response> {
+    let id: usize = q
+        .get("m")
+        .and_then(|m| m.parse().ok())
+        .ok_or_else(|| Response::error(400, "m: expected a material index"))?;
+    let m = reg
+        .get(id)
+        .ok_or_else(|| Response::error(404, "no such material"))?;
+    let Some(source) = m.source.clone() else {
+        return Err(Response::error(
+            404,
+            "this material has no source that opens",
+        ));
+    };
+    let (table, measured) = (m.brdf.clone(), m.measured_source);
+    let body = reg.cached(format!("compare:{id}"), move || {
+        let thetas: &[f64] = if measured {
+            &[2.0, 30.0, 60.0, 80.0]
+        } else {
+            &[0.0, 30.0, 60.0, 80.0]
+        };
+        let opts = MetricOptions {
+            pairs: 20_000,
+            seed: 1,
+            albedo_thetas: thetas.iter().map(|t| t.to_radians()).collect(),
+            cap: measured.then(|| 80f64.to_radians()),
+            weight: if measured {
+                Weight::CosInCosOut
+            } else {
+                Weight::CosIn
+            },
+        };
+        let src_albedo = suite::albedos(source.as_ref(), &opts.albedo_thetas);
+        match suite::metrics(table.as_ref(), source.as_ref(), &src_albedo, &opts) {
+            Ok(r) => json!({
+                "rel_rmse": r.rel_rmse,
+                "max_rel": r.max_rel,
+                "albedo_err": r.albedo_err,
+                "pairs": opts.pairs,
+                "weight": if measured { "cos θi cos θo, within 80°" } else { "cos θi" },
+            })
+            .to_string(),
+            Err(e) => json!({ "error": e.to_string() }).to_string(),
+        }
+    });
+    Ok(Response::json(body.to_string()))
+}

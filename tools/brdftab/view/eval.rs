@@ -1,0 +1,170 @@
+//! The numbers behind each view, computed from any `&dyn Brdf` in one batched evaluation each.
+//!
+//! Angles arrive in degrees (the page's units) and are turned into directions here; every
+//! result is plain arrays the page draws. A view's luminance `y` (Rec. 709 weights for RGB, the
+//! mean of a spectrum) is what one curve or one surface shows; the per-channel values ride along
+//! where the page can use them.
+
+use brdftab::Brdf;
+use brdftab::geometry::{self, HalfDiff};
+use brdftab::spectrum::Channels;
+use glam::DVec3;
+
+use crate::preview::image::to_srgb8;
+use serde_json::{Value, json};
+
+/// f_r of every pair (`wi[k]`, `wo[k]`), channel-interleaved; non-finite values become 0.
+fn eval_pairs(brdf: &dyn Brdf, wi: &[DVec3], wo: &[DVec3]) -> Vec<f32> {
+    let mut out = vec![0.0f32; wi.len() * brdf.channels().len()];
+    brdf.eval_batch(wi, wo, &mut out);
+    for x in &mut out {
+        if !x.is_finite() {
+            *x = 0.0;
+        }
+    }
+    out
+}
+
+/// The luminance of one pixel's channels.
+fn luminance(channels: &Channels, f: &[f32]) -> f32 {
+    match (channels, f) {
+        (Channels::Rgb, [r, g, b]) => 0.2126 * r + 0.7152 * g + 0.0722 * b,
+        _ => f.iter().sum::<f32>() / f.len().max(1) as f32,
+    }
+}
+
+/// The luminance of each pair of an interleaved result.
+fn luminances(brdf: &dyn Brdf, f: &[f32]) -> Vec<f32> {
+    let c = brdf.channels().len().max(1);
+    f.chunks(c).map(|p| luminance(brdf.channels(), p)).collect()
+}
+
+/// The in-plane polar curve: light at θi on the −x side, the viewer swept over θo ∈ [−90°, 90°]
+/// in the plane of incidence (positive θo towards the mirror direction), `n` points.
+pub fn polar(brdf: &dyn Brdf, theta_i_deg: f64, n: usize) -> Value {
+    let wi = geometry::spherical(theta_i_deg.to_radians(), std::f64::consts::PI);
+    let thetas: Vec<f64> = (0..n)
+        .map(|k| -90.0 + 180.0 * k as f64 / (n - 1).max(1) as f64)
+        .collect();
+    let wo: Vec<DVec3> = thetas
+        .iter()
+        .map(|t| {
+            let phi = if *t < 0.0 { std::f64::consts::PI } else { 0.0 };
+            geometry::spherical(t.abs().to_radians(), phi)
+        })
+        .collect();
+    let f = eval_pairs(brdf, &vec![wi; n], &wo);
+    let c = brdf.channels().len().max(1);
+    let per_channel: Vec<Vec<f32>> = (0..c)
+        .map(|ch| f.iter().skip(ch).step_by(c).copied().collect())
+        .collect();
+    json!({ "theta_o": thetas, "y": luminances(brdf, &f), "f": per_channel })
+}
+
+/// The lobe for light at (θi, φ = 180°): the luminance of f_r over the outgoing hemisphere on an
+/// `nt` × `np` grid of (θo ∈ [0°, 90°], φo ∈ [0°, 360°]), row by row.
+pub fn lobe(brdf: &dyn Brdf, theta_i_deg: f64, nt: usize, np: usize) -> Value {
+    let wi = geometry::spherical(theta_i_deg.to_radians(), std::f64::consts::PI);
+    let mut wo = Vec::with_capacity(nt * np);
+    for i in 0..nt {
+        let t = (90.0 * i as f64 / (nt - 1).max(1) as f64)
+            .min(89.5)
+            .to_radians();
+        for j in 0..np {
+            wo.push(geometry::spherical(
+                t,
+                std::f64::consts::TAU * j as f64 / np as f64,
+            ));
+        }
+    }
+    let f = eval_pairs(brdf, &vec![wi; wo.len()], &wo);
+    json!({ "nt": nt, "np": np, "y": luminances(brdf, &f) })
+}
+
+/// The MERL-style θh × θd slice at φd = 90°: `n` × `n` luminances, θh along rows' columns
+/// (`y[d * n + h]`), both angles over [0°, 90°].
+pub fn slice(brdf: &dyn Brdf, n: usize) -> Value {
+    let step = std::f64::consts::FRAC_PI_2 / (n - 1).max(1) as f64;
+    let mut wi = Vec::with_capacity(n * n);
+    let mut wo = Vec::with_capacity(n * n);
+    for d in 0..n {
+        for h in 0..n {
+            let (i, o) = geometry::from_half_diff(HalfDiff {
+                theta_h: h as f64 * step,
+                phi_h: 0.0,
+                theta_d: d as f64 * step,
+                phi_d: std::f64::consts::FRAC_PI_2,
+            });
+            wi.push(i);
+            wo.push(o);
+        }
+    }
+    let f = eval_pairs(brdf, &wi, &wo);
+    json!({ "n": n, "y": luminances(brdf, &f) })
+}
+
+/// A sphere seen from +z (orthographic) under a distant light from (θ, φ) measured from the view
+/// axis: radiance f_r · cos θi · π (a white Lambertian surface shows its albedo), times
+/// `exposure`, as `size` × `size` sRGB bytes (RGB, row by row; black off the sphere).
+pub fn sphere(
+    brdf: &dyn Brdf,
+    light_theta_deg: f64,
+    light_phi_deg: f64,
+    size: usize,
+    exposure: f64,
+) -> Value {
+    let light = geometry::spherical(light_theta_deg.to_radians(), light_phi_deg.to_radians());
+    let view = DVec3::Z;
+    let (mut wi, mut wo, mut pixels) = (Vec::new(), Vec::new(), Vec::new());
+    for py in 0..size {
+        for px in 0..size {
+            let x = (px as f64 + 0.5) / size as f64 * 2.0 - 1.0;
+            let y = 1.0 - (py as f64 + 0.5) / size as f64 * 2.0;
+            let r2 = x * x + y * y;
+            if r2 >= 1.0 {
+                continue;
+            }
+            let n = DVec3::new(x, y, (1.0 - r2).sqrt());
+            // The tangent follows the sphere's latitude (local x), so anisotropy shows as on a
+            // turned object.
+            let t = DVec3::Y.cross(n).try_normalize().unwrap_or(DVec3::X);
+            let b = n.cross(t);
+            let local = |d: DVec3| DVec3::new(d.dot(t), d.dot(b), d.dot(n));
+            wi.push(local(light));
+            wo.push(local(view));
+            pixels.push(py * size + px);
+        }
+    }
+    let f = eval_pairs(brdf, &wi, &wo);
+    let c = brdf.channels().len().max(1);
+    let mut rgb = vec![0u8; size * size * 3];
+    for (k, &p) in pixels.iter().enumerate() {
+        let cos = wi[k].z.max(0.0) * std::f64::consts::PI * exposure;
+        let v = &f[k * c..(k + 1) * c];
+        let px: [f32; 3] = match (brdf.channels(), v) {
+            (Channels::Rgb, [r, g, b]) => [*r, *g, *b],
+            _ => [luminance(brdf.channels(), v); 3],
+        };
+        for (ch, x) in px.iter().enumerate() {
+            rgb[p * 3 + ch] = to_srgb8((*x as f64 * cos) as f32, 1.0);
+        }
+    }
+    json!({ "size": size, "rgb": rgb })
+}
+
+/// The directional albedo at θ′ = 0°, 5°, ..., 85°, 89° (azimuth 0) per channel and its
+/// luminance, with the quadrature of the accuracy suite.
+pub fn albedo(brdf: &dyn Brdf) -> Value {
+    let mut deg: Vec<f64> = (0..18).map(|k| 5.0 * k as f64).collect();
+    deg.push(89.0);
+    let rad: Vec<f64> = deg.iter().map(|d| d.to_radians()).collect();
+    let a = crate::report::suite::albedos(brdf, &rad);
+    let y: Vec<f64> = a
+        .iter()
+        .map(|row| {
+            let f: Vec<f32> = row.iter().map(|&x| x as f32).collect();
+            luminance(brdf.channels(), &f) as f64
+        })
+        .collect();
+    json!({ "theta": deg, "y": y, "a": a })
+}

@@ -1,0 +1,179 @@
+//! The materials a viewer answers for, fixed when it starts.
+//!
+//! Each SOURCE of the command line becomes one material, and a database becomes one material
+//! per table. Every material is opened here, once (tables decoded eagerly, so a slider never
+//! waits on a chunk and a corrupt table fails the start), and gets an index: the page names
+//! materials by that index only, never by path. A table whose provenance names a source that
+//! opens — a model spec, or a measured file of that name beside the database — is paired with
+//! it, so the page can show the difference and the error figures.
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+
+use brdftab::source::{OpenOptions, SourceKind, classify};
+use brdftab::store::{db, info, tables};
+use brdftab::{Brdf, Error, Result};
+use serde_json::{Value, json};
+
+/// An opened BRDF shared between the server's threads.
+pub type Shared = Arc<dyn Brdf + Send + Sync>;
+
+/// One material: what the list shows of it, its BRDF, and its source if it has one that opens.
+pub struct Material {
+    /// What `/api/materials` says of it (name, kind, channels, grid, bytes, ratio, codec, ...).
+    pub info: Value,
+    /// The material itself.
+    pub brdf: Shared,
+    /// The source a table was baked from, when its provenance names one that opens.
+    pub source: Option<Shared>,
+    /// True for measured data (compared within 80° of the normal, as the demo does).
+    pub measured_source: bool,
+}
+
+/// Every material, by index, and a cache of the slow figures (error figures, plausibility).
+pub struct Registry {
+    /// The materials in command-line order (a database's tables in file order).
+    pub materials: Vec<Material>,
+    cache: Mutex<HashMap<String, Arc<String>>>,
+}
+
+impl Registry {
+    /// Opens every SOURCE (a database lists its tables); fails on the first that does not open.
+    pub fn open(sources: &[String]) -> Result<Registry> {
+        let mut materials = Vec::new();
+        for s in sources {
+            for (name, source, summary) in entries(s)? {
+                materials.push(material(&name, &source, summary)?);
+            }
+        }
+        if materials.is_empty() {
+            return Err(Error::arg("SOURCE", "no materials to show"));
+        }
+        for (i, m) in materials.iter_mut().enumerate() {
+            m.info["id"] = json!(i);
+        }
+        Ok(Registry {
+            materials,
+            cache: Mutex::new(HashMap::new()),
+        })
+    }
+
+    /// The material of index `id`, if there is one.
+    pub fn get(&self, id: usize) -> Option<&Material> {
+        self.materials.get(id)
+    }
+
+    /// The value cached under `key`, computing it with `f` the first time.
+    pub fn cached(&self, key: String, f: impl FnOnce() -> String) -> Arc<String> {
+        if let Some(v) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
+            return v;
+        }
+        let v = Arc::new(f());
+        if let Ok(mut c) = self.cache.lock() {
+            c.insert(key, v.clone());
+        }
+        v
+    }
+}
+
+/// The (name, SOURCE, store summary) of every material SOURCE `s` holds.
+fn entries(s: &str) -> Result<Vec<(String, String, Option<Value>)>> {
+    let (path, name) = db::split_source(s);
+    if classify(s) != SourceKind::Table || !tables::is_store_file(path) {
+        return Ok(vec![(display_name(s), s.to_owned(), None)]);
+    }
+    let rows = match name {
+        Some(n) => vec![info::table_info(path, n)?],
+        None => info::list(path)?,
+    };
+    Ok(rows
+        .into_iter()
+        .map(|r| {
+            let n = r["name"].as_str().unwrap_or_default().to_owned();
+            (n.clone(), format!("{path}#{n}"), Some(r))
+        })
+        .collect())
+}
+
+/// A short name for a SOURCE that is not a database entry: the model of a spec, else the file
+/// name.
+fn display_name(s: &str) -> String {
+    if s.trim_start().starts_with('{') {
+        return brdftab::source::spec(s)
+            .map(|m| m.name().to_owned())
+            .unwrap_or_else(|_| "spec".to_owned());
+    }
+    Path::new(s)
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_else(|| s.to_owned())
+}
+
+/// Opens one material and describes it.
+fn material(name: &str, source: &str, summary: Option<Value>) -> Result<Material> {
+    let kind = classify(source);
+    let brdf: Shared = Arc::from(brdftab::open_with(source, &OpenOptions::new().eager(true))?);
+    let mut info = json!({
+        "name": name,
+        "kind": kind.name(),
+        "channels": brdf.channels().names(),
+        "description": brdf.describe(),
+    });
+    if kind == SourceKind::Spec {
+        info["spec"] =
+            serde_json::from_str(&brdftab::source::spec(source)?.to_json()).unwrap_or(Value::Null);
+    }
+    let (mut paired, mut measured_source) = (None, false);
+    if let Some(s) = &summary {
+        let shape: Vec<String> = s["shape"]
+            .as_array()
+            .map(|a| a.iter().map(|x| x.to_string()).collect())
+            .unwrap_or_default();
+        info["grid"] = json!(format!(
+            "{} {} {}",
+            s["parameterization"].as_str().unwrap_or(""),
+            shape.join("×"),
+            s["symmetry"].as_str().unwrap_or("")
+        ));
+        info["bytes"] = s["bytes"].clone();
+        info["ratio"] = s["ratio_to_f32"].clone();
+        info["codec"] = s["codec"].clone();
+        info["provenance"] = s["source"].clone();
+        let dir = Path::new(db::split_source(source).0).parent();
+        (paired, measured_source) = provenance_source(&s["source"], dir);
+    }
+    info["has_source"] = json!(paired.is_some());
+    Ok(Material {
+        info,
+        brdf,
+        source: paired,
+        measured_source,
+    })
+}
+
+/// The source a table's provenance names, if it opens: a model spec, or a measured file of the
+/// recorded name in the table's directory (the provenance keeps the file name only). Whether it
+/// is measured rides along.
+fn provenance_source(p: &Value, dir: Option<&Path>) -> (Option<Shared>, bool) {
+    match p["kind"].as_str() {
+        Some("model") => {
+            let spec = p["spec"].to_string();
+            let opened = brdftab::open(&spec).ok().map(Arc::from);
+            (opened, false)
+        }
+        Some("measured") => {
+            let Some(file) = p["file"].as_str().filter(|f| !f.contains(['/', '\\'])) else {
+                return (None, false);
+            };
+            let path = dir.unwrap_or(Path::new(".")).join(file);
+            let opened = path
+                .to_str()
+                .filter(|p| classify(p).is_measured() && Path::new(p).is_file())
+                .and_then(|p| brdftab::open(p).ok())
+                .map(Arc::from);
+            (opened, true)
+        }
+        _ => (None, false),
+    }
+}
