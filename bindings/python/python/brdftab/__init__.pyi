@@ -47,6 +47,17 @@ class Brdf:
     def table(self, **options: Any) -> Table:
         """The decoded table (other sources are baked with the keywords of `bake`); unpacks as
         `values, grid = b.table()`."""
+    def sampling_nodes(
+        self,
+        adjoint: bool = False,
+        theta_h: int = 64,
+        phi_h: int = 64,
+        theta_o: int = 32,
+        phi_o: int = 16,
+    ) -> dict[str, Any]:
+        """The node densities of the library's importance sampler: {"version", "nx", "ny",
+        "nt", "np", "isotropic", "data": float32 (nt·np, ny, nx)}; adjoint=True conditions on
+        wi (Mitsuba's convention)."""
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
 
 class Table:
