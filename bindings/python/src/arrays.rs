@@ -130,7 +130,7 @@ impl<'py, T: Row> Rows<'py, T> {
             .as_slice()
             .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
         let len = flat.len() / w;
-        let aligned = (flat.as_ptr() as usize) % std::mem::align_of::<T>() == 0;
+        let aligned = (flat.as_ptr() as usize).is_multiple_of(std::mem::align_of::<T>());
         let (owned, ptr) = if aligned {
             (Vec::new(), flat.as_ptr() as *const T)
         } else {
@@ -267,7 +267,9 @@ pub(crate) fn zeros<'py, T: Element>(
 /// A fresh `(n, 3)` float64 output array's numbers as `[DVec3]` (numpy's allocations are
 /// aligned; a misaligned one is an error, not undefined behaviour).
 pub(crate) fn as_rows_mut(flat: &mut [f64]) -> PyResult<&mut [DVec3]> {
-    if (flat.as_ptr() as usize) % std::mem::align_of::<DVec3>() != 0 || flat.len() % 3 != 0 {
+    if !(flat.as_ptr() as usize).is_multiple_of(std::mem::align_of::<DVec3>())
+        || !flat.len().is_multiple_of(3)
+    {
         return Err(PyValueError::new_err("internal: misaligned output array"));
     }
     // SAFETY: aligned (checked), `len / 3` rows of three f64 = `DVec3` (`#[repr(C)]`, asserted

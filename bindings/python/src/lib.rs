@@ -75,6 +75,9 @@ fn batch<T: Send>(py: Python<'_>, n: usize, f: impl FnOnce() -> T + Send) -> PyR
     r.map_err(panic_err)
 }
 
+/// One block of `sample`'s outputs, numbered: (block, ((wi, pdf), weights)).
+type SampleBlock<'a> = (usize, ((&'a mut [DVec3], &'a mut [f64]), &'a mut [f32]));
+
 fn panic_err(m: String) -> PyErr {
     Error::new_err(format!("internal error in brdftab (please report): {m}"))
 }
@@ -454,19 +457,18 @@ impl PyBrdf {
                 ),
                 None => {
                     let cw = c.max(1);
-                    let go =
-                        |(k, ((wi, pd), w)): (usize, ((&mut [DVec3], &mut [f64]), &mut [f32]))| {
-                            let (a, b) = p.block(k * BLOCK, pd.len());
-                            brdf.sample_batch(
-                                a,
-                                b,
-                                SampleOut {
-                                    wi,
-                                    pdf: pd,
-                                    weight: w,
-                                },
-                            )
-                        };
+                    let go = |(k, ((wi, pd), w)): SampleBlock<'_>| {
+                        let (a, b) = p.block(k * BLOCK, pd.len());
+                        brdf.sample_batch(
+                            a,
+                            b,
+                            SampleOut {
+                                wi,
+                                pdf: pd,
+                                weight: w,
+                            },
+                        )
+                    };
                     if n >= brdftab::batch::PARALLEL {
                         brdftab::par::install(|| {
                             wi_s.par_chunks_mut(BLOCK)
@@ -546,7 +548,7 @@ impl PyBrdf {
             let nodes = [theta_h, phi_h, theta_o, phi_o]
                 .iter()
                 .try_fold(1usize, |a, &x| a.checked_mul(x.max(1)));
-            if !nodes.is_some_and(|n| n <= 1 << 26) {
+            if nodes.is_none_or(|n| n > 1 << 26) {
                 return Err(PyValueError::new_err(
                     "theta_h·phi_h·theta_o·phi_o: at most 2^26 nodes",
                 ));
