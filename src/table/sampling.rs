@@ -207,9 +207,26 @@ pub struct SamplingNodes {
 }
 
 impl SamplingNodes {
-    /// The node densities of `brdf` (f_r·cos θi, channel mean) at resolution `res`.
+    /// The node densities of `brdf` (f_r·cos θi, channel mean) at resolution `res`, on the
+    /// calling thread (what [`TableSampler::build`] runs, lazily, inside a `OnceLock`).
     /// `isotropic`: one conditioning node over φo.
     pub fn build(brdf: &dyn Brdf, isotropic: bool, res: &SamplingResolution) -> SamplingNodes {
+        Self::build_with(brdf, isotropic, res, false)
+    }
+
+    /// [`SamplingNodes::build`] with the conditioning nodes spread over the library's pool
+    /// ([`crate::par`]): for hosts that export the nodes (the Mitsuba plugin at scene load).
+    pub fn build_par(brdf: &dyn Brdf, isotropic: bool, res: &SamplingResolution) -> SamplingNodes {
+        Self::build_with(brdf, isotropic, res, true)
+    }
+
+    fn build_with(
+        brdf: &dyn Brdf,
+        isotropic: bool,
+        res: &SamplingResolution,
+        par: bool,
+    ) -> SamplingNodes {
+        use rayon::prelude::*;
         let nx = res.theta_h.max(2);
         let ny = res.phi_h.max(2);
         let nt = res.theta_o.max(1);
@@ -219,11 +236,10 @@ impl SamplingNodes {
         } else {
             SamplingResolution::default().floor
         };
-        let c = brdf.channels().len().clamp(1, MAX_CHANNELS);
-        let mut f = [0.0f32; MAX_CHANNELS];
         let plane = nx * ny;
         let mut data = vec![0.0f32; nt * np * plane];
-        for kt in 0..nt {
+        let fill = |(slice, d): (usize, &mut [f32])| {
+            let (kt, kp) = (slice / np, slice % np);
             let t = if nt == 1 {
                 0.5
             } else {
@@ -232,55 +248,13 @@ impl SamplingNodes {
             // The last node (t = 1) is the horizon, where f_r is 0: take it just above.
             let zo = (1.0 - t * t).max(1e-2);
             let ro = (1.0 - zo * zo).max(0.0).sqrt();
-            for kp in 0..np {
-                let (sp, cp) = (TAU * kp as f64 / np as f64).sin_cos();
-                let wo = DVec3::new(ro * cp, ro * sp, zo);
-                let d = &mut data[(kt * np + kp) * plane..(kt * np + kp + 1) * plane];
-                let (mut sum, mut valid) = (0.0f64, 0usize);
-                for (k, v) in d.iter_mut().enumerate() {
-                    let u = [
-                        (k % nx) as f64 / (nx - 1) as f64,
-                        (k / nx) as f64 / (ny - 1) as f64,
-                    ];
-                    let (h, sin_th) = half_of(u);
-                    let dot = wo.dot(h);
-                    let wi = 2.0 * dot * h - wo;
-                    if dot <= 0.0 || wi.z <= 0.0 {
-                        *v = -1.0; // marks a node whose mirror image is below the horizon
-                        continue;
-                    }
-                    valid += 1;
-                    brdf.eval(wi, wo, &mut f[..c]);
-                    let fr = f[..c].iter().map(|&x| x as f64).sum::<f64>() / c as f64;
-                    let g = fr * wi.z * 4.0 * dot * half_jacobian(u[0], sin_th);
-                    if g.is_finite() && g > 0.0 {
-                        *v = g as f32;
-                        sum += g;
-                    }
-                }
-                // A node with nothing measured is uniform on the square. Otherwise the valid
-                // nodes share `floor` × the node's mass, and every node `floor` / 10 of it
-                // (cells across the horizon).
-                let (on_valid, everywhere) = if sum > 0.0 && sum.is_finite() {
-                    (
-                        (floor * sum / valid.max(1) as f64) as f32,
-                        (0.1 * floor * sum / plane as f64) as f32,
-                    )
-                } else {
-                    (1.0, 1.0)
-                };
-                for (k, v) in d.iter_mut().enumerate() {
-                    *v = if k % nx == 0 {
-                        // The pole (s = 0), where the Jacobian vanishes: no floor, so the
-                        // density of `wi` stays finite there.
-                        0.0
-                    } else if *v < 0.0 {
-                        everywhere
-                    } else {
-                        *v + on_valid + everywhere
-                    };
-                }
-            }
+            let (sp, cp) = (TAU * kp as f64 / np as f64).sin_cos();
+            node_plane(brdf, DVec3::new(ro * cp, ro * sp, zo), nx, floor, d);
+        };
+        if par {
+            crate::par::install(|| data.par_chunks_mut(plane).enumerate().for_each(fill));
+        } else {
+            data.chunks_mut(plane).enumerate().for_each(fill);
         }
         SamplingNodes {
             nx,
@@ -290,6 +264,56 @@ impl SamplingNodes {
             isotropic,
             data,
         }
+    }
+}
+
+/// One conditioning node's densities `d` (`nx` columns) for the view `wo`, floor included.
+fn node_plane(brdf: &dyn Brdf, wo: DVec3, nx: usize, floor: f64, d: &mut [f32]) {
+    let c = brdf.channels().len().clamp(1, MAX_CHANNELS);
+    let mut f = [0.0f32; MAX_CHANNELS];
+    let (plane, ny) = (d.len(), d.len() / nx);
+    let (mut sum, mut valid) = (0.0f64, 0usize);
+    for (k, v) in d.iter_mut().enumerate() {
+        let u = [
+            (k % nx) as f64 / (nx - 1) as f64,
+            (k / nx) as f64 / (ny - 1) as f64,
+        ];
+        let (h, sin_th) = half_of(u);
+        let dot = wo.dot(h);
+        let wi = 2.0 * dot * h - wo;
+        if dot <= 0.0 || wi.z <= 0.0 {
+            *v = -1.0; // marks a node whose mirror image is below the horizon
+            continue;
+        }
+        valid += 1;
+        brdf.eval(wi, wo, &mut f[..c]);
+        let fr = f[..c].iter().map(|&x| x as f64).sum::<f64>() / c as f64;
+        let g = fr * wi.z * 4.0 * dot * half_jacobian(u[0], sin_th);
+        if g.is_finite() && g > 0.0 {
+            *v = g as f32;
+            sum += g;
+        }
+    }
+    // A node with nothing measured is uniform on the square. Otherwise the valid nodes share
+    // `floor` × the node's mass, and every node `floor` / 10 of it (cells across the horizon).
+    let (on_valid, everywhere) = if sum > 0.0 && sum.is_finite() {
+        (
+            (floor * sum / valid.max(1) as f64) as f32,
+            (0.1 * floor * sum / plane as f64) as f32,
+        )
+    } else {
+        (1.0, 1.0)
+    };
+    for (k, v) in d.iter_mut().enumerate() {
+        *v = if k % nx == 0 {
+            // The pole (s = 0), where the Jacobian vanishes: no floor, so the density of `wi`
+            // stays finite there.
+            0.0
+        } else if *v < 0.0 {
+            everywhere
+        } else {
+            *v + on_valid + everywhere
+        };
     }
 }
 
@@ -676,6 +700,10 @@ mod tests {
         let ggx = open(r#"{"model": "ggx", "alpha": 0.3}"#);
         let n = SamplingNodes::build(ggx.as_ref(), true, &res);
         assert_eq!((n.nx, n.ny, n.nt, n.np), (12, 10, 5, 1));
+        assert_eq!(
+            n.data,
+            SamplingNodes::build_par(ggx.as_ref(), true, &res).data
+        );
         assert_eq!(n.data.len(), 12 * 10 * 5);
         let a = SamplingNodes::build(&Adjoint(ggx.as_ref()), true, &res);
         for (x, y) in n.data.iter().zip(&a.data) {

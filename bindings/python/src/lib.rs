@@ -563,8 +563,8 @@ impl PyBrdf {
             let iso = self.inner.flags().isotropic;
             let brdf: &dyn Brdf = self.inner.as_ref();
             let n = unlocked(py, || match adjoint {
-                true => SamplingNodes::build(&Adjoint(brdf), iso, &res),
-                false => SamplingNodes::build(brdf, iso, &res),
+                true => SamplingNodes::build_par(&Adjoint(brdf), iso, &res),
+                false => SamplingNodes::build_par(brdf, iso, &res),
             })?;
             self.check_loaded()?;
             let shape = [n.nt * n.np, n.ny, n.nx];
