@@ -430,6 +430,35 @@ impl Kernel {
         self.exact
     }
 
+    /// The kernel's three axes (θh, θd, φd) as [`super::device`] describes them: per knot
+    /// interval the line s = c + t·d (t = v·K), the node count and the cut.
+    pub(crate) fn device_axes(&self) -> [super::device::KernelAxis; 3] {
+        let cut = self.cut.to_array();
+        std::array::from_fn(|i| {
+            let a = &self.axes[i];
+            super::device::KernelAxis {
+                c: a.lines.iter().map(|l| l[0]).collect(),
+                d: a.lines.iter().map(|l| l[1]).collect(),
+                nodes: a.n,
+                cut: cut[i],
+            }
+        })
+    }
+
+    /// θh's variable: [`WarpVar::QuarterPower`] or [`WarpVar::SqrtSine`].
+    pub(crate) fn h_var(&self) -> WarpVar {
+        if self.h_quarter_power {
+            WarpVar::QuarterPower
+        } else {
+            WarpVar::SqrtSine
+        }
+    }
+
+    /// φd is folded onto [0, π/2] (reciprocity): v_φ = |d_y|/(|d_x| + |d_y|).
+    pub(crate) fn quarter(&self) -> bool {
+        self.quarter
+    }
+
     /// Whether some axis resamples a fixed mapping (MERL-style grids), so that pairs beyond its
     /// cut take the general lookup; false on adaptive (warped) grids.
     pub fn resampled(&self) -> bool {
@@ -561,12 +590,15 @@ impl Kernel {
             1 => self.blend::<1>(v, out, values),
             _ => self.blend::<0>(v, out, values),
         }
-        if self.quantity != Quantity::Fr {
-            project_out(
+        if self.quantity != Quantity::Fr
+            && let Some((i, o)) = unit_pair(wi, wo)
+        {
+            // In f32, as the RGB lookup does (one rule for every channel count).
+            let cos = [i.z as f32, o.z as f32];
+            project_f32(
                 self.quantity,
                 self.calibration.as_ref(),
-                wi,
-                wo,
+                cos,
                 &mut out[..self.channels],
             );
         }
@@ -748,6 +780,29 @@ pub fn project_out(
             }
         }
         None => out.fill(0.0),
+    }
+}
+
+/// The kernel's projection of an interpolated `quantity` (other than f_r) at unit directions
+/// with z = `cos_i`, `cos_o`, in f32: times 1/max(factor, [`MIN_COS_PRODUCT`]), clamped at 0,
+/// then times the `calibration`'s k_in(θi) k_out(θo) — what [`Kernel::eval`] does for every
+/// channel count (the RGB path in lanes), and what `super::device` states for devices.
+pub(crate) fn project_f32(
+    quantity: Quantity,
+    calibration: Option<&Calibration>,
+    [cos_i, cos_o]: [f32; 2],
+    out: &mut [f32],
+) {
+    let f = match quantity {
+        Quantity::FrCosOut => cos_o,
+        _ => cos_i * cos_o,
+    };
+    let inv = 1.0 / f.max(MIN_COS_PRODUCT);
+    for x in out.iter_mut() {
+        *x = (*x * inv).max(0.0);
+    }
+    if let Some(c) = calibration {
+        c.apply(cos_i, cos_o, out);
     }
 }
 

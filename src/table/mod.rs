@@ -8,6 +8,7 @@
 //! - [`fill`]: any `Brdf` → values, chunk by chunk ([`bake_chunks`], for streaming
 //!   writers) or into a [`Table`];
 //! - [`lookup`]: nearest and multilinear interpolation ([`Interp`]);
+//! - [`device`]: [`device::DeviceLayout`], a table as a GPU or JIT host uploads and evaluates it;
 //! - [`tabulated`]: [`TabulatedBrdf`], the `Brdf` over a table — every chunk in memory, or loaded
 //!   on first touch through a [`ChunkLoader`];
 //! - [`presets`]: `small`, `medium`, `large` grids with measured accuracy;
@@ -19,6 +20,7 @@
 
 pub mod adaptive;
 pub mod calibration;
+pub mod device;
 pub mod fill;
 pub mod grid;
 mod horizon;

@@ -363,6 +363,16 @@ impl TabulatedBrdf {
         }
     }
 
+    /// The table as a GPU or JIT host evaluates it, for this BRDF's interpolation
+    /// ([`super::device::DeviceLayout`]; loads every chunk).
+    ///
+    /// # Errors
+    /// A chunk that does not load, or [`Error::Unsupported`] (see
+    /// [`super::device::DeviceLayout::new`]).
+    pub fn device_layout(&self) -> Result<super::device::DeviceLayout> {
+        super::device::DeviceLayout::new(&self.to_table()?, self.interp)
+    }
+
     /// The whole table in memory as stored (loads every chunk; negative values included).
     pub fn to_table(&self) -> Result<Table> {
         self.load_all()?;

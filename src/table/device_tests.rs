@@ -1,0 +1,306 @@
+//! [`DeviceLayout::eval`] against [`TabulatedBrdf`]'s lookup, for every table kind.
+
+use super::*;
+use crate::brdf::Brdf;
+use crate::rng::Pcg32;
+use crate::spec::ModelSpec;
+use crate::spectrum::Channels;
+use crate::table::adaptive::{AdaptiveOptions, adaptive_grid};
+use crate::table::grid::{Grid, Mapping};
+use crate::table::{BakeOptions, TabulatedBrdf, bake};
+
+fn sym(isotropic: bool, reciprocal: bool, bilateral: bool) -> Symmetry {
+    Symmetry {
+        isotropic,
+        reciprocal,
+        bilateral,
+    }
+}
+
+fn source(spec: &str, channels: &Channels) -> Box<dyn Brdf> {
+    ModelSpec::parse(spec).unwrap().build(channels).unwrap()
+}
+
+const GGX: &str = r#"{"model": "ggx", "alpha": 0.2}"#;
+const WARD: &str = r#"{"model": "ward", "alpha_x": 0.2, "alpha_y": 0.4, "ks": 0.5}"#;
+
+/// Random pairs (some below the horizon, some not unit), near-specular pairs and pairs
+/// rounded to f32 (what a device's directions are).
+fn pairs() -> Vec<(DVec3, DVec3)> {
+    let mut r = Pcg32::new(11);
+    let dir = |r: &mut Pcg32| {
+        let z = r.next_f64() * 1.1 - 0.05;
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        let p = std::f64::consts::TAU * r.next_f64();
+        DVec3::new(s * p.cos(), s * p.sin(), z)
+    };
+    let mut out = Vec::new();
+    for i in 0..40_000 {
+        let wi = dir(&mut r);
+        let mut wo = dir(&mut r);
+        if i % 3 == 0 {
+            let n = dir(&mut r) * 1e-3;
+            wo = DVec3::new(-wi.x, -wi.y, wi.z) + n;
+        }
+        let f32_of = |v: DVec3| v.as_vec3().as_dvec3();
+        match i % 4 {
+            0 => out.push((f32_of(wi), f32_of(wo))),
+            1 => out.push((wi * 2.5, wo)),
+            _ => out.push((wi, wo)),
+        }
+    }
+    out
+}
+
+/// Compares the device layout with the table's lookup for both interpolations; returns the
+/// largest relative difference (exact equality is expected).
+fn check(name: &str, table: Table, want_kind: DeviceKind) {
+    let c = table.grid().channels().len();
+    for interp in [Interp::Linear, Interp::Nearest] {
+        let d = DeviceLayout::new(&table, interp).unwrap();
+        assert_eq!(d.version, VERSION);
+        let kind = if interp == Interp::Nearest {
+            DeviceKind::Grid
+        } else {
+            want_kind
+        };
+        assert_eq!(d.kind, kind, "{name} {interp:?}");
+        let tb = TabulatedBrdf::from_table(table.clone()).with_interp(interp);
+        let (mut a, mut b) = (vec![0f32; c], vec![0f32; c]);
+        let mut nonzero = 0;
+        for (wi, wo) in pairs() {
+            d.eval(wi, wo, &mut a);
+            tb.eval(wi, wo, &mut b);
+            assert_eq!(a, b, "{name} {interp:?}: {wi} {wo}");
+            nonzero += (b[0] != 0.0) as usize;
+        }
+        assert!(nonzero > 10_000, "{name}: {nonzero}");
+    }
+}
+
+fn baked(spec: &str, grid: Grid) -> Table {
+    let src = source(spec, grid.channels());
+    bake(src.as_ref(), &grid, &BakeOptions::default())
+        .unwrap()
+        .0
+}
+
+fn sized(param: Param, sizes: [usize; 4], m: [Mapping; 2], s: Symmetry) -> Grid {
+    Grid::with_sizes(param, sizes, m, Channels::Rgb, s).unwrap()
+}
+
+#[test]
+fn grid_layouts_evaluate_as_the_table() {
+    use Mapping::{Cos, Sqrt, Uniform};
+    use Param::{HalfDiff, InOut};
+    let cases = [
+        (
+            "halfdiff isotropic (small preset mappings)",
+            GGX,
+            sized(
+                HalfDiff,
+                [16, 1, 16, 32],
+                [Sqrt, Cos],
+                sym(true, true, true),
+            ),
+        ),
+        ("MERL grid", GGX, Grid::merl(Channels::Rgb)),
+        (
+            "inout isotropic",
+            GGX,
+            sized(
+                InOut,
+                [16, 1, 16, 32],
+                [Uniform, Uniform],
+                sym(true, false, false),
+            ),
+        ),
+        (
+            "inout isotropic bilateral",
+            GGX,
+            sized(
+                InOut,
+                [16, 1, 16, 32],
+                [Uniform, Uniform],
+                sym(true, false, true),
+            ),
+        ),
+        (
+            "inout packed reciprocal isotropic",
+            GGX,
+            sized(
+                InOut,
+                [16, 1, 16, 32],
+                [Uniform, Uniform],
+                sym(true, true, true),
+            ),
+        ),
+        (
+            "inout packed reciprocal anisotropic",
+            WARD,
+            sized(
+                InOut,
+                [8, 16, 8, 16],
+                [Uniform, Uniform],
+                sym(false, true, true),
+            ),
+        ),
+        (
+            "inout anisotropic bilateral",
+            WARD,
+            sized(
+                InOut,
+                [16, 16, 16, 16],
+                [Uniform, Uniform],
+                sym(false, false, true),
+            ),
+        ),
+        (
+            "halfdiff anisotropic",
+            WARD,
+            sized(
+                HalfDiff,
+                [16, 16, 12, 16],
+                [Sqrt, Uniform],
+                sym(false, true, true),
+            ),
+        ),
+        (
+            "halfdiff no symmetry",
+            WARD,
+            sized(
+                HalfDiff,
+                [12, 16, 8, 16],
+                [Sqrt, Uniform],
+                sym(false, false, false),
+            ),
+        ),
+    ];
+    for (name, spec, grid) in cases {
+        check(name, baked(spec, grid), DeviceKind::Grid);
+    }
+}
+
+#[test]
+fn kernel_layouts_evaluate_as_the_table() {
+    use crate::table::warp::WarpVar;
+    let spectral = Channels::wavelengths(vec![450.0, 550.0, 650.0, 700.0]).unwrap();
+    let cases = [
+        (
+            Quantity::Fr,
+            WarpVar::SqrtSine,
+            sym(true, true, true),
+            Channels::Rgb,
+        ),
+        (
+            Quantity::FrCosOut,
+            WarpVar::QuarterPower,
+            sym(true, false, true),
+            Channels::Rgb,
+        ),
+        (
+            Quantity::FrCosCos,
+            WarpVar::SqrtSine,
+            sym(true, true, true),
+            spectral.clone(),
+        ),
+        (
+            Quantity::Fr,
+            WarpVar::QuarterPower,
+            sym(true, false, true),
+            spectral,
+        ),
+    ];
+    for (quantity, h_var, s, channels) in cases {
+        let opts = AdaptiveOptions {
+            nodes: [24, 16, 9],
+            fine: [64, 32, 16],
+            quantity,
+            h_var,
+            ..Default::default()
+        };
+        let src = source(GGX, &channels);
+        let grid = adaptive_grid(src.as_ref(), s, &opts).unwrap();
+        let t = baked(GGX, grid);
+        let name = format!(
+            "adaptive {quantity:?} {h_var:?} {} channels",
+            channels.len()
+        );
+        check(&name, t.clone(), DeviceKind::Kernel);
+        assert!(
+            DeviceLayout::new(&t, Interp::Linear)
+                .unwrap()
+                .grid
+                .is_none()
+        );
+        if quantity == Quantity::FrCosOut {
+            // Calibrated: k_in and k_out on 9 nodes.
+            let n = 9 * channels.len();
+            let f: Vec<f32> = (0..n).map(|i| 0.9 + 0.02 * (i % 11) as f32).collect();
+            let o: Vec<f32> = f.iter().rev().copied().collect();
+            let cal = Calibration::new(f, Some(o), channels.len(), 0.95).unwrap();
+            let (g, v, _) = t.into_parts();
+            let t = Table::new(g.with_calibration(cal).unwrap(), v, "calibrated").unwrap();
+            check(&format!("{name}, calibrated"), t, DeviceKind::Kernel);
+        }
+    }
+    // MERL-style fixed mappings, resampled: exact values (small) and f16 codes (MERL size),
+    // with the grid beside them for pairs beyond θh's cut.
+    for sizes in [[16, 1, 16, 32], [90, 1, 90, 180]] {
+        let g = sized(
+            Param::HalfDiff,
+            sizes,
+            [Mapping::Sqrt, Mapping::Uniform],
+            sym(true, true, true),
+        );
+        let t = baked(GGX, g);
+        assert!(
+            DeviceLayout::new(&t, Interp::Linear)
+                .unwrap()
+                .grid
+                .is_some()
+        );
+        check(&format!("resampled {sizes:?}"), t, DeviceKind::Kernel);
+    }
+}
+
+#[test]
+fn f_r_tables_read_negative_values_as_zero() {
+    let g = sized(
+        Param::InOut,
+        [4, 1, 4, 8],
+        [Mapping::Uniform, Mapping::Uniform],
+        sym(true, false, true),
+    );
+    let mut t = baked(GGX, g);
+    for (i, x) in t.values_mut().iter_mut().enumerate() {
+        if i % 5 == 0 {
+            *x = -1.0;
+        }
+    }
+    check("unmeasured cells", t, DeviceKind::Grid);
+}
+
+#[test]
+fn inconsistent_layouts_do_not_panic() {
+    let g = sized(
+        Param::HalfDiff,
+        [16, 1, 16, 32],
+        [Mapping::Sqrt, Mapping::Uniform],
+        sym(true, true, true),
+    );
+    let mut d = DeviceLayout::new(&baked(GGX, g), Interp::Linear).unwrap();
+    let mut out = [0f32; 8];
+    if let Some(k) = &mut d.kernel {
+        k.values.truncate(7);
+        k.axes[1].c.clear();
+    }
+    if let Some(g) = &mut d.grid {
+        g.values.clear();
+    }
+    for (wi, wo) in pairs().into_iter().take(2000) {
+        d.eval(wi, wo, &mut out);
+        d.eval(wi, wo, &mut out[..1]);
+        assert!(out.iter().all(|x| x.is_finite()));
+    }
+}
