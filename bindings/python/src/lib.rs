@@ -21,7 +21,8 @@ use brdftab::request::{
     self, BakeSettings, ConvertOutput, ConvertSettings, FitSettings, OpenSettings,
 };
 use brdftab::source::{self, OpenOptions, SourceKind};
-use brdftab::table::TabulatedBrdf;
+use brdftab::table::device::DeviceLayout;
+use brdftab::table::{Interp, TabulatedBrdf};
 use brdftab::{Brdf, Channels};
 use glam::{DVec2, DVec3};
 use numpy::ndarray::{ArrayD, IxDyn};
@@ -140,6 +141,31 @@ impl PyTable {
     #[getter]
     fn grid(&self, py: Python<'_>) -> Py<PyAny> {
         self.grid.clone_ref(py)
+    }
+
+    /// The table as a GPU or JIT host evaluates it, for lookups with `interp` ("linear" or
+    /// "nearest"): the library's device layout (`brdftab::table::device`), a dict with
+    /// "version" (refuse any other than the one you implement), "kind" ("kernel" or "grid"),
+    /// "channels", "channel_names", "quantity", "calibration" (None or its factors), "kernel"
+    /// and "grid" (None or dicts of the layout's fields, each with its float32 "values").
+    #[pyo3(signature = (interp = "linear"))]
+    fn device_layout(&self, py: Python<'_>, interp: &str) -> PyResult<Py<PyAny>> {
+        guard(|| {
+            let interp: Interp = interp.parse().map_err(lib_err)?;
+            let t = &self.table;
+            let d = unlocked(py, || DeviceLayout::new(t, interp))?.map_err(lib_err)?;
+            let v = serde_json::to_value(&d).map_err(|e| Error::new_err(e.to_string()))?;
+            let out = to_py(py, &v)?;
+            let dict = out.bind(py).cast::<PyDict>()?;
+            dict.set_item("channel_names", t.grid().channels().names())?;
+            if let (Some(k), Some(kd)) = (d.kernel, dict.get_item("kernel")?) {
+                kd.set_item("values", k.values.into_pyarray(py))?;
+            }
+            if let (Some(g), Some(gd)) = (d.grid, dict.get_item("grid")?) {
+                gd.set_item("values", g.values.into_pyarray(py))?;
+            }
+            Ok(out)
+        })
     }
 
     /// `values, grid = table`.

@@ -21,9 +21,10 @@ brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only.
 - Scalar variants (``scalar_rgb``, ``scalar_spectral``) call the library for every query (the
   native source: RGL files evaluate with their own adaptive parameterization).
 - JIT variants (``llvm_ad_rgb``, ``cuda_ad_rgb``) cannot call back into the host per query:
-  the plugin bakes (or loads) a table, uploads its decoded values once, and evaluates it in
-  Dr.Jit operations that mirror the Rust lookup (``src/table/{grid,symmetry,lookup}.rs``):
-  half/difference coordinates, symmetry folds, axis mappings and multilinear interpolation.
+  the plugin bakes (or loads) a table, uploads the library's *device layout* of it once
+  (``Table.device_layout``, Rust ``src/table/device.rs``: the kernel's knot lines and packed
+  values, or a dense grid with its folds and axis mappings) and evaluates that layout in Dr.Jit
+  operations (:class:`JitTable`), tested equal to the Rust lookup to 1e-5 for every table kind.
   Sampling is the library's (``src/table/sampling.rs``): wo is drawn as the mirror image of
   wi about a half vector from conditional 2D warps of f_r cos θo over the half vector, on the
   node densities the library exports (``Brdf.sampling_nodes``), conditioned on θi (and φi for
@@ -240,7 +241,10 @@ def _fast_atan2(y, x):
     num, den = dr.select(swap, ax, ay), dr.select(swap, ay, ax)
     z = dr.select(den > 0, num / dr.select(den > 0, den, 1.0), 0.0)
     big = z > 0.414213562373095
-    base = dr.select(big, math.pi / 4, 0.0)
+    # Typed: a select of two Python floats would be the variant's Float (float32), and π/4
+    # rounded to float32 is 2.2e-8 off (the 5e-4 mismatch of issue 26 at φ nodes).
+    F = type(z)
+    base = dr.select(big, F(math.pi / 4), F(0.0))
     t = dr.select(big, (z - 1.0) / (z + 1.0), z)
     t2 = t * t
     r = base + (((8.05374449538e-2 * t2 - 1.38776856032e-1) * t2 + 1.99777106478e-1) * t2
@@ -250,86 +254,87 @@ def _fast_atan2(y, x):
     return dr.select(y < 0, -r, r)
 
 
-class JitTable:
-    """A brdftab table uploaded to Dr.Jit and evaluated with Dr.Jit operations, mirroring
-    ``src/table/lookup.rs`` (linear and nearest lookups), ``symmetry.rs`` (canonical
-    coordinates) and ``grid.rs`` (stored axes: mappings, node placement, folds, periods).
+#: The version of the library's device layout (``Table.device_layout()``) this code implements.
+LAYOUT_VERSION = 1
 
-    Coordinates are computed in float64 (as the Rust code does), weights and values in float32.
+
+class JitTable:
+    """A brdftab table uploaded to Dr.Jit and evaluated with Dr.Jit operations: an
+    implementation of the library's *device layout* (``Table.device_layout(interp)``, Rust
+    ``brdftab::table::device``), whose reference evaluator ``DeviceLayout::eval`` is tested equal
+    to the library's table lookup. Two layouts:
+
+    - ``kernel`` (``KernelLayout``): warp variables in float32 from the unit vectors, per axis a
+      knot line giving the fractional node index, eight corners; for a resampled axis, pairs at
+      or beyond its cut take the ``grid`` layout beside it;
+    - ``grid`` (``GridLayout``): canonical coordinates (float64, the symmetry folds), per stored
+      axis its mapping and node placement, the nearest node or 16 corners.
+
+    Weights and values are float32, blended in the reference's order.
     """
 
-    def __init__(self, values, grid, interp="linear"):
+    def __init__(self, layout):
         import drjit as dr
         import mitsuba as mi
 
-        if grid.get("packed"):
-            raise brdftab.Error("packed inout reciprocal tables are not supported by the JIT path")
-        self.param = grid["param"]
-        self.sym = grid["symmetry"]
-        # What the values are (grid.rs, Quantity): "fr", "fr_cos_cos" or "fr_cos_out"; lookups
-        # of the last two divide by the cosines, as the Rust lookups do.
-        self.quantity = grid.get("quantity", "fr")
-        if self.quantity not in ("fr", "fr_cos_cos", "fr_cos_out"):
-            raise brdftab.Error(f"table quantity {self.quantity!r} is not supported by the JIT path")
+        version = layout.get("version")
+        if version != LAYOUT_VERSION:
+            raise brdftab.Error(
+                f"device layout version {version!r}: this plugin implements version "
+                f"{LAYOUT_VERSION} (brdftab and brdftab.mitsuba from different releases?)")
+        self.kind = layout.get("kind")
+        if self.kind not in ("kernel", "grid"):
+            raise brdftab.Error(f"device layout kind {self.kind!r} is not supported by the JIT path")
+        self.c = int(layout["channels"])
+        self.quantity = layout["quantity"]
+        self.channel_names = layout["channel_names"]
+        self.wavelengths = None
+        if self.channel_names and self.channel_names[0].endswith("nm"):
+            self.wavelengths = [float(x[:-2]) for x in self.channel_names]
+        self.Float64 = dr.float64_array_t(mi.Float)
+        self.UInt = mi.UInt32
         # The albedo calibration (table/calibration.rs): per-channel factors k_in(θi) and
-        # k_out(θo) on nodes uniform in t = sqrt(1 - cos θ), channels innermost; lookups
-        # multiply by them.
+        # k_out(θo) on nodes uniform in t = sqrt(1 - cos θ), channels innermost.
         self.calibration = None
-        cal = grid.get("calibration")
+        cal = layout.get("calibration")
         if cal is not None:
             c = int(cal["channels"])
             f_in = np.asarray(cal["factors"], np.float32)
             f_out = cal.get("out_factors")
             f_out = None if f_out is None else mi.Float(np.asarray(f_out, np.float32))
             self.calibration = (mi.Float(f_in), f_out, c, f_in.size // c, float(cal["t_end"]))
-        self.axes = [dict(ax) for ax in grid["stored_axes"]]
-        self.shape = list(grid["stored_shape"])
-        self.c = int(values.shape[-1])
-        self.interp = interp
-        self.channel_names = grid["channel_names"]
-        self.wavelengths = None
-        if self.channel_names and self.channel_names[0].endswith("nm"):
-            self.wavelengths = [float(x[:-2]) for x in self.channel_names]
-        self.values = mi.Float(np.ascontiguousarray(values, dtype=np.float32).ravel())
-        dr.eval(self.values)
-        self.Float64 = dr.float64_array_t(mi.Float)
-        self.UInt = mi.UInt32
-        for ax in self.axes:
-            # Warped axes (adaptive grids): the knots as a Dr.Jit array, for gathers.
-            if isinstance(ax["mapping"], dict) and "warp" in ax["mapping"]:
-                ax["_knots"] = self.Float64(np.asarray(ax["mapping"]["warp"]["knots"], np.float64))
-        # Adaptive grids: Rust looks them up with table/kernel.rs (float32 warp variables from
-        # the vectors); mirror it, so that both compute the same node weights.
         self.kernel = None
-        want = {0: ("sqrt_sine", "quarter_power"), 2: ("half_power",), 3: ("pseudo_angle",)}
-        if (interp == "linear" and self.param == "halfdiff" and self.sym["isotropic"]
-                and self.sym["bilateral"]
-                and all(isinstance(self.axes[k]["mapping"], dict)
-                        and self.axes[k]["mapping"].get("warp", {}).get("var") in v
-                        and self.axes[k]["nodes"] in (("edges",) if k == 3 else ("edges", "centers"))
-                        and self.axes[k]["size"] >= 2
-                        for k, v in want.items())):
-            ks = []
-            for k in (0, 2, 3):
-                knots = np.asarray(self.axes[k]["mapping"]["warp"]["knots"], np.float32)
-                n = self.axes[k]["size"]
-                # Axis::new in kernel.rs: s = u·n − ½ (centers) or u·(n − 1) (edges) in float64,
-                # and on knot interval j the line s = c + t·d (t = v·K), c and d in float32.
-                if self.axes[k]["nodes"] == "centers":
-                    s_ = knots.astype(np.float64) * float(n) + -0.5
-                else:
-                    s_ = knots.astype(np.float64) * float(n - 1) + 0.0
-                d = np.diff(s_)
-                c = s_[:-1] - np.arange(len(d), dtype=np.float64) * d
-                ks.append((mi.Float(c.astype(np.float32)), mi.Float(d.astype(np.float32)),
-                           float(len(knots) - 1), n))
-            self.kernel = ks
-            self.h_quarter_power = self.axes[0]["mapping"]["warp"]["var"] == "quarter_power"
-            # Packed::new in kernel.rs: the kernel reads f16 codes of the values scaled by 2^e.
-            self.kernel_values = mi.Float(kernel_values(values).ravel())
-            dr.eval(self.kernel_values)
+        k = layout.get("kernel")
+        if k is not None:
+            self.kernel = dict(k)
+            self.kernel["axes"] = [
+                (mi.Float(np.asarray(a["c"], np.float32)), mi.Float(np.asarray(a["d"], np.float32)),
+                 len(a["c"]), int(a["nodes"]), float(a["cut"]))
+                for a in k["axes"]]
+            self.kernel["values"] = mi.Float(np.ascontiguousarray(k["values"], np.float32))
+            dr.eval(self.kernel["values"])
+        self.grid = None
+        g = layout.get("grid")
+        if g is not None:
+            self.grid = dict(g)
+            self.param, self.sym, self.interp = g["param"], g["symmetry"], g["interp"]
+            if self.param not in ("inout", "halfdiff") or self.interp not in ("linear", "nearest"):
+                raise brdftab.Error(f"device layout grid {self.param!r}, {self.interp!r} is not "
+                                    "supported by the JIT path")
+            self.axes = [dict(ax) for ax in g["axes"]]
+            self.shape = [int(n) for n in g["shape"]]
+            self.values = mi.Float(np.ascontiguousarray(g["values"], np.float32))
+            dr.eval(self.values)
+            for ax in self.axes:
+                # Warped axes (adaptive grids): the knots as a Dr.Jit array, for gathers.
+                if isinstance(ax["mapping"], dict) and "warp" in ax["mapping"]:
+                    ax["_knots"] = self.Float64(
+                        np.asarray(ax["mapping"]["warp"]["knots"], np.float64))
+        if (self.kind == "kernel") != (self.kernel is not None) or (
+                self.kernel is None and self.grid is None):
+            raise brdftab.Error(f"device layout of kind {self.kind!r} without its arrays")
 
-    # -- symmetry.rs: canonical coordinates ----------------------------------------------
+    # -- GridLayout: canonical coordinates (symmetry.rs) -------------------------------------
     def coords(self, wi, wo):
         """Canonical [x0, x1, x2, x3] (float64) and the validity mask."""
         import drjit as dr
@@ -340,17 +345,17 @@ class JitTable:
 
         def unit(v):
             n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
-            inv = dr.rsqrt(dr.maximum(n2, 1e-300))
+            inv = 1.0 / dr.sqrt(dr.maximum(n2, 1e-300))
             return [v[0] * inv, v[1] * inv, v[2] * inv], n2 > 0
 
         wi, ok_i = unit(wi)
         wo, ok_o = unit(wo)
         valid = ok_i & ok_o & (wi[2] > 0) & (wo[2] > 0)
         iso, rec, bil = self.sym["isotropic"], self.sym["reciprocal"], self.sym["bilateral"]
-        pi, tau = math.pi, 2 * math.pi
+        tau = 2 * math.pi
 
-        # Linear lookups use the Rust code's polynomial acos/atan2 (canonical_coords_fast),
-        # nearest lookups the exact functions (canonical_coords), as lookup.rs does.
+        # Linear lookups use the polynomial acos/atan2 (canonical_coords_fast), nearest lookups
+        # the exact functions (canonical_coords).
         fast = self.interp != "nearest"
 
         def acos(x):
@@ -361,19 +366,27 @@ class JitTable:
 
         if self.param == "inout":
             ti, to = acos(wi[2]), acos(wo[2])
+            swap = ti > to
             if iso:
                 dot = wi[0] * wo[0] + wi[1] * wo[1]
                 cross = wi[0] * wo[1] - wi[1] * wo[0]
                 d = atan2(cross, dot)
+                if rec:  # θ1 ≤ θ2: (θi, θo, Δφ) → (θo, θi, −Δφ)
+                    ti, to, d = dr.select(swap, to, ti), dr.select(swap, ti, to), dr.select(swap, -d, d)
                 d = dr.abs(d) if bil else dr.select(d < 0, d + tau, d)
                 return [ti, F(0.0), to, d], valid
             a1, a3 = atan2(wi[1], wi[0]), atan2(wo[1], wo[0])
+            if rec:
+                ti, to = dr.select(swap, to, ti), dr.select(swap, ti, to)
+                a1, a3 = dr.select(swap, a3, a1), dr.select(swap, a1, a3)
             if bil:
                 neg = a1 < 0
                 a1, a3 = dr.select(neg, -a1, a1), dr.select(neg, -a3, a3)
             a1 = dr.select(a1 < 0, a1 + tau, a1)
             a3 = dr.select(a3 < 0, a3 + tau, a3)
             return [ti, a1, to, a3], valid
+        if not fast:
+            return self._half_diff_exact(wi, wo, valid)
         # halfdiff, as half_diff_angles_fast: unnormalized h = wi + wo
         h = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]
         hxy2 = h[0] * h[0] + h[1] * h[1]
@@ -387,9 +400,37 @@ class JitTable:
         x = (wi[0] * h[0] + wi[1] * h[1]) * h[2] - wi[2] * hxy2
         pole = ~(hxy2 > 1e-24 * hh)
         pd = dr.select(pole, atan2(wi[1], wi[0]), atan2(y, x))
-        ph = F(0.0)
-        if not iso:
-            ph = atan2(h[1], h[0])
+        return self._fold_half_diff(th, atan2(h[1], h[0]), td, pd), valid
+
+    def _half_diff_exact(self, wi, wo, valid):
+        """geometry::half_diff_vectors: h normalized, d = wi rotated by −φh about z, −θh
+        about y; exact acos/atan2."""
+        import drjit as dr
+
+        h = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]
+        n2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2]
+        valid &= n2 > 0
+        inv = 1.0 / dr.sqrt(dr.maximum(n2, 1e-300))
+        h = [h[0] * inv, h[1] * inv, h[2] * inv]
+        th = dr.acos(dr.clip(h[2], -1.0, 1.0))
+        ph = dr.atan2(h[1], h[0])
+        sp, cp = dr.sin(-ph), dr.cos(-ph)
+        x1, y1, z1 = cp * wi[0] - sp * wi[1], sp * wi[0] + cp * wi[1], wi[2]
+        st, ct = dr.sin(-th), dr.cos(-th)
+        dx, dy, dz = ct * x1 + st * z1, y1, -st * x1 + ct * z1
+        td = dr.acos(dr.clip(dz, -1.0, 1.0))
+        pd = dr.atan2(dy, dx)
+        return self._fold_half_diff(th, ph, td, pd), valid
+
+    def _fold_half_diff(self, th, ph, td, pd):
+        """symmetry.rs fold_half_diff."""
+        import drjit as dr
+
+        iso, rec, bil = self.sym["isotropic"], self.sym["reciprocal"], self.sym["bilateral"]
+        pi, tau = math.pi, 2 * math.pi
+        if iso:
+            ph = self.Float64(0.0)
+        else:
             if bil:
                 neg = ph < 0
                 ph, pd = dr.select(neg, -ph, ph), dr.select(neg, -pd, pd)
@@ -404,9 +445,9 @@ class JitTable:
             pd = dr.abs(pd)
         else:
             pd = dr.select(pd < 0, pd + tau, pd)
-        return [th, ph, td, pd], valid
+        return [th, ph, td, pd]
 
-    # -- grid.rs: StoredAxis ---------------------------------------------------------------
+    # -- GridLayout: stored axes (grid.rs, StoredAxis) -----------------------------------------
     @staticmethod
     def _cell_coordinate(ax, x, exact):
         import drjit as dr
@@ -428,8 +469,10 @@ class JitTable:
             u = r
         elif m == "sqrt":
             u = dr.sqrt(dr.maximum(r, 0.0))
-        else:  # cos (θ axes, lo = 0)
+        elif m == "cos":  # θ axes, lo = 0
             u = (math.cos(lo) - dr.cos(x)) / (math.cos(lo) - math.cos(hi))
+        else:
+            raise brdftab.Error(f"axis mapping {m!r} is not supported by the JIT path")
         if nodes == "centers":
             return u * n - 0.5
         if nodes == "edges":
@@ -510,47 +553,57 @@ class JitTable:
         i = dr.select(i > 0, dr.minimum(i, n - 1.0), 0.0)
         return self.UInt(i)
 
-    # -- lookup.rs ---------------------------------------------------------------------------
+    # -- DeviceLayout::eval --------------------------------------------------------------------
     def lookup(self, wi, wo, active=True):
         """f_r per channel: a list of c float32 arrays (0 where invalid)."""
         import drjit as dr
 
-        if self.kernel is not None:
-            return self._kernel_lookup(wi, wo, active)
+        if self.kernel is None:
+            return self._grid_lookup(wi, wo, active)
+        out, inside, valid = self._kernel_lookup(wi, wo, active)
+        if self.grid is not None:  # resampled axes: pairs beyond a cut take the grid
+            g = self._grid_lookup(wi, wo, active & ~inside)
+            out = [dr.select(inside, a, b) for a, b in zip(out, g)]
+            return [dr.select(valid, x, 0.0) for x in out]
+        return [dr.select(valid & inside, x, 0.0) for x in out]
+
+    def _grid_lookup(self, wi, wo, active):
+        """GridLayout::eval, then the quantity's projection in float64 (kernel.rs
+        ``project_out``)."""
+        import drjit as dr
+
         x, valid = self.coords(wi, wo)
         valid &= active
         n0, s1, n2, s3 = self.shape
         c = self.c
         Fl = type(self.values)
-        out = [Fl(0.0) for _ in range(c)]
         if self.interp == "nearest":
             idx = [self._nearest(self.axes[k], x[k]) for k in range(4)]
             base = (((idx[0] * s1 + idx[1]) * n2 + idx[2]) * s3 + idx[3]) * c
             out = [dr.gather(Fl, self.values, base + k, valid) for k in range(c)]
-            if self.quantity != "fr":
-                out = self._project(wi, wo, out)
-            return [dr.select(valid, o, 0.0) for o in out]
-        lin = [self._linear(self.axes[k], x[k]) for k in range(4)]
-        corners1 = [(lin[1][0], 1.0 - lin[1][2])]
-        if s1 > 1:
-            corners1.append((lin[1][1], lin[1][2]))
-        for a, wa in ((lin[0][0], 1.0 - lin[0][2]), (lin[0][1], lin[0][2])):
-            for p, wp in corners1:
-                for b, wb in ((lin[2][0], 1.0 - lin[2][2]), (lin[2][1], lin[2][2])):
-                    w2 = wa * wp * wb
-                    row = ((a * s1 + p) * n2 + b) * s3
-                    for q, wq in ((lin[3][0], 1.0 - lin[3][2]), (lin[3][1], lin[3][2])):
-                        wt = w2 * wq
-                        base = (row + q) * c
-                        for k in range(c):
-                            out[k] = dr.fma(wt, dr.gather(Fl, self.values, base + k, valid), out[k])
+        else:
+            lin = [self._linear(self.axes[k], x[k]) for k in range(4)]
+            out = [Fl(0.0) for _ in range(c)]
+            corners1 = [(lin[1][0], 1.0 - lin[1][2])]
+            if s1 > 1:
+                corners1.append((lin[1][1], lin[1][2]))
+            for a, wa in ((lin[0][0], 1.0 - lin[0][2]), (lin[0][1], lin[0][2])):
+                for p, wp in corners1:
+                    for b, wb in ((lin[2][0], 1.0 - lin[2][2]), (lin[2][1], lin[2][2])):
+                        w2 = wa * wp * wb
+                        row = ((a * s1 + p) * n2 + b) * s3
+                        for q, wq in ((lin[3][0], 1.0 - lin[3][2]), (lin[3][1], lin[3][2])):
+                            wt = w2 * wq
+                            base = (row + q) * c
+                            for k in range(c):
+                                out[k] = out[k] + wt * dr.gather(Fl, self.values, base + k, valid)
         if self.quantity != "fr":
             out = self._project(wi, wo, out)
         return [dr.select(valid, o, 0.0) for o in out]
 
     def _project(self, wi, wo, out):
         """f_r from an interpolated quantity (kernel.rs, ``project_out``): divided by cos θo
-        or cos θi cos θo of the unit directions (at least 1e-30), clamped at 0."""
+        or cos θi cos θo of the unit directions (at least 1e-30) in float64, clamped at 0."""
         import drjit as dr
 
         F64 = self.Float64
@@ -591,19 +644,21 @@ class JitTable:
             out = blend(f_out, oz, out)
         return out
 
-
-    # -- kernel.rs (adaptive grids) -----------------------------------------------------------
+    # -- KernelLayout --------------------------------------------------------------------------
     def _kernel_lookup(self, wi, wo, active):
-        """Kernel::eval: float32 warp variables, knot and node split per axis, eight corners."""
+        """KernelLayout::vars and ::blend, then the projection in float32 (kernel.rs
+        ``project_f32``). Returns (values, inside every cut, valid)."""
         import drjit as dr
 
-        F64, Fl, U = self.Float64, type(self.values), self.UInt
+        F64, U = self.Float64, self.UInt
+        kv = self.kernel["values"]
+        Fl = type(kv)
         wi = [F64(wi.x), F64(wi.y), F64(wi.z)]
         wo = [F64(wo.x), F64(wo.y), F64(wo.z)]
 
         def unit(v):
             n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
-            inv = dr.rsqrt(dr.maximum(n2, 1e-300))
+            inv = 1.0 / dr.sqrt(dr.maximum(n2, 1e-300))
             return [Fl(c * inv) for c in v], n2 > 0
 
         (ix, iy, iz), ok_i = unit(wi)
@@ -613,72 +668,52 @@ class JitTable:
         r2 = hx * hx + hy * hy
         hh = r2 + hz * hz
         hl = dr.sqrt(hh)
-        # sin θh = r/|h| (SqrtSine), or 1 − cos θh = r²/(|h|(|h| + hz)) (QuarterPower).
-        if self.h_quarter_power:
+        if self.kernel["h_var"] == "quarter_power":
             vh = dr.sqrt(dr.sqrt(r2 / (hh + hl * hz)))
         else:
             vh = dr.sqrt(dr.sqrt(r2 / hh))
         ex, ey, ez = ix - ox, iy - oy, iz - oz
         e2 = ex * ex + ey * ey + ez * ez
+        vd = dr.sqrt(e2 / (2.0 * (2.0 + hl)))
         dx = hz * (hx * ix + hy * iy) - r2 * iz
         dy = dr.abs(hl * (hx * iy - hy * ix))
         den = dr.abs(dx) + dy
-        vd = dr.sqrt(e2 / (2.0 * (2.0 + hl)))
         safe = dr.select(den > 0, den, 1.0)
-        if self.sym["reciprocal"]:
+        if self.kernel["quarter"]:
             vp = dr.select(den > 0, dy / safe, 0.0)
         else:
             vp = dr.select(den > 0, 0.5 - 0.5 * (dx / safe), 0.0)
+        inside = dr.full(dr.mask_t(Fl), True, dr.width(vh))
         nodes = []
-        for (c_, d_, k, n), v in zip(self.kernel, (vh, vd, vp)):
-            t = v * k
-            ju = U(dr.trunc(dr.minimum(t, k - 0.5)))
+        for (c_, d_, k, n, cut), v in zip(self.kernel["axes"], (vh, vd, vp)):
+            inside &= v < cut
+            t = v * float(k)
+            ju = dr.minimum(U(dr.trunc(dr.minimum(t, k - 0.5))), k - 1)
             sv = dr.gather(Fl, c_, ju) + t * dr.gather(Fl, d_, ju)
             sv = dr.minimum(dr.maximum(sv, 0.0), n - 1.0)
-            i = dr.trunc(dr.minimum(sv, n - 1.5))
+            i = dr.minimum(dr.trunc(dr.minimum(sv, n - 1.5)), float(n - 2))
             nodes.append((U(i), sv - i))
         (ih, th), (id_, td), (ip, tp) = nodes
         c = self.c
-        row = self.shape[3] * c
-        chunk = self.shape[2] * row
+        row = self.kernel["axes"][2][3] * c
+        chunk = self.kernel["axes"][1][3] * row
         o = ih * chunk + id_ * row + ip * c
         oh, od, op = 1.0 - th, 1.0 - td, 1.0 - tp
         rows = [(o, oh * od), (o + row, oh * td), (o + chunk, th * od), (o + chunk + row, th * td)]
         out = [Fl(0.0) for _ in range(c)]
+        ok = valid & inside
         for r, w in rows:
             w0, w1 = w * op, w * tp
             for ch in range(c):
-                x0 = dr.gather(Fl, self.kernel_values, r + ch, valid)
-                x1 = dr.gather(Fl, self.kernel_values, r + c + ch, valid)
+                x0 = dr.gather(Fl, kv, r + ch, ok)
+                x1 = dr.gather(Fl, kv, r + c + ch, ok)
                 out[ch] = out[ch] + (w0 * x0 + w1 * x1)
         if self.quantity != "fr":
-            # The RGB kernel: times 1/(cos θo) or 1/(cos θi cos θo) in float32 (at least
-            # 1e-30), clamped at 0.
             cc = oz if self.quantity == "fr_cos_out" else iz * oz
             inv = 1.0 / dr.maximum(cc, 1e-30)
             out = [dr.maximum(x * inv, 0.0) for x in out]
-        out = self._calibrate(iz, oz, out)
-        return [dr.select(valid, x, 0.0) for x in out]
-
-
-def kernel_values(values):
-    """The values as the Rust kernel (``Packed::new`` in ``src/table/kernel.rs``) reads them:
-    scaled by 2^e so that the largest finite magnitude lies in [2^14, 2^15), rounded to float16
-    (to nearest even), scaled magnitudes below 2^-14 (and non-finite values) set to 0, and
-    scaled back (exactly: a power of two); negative values (extrapolated nodes beyond the
-    horizon) keep their sign. Returns float32 values of the same shape."""
-    v = np.asarray(values, np.float32)
-    fin = np.abs(v[np.isfinite(v)])
-    mx = max(float(fin.max()), 0.0) if fin.size else 0.0
-    if mx >= float(np.finfo(np.float32).tiny):
-        e = int(np.clip(14 - (int(np.frexp(np.float32(mx))[1]) - 1), -120, 120))
-    else:
-        e = 120 if mx > 0 else 0
-    x = v * np.float32(2.0**e)
-    with np.errstate(invalid="ignore"):
-        keep = np.isfinite(x) & (np.abs(x) >= np.float32(2.0**-14))
-    q = np.where(keep, x, np.float32(0)).astype(np.float16).astype(np.float32)
-    return q * np.float32(2.0**-e)
+            out = self._calibrate(iz, oz, out)
+        return out, inside, valid
 
 
 class JitBrdftabBSDF(_Common):
@@ -706,8 +741,12 @@ class JitBrdftabBSDF(_Common):
                 options[key] = str(v)
         if self.spectral and brdftab_kind(self.source) in ("spec", "rgl"):
             options.setdefault("wavelengths", list(range(380, 781, 20)))
-        values, grid = self._table(options)
-        self.table = JitTable(values, grid, self.interp)
+        table = self._table(options)
+        # The table as the library describes it for devices (`Table.device_layout`): the JIT
+        # lookup implements that layout, not the grid's description.
+        interp = "nearest" if self.interp == "nearest" else "linear"
+        self.table = JitTable(table.device_layout(interp))
+        grid = table.grid
         # The library's importance sampler (conditional half-vector warps of f_r cos θo given
         # wi), on the densities it exports for the table (or the source): brdftab._halfwarp.
         iso = grid["symmetry"]["isotropic"]
@@ -722,10 +761,7 @@ class JitBrdftabBSDF(_Common):
         # Brdf, else the source.
         self._sampled = self.brdf
         if brdftab_kind(self.source) == "table" and not options:
-            values, grid = self.brdf.table()
-            if not grid.get("packed"):
-                return values, grid
-            options = {}
+            return self.brdf.table()
         # MERL files keep their own cells, RGL files get the library's adaptive grid.
         if brdftab_kind(self.source) not in ("merl", "rgl"):
             options.setdefault("preset", "medium")

@@ -5,13 +5,12 @@ def register() -> None:
 
 def plugin_class() -> type: ...
 
-class JitTable:
-    """A brdftab table evaluated in Dr.Jit operations (mirrors the Rust lookup)."""
+LAYOUT_VERSION: int
 
-    def __init__(self, values: Any, grid: dict[str, Any], interp: str = "linear") -> None: ...
+class JitTable:
+    """A brdftab table evaluated in Dr.Jit operations: an implementation of the library's
+    device layout (`Table.device_layout(interp)`), tested against the library's lookup."""
+
+    def __init__(self, layout: dict[str, Any]) -> None: ...
     def coords(self, wi: Any, wo: Any) -> tuple[list[Any], Any]: ...
     def lookup(self, wi: Any, wo: Any, active: Any = True) -> list[Any]: ...
-
-def kernel_values(values: Any) -> Any:
-    """The values as the Rust kernel of adaptive tables reads them (float16 codes of values
-    scaled by a power of two), as float32 of the same shape."""
