@@ -26,11 +26,10 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::geometry;
 use crate::table::Table;
 use crate::table::calibration::Calibration;
 use crate::table::grid::{Param, Quantity, StoredAxis};
-use crate::table::kernel::{Kernel, Packed, project_f32, project_out};
+use crate::table::kernel::{Kernel, Packed, project_f32, project_out, warp_vars};
 use crate::table::lookup::Interp;
 use crate::table::symmetry::{
     Symmetry, canonical_coords, canonical_coords_fast, canonical_corner_inout,
@@ -105,7 +104,7 @@ pub struct GridLayout {
 /// One axis of a [`KernelLayout`].
 #[derive(Debug, Clone, Serialize)]
 pub struct KernelAxis {
-    /// Per knot interval j (of K = `c.len()`): s = c[j] + t·d[j] at t = v·K ∈ [j, j + 1].
+    /// Per knot interval j (of K = `c.len()`): s = `c[j] + t·d[j]` at t = v·K ∈ \[j, j + 1\].
     pub c: Vec<f32>,
     /// The slopes (see `c`).
     pub d: Vec<f32>,
@@ -306,44 +305,20 @@ impl GridLayout {
 impl KernelLayout {
     /// The warp variables (v_h, v_d, v_φ) of a pair in f32 and (cos θi, cos θo), from the
     /// unit vectors (made unit in f64 unless they are within 2⁻⁴⁰ of it, then rounded to
-    /// f32); `None` below the horizon. With h = ωi + ωo and e = ωi − ωo:
-    /// v_h = (r²/|h|²)^¼ (SqrtSine) or (r²/(|h|² + |h| h_z))^¼ (QuarterPower), r² = h_x² + h_y²;
+    /// f32); `None` below the horizon. With h = ωi + ωo, e = ωi − ωo and r² = h_x² + h_y²:
+    /// v_h = (r²/|h|²)^¼ (SqrtSine) or (r²/(|h|² + |h| h_z))^¼ (QuarterPower);
     /// v_d = (|e|²/(2(2 + |h|)))^½; d_x = h_z(h_x ωi_x + h_y ωi_y) − r² ωi_z,
-    /// d_y = |(|h|(h_x ωi_y − h_y ωi_x))|, v_φ as [`KernelLayout::quarter`] says (0 when
-    /// |d_x| + |d_y| = 0).
+    /// d_y = ||h|(h_x ωi_y − h_y ωi_x)|, and v_φ as [`KernelLayout::quarter`] says (0 when
+    /// |d_x| + |d_y| = 0). The operations and their order are those of the kernel.
     pub fn vars(&self, wi: DVec3, wo: DVec3) -> Option<([f32; 3], [f32; 2])> {
-        let (wi, wo) = (geometry::unit(wi)?, geometry::unit(wo)?);
-        if !(wi.z > 0.0 && wo.z > 0.0) {
-            return None;
-        }
-        let (ix, iy, iz) = (wi.x as f32, wi.y as f32, wi.z as f32);
-        let (ox, oy, oz) = (wo.x as f32, wo.y as f32, wo.z as f32);
-        let (hx, hy, hz) = (ix + ox, iy + oy, iz + oz);
-        let r2 = hx * hx + hy * hy;
-        let hh = r2 + hz * hz;
-        let hl = hh.sqrt();
-        let vh = match self.h_var {
-            WarpVar::QuarterPower => (r2 / (hh + hl * hz)).sqrt().sqrt(),
-            _ => (r2 / hh).sqrt().sqrt(),
-        };
-        let (ex, ey, ez) = (ix - ox, iy - oy, iz - oz);
-        let vd = ((ex * ex + ey * ey + ez * ez) / (2.0 * (2.0 + hl))).sqrt();
-        let dx = hz * (hx * ix + hy * iy) - r2 * iz;
-        let dy = (hl * (hx * iy - hy * ix)).abs();
-        let den = dx.abs() + dy;
-        let vp = match (den > 0.0, self.quarter) {
-            (false, _) => 0.0,
-            (true, true) => dy / den,
-            (true, false) => 0.5 - 0.5 * (dx / den),
-        };
-        Some(([vh, vd, vp], [iz, oz]))
+        warp_vars(wi, wo, self.h_var == WarpVar::QuarterPower, self.quarter)
     }
 
     /// The eight corners blended in f32 into `out` (zeroed by the caller). Per axis: t = v·K,
-    /// knot interval j = trunc(min(t, K − ½)), s = c[j] + t·d[j] clamped to [0, n − 1], lower
+    /// knot interval j = trunc(min(t, K − ½)), s = `c[j] + t·d[j]` clamped to \[0, n − 1\], lower
     /// node i = trunc(min(s, n − 1.5)), weight s − i. The four (θh, θd) rows in order
     /// (i_h, i_d), (i_h, i_d + 1), (i_h + 1, i_d), (i_h + 1, i_d + 1), each adding
-    /// w·(1 − t_φ)·x[i_φ] + w·t_φ·x[i_φ + 1] per channel.
+    /// `w·(1 − t_φ)·x[i_φ] + w·t_φ·x[i_φ + 1]` per channel.
     pub fn blend(&self, v: [f32; 3], out: &mut [f32]) {
         let node = |a: &KernelAxis, v: f32| {
             let k = a.c.len() as f32;
@@ -371,8 +346,8 @@ impl KernelLayout {
             if let (Some(a), Some(b)) =
                 (self.values.get(r..r + c), self.values.get(r + c..r + 2 * c))
             {
-                for k in 0..c {
-                    out[k] += w0 * a[k] + w1 * b[k];
+                for ((o, &x0), &x1) in out.iter_mut().zip(a).zip(b) {
+                    *o += w0 * x0 + w1 * x1;
                 }
             }
         }

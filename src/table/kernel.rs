@@ -469,36 +469,7 @@ impl Kernel {
     /// path; [`reference_vars`] is the same in the paper's terms).
     #[inline(always)]
     pub fn vars(&self, wi: DVec3, wo: DVec3) -> Option<[f32; 3]> {
-        let (wi, wo) = (geometry::unit(wi)?, geometry::unit(wo)?);
-        if !(wi.z > 0.0 && wo.z > 0.0) {
-            return None;
-        }
-        let (ix, iy, iz) = (wi.x as f32, wi.y as f32, wi.z as f32);
-        let (ox, oy, oz) = (wo.x as f32, wo.y as f32, wo.z as f32);
-        let (hx, hy, hz) = (ix + ox, iy + oy, iz + oz);
-        let r2 = hx * hx + hy * hy;
-        let hl = (r2 + hz * hz).sqrt();
-        // sin²θh = r²/|h|², and 1 − cos θd = 1 − |h|/2 = |ωi − ωo|²/(2(2 + |h|)): no
-        // cancellation near θh = 0 or θd = 0.
-        let (ex, ey, ez) = (ix - ox, iy - oy, iz - oz);
-        let vd = ((ex * ex + ey * ey + ez * ez) / (2.0 * (2.0 + hl))).sqrt();
-        // sin θh = r/|h|, or 1 − cos θh = r²/(|h|(|h| + hz)): no cancellation near θh = 0.
-        let vh = if self.h_quarter_power {
-            (r2 / (r2 + hz * hz + hl * hz)).sqrt().sqrt()
-        } else {
-            (r2 / (r2 + hz * hz)).sqrt().sqrt()
-        };
-        let dx = hz * (hx * ix + hy * iy) - r2 * iz;
-        let dy = (hl * (hx * iy - hy * ix)).abs();
-        let den = dx.abs() + dy;
-        let vp = if !(den > 0.0) {
-            0.0
-        } else if self.quarter {
-            dy / den
-        } else {
-            0.5 - 0.5 * (dx / den)
-        };
-        Some([vh, vd, vp])
+        warp_vars(wi, wo, self.h_quarter_power, self.quarter).map(|(v, _)| v)
     }
 
     /// [`Kernel::vars`] on four lanes: the three quotients in one division, the square roots
@@ -579,7 +550,7 @@ impl Kernel {
                 self.rgb::<false, false, false>(wi, wo, out, values)
             };
         }
-        let Some(v) = self.vars(wi, wo) else {
+        let Some((v, cos)) = warp_vars(wi, wo, self.h_quarter_power, self.quarter) else {
             out[..self.channels].fill(0.0);
             return true;
         };
@@ -590,17 +561,10 @@ impl Kernel {
             1 => self.blend::<1>(v, out, values),
             _ => self.blend::<0>(v, out, values),
         }
-        if self.quantity != Quantity::Fr
-            && let Some((i, o)) = unit_pair(wi, wo)
-        {
+        if self.quantity != Quantity::Fr {
             // In f32, as the RGB lookup does (one rule for every channel count).
-            let cos = [i.z as f32, o.z as f32];
-            project_f32(
-                self.quantity,
-                self.calibration.as_ref(),
-                cos,
-                &mut out[..self.channels],
-            );
+            let out = &mut out[..self.channels];
+            project_f32(self.quantity, self.calibration.as_ref(), cos, out);
         }
         true
     }
@@ -781,6 +745,51 @@ pub fn project_out(
         }
         None => out.fill(0.0),
     }
+}
+
+/// The warp variables (v_h, v_d, v_φ) of a pair in f32 and (cos θi, cos θo), or `None` below
+/// the horizon: [`Kernel::vars`] (and `super::device`'s `KernelLayout::vars`). With h = ωi + ωo
+/// (not normalized), e = ωi − ωo and r² = h_x² + h_y²: v_h = (r²/|h|²)^¼, or
+/// (r²/(|h|² + |h| h_z))^¼ for `h_quarter_power`; v_d = (|e|²/(2(2 + |h|)))^½; the
+/// difference vector's d_x = h_z(h_x ωi_x + h_y ωi_y) − r² ωi_z, d_y = ||h|(h_x ωi_y − h_y ωi_x)|
+/// give v_φ = d_y/(|d_x| + d_y) (`quarter`) or ½ − ½ d_x/(|d_x| + d_y), 0 when both vanish.
+#[inline(always)]
+pub(crate) fn warp_vars(
+    wi: DVec3,
+    wo: DVec3,
+    h_quarter_power: bool,
+    quarter: bool,
+) -> Option<([f32; 3], [f32; 2])> {
+    let (wi, wo) = (geometry::unit(wi)?, geometry::unit(wo)?);
+    if !(wi.z > 0.0 && wo.z > 0.0) {
+        return None;
+    }
+    let (ix, iy, iz) = (wi.x as f32, wi.y as f32, wi.z as f32);
+    let (ox, oy, oz) = (wo.x as f32, wo.y as f32, wo.z as f32);
+    let (hx, hy, hz) = (ix + ox, iy + oy, iz + oz);
+    let r2 = hx * hx + hy * hy;
+    let hl = (r2 + hz * hz).sqrt();
+    // sin²θh = r²/|h|², and 1 − cos θd = 1 − |h|/2 = |ωi − ωo|²/(2(2 + |h|)): no
+    // cancellation near θh = 0 or θd = 0.
+    let (ex, ey, ez) = (ix - ox, iy - oy, iz - oz);
+    let vd = ((ex * ex + ey * ey + ez * ez) / (2.0 * (2.0 + hl))).sqrt();
+    // sin θh = r/|h|, or 1 − cos θh = r²/(|h|(|h| + hz)): no cancellation near θh = 0.
+    let vh = if h_quarter_power {
+        (r2 / (r2 + hz * hz + hl * hz)).sqrt().sqrt()
+    } else {
+        (r2 / (r2 + hz * hz)).sqrt().sqrt()
+    };
+    let dx = hz * (hx * ix + hy * iy) - r2 * iz;
+    let dy = (hl * (hx * iy - hy * ix)).abs();
+    let den = dx.abs() + dy;
+    let vp = if !(den > 0.0) {
+        0.0
+    } else if quarter {
+        dy / den
+    } else {
+        0.5 - 0.5 * (dx / den)
+    };
+    Some(([vh, vd, vp], [iz, oz]))
 }
 
 /// The kernel's projection of an interpolated `quantity` (other than f_r) at unit directions
