@@ -159,6 +159,9 @@ def test_jit_lookup_matches_rust(case, interp, tmp_path, rgl):
     rel = np.abs(got - want) / np.maximum(np.abs(want), 1e-6 * np.abs(want).max())
     print(f"case {case} {layout['kind']} {interp}: max rel {rel.max():.2e}, "
           f"exact {np.mean(got == want):.4f}")
+    # The contract is 1e-5 (a device may round differently); the LLVM backend does the same
+    # IEEE operations as DeviceLayout::eval, so nearly every pair is bit-equal (measured: all).
+    assert np.mean(got == want) >= 0.999, np.mean(got == want)
     if interp == "linear":
         assert rel.max() <= 1e-5, rel.max()
     else:

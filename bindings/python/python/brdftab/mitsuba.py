@@ -254,6 +254,21 @@ def _fast_atan2(y, x):
     return dr.select(y < 0, -r, r)
 
 
+def _unit(v, keep_unit):
+    """geometry.rs ``normalize`` (v / |v|, component by component) or, with ``keep_unit``,
+    ``unit`` (v as is when |v|² is 1 within 2^-40); float64 components and the validity mask
+    (|v|² > 0)."""
+    import drjit as dr
+
+    n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+    length = dr.sqrt(dr.maximum(n2, 1e-300))
+    u = [c / length for c in v]
+    if keep_unit:
+        near = dr.abs(n2 - 1.0) <= 2.0**-40
+        u = [dr.select(near, c, x) for c, x in zip(v, u)]
+    return u, n2 > 0
+
+
 #: The version of the library's device layout (``Table.device_layout()``) this code implements.
 LAYOUT_VERSION = 1
 
@@ -340,23 +355,14 @@ class JitTable:
         import drjit as dr
 
         F = self.Float64
-        wi = [F(wi.x), F(wi.y), F(wi.z)]
-        wo = [F(wo.x), F(wo.y), F(wo.z)]
-
-        def unit(v):
-            n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
-            inv = 1.0 / dr.sqrt(dr.maximum(n2, 1e-300))
-            return [v[0] * inv, v[1] * inv, v[2] * inv], n2 > 0
-
-        wi, ok_i = unit(wi)
-        wo, ok_o = unit(wo)
+        # Linear lookups use the polynomial acos/atan2 (canonical_coords_fast) on `unit`
+        # vectors, nearest lookups the exact functions (canonical_coords) on normalized ones.
+        fast = self.interp != "nearest"
+        wi, ok_i = _unit([F(wi.x), F(wi.y), F(wi.z)], fast)
+        wo, ok_o = _unit([F(wo.x), F(wo.y), F(wo.z)], fast)
         valid = ok_i & ok_o & (wi[2] > 0) & (wo[2] > 0)
         iso, rec, bil = self.sym["isotropic"], self.sym["reciprocal"], self.sym["bilateral"]
         tau = 2 * math.pi
-
-        # Linear lookups use the polynomial acos/atan2 (canonical_coords_fast), nearest lookups
-        # the exact functions (canonical_coords).
-        fast = self.interp != "nearest"
 
         def acos(x):
             return _fast_acos(x) if fast else dr.acos(dr.clip(x, -1.0, 1.0))
@@ -607,8 +613,8 @@ class JitTable:
         import drjit as dr
 
         F64 = self.Float64
-        iz = F64(wi.z) / dr.sqrt(dr.maximum(F64(wi.x) ** 2 + F64(wi.y) ** 2 + F64(wi.z) ** 2, 1e-300))
-        oz = F64(wo.z) / dr.sqrt(dr.maximum(F64(wo.x) ** 2 + F64(wo.y) ** 2 + F64(wo.z) ** 2, 1e-300))
+        iz = _unit([F64(wi.x), F64(wi.y), F64(wi.z)], False)[0][2]
+        oz = _unit([F64(wo.x), F64(wo.y), F64(wo.z)], False)[0][2]
         f = oz if self.quantity == "fr_cos_out" else iz * oz
         s = 1.0 / dr.maximum(f, 1e-30)
         out = [dr.maximum(type(o)(F64(o) * s), 0.0) for o in out]
@@ -653,16 +659,9 @@ class JitTable:
         F64, U = self.Float64, self.UInt
         kv = self.kernel["values"]
         Fl = type(kv)
-        wi = [F64(wi.x), F64(wi.y), F64(wi.z)]
-        wo = [F64(wo.x), F64(wo.y), F64(wo.z)]
-
-        def unit(v):
-            n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
-            inv = 1.0 / dr.sqrt(dr.maximum(n2, 1e-300))
-            return [Fl(c * inv) for c in v], n2 > 0
-
-        (ix, iy, iz), ok_i = unit(wi)
-        (ox, oy, oz), ok_o = unit(wo)
+        (ix, iy, iz), ok_i = _unit([F64(wi.x), F64(wi.y), F64(wi.z)], True)
+        (ox, oy, oz), ok_o = _unit([F64(wo.x), F64(wo.y), F64(wo.z)], True)
+        ix, iy, iz, ox, oy, oz = (Fl(x) for x in (ix, iy, iz, ox, oy, oz))
         valid = ok_i & ok_o & (iz > 0) & (oz > 0) & active
         hx, hy, hz = ix + ox, iy + oy, iz + oz
         r2 = hx * hx + hy * hy
