@@ -143,13 +143,10 @@ impl DeviceLayout {
         let grid = table.grid();
         let channels = grid.channels().len();
         let quantity = grid.quantity();
-        let mut values = unpacked(table)?;
-        if quantity == Quantity::Fr {
-            // As `TabulatedBrdf` sets them aside: an f_r table's negative values are unmeasured.
-            for x in values.iter_mut().filter(|x| **x < 0.0) {
-                *x = 0.0;
-            }
-        }
+        // As `TabulatedBrdf` sets them aside: an f_r table's negative values are unmeasured.
+        let fr = quantity == Quantity::Fr;
+        let read = |x: f32| if fr && x < 0.0 { 0.0 } else { x };
+        let values = unpacked(table, read)?;
         let kernel = match interp {
             Interp::Linear => Kernel::new(grid),
             Interp::Nearest => None,
@@ -219,10 +216,11 @@ impl DeviceLayout {
 
 /// The stored values in the full rectangle of the stored axes: a packed `inout` reciprocal
 /// table's corners below the diagonal are filled from their reciprocal node.
-fn unpacked(table: &Table) -> Result<Vec<f32>> {
+/// Each value goes through `read` (one pass: this copy is the layout's only one).
+fn unpacked(table: &Table, read: impl Fn(f32) -> f32) -> Result<Vec<f32>> {
     let grid = table.grid();
     if !grid.layout().packed {
-        return Ok(table.values().to_vec());
+        return Ok(table.values().iter().map(|&x| read(x)).collect());
     }
     let shape = grid.stored_shape();
     let c = grid.channels().len();
@@ -241,7 +239,7 @@ fn unpacked(table: &Table) -> Result<Vec<f32>> {
                 for q in 0..shape[3] {
                     let idx = canonical_corner_inout(sym, [a, p, b, q], n3);
                     match table.node(idx) {
-                        Some(v) => out.extend_from_slice(v),
+                        Some(v) => out.extend(v.iter().map(|&x| read(x))),
                         None => out.extend(std::iter::repeat_n(0.0, c)),
                     }
                 }
