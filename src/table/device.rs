@@ -28,7 +28,7 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::table::Table;
 use crate::table::calibration::Calibration;
-use crate::table::grid::{Param, Quantity, StoredAxis};
+use crate::table::grid::{Grid, Param, Quantity, StoredAxis};
 use crate::table::kernel::{Kernel, Packed, project_f32, project_out, warp_vars};
 use crate::table::lookup::Interp;
 use crate::table::symmetry::{
@@ -140,13 +140,32 @@ impl DeviceLayout {
     /// # Errors
     /// [`Error::Unsupported`] when the unpacked grid would not fit in memory.
     pub fn new(table: &Table, interp: Interp) -> Result<DeviceLayout> {
-        let grid = table.grid();
+        let fr = table.grid().quantity() == Quantity::Fr;
+        let values = unpacked(table, |x| read(fr, x))?;
+        Ok(DeviceLayout::build(table.grid(), values, interp))
+    }
+
+    /// [`DeviceLayout::new`] taking the table: its values become the layout's without a copy
+    /// (unless the layout is packed, or a kernel's).
+    ///
+    /// # Errors
+    /// As [`DeviceLayout::new`].
+    pub fn from_table(table: Table, interp: Interp) -> Result<DeviceLayout> {
+        if table.grid().layout().packed {
+            return DeviceLayout::new(&table, interp);
+        }
+        let (grid, mut values, _) = table.into_parts();
+        let fr = grid.quantity() == Quantity::Fr;
+        for x in values.iter_mut() {
+            *x = read(fr, *x);
+        }
+        Ok(DeviceLayout::build(&grid, values, interp))
+    }
+
+    /// The layout of `grid` with `values` as lookups read them (unpacked, f_r clamped).
+    fn build(grid: &Grid, values: Vec<f32>, interp: Interp) -> DeviceLayout {
         let channels = grid.channels().len();
         let quantity = grid.quantity();
-        // As `TabulatedBrdf` sets them aside: an f_r table's negative values are unmeasured.
-        let fr = quantity == Quantity::Fr;
-        let read = |x: f32| if fr && x < 0.0 { 0.0 } else { x };
-        let values = unpacked(table, read)?;
         let kernel = match interp {
             Interp::Linear => Kernel::new(grid),
             Interp::Nearest => None,
@@ -173,7 +192,7 @@ impl DeviceLayout {
             }
             None => (DeviceKind::Grid, None, Some(general(values))),
         };
-        Ok(DeviceLayout {
+        DeviceLayout {
             version: VERSION,
             kind,
             channels,
@@ -181,7 +200,7 @@ impl DeviceLayout {
             calibration: grid.calibration().cloned(),
             kernel,
             grid: grid_layout,
-        })
+        }
     }
 
     /// f_r of the pair in `out[..channels]` (0 below the horizon and for invalid directions):
@@ -212,6 +231,13 @@ impl DeviceLayout {
             }
         }
     }
+}
+
+/// A stored value as lookups read it: as `TabulatedBrdf` sets them aside, an f_r table's
+/// negative values (unmeasured cells) are 0.
+#[inline]
+fn read(fr: bool, x: f32) -> f32 {
+    if fr && x < 0.0 { 0.0 } else { x }
 }
 
 /// The stored values in the full rectangle of the stored axes: a packed `inout` reciprocal

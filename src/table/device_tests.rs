@@ -58,6 +58,9 @@ fn check(name: &str, table: Table, want_kind: DeviceKind) {
     let c = table.grid().channels().len();
     for interp in [Interp::Linear, Interp::Nearest] {
         let d = DeviceLayout::new(&table, interp).unwrap();
+        let moved = DeviceLayout::from_table(table.clone(), interp).unwrap();
+        let values = |d: &DeviceLayout| d.grid.as_ref().map(|g| g.values.clone());
+        assert_eq!(values(&d), values(&moved), "{name}");
         assert_eq!(d.version, VERSION);
         let kind = if interp == Interp::Nearest {
             DeviceKind::Grid

@@ -370,7 +370,7 @@ impl TabulatedBrdf {
     /// A chunk that does not load, or [`Error::Unsupported`] (see
     /// [`super::device::DeviceLayout::new`]).
     pub fn device_layout(&self) -> Result<super::device::DeviceLayout> {
-        super::device::DeviceLayout::new(&self.to_table()?, self.interp)
+        super::device::DeviceLayout::from_table(self.to_table()?, self.interp)
     }
 
     /// The whole table in memory as stored (loads every chunk; negative values included).

@@ -154,17 +154,7 @@ impl PyTable {
             let interp: Interp = interp.parse().map_err(lib_err)?;
             let t = &self.table;
             let d = unlocked(py, || DeviceLayout::new(t, interp))?.map_err(lib_err)?;
-            let v = serde_json::to_value(&d).map_err(|e| Error::new_err(e.to_string()))?;
-            let out = to_py(py, &v)?;
-            let dict = out.bind(py).cast::<PyDict>()?;
-            dict.set_item("channel_names", t.grid().channels().names())?;
-            if let (Some(k), Some(kd)) = (d.kernel, dict.get_item("kernel")?) {
-                kd.set_item("values", k.values.into_pyarray(py))?;
-            }
-            if let (Some(g), Some(gd)) = (d.grid, dict.get_item("grid")?) {
-                gd.set_item("values", g.values.into_pyarray(py))?;
-            }
-            Ok(out)
+            layout_dict(py, d, t.grid().channels())
         })
     }
 
@@ -187,6 +177,22 @@ impl PyTable {
             self.table.description()
         )
     }
+}
+
+/// A device layout as the dict `Table.device_layout` and `Brdf.device_layout` return: its
+/// fields as JSON values, "channel_names", and each value array moved into numpy (no copy).
+fn layout_dict(py: Python<'_>, d: DeviceLayout, channels: &Channels) -> PyResult<Py<PyAny>> {
+    let v = serde_json::to_value(&d).map_err(|e| Error::new_err(e.to_string()))?;
+    let out = to_py(py, &v)?;
+    let dict = out.bind(py).cast::<PyDict>()?;
+    dict.set_item("channel_names", channels.names())?;
+    if let (Some(k), Some(kd)) = (d.kernel, dict.get_item("kernel")?) {
+        kd.set_item("values", k.values.into_pyarray(py))?;
+    }
+    if let (Some(g), Some(gd)) = (d.grid, dict.get_item("grid")?) {
+        gd.set_item("values", g.values.into_pyarray(py))?;
+    }
+    Ok(out)
 }
 
 /// A serde_json value as a Python object (through `json.loads`: dicts, lists, floats, ...).
@@ -549,6 +555,23 @@ impl PyBrdf {
             let flat: Vec<f64> = curve.into_iter().flatten().collect();
             let shape: Vec<usize> = if single { vec![c] } else { vec![k, c] };
             shaped_f64(py, flat, &shape)
+        })
+    }
+
+    /// A table SOURCE's device layout for this BRDF's interpolation (`Table.device_layout`),
+    /// without the copy `table().device_layout()` makes: the decoded table moves into it.
+    /// Raises `brdftab.Error` for any other source (bake it: `table(...).device_layout()`).
+    fn device_layout(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        guard(|| {
+            let Some(t) = &self.table else {
+                return Err(Error::new_err(format!(
+                    "{}: not a table (use Brdf.table(...).device_layout())",
+                    self.source
+                )));
+            };
+            let t = t.clone();
+            let d = unlocked(py, move || t.device_layout())?.map_err(lib_err)?;
+            layout_dict(py, d, self.inner.channels())
         })
     }
 

@@ -146,6 +146,10 @@ def test_jit_lookup_matches_rust(case, interp, tmp_path, rgl):
     brdftab.bake(src, out, **opts)
     b = brdftab.open(out, interp=interp)
     layout = b.table().device_layout(interp)
+    moved = b.device_layout()  # the opened table's own layout: the same arrays
+    for part in ("kernel", "grid"):
+        if layout[part] is not None:
+            np.testing.assert_array_equal(layout[part]["values"], moved[part]["values"])
     jt = JitTable(layout)
     rng = np.random.default_rng(case)
     wi, wo = rng.normal(size=(20000, 3)), rng.normal(size=(20000, 3))
@@ -176,6 +180,8 @@ def test_jit_table_refuses_unknown_layouts():
 
     layout = brdftab.open('{"model": "lambert", "kd": 0.5}').table(grid="4x1x4x8").device_layout()
     assert layout["version"] == 1 and layout["kind"] in ("kernel", "grid")
+    with pytest.raises(brdftab.Error, match="not a table"):
+        brdftab.open('{"model": "lambert", "kd": 0.5}').device_layout()
     for bad in ({"version": 2}, {"kind": "octree"}):
         with pytest.raises(brdftab.Error):
             JitTable({**layout, **bad})

@@ -17,6 +17,10 @@ class Error(Exception):
 class Brdf:
     """A BRDF opened from a SOURCE (spec, table, DB#NAME, MERL .binary, RGL .bsdf)."""
 
+    def device_layout(self) -> dict[str, Any]:
+        """A table SOURCE's device layout for its interpolation (`Table.device_layout`), the
+        decoded table moved into it; brdftab.Error for any other source."""
+
     @property
     def channels(self) -> list[str]: ...
     @property

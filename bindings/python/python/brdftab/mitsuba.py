@@ -740,27 +740,38 @@ class JitBrdftabBSDF(_Common):
                 options[key] = str(v)
         if self.spectral and brdftab_kind(self.source) in ("spec", "rgl"):
             options.setdefault("wavelengths", list(range(380, 781, 20)))
-        table = self._table(options)
-        # The table as the library describes it for devices (`Table.device_layout`): the JIT
-        # lookup implements that layout, not the grid's description.
-        interp = "nearest" if self.interp == "nearest" else "linear"
-        self.table = JitTable(table.device_layout(interp))
-        grid = table.grid
+        # The table as the library describes it for devices (`device_layout`): the JIT lookup
+        # implements that layout, not the grid's description. An opened table moves its values
+        # into the layout (`Brdf.device_layout`, for the interpolation it was opened with); a
+        # table baked in memory, or an `interp` other than linear/nearest, goes through
+        # `Table.device_layout` (linear unless nearest).
+        layout = self._table(options)
+        self.table = JitTable(layout)
         # The library's importance sampler (conditional half-vector warps of f_r cos θo given
         # wi), on the densities it exports for the table (or the source): brdftab._halfwarp.
-        iso = grid["symmetry"]["isotropic"]
+        # (A kernel layout is of an isotropic table.)
+        iso = layout["kind"] == "kernel" or layout["grid"]["symmetry"]["isotropic"]
         res = int(_prop(props, "sampling_res", 64 if iso else 48))
         nodes = self._sampled.sampling_nodes(adjoint=True, theta_h=res, phi_h=res,
                                              theta_o=32 if iso else 12)
         self.sampler = HalfVectorSampler(nodes)
         dr.eval()
 
+    def _layout(self, table):
+        """The device layout of ``table``: a Brdf over a table (its values move into the
+        layout) or a ``brdftab.Table``."""
+        if hasattr(table, "values") or self.interp not in ("linear", "nearest"):
+            tab = table if hasattr(table, "values") else table.table()
+            return tab.device_layout("nearest" if self.interp == "nearest" else "linear")
+        return table.device_layout()
+
     def _table(self, options):
+        """The device layout of the table the plugin evaluates (see ``__init__``)."""
         # What the sampling distributions are built from: the table when it is at hand as a
         # Brdf, else the source.
         self._sampled = self.brdf
         if brdftab_kind(self.source) == "table" and not options:
-            return self.brdf.table()
+            return self._layout(self.brdf)
         # MERL files keep their own cells, RGL files get the library's adaptive grid.
         if brdftab_kind(self.source) not in ("merl", "rgl"):
             options.setdefault("preset", "medium")
@@ -776,14 +787,14 @@ class JitBrdftabBSDF(_Common):
                 try:
                     t = brdftab.open(hit["path"], interp=self.interp)
                     self._sampled = t
-                    return t.table()
+                    return self._layout(t)
                 except brdftab.Error:
                     if refresh:  # a fresh bake that does not open is the library's error
                         raise
         b = self.brdf
         if "wavelengths" in options:
             b = brdftab.open(self.source, interp=self.interp, wavelengths=options.pop("wavelengths"))
-        return b.table(param="halfdiff", **options)
+        return self._layout(b.table(param="halfdiff", **options))
 
     def _f(self, wi, wo, si, active):
         import drjit as dr
