@@ -153,6 +153,8 @@ def test_a_large_eval_needs_about_its_output(tmp_path):
     r = subprocess.run([sys.executable, "-c", MEMORY, str(p)], capture_output=True, text=True,
                        check=True)
     growth, out = map(int, r.stdout.split())
-    # The result, plus slack for the allocator and the rayon threads' stacks (a copy of one
-    # input alone would be 96 MB).
-    assert growth < out + 24e6, (growth, out)
+    # The result, plus slack: locally the growth is the result to 0.1 MB, but one CI run saw
+    # 49 MB more (not reproduced; allocator arenas or huge pages of the worker threads are
+    # suspects). A copy of the inputs — the old binding's behaviour — is 192 MB (432 MB
+    # growth in all), which this bound still refuses.
+    assert growth < out + 64e6, (growth, out)
