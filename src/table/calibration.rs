@@ -217,23 +217,45 @@ impl Calibration {
     /// equal). `x` unchanged for a calibration of other than three channels.
     #[inline(always)]
     pub fn apply_rgb(&self, cos_i: f32, cos_o: f32, x: F4) -> F4 {
-        let Some(q) = &self.lanes else {
+        let Some((scale, last, last_cell)) = self.rgb_axis() else {
             return x;
         };
         let zero = F4::splat(0.0);
         let t = (F4::new(1.0 - cos_i, 1.0 - cos_o, 0.0, 0.0).max(zero)).sqrt();
-        let s = (t * F4::splat(self.scale)).min(F4::splat(self.last));
+        let s = (t * F4::splat(scale)).min(F4::splat(last));
         let (j, _) = s.trunc();
-        let last = self.factors.len() / 3 - 2;
         // s ≥ 0 and not NaN (max and min above return the other operand for NaN lanes).
-        let (ji, jo) = ((j[0] as usize).min(last), (j[1] as usize).min(last));
+        let (ji, jo) = ((j[0] as u32).min(last_cell), (j[1] as u32).min(last_cell));
         let [si, so, _, _] = s.to_array();
-        let (fi, fo) = (F4::splat(si - ji as f32), F4::splat(so - jo as f32));
-        let lerp = |o: usize, f: F4| match (F4::load(&q[o..]), F4::load(&q[o + 8..])) {
-            (Some(a), Some(b)) => a + f * (b - a),
-            _ => F4::splat(1.0),
+        self.apply_rgb_cells([ji, jo], [si - ji as f32, so - jo as f32], x)
+    }
+
+    /// What [`Calibration::apply_rgb`] needs of the axis to find a cosine's cell — the scale
+    /// from t to the fractional node, the last node (f32) and the last cell (nodes − 2) —, for
+    /// lookups that find cells in lanes of their own; `None` without the three-channel form
+    /// (`apply_rgb` then returns its input).
+    #[inline(always)]
+    pub(crate) fn rgb_axis(&self) -> Option<(f32, f32, u32)> {
+        self.lanes.as_ref()?;
+        Some((self.scale, self.last, (self.factors.len() / 3 - 2) as u32))
+    }
+
+    /// `x` times k_in at cell `cell[0]` with fraction `frac[0]` and k_out at `cell[1]`,
+    /// `frac[1]` (cells at most the last; see [`Calibration::rgb_axis`]): the interpolation
+    /// of [`Calibration::apply_rgb`].
+    #[inline(always)]
+    pub(crate) fn apply_rgb_cells(&self, cell: [u32; 2], frac: [f32; 2], x: F4) -> F4 {
+        let Some(q) = &self.lanes else {
+            return x;
         };
-        x * lerp(ji * 8, fi) * lerp(jo * 8 + 4, fo)
+        // Node o's four factors and node o + 1's (eight further on), one bounds check each.
+        let lerp =
+            |o: usize, f: F4| match q.get(o..o + 12).map(|q| (F4::load(q), F4::load(&q[8..]))) {
+                Some((Some(a), Some(b))) => a + f * (b - a),
+                _ => F4::splat(1.0),
+            };
+        let (ji, jo) = (cell[0] as usize, cell[1] as usize);
+        x * lerp(ji * 8, F4::splat(frac[0])) * lerp(jo * 8 + 4, F4::splat(frac[1]))
     }
 
     /// Multiplies `out[..channels]` by k_in(θi) · k_out(θo) for unit directions with z =

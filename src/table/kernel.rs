@@ -47,6 +47,9 @@ use crate::table::calibration::Calibration;
 use crate::table::grid::{Grid, Mapping, Nodes, Param, Quantity, StoredAxis};
 use crate::table::warp::{Warp, WarpVar};
 
+mod x8;
+pub use x8::LANES;
+
 /// A kernel table's values as its lookups read them: f16, scaled by a power of two.
 ///
 /// Half the bytes of f32, so a measured material's table (≈ 0.9 MB) stays in a core's L2
@@ -342,6 +345,9 @@ pub struct Kernel {
     /// Values are read exact ([`Packed::exact`]): resampled, and at most
     /// [`RESAMPLED_EXACT_MAX_VALUES`] of them.
     exact: bool,
+    /// [`Kernel::eval_x8`] runs: three channels, offsets within i32, and the CPU has AVX2 and
+    /// F16C (checked once, at construction).
+    x8: bool,
 }
 
 impl Kernel {
@@ -399,6 +405,8 @@ impl Kernel {
         }
         let axes: [Axis; 3] = axes.try_into().ok()?;
         let channels = grid.channels().len();
+        // The eight-lane path computes corner offsets in i32 lanes.
+        let x8 = channels == 3 && grid.stored_values() < (i32::MAX as usize) / 2 && x8::available();
         let per = |f: &dyn Fn(&Axis) -> f32| F4::new(f(&axes[0]), f(&axes[1]), f(&axes[2]), 0.0);
         let lanes = [
             per(&|a| a.k),
@@ -420,6 +428,7 @@ impl Kernel {
             exact: resampled && grid.stored_values() <= RESAMPLED_EXACT_MAX_VALUES,
             quantity: grid.quantity(),
             calibration: grid.calibration().cloned(),
+            x8,
         })
     }
 
@@ -597,15 +606,9 @@ impl Kernel {
             // Only resampled axes have a cut (< 2).
             Some((v, _, _)) if CUT && v.any_ge(self.cut) => false,
             Some((v, inv_cc, [cos_i, cos_o])) => {
-                let mut x = self.eval_rgb::<F16C, EXACT>(v, values);
-                if self.quantity != Quantity::Fr {
-                    // Extrapolated nodes beyond the horizon may pull the blend below 0.
-                    x = (x * F4::splat(inv_cc)).max(F4::splat(0.0));
-                }
-                if let Some(c) = &self.calibration {
-                    x = c.apply_rgb(cos_i, cos_o, x);
-                }
-                let [r, g, b, _] = x.to_array();
+                let x = self.eval_rgb::<F16C, EXACT>(v, values);
+                let cal = |c: &Calibration, x| c.apply_rgb(cos_i, cos_o, x);
+                let [r, g, b, _] = self.finish_rgb(x, inv_cc, cal).to_array();
                 out[..3].copy_from_slice(&[r, g, b]);
                 true
             }
@@ -614,6 +617,21 @@ impl Kernel {
                 true
             }
         }
+    }
+
+    /// f_r from the blended RGB `x` of a pair with 1/(its quantity's factor) `inv_cc`: a
+    /// quantity other than f_r divided by its factor and clamped at 0, then the calibration
+    /// applied by `cal` (at the pair's cosines; the one-pair and eight-lane paths' common end).
+    #[inline(always)]
+    fn finish_rgb(&self, mut x: F4, inv_cc: f32, cal: impl FnOnce(&Calibration, F4) -> F4) -> F4 {
+        if self.quantity != Quantity::Fr {
+            // Extrapolated nodes beyond the horizon may pull the blend below 0.
+            x = (x * F4::splat(inv_cc)).max(F4::splat(0.0));
+        }
+        if let Some(c) = &self.calibration {
+            x = cal(c, x);
+        }
+        x
     }
 
     /// [`Kernel::blend`] for three channels on four-lane registers ([`F4`]): the three axes'
@@ -644,11 +662,32 @@ impl Kernel {
         let rw = F4::pair_lanes::<0>(om, w) * F4::interleave_lo(om.lane::<1>(), w.lane::<1>());
         let (p0, p1) = (rw * om.lane::<2>(), rw * w.lane::<2>());
         let o = i[0] as usize * self.chunk + i[1] as usize * self.row + i[2] as usize * 3;
-        let mut acc = zero;
+        let weights = [
+            (p0.lane::<0>(), p1.lane::<0>()),
+            (p0.lane::<1>(), p1.lane::<1>()),
+            (p0.lane::<2>(), p1.lane::<2>()),
+            (p0.lane::<3>(), p1.lane::<3>()),
+        ];
+        self.blend_rows::<F16C, EXACT>(o, weights, values)
+    }
+
+    /// The RGB blend of [`Kernel::eval_rgb`] from the corner offset `o` (the lower corner's
+    /// first value) and the four (θh, θd) rows' weights of their two φd corners (each weight in
+    /// every lane); the scaled result times the table's unscale. Shared by the one-pair path
+    /// and the eight-lane one ([`x8`]), so both compute the same operations.
+    #[inline(always)]
+    fn blend_rows<const F16C: bool, const EXACT: bool>(
+        &self,
+        o: usize,
+        weights: [(F4, F4); 4],
+        values: &Packed,
+    ) -> F4 {
+        let mut acc = F4::splat(0.0);
         let load = |x: &[u16]| {
             if F16C {
                 #[cfg(target_arch = "x86_64")]
-                // SAFETY: `F16C` is true only in `rgb_f16c`, which runs when the CPU has F16C.
+                // SAFETY: `F16C` is true only in functions compiled with F16C enabled, which
+                // run when the CPU has it (`rgb_f16c`, `x8`).
                 return unsafe { F4::from_f16_f16c(x) };
             }
             F4::from_f16_normal(x)
@@ -659,23 +698,26 @@ impl Kernel {
         // padding, ignored).
         let span = o..o + self.chunk + self.row + 7;
         let offsets = [0, self.row, self.chunk, self.chunk + self.row];
-        let weights = [
-            (p0.lane::<0>(), p1.lane::<0>()),
-            (p0.lane::<1>(), p1.lane::<1>()),
-            (p0.lane::<2>(), p1.lane::<2>()),
-            (p0.lane::<3>(), p1.lane::<3>()),
-        ];
+        // The windows of row offset r: x[r..r + 4] and x[r + 3..r + 7].
+        fn windows<T>(x: &[T], r: usize) -> (&[T], &[T]) {
+            debug_assert!(r + 7 <= x.len());
+            // SAFETY: callers pass x = values[o..o + chunk + row + 7] and r ≤ chunk + row,
+            // so r + 7 ≤ x.len(): both windows lie within x.
+            unsafe { (x.get_unchecked(r..r + 4), x.get_unchecked(r + 3..r + 7)) }
+        }
         if EXACT {
             if let Some(x) = values.full.get(span) {
                 for (r, (w0, w1)) in offsets.into_iter().zip(weights) {
-                    if let (Some(a), Some(b)) = (F4::load(&x[r..]), F4::load(&x[r + 3..])) {
+                    let (a, b) = windows(x, r);
+                    if let (Some(a), Some(b)) = (F4::load(a), F4::load(b)) {
                         acc = acc + (w0 * a + w1 * b);
                     }
                 }
             }
         } else if let Some(x) = values.bits.get(span) {
             for (r, (w0, w1)) in offsets.into_iter().zip(weights) {
-                if let (Some(a), Some(b)) = (load(&x[r..]), load(&x[r + 3..])) {
+                let (a, b) = windows(x, r);
+                if let (Some(a), Some(b)) = (load(a), load(b)) {
                     acc = acc + (w0 * a + w1 * b);
                 }
             }
@@ -896,6 +938,7 @@ mod tests {
             exact: false,
             quantity: Quantity::Fr,
             calibration: None,
+            x8: false,
         }
     }
 

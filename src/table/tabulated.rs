@@ -39,7 +39,7 @@ use crate::geometry::HalfDiff;
 use crate::spectrum::Channels;
 use crate::table::Table;
 use crate::table::grid::{Grid, Param, Quantity};
-use crate::table::kernel::{Kernel, Packed, project_out};
+use crate::table::kernel::{Kernel, LANES, Packed, project_out};
 use crate::table::lookup::{Interp, Lookup, Prepared};
 use crate::table::sampling::{SamplingResolution, TableSampler};
 
@@ -181,6 +181,31 @@ impl TabulatedBrdf {
     /// instead of each lookup waiting for its own.
     fn eval_block(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
         let c = self.lookup.channels();
+        if let Some(k) = &self.kernel
+            && self.interp == Interp::Linear
+            && k.has_x8()
+        {
+            // Eight pairs per group in AVX2 lanes; the pairs the lanes leave, and the last
+            // ones, one at a time (the same values).
+            let values = self.packed();
+            let n = out.len() / c;
+            let whole = n - n % LANES;
+            for s in (0..whole).step_by(LANES) {
+                let og = &mut out[s * c..(s + LANES) * c];
+                let left = k.eval_x8(&wi[s..], &wo[s..], og, values);
+                if left != 0 {
+                    for (j, oc) in og.chunks_exact_mut(c).enumerate() {
+                        if left & (1 << j) != 0 {
+                            self.eval(wi[s + j], wo[s + j], oc);
+                        }
+                    }
+                }
+            }
+            for (j, oc) in out[whole * c..].chunks_exact_mut(c).enumerate() {
+                self.eval(wi[whole + j], wo[whole + j], oc);
+            }
+            return;
+        }
         if self.interp != Interp::Linear || self.kernel.is_some() {
             // Nearest lookups, and the kernel (its tables are cache resident: nothing to
             // prefetch), go one pair at a time.
