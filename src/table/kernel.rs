@@ -294,8 +294,10 @@ impl Axis {
     #[inline(always)]
     fn line(&self, j: i32) -> &[f32; 2] {
         let j = (j as u32).min(self.kmax) as usize;
-        // `lines` has kmax + 1 entries.
-        &self.lines[j]
+        debug_assert!(j < self.lines.len());
+        // SAFETY: `lines` has kmax + 1 entries (`Axis::from_knots`, the only constructor, sets
+        // kmax to their count − 1; neither changes afterwards), and j ≤ kmax.
+        unsafe { self.lines.get_unchecked(j) }
     }
 
     /// The lower node and the weight of the upper one at variable `v` ∈ [0, 1] (the scalar
