@@ -3,7 +3,11 @@
 //!
 //! - `lookup/{linear,nearest}_single`: one thread, 4096 pairs per iteration (time / 4096 = ns per
 //!   lookup);
-//! - `lookup/linear_batch`: `eval_batch` on 2^20 pairs, rayon on all cores.
+//! - `lookup/linear_batch`: `eval_batch` on 2^20 pairs, rayon on all cores;
+//! - `lookup/measured_{single,block}`: the default table of the shipped `cc_ibiza_sunset`
+//!   (an adaptive kernel table, cache resident) on one thread, one `eval` per pair against
+//!   `eval_batch` on the same 4096 pairs (below the parallel threshold, so one thread: the
+//!   eight-lane AVX2 path against the one-pair path, in the same run).
 //!
 //! Run: `cargo bench --bench lookup`. The machine may be shared: compare with CPU time
 //! (`brdftab bench FILE` prints both).
@@ -56,6 +60,29 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
+    let path = brdftab::measured::data::rgl_file("cc_ibiza_sunset_rgb.bsdf")
+        .unwrap_or_else(|e| panic!("{e}"));
+    let (measured, _) = brdftab::bake::BakeRequest::new(path.display().to_string().as_str())
+        .table(&brdftab::progress::Silent)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let measured = TabulatedBrdf::from_table(measured);
+    g.throughput(Throughput::Elements(wi.len() as u64));
+    g.bench_function("measured_single", |b| {
+        let mut f = [0.0f32; 3];
+        b.iter(|| {
+            for k in 0..wi.len() {
+                measured.eval(wi[k], wo[k], &mut f);
+                black_box(&f);
+            }
+        })
+    });
+    let mut block = vec![0.0f32; wi.len() * 3];
+    g.bench_function("measured_block", |b| {
+        b.iter(|| {
+            measured.eval_batch(&wi, &wo, &mut block);
+            black_box(&block);
+        })
+    });
     let (bi, bo) = pairs(1 << 20);
     let t = table();
     let mut out = vec![0.0f32; bi.len() * 3];
