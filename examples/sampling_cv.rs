@@ -10,7 +10,8 @@
 //! the table sampler built from it; `--res NH,NP,NT[,FLOOR]` sets the
 //! table sampler's θh, φh and θo nodes (and floor); SOURCE may be a model spec, e.g.
 //! `'{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}'`; `--grid G` bakes on grid
-//! G instead of the default, e.g. `medium`.)
+//! G instead of the default, e.g. `medium`; `--quantity fr|fr_cos_cos|fr_cos_out` bakes that
+//! stored quantity instead of the default.)
 
 use std::time::Instant;
 
@@ -19,7 +20,7 @@ use brdftab::analysis::weights::weight_stats;
 use brdftab::bake::{BakeRequest, BakeTarget, GridChoice};
 use brdftab::geometry;
 use brdftab::source;
-use brdftab::table::{SamplingResolution, TableSampler};
+use brdftab::table::{Quantity, SamplingResolution, TableSampler};
 
 /// A source sampled by a [`TableSampler`] built from it (`--wrap`): the sampler's quality
 /// separated from a table's.
@@ -132,6 +133,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut samples = 40_000;
     let (mut native, mut table) = (true, true);
     let mut grid: Option<GridChoice> = None;
+    let mut quantity: Option<Quantity> = None;
     let mut res = SamplingResolution::default();
     let mut res_set = false;
     let mut wrap = false;
@@ -144,6 +146,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--wrap" => wrap = true,
             "--table-only" => native = false,
             "--grid" => grid = args.next().map(|g| g.parse()).transpose()?,
+            "--quantity" => {
+                let q = args.next().unwrap_or_default();
+                quantity = Some(
+                    [Quantity::Fr, Quantity::FrCosCos, Quantity::FrCosOut]
+                        .into_iter()
+                        .find(|x| x.name() == q)
+                        .ok_or(format!("unknown quantity {q}"))?,
+                );
+            }
             "--res" => {
                 // θh,φh,θo[,floor] nodes of the table sampler (isotropic tables)
                 let v: Vec<f64> = args
@@ -197,6 +208,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mut req = BakeRequest::new(s.as_str());
             if let Some(g) = grid {
                 req = req.grid(g);
+            }
+            if let Some(q) = quantity {
+                req = req.quantity(q);
             }
             req.run(&BakeTarget::file(out.to_string_lossy()))?;
             let mut b = source::open_table(&out.to_string_lossy(), &Default::default())?;

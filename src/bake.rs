@@ -283,8 +283,9 @@ pub struct BakeRequest {
     /// [`GridChoice::Adaptive`]`(None)` or [`GridChoice::Default`].
     pub target_error: Option<f64>,
     /// What the table stores (`None`: [`Quantity::FrCosOut`] for measured sources, RGL files
-    /// and MERL files resampled to an error target, [`Quantity::Fr`] otherwise; see
-    /// [`Quantity`] for why).
+    /// and MERL files resampled to an error target, [`Quantity::FrCosCos`] for models whose f_r
+    /// is unbounded at the horizon ([`Brdf::grows_at_horizon`]), [`Quantity::Fr`] otherwise;
+    /// see [`Quantity`] for why).
     pub quantity: Option<Quantity>,
     /// Pin the table's directional albedo to the source's ([`crate::table::calibration`]) on
     /// tables that store a projected quantity and do not fold by reciprocity (measured sources
@@ -326,14 +327,18 @@ impl BakeRequest {
         self
     }
 
-    /// What the table stores: the request's own choice, or the default for its source.
-    pub fn effective_quantity(&self) -> Quantity {
+    /// What the table of `src` (this request's source, opened) stores: the request's own
+    /// choice, or the default for its source — f_r cos θo for measured data, f_r cos θi cos θo
+    /// for a model whose f_r is unbounded at the horizon ([`Brdf::grows_at_horizon`]), f_r
+    /// otherwise.
+    pub fn effective_quantity(&self, src: &dyn Brdf) -> Quantity {
         self.quantity
             .unwrap_or(match source::classify(&self.source) {
                 SourceKind::Rgl => Quantity::FrCosOut,
                 // Resampled onto an adaptive grid (an error target): bounded at the horizon
                 // like an RGL file's values. Its own cells are copied as they are (f_r).
                 SourceKind::Merl if self.adaptive() => Quantity::FrCosOut,
+                _ if src.grows_at_horizon() => Quantity::FrCosCos,
                 _ => Quantity::Fr,
             })
     }
@@ -439,7 +444,8 @@ impl BakeRequest {
     /// [`plan`](Self::plan), reporting an error-target search (about a second) on `progress`.
     pub fn plan_with(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<Plan> {
         let (mut sym, mut note) = self.resolve_symmetry(src);
-        if self.effective_quantity() == Quantity::FrCosOut && sym.reciprocal {
+        let quantity = self.effective_quantity(src);
+        if quantity == Quantity::FrCosOut && sym.reciprocal {
             // f_r cos θo differs between a pair and its swap: the table cannot fold by it.
             sym.reciprocal = false;
         }
@@ -463,13 +469,12 @@ impl BakeRequest {
                 ));
             }
         }
-        let albedo =
-            if self.calibrate && self.effective_quantity() != Quantity::Fr && !sym.reciprocal {
-                progress.note("integrating the source's albedo");
-                Some(AlbedoReference::new(src, &CalibrationOptions::default())?)
-            } else {
-                None
-            };
+        let albedo = if self.calibrate && quantity != Quantity::Fr && !sym.reciprocal {
+            progress.note("integrating the source's albedo");
+            Some(AlbedoReference::new(src, &CalibrationOptions::default())?)
+        } else {
+            None
+        };
         let mut search = None;
         let grid = match self.grid {
             GridChoice::Default
@@ -490,7 +495,7 @@ impl BakeRequest {
             },
         };
         Ok(Plan {
-            grid: grid.with_quantity(self.effective_quantity())?,
+            grid: grid.with_quantity(quantity)?,
             note,
             force,
             assumed,
@@ -540,13 +545,13 @@ impl BakeRequest {
             ));
         }
         let mut opts = target::TargetOptions::new(e);
-        if self.effective_quantity() != Quantity::Fr {
+        if self.effective_quantity(src) != Quantity::Fr {
             opts = opts.with_grazing(MEASURED_GRAZING_FACTOR);
         }
         target::search(
             src,
             sym,
-            &self.adaptive_options(adaptive::DEFAULT_NODES),
+            &self.adaptive_options(src, adaptive::DEFAULT_NODES),
             &opts,
             albedo,
             force,
@@ -555,8 +560,8 @@ impl BakeRequest {
     }
 
     /// The options of this request's adaptive grids of `nodes`.
-    fn adaptive_options(&self, nodes: [usize; 3]) -> adaptive::AdaptiveOptions {
-        let quantity = self.effective_quantity();
+    fn adaptive_options(&self, src: &dyn Brdf, nodes: [usize; 3]) -> adaptive::AdaptiveOptions {
+        let quantity = self.effective_quantity(src);
         adaptive::AdaptiveOptions {
             nodes,
             quantity,
@@ -582,7 +587,7 @@ impl BakeRequest {
             if self.param.is_some_and(|p| p != Param::HalfDiff) {
                 return Err(Error::arg("grid", "an adaptive grid is halfdiff"));
             }
-            return adaptive::adaptive_grid(src, sym, &self.adaptive_options(nodes));
+            return adaptive::adaptive_grid(src, sym, &self.adaptive_options(src, nodes));
         }
         match self.grid {
             GridChoice::Merl => Grid::merl(ch).with_symmetry(sym),
@@ -730,7 +735,9 @@ impl BakeRequest {
             }
             // Tables built whole before they are written: MERL cells, and calibrated tables
             // (the calibration needs every value; measured tables are small).
-            _ if self.keeps_merl_cells() || self.effective_quantity() != Quantity::Fr => {
+            _ if self.keeps_merl_cells()
+                || self.effective_quantity(src.as_ref()) != Quantity::Fr =>
+            {
                 let (table, r) = self.table_of(src.as_ref(), progress)?;
                 let (path, replace) = match target {
                     BakeTarget::Db { path, replace, .. } => (path.as_str(), *replace),

@@ -139,6 +139,16 @@ pub trait Brdf: Send + Sync {
     /// A short human-readable description (model name and parameters, or table and source).
     fn describe(&self) -> String;
 
+    /// Whether f_r grows without bound as one direction nears the horizon — Ward's
+    /// 1/√(cos θi cos θo), the original Phong's 1/cos θi. Bounded f_r cos θi cos θo is then
+    /// what a table of this BRDF should store (the bake's default for such sources): a table of
+    /// f_r itself blends a node near the horizon, where f_r is huge, over a whole cell, which
+    /// costs accuracy at grazing angles and gives its sampler a spike to follow. False by
+    /// default.
+    fn grows_at_horizon(&self) -> bool {
+        false
+    }
+
     /// f_r at one wavelength in nm. The default interpolates linearly between the channels
     /// (constant outside them); analytic models with spectral parameters override it to use
     /// their spectral data directly.
@@ -329,6 +339,9 @@ macro_rules! forward_brdf {
             }
             fn describe(&self) -> String {
                 (**self).describe()
+            }
+            fn grows_at_horizon(&self) -> bool {
+                (**self).grows_at_horizon()
             }
             fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
                 (**self).eval_wavelength(wi, wo, nm)

@@ -205,6 +205,18 @@ impl Brdf for Phong {
         }
     }
 
+    /// The variants that divide by cos θ′ alone or by a product with it (1/cos θ′,
+    /// 1/(cos θ′ cos θ), 1/√(cos θ′ cos θ)); the max and the mean stay bounded while the other
+    /// direction is above the horizon.
+    fn grows_at_horizon(&self) -> bool {
+        matches!(
+            self.variant,
+            PhongVariant::Original
+                | PhongVariant::Pumped(PumpX::Product)
+                | PhongVariant::Pumped(PumpX::Sqrt)
+        )
+    }
+
     fn describe(&self) -> String {
         let name = match self.variant {
             PhongVariant::Original => "phong".to_string(),

@@ -555,6 +555,11 @@ impl Brdf for Sum {
         self.flags
     }
 
+    /// When any term does (a sum is as unbounded as its worst term).
+    fn grows_at_horizon(&self) -> bool {
+        self.terms.iter().any(|t| t.grows_at_horizon())
+    }
+
     fn describe(&self) -> String {
         let parts: Vec<String> = self
             .terms

@@ -138,6 +138,11 @@ impl Brdf for Ward {
         }
     }
 
+    /// 1/√(cos θi cos θo): unbounded as either direction nears the horizon.
+    fn grows_at_horizon(&self) -> bool {
+        true
+    }
+
     fn describe(&self) -> String {
         format!(
             "ward ks={} alpha_x={} alpha_y={}",

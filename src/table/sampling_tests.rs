@@ -361,6 +361,7 @@ fn pdf_integrates_to_one() {
             );
         }
     }
-    assert!(ward().sampler().memory_bytes() < 4 << 20);
+    // 48 × 48 nodes per view, 20 × 16 views: 6.0 MB (`SamplingResolution::anisotropic`).
+    assert!(ward().sampler().memory_bytes() < 13 << 19);
     assert!(rgl_native().sampler().memory_bytes() < 3 << 19);
 }
