@@ -19,12 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         match a.as_str() {
             "--quantity" => {
                 let q = args.next().unwrap_or_default();
-                quantity = Some(
-                    [Quantity::Fr, Quantity::FrCosCos, Quantity::FrCosOut]
-                        .into_iter()
-                        .find(|x| x.name() == q)
-                        .ok_or(format!("unknown quantity {q}"))?,
-                );
+                quantity = Some(Quantity::from_name(&q).ok_or(format!("unknown quantity {q}"))?);
             }
             "--pairs" => pairs = args.next().and_then(|s| s.parse().ok()).unwrap_or(pairs),
             _ => specs.push(a),

@@ -148,12 +148,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--grid" => grid = args.next().map(|g| g.parse()).transpose()?,
             "--quantity" => {
                 let q = args.next().unwrap_or_default();
-                quantity = Some(
-                    [Quantity::Fr, Quantity::FrCosCos, Quantity::FrCosOut]
-                        .into_iter()
-                        .find(|x| x.name() == q)
-                        .ok_or(format!("unknown quantity {q}"))?,
-                );
+                quantity = Some(Quantity::from_name(&q).ok_or(format!("unknown quantity {q}"))?);
             }
             "--res" => {
                 // θh,φh,θo[,floor] nodes of the table sampler (isotropic tables)

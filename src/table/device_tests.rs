@@ -5,7 +5,7 @@ use crate::brdf::Brdf;
 use crate::rng::Pcg32;
 use crate::spec::ModelSpec;
 use crate::spectrum::Channels;
-use crate::table::adaptive::{AdaptiveOptions, adaptive_grid};
+use crate::table::adaptive::adaptive_grid;
 use crate::table::grid::{Grid, Mapping};
 use crate::table::{BakeOptions, TabulatedBrdf, bake};
 
@@ -215,13 +215,7 @@ fn kernel_layouts_evaluate_as_the_table() {
         ),
     ];
     for (quantity, h_var, s, channels) in cases {
-        let opts = AdaptiveOptions {
-            nodes: [24, 16, 9],
-            fine: [64, 32, 16],
-            quantity,
-            h_var,
-            ..Default::default()
-        };
+        let opts = crate::table::kernel::test_adaptive_options(quantity, h_var);
         let src = source(GGX, &channels);
         let grid = adaptive_grid(src.as_ref(), s, &opts).unwrap();
         let t = baked(GGX, grid);

@@ -467,6 +467,19 @@ impl Quantity {
         }
     }
 
+    /// The quantity of a [`Quantity::name`].
+    ///
+    /// ```
+    /// use brdftab::table::Quantity;
+    /// assert_eq!(Quantity::from_name("fr_cos_cos"), Some(Quantity::FrCosCos));
+    /// assert_eq!(Quantity::from_name("cos"), None);
+    /// ```
+    pub fn from_name(name: &str) -> Option<Quantity> {
+        [Quantity::Fr, Quantity::FrCosCos, Quantity::FrCosOut]
+            .into_iter()
+            .find(|q| q.name() == name)
+    }
+
     /// The factor of f_r in this quantity for a pair with cosines `cos_i`, `cos_o`.
     #[inline(always)]
     pub fn factor(self, cos_i: f64, cos_o: f64) -> f64 {

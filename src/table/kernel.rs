@@ -900,6 +900,31 @@ pub fn reference_vars(wi: DVec3, wo: DVec3, quarter: bool, h_var: WarpVar) -> Op
     ])
 }
 
+/// The adaptive-grid cases the kernel's tests bake (reciprocity, stored quantity, θh's
+/// variable): both θh variables, f_r and both projected quantities.
+#[cfg(test)]
+pub(crate) const TEST_CASES: [(bool, Quantity, WarpVar); 4] = [
+    (false, Quantity::Fr, WarpVar::SqrtSine),
+    (true, Quantity::Fr, WarpVar::QuarterPower),
+    (false, Quantity::FrCosOut, WarpVar::QuarterPower),
+    (true, Quantity::FrCosCos, WarpVar::SqrtSine),
+];
+
+/// The small adaptive grid the kernel's and the device layout's tests bake (24 × 16 × 9 nodes).
+#[cfg(test)]
+pub(crate) fn test_adaptive_options(
+    quantity: Quantity,
+    h_var: WarpVar,
+) -> crate::table::adaptive::AdaptiveOptions {
+    crate::table::adaptive::AdaptiveOptions {
+        nodes: [24, 16, 9],
+        fine: [64, 32, 16],
+        quantity,
+        h_var,
+        ..Default::default()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -907,7 +932,7 @@ mod tests {
     use crate::rng::Pcg32;
     use crate::spec::ModelSpec;
     use crate::spectrum::Channels;
-    use crate::table::adaptive::{AdaptiveOptions, adaptive_grid};
+    use crate::table::adaptive::adaptive_grid;
     use crate::table::symmetry::Symmetry;
     use crate::table::{BakeOptions, TabulatedBrdf, bake, lookup::Interp, lookup::Lookup};
 
@@ -1017,25 +1042,13 @@ mod tests {
             .unwrap();
         // f_r tables (θh by SqrtSine and QuarterPower) and tables of the other quantities, whose
         // lookups divide by the cosines (and whose nodes beyond the horizon are extrapolated).
-        let cases = [
-            (false, Quantity::Fr, WarpVar::SqrtSine),
-            (true, Quantity::Fr, WarpVar::QuarterPower),
-            (false, Quantity::FrCosOut, WarpVar::QuarterPower),
-            (true, Quantity::FrCosCos, WarpVar::SqrtSine),
-        ];
-        for (reciprocal, quantity, h_var) in cases {
+        for (reciprocal, quantity, h_var) in TEST_CASES {
             let sym = Symmetry {
                 isotropic: true,
                 reciprocal,
                 bilateral: true,
             };
-            let opts = AdaptiveOptions {
-                nodes: [24, 16, 9],
-                fine: [64, 32, 16],
-                quantity,
-                h_var,
-                ..Default::default()
-            };
+            let opts = test_adaptive_options(quantity, h_var);
             let grid = adaptive_grid(src.as_ref(), sym, &opts).unwrap();
             let (t, _) = bake(src.as_ref(), &grid, &BakeOptions::default()).unwrap();
             let k = Kernel::new(t.grid()).expect("an adaptive grid has a kernel");

@@ -54,7 +54,7 @@ impl Kernel {
     /// from the table's `values` ([`Packed::for_kernel`]), bit-equal to [`Kernel::eval`] pair by
     /// pair. Returns the lanes left to the caller's one-pair path (bit k: pair k; its output
     /// is unspecified): a direction that is not unit length (within
-    /// [`geometry::is_unit_l2`]) and a pair beyond a resampled axis's cut; all of them when the
+    /// [`crate::geometry::is_unit_l2`]) and a pair beyond a resampled axis's cut; all of them when the
     /// table is too short for some corner, there are fewer than [`LANES`] pairs or no
     /// eight-lane path ([`Kernel::has_x8`]).
     pub fn eval_x8(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32], values: &Packed) -> u8 {
@@ -328,11 +328,10 @@ mod tests {
     use crate::rng::Pcg32;
     use crate::spec::ModelSpec;
     use crate::spectrum::Channels;
-    use crate::table::adaptive::{AdaptiveOptions, adaptive_grid};
+    use crate::table::adaptive::adaptive_grid;
     use crate::table::calibration::Calibration;
     use crate::table::grid::{Grid, Mapping, Param, Quantity};
     use crate::table::symmetry::Symmetry;
-    use crate::table::warp::WarpVar;
     use crate::table::{BakeOptions, Table, TabulatedBrdf, bake};
 
     /// Pairs of every kind the lanes meet: random, near the normal and the horizon, mirror
@@ -369,24 +368,13 @@ mod tests {
             .build(&Channels::Rgb)
             .unwrap();
         let mut out = Vec::new();
-        for (reciprocal, quantity, h_var) in [
-            (false, Quantity::Fr, WarpVar::SqrtSine),
-            (true, Quantity::Fr, WarpVar::QuarterPower),
-            (false, Quantity::FrCosOut, WarpVar::QuarterPower),
-            (true, Quantity::FrCosCos, WarpVar::SqrtSine),
-        ] {
+        for (reciprocal, quantity, h_var) in super::super::TEST_CASES {
             let sym = Symmetry {
                 isotropic: true,
                 reciprocal,
                 bilateral: true,
             };
-            let opts = AdaptiveOptions {
-                nodes: [24, 16, 9],
-                fine: [64, 32, 16],
-                quantity,
-                h_var,
-                ..Default::default()
-            };
+            let opts = super::super::test_adaptive_options(quantity, h_var);
             let grid = adaptive_grid(ggx.as_ref(), sym, &opts).unwrap();
             let (t, _) = bake(ggx.as_ref(), &grid, &BakeOptions::default()).unwrap();
             let name = format!("adaptive {quantity:?} {h_var:?} reciprocal {reciprocal}");
