@@ -753,7 +753,7 @@ class JitBrdftabBSDF(_Common):
         iso = layout["kind"] == "kernel" or layout["grid"]["symmetry"]["isotropic"]
         res = int(_prop(props, "sampling_res", 64 if iso else 48))
         nodes = self._sampled.sampling_nodes(adjoint=True, theta_h=res, phi_h=res,
-                                             theta_o=32 if iso else 12)
+                                             theta_o=32 if iso else 20)
         self.sampler = HalfVectorSampler(nodes)
         dr.eval()
 
