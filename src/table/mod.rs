@@ -19,6 +19,7 @@
 //! one set of angular interpolation weights serves all channels.
 
 pub mod adaptive;
+mod alias2d;
 pub mod calibration;
 pub mod device;
 pub mod fill;

@@ -298,8 +298,9 @@ fn weights_are_bounded() {
 #[test]
 fn sampler_memory_is_bounded() {
     let s = phong().sampler();
-    // 32 views × (64 × 64 × 2 + 64) f32, as `info` reports before building.
-    assert_eq!(s.memory_bytes(), 32 * (64 * 64 * 2 + 64) * 4);
+    // 32 views × (64 × 64 densities + 126 half-strips + 64 × 63 cells) × 4 bytes, as `info`
+    // reports before building.
+    assert_eq!(s.memory_bytes(), 32 * (64 * 64 + 126 + 64 * 63) * 4);
     assert_eq!(
         s.memory_bytes(),
         SamplingResolution::default().memory_bytes(true)

@@ -123,11 +123,6 @@ impl Warp {
         })
     }
 
-    /// Bytes held (densities and CDFs).
-    pub(crate) fn memory_bytes(&self) -> usize {
-        4 * (self.pdf.data.len() + self.conditional.len() + self.marginal.len())
-    }
-
     /// The point of the unit square that the warp maps onto `u` (the inverse of sampling).
     #[inline]
     pub(crate) fn invert(&self, u: [f64; 2], k: &Corners) -> [f64; 2] {
