@@ -1,5 +1,6 @@
 //! Lookup timing: how fast a `Brdf` evaluates random pairs, one at a time on one thread and in
-//! batches ([`Brdf::eval_batch`]) on every core.
+//! batches ([`Brdf::eval_batch`]) on every core, and what its `sample` and `pdf` cost beside one
+//! `eval` in the same rounds (a renderer calls all three per bounce).
 //!
 //! The machines this runs on are shared, so each figure comes with its CPU-time twin (Linux
 //! schedstat; `None` elsewhere): wall-clock time alone says more about the neighbours than about
@@ -36,6 +37,13 @@ pub struct LookupTiming {
     pub lookups_per_s_batch_per_core_cpu_time: f64,
     /// Threads `eval_batch` may use.
     pub threads: usize,
+    /// Wall-clock ns per `sample` (direction, pdf and weight) on one thread, for the same views
+    /// and rounds as `eval`.
+    pub ns_per_sample_single_thread: f64,
+    /// Wall-clock ns per `pdf` on one thread, same pairs and rounds as `eval`.
+    pub ns_per_pdf_single_thread: f64,
+    /// Median over the rounds of one `sample` / one `eval` (each round times both).
+    pub sample_over_eval: f64,
 }
 
 /// Times `src` on `pairs` random pairs (uniform on the hemisphere, fixed seed), `repeats` times.
@@ -53,21 +61,37 @@ pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTim
             )
         })
         .unzip();
+    let u: Vec<glam::DVec2> = (0..pairs).map(|_| rng.next_dvec2()).collect();
     let mut out = vec![0.0f32; pairs * c];
-    // Warm up (loads lazy chunks, faults pages).
+    // Warm up (loads lazy chunks, faults pages, builds a table's sampler).
     src.eval_batch(&wi, &wo, &mut out);
+    std::hint::black_box(src.sample(wo[0], u[0], &mut out[..c]));
     let n = pairs as f64;
     let (mut single, mut single_cpu) = (Vec::new(), Vec::new());
+    let (mut sample, mut pdf, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..repeats {
         let (t, cpu) = (Instant::now(), thread_cpu_ns());
         for (k, o) in out.chunks_exact_mut(c).enumerate() {
             src.eval(wi[k], wo[k], o);
         }
-        single.push(t.elapsed().as_secs_f64() * 1e9 / n);
+        let eval_ns = t.elapsed().as_secs_f64() * 1e9 / n;
+        single.push(eval_ns);
         if let (Some(a0), Some(a1)) = (cpu, thread_cpu_ns()) {
             single_cpu.push((a1 - a0) as f64 / n);
         }
         std::hint::black_box(&out);
+        let t = Instant::now();
+        for (k, o) in out.chunks_exact_mut(c).enumerate() {
+            std::hint::black_box(src.sample(wo[k], u[k], o));
+        }
+        let sample_ns = t.elapsed().as_secs_f64() * 1e9 / n;
+        sample.push(sample_ns);
+        ratio.push(sample_ns / eval_ns);
+        let t = Instant::now();
+        for k in 0..pairs {
+            std::hint::black_box(src.pdf(wi[k], wo[k]));
+        }
+        pdf.push(t.elapsed().as_secs_f64() * 1e9 / n);
     }
     let (mut batch, mut batch_cpu) = (Vec::new(), Vec::new());
     for _ in 0..repeats {
@@ -91,6 +115,9 @@ pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTim
         lookups_per_s_batch: median(&mut batch),
         lookups_per_s_batch_per_core_cpu_time: median(&mut batch_cpu),
         threads: crate::par::threads(),
+        ns_per_sample_single_thread: median(&mut sample),
+        ns_per_pdf_single_thread: median(&mut pdf),
+        sample_over_eval: median(&mut ratio),
     })
 }
 
@@ -130,6 +157,8 @@ mod tests {
         let t = lookups(m.as_ref(), 2000, 3).unwrap();
         assert_eq!((t.pairs, t.channels, t.repeats), (2000, 3, 3));
         assert!(t.ns_per_lookup_single_thread > 0.0 && t.lookups_per_s_batch > 0.0);
+        assert!(t.ns_per_sample_single_thread > 0.0 && t.ns_per_pdf_single_thread > 0.0);
+        assert!(t.sample_over_eval > 0.0);
         assert!(lookups(m.as_ref(), 0, 3).is_err());
     }
 }

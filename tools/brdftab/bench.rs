@@ -120,6 +120,16 @@ pub fn bench(a: BenchArgs) -> Result<()> {
             t.threads,
             t.lookups_per_s_batch_per_core_cpu_time / 1e6
         );
+        let _ = writeln!(
+            o,
+            "sample:  {:.1} ns per sample (direction, pdf and weight) = {:.2}× one lookup (median of {r} rounds timing both, one thread)",
+            t.ns_per_sample_single_thread, t.sample_over_eval
+        );
+        let _ = writeln!(
+            o,
+            "pdf:     {:.1} ns per pdf (same pairs, one thread)",
+            t.ns_per_pdf_single_thread
+        );
     }
     print_out(&o)
 }
