@@ -55,6 +55,10 @@ fn compile(compiler: &str, extra: &[&str], src: &Path, exe: &Path) {
         .arg(src)
         .arg(format!("-L{}", lib.display()))
         .arg(format!("-Wl,-rpath,{}", lib.display()))
+        // DT_RPATH, not DT_RUNPATH: searched before LD_LIBRARY_PATH, which `cargo test` sets
+        // with target/<profile> (where an older `cargo build` may have left another
+        // libbrdftab_c.so) — the programs must run the library this test run built.
+        .arg("-Wl,--disable-new-dtags")
         .arg("-lbrdftab_c")
         .args(["-lpthread", "-lm"])
         .arg("-o")
