@@ -419,7 +419,7 @@ impl TableSampler {
                 w: [1.0 - ft, ft, 0.0, 0.0],
             };
         }
-        let mut phi = wo.y.atan2(wo.x);
+        let mut phi = fastmath::atan2(wo.y, wo.x);
         if phi < 0.0 {
             phi += TAU;
         }
