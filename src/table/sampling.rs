@@ -43,8 +43,8 @@
 //!   its weight, then drawn from), so [`TableSampler::pdf`] is the density of
 //!   [`TableSampler::sample`] for every `wo`, not only at the nodes.
 //! - **Cost**: a sample is a choice of node, two alias-table draws and a square root, two
-//!   `sin_cos` (polynomial, [`fastmath`]), a reflection, the density of the other preimage (two
-//!   [`fastmath::atan2`] and a bilinear lookup) and one evaluation of the source for the weight;
+//!   `sin_cos` (polynomial, `fastmath`), a reflection, the density of the other preimage (two
+//!   `fastmath::atan2` and a bilinear lookup) and one evaluation of the source for the weight;
 //!   it never allocates. (Drawing by two binary searches over CDFs interpolated
 //!   between nodes and two quadratics, as RGL's `Marginal2D` does, cost 283 ns per sample
 //!   of a measured table where this costs 184; `pdf` 125 → 89 ns.)
