@@ -68,8 +68,61 @@ pub struct SampleOut<'a> {
 ///
 /// If the lengths do not match `wo.len()` pairs of `c = brdf.channels().len()` weights.
 pub fn sample<B: Brdf + ?Sized>(brdf: &B, wo: &[DVec3], u: &[DVec2], out: SampleOut<'_>) {
-    let n = wo.len();
     let c = brdf.channels().len().max(1);
+    sample_blocks(c, wo, u, out, |wo, u, out| {
+        let SampleOut { wi, pdf, weight } = out;
+        for (k, ((wi, p), w)) in wi
+            .iter_mut()
+            .zip(pdf.iter_mut())
+            .zip(weight.chunks_exact_mut(c))
+            .enumerate()
+        {
+            let drawn = match drawable(wo[k], u[k]) {
+                true => brdf.sample(wo[k], u[k], w),
+                false => None,
+            };
+            match drawn {
+                Some(d) => {
+                    *wi = d.wi;
+                    *p = d.pdf;
+                }
+                None => no_sample(wi, p, w),
+            }
+        }
+    });
+}
+
+/// Whether a pair may have a sample: non-finite input has none (the NaN rule of every host),
+/// whatever the source.
+#[inline]
+pub fn drawable(wo: DVec3, u: DVec2) -> bool {
+    wo.is_finite() && u.is_finite()
+}
+
+/// The outputs of a pair without a sample: zeros.
+#[inline]
+pub fn no_sample(wi: &mut DVec3, pdf: &mut f64, weight: &mut [f32]) {
+    *wi = DVec3::ZERO;
+    *pdf = 0.0;
+    weight.fill(0.0);
+}
+
+/// [`sample`]'s blocks with another per-block body: `run(wo, u, out)` fills one block of at
+/// most [`BLOCK`] pairs (`wo` and `u` are the block's inputs, `out` its rows; `c` weights per
+/// pair), in parallel from [`PARALLEL`] pairs on. For sources that draw a block first and then
+/// evaluate its weights together (tables: [`Brdf::eval_batch`]'s eight-lane path).
+///
+/// # Panics
+///
+/// If the lengths do not match `wo.len()` pairs of `c` weights.
+pub fn sample_blocks(
+    c: usize,
+    wo: &[DVec3],
+    u: &[DVec2],
+    out: SampleOut<'_>,
+    run: impl Fn(&[DVec3], &[DVec2], SampleOut<'_>) + Sync + Send,
+) {
+    let n = wo.len();
     let SampleOut { wi, pdf, weight } = out;
     assert!(
         u.len() == n && wi.len() == n && pdf.len() == n && weight.len() == n * c,
@@ -79,32 +132,9 @@ pub fn sample<B: Brdf + ?Sized>(brdf: &B, wo: &[DVec3], u: &[DVec2], out: Sample
         pdf.len(),
         weight.len()
     );
-    // One parallel pass over the three outputs, zipped block by block.
-    let run = |s: usize, wi: &mut [DVec3], pdf: &mut [f64], w: &mut [f32]| {
-        for (k, ((wi, p), w)) in wi
-            .iter_mut()
-            .zip(pdf.iter_mut())
-            .zip(w.chunks_exact_mut(c))
-            .enumerate()
-        {
-            let (o, u) = (wo[s + k], u[s + k]);
-            // Non-finite input has no sample (the NaN rule of every host), whatever the source.
-            let drawn = match o.is_finite() && u.is_finite() {
-                true => brdf.sample(o, u, w),
-                false => None,
-            };
-            match drawn {
-                Some(d) => {
-                    *wi = d.wi;
-                    *p = d.pdf;
-                }
-                None => {
-                    *wi = DVec3::ZERO;
-                    *p = 0.0;
-                    w.fill(0.0);
-                }
-            }
-        }
+    let go = |s: usize, wi: &mut [DVec3], pdf: &mut [f64], weight: &mut [f32]| {
+        let m = wi.len();
+        run(&wo[s..s + m], &u[s..s + m], SampleOut { wi, pdf, weight })
     };
     if n >= PARALLEL {
         crate::par::install(|| {
@@ -112,10 +142,17 @@ pub fn sample<B: Brdf + ?Sized>(brdf: &B, wo: &[DVec3], u: &[DVec2], out: Sample
                 .zip(pdf.par_chunks_mut(BLOCK))
                 .zip(weight.par_chunks_mut(BLOCK * c))
                 .enumerate()
-                .for_each(|(b, ((wi, p), w))| run(b * BLOCK, wi, p, w))
+                .for_each(|(b, ((wi, p), w))| go(b * BLOCK, wi, p, w))
         });
     } else {
-        run(0, wi, pdf, weight);
+        for (b, ((wi, p), w)) in wi
+            .chunks_mut(BLOCK)
+            .zip(pdf.chunks_mut(BLOCK))
+            .zip(weight.chunks_mut(BLOCK * c))
+            .enumerate()
+        {
+            go(b * BLOCK, wi, p, w);
+        }
     }
 }
 

@@ -497,6 +497,20 @@ impl TableSampler {
         u: DVec2,
         weight: &mut [f32],
     ) -> Option<BrdfSample> {
+        let d = self.draw(wo, u)?;
+        let ch = brdf.channels().len();
+        brdf.eval(d.wi, d.wo, &mut weight[..ch]);
+        d.weigh(&mut weight[..ch]);
+        Some(BrdfSample {
+            wi: d.wi,
+            pdf: d.pdf,
+            delta: false,
+        })
+    }
+
+    /// The direction and density of [`TableSampler::sample`] without the weight's evaluation
+    /// (for callers that evaluate many draws at once: [`Draw::weigh`] finishes each).
+    pub fn draw(&self, wo: DVec3, u: DVec2) -> Option<Draw> {
         let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
             return None;
@@ -533,17 +547,29 @@ impl TableSampler {
         // Back from the nodes' frame. Unit to rounding (h and wo are unit, the rotation is
         // orthogonal): within what lookups take as unit, so no normalization.
         let wi = DVec3::new(c * wil.x - s * wil.y, s * wil.x + c * wil.y, wil.z);
-        let ch = brdf.channels().len();
-        brdf.eval(wi, wo, &mut weight[..ch]);
-        let k = wi.z / pdf;
-        for w in &mut weight[..ch] {
+        Some(Draw { wi, wo, pdf })
+    }
+}
+
+/// A direction drawn by [`TableSampler::draw`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Draw {
+    /// The drawn incident direction (unit).
+    pub wi: DVec3,
+    /// The view it was drawn for, unit: what the weight's evaluation takes.
+    pub wo: DVec3,
+    /// The density of `wi` (solid angle).
+    pub pdf: f64,
+}
+
+impl Draw {
+    /// Turns f_r(`wi`, `wo`) in `f` into the weight f_r cos θi / pdf (in f64, rounded once).
+    #[inline]
+    pub fn weigh(&self, f: &mut [f32]) {
+        let k = self.wi.z / self.pdf;
+        for w in f {
             *w = (*w as f64 * k) as f32;
         }
-        Some(BrdfSample {
-            wi,
-            pdf,
-            delta: false,
-        })
     }
 }
 

@@ -572,6 +572,55 @@ impl Brdf for TabulatedBrdf {
         self.sampler().pdf(wi, wo)
     }
 
+    /// Draws a run of pairs, then evaluates their weights together ([`Brdf::eval_batch`]'s
+    /// path: eight lookups per AVX2 group on kernel tables), then weighs them: the same values
+    /// as [`TabulatedBrdf::sample`] pair by pair, at a batch lookup's cost for the weights.
+    fn sample_batch(&self, wo: &[DVec3], u: &[DVec2], out: crate::batch::SampleOut<'_>) {
+        use crate::batch::{SampleOut, drawable, no_sample};
+        /// Pairs drawn before their weights are evaluated (on the stack: 3 kB of views).
+        const RUN: usize = 128;
+        let c = self.lookup.channels().max(1);
+        let sampler = self.sampler();
+        crate::batch::sample_blocks(c, wo, u, out, |wo, u, out| {
+            let SampleOut { wi, pdf, weight } = out;
+            let mut views = [DVec3::ZERO; RUN];
+            for (s, ((wi, pdf), weight)) in wi
+                .chunks_mut(RUN)
+                .zip(pdf.chunks_mut(RUN))
+                .zip(weight.chunks_mut(RUN * c))
+                .enumerate()
+            {
+                let s = s * RUN;
+                let m = wi.len();
+                for k in 0..m {
+                    let d = match drawable(wo[s + k], u[s + k]) {
+                        true => sampler.draw(wo[s + k], u[s + k]),
+                        false => None,
+                    };
+                    // A pair without a sample is evaluated at wi = 0 (f_r = 0, cheap) and
+                    // zeroed below.
+                    (wi[k], pdf[k], views[k]) = match d {
+                        Some(d) => (d.wi, d.pdf, d.wo),
+                        None => (DVec3::ZERO, 0.0, DVec3::Z),
+                    };
+                }
+                self.eval_block(wi, &views[..m], weight);
+                for (k, w) in weight.chunks_exact_mut(c).enumerate() {
+                    if pdf[k] > 0.0 {
+                        let d = crate::table::Draw {
+                            wi: wi[k],
+                            wo: views[k],
+                            pdf: pdf[k],
+                        };
+                        d.weigh(w);
+                    } else {
+                        no_sample(&mut wi[k], &mut pdf[k], w);
+                    }
+                }
+            }
+        });
+    }
+
     /// Parallel (rayon) above 16384 pairs, sequential below.
     fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
         let c = self.lookup.channels();

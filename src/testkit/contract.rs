@@ -240,7 +240,8 @@ fn sensitivity(brdf: &dyn Brdf, wi: DVec3, wo: DVec3, ch: usize, angle: f64) -> 
     .fold(0.0, f64::max)
 }
 
-/// `eval_batch` against `eval`, pair by pair (unnormalized and below-horizon pairs included).
+/// `eval_batch` against `eval` and `sample_batch` against `sample`, pair by pair
+/// (unnormalized, below-horizon and, for sampling, non-finite views included).
 fn batches(brdf: &dyn Brdf, opts: &Contract, pairs: &[(DVec3, DVec3)], log: &mut Log) {
     let c = brdf.channels().len();
     let (wi, wo): (Vec<DVec3>, Vec<DVec3>) = pairs
@@ -263,6 +264,49 @@ fn batches(brdf: &dyn Brdf, opts: &Contract, pairs: &[(DVec3, DVec3)], log: &mut
                     wi[k],
                     wo[k],
                     &want[..c]
+                )
+            });
+        }
+    }
+    // The same views drawn from in one batch and one by one (the `u` of pair k from its wi).
+    let mut wo_s = wo.clone();
+    wo_s[2] = DVec3::new(f64::NAN, 0.0, 1.0);
+    let u: Vec<DVec2> = wi
+        .iter()
+        .map(|a| DVec2::new(a.x.abs().fract(), a.y.abs().fract()))
+        .collect();
+    let n = wo_s.len();
+    let (mut swi, mut spdf, mut sw) = (vec![DVec3::ZERO; n], vec![0.0; n], vec![0.0f32; n * c]);
+    let out = crate::batch::SampleOut {
+        wi: &mut swi,
+        pdf: &mut spdf,
+        weight: &mut sw,
+    };
+    brdf.sample_batch(&wo_s, &u, out);
+    let mut w = [0.0f32; MAX_CHANNELS];
+    for k in 0..n {
+        let one = match crate::batch::drawable(wo_s[k], u[k]) {
+            true => brdf.sample(wo_s[k], u[k], &mut w[..c]),
+            false => None,
+        };
+        let got = &sw[k * c..(k + 1) * c];
+        let agrees = match one {
+            Some(s) => {
+                (swi[k] - s.wi).length() <= opts.batch_tolerance
+                    && close(spdf[k], s.pdf, opts.batch_tolerance)
+                    && (0..c).all(|ch| close(got[ch] as f64, w[ch] as f64, opts.batch_tolerance))
+            }
+            None => swi[k] == DVec3::ZERO && spdf[k] == 0.0 && got.iter().all(|&x| x == 0.0),
+        };
+        if !agrees {
+            log.fail("sample_batch", || {
+                format!(
+                    "wo {}, u {}: batch ({}, {}, {got:?}) vs sample {one:?} {:?}",
+                    wo_s[k],
+                    u[k],
+                    swi[k],
+                    spdf[k],
+                    &w[..c]
                 )
             });
         }
