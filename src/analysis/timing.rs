@@ -44,6 +44,8 @@ pub struct LookupTiming {
     pub ns_per_pdf_single_thread: f64,
     /// Median over the rounds of one `sample` / one `eval` (each round times both).
     pub sample_over_eval: f64,
+    /// Samples per second of CPU time of `sample_batch` on the same views (per core).
+    pub samples_per_s_batch_per_core_cpu_time: f64,
 }
 
 /// Times `src` on `pairs` random pairs (uniform on the hemisphere, fixed seed), `repeats` times.
@@ -105,6 +107,21 @@ pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTim
         }
         std::hint::black_box(&out);
     }
+    let (mut swi, mut spdf) = (vec![DVec3::ZERO; pairs], vec![0.0; pairs]);
+    let mut sample_batch = Vec::new();
+    for _ in 0..repeats {
+        let cpu = process_cpu_ns();
+        let out = crate::batch::SampleOut {
+            wi: &mut swi,
+            pdf: &mut spdf,
+            weight: &mut out,
+        };
+        src.sample_batch(&wo, &u, out);
+        if let (Some(a0), Some(a1)) = (cpu, process_cpu_ns()) {
+            sample_batch.push(n / ((a1 - a0) as f64 * 1e-9));
+        }
+        std::hint::black_box(&swi);
+    }
     Ok(LookupTiming {
         source: src.describe(),
         pairs,
@@ -118,6 +135,7 @@ pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTim
         ns_per_sample_single_thread: median(&mut sample),
         ns_per_pdf_single_thread: median(&mut pdf),
         sample_over_eval: median(&mut ratio),
+        samples_per_s_batch_per_core_cpu_time: median(&mut sample_batch),
     })
 }
 

@@ -130,6 +130,11 @@ pub fn bench(a: BenchArgs) -> Result<()> {
             "pdf:     {:.1} ns per pdf (same pairs, one thread)",
             t.ns_per_pdf_single_thread
         );
+        let _ = writeln!(
+            o,
+            "sample batch: {:.2} M samples/s per core of CPU time (sample_batch on the same views, median of {r})",
+            t.samples_per_s_batch_per_core_cpu_time / 1e6
+        );
     }
     print_out(&o)
 }
