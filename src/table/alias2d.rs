@@ -30,8 +30,8 @@
 //! Steps 2 and 3 do not depend on each other, so the chain of a draw is the slice choice, three
 //! loads and a square root; no quadratic, no search. (Alias tables over half-cells would save
 //! the coin's load and division but hold twice the entries: 1.5 × the bytes of the CDFs they
-//! replace, where cells hold the same.) The first uniform number draws the
-//! half-cell, the second the slice and the half-strip (each step rescales its remainder to
+//! replace, where cells hold the same.) The first uniform number draws the cell, the coin and
+//! f, the second the slice, the half-strip and t (each step rescales its remainder to
 //! [0, 1)). The alias tables store their probabilities in fixed point ([`Packing`]), so the
 //! drawn distribution matches the density to the rounding of the masses.
 
@@ -39,8 +39,8 @@ use super::warp2d::{Corners, Planes, Warp};
 
 /// Alias tables (Walker; Vose's construction) packed in one u32 per slot: draw slot i
 /// uniformly, keep it with probability `keep`, else take `other`. The top `bits` of an entry
-/// hold `other`, the rest `keep` in fixed point (2^−(32 − bits) steps: for the sampler's 63
-/// cells per row, 2^−26 of a slot's mass, finer than the f32 CDFs of [`Warp`]). A slot that
+/// hold `other`, the rest `keep` in fixed point (2^−(32 − bits) steps: 2^−25 of a slot's mass
+/// with the default sampler's 126 half-strips per slice, finer than the f32 CDFs of [`Warp`]). A slot that
 /// keeps everything names itself as `other` with `keep` 0 (the same draw, and 1 needs no
 /// representation).
 #[derive(Debug, Clone, Copy)]
