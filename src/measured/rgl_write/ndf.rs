@@ -234,6 +234,9 @@ fn project(q: &Quadrature, d_q: &[f64], nx: usize, ny: usize, isotropic: bool) -
 pub fn recover(brdf: &dyn Brdf, layout: &Layout) -> Result<Ndf> {
     let (nx, ny, iso) = (layout.ndf_nx, layout.ndf_ny, layout.isotropic);
     let f = retro(brdf, nx, ny, iso)?;
+    // Zeros from a source that failed while it was read (a corrupt table chunk) are that
+    // failure, not a black material.
+    brdf.health()?;
     let fmax = f.iter().cloned().fold(0.0, f64::max);
     if fmax <= 0.0 {
         return Err(Error::arg(
