@@ -187,7 +187,7 @@ impl DeviceLayout {
                     axes: k.device_axes(),
                     values: (0..packed.len()).map(|i| packed.get(i)).collect(),
                 };
-                let fallback = k.resampled().then(|| general(values));
+                let fallback = k.has_cut().then(|| general(values));
                 (DeviceKind::Kernel, Some(layout), fallback)
             }
             None => (DeviceKind::Grid, None, Some(general(values))),

@@ -19,19 +19,20 @@
 //! the bytes, so a measured material's table stays in L2; expanded with F16C when the CPU has
 //! it, chosen once per kernel).
 //!
-//! Grids on the MERL-style fixed mappings (sqrt θh, uniform θd and φd: `--grid
-//! 90x1x90x180 --param halfdiff`) take the same path: their mappings are *resampled* as knot
-//! lines in the same variables ([`RESAMPLED_KNOTS`] per axis, within [`RESAMPLE_TOLERANCE`]
-//! node units of the exact mapping). θd and φd are smooth in them; sqrt θh has a square-root
-//! singularity at θh = 90°, so pairs beyond the last interval that meets the tolerance (v_h ≳
-//! 0.98, both directions near the horizon) go to the general lookup ([`Kernel::eval`] returns
-//! false). Such a table keeps exact f32 values ([`Packed::exact`]) while they fit in a core's L2
-//! cache ([`RESAMPLED_EXACT_MAX_VALUES`]); a larger one (the MERL-size table: 4.4 MB of f32) is
-//! read from f16 codes like an adaptive table. Its lookups are bound by the lines they fetch
-//! from L3, and half the bytes made them a median 1.17× faster (27 paired rounds, 0.98–1.57×;
-//! `examples/merl_c_compare.rs`), at a rounding of at most 2^-11 of a value, far below such a
-//! grid's interpolation error; the stored f32 values stay what
-//! [`super::TabulatedBrdf::to_table`], nearest lookups and the pairs beyond the cut read.
+//! Grids on fixed mappings — the presets' (sqrt θh, cos θd, uniform φd) and MERL-style ones
+//! (uniform θd: `--grid 90x1x90x180 --param halfdiff`) — take the same path: their mappings
+//! are *resampled* as knot lines in the same variables ([`RESAMPLED_KNOTS`] per axis, within
+//! [`RESAMPLE_TOLERANCE`] node units of the exact mapping), θh in (1 − cos θh)^¼
+//! ([`WarpVar::QuarterPower`]), in which sqrt θh is smooth up to 90° (in √sin θh it has a
+//! square-root singularity there), θd and φd in their usual variables. An axis whose knot lines
+//! strayed from the mapping beyond some interval would get a *cut* there, pairs beyond it going
+//! to the general lookup ([`Kernel::eval`] returns false); none of these mappings has one.
+//! Such a table keeps exact f32 values ([`Packed::exact`]): it is what a user baked an
+//! analytic model on (a Lambert table gives kd to f32 rounding), and the stored f32 values
+//! stay what [`super::TabulatedBrdf::to_table`] and nearest lookups read. (The MERL-size grid
+//! used to read f16 codes beyond 1 MiB of values: a median 1.17× faster, L3-bound, at a
+//! rounding of up to 2^-11 of a value — given up when the presets, analytic tables, came to
+//! this path; BENCHMARKS.md.)
 //!
 //! [`Kernel::eval`] is tested against the reference path (angles through
 //! [`super::symmetry::canonical_coords`] and [`super::StoredAxis::linear`]) in this module's
@@ -193,13 +194,9 @@ impl Packed {
 
 /// The most stored values a grid with resampled axes may have for the kernel to take it: the
 /// kernel holds a table in one array, loaded whole at the first lookup; larger tables keep
-/// their lazily loaded chunks (and the general lookup). 8 M values is 32 MB of f32.
-pub const RESAMPLED_MAX_VALUES: usize = 8 << 20;
-
-/// The most stored values a grid with resampled axes may have for its kernel to read exact f32
-/// values ([`Packed::exact`]): 256 Ki values, 1 MiB, a core's L2 cache on the machines this was
-/// measured on. Larger tables are read from f16 codes ([`Packed::new`]), half the bytes.
-pub const RESAMPLED_EXACT_MAX_VALUES: usize = 256 << 10;
+/// their lazily loaded chunks (and the general lookup). 36 Mi values (144 MiB of f32) takes
+/// every preset (the large non-reciprocal one stores 35.2 M values).
+pub const RESAMPLED_MAX_VALUES: usize = 36 << 20;
 
 /// Knots of a resampled axis (a fixed mapping read in the kernel's variable).
 pub const RESAMPLED_KNOTS: usize = 1024;
@@ -316,6 +313,16 @@ impl Axis {
     }
 }
 
+/// Whether the kernel resamples fixed mapping `m` on stored axis `k` (0: θh, 2: θd, 3: φd):
+/// sqrt θh, uniform or cos θd, uniform φd.
+fn fixed_mapping_fits(k: usize, m: &Mapping) -> bool {
+    match k {
+        0 => *m == Mapping::Sqrt,
+        2 => matches!(m, Mapping::Uniform | Mapping::Cos),
+        _ => *m == Mapping::Uniform,
+    }
+}
+
 /// The fast linear lookup of a table on an adaptive grid (see the module docs).
 #[derive(Debug, Clone)]
 pub struct Kernel {
@@ -338,14 +345,15 @@ pub struct Kernel {
     /// Per axis the variable from which lookups take the general path (resampled axes; 2 on
     /// warped ones, never; lane 3: 2).
     cut: F4,
-    /// Some axis is resampled: RGB lookups check the cut.
+    /// Some axis is resampled (a fixed mapping).
     resampled: bool,
+    /// Some axis has a cut (< 2): RGB lookups check it.
+    cuts: bool,
     /// What the values are: lookups of a quantity other than f_r divide by its factor.
     quantity: Quantity,
     /// The albedo calibration lookups multiply by, if any.
     calibration: Option<Calibration>,
-    /// Values are read exact ([`Packed::exact`]): resampled, and at most
-    /// [`RESAMPLED_EXACT_MAX_VALUES`] of them.
+    /// Values are read exact ([`Packed::exact`]): some axis is resampled.
     exact: bool,
     /// [`Kernel::eval_x8`] runs: three channels, offsets within i32, and the CPU has AVX2 and
     /// F16C (checked once, at construction).
@@ -390,13 +398,21 @@ impl Kernel {
                     h_quarter_power = true;
                     axes.push(Axis::new(w, a.size, centers));
                 }
-                // MERL-style fixed mappings (sqrt θh, uniform θd and φd), resampled.
-                m @ (Mapping::Sqrt | Mapping::Uniform)
-                    if (k == 0) == (*m == Mapping::Sqrt)
+                // Fixed mappings — MERL's (sqrt θh, uniform θd and φd) and the presets' (cos
+                // θd) — resampled. θh in the quarter-power variable: sqrt θh is smooth in it
+                // up to 90°, where in v_h = √sin θh it has a square-root singularity.
+                m @ (Mapping::Sqrt | Mapping::Uniform | Mapping::Cos)
+                    if fixed_mapping_fits(k, m)
                         && grid.stored_values() <= RESAMPLED_MAX_VALUES
                         && a.lo == 0.0
                         && (a.hi - hi).abs() < 1e-12 =>
                 {
+                    let var = if k == 0 {
+                        h_quarter_power = true;
+                        WarpVar::QuarterPower
+                    } else {
+                        var
+                    };
                     let (axis, vcut) = Axis::resampled(a, var, hi)?;
                     axes.push(axis);
                     cut[i] = vcut;
@@ -427,7 +443,8 @@ impl Kernel {
             f16c: has_f16c(),
             cut: F4::new(cut[0], cut[1], cut[2], cut[3]),
             resampled,
-            exact: resampled && grid.stored_values() <= RESAMPLED_EXACT_MAX_VALUES,
+            cuts: cut.iter().any(|&c| c < 2.0),
+            exact: resampled,
             quantity: grid.quantity(),
             calibration: grid.calibration().cloned(),
             x8,
@@ -435,8 +452,7 @@ impl Kernel {
     }
 
     /// Whether this kernel reads exact (f32) values ([`Packed::exact`]): some axis resamples a
-    /// fixed mapping, on a table of at most [`RESAMPLED_EXACT_MAX_VALUES`] values. Warped
-    /// (adaptive) tables and larger fixed grids read f16 codes ([`Packed::new`]).
+    /// fixed mapping. Warped (adaptive) tables read f16 codes ([`Packed::new`]).
     pub fn exact_values(&self) -> bool {
         self.exact
     }
@@ -470,10 +486,17 @@ impl Kernel {
         self.quarter
     }
 
-    /// Whether some axis resamples a fixed mapping (MERL-style grids), so that pairs beyond its
-    /// cut take the general lookup; false on adaptive (warped) grids.
+    /// Whether some axis resamples a fixed mapping (MERL-style grids and the presets); false
+    /// on adaptive (warped) grids.
     pub fn resampled(&self) -> bool {
         self.resampled
+    }
+
+    /// Whether some resampled axis has a cut, beyond which pairs take the general lookup
+    /// ([`Kernel::eval`] returns false there). The fixed mappings the kernel takes today are
+    /// smooth in its variables over the whole axis, so none has.
+    pub fn has_cut(&self) -> bool {
+        self.cuts
     }
 
     /// The warp variables (v_h, v_d, v_φ) of a pair, or `None` below the horizon (the fast
@@ -548,14 +571,14 @@ impl Kernel {
             if self.f16c {
                 // SAFETY: `f16c` is set only when the CPU has F16C (`has_f16c`).
                 return unsafe {
-                    if self.resampled {
+                    if self.cuts {
                         self.rgb_f16c::<true>(wi, wo, out, values)
                     } else {
                         self.rgb_f16c::<false>(wi, wo, out, values)
                     }
                 };
             }
-            return if self.resampled {
+            return if self.cuts {
                 self.rgb::<false, false, true>(wi, wo, out, values)
             } else {
                 self.rgb::<false, false, false>(wi, wo, out, values)
@@ -962,6 +985,7 @@ mod tests {
             f16c: false,
             cut: F4::splat(2.0),
             resampled: false,
+            cuts: false,
             exact: false,
             quantity: Quantity::Fr,
             calibration: None,
@@ -1097,8 +1121,9 @@ mod tests {
     }
 
     #[test]
-    fn fixed_merl_style_mappings_are_resampled_and_agree_with_the_general_lookup() {
+    fn fixed_mappings_are_resampled_without_a_cut_and_agree_with_the_general_lookup() {
         use crate::table::grid::Grid;
+        use crate::table::presets::Preset;
         let src = ModelSpec::parse(r#"{"model": "cook_torrance", "m": 0.3}"#)
             .unwrap()
             .build(&Channels::Rgb)
@@ -1109,8 +1134,9 @@ mod tests {
                 reciprocal,
                 bilateral: true,
             };
-            // The MERL-size grid of `--grid 90x1x90x180 --param halfdiff`: sqrt θh, uniform θd.
-            let grid = Grid::with_sizes(
+            // The MERL-size grid of `--grid 90x1x90x180 --param halfdiff` (sqrt θh, uniform θd)
+            // and the small preset's (sqrt θh, cos θd).
+            let merl = Grid::with_sizes(
                 crate::table::Param::HalfDiff,
                 [90, 1, 90, 180],
                 [Mapping::Sqrt, Mapping::Uniform],
@@ -1118,60 +1144,54 @@ mod tests {
                 sym,
             )
             .unwrap();
-            let k = Kernel::new(&grid).expect("sqrt/uniform axes are resampled");
-            // 1.1 M values, more than L2: read as f16 codes. A small grid keeps exact values.
-            assert!(k.resampled() && !k.exact_values());
-            let small = Grid::with_sizes(
-                crate::table::Param::HalfDiff,
-                [16, 1, 16, 32],
-                [Mapping::Sqrt, Mapping::Uniform],
-                Channels::Rgb,
-                sym,
-            )
-            .unwrap();
-            let ks = Kernel::new(&small).expect("sqrt/uniform axes are resampled");
-            assert!(ks.resampled() && ks.exact_values());
-            // θh's sqrt mapping strays at grazing θh (v_h → 1): a cut there; θd and φd none.
-            let cut = k.cut.to_array();
-            assert!(cut[0] > 0.9 && cut[0] < 1.0, "{cut:?}");
-            assert_eq!((cut[1], cut[2]), (2.0, 2.0));
-            let (t, _) = bake(src.as_ref(), &grid, &BakeOptions::default()).unwrap();
-            let general = Lookup::new(t.grid());
-            let packed = Packed::for_kernel(&k, t.values());
-            let tb = TabulatedBrdf::from_table(t.clone());
-            let peak = t.values().iter().fold(0f32, |m, &x| m.max(x));
-            let (mut a, mut b, mut c) = ([0f32; 3], [0f32; 3], [0f32; 3]);
-            let (mut worst, mut fell_back) = (0f32, 0);
-            let mut r = Pcg32::new(8);
-            for i in 0..60_000 {
-                let (mut wi, mut wo) = random_pair(&mut r);
-                if i % 10 == 0 {
-                    // Near-grazing opposite pairs: θh near 90°, beyond θh's cut.
-                    wi = DVec3::new(0.999, 0.0, 0.0447).normalize();
-                    wo = DVec3::new(-0.9, -0.4, 0.02 + 0.01 * r.next_f64()).normalize();
+            let preset = Preset::Small.grid(None, sym, Channels::Rgb).unwrap();
+            assert_eq!(preset.axes()[2].mapping, Mapping::Cos);
+            let k = Kernel::new(&merl).expect("sqrt/uniform axes are resampled");
+            // Exact values, also beyond L2 (1.1 M values here).
+            assert!(k.resampled() && k.exact_values());
+            let kp = Kernel::new(&preset).expect("sqrt/cos axes are resampled");
+            assert!(kp.resampled() && kp.exact_values());
+            for (grid, k) in [(&merl, &k), (&preset, &kp)] {
+                // θh read as (1 − cos θh)^¼, in which sqrt θh is smooth up to 90°: no cut.
+                assert_eq!(k.h_var(), WarpVar::QuarterPower);
+                assert!(!k.has_cut(), "{:?}", k.cut.to_array());
+                let (t, _) = bake(src.as_ref(), grid, &BakeOptions::default()).unwrap();
+                let general = Lookup::new(t.grid());
+                let packed = Packed::for_kernel(k, t.values());
+                let tb = TabulatedBrdf::from_table(t.clone());
+                let peak = t.values().iter().fold(0f32, |m, &x| m.max(x));
+                let (mut a, mut b, mut c) = ([0f32; 3], [0f32; 3], [0f32; 3]);
+                let mut worst = 0f32;
+                let mut r = Pcg32::new(8);
+                for i in 0..60_000 {
+                    let (mut wi, mut wo) = random_pair(&mut r);
+                    if i % 10 == 0 {
+                        // Near-grazing opposite pairs: θh near 90°, where v_h = √sin θh
+                        // needed a cut.
+                        wi = DVec3::new(0.999, 0.0, 0.0447).normalize();
+                        wo = DVec3::new(-0.9, -0.4, 0.02 + 0.01 * r.next_f64()).normalize();
+                    }
+                    general.eval(Interp::Linear, wi, wo, &mut b, |i| t.chunk(i));
+                    tb.eval(wi, wo, &mut c);
+                    assert!(k.eval(wi, wo, &mut a, &packed), "no pair leaves the kernel");
+                    assert_eq!(a, c, "TabulatedBrdf uses the kernel");
+                    if !k.exact_values() {
+                        // Without F16C (the integer expansion) exactly the same.
+                        let mut soft = [0f32; 3];
+                        assert!(k.rgb::<false, false, true>(wi, wo, &mut soft, &packed));
+                        assert_eq!(a, soft, "{wi} {wo}");
+                    }
+                    for ch in 0..3 {
+                        // The same nodes; the kernel's f16 codes (≤ 2^-11 of each value, so of
+                        // the blend), f32 variables and knot lines (≤ 1e-4 node units from the
+                        // mapping) against the general lookup's f32 values and f64
+                        // coordinates.
+                        let e = (a[ch] - b[ch]).abs() / (b[ch].abs() * 1e-3 + peak * 1e-5);
+                        worst = worst.max(e);
+                    }
                 }
-                general.eval(Interp::Linear, wi, wo, &mut b, |i| t.chunk(i));
-                tb.eval(wi, wo, &mut c);
-                if !k.eval(wi, wo, &mut a, &packed) {
-                    fell_back += 1;
-                    assert_eq!(b, c, "beyond the cut TabulatedBrdf takes the general path");
-                    continue;
-                }
-                assert_eq!(a, c, "TabulatedBrdf uses the kernel");
-                // Without F16C (the integer expansion) exactly the same.
-                let mut soft = [0f32; 3];
-                assert!(k.rgb::<false, false, true>(wi, wo, &mut soft, &packed));
-                assert_eq!(a, soft, "{wi} {wo}");
-                for ch in 0..3 {
-                    // The same nodes; the kernel's f16 codes (≤ 2^-11 of each value, so of the
-                    // blend), f32 variables and knot lines (≤ 1e-4 node units from the
-                    // mapping) against the general lookup's f32 values and f64 coordinates.
-                    let e = (a[ch] - b[ch]).abs() / (b[ch].abs() * 1e-3 + peak * 1e-5);
-                    worst = worst.max(e);
-                }
+                assert!(worst <= 1.0, "worst scaled difference {worst}");
             }
-            assert!(worst <= 1.0, "worst scaled difference {worst}");
-            assert!(fell_back > 1000, "{fell_back}");
         }
     }
 }

@@ -389,9 +389,14 @@ mod tests {
             }
             out.push((name, t));
         }
-        // MERL-style fixed mappings, resampled: exact values (small) and f16 codes (MERL size),
-        // each with θh's cut.
-        for sizes in [[16, 1, 16, 32], [90, 1, 90, 180]] {
+        // Fixed mappings, resampled (exact values, no cut): MERL-style (uniform θd) and the
+        // presets' (cos θd).
+        let fixed = [
+            ([16, 1, 16, 32], Mapping::Uniform),
+            ([90, 1, 90, 180], Mapping::Uniform),
+            ([16, 1, 16, 32], Mapping::Cos),
+        ];
+        for (sizes, theta_d) in fixed {
             let sym = Symmetry {
                 isotropic: true,
                 reciprocal: true,
@@ -400,13 +405,13 @@ mod tests {
             let grid = Grid::with_sizes(
                 Param::HalfDiff,
                 sizes,
-                [Mapping::Sqrt, Mapping::Uniform],
+                [Mapping::Sqrt, theta_d.clone()],
                 Channels::Rgb,
                 sym,
             )
             .unwrap();
             let (t, _) = bake(ggx.as_ref(), &grid, &BakeOptions::default()).unwrap();
-            out.push((format!("resampled {sizes:?}"), t));
+            out.push((format!("resampled {sizes:?} θd {theta_d:?}"), t));
         }
         out
     }
@@ -430,7 +435,7 @@ mod tests {
                         continue;
                     }
                     taken += 1;
-                    assert!(fast, "{name}: a pair past a cut was taken");
+                    assert!(fast, "{name}: a pair the one-pair path leaves was taken");
                     let got: [f32; 3] = lanes[3 * j..3 * j + 3].try_into().unwrap();
                     assert_eq!(
                         got.map(f32::to_bits),
@@ -443,8 +448,7 @@ mod tests {
             }
             if available() {
                 // Left: the non-unit and NaN directions (pairs 6 and 7 of 23, on every 7th
-                // and 11th cycle) and, on resampled grids, the pairs beyond θh's cut (a fifth of
-                // these pairs on the MERL-size grid, many being grazing).
+                // and 11th cycle).
                 assert!(taken > 3 * left, "{name}: {taken} taken, {left} left");
                 assert!(left > 0, "{name}: leaving a lane was never exercised");
             } else {
