@@ -190,6 +190,13 @@ impl AliasWarp {
         })
     }
 
+    /// What a host needs to run this draw itself: the bits of `other` in an entry, the
+    /// normalized node densities, the half-strip tables (per slice) and the cell tables (per
+    /// slice and row).
+    pub(crate) fn parts(&self) -> (u32, &[f32], &[u32], &[u32]) {
+        (self.packing.bits, &self.pdf.data, &self.strips, &self.cells)
+    }
+
     /// Bytes held (densities and alias tables).
     pub(crate) fn memory_bytes(&self) -> usize {
         4 * (self.pdf.data.len() + self.strips.len() + self.cells.len())

@@ -40,7 +40,7 @@ pub(crate) mod warp2d;
 pub use fill::{BakeOptions, BakeStats, bake, bake_chunks};
 pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, Quantity, StoredAxis};
 pub use lookup::Interp;
-pub use sampling::{Adjoint, Draw, SamplingNodes, SamplingResolution, TableSampler};
+pub use sampling::{Adjoint, AliasTables, Draw, SamplingNodes, SamplingResolution, TableSampler};
 pub use symmetry::Symmetry;
 pub use tabulated::{ChunkLoader, TabulatedBrdf};
 

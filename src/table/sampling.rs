@@ -201,9 +201,9 @@ fn mirror_z(v: DVec3) -> DVec3 {
 /// node: t = ½) times `np` over φo ∈ [0, 2π) (periodic; 1 for isotropic sources), the floor
 /// included (see the module docs), not normalized.
 ///
-/// Hosts that sample on a device build the same warps from these (the Mitsuba plugin: one
-/// `MarginalContinuous2D1` over t, after the square, the half-vector map and the fold at the
-/// horizon of [`TableSampler::sample`]).
+/// Hosts that sample on a device run the same draw on these ([`SamplingNodes::alias`]: the
+/// Mitsuba plugin's `brdftab/_alias2d.py`), after the square, the half-vector map and the fold
+/// at the horizon of [`TableSampler::sample`].
 #[derive(Debug, Clone)]
 pub struct SamplingNodes {
     /// Nodes over s (the inner axis of `data`).
@@ -220,6 +220,36 @@ pub struct SamplingNodes {
     pub data: Vec<f32>,
 }
 
+/// The constant-time draw of [`TableSampler`] as data ([`SamplingNodes::alias`]), for hosts
+/// that run it themselves.
+///
+/// Per slice (conditioning node, `nt` × `np`, t outermost as in [`SamplingNodes::data`]) of
+/// `ny` rows × `nx` nodes:
+/// - `pdf`: the node densities normalized so that the slice's bilinear interpolant integrates
+///   to 1 over its (nx − 1)(ny − 1) cells of unit area (per unit area of the square: times
+///   (nx − 1)(ny − 1));
+/// - `strips`: 2(ny − 1) alias entries over the half-strips — slot h is strip h / 2, row
+///   h / 2 + h % 2, t across the strip from the density 2(1 − t) (even h) or 2t (odd h);
+/// - `cells`: per row, nx − 1 alias entries over its cells; within the drawn cell a coin
+///   weighted by the two end densities picks 2(1 − f) or 2f.
+///
+/// An entry e keeps its own slot with probability (e mod 2^(32 − b)) / 2^(32 − b) and otherwise
+/// gives slot e >> (32 − b), b = `other_bits`. Slot i of n is drawn by x = u·n, i = ⌊x⌋,
+/// f = x − i; the remainder f/keep (kept) or (f − keep)/(1 − keep) is the next step's uniform
+/// number. The first number of a draw gives the cell, the coin and f; the second the slice (by
+/// the conditioning weights, in corner order), the half-strip and t.
+#[derive(Debug, Clone)]
+pub struct AliasTables {
+    /// Bits of an entry's `other` slot (the top bits).
+    pub other_bits: u32,
+    /// Normalized node densities, the layout of [`SamplingNodes::data`].
+    pub pdf: Vec<f32>,
+    /// Per slice, 2(ny − 1) half-strip entries.
+    pub strips: Vec<u32>,
+    /// Per slice and row, nx − 1 cell entries.
+    pub cells: Vec<u32>,
+}
+
 impl SamplingNodes {
     /// The node densities of `brdf` (f_r·cos θi, channel mean) at resolution `res`, on the
     /// calling thread (what [`TableSampler::build`] runs, lazily, inside a `OnceLock`).
@@ -232,6 +262,29 @@ impl SamplingNodes {
     /// ([`crate::par`]): for hosts that export the nodes (the Mitsuba plugin at scene load).
     pub fn build_par(brdf: &dyn Brdf, isotropic: bool, res: &SamplingResolution) -> SamplingNodes {
         Self::build_with(brdf, isotropic, res, true)
+    }
+
+    /// The structure [`TableSampler`] draws these densities with: each slice normalized, its
+    /// alias tables over half-strips and over each row's cells (see `table::alias2d`). A slice
+    /// that does not integrate to a positive finite value (never, for nodes built here: the
+    /// floor keeps them positive) makes every slice uniform, as the sampler does.
+    pub fn alias(&self) -> AliasTables {
+        let planes = |data| Planes {
+            nx: self.nx,
+            ny: self.ny,
+            data,
+        };
+        let n = self.nt * self.np * self.nx * self.ny;
+        let w = AliasWarp::build(planes(self.data.clone()))
+            .or_else(|_| AliasWarp::build(planes(vec![1.0; n])))
+            .unwrap_or_else(|_| unreachable!("a uniform warp is a density"));
+        let (other_bits, pdf, strips, cells) = w.parts();
+        AliasTables {
+            other_bits,
+            pdf: pdf.to_vec(),
+            strips: strips.to_vec(),
+            cells: cells.to_vec(),
+        }
     }
 
     fn build_with(

@@ -576,12 +576,15 @@ impl PyBrdf {
     }
 
     /// The node densities of the library's importance sampler (`brdftab.table.SamplingNodes`
-    /// in Rust): {"version": 1, "nx", "ny", "nt", "np", "isotropic", "data": float32 array
-    /// (nt·np, ny, nx)} — g(s, y) of f_r cos θ over the half-vector square (s → θh = (π/2)(0.1 s
-    /// + 0.9 s²), y → φh = 2π y − π relative to the conditioning direction's azimuth) at nt
-    /// conditioning nodes uniform in t = sqrt(1 − cos θ) (times np over φ for anisotropic
-    /// sources). `adjoint=True` conditions on wi and weights by cos θo (Mitsuba's convention:
-    /// draw wo given wi). For hosts that sample on a device (the Mitsuba plugin).
+    /// in Rust): {"version": 2, "nx", "ny", "nt", "np", "isotropic", "data": float32 array
+    /// (nt·np, ny, nx), "alias": {...}} — g(s, y) of f_r cos θ over the half-vector square
+    /// (s → θh = (π/2)(0.1 s + 0.9 s²), y → φh = 2π y − π relative to the conditioning
+    /// direction's azimuth) at nt conditioning nodes uniform in t = sqrt(1 − cos θ) (times np
+    /// over φ for anisotropic sources), and the library's constant-time draw of them
+    /// (`brdftab.table.AliasTables`): {"other_bits", "pdf": float32 (nt·np, ny, nx)
+    /// normalized, "strips": uint32 (nt·np, 2(ny − 1)), "cells": uint32 (nt·np, ny, nx − 1)}.
+    /// `adjoint=True` conditions on wi and weights by cos θo (Mitsuba's convention: draw wo
+    /// given wi). For hosts that sample on a device (the Mitsuba plugin).
     #[pyo3(signature = (adjoint=false, theta_h=64, phi_h=64, theta_o=32, phi_o=16))]
     fn sampling_nodes(
         &self,
@@ -616,18 +619,32 @@ impl PyBrdf {
                 false => SamplingNodes::build_par(brdf, iso, &res),
             })?;
             self.check_loaded()?;
-            let shape = [n.nt * n.np, n.ny, n.nx];
-            let data = ArrayD::from_shape_vec(IxDyn(&shape), n.data)
-                .map_err(|e| Error::new_err(e.to_string()))?
-                .into_pyarray(py);
+            let a = unlocked(py, || n.alias())?;
+            let slices = n.nt * n.np;
+            let shape = [slices, n.ny, n.nx];
+            let array = |shape: &[usize], v: Vec<f32>| {
+                ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| Error::new_err(e.to_string()))
+            };
+            let entries = |shape: &[usize], v: Vec<u32>| {
+                ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| Error::new_err(e.to_string()))
+            };
+            let alias = PyDict::new(py);
+            alias.set_item("other_bits", a.other_bits)?;
+            alias.set_item("pdf", array(&shape, a.pdf)?.into_pyarray(py))?;
+            let strips = entries(&[slices, 2 * (n.ny - 1)], a.strips)?;
+            alias.set_item("strips", strips.into_pyarray(py))?;
+            let cells = entries(&[slices, n.ny, n.nx - 1], a.cells)?;
+            alias.set_item("cells", cells.into_pyarray(py))?;
+            let data = array(&shape, n.data)?.into_pyarray(py);
             let d = PyDict::new(py);
-            d.set_item("version", 1)?;
+            d.set_item("version", 2)?;
             d.set_item("nx", n.nx)?;
             d.set_item("ny", n.ny)?;
             d.set_item("nt", n.nt)?;
             d.set_item("np", n.np)?;
             d.set_item("isotropic", n.isotropic)?;
             d.set_item("data", data)?;
+            d.set_item("alias", alias)?;
             Ok(d.into_any().unbind())
         })
     }

@@ -212,16 +212,62 @@ def test_jit_eval_matches_measured_within_table_error(rgl, tmp_path, preset):
 
 CHI2 = [
     ("RGL", {"preset": "small"}, [0.4, 0.1, 0.91]),
-    ("RGL", {}, [0.02, 0.0, 1.0]),  # the default (adaptive) table, view within 2° of the normal
+    # The default (adaptive) table, view within 2° of the normal: the pdf's cell integrals at
+    # 8×8 points sum to 1.0062 (the peak at the normal is narrower than a cell), at 32×32 to
+    # 1.00008 — the former rejected one draw sequence in four (p = 0.002).
+    ("RGL", {}, [0.02, 0.0, 1.0], 32),
     # 80°: a peak narrower than the chi2 cells near the horizon; the cells' integral of the pdf
     # needs 32×32 points (at 8×8 it is off by 4 % in the two peak cells: p = 3e-6).
     ("RGL", {}, [0.985, 0.0, 0.17], 32),
     ('{"model": "ggx", "alpha": 0.4}', {"preset": "small"}, [0.0, 0.5, 0.866]),
     ('{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}', {}, [0.3, 0.2, 0.93]),
-    # anisotropic: conditioned on θi and φi (MarginalContinuous2D2)
+    # anisotropic: conditioned on θi and φi (four conditioning corners)
     ('{"model": "ward", "alpha_x": 0.1, "alpha_y": 0.3, "ks": 0.5}', {"preset": "small"},
      [0.5, 0.3, 0.81]),
 ]
+
+
+def test_jit_alias_draw_is_the_piecewise_bilinear_density(rgl):
+    """The plugin's draw (the library's alias tables, ``brdftab._alias2d``) has the density of
+    Mitsuba's ``MarginalContinuous2D1`` on the same nodes — an independent implementation of
+    the piecewise-bilinear warp — and its draws follow that density (a 2D histogram)."""
+    use("llvm_ad_rgb")
+    import mitsuba as mi
+    from brdftab._alias2d import AliasWarp2D
+
+    nodes = brdftab.open(str(rgl / RGL_FILE)).sampling_nodes(adjoint=True)
+    nt, ny, nx = nodes["nt"], nodes["ny"], nodes["nx"]
+    data = np.asarray(nodes["data"], np.float32).reshape(nt, ny, nx)
+    ref = mi.MarginalContinuous2D1(data, [np.linspace(0.0, 1.0, nt).tolist()], normalize=True)
+    warp = AliasWarp2D(nodes["alias"], nx, ny)
+    rng = np.random.default_rng(4)
+    n = 200_000
+    for t in (0.0, 0.0247, 0.5, 0.93, 1.0):
+        st = t * (nt - 1)
+        t0 = min(int(st), nt - 2)
+        ft = st - t0
+        corners = [(mi.UInt32(t0), mi.Float(1.0 - ft)), (mi.UInt32(t0 + 1), mi.Float(ft))]
+        u = mi.Point2f(rng.random(n), rng.random(n))
+        a = np.array(warp.eval(u, corners, True))
+        b = np.array(ref.eval(u, [mi.Float(t)], True))
+        # Both f32 sums of the same bilinear terms (normalized in f64 by the library, in f32 by
+        # Mitsuba): a few f32 roundings apart.
+        assert np.all(np.abs(a - b) <= 1e-5 * b + 1e-7 * b.max()), t
+        p, pdf = warp.sample(u, corners, True)
+        at = np.array(warp.eval(p, corners, True))
+        assert np.allclose(np.array(pdf), at, rtol=1e-4), t
+        # Drawn points against the density's cell integrals (16 × 16 cells, 8 × 8 points
+        # each): chi-square over cells expecting at least 5 points.
+        h, _, _ = np.histogram2d(np.array(p.x), np.array(p.y), bins=16, range=[[0, 1], [0, 1]])
+        g = (np.arange(128) + 0.5) / 128
+        x, y = np.meshgrid(g, g, indexing="ij")
+        ev = np.array(warp.eval(mi.Point2f(x.ravel(), y.ravel()), corners, True))
+        e = ev.reshape(16, 8, 16, 8).mean(axis=(1, 3)) / 256 * n
+        keep = e >= 5
+        chi = float((((h - e) ** 2) / e)[keep].sum())
+        dof = int(keep.sum()) - 1
+        # p > 1e-4: chi² below dof + 4.3 √(2 dof) (normal approximation, dof in the hundreds).
+        assert chi < dof + 4.3 * math.sqrt(2 * dof), (t, chi, dof)
 
 
 @pytest.mark.parametrize("case", range(len(CHI2)))

@@ -59,9 +59,12 @@ class Brdf:
         theta_o: int = 32,
         phi_o: int = 16,
     ) -> dict[str, Any]:
-        """The node densities of the library's importance sampler: {"version", "nx", "ny",
-        "nt", "np", "isotropic", "data": float32 (nt·np, ny, nx)}; adjoint=True conditions on
-        wi (Mitsuba's convention)."""
+        """The node densities of the library's importance sampler: {"version": 2, "nx", "ny",
+        "nt", "np", "isotropic", "data": float32 (nt·np, ny, nx), "alias": {"other_bits",
+        "pdf": float32 (nt·np, ny, nx) normalized, "strips": uint32 (nt·np, 2(ny − 1)),
+        "cells": uint32 (nt·np, ny, nx − 1)}} — "alias" is the library's constant-time draw
+        (Rust ``brdftab::table::AliasTables``); adjoint=True conditions on wi (Mitsuba's
+        convention)."""
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
 
 class Table:

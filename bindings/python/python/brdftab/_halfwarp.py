@@ -8,21 +8,20 @@ exports (:meth:`brdftab.Brdf.sampling_nodes`, adjoint: conditioned on wi, ∝ f_
 
 - the unit square (s, y) ↦ half vector h, θh = (π/2)(0.1 s + 0.9 s²), φh = 2π y − π relative
   to φi (isotropic sources); wo = 2 (wi·h) h − wi, dωo = 4 (wi·h) sin θh dθh/ds dφh/dy ds dy;
-- the densities at the nodes as Mitsuba's ``MarginalContinuous2D1`` over t = sqrt(1 − cos θi)
-  (``MarginalContinuous2D2`` over t and φi for anisotropic sources, the first φ slice repeated
-  at 2π), the same piecewise-bilinear warp as the library's and the RGL format's, interpolated
-  linearly between conditioning nodes, so sample and pdf agree for every wi;
+- the densities at the nodes drawn with the library's own alias tables (``_alias2d``: the
+  normalized slices interpolated linearly between conditioning nodes over t = sqrt(1 − cos θi),
+  bilinearly over t and φi for anisotropic sources, the same piecewise-bilinear density as the
+  library's and the RGL format's), so sample and pdf agree for every wi;
 - a draw whose mirror image falls below the horizon is folded above it (z → −z), and the
   density of wo is the sum over both preimages.
 
-Only the map and the fold are written here; the node densities are the library's.
+Only the map, the fold and the conditioning weights are written here; the node densities and
+their draw are the library's.
 """
 
 from __future__ import annotations
 
 import math
-
-import numpy as np
 
 _LINEAR = 0.1  # sampling.rs `LINEAR`
 
@@ -31,42 +30,47 @@ class HalfVectorSampler:
     """Draws wo given wi ∝ f_r(wi, wo) cos θo from the library's node densities."""
 
     def __init__(self, nodes):
-        import mitsuba as mi
+        from ._alias2d import AliasWarp2D
 
-        if nodes.get("version") != 1:
-            raise ValueError(f"sampling nodes version {nodes.get('version')!r}: expected 1")
-        nt, np_, ny, nx = (int(nodes[k]) for k in ("nt", "np", "ny", "nx"))
-        data = np.asarray(nodes["data"], np.float32).reshape(nt, np_, ny, nx)
-        if nt == 1:  # one node (t = ½): Mitsuba wants two parameter values
-            data = np.concatenate([data, data], 0)
-            t = [0.0, 1.0]
-        else:
-            t = np.linspace(0.0, 1.0, nt).tolist()
-        self.isotropic = bool(nodes["isotropic"]) or np_ == 1
-        if self.isotropic:
-            self.warp = mi.MarginalContinuous2D1(data[:, 0], [t], normalize=True)
-        else:
-            # Periodic over φi: the first slice again at 2π.
-            data = np.concatenate([data, data[:, :1]], 1)
-            phi = (np.arange(np_ + 1) * (2 * math.pi / np_)).tolist()
-            self.warp = mi.MarginalContinuous2D2(data, [t, phi], normalize=True)
-        self.bytes = data.nbytes
+        if nodes.get("version") != 2:
+            raise ValueError(f"sampling nodes version {nodes.get('version')!r}: expected 2")
+        self.nt, self.np, ny, nx = (int(nodes[k]) for k in ("nt", "np", "ny", "nx"))
+        self.isotropic = bool(nodes["isotropic"]) or self.np == 1
+        self.warp = AliasWarp2D(nodes["alias"], nx, ny)
+        self.bytes = self.warp.bytes
 
     # -- the frame of the nodes ---------------------------------------------------------------
     def _frame(self, b):
-        """(cos φ, sin φ) rotating into the nodes' frame (isotropic) and the warp's parameters."""
+        """(cos φ, sin φ) rotating into the nodes' frame (isotropic) and the conditioning
+        corners: (slice, weight) pairs, linear over t = sqrt(1 − cos θ) (bilinear over t and
+        φ, periodic, for anisotropic sources), as ``TableSampler`` weighs its slices."""
         import drjit as dr
+        import mitsuba as mi
 
-        t = dr.sqrt(dr.maximum(1.0 - b.z, 0.0))
-        t = dr.minimum(t, 1.0)
+        F, U = type(b.x), mi.UInt32
+        if self.nt == 1:
+            t0, t1, ft = U(0), U(0), F(0.0)
+        else:
+            t = dr.sqrt(dr.maximum(1.0 - b.z, 0.0))
+            st = dr.clip(t * (self.nt - 1), 0.0, float(self.nt - 1))
+            t0 = dr.minimum(U(st), self.nt - 2)
+            t1, ft = t0 + 1, st - F(t0)
         if self.isotropic:
             r2 = b.x * b.x + b.y * b.y
             ok = r2 > 1e-20
             inv = dr.rsqrt(dr.select(ok, r2, 1.0))
-            return dr.select(ok, b.x * inv, 1.0), dr.select(ok, b.y * inv, 0.0), [t]
+            corners = [(t0, 1.0 - ft), (t1, ft)]
+            return dr.select(ok, b.x * inv, 1.0), dr.select(ok, b.y * inv, 0.0), corners
+        n = self.np
         phi = dr.atan2(b.y, b.x)
         phi = dr.select(phi < 0, phi + 2 * math.pi, phi)
-        return type(b.x)(1.0), type(b.x)(0.0), [t, phi]
+        sp = phi * (n / (2 * math.pi))
+        p0 = dr.minimum(U(sp), n - 1)
+        p1 = dr.select(p0 + 1 == n, 0, p0 + 1)
+        fp = dr.clip(sp - F(p0), 0.0, 1.0)
+        corners = [(t0 * n + p0, (1.0 - ft) * (1.0 - fp)), (t0 * n + p1, (1.0 - ft) * fp),
+                   (t1 * n + p0, ft * (1.0 - fp)), (t1 * n + p1, ft * fp)]
+        return F(1.0), F(0.0), corners
 
     @staticmethod
     def _rot(v, c, s):
@@ -113,7 +117,7 @@ class HalfVectorSampler:
         y = y - dr.floor(y)
         return mi.Point2f(dr.clip(s, 0.0, 1.0), y), r
 
-    def _density_at(self, al, bl, param, active):
+    def _density_at(self, al, bl, corners, active):
         """Density (solid angle of al) of drawing the half vector of (al, bl), nodes' frame."""
         import drjit as dr
 
@@ -124,7 +128,7 @@ class HalfVectorSampler:
         dot = dr.dot(bl, h)
         ok &= (h.z > 0) & (dot > 0)
         u, sin_th = self._square_of(h)
-        d = self.warp.eval(u, param, ok) / (4.0 * dot * self._jacobian(u.x, sin_th))
+        d = self.warp.eval(u, corners, ok) / (4.0 * dot * self._jacobian(u.x, sin_th))
         return dr.select(ok & dr.isfinite(d), d, 0.0)
 
     # -- the plugin's entry points ------------------------------------------------------------
@@ -133,9 +137,9 @@ class HalfVectorSampler:
         direction is drawn."""
         import drjit as dr
 
-        c, s, param = self._frame(wi)
+        c, s, corners = self._frame(wi)
         bl = self._rot(wi, c, s)
-        p, pdf_sq = self.warp.sample(u, param, active)
+        p, pdf_sq = self.warp.sample(u, corners, active)
         h, sin_th = self._half_of(p)
         dot = dr.dot(bl, h)
         ok = active & (dot > 0)
@@ -144,7 +148,7 @@ class HalfVectorSampler:
         # Folded at the horizon: the other preimage of the result is its mirror image. Above,
         # the mirror of `drawn` has a density only when drawn.z < wi.z (else its half vector is
         # below the horizon and `_density_at` gives 0); below, the result is mirror(drawn).
-        other = self._density_at(self._mirror(drawn), bl, param, ok)
+        other = self._density_at(self._mirror(drawn), bl, corners, ok)
         al = dr.select(drawn.z > 0, drawn, self._mirror(drawn))
         pdf = here + other
         ok &= (al.z > 0) & (pdf > 0) & dr.isfinite(pdf)
@@ -153,7 +157,7 @@ class HalfVectorSampler:
 
     def pdf(self, wi, wo, active):
         """The density with which :meth:`sample` draws unit wo given unit wi."""
-        c, s, param = self._frame(wi)
+        c, s, corners = self._frame(wi)
         bl, al = self._rot(wi, c, s), self._rot(wo, c, s)
-        return (self._density_at(al, bl, param, active)
-                + self._density_at(self._mirror(al), bl, param, active))
+        return (self._density_at(al, bl, corners, active)
+                + self._density_at(self._mirror(al), bl, corners, active))
