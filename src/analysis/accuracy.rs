@@ -209,6 +209,9 @@ pub fn compare_region(
             })
             .collect()
     });
+    // Either side failed while it was read (a corrupt table chunk): its zeros are no result.
+    approx.health()?;
+    reference.health()?;
     let mut e2 = vec![0.0; c];
     let mut r2 = vec![0.0; c];
     let mut f2 = 0.0;

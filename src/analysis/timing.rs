@@ -68,6 +68,8 @@ pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTim
     // Warm up (loads lazy chunks, faults pages, builds a table's sampler).
     src.eval_batch(&wi, &wo, &mut out);
     std::hint::black_box(src.sample(wo[0], u[0], &mut out[..c]));
+    // A source that failed while it was read (a corrupt table chunk) would time its zeros.
+    src.health()?;
     let n = pairs as f64;
     let (mut single, mut single_cpu) = (Vec::new(), Vec::new());
     let (mut sample, mut pdf, mut ratio) = (Vec::new(), Vec::new(), Vec::new());

@@ -263,6 +263,8 @@ pub fn relative_rmse(source: &dyn Brdf, model: &dyn Brdf, pairs: &Pairs) -> Resu
     }
     let f = eval_cos(source, pairs);
     let g = eval_cos(model, pairs);
+    // Zeros from a source that failed while it was read (a corrupt table chunk) are its error.
+    source.health()?;
     Ok(rel_rmse(&g, &f))
 }
 
@@ -338,6 +340,9 @@ pub fn fit_with_progress(
         opts.seed,
     );
     let target_lin = eval_cos(source, &pairs);
+    // A source that failed while it was read (a corrupt table chunk) gave zeros: fitting
+    // them would return a black material.
+    source.health()?;
     let problem = Problem {
         base: base.clone(),
         params: &params,

@@ -71,6 +71,8 @@ pub fn slice(a: SliceArgs) -> Result<()> {
             slice::incident(a.theta_in.to_radians(), a.phi_in.to_radians()),
         ),
     };
+    // A source that failed while it was read (a corrupt table chunk) drew zeros.
+    brdf.health()?;
     let what = match a.kind {
         SliceKind::Halfdiff => format!(
             "f_r, x = θh 0..90°, y = θd 0..90° (top to bottom), φd = {}°",

@@ -639,6 +639,8 @@ pub fn render(brdf: &dyn Brdf, opts: &RenderOptions, progress: &dyn Progress) ->
             img.data[i..i + tw * 3].copy_from_slice(chunk);
         }
     }
+    // A source that failed while it was read (a corrupt table chunk) rendered zeros.
+    brdf.health()?;
     Ok(img)
 }
 

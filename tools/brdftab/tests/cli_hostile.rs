@@ -74,6 +74,34 @@ fn a_corrupt_chunk_read_lazily_is_an_error_everywhere() {
     assert!(!npy.exists(), "export left a partial .npy");
     let r = brdftab(&["db", "verify", s(&bad)]);
     assert!(!r.ok && r.stderr.contains("checksum"), "{}", r.stderr);
+    // Everything else that evaluates the table: an image, a fit or a timing of its zeros is
+    // no result (each once printed one and exited 0).
+    let png = d.join("x.png");
+    for args in [
+        vec!["slice", s(&bad), "-o", s(&png)],
+        vec![
+            "render",
+            s(&bad),
+            "-o",
+            s(&png),
+            "--size",
+            "8x8",
+            "--spp",
+            "1",
+        ],
+        vec!["fit", s(&bad), "--model", "ggx"],
+        vec!["bench", s(&bad), "--pairs", "1000"],
+        vec!["sample", s(&bad), "--wo", "0,0,1", "--count", "3"],
+    ] {
+        let r = brdftab(&args);
+        assert!(
+            !r.ok && r.stderr.starts_with("error: ") && r.stderr.contains("checksum"),
+            "{args:?}: {}{}",
+            r.stdout,
+            r.stderr
+        );
+        assert!(!png.exists(), "{args:?} wrote an image of a corrupt table");
+    }
 }
 
 #[test]

@@ -103,14 +103,21 @@ pub fn models() -> Response {
     Response::json(serde_json::to_string(brdftab::spec::MODELS).unwrap_or_default())
 }
 
+/// `body` as JSON, or a 500 error when `brdf` failed while it was read (a corrupt table chunk):
+/// the zeros it gave are no answer.
+fn answer(brdf: &dyn brdftab::Brdf, body: String) -> Result<Response, Response> {
+    brdf.health()
+        .map_err(|e| Response::error(500, &e.to_string()))?;
+    Ok(Response::json(body))
+}
+
 /// `/api/polar?theta_i=DEG&n=N`.
 pub fn polar(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let t = target(reg, q)?;
     let ti = q.num("theta_i", 30.0, 0.0, 89.9)?;
     let n = q.count("n", 181, 2, 2001)?;
-    Ok(Response::json(
-        eval::polar(t.brdf.as_ref(), ti, n).to_string(),
-    ))
+    let body = eval::polar(t.brdf.as_ref(), ti, n).to_string();
+    answer(t.brdf.as_ref(), body)
 }
 
 /// `/api/lobe?theta_i=DEG&nt=N&np=N`.
@@ -119,16 +126,16 @@ pub fn lobe(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let ti = q.num("theta_i", 30.0, 0.0, 89.9)?;
     let nt = q.count("nt", 24, 2, 96)?;
     let np = q.count("np", 48, 3, 192)?;
-    Ok(Response::json(
-        eval::lobe(t.brdf.as_ref(), ti, nt, np).to_string(),
-    ))
+    let body = eval::lobe(t.brdf.as_ref(), ti, nt, np).to_string();
+    answer(t.brdf.as_ref(), body)
 }
 
 /// `/api/slice?n=N`.
 pub fn slice(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let t = target(reg, q)?;
     let n = q.count("n", 64, 2, 256)?;
-    Ok(Response::json(eval::slice(t.brdf.as_ref(), n).to_string()))
+    let body = eval::slice(t.brdf.as_ref(), n).to_string();
+    answer(t.brdf.as_ref(), body)
 }
 
 /// `/api/sphere?lt=DEG&lp=DEG&size=N&exposure=X`.
@@ -139,7 +146,7 @@ pub fn sphere(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let size = q.count("size", 128, 8, 256)?;
     let exposure = q.num("exposure", 1.0, 1e-3, 1e3)?;
     let v = eval::sphere(t.brdf.as_ref(), lt, lp, size, exposure);
-    Ok(Response::json(v.to_string()))
+    answer(t.brdf.as_ref(), v.to_string())
 }
 
 /// The value of `f` on the target, cached under `what` for registered materials.
@@ -156,7 +163,7 @@ fn cached_view(
             .to_string(),
         None => f(t.brdf.as_ref()),
     };
-    Ok(Response::json(body))
+    answer(t.brdf.as_ref(), body)
 }
 
 /// `/api/albedo`: the albedo curve.
@@ -198,6 +205,7 @@ pub fn compare(reg: &Registry, q: &Query) -> Result<Response, Response> {
         ));
     };
     let (table, measured) = (m.brdf.clone(), m.measured_source);
+    let (table_health, source_health) = (table.clone(), source.clone());
     let body = reg.cached(format!("compare:{id}"), move || {
         let thetas: &[f64] = if measured {
             &[2.0, 30.0, 60.0, 80.0]
@@ -228,5 +236,53 @@ pub fn compare(reg: &Registry, q: &Query) -> Result<Response, Response> {
             Err(e) => json!({ "error": e.to_string() }).to_string(),
         }
     });
-    Ok(Response::json(body.to_string()))
+    source_health
+        .health()
+        .map_err(|e| Response::error(500, &e.to_string()))?;
+    answer(table_health.as_ref(), body.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use brdftab::{Brdf, Channels, Flags};
+    use glam::DVec3;
+
+    /// A black BRDF that reports a read failure, as a table with a corrupt chunk does.
+    struct Failed(Channels);
+
+    impl Brdf for Failed {
+        fn channels(&self) -> &Channels {
+            &self.0
+        }
+        fn eval(&self, _: DVec3, _: DVec3, out: &mut [f32]) {
+            out.fill(0.0);
+        }
+        fn flags(&self) -> Flags {
+            Flags::default()
+        }
+        fn describe(&self) -> String {
+            "failed".into()
+        }
+        fn health(&self) -> brdftab::Result<()> {
+            Err(brdftab::Error::Unsupported(
+                "chunk 0: checksum mismatch".into(),
+            ))
+        }
+    }
+
+    #[test]
+    fn a_source_that_failed_answers_its_error_not_its_zeros() {
+        let failed = Failed(Channels::Rgb);
+        let body = eval::polar(&failed, 30.0, 5).to_string();
+        let r = answer(&failed, body).unwrap_err();
+        assert_eq!(r.status, 500);
+        assert!(String::from_utf8_lossy(&r.body).contains("checksum"));
+        let lambert = brdftab::ModelSpec::parse(r#"{"model": "lambert", "kd": 0.5}"#)
+            .unwrap()
+            .build(&Channels::Rgb)
+            .unwrap();
+        let body = eval::polar(lambert.as_ref(), 30.0, 5).to_string();
+        assert_eq!(answer(lambert.as_ref(), body).unwrap().status, 200);
+    }
 }
