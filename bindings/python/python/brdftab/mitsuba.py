@@ -28,8 +28,8 @@ brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only.
   Sampling is the library's (``src/table/sampling.rs``): wo is drawn as the mirror image of
   wi about a half vector from conditional 2D warps of f_r cos θo over the half vector, on the
   node densities the library exports (``Brdf.sampling_nodes``), conditioned on θi (and φi for
-  anisotropic tables) with Mitsuba's ``MarginalContinuous2D1``/``2D2``, with the exactly
-  consistent pdf (``brdftab._halfwarp``).
+  anisotropic tables), drawn with the library's own alias tables (``brdftab._alias2d``), with
+  the exactly consistent pdf (``brdftab._halfwarp``).
 """
 
 from __future__ import annotations
