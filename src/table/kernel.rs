@@ -1,5 +1,6 @@
-//! The fast lookup of adaptive (warped) `halfdiff` tables: what a renderer calls per shading
-//! point on a measured material.
+//! The fast lookup of isotropic `halfdiff` tables — adaptive (warped) ones and the presets' and
+//! MERL-style fixed mappings: what a renderer calls per shading point on a measured material or
+//! a baked analytic model.
 //!
 //! The general lookup ([`super::lookup`]) computes the four Rusinkiewicz angles with acos and
 //! atan2 and maps each through its axis. On a table whose θh, θd and φd axes are all
@@ -363,8 +364,9 @@ pub struct Kernel {
 impl Kernel {
     /// The kernel of `grid` when it applies: `halfdiff`, isotropic and bilateral, θh (by
     /// [`WarpVar::SqrtSine`] or [`WarpVar::QuarterPower`]), θd and φd warped with their default
-    /// variables on edge nodes. `None` otherwise (use the general
-    /// lookup).
+    /// variables on edge nodes, or on fixed mappings over the whole axes (sqrt θh, uniform or
+    /// cos θd, uniform φd on edge nodes; at most [`RESAMPLED_MAX_VALUES`] values), resampled.
+    /// `None` otherwise (use the general lookup).
     pub fn new(grid: &Grid) -> Option<Kernel> {
         let s = grid.symmetry();
         if grid.param() != Param::HalfDiff || !s.isotropic || !s.bilateral {

@@ -15,7 +15,9 @@
 //! | large  | 180 × – × 360 × 360    | 128 × 96 × 64 × 96   | 180 × – × 180 × 360 | 90 × 180 × 90 × 180 |
 //!
 //! Stored RGB values for an isotropic, reciprocal, bilateral source: small 52 k, medium 4.4 M
-//! (17.7 MB as f32, the size of a MERL file), large 17.7 M.
+//! (17.7 MB as f32, the size of a MERL file), large 17.7 M. Isotropic `halfdiff` presets are
+//! looked up by [`crate::table::kernel`] (their mappings resampled as knot lines, values exact):
+//! one lookup of the medium table takes 36–44 ns (BENCHMARKS.md, "Preset tables on the kernel").
 //!
 //! Measured accuracy (`cargo run --release --example table_accuracy -- --seeds 5 small medium
 //! large`; linear lookup, cosine-weighted relative RMSE over 10^5 random pairs, median over 5
