@@ -227,6 +227,43 @@ CHI2 = [
 ]
 
 
+@pytest.mark.parametrize("variant", ["llvm_ad_rgb", "llvm_ad_spectral"])
+def test_jit_calls_honour_the_active_mask(rgl, variant):
+    """eval, pdf, eval_pdf and sample run the table inside a symbolic branch on ``active``
+    (skipped for packets with no active lane): active lanes get what an all-active call gives,
+    the others zeros — in blocks, as coherent lanes come, and lane by lane."""
+    use(variant)
+    d = mi.load_dict({"type": "brdftab", "source": str(rgl / RGL_FILE)})
+    n = 4096
+    wi, wo = random_dirs(n, 7, 0.1), random_dirs(n, 8, 0.1)
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.wi = mi.Vector3f(*wi.T)
+    if variant.endswith("spectral"):
+        si.wavelengths = mi.Spectrum(450.0, 520.0, 600.0, 680.0)
+    v = mi.Vector3f(*wo.T)
+    u = mi.Point2f(*np.random.default_rng(9).random((2, n)))
+    ctx = mi.BSDFContext()
+    full_e = np.array(d.eval(ctx, si, v))
+    full_p = np.array(d.pdf(ctx, si, v))
+    full_bs, full_w = d.sample(ctx, si, 0.5, u)
+    full_wo, full_w = np.array(full_bs.wo), np.array(full_w)
+    assert np.count_nonzero(full_p) > n // 2 and np.count_nonzero(full_e) > n // 2
+    lanes = np.arange(n)
+    for keep in ((lanes // 512) % 2 == 0, lanes % 3 == 0):
+        m = mi.Bool(keep)
+        e = np.array(d.eval(ctx, si, v, m))
+        p = np.array(d.pdf(ctx, si, v, m))
+        e2, p2 = d.eval_pdf(ctx, si, v, m)
+        bs, w = d.sample(ctx, si, 0.5, u, m)
+        for got, full in ((e, full_e), (np.array(e2), full_e), (np.array(w), full_w)):
+            assert np.array_equal(got[..., keep], full[..., keep])
+            assert not np.any(got[..., ~keep])
+        for got in (p, np.array(p2)):
+            assert np.array_equal(got[keep], full_p[keep]) and not np.any(got[~keep])
+        assert np.array_equal(np.array(bs.wo)[:, keep], full_wo[:, keep])
+        assert not np.any(np.array(bs.pdf)[~keep])
+
+
 def test_jit_alias_draw_is_the_piecewise_bilinear_density(rgl):
     """The plugin's draw (the library's alias tables, ``brdftab._alias2d``) has the density of
     Mitsuba's ``MarginalContinuous2D1`` on the same nodes — an independent implementation of

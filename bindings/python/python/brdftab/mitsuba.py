@@ -796,7 +796,9 @@ class JitBrdftabBSDF(_Common):
             b = brdftab.open(self.source, interp=self.interp, wavelengths=options.pop("wavelengths"))
         return self._layout(b.table(param="halfdiff", **options))
 
-    def _f(self, wi, wo, si, active):
+    def _f(self, wi, wo, lam, active):
+        """f_r of the table at (wi, wo) as the variant's spectrum; ``lam``: the wavelengths of
+        a spectral variant (``si.wavelengths``), else None."""
         import drjit as dr
         import mitsuba as mi
 
@@ -807,7 +809,6 @@ class JitBrdftabBSDF(_Common):
         if wl is None:  # an RGB table in a spectral variant: its mean
             return mi.Spectrum(sum(f) / len(f))
         out = []
-        lam = si.wavelengths
         for i in range(len(lam)):
             x = lam[i]
             v = dr.select(x <= wl[0], f[0], f[-1])
@@ -817,20 +818,40 @@ class JitBrdftabBSDF(_Common):
             out.append(v)
         return mi.Spectrum(out)
 
-    def eval(self, ctx, si, wo, active=True):
+    def _when(self, active, si, args, on, off):
+        """``on(*args, lam)`` where ``active``, ``off(*args, lam)`` elsewhere (``lam``: the
+        spectral variant's wavelengths, else None), as a symbolic branch. Dr.Jit's LLVM backend
+        then skips the table for packets of lanes none of which needs it — rays that missed the
+        object, other materials, finished paths — where a masked evaluation computes every lane
+        (a table lookup costs about as much as the rest of a path; BENCHMARKS.md)."""
         import drjit as dr
+
+        if self.spectral:
+            return dr.if_stmt(args=(*args, si.wavelengths), cond=active, true_fn=on,
+                              false_fn=off, label="brdftab")
+        return dr.if_stmt(args=tuple(args), cond=active, true_fn=lambda *a: on(*a, None),
+                          false_fn=lambda *a: off(*a, None), label="brdftab")
+
+    def _value(self, wi, wo, lam, active):
+        """f_r cos θo (0 where not ``active``)."""
+        import drjit as dr
+
+        return dr.select(active, self._f(wi, wo, lam, active) * dr.normalize(wo).z, 0.0)
+
+    def eval(self, ctx, si, wo, active=True):
         import mitsuba as mi
 
         active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
         if self.delta:
             return mi.Spectrum(0.0)
-        cos_o = dr.normalize(wo).z
-        return dr.select(active, self._f(si.wi, wo, si, active) * cos_o, 0.0)
+        return self._when(active, si, (si.wi, wo, active),
+                          lambda wi, wo, a, lam: self._value(wi, wo, lam, a),
+                          lambda wi, wo, a, lam: mi.Spectrum(0.0))
 
-    def _pdf(self, si, wo, active):
+    def _pdf(self, wi, wo, active):
         import drjit as dr
 
-        return self.sampler.pdf(dr.normalize(si.wi), dr.normalize(wo), active)
+        return self.sampler.pdf(dr.normalize(wi), dr.normalize(wo), active)
 
     def pdf(self, ctx, si, wo, active=True):
         import mitsuba as mi
@@ -838,26 +859,44 @@ class JitBrdftabBSDF(_Common):
         active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
         if self.delta:
             return mi.Float(0.0)
-        return self._pdf(si, wo, active)
+        return self._when(active, si, (si.wi, wo, active),
+                          lambda wi, wo, a, lam: self._pdf(wi, wo, a),
+                          lambda wi, wo, a, lam: mi.Float(0.0))
 
     def eval_pdf(self, ctx, si, wo, active=True):
-        return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+        import mitsuba as mi
+
+        active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
+        if self.delta:
+            return mi.Spectrum(0.0), mi.Float(0.0)
+        return self._when(active, si, (si.wi, wo, active),
+                          lambda wi, wo, a, lam: (self._value(wi, wo, lam, a),
+                                                  self._pdf(wi, wo, a)),
+                          lambda wi, wo, a, lam: (mi.Spectrum(0.0), mi.Float(0.0)))
 
     def sample(self, ctx, si, sample1, sample2, active=True):
         import drjit as dr
         import mitsuba as mi
 
         active = mi.Bool(active) & (si.wi.z > 0)
+
+        def on(wi, u, a, lam):
+            wo, pdf = self.sampler.sample(dr.normalize(wi), u, a)
+            ok = a & (wo.z > 0) & (pdf > 0)
+            value = self._value(wi, wo, lam, ok)
+            return wo, pdf, dr.select(ok, value / dr.maximum(pdf, 1e-20), 0.0)
+
+        def off(wi, u, a, lam):
+            return mi.Vector3f(0.0), mi.Float(0.0), mi.Spectrum(0.0)
+
+        wo, pdf, weight = self._when(active, si, (si.wi, sample2, active), on, off)
         bs = dr.zeros(mi.BSDFSample3f)
-        wo, pdf = self.sampler.sample(dr.normalize(si.wi), sample2, active)
         bs.wo = wo
         bs.pdf = pdf
         bs.eta = 1.0
         bs.sampled_type = mi.UInt32(+self.m_flags & ~int(mi.BSDFFlags.FrontSide))
         bs.sampled_component = mi.UInt32(0)
-        ok = active & (wo.z > 0) & (bs.pdf > 0)
-        value = self.eval(ctx, si, wo, ok)
-        return bs, dr.select(ok, value / dr.maximum(bs.pdf, 1e-20), 0.0)
+        return bs, weight
 
     def traverse(self, callback):
         pass
