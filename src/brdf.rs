@@ -204,16 +204,14 @@ pub trait Brdf: Send + Sync {
 
     /// Directional albedo a(wi) = ∫ f_r(wi, wo) cos θo dωo for every channel into `out`.
     ///
-    /// The default integrates numerically ([`crate::analysis::albedo::integrate`] with the
-    /// default options); models with
-    /// a closed form override it. For delta models it is the reflectance of the delta lobe.
+    /// The default integrates numerically ([`albedo_with`] the default
+    /// [`Options`](crate::quadrature::Options): 1e-6 relative); models with a closed form
+    /// override it, and data — tables, measured files — integrate to
+    /// [`Options::DATA`](crate::quadrature::Options::DATA) (1e-4, bounded work), which their
+    /// interpolation's kinks would otherwise drive to the interval limits. For delta models it
+    /// is the reflectance of the delta lobe.
     fn albedo(&self, wi: DVec3, out: &mut [f64]) {
-        let opts = crate::quadrature::Options::default();
-        let est = crate::quadrature::hemisphere(self.channels().len(), wi, &opts, |wi, wo, f| {
-            self.eval(wi, wo, f)
-        });
-        let c = est.value.len().min(out.len());
-        out[..c].copy_from_slice(&est.value[..c]);
+        albedo_with(self, wi, &crate::quadrature::Options::default(), out)
     }
 
     /// Draws an incident direction `wi` for the outgoing direction `wo` from two uniform numbers
@@ -379,3 +377,20 @@ macro_rules! forward_brdf {
 
 forward_brdf!(Box);
 forward_brdf!(std::sync::Arc);
+
+/// The directional albedo of `brdf` at `wi` by adaptive quadrature to `opts`
+/// ([`crate::quadrature::hemisphere`]), every channel into `out`: the default of
+/// [`Brdf::albedo`], and with [`Options::DATA`](crate::quadrature::Options::DATA) that of
+/// tables and measured data.
+pub fn albedo_with<B: Brdf + ?Sized>(
+    brdf: &B,
+    wi: DVec3,
+    opts: &crate::quadrature::Options,
+    out: &mut [f64],
+) {
+    let est = crate::quadrature::hemisphere(brdf.channels().len(), wi, opts, |wi, wo, f| {
+        brdf.eval(wi, wo, f)
+    });
+    let c = est.value.len().min(out.len());
+    out[..c].copy_from_slice(&est.value[..c]);
+}

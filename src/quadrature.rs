@@ -32,6 +32,17 @@ impl Default for Options {
 }
 
 impl Options {
+    /// For data — tables, measured files: a 1e-4 target with at most 32 outer and 64 inner
+    /// intervals. A piecewise-linear table's kinks (and a measurement's noise) defeat the
+    /// default 1e-6 target, which then refines to its interval limits (seconds per direction);
+    /// here about 30 000 evaluations per direction suffice, and the data are not more
+    /// accurate than this anyway.
+    pub const DATA: Options = Options {
+        rel_tol: 1e-4,
+        max_outer: 32,
+        max_inner: 64,
+    };
+
     /// The most times `hemisphere` calls `eval` with these options, whatever the integrand:
     /// the lobe search, then every G7/K15 rule the outer (φ) rule may apply (the 4 quadrants,
     /// then two per bisection up to `max_outer` intervals) times 15 nodes, each node an inner

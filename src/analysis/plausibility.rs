@@ -55,9 +55,10 @@ pub struct Options {
     pub reciprocity_floor: f64,
     /// Largest albedo excess over 1 still called energy conserving (quadrature slack).
     pub albedo_tolerance: f64,
-    /// How the albedo is computed: `None` asks the BRDF ([`Brdf::albedo`]: a closed form or the
-    /// default quadrature); `Some` integrates with these settings (bounded work for tables,
-    /// whose kinks drive the default 1e-6 target to its interval limits).
+    /// How the albedo is computed: `None` asks the BRDF ([`Brdf::albedo`]: a closed form, the
+    /// default quadrature, or for tables and measured data the bounded
+    /// [`Options::DATA`](super::albedo::Options::DATA)); `Some` integrates every source with
+    /// these settings.
     pub albedo: Option<super::albedo::Options>,
 }
 

@@ -494,6 +494,11 @@ impl Brdf for MerlBrdf {
         out.copy_from_slice(&self.cell_at(k));
     }
 
+    /// By quadrature to [`crate::quadrature::Options::DATA`] (see [`Brdf::albedo`]).
+    fn albedo(&self, wi: DVec3, out: &mut [f64]) {
+        crate::brdf::albedo_with(self, wi, &crate::quadrature::Options::DATA, out)
+    }
+
     fn flags(&self) -> Flags {
         // The φd ≡ φd + π fold makes every lookup reciprocal; only φd ∈ [0, π) is stored, and
         // the data are isotropic by construction (no φh).

@@ -645,6 +645,11 @@ impl Brdf for RglBrdf {
         self.sampler().pdf(wi, wo)
     }
 
+    /// By quadrature to [`crate::quadrature::Options::DATA`] (see [`Brdf::albedo`]).
+    fn albedo(&self, wi: DVec3, out: &mut [f64]) {
+        crate::brdf::albedo_with(self, wi, &crate::quadrature::Options::DATA, out)
+    }
+
     fn flags(&self) -> Flags {
         Flags {
             isotropic: self.isotropic,

@@ -542,6 +542,11 @@ impl Brdf for TabulatedBrdf {
     }
 
     /// Only the symmetries the table stores are declared (a reduced table has them exactly).
+    /// By quadrature to [`crate::quadrature::Options::DATA`] (see [`Brdf::albedo`]).
+    fn albedo(&self, wi: DVec3, out: &mut [f64]) {
+        crate::brdf::albedo_with(self, wi, &crate::quadrature::Options::DATA, out)
+    }
+
     fn flags(&self) -> Flags {
         let s = self.grid.symmetry();
         Flags {

@@ -51,14 +51,10 @@ use brdftab::spectrum::{Channels, MAX_CHANNELS};
 use brdftab::table::presets::Preset;
 use brdftab::table::{Param, Symmetry, Table, TabulatedBrdf};
 
-/// Quadrature settings of the albedo metric: a 1e-4 target with bounded interval counts, so a
-/// piecewise-linear table (whose kinks defeat a 1e-6 target) costs at most ~30 000 evaluations
-/// per angle.
-pub const ALBEDO_OPTIONS: albedo::Options = albedo::Options {
-    rel_tol: 1e-4,
-    max_outer: 32,
-    max_inner: 64,
-};
+/// Quadrature settings of the albedo metric: the library's settings for data (a 1e-4 target
+/// with bounded interval counts, so a piecewise-linear table, whose kinks defeat a 1e-6
+/// target, costs at most ~30 000 evaluations per angle).
+pub const ALBEDO_OPTIONS: albedo::Options = albedo::Options::DATA;
 
 /// Written where a metric was not measured (see the module docs).
 pub const NOT_MEASURED: f64 = -1.0;
