@@ -1,5 +1,6 @@
 //! `albedo` and `check`: directional albedo and the plausibility report of a SOURCE.
 
+use crate::text::print_out;
 use brdftab::analysis::{albedo, plausibility};
 use brdftab::{Error, Result};
 use clap::Args;
@@ -45,7 +46,7 @@ pub fn albedo(a: AlbedoArgs) -> Result<()> {
         let vals: Vec<String> = row.iter().map(|&x| sig7(x)).collect();
         text += &format!("{t} {}\n", vals.join(" "));
     }
-    emit(&text)
+    print_out(&text)
 }
 
 /// Prints the plausibility report (text or JSON).
@@ -56,19 +57,10 @@ pub fn check(a: CheckArgs) -> Result<()> {
     if a.json {
         let json = serde_json::to_string(&report)
             .map_err(|e| Error::Unsupported(format!("cannot serialize the report: {e}")))?;
-        emit(&format!("{json}\n"))
+        print_out(&format!("{json}\n"))
     } else {
-        emit(&report.to_string())
+        print_out(&report.to_string())
     }
-}
-
-/// Writes `text` to stdout; a failed write (e.g. a closed pipe) is an error, not a panic.
-pub fn emit(text: &str) -> Result<()> {
-    use std::io::Write;
-    let mut out = std::io::stdout().lock();
-    out.write_all(text.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(|e| Error::io("stdout", e))
 }
 
 /// Parses `0,30,60` as degrees in [0, 90].

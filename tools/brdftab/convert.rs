@@ -7,6 +7,7 @@ use clap::Args;
 
 use crate::bake::flag;
 use crate::progress::Bar;
+use crate::text::outln;
 
 /// Arguments of `brdftab convert`.
 #[derive(Args)]
@@ -24,13 +25,15 @@ pub struct ConvertArgs {
 /// Converts between formats and prints what was written.
 pub fn convert(a: ConvertArgs) -> Result<()> {
     match request::convert(&a.input, &a.output, &a.settings, &Bar::values()).map_err(flag)? {
-        ConvertOutput::Merl(r) => println!(
+        ConvertOutput::Merl(r) => outln!(
             "{}: {} resampled on the MERL grid (90 × 90 × 180 cell centres) in {:.2} s",
-            r.output, r.source, r.seconds
-        ),
+            r.output,
+            r.source,
+            r.seconds
+        )?,
         ConvertOutput::Rgl(r) => {
             let f = &r.written.fields;
-            println!(
+            outln!(
                 "{}: {} as an RGL tensor file ({} φi × {} θi, {n}×{n} table, {} bytes, {:.2} s)",
                 a.output,
                 r.source,
@@ -39,31 +42,36 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
                 r.written.bytes,
                 r.seconds,
                 n = f.n
-            );
+            )?;
             if let Some(e) = r.error {
-                println!(
+                outln!(
                     "  error vs source (read back, {} pairs within 80°): relative RMSE of f_r weighted by cos θi cos θo {:.3e}, max relative {:.3e}",
-                    e.pairs, e.rel_rmse, e.max_rel
-                );
+                    e.pairs,
+                    e.rel_rmse,
+                    e.max_rel
+                )?;
             }
         }
         ConvertOutput::Table { report: r, interp } => {
-            println!("{}: {}", r.output, r.source);
-            println!(
+            outln!("{}: {}", r.output, r.source)?;
+            outln!(
                 "  grid: {} ({} values, {:.2} s)",
                 r.grid_line(),
                 r.values,
                 r.seconds
-            );
+            )?;
             if let Some(acc) = r.accuracy {
-                println!(
+                outln!(
                     "  accuracy vs native ({interp:?}, {} pairs): cosine-weighted relative RMSE {:.3e}, max relative {:.3e}",
-                    acc.pairs, acc.rel_rmse, acc.max_rel
-                );
-                println!(
+                    acc.pairs,
+                    acc.rel_rmse,
+                    acc.max_rel
+                )?;
+                outln!(
                     "  within 80° of the normal (Ngan et al.'s cut; grazing f_r of measured data ∝ 1/cos θo): relative RMSE {:.3e}, max relative {:.3e}",
-                    acc.rel_rmse_80, acc.max_rel_80
-                );
+                    acc.rel_rmse_80,
+                    acc.max_rel_80
+                )?;
             }
         }
     }

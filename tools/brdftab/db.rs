@@ -5,6 +5,7 @@ use brdftab::store::{self, db};
 use brdftab::{Error, Result};
 use clap::{Args, Subcommand};
 
+use crate::text::outln;
 use brdftab::request::BakeSettings;
 
 /// Arguments of `brdftab db`.
@@ -84,7 +85,7 @@ pub fn run(a: DbArgs) -> Result<()> {
         }
         DbCommand::Verify(a) => {
             let n = db::verify(&a.db)?;
-            println!("ok: {} ({n} chunks checked)", a.db);
+            outln!("ok: {} ({n} chunks checked)", a.db)?;
             Ok(())
         }
     }
@@ -94,9 +95,9 @@ fn list(path: &str, as_json: bool) -> Result<()> {
     let rows = store::info::list(path)?;
     if as_json {
         let json = serde_json::to_string_pretty(&rows).unwrap_or_default();
-        println!("{json}");
+        outln!("{json}")?;
     } else {
-        print!("{}", store::info::list_text(&rows));
+        crate::text::print_out(&store::info::list_text(&rows))?;
     }
     Ok(())
 }

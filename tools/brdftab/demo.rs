@@ -25,9 +25,9 @@ use brdftab::{Brdf, Channels, Error, Result};
 use brdftab_tools::report::suite::{self, MetricOptions};
 use clap::Args;
 
-use crate::analysis::emit;
 use crate::bake::flag_named;
 use crate::demo_extra::{BAKED_MODELS, plausibility_table, preview_renders, rate_distortion};
+use crate::text::print_out;
 
 /// Arguments of `brdftab demo`.
 #[derive(Args)]
@@ -81,7 +81,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     let sources = sources(a.rgl.as_deref())?;
 
     // Bake every source into the database.
-    emit(&format!(
+    print_out(&format!(
         "\nBaking {} sources (grids: {}) into {}\n",
         sources.len(),
         a.preset
@@ -107,7 +107,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     // Read every table back from the database and measure it against its source.
     eprintln!("[{:.1} s] baked", t0.elapsed().as_secs_f64());
     let st = store::Store::open(&db)?;
-    emit(&format!(
+    print_out(&format!(
         "\n{:<24} {:<30} {:>9} {:>7} {:>9} {:>8} {:<13} {:>6}\n",
         "source",
         "grid (stored)",
@@ -153,7 +153,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         let r = plausibility::check(&tab, &fast_plausibility());
         let yn = |b: bool| if b { "y" } else { "N" };
         let shape = tab.grid().stored_shape().map(|x| x.to_string()).join("×");
-        emit(&format!(
+        print_out(&format!(
             "{:<24} {:<30} {:>9} {:>6.2}% {:>8.3}% {:>7.3}% {:<13} {:>6.2}\n",
             s.name,
             format!("{} {shape}", tab.grid().param()),
@@ -178,7 +178,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             previews.push((s.name.clone(), s.brdf.as_ref(), tab));
         }
     }
-    emit(
+    print_out(
         "\nbytes: compressed size in the database (log16 ≤ 1e-3 relative + predictor + zstd); vs f32: that size \
          relative to the stored values as plain f32;\nrel RMSE: relative RMSE of f_r cos θi of \
          the table read back from the database vs its source (50k random pairs;\nmeasured rows (rgl_*): of f_r cos θi cos θo with both directions within 80° of the normal, as `brdftab bench --measured`, since their f_r grows like 1/cos θo at grazing — see BENCHMARKS.md);\nalbedo: max \
@@ -188,12 +188,12 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     )?;
 
     if !fidelity_rows.is_empty() {
-        emit(&format!(
+        print_out(&format!(
             "\nEvery table over the whole domain (relative RMSE of f_r cos θi cos θo on a mirror-centred rule; albedo: worst over θ′ = 1..89°):\n{:<24} {:>9} {:>9} {:>9} {:>20}\n",
             "source", "≤ 80°", "whole", "grazing", "albedo"
         ))?;
         for (name, f) in &fidelity_rows {
-            emit(&format!(
+            print_out(&format!(
                 "{:<24} {:>8.2}% {:>8.2}% {:>8.2}% {:>8.2}% at {:>2}° {}\n",
                 name,
                 100.0 * f.rule.cap,
@@ -207,7 +207,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
                     .unwrap_or("?"),
             ))?;
         }
-        emit(
+        print_out(
             "(the measured tables' bars: 1 % within 80°, 1.5 % whole, 3 % grazing, 1 % albedo; `brdftab bench --measured` adds random-pair figures, sizes and speed. Ward's f_r grows like 1/√(cos θi cos θo): its table of f_r, on the medium preset, cannot follow it beyond 80°)\n",
         )?;
     }
@@ -222,7 +222,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     for p in outputs {
         text += &format!("  {}\n", p.display());
     }
-    emit(&text)
+    print_out(&text)
 }
 
 /// The models, then the RGL materials found on disk.

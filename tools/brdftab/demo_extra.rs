@@ -11,7 +11,7 @@ use brdftab::{Brdf, Error, Result};
 use brdftab_tools::preview::{self, EnvChoice, RenderOptions};
 use brdftab_tools::report::{plot, suite};
 
-use crate::analysis::emit;
+use crate::text::print_out;
 
 /// The models the demo bakes, as (table name, spec). Delta models (the mirror) cannot be
 /// tabulated and are left out.
@@ -45,7 +45,7 @@ pub const CT_GOLD: &str = r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"c
 
 /// Prints the plausibility table of the lecture's models ([`plausibility::lecture_table`]).
 pub fn plausibility_table() -> Result<()> {
-    emit(&plausibility::lecture_table())
+    print_out(&plausibility::lecture_table())
 }
 
 /// Renders source | table | difference for each preview, small, and writes PNGs.
@@ -63,7 +63,7 @@ pub fn preview_renders(
         env: EnvChoice::Sky,
         ..Default::default()
     };
-    emit(&format!(
+    print_out(&format!(
         "\nPreview renders ({}×{}, {} spp, path tracer ≤ 3 bounces, sky, fixed sampling; same seed for both):\n",
         opts.width, opts.height, opts.spp
     ))?;
@@ -76,7 +76,7 @@ pub fn preview_renders(
         let side = preview::image::Image::hstack(&[&a, &b, &diff.to_rgb()?], 4, 0.0)?;
         let path = out.join(format!("render_{name}.png"));
         preview::image::write_png(&side, &path, 0.0)?;
-        emit(&format!(
+        print_out(&format!(
             "  {:<24} rendered rel RMSE table vs source {:.3}%\n",
             name,
             100.0 * cmp.rel_rmse
@@ -106,7 +106,9 @@ pub fn rate_distortion(out: &Path) -> Result<Vec<PathBuf>> {
         seed: 2,
     };
     let report = suite::run(&cfg, &Silent)?;
-    emit("\nRate–distortion, Cook-Torrance m = 0.3 gold (bytes vs cosine-weighted rel RMSE):\n")?;
+    print_out(
+        "\nRate–distortion, Cook-Torrance m = 0.3 gold (bytes vs cosine-weighted rel RMSE):\n",
+    )?;
     for r in &report.rows {
         if r.status != "ok" {
             // f16 cannot hold the sharpest peaks of some grids: that point is skipped, say so.
@@ -116,7 +118,7 @@ pub fn rate_distortion(out: &Path) -> Result<Vec<PathBuf>> {
             );
             continue;
         }
-        emit(&format!(
+        print_out(&format!(
             "  {:<7} {:<11} {:>10} bytes  {:.3}%\n",
             r.preset,
             r.codec,

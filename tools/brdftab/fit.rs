@@ -6,6 +6,7 @@ use brdftab::{Error, Result};
 use clap::Args;
 
 use crate::bake::flag;
+use crate::text::outln;
 
 /// Arguments of `brdftab fit`.
 #[derive(Args)]
@@ -36,6 +37,6 @@ pub fn fit(a: FitArgs) -> Result<()> {
     } else {
         result.spec.to_json()
     };
-    println!("{text}");
+    outln!("{text}")?;
     Ok(())
 }

@@ -2,6 +2,7 @@
 
 use std::io::Write;
 
+use crate::text::outln;
 use brdftab::spec::MODELS;
 use brdftab::{Error, Result};
 use clap::Args;
@@ -42,13 +43,13 @@ pub fn eval(a: EvalArgs) -> Result<()> {
 /// Lists every model.
 pub fn models(a: ModelsArgs) -> Result<()> {
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(MODELS).unwrap_or_default()
-        );
+        )?;
     } else {
         for m in MODELS {
-            println!(
+            outln!(
                 "{:<17} {}\n{:<17} params: {}\n{:<17} e.g. {}",
                 m.name,
                 m.description,
@@ -56,7 +57,7 @@ pub fn models(a: ModelsArgs) -> Result<()> {
                 m.params_line(),
                 "",
                 m.example
-            );
+            )?;
         }
     }
     Ok(())

@@ -8,6 +8,7 @@ use brdftab_tools::preview::{self, EnvChoice, Image, LightChoice, Mode, RenderOp
 use clap::Args;
 
 use crate::bake::flag_named;
+use crate::text::outln;
 
 /// Arguments of `brdftab render`.
 #[derive(Args)]
@@ -143,23 +144,26 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let (diff, legend) = preview::difference_image(&img, &img_b)?;
     let dp = diff_path(&a.output);
     preview::write_png(&diff, &dp, 0.0)?;
-    println!(
+    outln!(
         "relative RMSE: {:.6} ({:.4}%)",
         r.rel_rmse,
         100.0 * r.rel_rmse
-    );
-    println!("RMSE: {:.6e}  max |a-b|: {:.6e}", r.rmse, r.max_abs);
-    println!(
+    )?;
+    outln!("RMSE: {:.6e}  max |a-b|: {:.6e}", r.rmse, r.max_abs)?;
+    outln!(
         "mean {}: {:.6}  mean {}: {:.6}",
-        a.source, r.mean_a, other, r.mean_b
-    );
-    println!(
+        a.source,
+        r.mean_a,
+        other,
+        r.mean_b
+    )?;
+    outln!(
         "side by side: {} ({} left, {} right)",
         a.output.display(),
         a.source,
         other
-    );
-    println!("difference: {} — {legend}", dp.display());
+    )?;
+    outln!("difference: {} — {legend}", dp.display())?;
     Ok(())
 }
 

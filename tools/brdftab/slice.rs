@@ -1,5 +1,6 @@
 //! `slice`: a slice image of any SOURCE.
 
+use crate::text::outln;
 use brdftab::{Brdf, Error, Result};
 use brdftab_tools::preview::slice;
 use clap::{Args, ValueEnum};
@@ -84,6 +85,6 @@ pub fn slice(a: SliceArgs) -> Result<()> {
         ),
     };
     let legend = slice::write(&img, channel, &a.output)?;
-    println!("{}: {what}; {legend}", a.output);
+    outln!("{}: {what}; {legend}", a.output)?;
     Ok(())
 }

@@ -1,20 +1,12 @@
 //! `info`: what a table file or a measured file holds (the library's `store::info` and
 //! `measured::info` say it; this prints).
 
+use brdftab::Result;
 use brdftab::store::{db, info, tables};
-use brdftab::{Error, Result};
 use clap::Args;
 
 use crate::source;
-
-/// Writes `text` to stdout; a closed pipe (`| head`) is not an error.
-pub fn print_out(text: &str) -> Result<()> {
-    use std::io::Write;
-    match std::io::stdout().lock().write_all(text.as_bytes()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::io("stdout", e)),
-        _ => Ok(()),
-    }
-}
+use crate::text::print_out;
 
 /// Arguments of `brdftab info`.
 #[derive(Args)]

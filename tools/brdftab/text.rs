@@ -10,6 +10,25 @@ use glam::DVec3;
 
 use brdftab::{Error, Result};
 
+/// Writes `text` to stdout and flushes; a failed write is an error, not a panic (`println!`
+/// panics on a closed pipe: `brdftab models | head -1`). `main` ends quietly when the error
+/// is a closed pipe.
+pub fn print_out(text: &str) -> brdftab::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| brdftab::Error::io("stdout", e))
+}
+
+/// `println!` through [`print_out`]: evaluates to its `Result` (use `?`).
+macro_rules! outln {
+    ($($t:tt)*) => {
+        $crate::text::print_out(&format!("{}\n", format_args!($($t)*)))
+    };
+}
+pub(crate) use outln;
+
 /// Parses a line of exactly `N` numbers; `None` for blank and `#` lines. `name` and `lineno`
 /// go into the error.
 pub fn parse_numbers<const N: usize>(

@@ -300,3 +300,40 @@ fn nan_directions_give_zero() {
         assert_eq!(r.stdout, "0\n0\n", "{src}");
     }
 }
+
+/// A reader that went away (`brdftab models | head -1`) ends the command quietly with status 0:
+/// never a panic (`println!` panics on a closed pipe). The pipe's read end is closed before
+/// the command writes, so every write fails.
+#[test]
+fn a_closed_stdout_is_not_a_panic() {
+    use std::process::Stdio;
+    let d = TempDir::new("hostile-pipe");
+    let table = d.path().join("t.btdb");
+    let r = brdftab(&["bake", CT, "-o", s(&table), "--grid", "8x1x8x8"]);
+    assert!(r.ok, "{}", r.stderr);
+    let runs: [&[&str]; 7] = [
+        &["models"],
+        &["models", "--json"],
+        &["--help"],
+        &["info", s(&table)],
+        &["db", "list", s(&table)],
+        &["albedo", s(&table), "--theta", "0,45"],
+        &["fit", s(&table), "--model", "lambert"],
+    ];
+    for args in runs {
+        let mut child = common::command(args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            out.status.success() && !err.contains("panicked"),
+            "{args:?}: {:?} {err}",
+            out.status
+        );
+    }
+}
