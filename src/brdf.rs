@@ -205,9 +205,9 @@ pub trait Brdf: Send + Sync {
     /// Directional albedo a(wi) = ∫ f_r(wi, wo) cos θo dωo for every channel into `out`.
     ///
     /// The default integrates numerically ([`albedo_with`] the default
-    /// [`Options`](crate::quadrature::Options): 1e-6 relative); models with a closed form
+    /// [`Options`](crate::analysis::albedo::Options): 1e-6 relative); models with a closed form
     /// override it, and data — tables, measured files — integrate to
-    /// [`Options::DATA`](crate::quadrature::Options::DATA) (1e-4, bounded work), which their
+    /// [`Options::DATA`](crate::analysis::albedo::Options::DATA) (1e-4, bounded work), which their
     /// interpolation's kinks would otherwise drive to the interval limits. For delta models it
     /// is the reflectance of the delta lobe.
     fn albedo(&self, wi: DVec3, out: &mut [f64]) {
@@ -379,8 +379,8 @@ forward_brdf!(Box);
 forward_brdf!(std::sync::Arc);
 
 /// The directional albedo of `brdf` at `wi` by adaptive quadrature to `opts`
-/// ([`crate::quadrature::hemisphere`]), every channel into `out`: the default of
-/// [`Brdf::albedo`], and with [`Options::DATA`](crate::quadrature::Options::DATA) that of
+/// ([`crate::analysis::albedo::integrate`]), every channel into `out`: the default of
+/// [`Brdf::albedo`], and with [`Options::DATA`](crate::analysis::albedo::Options::DATA) that of
 /// tables and measured data.
 pub fn albedo_with<B: Brdf + ?Sized>(
     brdf: &B,

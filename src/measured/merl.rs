@@ -494,7 +494,7 @@ impl Brdf for MerlBrdf {
         out.copy_from_slice(&self.cell_at(k));
     }
 
-    /// By quadrature to [`crate::quadrature::Options::DATA`] (see [`Brdf::albedo`]).
+    /// By quadrature to [`crate::analysis::albedo::Options::DATA`] (see [`Brdf::albedo`]).
     fn albedo(&self, wi: DVec3, out: &mut [f64]) {
         crate::brdf::albedo_with(self, wi, &crate::quadrature::Options::DATA, out)
     }

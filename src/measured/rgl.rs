@@ -645,7 +645,7 @@ impl Brdf for RglBrdf {
         self.sampler().pdf(wi, wo)
     }
 
-    /// By quadrature to [`crate::quadrature::Options::DATA`] (see [`Brdf::albedo`]).
+    /// By quadrature to [`crate::analysis::albedo::Options::DATA`] (see [`Brdf::albedo`]).
     fn albedo(&self, wi: DVec3, out: &mut [f64]) {
         crate::brdf::albedo_with(self, wi, &crate::quadrature::Options::DATA, out)
     }

@@ -542,7 +542,7 @@ impl Brdf for TabulatedBrdf {
     }
 
     /// Only the symmetries the table stores are declared (a reduced table has them exactly).
-    /// By quadrature to [`crate::quadrature::Options::DATA`] (see [`Brdf::albedo`]).
+    /// By quadrature to [`crate::analysis::albedo::Options::DATA`] (see [`Brdf::albedo`]).
     fn albedo(&self, wi: DVec3, out: &mut [f64]) {
         crate::brdf::albedo_with(self, wi, &crate::quadrature::Options::DATA, out)
     }
