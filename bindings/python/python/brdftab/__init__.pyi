@@ -47,7 +47,11 @@ class Brdf:
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32]]:
         """(wi (n, 3), pdf (n,), weight = f cos θi / pdf (n, c)) for u in [0, 1)² of shape (n, 2)."""
     def albedo(self, theta: ArrayLike) -> npt.NDArray[np.float64]:
-        """Directional albedo at θ′ in radians: (k, c) float64."""
+        """Directional albedo at θ′ in radians: (k, c) float64.
+
+        A closed form where the model has one, else adaptive quadrature: 1e-6 relative for
+        models, 1e-4 for tables and measured data.
+        """
     def table(self, **options: Any) -> Table:
         """The decoded table (other sources are baked with the keywords of `bake`); unpacks as
         `values, grid = b.table()`."""
