@@ -387,9 +387,14 @@ pub fn model_info(name: &str) -> Option<&'static ModelInfo> {
     MODELS.iter().find(|m| m.name == name)
 }
 
-/// Checks one parameter's JSON value against its bound. `field` names it in errors.
+/// Checks one parameter's JSON value against its bound and
+/// [`NUMBER_RANGE`](crate::spectrum::NUMBER_RANGE). `field` names
+/// it in errors.
 fn check_param(p: &ParamInfo, field: &str, v: &serde_json::Value) -> Result<()> {
     let number = |x: Option<f64>, field: &str| -> Result<()> {
+        if let Some(x) = x.filter(|x| x.is_finite()) {
+            crate::spectrum::check_range(x, field)?;
+        }
         let ok = match (x, p.bound) {
             (Some(x), Bound::NonNegative) => x.is_finite() && x >= 0.0,
             (Some(x), Bound::Positive) => x.is_finite() && x > 0.0,
@@ -800,6 +805,70 @@ mod tests {
         let e = ModelSpec::parse(r#"{"model": "ggx", "alpha": 0.1, "alpha_x": 0.2}"#).unwrap_err();
         assert!(e.to_string().contains("alpha"), "{e}");
         assert!(MODELS[9].params_line().contains("alpha_x: number > 0"));
+    }
+
+    /// Every number at either end of [`crate::spectrum::NUMBER_RANGE`] evaluates to finite
+    /// values (the range is safe), and just beyond it is an error naming the field.
+    #[test]
+    fn numbers_at_the_range_ends_evaluate_finite_and_beyond_are_errors() {
+        use crate::geometry::spherical;
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let (lo, hi) = (
+            *crate::spectrum::NUMBER_RANGE.start(),
+            *crate::spectrum::NUMBER_RANGE.end(),
+        );
+        // Normal, oblique, mirror, retro and grazing pairs.
+        let pairs = [
+            (glam::DVec3::Z, glam::DVec3::Z),
+            (spherical(0.4, 0.0), spherical(0.4, PI)),
+            (spherical(0.7, 1.0), spherical(0.2, 2.0)),
+            (spherical(1.2, 0.3), spherical(1.2, 0.3)),
+            (
+                spherical(FRAC_PI_2 - 1e-4, 0.0),
+                spherical(FRAC_PI_2 - 1e-4, PI),
+            ),
+            (spherical(FRAC_PI_2 - 1e-4, 0.0), spherical(0.01, 1.0)),
+        ];
+        let mut checked = 0;
+        for m in MODELS {
+            for p in m.params {
+                let numeric = matches!(p.kind, Kind::Number | Kind::Radians | Kind::Value);
+                if !numeric {
+                    continue;
+                }
+                for (x, ok) in [
+                    (lo, true),
+                    (hi, true),
+                    (lo / 10.0, false),
+                    (hi * 10.0, false),
+                ] {
+                    let mut j: serde_json::Value = serde_json::from_str(m.example).unwrap();
+                    if p.name == "alpha" || p.name == "alpha_x" || p.name == "alpha_y" {
+                        // Keep the example's own choice of isotropic or anisotropic α.
+                        if j.get(p.name).is_none() {
+                            continue;
+                        }
+                    }
+                    j[p.name] = serde_json::json!(x);
+                    let parsed = ModelSpec::parse(&j.to_string());
+                    if !ok {
+                        let e = parsed.expect_err(&j.to_string()).to_string();
+                        assert!(e.contains(p.name) && e.contains("out of range"), "{e}");
+                        continue;
+                    }
+                    // Rules between parameters (Schlick F0 ≤ 1, ...) may refuse an end.
+                    let Ok(spec) = parsed else { continue };
+                    let b = build(&spec, &Channels::Rgb).unwrap();
+                    let mut f = [0.0f32; 3];
+                    for (wi, wo) in pairs {
+                        b.eval(wi, wo, &mut f);
+                        assert!(f.iter().all(|v| v.is_finite()), "{j}: {f:?} at {wi} {wo}");
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked >= 20, "{checked} specs evaluated");
     }
 
     #[test]

@@ -195,8 +195,9 @@ impl Value {
         }
     }
 
-    /// Checks the value: finite, and `>= min` (use `f64::NEG_INFINITY` for no bound); spectra
-    /// need matching lengths and increasing wavelengths. `field` names the value in the error.
+    /// Checks the value: finite, `>= min` (use `f64::NEG_INFINITY` for no bound) and 0 or of a
+    /// magnitude in [`NUMBER_RANGE`]; spectra need matching lengths and increasing wavelengths.
+    /// `field` names the value in the error.
     pub fn validate(&self, field: &str, min: f64) -> Result<()> {
         if let Value::Spectral {
             wavelengths,
@@ -234,6 +235,7 @@ impl Value {
                     format!("{v} is below the minimum {min}"),
                 ));
             }
+            check_range(v, field)?;
         }
         Ok(())
     }
@@ -313,6 +315,27 @@ impl<'de> Deserialize<'de> for Value {
             ))),
         }
     }
+}
+
+/// The magnitudes a model parameter may have besides 0 (every [`Value`] and every number of a
+/// [`crate::ModelSpec`]): the models compute in f64 and return f32, and beyond this range their
+/// values over- or underflow (k_d = 1e300 evaluated as inf, a GGX α of 1e300 or a refractive
+/// index of 1e-300 as NaN).
+pub const NUMBER_RANGE: std::ops::RangeInclusive<f64> = 1e-12..=1e12;
+
+/// `x` is 0 or its magnitude lies in [`NUMBER_RANGE`]; else the error for `field`.
+pub(crate) fn check_range(x: f64, field: &str) -> Result<()> {
+    if x == 0.0 || NUMBER_RANGE.contains(&x.abs()) {
+        return Ok(());
+    }
+    Err(Error::spec(
+        field,
+        format!(
+            "{x:e} is out of range: 0 or a magnitude within [{:e}, {:e}]",
+            NUMBER_RANGE.start(),
+            NUMBER_RANGE.end()
+        ),
+    ))
 }
 
 #[cfg(test)]
