@@ -46,7 +46,7 @@
 //! Choices where the source has no measurement to offer:
 //! - the θi = 90° slice evaluates the source at θi = 89.5° (f_r·cos θo at exact grazing incidence
 //!   is 0 by the [`Brdf`] conventions; readers interpolate towards this slice above 78.5°);
-//! - grid points whose ωo falls below the horizon are filled from their valid neighbours (they
+//! - grid points whose ωo falls below the horizon continue their valid neighbours linearly (they
 //!   are corners of cells readers interpolate in, never evaluated themselves); the `valid` field
 //!   marks them 0 (a bit per sample, packed most significant bit first over φi × θi × N × N —
 //!   the published files' `valid` has exactly that many bytes, φi·θi·N²/8, though what their bits

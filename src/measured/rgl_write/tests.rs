@@ -346,3 +346,34 @@ pub(crate) fn rgl_files() -> Vec<std::path::PathBuf> {
     assert!(!v.is_empty(), "no .bsdf files in {}", rgl_dir().display());
     v
 }
+
+/// Below-horizon points continue a linear profile exactly, stop at 0 where it would turn
+/// negative, and take the neighbours' mean where no two filled points line up.
+#[test]
+fn the_fill_continues_valid_values_linearly() {
+    let n = 8;
+    for (slope, last_valid) in [(1.0f32, 4usize), (1.0, 2)] {
+        let mut plane = vec![-7.0f32; n * n];
+        let mut valid = vec![false; n * n];
+        for j in 0..n {
+            for i in 0..=last_valid {
+                plane[i + j * n] = 3.0 + last_valid as f32 - slope * i as f32;
+                valid[i + j * n] = true;
+            }
+        }
+        super::values::fill_below_horizon(&mut plane, &valid, n);
+        for j in 0..n {
+            for i in 0..n {
+                let expect = (3.0 + last_valid as f32 - slope * i as f32).max(0.0);
+                assert_eq!(plane[i + j * n], expect, "({i}, {j}) of {last_valid}");
+            }
+        }
+    }
+    // One valid point: its neighbours take its value (no line to continue), and so on outwards.
+    let mut plane = vec![0.0f32; n * n];
+    let mut valid = vec![false; n * n];
+    plane[3 + 3 * n] = 2.5;
+    valid[3 + 3 * n] = true;
+    super::values::fill_below_horizon(&mut plane, &valid, n);
+    assert!(plane.iter().all(|&v| v == 2.5), "{plane:?}");
+}
