@@ -3,14 +3,38 @@
 //! directional albedo error over θ′ = 1–89°, each table against the source it was baked from.
 //!
 //! `cargo run --release --example measured_fidelity -- data/rgl/*.bsdf` (set `GRID` to a
-//! `--grid` value to bake another grid than the default).
+//! `--grid` value to bake another grid than the default). With `--merl` first, the same figures
+//! for the MERL file each source converts to (`brdftab convert SOURCE out.binary`: cell means,
+//! looked up by cell as the MERL reader does) instead of its default table.
 
 use brdftab::analysis::fidelity::{FidelityOptions, measure};
 use brdftab::bake::BakeRequest;
 use brdftab::table::TabulatedBrdf;
 fn main() -> brdftab::Result<()> {
-    let files: Vec<String> = std::env::args().skip(1).collect();
+    let mut files: Vec<String> = std::env::args().skip(1).collect();
+    let merl = files.first().is_some_and(|a| a == "--merl");
+    if merl {
+        files.remove(0);
+    }
     for f in files {
+        if merl {
+            let src = brdftab::source::open(&f)?;
+            let t0 = std::time::Instant::now();
+            let m = brdftab::measured::MerlBrdf::from_brdf(src.as_ref());
+            let secs = t0.elapsed().as_secs_f64();
+            let opts = FidelityOptions {
+                pairs: 100_000,
+                ..Default::default()
+            };
+            let fi = measure(&m, src.as_ref(), &opts)?;
+            println!(
+                "{f}: MERL file written in {secs:.1}s\n   {}  a={:.4} ref={:.4}",
+                fi.summary(),
+                fi.albedo.approx,
+                fi.albedo.reference
+            );
+            continue;
+        }
         let mut req = BakeRequest::new(f.as_str());
         if let Ok(g) = std::env::var("GRID") {
             req = req.grid(g.parse::<brdftab::bake::GridChoice>()?);

@@ -201,7 +201,7 @@ pub enum BakeTarget {
     },
     /// A raw (uncompressed f32) table file.
     Raw(String),
-    /// A MERL `.binary` file: the source resampled at the MERL cell centres, in RGB (the grid,
+    /// A MERL `.binary` file: the source resampled as MERL cell means, in RGB (the grid,
     /// symmetry and codec of the request do not apply; the format fixes them).
     Merl(String),
 }

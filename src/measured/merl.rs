@@ -46,8 +46,8 @@
 //! a linear lookup above the horizon interpolates them with their neighbours. `eval` of either
 //! a file or a table is 0 when a direction itself is below the horizon. Only a source that is
 //! *not* on the MERL grid (an analytic model, an RGL file, a table on another grid) is resampled
-//! by directions, and there a cell whose centre is below the horizon has no value and is written
-//! as −1, as the database does.
+//! by directions, as cell means ([`super::merl_resample`]), and there a cell none of whose
+//! points lies above the horizon has no value and is written as −1, as the database does.
 //!
 //! # Identification
 //!
@@ -58,12 +58,11 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::Path;
 
 use glam::DVec3;
-use rayon::prelude::*;
 
 use crate::brdf::{BakeSource, Brdf, Flags};
 use crate::error::{Error, Result};
 use crate::geometry::{self, HalfDiff};
-use crate::spectrum::{Channels, RGB_WAVELENGTHS};
+use crate::spectrum::Channels;
 
 /// θh resolution.
 pub const RES_THETA_H: usize = 90;
@@ -184,10 +183,10 @@ pub fn sha256_file(path: impl AsRef<Path>) -> Result<String> {
 /// reference reader's nearest lookup.
 #[derive(Clone)]
 pub struct MerlBrdf {
-    name: String,
+    pub(super) name: String,
     /// Raw stored values, channel-planar R, G, B (3 × [`SAMPLES`]).
-    data: Vec<f64>,
-    channels: Channels,
+    pub(super) data: Vec<f64>,
+    pub(super) channels: Channels,
 }
 
 impl std::fmt::Debug for MerlBrdf {
@@ -301,80 +300,6 @@ impl MerlBrdf {
             data,
             channels: Channels::Rgb,
         })
-    }
-
-    /// Resamples any BRDF at the cell centres of the MERL grid and stores f_r / scale.
-    ///
-    /// A source that stores a value at the cell centre ([`BakeSource::stored_node`]: a MERL
-    /// measurement, a `halfdiff` table on the MERL grid) gives it as stored, so MERL → MERL and
-    /// MERL → table → MERL keep every cell — to f32 precision, the precision of
-    /// [`BakeSource::stored_node`] — and every unmeasured cell: a negative stored value is written as
-    /// the database's −1. Any other source is evaluated at the cell centre (RGB channels: `eval`;
-    /// other channel sets: [`Brdf::eval_wavelength`] at the representative RGB wavelengths);
-    /// there cells whose centre puts a direction below the horizon are stored as −1
-    /// (unmeasured), as in the database. Runs in parallel.
-    pub fn from_brdf(brdf: &dyn Brdf) -> Self {
-        let rgb = *brdf.channels() == Channels::Rgb;
-        let stored = rgb;
-        let plane = RES_THETA_D * RES_PHI_D;
-        let mut cells = vec![[0.0f64; 3]; SAMPLES];
-        crate::par::install(|| {
-            cells
-                .par_chunks_mut(plane)
-                .enumerate()
-                .for_each(|(ith, chunk)| {
-                    for itd in 0..RES_THETA_D {
-                        for ipd in 0..RES_PHI_D {
-                            let hd = cell_center(ith, itd, ipd);
-                            let cell = &mut chunk[ipd + RES_PHI_D * itd];
-                            let mut f = [0.0f32; 3];
-                            if stored
-                                && brdf
-                                    .bake_source()
-                                    .is_some_and(|b| b.stored_node(hd, &mut f))
-                            {
-                                for c in 0..3 {
-                                    cell[c] = if f[c] < 0.0 {
-                                        -1.0
-                                    } else if f[c].is_finite() {
-                                        f[c] as f64 / SCALE[c]
-                                    } else {
-                                        0.0
-                                    };
-                                }
-                                continue;
-                            }
-                            let (wi, wo) = geometry::from_half_diff(hd);
-                            if wi.z <= 0.0 || wo.z <= 0.0 {
-                                // Below the horizon: no value, marked as the database does.
-                                *cell = [-1.0; 3];
-                                continue;
-                            }
-                            if rgb {
-                                brdf.eval(wi, wo, &mut f);
-                            } else {
-                                for (c, nm) in RGB_WAVELENGTHS.iter().enumerate() {
-                                    f[c] = brdf.eval_wavelength(wi, wo, *nm) as f32;
-                                }
-                            }
-                            for c in 0..3 {
-                                cell[c] = f[c] as f64 / SCALE[c];
-                            }
-                        }
-                    }
-                })
-        });
-        let mut data = vec![0.0f64; 3 * SAMPLES];
-        for (k, cell) in cells.iter().enumerate() {
-            for c in 0..3 {
-                data[c * SAMPLES + k] = cell[c];
-            }
-        }
-        MerlBrdf {
-            name: format!("resampled {}", brdf.describe()),
-            data,
-            channels: Channels::Rgb,
-        }
     }
 
     /// The file's bytes: header and the raw samples, little-endian.

@@ -25,6 +25,7 @@ pub mod data;
 pub mod info;
 pub mod merl;
 pub mod merl_manifest;
+pub mod merl_resample;
 pub mod rgl;
 pub mod rgl_normal;
 pub mod rgl_write;

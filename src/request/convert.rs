@@ -48,7 +48,8 @@ pub const DEFAULT_PAIRS: usize = 200_000;
 /// What [`convert`] wrote.
 #[derive(Debug, Clone)]
 pub enum ConvertOutput {
-    /// A MERL `.binary`: the source resampled at the MERL cell centres.
+    /// A MERL `.binary`: the source resampled as MERL cell means
+    /// ([`crate::measured::merl_resample`]).
     Merl(BakeReport),
     /// An RGL `.bsdf` file, with the error of the file read back.
     Rgl(Converted),

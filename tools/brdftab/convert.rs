@@ -15,7 +15,7 @@ pub struct ConvertArgs {
     /// Any SOURCE: a MERL `.binary`, an RGL `.bsdf`, a spec, a table.
     input: String,
     /// The output: an RGL `.bsdf` (loads in Mitsuba 3 and pbrt-v4), a MERL `.binary` (the
-    /// source resampled at the MERL cell centres), a table database entry `DB#NAME` (or a
+    /// source's mean over each MERL cell), a table database entry `DB#NAME` (or a
     /// `.btdb` file, named after the input), or a raw table file.
     output: String,
     #[command(flatten)]
@@ -26,7 +26,7 @@ pub struct ConvertArgs {
 pub fn convert(a: ConvertArgs) -> Result<()> {
     match request::convert(&a.input, &a.output, &a.settings, &Bar::values()).map_err(flag)? {
         ConvertOutput::Merl(r) => outln!(
-            "{}: {} resampled on the MERL grid (90 × 90 × 180 cell centres) in {:.2} s",
+            "{}: {} resampled on the MERL grid (means over 90 × 90 × 180 cells) in {:.2} s",
             r.output,
             r.source,
             r.seconds

@@ -981,7 +981,7 @@ fn convert(
                 "output": r.output,
                 "format": "merl",
                 "source": r.source,
-                "grid": "merl 90x90x180 cell centres",
+                "grid": "merl 90x90x180 cell means",
                 "seconds": r.seconds,
             }),
             ConvertOutput::Rgl(r) => {
