@@ -59,6 +59,7 @@ impl BlinnPhong {
         if !(n.is_finite() && n >= 0.0) {
             return Err(Error::spec("n", format!("{n} must be a finite number ≥ 0")));
         }
+        crate::spectrum::check_range(n, "n")?;
         Ok(BlinnPhong {
             channels: channels.clone(),
             ks: ks.resolve(channels),

@@ -65,6 +65,7 @@ impl CookTorrance {
                 format!("{m} must be a finite number > 0"),
             ));
         }
+        crate::spectrum::check_range(m, "m")?;
         ks.validate("ks", 0.0)?;
         Ok(CookTorrance {
             channels: channels.clone(),

@@ -83,6 +83,7 @@ impl Ggx {
                     format!("{a} must be a finite number > 0"),
                 ));
             }
+            crate::spectrum::check_range(a, name)?;
         }
         ks.validate("ks", 0.0)?;
         Ok(Ggx {

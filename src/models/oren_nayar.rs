@@ -54,6 +54,7 @@ impl OrenNayar {
                 format!("{sigma} must be a finite number ≥ 0"),
             ));
         }
+        crate::spectrum::check_range(sigma, "sigma")?;
         let s2 = sigma * sigma;
         Ok(OrenNayar {
             channels: channels.clone(),

@@ -88,6 +88,7 @@ impl Phong {
                 format!("{n} must be a finite number ≥ 0"),
             ));
         }
+        crate::spectrum::check_range(n, "n")?;
         Ok(Phong {
             channels: channels.clone(),
             variant,

@@ -115,6 +115,7 @@ impl Sum {
                     format!("{w} must be a finite number ≥ 0"),
                 ));
             }
+            crate::spectrum::check_range(w, &format!("weights[{i}]"))?;
         }
         for (i, t) in terms.iter().enumerate() {
             if t.channels() != channels {

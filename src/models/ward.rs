@@ -63,6 +63,7 @@ impl Ward {
                     format!("{a} must be a finite number > 0"),
                 ));
             }
+            crate::spectrum::check_range(a, name)?;
         }
         Ok(Ward {
             channels: channels.clone(),
