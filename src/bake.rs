@@ -711,8 +711,7 @@ impl BakeRequest {
         let src = self.open_source()?;
         if let BakeTarget::Merl(path) = target {
             let t0 = Instant::now();
-            let _stage = Stage::begin(progress, "resampling on the MERL grid", 0);
-            let merl = crate::measured::MerlBrdf::from_brdf(src.as_ref());
+            let merl = crate::measured::MerlBrdf::from_brdf_with(src.as_ref(), progress);
             src.health()?;
             merl.write(path)?;
             let mut report =

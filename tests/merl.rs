@@ -158,7 +158,24 @@ fn resampled_lambert_round_trips() {
         .unwrap()
         .build(&brdftab::Channels::Rgb)
         .unwrap();
-    let m = MerlBrdf::from_brdf(&*brdf);
+    let log = brdftab::testkit::ProgressLog::default();
+    let m = MerlBrdf::from_brdf_with(&*brdf, &log);
+    // One stage of 90 θh rows, every row reported, in any order (rows run in parallel).
+    let calls = log.calls();
+    assert_eq!(
+        calls.first().map(String::as_str),
+        Some("begin resampling on the MERL grid 90")
+    );
+    assert_eq!(calls.last().map(String::as_str), Some("end"));
+    let mut sets: Vec<&str> = calls[1..calls.len() - 1]
+        .iter()
+        .map(String::as_str)
+        .collect();
+    sets.sort_by_key(|s| s[4..].parse::<u32>().unwrap());
+    assert_eq!(
+        sets,
+        (1..=90).map(|k| format!("set {k}")).collect::<Vec<_>>()
+    );
     let dir = TempDir::new("merl-lambert");
     let p = dir.join("lambert.binary");
     m.write(&p).unwrap();

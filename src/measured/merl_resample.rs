@@ -44,8 +44,11 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use rayon::prelude::*;
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use crate::brdf::Brdf;
 use crate::geometry::{self, HalfDiff};
+use crate::progress::{Progress, Silent, Stage};
 use crate::spectrum::{Channels, RGB_WAVELENGTHS};
 
 use super::merl::{MerlBrdf, RES_PHI_D, RES_THETA_D, RES_THETA_H, SAMPLES, SCALE, cell_center};
@@ -76,6 +79,15 @@ impl MerlBrdf {
     /// # Ok::<(), brdftab::Error>(())
     /// ```
     pub fn from_brdf(brdf: &dyn Brdf) -> Self {
+        Self::from_brdf_with(brdf, &Silent)
+    }
+
+    /// [`MerlBrdf::from_brdf`], reporting the θh rows done (of 90) to `progress` as a stage
+    /// `"resampling on the MERL grid"` (a file from a measurement takes seconds: 54 evaluations
+    /// per cell).
+    pub fn from_brdf_with(brdf: &dyn Brdf, progress: &dyn Progress) -> Self {
+        let _stage = Stage::begin(progress, "resampling on the MERL grid", RES_THETA_H as u64);
+        let done = AtomicUsize::new(0);
         let rgb = *brdf.channels() == Channels::Rgb;
         let stored = rgb;
         let plane = RES_THETA_D * RES_PHI_D;
@@ -114,6 +126,7 @@ impl MerlBrdf {
                             };
                         }
                     }
+                    progress.set((done.fetch_add(1, Ordering::Relaxed) + 1) as u64);
                 })
         });
         let mut data = vec![0.0f64; 3 * SAMPLES];
