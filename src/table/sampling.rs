@@ -550,9 +550,8 @@ impl TableSampler {
         u: DVec2,
         weight: &mut [f32],
     ) -> Option<BrdfSample> {
-        let d = self.draw(wo, u)?;
         let ch = brdf.channels().len();
-        brdf.eval(d.wi, d.wo, &mut weight[..ch]);
+        let d = self.draw_and(wo, u, |wi, wo| brdf.eval(wi, wo, &mut weight[..ch]))?;
         d.weigh(&mut weight[..ch]);
         Some(BrdfSample {
             wi: d.wi,
@@ -564,6 +563,15 @@ impl TableSampler {
     /// The direction and density of [`TableSampler::sample`] without the weight's evaluation
     /// (for callers that evaluate many draws at once: [`Draw::weigh`] finishes each).
     pub fn draw(&self, wo: DVec3, u: DVec2) -> Option<Draw> {
+        self.draw_and(wo, u, |_, _| {})
+    }
+
+    /// [`TableSampler::draw`], calling `eval(wi, wo)` as soon as the direction is known (before
+    /// the folded preimage's density, whose chain then runs beside the evaluation's instead of
+    /// ahead of it in program order). `eval` may be called for a draw that then returns `None`
+    /// (a density that is not positive and finite).
+    #[inline]
+    pub fn draw_and(&self, wo: DVec3, u: DVec2, eval: impl FnOnce(DVec3, DVec3)) -> Option<Draw> {
         let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
             return None;
@@ -582,24 +590,25 @@ impl TableSampler {
         // Folded at the horizon: the other preimage of `wil` is its mirror image below it.
         // The mirror image of `drawn` below the horizon has its half vector (∝ wo + mirror)
         // above the horizon only when drawn.z < wo.z; otherwise its density is 0.
-        let (wil, pdf) = if drawn.z > 0.0 {
-            let other = if drawn.z < wol.z {
-                self.density_at(mirror_z(drawn), wol, &k)
-            } else {
-                0.0
-            };
-            (drawn, here + other)
+        // `other`: where the other preimage's density is to be read, if anywhere.
+        let (wil, other) = if drawn.z > 0.0 {
+            (drawn, (drawn.z < wol.z).then(|| mirror_z(drawn)))
         } else {
             // The other preimage is `wil` itself, whose half vector is always above.
             let wil = mirror_z(drawn);
-            (wil, here + self.density_at(wil, wol, &k))
+            (wil, Some(wil))
         };
-        if !(wil.z > 0.0) || !(pdf > 0.0) || !pdf.is_finite() {
+        if !(wil.z > 0.0) {
             return None;
         }
         // Back from the nodes' frame. Unit to rounding (h and wo are unit, the rotation is
         // orthogonal): within what lookups take as unit, so no normalization.
         let wi = DVec3::new(c * wil.x - s * wil.y, s * wil.x + c * wil.y, wil.z);
+        eval(wi, wo);
+        let pdf = here + other.map_or(0.0, |p| self.density_at(p, wol, &k));
+        if !(pdf > 0.0) || !pdf.is_finite() {
+            return None;
+        }
         Some(Draw { wi, wo, pdf })
     }
 }
