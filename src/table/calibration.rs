@@ -282,6 +282,36 @@ impl Calibration {
         ))
     }
 
+    /// [`Calibration::apply`] four channels at a time (the same operations lane by lane, tested
+    /// equal): what the kernel's lookups of other than three channels call.
+    #[inline(always)]
+    pub(crate) fn apply_lanes(&self, cos_i: f32, cos_o: f32, out: &mut [f32]) {
+        self.apply_lanes_cells(self.cells(cos_i, cos_o), out)
+    }
+
+    /// The cells (node, fraction) of both cosines that [`Calibration::apply_lanes`] reads: a
+    /// lookup finds them before its blend, beside the blend's chain.
+    #[inline(always)]
+    pub(crate) fn cells(&self, cos_i: f32, cos_o: f32) -> [(usize, f32); 2] {
+        [self.cell(cos_i), self.cell(cos_o)]
+    }
+
+    /// [`Calibration::apply_lanes`] at cells found by [`Calibration::cells`].
+    #[inline(always)]
+    pub(crate) fn apply_lanes_cells(
+        &self,
+        [(ji, fi), (jo, fo)]: [(usize, f32); 2],
+        out: &mut [f32],
+    ) {
+        let c = self.channels;
+        let n = c.min(out.len());
+        let out = &mut out[..n];
+        lerp_into(&self.factors, ji, c, fi, out);
+        if let Some(o) = &self.out_factors {
+            lerp_into(o, jo, c, fo, out);
+        }
+    }
+
     /// Multiplies `out[..channels]` by k_in(θi) · k_out(θo) for unit directions with z =
     /// `cos_i`, `cos_o`: on each, linear between the nodes ⌊s⌋ and ⌊s⌋ + 1 (the plain form of
     /// the lookup; the kernel calls it as it is).
@@ -300,6 +330,31 @@ impl Calibration {
                 *x *= a[k] + f * (b[k] - a[k]);
             }
         }
+    }
+}
+
+/// `out[k] *= a[k] + f (b[k] − a[k])` with a, b the factors of nodes `j`, `j` + 1 (`c` per
+/// node): four at a time, then one at a time (the same operations in each lane).
+#[inline(always)]
+fn lerp_into(factors: &[f32], j: usize, c: usize, f: f32, out: &mut [f32]) {
+    let (Some(a), Some(b)) = (
+        factors.get(j * c..(j + 1) * c),
+        factors.get((j + 1) * c..(j + 2) * c),
+    ) else {
+        return;
+    };
+    let fv = F4::splat(f);
+    let mut k = 0;
+    while k + 4 <= out.len() {
+        if let (Some(x), Some(a4), Some(b4)) =
+            (F4::load(&out[k..]), F4::load(&a[k..]), F4::load(&b[k..]))
+        {
+            out[k..k + 4].copy_from_slice(&(x * (a4 + fv * (b4 - a4))).to_array());
+        }
+        k += 4;
+    }
+    for k in k..out.len() {
+        out[k] *= a[k] + f * (b[k] - a[k]);
     }
 }
 
@@ -629,6 +684,32 @@ mod tests {
                 c.apply(ci, co, &mut v);
                 let w = c.apply_rgb(ci, co, F4::new(0.3, 1.7, 0.01, 0.0)).to_array();
                 assert_eq!(v, [w[0], w[1], w[2]], "{ci} {co}");
+            }
+        }
+    }
+
+    /// The four-at-a-time form of other channel counts equals the plain one value for value,
+    /// at counts that leave every remainder of four, at the axis's ends and beyond them.
+    #[test]
+    fn the_lanes_of_any_channel_count_equal_the_plain_form() {
+        for ch in [1usize, 2, 4, 5, 7, 12] {
+            let k_in: Vec<f32> = (0..33 * ch).map(|i| 0.9 + 0.0007 * i as f32).collect();
+            let k_out: Vec<f32> = (0..33 * ch).map(|i| 1.1 - 0.0009 * i as f32).collect();
+            for out in [None, Some(k_out)] {
+                let c = Calibration::new(k_in.clone(), out, ch, 0.99).unwrap();
+                for (ci, co) in [
+                    (1.0, 1.0),
+                    (0.0, 0.0),
+                    (0.37, 0.91),
+                    (-0.2, 1.5),
+                    (f32::NAN, 0.5),
+                ] {
+                    let x: Vec<f32> = (0..ch).map(|k| 0.3 + 0.11 * k as f32).collect();
+                    let (mut v, mut w) = (x.clone(), x);
+                    c.apply(ci, co, &mut v);
+                    c.apply_lanes(ci, co, &mut w);
+                    assert_eq!(v, w, "{ch} channels at {ci} {co}");
+                }
             }
         }
     }

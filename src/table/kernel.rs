@@ -593,6 +593,8 @@ impl Kernel {
         if F4::new(v[0], v[1], v[2], 0.0).any_ge(self.cut) {
             return false;
         }
+        // The calibration's cells first: they need only the cosines (see `rgb`).
+        let cells = (self.calibration.as_ref()).map(|c| c.cells(cos[0], cos[1]));
         #[cfg(target_arch = "x86_64")]
         if self.exact {
             self.blend_lanes::<false, true>(v, out, values);
@@ -607,7 +609,10 @@ impl Kernel {
         if self.quantity != Quantity::Fr {
             // In f32, as the RGB lookup does (one rule for every channel count).
             let out = &mut out[..self.channels];
-            project_f32(self.quantity, self.calibration.as_ref(), cos, out);
+            project_f32_lanes(self.quantity, None, cos, out);
+            if let (Some(c), Some(cells)) = (&self.calibration, cells) {
+                c.apply_lanes_cells(cells, out);
+            }
         }
         true
     }
@@ -963,6 +968,34 @@ pub(crate) fn project_f32(
     }
 }
 
+/// [`project_f32`] four channels at a time (the same operations lane by lane, tested equal).
+#[inline(always)]
+pub(crate) fn project_f32_lanes(
+    quantity: Quantity,
+    calibration: Option<&Calibration>,
+    [cos_i, cos_o]: [f32; 2],
+    out: &mut [f32],
+) {
+    let f = match quantity {
+        Quantity::FrCosOut => cos_o,
+        _ => cos_i * cos_o,
+    };
+    let inv = 1.0 / f.max(MIN_COS_PRODUCT);
+    let (iv, zero) = (F4::splat(inv), F4::splat(0.0));
+    let mut chunks = out.chunks_exact_mut(4);
+    for x4 in &mut chunks {
+        if let Some(x) = F4::load(x4) {
+            x4.copy_from_slice(&(x * iv).max(zero).to_array());
+        }
+    }
+    for x in chunks.into_remainder() {
+        *x = (*x * inv).max(0.0);
+    }
+    if let Some(c) = calibration {
+        c.apply_lanes(cos_i, cos_o, out);
+    }
+}
+
 /// Whether the CPU has F16C (x86-64 only).
 fn has_f16c() -> bool {
     #[cfg(target_arch = "x86_64")]
@@ -1230,13 +1263,35 @@ mod tests {
                 let (t, _) = bake(src.as_ref(), &grid, &BakeOptions::default()).unwrap();
                 let k = Kernel::new(t.grid()).expect("an adaptive grid has a kernel");
                 let (packed, exact) = (Packed::new(t.values()), Packed::exact(t.values()));
+                // The same table calibrated, where a table may be: its `eval` (the lanes, the
+                // projection, the calibration found before the blend) against the plain steps.
+                let calibrated = (quantity != Quantity::Fr && !reciprocal).then(|| {
+                    let k_in: Vec<f32> = (0..17 * nch).map(|i| 0.9 + 0.001 * i as f32).collect();
+                    let k_out: Vec<f32> = (0..17 * nch).map(|i| 1.2 - 0.002 * i as f32).collect();
+                    let cal = Calibration::new(k_in, Some(k_out), nch, 0.99).unwrap();
+                    let g = t.grid().clone().with_calibration(cal.clone()).unwrap();
+                    (Kernel::new(&g).expect("a kernel"), cal)
+                });
                 let mut r = Pcg32::new(7 + nch as u64);
                 let (mut a, mut b) = (vec![0f32; nch], vec![0f32; nch]);
                 for _ in 0..20_000 {
                     let (wi, wo) = random_pair(&mut r);
                     let Some(v) = k.vars(wi, wo) else { continue };
+                    if let Some((kc, cal)) = &calibrated {
+                        kc.eval(wi, wo, &mut a, &packed);
+                        kc.blend::<0>(v, &mut b, &packed);
+                        let cos = [wi.z as f32, wo.z as f32];
+                        project_f32(quantity, Some(cal), cos, &mut b);
+                        assert_eq!(a, b, "{nch} channels, calibrated eval: {wi} {wo}");
+                    }
                     for (values, exact) in [(&packed, false), (&exact, true)] {
                         k.blend::<0>(v, &mut b, values);
+                        // The projection (quantity and clamp) four at a time, too.
+                        let cos = [wi.z as f32, wo.z as f32];
+                        let (mut p, mut q) = (b.clone(), b.clone());
+                        project_f32(quantity, None, cos, &mut p);
+                        project_f32_lanes(quantity, None, cos, &mut q);
+                        assert_eq!(p, q, "{nch} channels, projection: {wi} {wo}");
                         #[cfg(target_arch = "x86_64")]
                         {
                             if exact {
