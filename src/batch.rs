@@ -4,14 +4,17 @@
 //! caller and used to loop over them each in its own way (the C ABI sequentially, Python on
 //! rayon after copying the arrays). One implementation here — blocks of [`BLOCK`] pairs, on
 //! the library's fork-safe pool ([`crate::par`]) from [`PARALLEL`] pairs on, the NaN rule of
-//! every host applied once — makes a host's rate the library's rate. [`Brdf::eval_batch`] is
-//! the third batch entry; tables override it, these two are plain loops over the trait's
-//! one-pair methods.
+//! every host applied once — makes a host's rate the library's rate. The trait's batch methods
+//! ([`Brdf::eval_batch`], [`Brdf::pdf_batch`], [`Brdf::sample_batch`]) run on these blocks; this
+//! module knows nothing of the trait, so that it and [`crate::brdf`] import each other in no
+//! circle.
+//!
+//! [`Brdf::eval_batch`]: crate::brdf::Brdf::eval_batch
+//! [`Brdf::pdf_batch`]: crate::brdf::Brdf::pdf_batch
+//! [`Brdf::sample_batch`]: crate::brdf::Brdf::sample_batch
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
-
-use crate::brdf::Brdf;
 
 /// Pairs per block handed to one rayon task.
 pub const BLOCK: usize = 4096;
@@ -32,27 +35,7 @@ pub fn blocks<T: Send>(out: &mut [T], width: usize, f: impl Fn(usize, &mut [T]) 
     }
 }
 
-/// `out[k] = brdf.pdf(wi[k], wo[k])`; see [`Brdf::pdf_batch`].
-///
-/// # Panics
-///
-/// If the three lengths differ (a caller's bug, as in [`crate::brdf::check_batch`]).
-pub fn pdf<B: Brdf + ?Sized>(brdf: &B, wi: &[DVec3], wo: &[DVec3], out: &mut [f64]) {
-    assert!(
-        wi.len() == wo.len() && out.len() == wi.len(),
-        "pdf_batch: {} wi, {} wo and {} outputs do not match",
-        wi.len(),
-        wo.len(),
-        out.len()
-    );
-    blocks(out, 1, |s, o| {
-        for ((p, a), b) in o.iter_mut().zip(&wi[s..]).zip(&wo[s..]) {
-            *p = brdf.pdf(*a, *b);
-        }
-    });
-}
-
-/// The outputs of [`sample`]: one row per pair.
+/// The outputs of [`Brdf::sample_batch`](crate::brdf::Brdf::sample_batch): one row per pair.
 pub struct SampleOut<'a> {
     /// Drawn incident directions (0 where there is no sample).
     pub wi: &'a mut [DVec3],
@@ -60,36 +43,6 @@ pub struct SampleOut<'a> {
     pub pdf: &'a mut [f64],
     /// `c` weights per pair, f_r cos θi / pdf (0 where there is no sample).
     pub weight: &'a mut [f32],
-}
-
-/// Draws `wi` for every `wo[k]` from `u[k]`; see [`Brdf::sample_batch`].
-///
-/// # Panics
-///
-/// If the lengths do not match `wo.len()` pairs of `c = brdf.channels().len()` weights.
-pub fn sample<B: Brdf + ?Sized>(brdf: &B, wo: &[DVec3], u: &[DVec2], out: SampleOut<'_>) {
-    let c = brdf.channels().len().max(1);
-    sample_blocks(c, wo, u, out, |wo, u, out| {
-        let SampleOut { wi, pdf, weight } = out;
-        for (k, ((wi, p), w)) in wi
-            .iter_mut()
-            .zip(pdf.iter_mut())
-            .zip(weight.chunks_exact_mut(c))
-            .enumerate()
-        {
-            let drawn = match drawable(wo[k], u[k]) {
-                true => brdf.sample(wo[k], u[k], w),
-                false => None,
-            };
-            match drawn {
-                Some(d) => {
-                    *wi = d.wi;
-                    *p = d.pdf;
-                }
-                None => no_sample(wi, p, w),
-            }
-        }
-    });
 }
 
 /// Whether a pair may have a sample: non-finite input has none (the NaN rule of every host),
@@ -107,10 +60,14 @@ pub fn no_sample(wi: &mut DVec3, pdf: &mut f64, weight: &mut [f32]) {
     weight.fill(0.0);
 }
 
-/// [`sample`]'s blocks with another per-block body: `run(wo, u, out)` fills one block of at
-/// most [`BLOCK`] pairs (`wo` and `u` are the block's inputs, `out` its rows; `c` weights per
-/// pair), in parallel from [`PARALLEL`] pairs on. For sources that draw a block first and then
-/// evaluate its weights together (tables: [`Brdf::eval_batch`]'s eight-lane path).
+/// The blocks of a batch of samples: `run(wo, u, out)` fills one block of at most [`BLOCK`]
+/// pairs (`wo` and `u` are the block's inputs, `out` its rows; `c` weights per pair), in
+/// parallel from [`PARALLEL`] pairs on. [`Brdf::sample_batch`]'s default draws pair by pair in
+/// `run`; tables draw a block first and then evaluate its weights together (their
+/// [`Brdf::eval_batch`]'s eight-lane path).
+///
+/// [`Brdf::sample_batch`]: crate::brdf::Brdf::sample_batch
+/// [`Brdf::eval_batch`]: crate::brdf::Brdf::eval_batch
 ///
 /// # Panics
 ///
@@ -159,6 +116,7 @@ pub fn sample_blocks(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::brdf::Brdf;
     use crate::models::lambert::Lambert;
     use crate::spectrum::{Channels, Value};
 
@@ -178,7 +136,7 @@ mod tests {
         let n = PARALLEL + 3 * BLOCK / 2 + 5;
         let (wi, wo) = (dirs(n), dirs(n + 9)[9..].to_vec());
         let mut p = vec![-1.0; n];
-        pdf(&b, &wi, &wo, &mut p);
+        b.pdf_batch(&wi, &wo, &mut p);
         for k in [0, BLOCK - 1, BLOCK, n - 1] {
             assert_eq!(p[k], b.pdf(wi[k], wo[k]));
         }
@@ -193,7 +151,7 @@ mod tests {
             pdf: &mut sp,
             weight: &mut sw,
         };
-        sample(&b, &nan_wo, &u, out);
+        b.sample_batch(&nan_wo, &u, out);
         let mut drawn = 0;
         for k in [0, 1, BLOCK - 1, BLOCK + 1, n - 2, n - 1] {
             let mut w = [0.0f32; 3];

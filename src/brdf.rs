@@ -187,7 +187,18 @@ pub trait Brdf: Send + Sync {
     ///
     /// If the three lengths differ (a caller's bug, as for [`Brdf::eval_batch`]).
     fn pdf_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f64]) {
-        crate::batch::pdf(self, wi, wo, out)
+        assert!(
+            wi.len() == wo.len() && out.len() == wi.len(),
+            "pdf_batch: {} wi, {} wo and {} outputs do not match",
+            wi.len(),
+            wo.len(),
+            out.len()
+        );
+        crate::batch::blocks(out, 1, |s, o| {
+            for ((p, a), b) in o.iter_mut().zip(&wi[s..]).zip(&wo[s..]) {
+                *p = self.pdf(*a, *b);
+            }
+        });
     }
 
     /// Draws `wi` for every `wo[k]` from `u[k]` into `out` (wi, pdf, and `c` weights per pair).
@@ -199,7 +210,25 @@ pub trait Brdf: Send + Sync {
     ///
     /// If the lengths do not match `wo.len()` pairs.
     fn sample_batch(&self, wo: &[DVec3], u: &[DVec2], out: crate::batch::SampleOut<'_>) {
-        crate::batch::sample(self, wo, u, out)
+        use crate::batch::{SampleOut, drawable, no_sample};
+        let c = self.channels().len().max(1);
+        crate::batch::sample_blocks(c, wo, u, out, |wo, u, out| {
+            let SampleOut { wi, pdf, weight } = out;
+            let rows = wi
+                .iter_mut()
+                .zip(pdf.iter_mut())
+                .zip(weight.chunks_exact_mut(c));
+            for (k, ((wi, p), w)) in rows.enumerate() {
+                let drawn = match drawable(wo[k], u[k]) {
+                    true => self.sample(wo[k], u[k], w),
+                    false => None,
+                };
+                match drawn {
+                    Some(d) => (*wi, *p) = (d.wi, d.pdf),
+                    None => no_sample(wi, p, w),
+                }
+            }
+        });
     }
 
     /// Directional albedo a(wi) = ∫ f_r(wi, wo) cos θo dωo for every channel into `out`.

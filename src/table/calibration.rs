@@ -667,19 +667,23 @@ mod tests {
         }
     }
 
+    /// Cosine pairs (cos θi, cos θo) for the lane forms: the axis's ends, inside, beyond both
+    /// ends, and NaN.
+    const COSINES: [(f32, f32); 5] = [
+        (1.0, 1.0),
+        (0.0, 0.0),
+        (0.37, 0.91),
+        (-0.2, 1.5),
+        (f32::NAN, 0.5),
+    ];
+
     #[test]
     fn the_lane_form_equals_the_plain_one() {
         let k_in: Vec<f32> = (0..33 * 3).map(|i| 0.9 + 0.002 * i as f32).collect();
         let k_out: Vec<f32> = (0..33 * 3).map(|i| 1.1 - 0.003 * i as f32).collect();
         for out in [None, Some(k_out)] {
             let c = Calibration::new(k_in.clone(), out, 3, 0.99).unwrap();
-            for (ci, co) in [
-                (1.0, 1.0),
-                (0.0, 0.0),
-                (0.37, 0.91),
-                (-0.2, 1.5),
-                (f32::NAN, 0.5),
-            ] {
+            for (ci, co) in COSINES {
                 let mut v = [0.3f32, 1.7, 0.01];
                 c.apply(ci, co, &mut v);
                 let w = c.apply_rgb(ci, co, F4::new(0.3, 1.7, 0.01, 0.0)).to_array();
@@ -697,13 +701,7 @@ mod tests {
             let k_out: Vec<f32> = (0..33 * ch).map(|i| 1.1 - 0.0009 * i as f32).collect();
             for out in [None, Some(k_out)] {
                 let c = Calibration::new(k_in.clone(), out, ch, 0.99).unwrap();
-                for (ci, co) in [
-                    (1.0, 1.0),
-                    (0.0, 0.0),
-                    (0.37, 0.91),
-                    (-0.2, 1.5),
-                    (f32::NAN, 0.5),
-                ] {
+                for (ci, co) in COSINES {
                     let x: Vec<f32> = (0..ch).map(|k| 0.3 + 0.11 * k as f32).collect();
                     let (mut v, mut w) = (x.clone(), x);
                     c.apply(ci, co, &mut v);

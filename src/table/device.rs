@@ -29,6 +29,7 @@ use crate::error::{Error, Result};
 use crate::table::Table;
 use crate::table::calibration::Calibration;
 use crate::table::grid::{Grid, Param, Quantity, StoredAxis};
+pub use crate::table::kernel::KernelAxis;
 use crate::table::kernel::{Kernel, Packed, project_f32, project_out, warp_vars};
 use crate::table::lookup::Interp;
 use crate::table::symmetry::{
@@ -99,19 +100,6 @@ pub struct GridLayout {
     /// The values as lookups read them (an f_r table's negative, unmeasured, values are 0).
     #[serde(skip)]
     pub values: Vec<f32>,
-}
-
-/// One axis of a [`KernelLayout`].
-#[derive(Debug, Clone, Serialize)]
-pub struct KernelAxis {
-    /// Per knot interval j (of K = `c.len()`): s = `c[j] + t·d[j]` at t = v·K ∈ \[j, j + 1\].
-    pub c: Vec<f32>,
-    /// The slopes (see `c`).
-    pub d: Vec<f32>,
-    /// Number of nodes (≥ 2).
-    pub nodes: usize,
-    /// Pairs whose variable is at or above the cut take the [`GridLayout`] (2: never).
-    pub cut: f32,
 }
 
 /// What [`super::kernel`] evaluates: three axes (θh, θd, φd) whose fractional node index is a

@@ -324,6 +324,21 @@ fn fixed_mapping_fits(k: usize, m: &Mapping) -> bool {
     }
 }
 
+/// One axis of a [`KernelLayout`](super::device::KernelLayout): what a device evaluates of
+/// this kernel's axes. Defined here (the kernel writes it), re-exported by [`super::device`].
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct KernelAxis {
+    /// Per knot interval j (of K = `c.len()`): s = `c[j] + t·d[j]` at t = v·K ∈ \[j, j + 1\].
+    pub c: Vec<f32>,
+    /// The slopes (see `c`).
+    pub d: Vec<f32>,
+    /// Number of nodes (≥ 2).
+    pub nodes: usize,
+    /// Pairs whose variable is at or above the cut take the
+    /// [`GridLayout`](super::device::GridLayout) (2: never).
+    pub cut: f32,
+}
+
 /// The fast linear lookup of a table on an adaptive grid (see the module docs).
 #[derive(Debug, Clone)]
 pub struct Kernel {
@@ -461,11 +476,11 @@ impl Kernel {
 
     /// The kernel's three axes (θh, θd, φd) as [`super::device`] describes them: per knot
     /// interval the line s = c + t·d (t = v·K), the node count and the cut.
-    pub(crate) fn device_axes(&self) -> [super::device::KernelAxis; 3] {
+    pub(crate) fn device_axes(&self) -> [KernelAxis; 3] {
         let cut = self.cut.to_array();
         std::array::from_fn(|i| {
             let a = &self.axes[i];
-            super::device::KernelAxis {
+            KernelAxis {
                 c: a.lines.iter().map(|l| l[0]).collect(),
                 d: a.lines.iter().map(|l| l[1]).collect(),
                 nodes: a.n,
@@ -791,18 +806,7 @@ impl Kernel {
         const RUNS: usize = crate::spectrum::MAX_CHANNELS.div_ceil(4);
         let c = self.channels.min(4 * RUNS);
         let runs = c.div_ceil(4);
-        let (ih, th) = self.axes[0].node(v[0]);
-        let (id, td) = self.axes[1].node(v[1]);
-        let (ip, tp) = self.axes[2].node(v[2]);
-        let o = ih * self.chunk + id * self.row + ip * c;
-        let rows = [o, o + self.row, o + self.chunk, o + self.chunk + self.row];
-        let w = [
-            (1.0 - th) * (1.0 - td),
-            (1.0 - th) * td,
-            th * (1.0 - td),
-            th * td,
-        ];
-        let (wp0, wp1) = (1.0 - tp, tp);
+        let (rows, w, (wp0, wp1)) = self.corners(v, c);
         let mut acc = [F4::splat(0.0); RUNS];
         let n = values.len();
         let load = |r: usize| -> Option<F4> {
@@ -836,16 +840,15 @@ impl Kernel {
         }
     }
 
-    /// Trilinear blend of the eight corners; `N` > 0: exactly N channels in registers. The
-    /// reference of [`Kernel::eval_rgb`] (which computes the same operations in lanes).
+    /// The corners of a trilinear blend at warp variables `v` with `c` channels per node: the
+    /// offsets of the four (θh, θd) corner rows, each holding its two φd corners side by side
+    /// (`c` values apart), the rows' weights, and the two φd weights.
     #[inline(always)]
-    fn blend<const N: usize>(&self, v: [f32; 3], out: &mut [f32], values: &Packed) {
-        let c = if N > 0 { N } else { self.channels };
+    fn corners(&self, v: [f32; 3], c: usize) -> ([usize; 4], [f32; 4], (f32, f32)) {
         let (ih, th) = self.axes[0].node(v[0]);
         let (id, td) = self.axes[1].node(v[1]);
         let (ip, tp) = self.axes[2].node(v[2]);
         let o = ih * self.chunk + id * self.row + ip * c;
-        // The four (θh, θd) corner rows, each holding the two φd corners side by side.
         let rows = [o, o + self.row, o + self.chunk, o + self.chunk + self.row];
         let w = [
             (1.0 - th) * (1.0 - td),
@@ -853,7 +856,15 @@ impl Kernel {
             th * (1.0 - td),
             th * td,
         ];
-        let (wp0, wp1) = (1.0 - tp, tp);
+        (rows, w, (1.0 - tp, tp))
+    }
+
+    /// Trilinear blend of the eight corners; `N` > 0: exactly N channels in registers. The
+    /// reference of [`Kernel::eval_rgb`] (which computes the same operations in lanes).
+    #[inline(always)]
+    fn blend<const N: usize>(&self, v: [f32; 3], out: &mut [f32], values: &Packed) {
+        let c = if N > 0 { N } else { self.channels };
+        let (rows, w, (wp0, wp1)) = self.corners(v, c);
         let out = &mut out[..c];
         out.fill(0.0);
         let n = values.len();
@@ -955,17 +966,23 @@ pub(crate) fn project_f32(
     [cos_i, cos_o]: [f32; 2],
     out: &mut [f32],
 ) {
-    let f = match quantity {
-        Quantity::FrCosOut => cos_o,
-        _ => cos_i * cos_o,
-    };
-    let inv = 1.0 / f.max(MIN_COS_PRODUCT);
+    let inv = inverse_factor(quantity, [cos_i, cos_o]);
     for x in out.iter_mut() {
         *x = (*x * inv).max(0.0);
     }
     if let Some(c) = calibration {
         c.apply(cos_i, cos_o, out);
     }
+}
+
+/// 1/max(factor, [`MIN_COS_PRODUCT`]) of a stored `quantity` at cosines (cos θi, cos θo).
+#[inline(always)]
+fn inverse_factor(quantity: Quantity, [cos_i, cos_o]: [f32; 2]) -> f32 {
+    let f = match quantity {
+        Quantity::FrCosOut => cos_o,
+        _ => cos_i * cos_o,
+    };
+    1.0 / f.max(MIN_COS_PRODUCT)
 }
 
 /// [`project_f32`] four channels at a time (the same operations lane by lane, tested equal).
@@ -976,11 +993,7 @@ pub(crate) fn project_f32_lanes(
     [cos_i, cos_o]: [f32; 2],
     out: &mut [f32],
 ) {
-    let f = match quantity {
-        Quantity::FrCosOut => cos_o,
-        _ => cos_i * cos_o,
-    };
-    let inv = 1.0 / f.max(MIN_COS_PRODUCT);
+    let inv = inverse_factor(quantity, [cos_i, cos_o]);
     let (iv, zero) = (F4::splat(inv), F4::splat(0.0));
     let mut chunks = out.chunks_exact_mut(4);
     for x4 in &mut chunks {
@@ -1172,6 +1185,24 @@ mod tests {
         }
     }
 
+    /// `src` baked on the adaptive grid of one of [`TEST_CASES`] (isotropic, bilateral), and
+    /// its kernel.
+    fn test_table(
+        src: &dyn Brdf,
+        (reciprocal, quantity, h_var): (bool, Quantity, WarpVar),
+    ) -> (crate::table::Table, Kernel) {
+        let sym = Symmetry {
+            isotropic: true,
+            reciprocal,
+            bilateral: true,
+        };
+        let opts = test_adaptive_options(quantity, h_var);
+        let grid = adaptive_grid(src, sym, &opts).unwrap();
+        let (t, _) = bake(src, &grid, &BakeOptions::default()).unwrap();
+        let k = Kernel::new(t.grid()).expect("an adaptive grid has a kernel");
+        (t, k)
+    }
+
     #[test]
     fn kernel_agrees_with_the_general_lookup() {
         let src = ModelSpec::parse(r#"{"model": "ggx", "alpha": 0.05}"#)
@@ -1181,15 +1212,7 @@ mod tests {
         // f_r tables (θh by SqrtSine and QuarterPower) and tables of the other quantities, whose
         // lookups divide by the cosines (and whose nodes beyond the horizon are extrapolated).
         for (reciprocal, quantity, h_var) in TEST_CASES {
-            let sym = Symmetry {
-                isotropic: true,
-                reciprocal,
-                bilateral: true,
-            };
-            let opts = test_adaptive_options(quantity, h_var);
-            let grid = adaptive_grid(src.as_ref(), sym, &opts).unwrap();
-            let (t, _) = bake(src.as_ref(), &grid, &BakeOptions::default()).unwrap();
-            let k = Kernel::new(t.grid()).expect("an adaptive grid has a kernel");
+            let (t, k) = test_table(src.as_ref(), (reciprocal, quantity, h_var));
             let general = Lookup::new(t.grid());
             let tb = TabulatedBrdf::from_table(t.clone());
             let packed = Packed::new(t.values());
@@ -1253,15 +1276,7 @@ mod tests {
             .build(&channels)
             .unwrap();
             for (reciprocal, quantity, h_var) in TEST_CASES {
-                let sym = Symmetry {
-                    isotropic: true,
-                    reciprocal,
-                    bilateral: true,
-                };
-                let opts = test_adaptive_options(quantity, h_var);
-                let grid = adaptive_grid(src.as_ref(), sym, &opts).unwrap();
-                let (t, _) = bake(src.as_ref(), &grid, &BakeOptions::default()).unwrap();
-                let k = Kernel::new(t.grid()).expect("an adaptive grid has a kernel");
+                let (t, k) = test_table(src.as_ref(), (reciprocal, quantity, h_var));
                 let (packed, exact) = (Packed::new(t.values()), Packed::exact(t.values()));
                 // The same table calibrated, where a table may be: its `eval` (the lanes, the
                 // projection, the calibration found before the blend) against the plain steps.
