@@ -3,6 +3,7 @@ its Dr.Jit table lookup against the Rust lookup, and its sampler through `mitsub
 
 import math
 import os
+import pathlib
 
 import numpy as np
 import pytest
@@ -352,6 +353,38 @@ def test_jit_render_matches_measured(rgl):
     assert np.isfinite(ours).all()
     rel = abs(ours.mean() - ref.mean()) / ref.mean()
     assert rel < 0.03, rel
+
+
+# The scenes issue 22 measured the plugin's default tables in, against `measured` on the same
+# file (bench/fidelity.py holds them and the rest of the table): the sphere under a constant
+# environment and lit from the side (the terminator's bright bands, +2.6 % and +2.7 % then), the
+# plane lit 10° above the horizon (paper_white +11 %), the view along the normal (cc_ibiza 0.150
+# against 0.180, vch_golden_yellow 0.262 against 0.282). Each within the issue's bar for what it
+# integrates (fidelity.SCENES: the albedo's 1 %, 1 % within 80°, the grazing band's 3 %), in
+# every channel the file holds no negative values in (`measured` renders those, brdftab clips
+# them as the reference reader does).
+ISSUE_22_SCENES = {
+    "paper_white_rgb.bsdf": ["sphere_env", "sphere_terminator", "plane_light10_view45"],
+    "vch_golden_yellow_rgb.bsdf": ["sphere_env", "sphere_terminator", "normal_view_env"],
+    "cc_ibiza_sunset_rgb.bsdf": ["normal_view_env"],
+}
+
+
+@pytest.mark.parametrize("name", sorted(ISSUE_22_SCENES))
+def test_jit_renders_the_issue_22_scenes_as_measured_does(rgl, name):
+    use("llvm_ad_rgb")
+    import sys
+
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "bench"))
+    import fidelity
+
+    scenes = [s for s in fidelity.SCENES if s[0] in ISSUE_22_SCENES[name]]
+    assert len(scenes) == len(ISSUE_22_SCENES[name])
+    rows = fidelity.compare(mi, rgl / name, scenes, spp_scale=0.25)
+    compared = [x for r in rows for x in r["rel"] if x is not None]
+    assert len(compared) >= 2 * len(rows), rows  # at least two channels per scene
+    bad = [(r["scene"], r["rel"], r["bar"]) for r in rows if not r["ok"]]
+    assert not bad, bad
 
 
 def test_jit_bad_input():
