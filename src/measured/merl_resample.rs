@@ -139,6 +139,7 @@ impl MerlBrdf {
             name: format!("resampled {}", brdf.describe()),
             data,
             channels: Channels::Rgb,
+            sampler: std::sync::OnceLock::new(),
         }
     }
 }

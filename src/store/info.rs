@@ -21,6 +21,11 @@ pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
     let h = t.header();
     let bytes = t.compressed_bytes();
     let isotropic = h.symmetry.split('+').any(|p| p == "isotropic");
+    // The sampler a table builds when opened with its default lookup: nearest on a grid of
+    // cells (TabulatedBrdf::default_interp).
+    let cells = t
+        .grid()
+        .is_ok_and(|g| crate::table::Interp::default_for(&g) == crate::table::Interp::Nearest);
     Ok(json!({
         "name": h.name,
         "source": h.source,
@@ -35,7 +40,7 @@ pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
         "chunks": t.chunk_count(),
         "bytes": bytes,
         "ratio_to_f32": (h.values as f64 * 4.0) / (bytes.max(1) as f64),
-        "sampling_bytes": SamplingResolution::for_isotropy(isotropic).memory_bytes(isotropic),
+        "sampling_bytes": SamplingResolution::for_lookup(isotropic, cells).memory_bytes(isotropic),
     }))
 }
 

@@ -28,6 +28,23 @@ pub enum Interp {
     Linear,
 }
 
+impl Interp {
+    /// The interpolation a table on `grid` is read with unless told otherwise: nearest when an
+    /// axis holds cells rather than nodes ([`super::Nodes::CellStart`], the MERL grid: a MERL
+    /// reader looks such values up by cell, so nearest reproduces the source), linear otherwise.
+    pub fn default_for(grid: &Grid) -> Interp {
+        if grid
+            .axes()
+            .iter()
+            .any(|a| a.nodes == super::grid::Nodes::CellStart)
+        {
+            Interp::Nearest
+        } else {
+            Interp::Linear
+        }
+    }
+}
+
 impl std::str::FromStr for Interp {
     type Err = crate::Error;
 

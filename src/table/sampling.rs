@@ -2,9 +2,10 @@
 //! warps of f_r·cos θi over the half vector, in the manner of the RGL format's own warps.
 //!
 //! A [`TableSampler`] draws `wi` given `wo`. [`TabulatedBrdf`](super::TabulatedBrdf) uses it for
-//! `sample` and `pdf`, and so does the native RGL reader
+//! `sample` and `pdf`, and so do the native RGL reader
 //! ([`RglBrdf`](crate::measured::RglBrdf)), whose file's own warps are conditioned on the other
-//! direction.
+//! direction, and the MERL reader ([`MerlBrdf`](crate::measured::MerlBrdf)), whose format has
+//! none.
 //!
 //! # Design
 //!
@@ -108,6 +109,17 @@ impl SamplingResolution {
         }
     }
 
+    /// The default for a source looked up as `isotropic` and `nearest` say:
+    /// [`SamplingResolution::binned`] for isotropic nearest lookups, else
+    /// [`SamplingResolution::for_isotropy`].
+    pub fn for_lookup(isotropic: bool, nearest: bool) -> Self {
+        if isotropic && nearest {
+            Self::binned()
+        } else {
+            Self::for_isotropy(isotropic)
+        }
+    }
+
     /// Bytes a [`TableSampler`] of this resolution holds (`isotropic`: one node per θo).
     pub fn memory_bytes(&self, isotropic: bool) -> usize {
         let (nx, ny) = (self.theta_h.max(2), self.phi_h.max(2));
@@ -115,6 +127,18 @@ impl SamplingResolution {
         // f32 node densities, u32 alias entries over 2(ny − 1) half-strips and each row's
         // nx − 1 cells (`table::alias2d`).
         4 * views * (nx * ny + 2 * (ny - 1) + ny * (nx - 1))
+    }
+
+    /// The default for isotropic sources looked up by cell — a MERL file, a table read with
+    /// nearest lookups — whose values step from cell to cell as the view moves: 48 θo nodes
+    /// instead of 32 (1.6 MB). On a MERL file of `cc_ibiza_sunset` the weights' coefficient of
+    /// variation at a 75° view goes from 0.105 to 0.098, at 85° from 0.167 to 0.124; more θh
+    /// or φh nodes change it by less than 0.01.
+    pub fn binned() -> Self {
+        SamplingResolution {
+            theta_o: 48,
+            ..Default::default()
+        }
     }
 
     /// The default for anisotropic sources (fewer nodes per view, 20 × 16 views: with 12 θo

@@ -1,7 +1,7 @@
 //! Specifications of table importance sampling: chi-square tests of the sampler against its pdf
 //! for every kind of sampler — isotropic tables baked from analytic models and from measured
-//! (RGL) data, an anisotropic table on a full 4D grid (Ward), and the native RGL reader (which
-//! samples with the same structure) — weight = f_r cos θi / pdf, `pdf()` = the sampler's
+//! (RGL) data, an anisotropic table on a full 4D grid (Ward), and the native RGL and MERL
+//! readers (which sample with the same structure) — weight = f_r cos θi / pdf, `pdf()` = the sampler's
 //! density, and the mean weight = the table's directional albedo.
 
 use glam::DVec3;
@@ -19,9 +19,9 @@ use crate::table::{
     BakeOptions, Grid, Mapping, Param, SamplingResolution, Symmetry, TabulatedBrdf, bake,
 };
 
-/// Chi-square cases in this file (5 samplers × 5 directions): the Šidák correction counts them
+/// Chi-square cases in this file (6 samplers × 5 directions): the Šidák correction counts them
 /// all.
-const CASES: usize = 25;
+const CASES: usize = 30;
 /// Samples per chi-square case.
 const SAMPLES: usize = 1_000_000;
 
@@ -111,6 +111,22 @@ fn rgl_native() -> &'static RglBrdf {
     T.get_or_init(|| RglBrdf::open(rgl_path("cc_iris_purple_gem_rgb.bsdf")).unwrap())
 }
 
+/// The native MERL reader, on a MERL file written from Cook-Torrance gold (its cells step by a
+/// degree in θd and φd, finer near the peak in θh): it samples with a
+/// [`super::TableSampler`] built from itself.
+fn merl_native() -> &'static crate::measured::MerlBrdf {
+    static T: OnceLock<crate::measured::MerlBrdf> = OnceLock::new();
+    T.get_or_init(|| {
+        let m = ModelSpec::parse(
+            r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#,
+        )
+        .unwrap()
+        .build(&Channels::Rgb)
+        .unwrap();
+        crate::measured::MerlBrdf::from_brdf(m.as_ref())
+    })
+}
+
 /// The chi-square test of the crate's harness (`analysis::chi2`, bins in (cos θ, φ), expected
 /// counts by adaptive quadrature of `pdf()`) for [`test_wos`] direction `case`, Šidák-corrected
 /// over the [`CASES`] cases.
@@ -192,6 +208,11 @@ chi2_tests! {
     chi2_rgl_native_60: rgl_native, "rgl native cc_iris_purple_gem", 2;
     chi2_rgl_native_80: rgl_native, "rgl native cc_iris_purple_gem", 3;
     chi2_rgl_native_88: rgl_native, "rgl native cc_iris_purple_gem", 4;
+    chi2_merl_native_0: merl_native, "merl native cook_torrance Au", 0;
+    chi2_merl_native_30: merl_native, "merl native cook_torrance Au", 1;
+    chi2_merl_native_60: merl_native, "merl native cook_torrance Au", 2;
+    chi2_merl_native_80: merl_native, "merl native cook_torrance Au", 3;
+    chi2_merl_native_88: merl_native, "merl native cook_torrance Au", 4;
 }
 
 #[test]

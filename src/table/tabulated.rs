@@ -251,11 +251,13 @@ impl TabulatedBrdf {
     }
 
     /// The importance sampler of [`Brdf::sample`]/[`Brdf::pdf`], built on first use with
-    /// [`SamplingResolution::default`] (isotropic tables) or [`SamplingResolution::anisotropic`].
+    /// [`SamplingResolution::default`] (isotropic tables), [`SamplingResolution::binned`]
+    /// (isotropic tables read with nearest lookups) or [`SamplingResolution::anisotropic`].
     pub fn sampler(&self) -> &TableSampler {
         self.sampler.get_or_init(|| {
             let iso = self.grid.symmetry().isotropic;
-            TableSampler::build(self, iso, &SamplingResolution::for_isotropy(iso))
+            let res = SamplingResolution::for_lookup(iso, self.interp == Interp::Nearest);
+            TableSampler::build(self, iso, &res)
         })
     }
 
@@ -269,16 +271,7 @@ impl TabulatedBrdf {
     /// cells rather than nodes ([`Nodes::CellStart`](super::Nodes), the MERL grid: a MERL reader
     /// looks such values up by cell, so nearest reproduces the source), linear otherwise.
     pub fn default_interp(&self) -> Interp {
-        let cells = self
-            .grid()
-            .axes()
-            .iter()
-            .any(|a| a.nodes == super::Nodes::CellStart);
-        if cells {
-            Interp::Nearest
-        } else {
-            Interp::Linear
-        }
+        Interp::default_for(self.grid())
     }
 
     /// The interpolation in use.
