@@ -143,16 +143,21 @@ impl PyTable {
         self.grid.clone_ref(py)
     }
 
-    /// The table as a GPU or JIT host evaluates it, for lookups with `interp` ("linear" or
-    /// "nearest"): the library's device layout (`brdftab::table::device`), a dict with
+    /// The table as a GPU or JIT host evaluates it, for lookups with `interp` ("linear",
+    /// "nearest", or "auto": the table's default, nearest on a grid of MERL cells): the
+    /// library's device layout (`brdftab::table::device`), a dict with
     /// "version" (refuse any other than the one you implement), "kind" ("kernel" or "grid"),
     /// "channels", "channel_names", "quantity", "calibration" (None or its factors), "kernel"
     /// and "grid" (None or dicts of the layout's fields, each with its float32 "values").
     #[pyo3(signature = (interp = "linear"))]
     fn device_layout(&self, py: Python<'_>, interp: &str) -> PyResult<Py<PyAny>> {
         guard(|| {
-            let interp: Interp = interp.parse().map_err(lib_err)?;
             let t = &self.table;
+            let interp: Interp = if interp.trim().eq_ignore_ascii_case("auto") {
+                Interp::default_for(t.grid())
+            } else {
+                interp.parse().map_err(lib_err)?
+            };
             let d = unlocked(py, || DeviceLayout::new(t, interp))?.map_err(lib_err)?;
             layout_dict(py, d, t.grid().channels())
         })

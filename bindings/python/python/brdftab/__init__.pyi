@@ -79,7 +79,8 @@ class Table:
     @property
     def grid(self) -> dict[str, Any]: ...
     def device_layout(self, interp: str = "linear") -> dict[str, Any]:
-        """The table as a GPU or JIT host evaluates it for lookups with `interp`: the library's
+        """The table as a GPU or JIT host evaluates it for lookups with `interp` ("linear",
+        "nearest", or "auto": nearest on a grid of MERL cells, linear otherwise): the library's
         device layout, a dict with "version", "kind" ("kernel" or "grid"), "channels",
         "channel_names", "quantity", "calibration", "kernel" and "grid" (None or the layout's
         fields, each with its float32 "values")."""

@@ -6,7 +6,8 @@
 >>> bsdf = mi.load_dict({"type": "brdftab", "source": "paper_white_rgb.bsdf"})  # doctest: +SKIP
 
 Properties: ``source`` (string, any SOURCE: spec, table, ``DB#NAME``, MERL, RGL), optional
-``interp`` (``"linear"`` or ``"nearest"``), and for JIT variants optional ``preset`` / ``grid``
+``interp`` (``"auto"``, the default: nearest on tables of MERL cells as every host of the
+library reads them, linear otherwise; or ``"linear"`` or ``"nearest"``), and for JIT variants optional ``preset`` / ``grid``
 (the table a non-table source is baked on, default ``medium``; RGL files: the library's
 adaptive grid, MERL files: their own cells), ``sampling_res`` (the
 resolution of the sampling distributions: half-vector nodes per axis, default 64, 48 for
@@ -125,7 +126,7 @@ class _Common:
         if not isinstance(src, str) or not src:
             raise ValueError("brdftab plugin: the string property `source` is required")
         self.source = src
-        self.interp = str(_prop(props, "interp", "linear"))
+        self.interp = str(_prop(props, "interp", "auto"))
         self.spectral = mi.is_spectral
         self.brdf = brdftab.open(src, interp=self.interp)
         if not self.spectral and len(self.brdf.channels) != 3:
@@ -743,8 +744,8 @@ class JitBrdftabBSDF(_Common):
         # The table as the library describes it for devices (`device_layout`): the JIT lookup
         # implements that layout, not the grid's description. An opened table moves its values
         # into the layout (`Brdf.device_layout`, for the interpolation it was opened with); a
-        # table baked in memory, or an `interp` other than linear/nearest, goes through
-        # `Table.device_layout` (linear unless nearest).
+        # table baked in memory goes through `Table.device_layout` (`auto`: nearest on MERL
+        # cells, linear otherwise).
         layout = self._table(options)
         self.table = JitTable(layout)
         # The library's importance sampler (conditional half-vector warps of f_r cos θo given
@@ -752,17 +753,23 @@ class JitBrdftabBSDF(_Common):
         # (A kernel layout is of an isotropic table.)
         iso = layout["kind"] == "kernel" or layout["grid"]["symmetry"]["isotropic"]
         res = int(_prop(props, "sampling_res", 64 if iso else 48))
+        # The library's conditioning (SamplingResolution::for_lookup): 32 θi nodes, 48 for a
+        # table read by cell (its values step as the view moves), 20 anisotropic.
+        nearest = layout["kind"] == "grid" and layout["grid"]["interp"] == "nearest"
+        views = (48 if nearest else 32) if iso else 20
         nodes = self._sampled.sampling_nodes(adjoint=True, theta_h=res, phi_h=res,
-                                             theta_o=32 if iso else 20)
+                                             theta_o=views)
         self.sampler = HalfVectorSampler(nodes)
         dr.eval()
 
     def _layout(self, table):
         """The device layout of ``table``: a Brdf over a table (its values move into the
-        layout) or a ``brdftab.Table``."""
-        if hasattr(table, "values") or self.interp not in ("linear", "nearest"):
-            tab = table if hasattr(table, "values") else table.table()
-            return tab.device_layout("nearest" if self.interp == "nearest" else "linear")
+        layout, for the interpolation it was opened with: ``auto`` resolved) or a
+        ``brdftab.Table`` (``auto``: the library's default for its grid)."""
+        if hasattr(table, "values"):
+            return table.device_layout(self.interp)
+        if table.interp not in ("linear", "nearest"):
+            return table.table().device_layout(self.interp)
         return table.device_layout()
 
     def _table(self, options):
