@@ -225,6 +225,8 @@ CHI2 = [
     # anisotropic: conditioned on θi and φi (four conditioning corners)
     ('{"model": "ward", "alpha_x": 0.1, "alpha_y": 0.3, "ks": 0.5}', {"preset": "small"},
      [0.5, 0.3, 0.81]),
+    # a MERL file: the table of its cells read by cell, its sampler on 48 θi views
+    ("MERL", {}, [0.6, 0.1, 0.79]),
 ]
 
 
@@ -309,15 +311,20 @@ def test_jit_alias_draw_is_the_piecewise_bilinear_density(rgl):
 
 
 @pytest.mark.parametrize("case", range(len(CHI2)))
-def test_jit_chi2_sampling(rgl, case):
+def test_jit_chi2_sampling(rgl, case, tmp_path):
     """The plugin's sample and pdf agree (mitsuba.chi2) for isotropic and anisotropic tables,
-    near the normal and at 80°."""
+    near the normal and at 80°, and for a MERL file's cells."""
     use("llvm_ad_rgb")
     from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
 
     src, opts, wi, *ires = CHI2[case]
     if src == "RGL":
         src = str(rgl / RGL_FILE)
+    if src == "MERL":
+        src = str(tmp_path / "ct.binary")
+        brdftab.convert('{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}',
+                        src)
+        opts = {"cache_dir": str(tmp_path)}
     wi = [float(x) for x in np.asarray(wi) / np.linalg.norm(wi)]
     d = {"type": "brdftab", "source": src, **opts}
     chi2 = ChiSquareTest(
