@@ -435,7 +435,7 @@ impl Brdf for MerlBrdf {
     /// ([`TableSampler`], built from this reader on first use: 197 k lookups, about
     /// 30 ms). A MERL file carries no sampling data of its own; the cosine-weighted
     /// default the trait would give leaves a glossy measurement's weights with a coefficient of
-    /// variation of 3–25 (a MERL file of `cc_ibiza_sunset`, views 3–85°), against 0.03–0.17
+    /// variation of 3–25 (a MERL file of `cc_ibiza_sunset`, views 3–85°), against 0.06–0.12
     /// with this sampler (BENCHMARKS.md).
     fn sample(
         &self,
