@@ -117,3 +117,41 @@ fn requests_a_target_cannot_serve_are_refused() {
     );
     refused(BakeRequest::new(ggx).target_error(-1.0));
 }
+
+/// A model's adaptive table is judged where the model is used: over the whole hemisphere.
+/// Issue 22's bars for measured tables (cos θi cos θo-weighted relative RMSE within 1.5 % over
+/// the whole hemisphere and 3 % in the grazing band, directional albedo within 1 % at every θ′
+/// from 1° to 89°) hold for bounded models' tables baked to a 0.1 % target. Before the grids
+/// reached the horizon (θh nodes stopped at 85°, the search judged within 80° only) these
+/// tables met the target inside the cap and were 5.6 % (GGX copper), 11 % (Cook-Torrance gold)
+/// and 18 % (Oren-Nayar) off in the grazing band, up to 18 % in albedo.
+#[test]
+fn a_model_table_to_a_target_is_faithful_over_the_whole_hemisphere() {
+    use brdftab::analysis::fidelity::{self, FidelityOptions};
+    let opts = FidelityOptions {
+        pairs: 100_000,
+        seed: 7,
+        ..Default::default()
+    };
+    for spec in [
+        r#"{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}"#,
+        r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#,
+        r#"{"model": "oren_nayar", "kd": 0.25, "sigma": 0.3}"#,
+    ] {
+        let (t, r) = BakeRequest::new(spec)
+            .target_error(0.001)
+            .table(&Silent)
+            .unwrap();
+        // The search judged the grazing band too (3× the target; Cook-Torrance's rule error
+        // there stays at 0.5 % on the ladder's largest grid, which is then what it gets).
+        let s = r.target.expect("searched");
+        assert_eq!(s.grazing_target, Some(0.003), "{spec}: {}", s.summary());
+        let src = source::open(spec).unwrap();
+        let tb = TabulatedBrdf::from_table(t);
+        let f = fidelity::measure(&tb, src.as_ref(), &opts).unwrap();
+        let msg = format!("{spec}: {}", f.summary());
+        assert!(f.whole <= 0.015, "{msg}");
+        assert!(f.grazing <= 0.03, "{msg}");
+        assert!(f.albedo.worst <= 0.01, "{msg}");
+    }
+}

@@ -68,7 +68,8 @@ pub struct BakeSettings {
     pub supersample: Option<usize>,
     /// Pick the smallest adaptive grid whose table meets this error: relative RMSE of
     /// f_r cos θi cos θo, both directions within 80°, on a mirror-centred product rule (`0.5%`
-    /// or `0.005`); measured sources also within 3× it in the grazing band beyond 80°.
+    /// or `0.005`), and within 3× it in the grazing band beyond 80° (every table but one of a
+    /// measurement's own f_r, which grows without bound at the horizon).
     /// Isotropic bilateral sources; not with given node counts.
     #[cfg_attr(feature = "clap", arg(long))]
     pub target_error: Option<ErrorTarget>,

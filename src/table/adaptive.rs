@@ -39,8 +39,8 @@ pub struct AdaptiveOptions {
     /// What the grid's values are: the warps follow the variation of that quantity.
     pub quantity: Quantity,
     /// θh's warp variable: [`WarpVar::SqrtSine`] (the default), or [`WarpVar::QuarterPower`],
-    /// whose finite slope at 90° lets the warp place nodes up to the horizon (measured tables
-    /// judged over the whole hemisphere).
+    /// whose finite slope at 90° lets the warp place nodes up to the horizon (what a bake uses
+    /// for every table judged over the whole hemisphere: all but a measurement's own f_r).
     pub h_var: WarpVar,
 }
 

@@ -5,8 +5,8 @@
 //! more. [`search`] fits the warps once (they do not depend on the node counts), then bakes
 //! the grids of a [`LADDER`] of node counts in memory (calibrating each as the final table will
 //! be, [`crate::table::calibration`]) and measures each against the source with the fidelity
-//! metric — relative RMSE of f_r cos θi cos θo, both directions within 80°, and for measured
-//! tables also in the grazing band beyond — and keeps the smallest that meets the target.
+//! metric — relative RMSE of f_r cos θi cos θo, both directions within 80°, and in the grazing
+//! band beyond — and keeps the smallest that meets the target.
 //!
 //! The metric is measured on a deterministic product rule centred on the mirror direction
 //! ([`PairRule`]), not on random pairs: for peaky materials a random estimate is heavy tailed
@@ -50,9 +50,10 @@ pub struct TargetOptions {
     pub target: f64,
     /// When set, the grazing band (a direction beyond the cap) is judged too, against this
     /// multiple of the target: a table meets the target when its error within the cap is at most
-    /// `target` and its error in the band at most `grazing_factor · target`. Measured tables are
-    /// judged so (3: the bars are 1 % within 80° and 3 % in the band); analytic tables
-    /// of f_r, whose grids stop short of the horizon, within the cap only.
+    /// `target` and its error in the band at most `grazing_factor · target`. Every bake judges
+    /// it so (3: the fidelity bars are 1 % within 80° and 3 % in the band) except one of a
+    /// measurement's own f_r, which grows like 1/cos θ at the horizon (its grid stops short of
+    /// it).
     pub grazing_factor: Option<f64>,
     /// Directions beyond this angle from the normal do not count in the cap (degrees).
     pub cap_deg: f64,
