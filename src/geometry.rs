@@ -91,6 +91,14 @@ pub fn elevation(d: DVec3) -> f64 {
     2.0 * (0.5 * dist).min(1.0).asin()
 }
 
+/// Mirror image across the surface plane: (x, y, −z). Samplers that fold a draw below the
+/// horizon back above it (rather than refuse it) give the folded direction the density of both
+/// its preimages, `w` and `mirror_z(w)`.
+#[inline]
+pub fn mirror_z(w: DVec3) -> DVec3 {
+    DVec3::new(w.x, w.y, -w.z)
+}
+
 /// Mirror reflection about the local normal z: (−x, −y, z).
 #[inline]
 pub fn reflect_z(w: DVec3) -> DVec3 {

@@ -16,12 +16,16 @@
 //! a_max = 2π k_s / (n + 2); the pumped-up versions do not lose energy at grazing angles like the
 //! reciprocal one does (the product and sqrt versions gain without bound there).
 //!
-//! Importance sampling draws the lobe cos^n ψ around the reflection of `wo`, mixed with cosine
-//! sampling for robustness (directions the lobe sends below the horizon are rejected, so the
-//! sampled density is exactly the mixture density restricted to the upper hemisphere).
+//! Importance sampling draws the lobe cos^n ψ around the reflection of `wo` alone: f_r cos θi
+//! over the lobe's density is (2π k_s/(n + 1)) cos θi / X, bounded for every variant (constant
+//! for the original model, 1/cos θ for the product one; see [`Phong::sample`]). A draw the lobe
+//! sends below the horizon is folded back above it (z → −z) rather than refused, so grazing views
+//! waste no samples; the density of a direction is then the lobe's at it plus at its mirror image
+//! below the horizon (which is exact, and never larger: the folded direction is the nearer to the
+//! lobe's axis).
 
 use glam::{DVec2, DVec3};
-use std::f64::consts::{FRAC_1_PI, PI};
+use std::f64::consts::PI;
 
 use crate::brdf::{Brdf, BrdfSample, Flags};
 use crate::error::Result;
@@ -53,14 +57,6 @@ pub enum PhongVariant {
     /// The pumped-up reciprocal Phong model with a symmetric X.
     Pumped(PumpX),
 }
-
-/// Probability of drawing from the cos^n ψ lobe (the rest is cosine-weighted).
-///
-/// The lobe dominates f·cos for every variant, so most samples go there; the cosine part bounds
-/// the weight f·cos θi / pdf by f·π/(1 − LOBE_PROB) where the lobe density is small (the
-/// original and pumped variants have their 1/X growth near the horizon, which the lobe alone does
-/// not follow).
-pub const LOBE_PROB: f64 = 0.85;
 
 /// A member of the Phong family (see the module docs): k_s cos^n ψ / X.
 #[derive(Debug, Clone)]
@@ -160,7 +156,8 @@ impl Phong {
         }
     }
 
-    /// Density of the cos^n ψ lobe around the reflection of `wo` (hemisphere-normalized).
+    /// Density of the cos^n ψ lobe around the reflection of `wo` (normalized over the
+    /// hemisphere around that axis), at any direction `wi`, above the horizon or not.
     #[inline]
     fn lobe_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
         let cos_psi = geometry::reflect_z(wo).dot(wi);
@@ -169,6 +166,13 @@ impl Phong {
         } else {
             0.0
         }
+    }
+
+    /// The density of [`Brdf::sample`] at a unit `wi` above the horizon: the lobe's at `wi` and
+    /// at its mirror image below the horizon (the fold's other preimage).
+    #[inline]
+    fn folded_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        self.lobe_pdf(wi, wo) + self.lobe_pdf(geometry::mirror_z(wi), wo)
     }
 }
 
@@ -235,54 +239,37 @@ impl Brdf for Phong {
         )
     }
 
-    /// Mixture of the cos^n ψ lobe around reflect(wo) (probability [`LOBE_PROB`]) and cosine
-    /// sampling; weight f_r cos θi / pdf with pdf the exact mixture density.
+    /// The cos^n ψ lobe around reflect(wo), folded at the horizon (module docs); weight
+    /// f_r cos θi / pdf with pdf the exact density of the fold ([`Phong::folded_pdf`]). The weight
+    /// is (2π k_s/(n + 1)) · cos θi / X · cos^n ψ / (cos^n ψ + cos^n ψ′), ψ′ the mirror image's
+    /// angle to the axis: the lobe's constant for the original model wherever nothing folds, and
+    /// at least half of it where something does.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
             return None;
         }
-        if u.x < LOBE_PROB {
-            // Fused lobe branch: cos ψ = u₀^{1/(n+1)} gives cos^n ψ = u₀ / cos ψ without a
-            // second power, and f, the mixture pdf and the weight all follow from it.
-            let u0 = u.x / LOBE_PROB;
-            let cos_psi = u0.powf(self.inv_n1);
-            let sin_psi = (1.0 - cos_psi * cos_psi).max(0.0).sqrt();
-            let (s, c) = crate::fastmath::sin_cos_2pi(u.y);
-            let r = geometry::reflect_z(wo);
-            let wi = Frame::from_normal(r).to_world(DVec3::new(sin_psi * c, sin_psi * s, cos_psi));
-            if !(wi.z > 0.0 && cos_psi > 0.0) {
-                return None;
-            }
-            let lobe = u0 / cos_psi;
-            let pdf = LOBE_PROB * self.lobe_norm * lobe + (1.0 - LOBE_PROB) * wi.z * FRAC_1_PI;
-            if !(pdf > 0.0 && pdf.is_finite()) {
-                return None;
-            }
-            let v = lobe / self.x(wi.z, wo.z) * wi.z / pdf;
-            for (w, &k) in weight[..self.ks.len()].iter_mut().zip(&self.ks) {
-                *w = (k * v).min(f32::MAX as f64) as f32;
-            }
-            return Some(BrdfSample {
-                wi,
-                pdf,
-                delta: false,
-            });
-        }
-        let u0 = ((u.x - LOBE_PROB) / (1.0 - LOBE_PROB)).min(1.0 - f64::EPSILON);
-        let wi = geometry::cosine_hemisphere(DVec2::new(u0, u.y));
-        if wi.z <= 0.0 {
+        // cos ψ = u₀^{1/(n+1)} has density (n + 1) cos^n ψ on [0, 1].
+        let cos_psi = u.x.powf(self.inv_n1);
+        let sin_psi = (1.0 - cos_psi * cos_psi).max(0.0).sqrt();
+        let (s, c) = crate::fastmath::sin_cos_2pi(u.y);
+        let r = geometry::reflect_z(wo);
+        let drawn = Frame::from_normal(r).to_world(DVec3::new(sin_psi * c, sin_psi * s, cos_psi));
+        let wi = if drawn.z < 0.0 {
+            geometry::mirror_z(drawn)
+        } else {
+            drawn
+        };
+        if !(wi.z > 0.0) {
             return None;
         }
-        let pdf = self.pdf(wi, wo);
-        if pdf.is_nan() || pdf <= 0.0 {
+        let pdf = self.folded_pdf(wi, wo);
+        let v = self.lobe_over_x(wi, wo) * wi.z / pdf;
+        if !(pdf > 0.0 && pdf.is_finite() && v.is_finite()) {
             return None;
         }
-        let c = self.ks.len();
-        self.eval(wi, wo, &mut weight[..c]);
-        let s = wi.z / pdf;
-        for w in &mut weight[..c] {
-            *w = (*w as f64 * s) as f32;
+        for (w, &k) in weight[..self.ks.len()].iter_mut().zip(&self.ks) {
+            *w = (k * v).min(f32::MAX as f64) as f32;
         }
         Some(BrdfSample {
             wi,
@@ -295,7 +282,7 @@ impl Brdf for Phong {
         let Some((wi, wo)) = geometry::upper_pair(wi, wo) else {
             return 0.0;
         };
-        LOBE_PROB * self.lobe_pdf(wi, wo) + (1.0 - LOBE_PROB) * wi.z * FRAC_1_PI
+        self.folded_pdf(wi, wo)
     }
 }
 
@@ -369,6 +356,51 @@ mod tests {
         // The ratio is cos θ / cos θ′ ≠ 1.
         assert!((a[0] / b[0] - (wo.z / wi.z) as f32).abs() < 1e-5);
         assert!((a[0] - b[0]).abs() > 1e-3 * a[0]);
+    }
+
+    #[test]
+    fn sampler_passes_chi_square() {
+        use crate::models::test_util::chi2_models;
+        let v = |variant, n| Phong::new(variant, Value::Grey(0.5), n, &Channels::Rgb).unwrap();
+        chi2_models(&[
+            &v(PhongVariant::Original, 20.0),
+            &v(PhongVariant::Reciprocal, 2.0),
+            &v(PhongVariant::Max, 0.0),
+            &v(PhongVariant::Pumped(PumpX::Product), 200.0),
+        ]);
+    }
+
+    /// The original model's f_r cos θi is k_s cos^n ψ, which the lobe's density (n + 1)/2π
+    /// cos^n ψ follows exactly: every weight is 2π k_s/(n + 1) where nothing folds, and between
+    /// half of that and that where the fold adds the mirror image's density (never larger than
+    /// the direction's own). No draw is refused, at any view.
+    #[test]
+    fn original_phong_weights_are_the_lobe_constant_and_nothing_is_refused() {
+        let n = 20.0;
+        let p = Phong::original(Value::Grey(0.5), n, &Channels::Rgb).unwrap();
+        let c = 2.0 * PI * 0.5 / (n + 1.0);
+        let mut rng = crate::rng::Pcg32::new(3);
+        for deg in [0.0f64, 30.0, 60.0, 80.0, 89.0] {
+            let wo = geometry::spherical(deg.to_radians(), 0.7);
+            let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+            for _ in 0..20_000 {
+                let mut w = [0.0f32; 3];
+                let s = p
+                    .sample(wo, rng.next_dvec2(), &mut w)
+                    .expect("no draw is refused");
+                assert!(s.wi.z > 0.0);
+                lo = lo.min(w[0] as f64);
+                hi = hi.max(w[0] as f64);
+            }
+            assert!(
+                hi <= c * (1.0 + 1e-6) && lo >= 0.5 * c * (1.0 - 1e-6),
+                "{deg}°: {lo}..{hi} vs {c}"
+            );
+            if deg == 0.0 {
+                // The lobe around the normal: nothing reaches the horizon's mirror side.
+                assert!(lo >= c * (1.0 - 1e-6), "{lo} vs {c}");
+            }
+        }
     }
 
     #[test]

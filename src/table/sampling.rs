@@ -67,7 +67,7 @@ use super::alias2d::AliasWarp;
 use super::warp2d::{Corners, Planes};
 use crate::brdf::{Brdf, BrdfSample};
 use crate::fastmath;
-use crate::geometry;
+use crate::geometry::{self, mirror_z};
 use crate::spectrum::MAX_CHANNELS;
 
 /// Resolution of a [`TableSampler`] (see the module docs).
@@ -211,12 +211,6 @@ fn square_of(h: DVec3) -> [f64; 2] {
     let y = (fastmath::atan2(h.y, h.x) + PI) * (1.0 / TAU);
     // atan2 ∈ [−π, π]: y ∈ [0, 1], and 1 is 0.
     [s, if y >= 1.0 { y - 1.0 } else { y }]
-}
-
-/// (x, y, −z).
-#[inline]
-fn mirror_z(v: DVec3) -> DVec3 {
-    DVec3::new(v.x, v.y, -v.z)
 }
 
 /// The densities a [`TableSampler`] is built from: g(s, y) at `nx` × `ny` nodes of the unit
