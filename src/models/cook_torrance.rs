@@ -20,7 +20,7 @@
 //! visible one of the pair is H with probability ⟨V,H⟩⁺ / (⟨V,H⟩⁺ + ⟨V,H′⟩⁺), so the density
 //! is D(H) cos α · 2⟨V,H⟩⁺ / (⟨V,H⟩⁺ + ⟨V,H′⟩⁺): α keeps the marginal of D cos α (drawn as
 //! the Beckmann distribution draws it), and the azimuth of H relative to V's has the density
-//! (1 + k cos φ′)/2π, k = tan α tan θv, clipped to [0, 1/π] ([`visible_azimuth`]). L = 2 (V·H) H
+//! (1 + k cos φ′)/2π, k = tan α tan θv, clipped to [0, 1/π] ([`visible`]). L = 2 (V·H) H
 //! − V has density D(H) cos α / (2 (⟨V,H⟩⁺ + ⟨V,H′⟩⁺)) and weight f cos θl / pdf =
 //! F · G(L, V) / G₁(V, H) ≤ F: Fresnel alone wherever L is not shadowed. A draw below the
 //! horizon is folded back above it (z → −z) and its density is that of both preimages. On rough
@@ -31,7 +31,7 @@
 //! its draws at grazing views and reached a weight CV of 1.05 for gold, m = 0.3.)
 
 use glam::{DVec2, DVec3};
-use std::f64::consts::{FRAC_1_PI, PI};
+use std::f64::consts::FRAC_1_PI;
 
 use crate::brdf::{Brdf, BrdfSample, Flags};
 use crate::error::Result;
@@ -40,6 +40,7 @@ use crate::geometry;
 use crate::spectrum::{Channels, Value};
 
 use super::beckmann::Beckmann;
+use super::visible;
 
 /// Cook-Torrance: k_s · D · G · F / (4 (N·V)(N·L)), normalized Beckmann D, V-cavity G, F at L·H.
 #[derive(Debug, Clone)]
@@ -105,26 +106,11 @@ impl CookTorrance {
         (k * n_dot_v).min(k * n_dot_l).min(1.0)
     }
 
-    /// The density with which the visible-normal draw gives direction `x` for unit `v` (module
-    /// docs), `x` on either side of the horizon (a fold's preimage below it): with H =
-    /// normalize(x + v) and H′ its cavity partner, D(H) cos α / (2 (⟨V,H⟩⁺ + ⟨V,H′⟩⁺)); 0 where
-    /// H is below the horizon or faces away from `v`.
+    /// The density with which the visible-normal draw gives direction `x` for unit `v`
+    /// ([`visible::density`] with this model's D), `x` on either side of the horizon.
     #[inline]
     fn visible_density(&self, x: DVec3, v: DVec3) -> f64 {
-        let h = x + v;
-        let hh = h.length_squared();
-        if !(h.z > 0.0 && hh > 0.0) {
-            return 0.0;
-        }
-        let inv = 1.0 / hh.sqrt();
-        let cos_a = h.z * inv;
-        let a = v.dot(h) * inv;
-        if !(a > 0.0) {
-            return 0.0;
-        }
-        // ⟨V,H′⟩ with H′ = (−h_x, −h_y, h_z)/|h|.
-        let b = ((v.z * h.z - v.x * h.x - v.y * h.y) * inv).max(0.0);
-        self.d.d(cos_a) * cos_a / (2.0 * (a + b))
+        visible::density(x, v, |cos_a| self.d.d(cos_a))
     }
 
     /// The density of [`Brdf::sample`] at unit `l` above the horizon: both preimages of the
@@ -209,7 +195,7 @@ impl Brdf for CookTorrance {
 
     /// The V-cavity's visible normals, folded at the horizon (module docs): u.x draws α as the
     /// Beckmann distribution does (with D at the drawn normal, no `exp`), u.y the azimuth
-    /// relative to V's ([`visible_azimuth`]). The density is that of both preimages of the
+    /// relative to V's ([`visible::normal`]). The density is that of both preimages of the
     /// result, the draw's own and its mirror image's (one `exp`, and none where the mirror
     /// image's half vector is below the horizon); f is the draw's where nothing folds and shares
     /// the other preimage's D where something does. [`CookTorrance::folded_density`] is the same
@@ -246,28 +232,12 @@ impl Brdf for CookTorrance {
         let tan_a = tan2.sqrt();
         // D = exp(−tan² α/m²) / (π m² cos⁴ α) with exp(−tan² α/m²) = 1 − u.x.
         let d = one_minus * self.d.inv_pi_m2() * (inv_c2 * inv_c2);
-        // V's azimuth as a unit vector (any at the normal, where k = 0).
-        let rho = (v.x * v.x + v.y * v.y).sqrt();
-        let (cx, sx) = if rho > 0.0 {
-            (v.x / rho, v.y / rho)
-        } else {
-            (1.0, 0.0)
-        };
-        let phi = visible_azimuth(tan_a * rho / v.z, 2.0 * u.y - 1.0);
-        let (sp, cp) = sin_cos(phi);
-        let sin_a = tan_a * cos_a;
-        let h = DVec3::new(
-            sin_a * (cp * cx - sp * sx),
-            sin_a * (cp * sx + sp * cx),
-            cos_a,
-        );
+        let h = visible::normal(cos_a, tan_a, v, u.y);
         let vh = v.dot(h);
         if !(vh > 0.0) {
             return None;
         }
-        // ⟨V, H′⟩ of the cavity partner H′ = (−h_x, −h_y, h_z).
-        let vh_partner = (v.z * h.z - v.x * h.x - v.y * h.y).max(0.0);
-        let p_drawn = d * cos_a / (2.0 * (vh + vh_partner));
+        let p_drawn = d * cos_a / (2.0 * (vh + visible::partner_dot(v, h)));
         let drawn = (2.0 * vh) * h - v;
         let other = geometry::mirror_z(drawn);
         let (l, dg, l_dot_h, pdf) = if drawn.z > 0.0 {
@@ -313,96 +283,6 @@ impl Brdf for CookTorrance {
             None => 0.0,
         }
     }
-}
-
-/// The azimuth φ′ ∈ (−π, π) of a V-cavity visible normal relative to the view's azimuth, drawn
-/// from t ∈ [−1, 1) (its sign picks the side): density (1 + k cos φ′)/2π with k = tan α tan θv,
-/// clipped to [0, 1/π] — where k cos φ′ > 1 the partner facet is hidden and the drawn one is
-/// seen alone (1/π), where k cos φ′ < −1 it hides the drawn one (0). The CDF over x = |φ′|,
-/// (x + k sin x)/π (or 2x/π below the clip at cos φc = 1/k, and the same shifted above it), is
-/// inverted by [`solve_kepler`] from a start that keeps Newton's steps quadratic where the
-/// density vanishes at the end of the range (a double root there).
-fn visible_azimuth(k: f64, t: f64) -> f64 {
-    let s = t.abs().min(1.0);
-    let x = if k <= 1.0 {
-        let c = PI * s;
-        // Near x = π: with y = π − x, (1 − k) y + k y³/6 ≈ π − c; each term alone overestimates y.
-        let c1 = PI - c;
-        let x0 = if c1 < 0.5 {
-            let cubic = if k > 0.0 { (6.0 * c1 / k).cbrt() } else { c1 };
-            let linear = if k < 1.0 {
-                c1 / (1.0 - k)
-            } else {
-                f64::INFINITY
-            };
-            PI - cubic.min(linear)
-        } else {
-            newton_start(k, c)
-        };
-        solve_kepler(k, c, x0, 0.0, PI)
-    } else {
-        let phi_c = (1.0 / k).acos();
-        if PI * s <= 2.0 * phi_c {
-            0.5 * PI * s
-        } else {
-            let sin_c = (1.0 - 1.0 / (k * k)).sqrt();
-            let c = PI * s - phi_c + k * sin_c;
-            // Near x₁ = π − φc, where the density vanishes: x₁ + k sin x₁ − c ≈ a (x₁ − x)²/2
-            // with a = k sin φc = √(k² − 1).
-            let (x1, a) = (PI - phi_c, k * sin_c);
-            let gap = x1 + k * sin_c - c;
-            let x0 = if gap < 0.5 * a {
-                x1 - (2.0 * gap / a).sqrt()
-            } else {
-                newton_start(k, c)
-            };
-            solve_kepler(k, c, x0, phi_c, x1)
-        }
-    };
-    if t < 0.0 { -x } else { x }
-}
-
-/// (sin x, cos x) for x ∈ [−π, π].
-#[inline]
-fn sin_cos(x: f64) -> (f64, f64) {
-    crate::fastmath::sin_cos_2pi(x * (0.5 / PI))
-}
-
-/// One Newton step for x + k sin x = c from x = c.
-#[inline]
-fn newton_start(k: f64, c: f64) -> f64 {
-    let (s, co) = sin_cos(c);
-    c - k * s / (1.0 + k * co).max(0.5)
-}
-
-/// The x ∈ [lo, hi] with x + k sin x = c (increasing there), by Newton steps from `x0`, kept
-/// inside a bracket that shrinks on every step (bisection where a step would leave it); to
-/// 1e-10 in c, far below what the drawn distribution could show (its density is computed from
-/// the drawn direction, exactly). Two steps on average, at most eight on a million draws.
-fn solve_kepler(k: f64, c: f64, x0: f64, mut lo: f64, mut hi: f64) -> f64 {
-    let mut x = x0.clamp(lo, hi);
-    for _ in 0..60 {
-        let (s, co) = sin_cos(x);
-        let h = x + k * s - c;
-        if h.abs() <= 1e-10 {
-            break;
-        }
-        if h > 0.0 {
-            hi = x;
-        } else {
-            lo = x;
-        }
-        let next = x - h / (1.0 + k * co);
-        x = if next > lo && next < hi {
-            next
-        } else {
-            0.5 * (lo + hi)
-        };
-        if hi - lo <= 1e-15 {
-            break;
-        }
-    }
-    x
 }
 
 #[cfg(test)]
@@ -514,41 +394,6 @@ mod tests {
             &ct(0.6, FresnelSpec::None),
             &ct(1.2, FresnelSpec::None),
         ]);
-    }
-
-    /// The inverse CDF of the visible normals' azimuth: (x + k sin x)/π, or the clipped form
-    /// for k > 1, evaluated at the drawn x gives back the number it was drawn from, over k from
-    /// 0 to 50 and the whole range of t, ends included.
-    #[test]
-    fn visible_azimuth_inverts_its_cdf() {
-        let cdf = |k: f64, x: f64| -> f64 {
-            if k <= 1.0 {
-                return (x + k * x.sin()) / PI;
-            }
-            let pc = (1.0 / k).acos();
-            if x <= pc {
-                2.0 * x / PI
-            } else {
-                (2.0 * pc + (x - pc) + k * (x.sin() - pc.sin())) / PI
-            }
-        };
-        for k in [
-            0.0, 1e-6, 0.3, 0.9, 0.999_999, 1.0, 1.000_001, 1.5, 4.0, 50.0,
-        ] {
-            for j in 0..=1000 {
-                let t = -1.0 + 2.0 * j as f64 / 1000.0;
-                let x = visible_azimuth(k, t.min(1.0 - 1e-16));
-                assert!(
-                    x.abs() <= PI && (x >= 0.0) == (t >= 0.0),
-                    "k={k} t={t}: {x}"
-                );
-                let back = cdf(k, x.abs());
-                assert!(
-                    (back - t.abs().min(1.0)).abs() < 1e-9,
-                    "k={k} t={t}: {back}"
-                );
-            }
-        }
     }
 
     /// f cos θl / pdf of a visible normal is F · G(L, V) / G₁(V, H) ≤ F: with F = 1, no weight

@@ -14,6 +14,7 @@ pub mod mirror;
 pub mod oren_nayar;
 pub mod phong;
 pub mod sum;
+pub mod visible;
 pub mod ward;
 
 #[cfg(test)]
