@@ -198,7 +198,7 @@ impl Brdf for CookTorrance {
     /// relative to V's ([`visible::normal`]). The density is that of both preimages of the
     /// result, the draw's own and its mirror image's (one `exp`, and none where the mirror
     /// image's half vector is below the horizon); f is the draw's where nothing folds and shares
-    /// the other preimage's D where something does. [`CookTorrance::folded_density`] is the same
+    /// the other preimage's D where something does. `CookTorrance::folded_density` is the same
     /// density in plain terms (`pdf`), tested equal.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let v = geometry::unit(wo)?;

@@ -240,7 +240,7 @@ impl Brdf for Phong {
     }
 
     /// The cos^n ψ lobe around reflect(wo), folded at the horizon (module docs); weight
-    /// f_r cos θi / pdf with pdf the exact density of the fold ([`Phong::folded_pdf`]). The weight
+    /// f_r cos θi / pdf with pdf the exact density of the fold (`Phong::folded_pdf`). The weight
     /// is (2π k_s/(n + 1)) · cos θi / X · cos^n ψ / (cos^n ψ + cos^n ψ′), ψ′ the mirror image's
     /// angle to the axis: the lobe's constant for the original model wherever nothing folds, and
     /// at least half of it where something does.
