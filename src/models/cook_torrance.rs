@@ -196,10 +196,11 @@ impl Brdf for CookTorrance {
     /// The V-cavity's visible normals, folded at the horizon (module docs): u.x draws α as the
     /// Beckmann distribution does (with D at the drawn normal, no `exp`), u.y the azimuth
     /// relative to V's ([`visible::normal`]). The density is that of both preimages of the
-    /// result, the draw's own and its mirror image's (one `exp`, and none where the mirror
-    /// image's half vector is below the horizon); f is the draw's where nothing folds and shares
-    /// the other preimage's D where something does. `CookTorrance::folded_density` is the same
-    /// density in plain terms (`pdf`), tested equal.
+    /// result, the draw's own (from the inversion, no `exp`) and its mirror image's (one `exp`,
+    /// none where the mirror image's half vector is below the horizon); f is the draw's where
+    /// nothing folds and is evaluated at the folded direction where something does.
+    /// `CookTorrance::folded_density` is the same density in plain terms (`pdf`; the contract
+    /// tests hold them equal).
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let v = geometry::unit(wo)?;
         if v.z <= 0.0 {
