@@ -74,7 +74,7 @@ pub struct BakeSettings {
     #[cfg_attr(feature = "clap", arg(long))]
     pub target_error: Option<ErrorTarget>,
     /// Pin the table's directional albedo to the source's (default true; tables of measured
-    /// sources that store f_r cos θo).
+    /// sources that store f_r cos θo, and adaptive tables of models).
     #[cfg_attr(feature = "clap", arg(long))]
     pub calibrate: Option<bool>,
     /// Replace an existing table of that name (database outputs).

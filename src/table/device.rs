@@ -203,7 +203,7 @@ impl DeviceLayout {
                 None => return,
                 Some((v, cos)) if v.iter().zip(&k.axes).all(|(v, a)| *v < a.cut) => {
                     k.blend(v, out);
-                    if self.quantity != Quantity::Fr {
+                    if self.quantity != Quantity::Fr || self.calibration.is_some() {
                         project_f32(self.quantity, self.calibration.as_ref(), cos, out);
                     }
                     return;
@@ -214,7 +214,7 @@ impl DeviceLayout {
         }
         if let Some(g) = &self.grid {
             g.eval(wi, wo, out);
-            if self.quantity != Quantity::Fr {
+            if self.quantity != Quantity::Fr || self.calibration.is_some() {
                 project_out(self.quantity, self.calibration.as_ref(), wi, wo, out);
             }
         }

@@ -220,11 +220,16 @@ fn kernel_layouts_evaluate_as_the_table() {
                 .grid
                 .is_none()
         );
-        if quantity == Quantity::FrCosOut {
-            // Calibrated: k_in and k_out on 9 nodes.
+        {
+            // Calibrated: k_in and k_out on 9 nodes (the same factors where the table folds
+            // by reciprocity), on every quantity.
             let n = 9 * channels.len();
             let f: Vec<f32> = (0..n).map(|i| 0.9 + 0.02 * (i % 11) as f32).collect();
-            let o: Vec<f32> = f.iter().rev().copied().collect();
+            let o: Vec<f32> = if s.reciprocal {
+                f.clone()
+            } else {
+                f.iter().rev().copied().collect()
+            };
             let cal = Calibration::new(f, Some(o), channels.len(), 0.95).unwrap();
             let (g, v, _) = t.into_parts();
             let t = Table::new(g.with_calibration(cal).unwrap(), v, "calibrated").unwrap();

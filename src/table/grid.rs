@@ -773,12 +773,6 @@ impl Grid {
                 "f_r cos θo is not reciprocal: a grid storing it cannot fold by reciprocity",
             ));
         }
-        if quantity == Quantity::Fr && self.calibration.is_some() {
-            return Err(Error::arg(
-                "quantity",
-                "an albedo calibration belongs to a table of a projected quantity",
-            ));
-        }
         self.quantity = quantity;
         Ok(self)
     }
@@ -786,15 +780,16 @@ impl Grid {
     pub fn calibration(&self) -> Option<&Calibration> {
         self.calibration.as_ref()
     }
-    /// The same grid with lookups multiplied by `calibration`'s k(θi). Only for a grid storing a
-    /// projected quantity (not f_r, so not folded by reciprocity, which a factor of θi alone
-    /// would break), with one factor per channel.
+    /// The same grid with lookups multiplied by `calibration`'s k_in(θi) k_out(θo), one factor
+    /// per channel. A grid folded by reciprocity takes only a symmetric calibration (k_out =
+    /// k_in, [`Calibration::is_symmetric`]): other factors would break the reciprocity its
+    /// fold assumes.
     pub fn with_calibration(mut self, calibration: Calibration) -> Result<Grid> {
-        if self.quantity == Quantity::Fr || self.symmetry.reciprocal {
+        if self.symmetry.reciprocal && !calibration.is_symmetric() {
             return Err(Error::arg(
                 "calibration",
-                "an albedo calibration needs a table of a projected quantity, not folded by \
-                 reciprocity",
+                "a table folded by reciprocity takes only a symmetric albedo calibration \
+                 (k_out = k_in)",
             ));
         }
         if calibration.channels() != self.channels.len() {

@@ -621,13 +621,13 @@ impl Kernel {
         }
         #[cfg(not(target_arch = "x86_64"))]
         self.blend::<0>(v, out, values);
+        let out = &mut out[..self.channels];
         if self.quantity != Quantity::Fr {
             // In f32, as the RGB lookup does (one rule for every channel count).
-            let out = &mut out[..self.channels];
             project_f32_lanes(self.quantity, None, cos, out);
-            if let (Some(c), Some(cells)) = (&self.calibration, cells) {
-                c.apply_lanes_cells(cells, out);
-            }
+        }
+        if let (Some(c), Some(cells)) = (&self.calibration, cells) {
+            c.apply_lanes_cells(cells, out);
         }
         true
     }
@@ -888,8 +888,8 @@ pub const MIN_COS_PRODUCT: f32 = 1e-30;
 
 /// f_r from an interpolated `quantity`: `out` divided by the quantity's factor for the pair
 /// (unit vectors made here) and clamped at 0 (extrapolated nodes beyond the horizon may pull
-/// the blend below 0), then multiplied by the `calibration`'s k(θi) if there is one; 0 for
-/// pairs below the horizon.
+/// the blend below 0; f_r itself is left as it is), then multiplied by the `calibration`'s
+/// k_in(θi) k_out(θo) if there is one; 0 for pairs below the horizon.
 pub fn project_out(
     quantity: Quantity,
     calibration: Option<&Calibration>,
@@ -899,9 +899,11 @@ pub fn project_out(
 ) {
     match geometry::upper_pair(wi, wo) {
         Some((wi, wo)) => {
-            let s = 1.0 / quantity.factor(wi.z, wo.z).max(MIN_COS_PRODUCT as f64);
-            for x in out.iter_mut() {
-                *x = ((*x as f64 * s) as f32).max(0.0);
+            if quantity != Quantity::Fr {
+                let s = 1.0 / quantity.factor(wi.z, wo.z).max(MIN_COS_PRODUCT as f64);
+                for x in out.iter_mut() {
+                    *x = ((*x as f64 * s) as f32).max(0.0);
+                }
             }
             if let Some(c) = calibration {
                 c.apply(wi.z as f32, wo.z as f32, out);
@@ -956,8 +958,8 @@ pub(crate) fn warp_vars(
     Some(([vh, vd, vp], [iz, oz]))
 }
 
-/// The kernel's projection of an interpolated `quantity` (other than f_r) at unit directions
-/// with z = `cos_i`, `cos_o`, in f32: times 1/max(factor, [`MIN_COS_PRODUCT`]), clamped at 0,
+/// The kernel's projection of an interpolated `quantity` at unit directions with z = `cos_i`,
+/// `cos_o`, in f32: other than f_r, times 1/max(factor, [`MIN_COS_PRODUCT`]) and clamped at 0;
 /// then times the `calibration`'s k_in(θi) k_out(θo) — what [`Kernel::eval`] does for every
 /// channel count (the RGB path in lanes), and what `super::device` states for devices.
 pub(crate) fn project_f32(
@@ -966,9 +968,11 @@ pub(crate) fn project_f32(
     [cos_i, cos_o]: [f32; 2],
     out: &mut [f32],
 ) {
-    let inv = inverse_factor(quantity, [cos_i, cos_o]);
-    for x in out.iter_mut() {
-        *x = (*x * inv).max(0.0);
+    if quantity != Quantity::Fr {
+        let inv = inverse_factor(quantity, [cos_i, cos_o]);
+        for x in out.iter_mut() {
+            *x = (*x * inv).max(0.0);
+        }
     }
     if let Some(c) = calibration {
         c.apply(cos_i, cos_o, out);
@@ -993,16 +997,18 @@ pub(crate) fn project_f32_lanes(
     [cos_i, cos_o]: [f32; 2],
     out: &mut [f32],
 ) {
-    let inv = inverse_factor(quantity, [cos_i, cos_o]);
-    let (iv, zero) = (F4::splat(inv), F4::splat(0.0));
-    let mut chunks = out.chunks_exact_mut(4);
-    for x4 in &mut chunks {
-        if let Some(x) = F4::load(x4) {
-            x4.copy_from_slice(&(x * iv).max(zero).to_array());
+    if quantity != Quantity::Fr {
+        let inv = inverse_factor(quantity, [cos_i, cos_o]);
+        let (iv, zero) = (F4::splat(inv), F4::splat(0.0));
+        let mut chunks = out.chunks_exact_mut(4);
+        for x4 in &mut chunks {
+            if let Some(x) = F4::load(x4) {
+                x4.copy_from_slice(&(x * iv).max(zero).to_array());
+            }
         }
-    }
-    for x in chunks.into_remainder() {
-        *x = (*x * inv).max(0.0);
+        for x in chunks.into_remainder() {
+            *x = (*x * inv).max(0.0);
+        }
     }
     if let Some(c) = calibration {
         c.apply_lanes(cos_i, cos_o, out);
@@ -1278,15 +1284,20 @@ mod tests {
             for (reciprocal, quantity, h_var) in TEST_CASES {
                 let (t, k) = test_table(src.as_ref(), (reciprocal, quantity, h_var));
                 let (packed, exact) = (Packed::new(t.values()), Packed::exact(t.values()));
-                // The same table calibrated, where a table may be: its `eval` (the lanes, the
-                // projection, the calibration found before the blend) against the plain steps.
-                let calibrated = (quantity != Quantity::Fr && !reciprocal).then(|| {
+                // The same table calibrated (symmetric factors where it folds by reciprocity):
+                // its `eval` (the lanes, the projection, the calibration found before the
+                // blend) against the plain steps.
+                let calibrated = {
                     let k_in: Vec<f32> = (0..17 * nch).map(|i| 0.9 + 0.001 * i as f32).collect();
-                    let k_out: Vec<f32> = (0..17 * nch).map(|i| 1.2 - 0.002 * i as f32).collect();
+                    let k_out: Vec<f32> = if reciprocal {
+                        k_in.clone()
+                    } else {
+                        (0..17 * nch).map(|i| 1.2 - 0.002 * i as f32).collect()
+                    };
                     let cal = Calibration::new(k_in, Some(k_out), nch, 0.99).unwrap();
                     let g = t.grid().clone().with_calibration(cal.clone()).unwrap();
-                    (Kernel::new(&g).expect("a kernel"), cal)
-                });
+                    Some((Kernel::new(&g).expect("a kernel"), cal))
+                };
                 let mut r = Pcg32::new(7 + nch as u64);
                 let (mut a, mut b) = (vec![0f32; nch], vec![0f32; nch]);
                 for _ in 0..20_000 {

@@ -88,6 +88,9 @@ pub struct TabulatedBrdf {
     /// The values are not f_r ([`Quantity`]): general lookups divide by the quantity's factor
     /// (the kernel does so itself).
     project: bool,
+    /// The values are not f_r or the grid has an albedo calibration: general lookups finish
+    /// with [`project_out`].
+    finish: bool,
     description: String,
     error: Mutex<Option<Error>>,
     /// Importance sampling distributions, built on first `sample`/`pdf` (see [`super::sampling`]).
@@ -113,6 +116,7 @@ impl TabulatedBrdf {
         let l = grid.layout();
         let kernel = Kernel::new(&grid);
         let project = grid.quantity() != Quantity::Fr;
+        let grid_calibrated = grid.calibration().is_some();
         let mut unmeasured = Vec::with_capacity(l.chunk_count());
         let mut chunks = Vec::with_capacity(l.chunk_count());
         for i in 0..l.chunk_count() {
@@ -138,6 +142,7 @@ impl TabulatedBrdf {
             loader: None,
             interp: Interp::Linear,
             project,
+            finish: project || grid_calibrated,
             description,
             error: Mutex::new(None),
             failed: AtomicBool::new(false),
@@ -158,6 +163,7 @@ impl TabulatedBrdf {
             .map(|_| OnceLock::new())
             .collect();
         let project = grid.quantity() != Quantity::Fr;
+        let grid_calibrated = grid.calibration().is_some();
         TabulatedBrdf {
             lookup: Lookup::new(&grid),
             kernel: Kernel::new(&grid),
@@ -168,6 +174,7 @@ impl TabulatedBrdf {
             loader: Some(loader),
             interp: Interp::Linear,
             project,
+            finish: project || grid_calibrated,
             description: description.into(),
             error: Mutex::new(None),
             failed: AtomicBool::new(false),
@@ -225,7 +232,7 @@ impl TabulatedBrdf {
             for (k, oc) in og.chunks_exact_mut(c).enumerate() {
                 if !prep[k].gather(c, oc) {
                     self.eval(wi[s + k], wo[s + k], oc);
-                } else if self.project {
+                } else if self.finish {
                     project_out(
                         self.grid.quantity(),
                         self.grid.calibration(),
@@ -507,7 +514,7 @@ impl Brdf for TabulatedBrdf {
         // Not a kernel table, a nearest lookup, or a pair beyond a resampled axis's cut.
         self.lookup
             .eval(self.interp, wi, wo, out, |a| self.chunk(a));
-        if self.project {
+        if self.finish {
             project_out(
                 self.grid.quantity(),
                 self.grid.calibration(),
@@ -634,7 +641,7 @@ impl BakeSource for TabulatedBrdf {
     fn stored_node(&self, hd: HalfDiff, out: &mut [f32]) -> bool {
         let c = self.lookup.channels();
         // A stored quantity other than f_r: such nodes are evaluated, not copied.
-        if self.grid.param() != Param::HalfDiff || out.len() < c || self.project {
+        if self.grid.param() != Param::HalfDiff || out.len() < c || self.finish {
             return false;
         }
         let x = crate::table::symmetry::canonical_half_diff(self.grid.symmetry(), hd);
