@@ -131,6 +131,11 @@ CASES = [
                                             symmetry="isotropic,reciprocal,bilateral")),
     # MERL-style fixed mappings on a small grid: the kernel's resampled axes, the grid beyond
     ('{"model": "ggx", "alpha": 0.3}', dict(grid="16x1x16x32", param="halfdiff")),
+    # adaptive tables of models, calibrated with one symmetric factor: f_r (the plugin's
+    # default for GGX) and f_r cos θi cos θo (Cook-Torrance, unbounded at the horizon)
+    ('{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}', dict(target_error=0.004)),
+    ('{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}',
+     dict(target_error=0.01)),
 ]
 
 
@@ -173,6 +178,38 @@ def test_jit_lookup_matches_rust(case, interp, tmp_path, rgl):
         # a nearest lookup exactly on a cell boundary may round to the other cell
         assert np.mean(rel > 1e-6) < 1e-4, rel.max()
     assert np.all(got[::97] == 0)
+
+
+def test_jit_tables_of_isotropic_models_are_adaptive_and_calibrated(tmp_path):
+    """The JIT variants bake an isotropic model to MODEL_TARGET_ERROR (calibrated: its albedo
+    pinned with one symmetric factor), an anisotropic one on the medium preset; the plugin's
+    lookups are the library's table of that request."""
+    use("llvm_ad_rgb")
+    from brdftab.mitsuba import MODEL_TARGET_ERROR
+
+    wi, wo = random_dirs(4000, 11, 0.02), random_dirs(4000, 12, 0.02)
+    wi, wo = wi.astype(np.float32).astype(np.float64), wo.astype(np.float32).astype(np.float64)
+    ggx = '{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}'
+    ward = '{"model": "ward", "alpha_x": 0.2, "alpha_y": 0.4, "ks": 0.5}'
+    for src, opts, calibrated in ((ggx, dict(target_error=MODEL_TARGET_ERROR), True),
+                                  (ward, dict(preset="medium"), False)):
+        d = mi.load_dict({"type": "brdftab", "source": src, "cache_dir": str(tmp_path)})
+        assert (d.table.calibration is not None) == calibrated
+        out = str(tmp_path / "t.btdb")
+        brdftab.bake(src, out, codec="f32", **opts)
+        t = brdftab.open(out)
+        want = t.eval(wi, wo)
+        got = np.stack([np.array(x) for x in d.table.lookup(mi.Vector3f(*wi.T),
+                                                            mi.Vector3f(*wo.T))], -1)
+        np.testing.assert_allclose(got, want, rtol=1e-5, atol=1e-6 * np.abs(want).max())
+        # f_r is reciprocal through the calibration too
+        back = np.stack([np.array(x) for x in d.table.lookup(mi.Vector3f(*wo.T),
+                                                             mi.Vector3f(*wi.T))], -1)
+        np.testing.assert_allclose(back, got, rtol=1e-5, atol=1e-6 * np.abs(want).max())
+        if calibrated:  # a small table: 288 k values against the medium preset's 4.4 M
+            assert t.table().values.size < 1_000_000
+            # its f16 codes read four to a word (the bit-equal lookups above)
+            assert d.table.kernel["packed"] is not None
 
 
 def test_jit_table_refuses_unknown_layouts():

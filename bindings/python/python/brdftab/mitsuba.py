@@ -8,8 +8,10 @@
 Properties: ``source`` (string, any SOURCE: spec, table, ``DB#NAME``, MERL, RGL), optional
 ``interp`` (``"auto"``, the default: nearest on tables of MERL cells as every host of the
 library reads them, linear otherwise; or ``"linear"`` or ``"nearest"``), and for JIT variants optional ``preset`` / ``grid``
-(the table a non-table source is baked on, default ``medium``; RGL files: the library's
-adaptive grid, MERL files: their own cells), ``sampling_res`` (the
+(the table a non-table source is baked on; default: for an isotropic model the smallest
+adaptive grid within :data:`MODEL_TARGET_ERROR`, calibrated to the model's albedo, for other
+models ``medium``; RGL files: the library's adaptive grid, MERL files: their own cells),
+``sampling_res`` (the
 resolution of the sampling distributions: half-vector nodes per axis, default 64, 48 for
 anisotropic tables), ``cache`` (bool, default
 true: baked tables are kept in the cache of baked tables, :func:`brdftab.bake_cached`, so a
@@ -43,6 +45,13 @@ import brdftab
 from brdftab._halfwarp import HalfVectorSampler
 
 _REGISTERED = set()
+
+#: The error target of the JIT variants' tables of isotropic models (relative RMSE of
+#: f_r cos θi cos θo, ``brdftab.bake``'s ``target_error``). The medium preset (4.4 M values,
+#: 17.7 MB in float32) made a render's table lookups miss the CPU caches: GGX copper α = 0.1
+#: at this target is 288 k values with the same albedo and within-80° figures, and renders at
+#: 1.25× the speed (BENCHMARKS.md, "Model tables sized for a renderer").
+MODEL_TARGET_ERROR = 0.002
 
 
 def register():
@@ -255,6 +264,40 @@ def _fast_atan2(y, x):
     return dr.select(y < 0, -r, r)
 
 
+def _packed_codes(values, channels):
+    """A kernel table's values as f16 codes in 64-bit words, one word per node (channels
+    padded to four), when they are f16 values scaled by one power of two — the kernel's
+    ``Packed`` (table/kernel.rs) of adaptive tables — and have at most four channels; else None.
+
+    Returns (words, scale): a lookup gathers node n's word, moves each code's bits into a
+    float32's (sign to bit 31, exponent and mantissa shifted by 13: the code's value times
+    2⁻¹¹², exact for every finite code, subnormal ones included) and multiplies by ``scale`` =
+    2¹¹² × the table's power of two, also exact: the values the lookup blends are bit for bit the
+    float32 values of the layout. Why: gathers of float32 channels (3 per node, 24 per lookup)
+    and their 12 bytes per node were most of a lookup's time in a render (BENCHMARKS.md).
+    """
+    import drjit as dr
+    import mitsuba as mi
+
+    if channels > 4 or values.size == 0 or not np.all(np.isfinite(values)):
+        return None
+    top = float(np.abs(values).max())
+    if top == 0.0:
+        return None
+    e0 = int(np.floor(np.log2(65504.0 / top)))
+    for e in (e0, e0 - 1, e0 + 1, e0 - 2):
+        scaled = values * np.float32(2.0**e)
+        if not np.all(np.abs(scaled) <= 65504.0):
+            continue
+        codes = scaled.astype(np.float16)
+        if np.array_equal(codes.astype(np.float32), scaled):
+            four = np.zeros((values.size // channels, 4), np.uint16)
+            four[:, :channels] = codes.view(np.uint16).reshape(-1, channels)
+            words = dr.uint64_array_t(mi.Float)(four.reshape(-1).view(np.uint64))
+            return words, float(2.0 ** (112 - e))
+    return None
+
+
 def _unit(v, keep_unit):
     """geometry.rs ``normalize`` (v / |v|, component by component) or, with ``keep_unit``,
     ``unit`` (v as is when |v|² is 1 within 2^-40); float64 components and the validity mask
@@ -327,8 +370,14 @@ class JitTable:
                 (mi.Float(np.asarray(a["c"], np.float32)), mi.Float(np.asarray(a["d"], np.float32)),
                  len(a["c"]), int(a["nodes"]), float(a["cut"]))
                 for a in k["axes"]]
-            self.kernel["values"] = mi.Float(np.ascontiguousarray(k["values"], np.float32))
-            dr.eval(self.kernel["values"])
+            values = np.ascontiguousarray(k["values"], np.float32)
+            self.kernel["values"] = mi.Float(values)
+            # The f16 codes of an adaptive table, four to a 64-bit word (module docs of
+            # _packed_codes): one gather per corner node instead of one per channel.
+            self.kernel["packed"] = _packed_codes(values, self.c)
+            if self.kernel["packed"] is not None:
+                self.kernel["values"] = None
+            dr.eval()
         self.grid = None
         g = layout.get("grid")
         if g is not None:
@@ -604,21 +653,23 @@ class JitTable:
                             base = (row + q) * c
                             for k in range(c):
                                 out[k] = out[k] + wt * dr.gather(Fl, self.values, base + k, valid)
-        if self.quantity != "fr":
+        if self.quantity != "fr" or self.calibration is not None:
             out = self._project(wi, wo, out)
         return [dr.select(valid, o, 0.0) for o in out]
 
     def _project(self, wi, wo, out):
-        """f_r from an interpolated quantity (kernel.rs, ``project_out``): divided by cos θo
-        or cos θi cos θo of the unit directions (at least 1e-30) in float64, clamped at 0."""
+        """f_r from an interpolated quantity (kernel.rs, ``project_out``): other than f_r,
+        divided by cos θo or cos θi cos θo of the unit directions (at least 1e-30) in float64,
+        clamped at 0; then the calibration."""
         import drjit as dr
 
         F64 = self.Float64
         iz = _unit([F64(wi.x), F64(wi.y), F64(wi.z)], False)[0][2]
         oz = _unit([F64(wo.x), F64(wo.y), F64(wo.z)], False)[0][2]
-        f = oz if self.quantity == "fr_cos_out" else iz * oz
-        s = 1.0 / dr.maximum(f, 1e-30)
-        out = [dr.maximum(type(o)(F64(o) * s), 0.0) for o in out]
+        if self.quantity != "fr":
+            f = oz if self.quantity == "fr_cos_out" else iz * oz
+            s = 1.0 / dr.maximum(f, 1e-30)
+            out = [dr.maximum(type(o)(F64(o) * s), 0.0) for o in out]
         Fl = type(out[0])
         return self._calibrate(Fl(iz), Fl(oz), out)
 
@@ -657,9 +708,11 @@ class JitTable:
         ``project_f32``). Returns (values, inside every cut, valid)."""
         import drjit as dr
 
+        import mitsuba as mi
+
         F64, U = self.Float64, self.UInt
         kv = self.kernel["values"]
-        Fl = type(kv)
+        Fl = mi.Float
         (ix, iy, iz), ok_i = _unit([F64(wi.x), F64(wi.y), F64(wi.z)], True)
         (ox, oy, oz), ok_o = _unit([F64(wo.x), F64(wo.y), F64(wo.z)], True)
         ix, iy, iz, ox, oy, oz = (Fl(x) for x in (ix, iy, iz, ox, oy, oz))
@@ -695,24 +748,38 @@ class JitTable:
             nodes.append((U(i), sv - i))
         (ih, th), (id_, td), (ip, tp) = nodes
         c = self.c
-        row = self.kernel["axes"][2][3] * c
-        chunk = self.kernel["axes"][1][3] * row
-        o = ih * chunk + id_ * row + ip * c
+        nodes_row = self.kernel["axes"][2][3]
+        nodes_chunk = self.kernel["axes"][1][3] * nodes_row
+        node = ih * nodes_chunk + id_ * nodes_row + ip
         oh, od, op = 1.0 - th, 1.0 - td, 1.0 - tp
-        rows = [(o, oh * od), (o + row, oh * td), (o + chunk, th * od), (o + chunk + row, th * td)]
+        rows = [(node, oh * od), (node + nodes_row, oh * td), (node + nodes_chunk, th * od),
+                (node + nodes_chunk + nodes_row, th * td)]
         out = [Fl(0.0) for _ in range(c)]
         ok = valid & inside
+        packed = self.kernel["packed"]
+        if packed is not None:
+            words, scale = packed
+            W = type(words)
+
+            def corner(n):
+                q = dr.gather(W, words, n, ok)
+                lo, hi = U(q & 0xFFFFFFFF), U(q >> 32)
+                codes = [lo & 0xFFFF, lo >> 16, hi & 0xFFFF, hi >> 16][:c]
+                return [dr.reinterpret_array(Fl, ((h & 0x7FFF) << 13) | ((h & 0x8000) << 16))
+                        * scale for h in codes]
+        else:
+            def corner(n):
+                return [dr.gather(Fl, kv, n * c + ch, ok) for ch in range(c)]
         for r, w in rows:
             w0, w1 = w * op, w * tp
+            x0, x1 = corner(r), corner(r + 1)
             for ch in range(c):
-                x0 = dr.gather(Fl, kv, r + ch, ok)
-                x1 = dr.gather(Fl, kv, r + c + ch, ok)
-                out[ch] = out[ch] + (w0 * x0 + w1 * x1)
+                out[ch] = out[ch] + (w0 * x0[ch] + w1 * x1[ch])
         if self.quantity != "fr":
             cc = oz if self.quantity == "fr_cos_out" else iz * oz
             inv = 1.0 / dr.maximum(cc, 1e-30)
             out = [dr.maximum(x * inv, 0.0) for x in out]
-            out = self._calibrate(iz, oz, out)
+        out = self._calibrate(iz, oz, out)
         return out, inside, valid
 
 
@@ -779,9 +846,17 @@ class JitBrdftabBSDF(_Common):
         self._sampled = self.brdf
         if brdftab_kind(self.source) == "table" and not options:
             return self._layout(self.brdf)
-        # MERL files keep their own cells, RGL files get the library's adaptive grid.
+        # MERL files keep their own cells, RGL files get the library's adaptive grid. Other
+        # sources: given a preset or grid, that; else an isotropic bilateral source (every
+        # isotropic model) the smallest adaptive grid within MODEL_TARGET_ERROR, calibrated to
+        # its albedo, and any other source the medium preset.
         if brdftab_kind(self.source) not in ("merl", "rgl"):
-            options.setdefault("preset", "medium")
+            flags = self.brdf.flags
+            if ("preset" in options or "grid" in options
+                    or not (flags["isotropic"] and flags["bilateral"])):
+                options.setdefault("preset", "medium")
+            else:
+                options.setdefault("target_error", MODEL_TARGET_ERROR)
         if options.get("preset") and options.get("grid"):
             options.pop("preset")
         if self.cache:

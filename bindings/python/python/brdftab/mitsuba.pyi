@@ -6,6 +6,7 @@ def register() -> None:
 def plugin_class() -> type: ...
 
 LAYOUT_VERSION: int
+MODEL_TARGET_ERROR: float
 
 class JitTable:
     """A brdftab table evaluated in Dr.Jit operations: an implementation of the library's
