@@ -898,8 +898,13 @@ impl Grid {
         } + &match &self.calibration {
             Some(c) => {
                 let (lo, hi) = c.range();
+                let kind = if c.is_symmetric() {
+                    "k(θi) k(θo), symmetric"
+                } else {
+                    "k_in(θi) k_out(θo)"
+                };
                 format!(
-                    ", albedo calibrated over θi ({} nodes, factors {lo:.3}–{hi:.3})",
+                    ", albedo calibrated ({kind}, {} nodes, factors {lo:.3}–{hi:.3})",
                     c.nodes()
                 )
             }
