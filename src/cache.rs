@@ -5,7 +5,8 @@
 //! 0.7–1.1 s per RGL file. [`bake_cached`] bakes once per (source content, bake settings,
 //! library version) and returns the file of the table; later loads open that file.
 //!
-//! - The key is an xxh3-128 of the library's version, the source's kind and content (the bytes
+//! - The key is an xxh3-128 of a tag of the bake's rules (changed when the same settings give
+//!   another table), the library's version, the source's kind and content (the bytes
 //!   of a file or database, the text of an inline spec) and the settings as JSON (`replace`
 //!   and `name` left out: they do not change the table). Editing a file in place changes its
 //!   key; a model spec is keyed by its text.
@@ -79,7 +80,9 @@ pub fn key(source: &str, settings: &BakeSettings) -> Result<String> {
         h.update(&(b.len() as u64).to_le_bytes());
         h.update(b);
     };
-    part(b"brdftab bake cache 1");
+    // The tag names what a bake of given settings makes: it changes with that, so tables of
+    // an older rule are not served (2: adaptive tables of models calibrated, session 20).
+    part(b"brdftab bake cache 2");
     part(env!("CARGO_PKG_VERSION").as_bytes());
     let kind = source::classify(source);
     part(kind.name().as_bytes());
