@@ -448,9 +448,7 @@ impl AlbedoReference {
             opts: opts.clone(),
         })
     }
-}
 
-impl AlbedoReference {
     /// The albedo a factor k(θ) of both directions is fitted to (a reciprocal table's): the
     /// mean of the light's and the viewer's, equal for a reciprocal source up to quadrature.
     fn mean_albedo(&self) -> Vec<f64> {

@@ -49,8 +49,8 @@ _REGISTERED = set()
 #: The error target of the JIT variants' tables of isotropic models (relative RMSE of
 #: f_r cos θi cos θo, ``brdftab.bake``'s ``target_error``). The medium preset (4.4 M values,
 #: 17.7 MB in float32) made a render's table lookups miss the CPU caches: GGX copper α = 0.1
-#: at this target is 288 k values with the same albedo and within-80° figures, and renders at
-#: 1.25× the speed (BENCHMARKS.md, "Model tables sized for a renderer").
+#: at this target is 288 k values with the same albedo and within-80° figures, and renders
+#: 1.2–1.35× as fast (BENCHMARKS.md, "Model tables sized for a renderer").
 MODEL_TARGET_ERROR = 0.002
 
 
@@ -707,7 +707,6 @@ class JitTable:
         """KernelLayout::vars and ::blend, then the projection in float32 (kernel.rs
         ``project_f32``). Returns (values, inside every cut, valid)."""
         import drjit as dr
-
         import mitsuba as mi
 
         F64, U = self.Float64, self.UInt
