@@ -13,6 +13,7 @@ use brdftab::table::Quantity;
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut quantity = None;
     let mut pairs = 100_000;
+    let mut target: Option<f64> = None;
     let mut specs = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -22,6 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 quantity = Some(Quantity::from_name(&q).ok_or(format!("unknown quantity {q}"))?);
             }
             "--pairs" => pairs = args.next().and_then(|s| s.parse().ok()).unwrap_or(pairs),
+            "--target" => target = args.next().and_then(|s| s.parse().ok()),
             _ => specs.push(a),
         }
     }
@@ -37,6 +39,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut req = BakeRequest::new(s.as_str());
         if let Some(q) = quantity {
             req = req.quantity(q);
+        }
+        if let Some(e) = target {
+            req = req.target_error(e);
         }
         let src = req.open_source()?;
         let (table, _) = req.table(&brdftab::progress::Silent)?;
