@@ -3,8 +3,9 @@
 //! the worst directional albedo over θ′ = 1–89°, each table against its source, with the stored
 //! quantity and the table's bytes.
 //!
-//! `cargo run --release --example model_fidelity -- [--quantity fr|fr_cos_cos] SPEC...`
-//! (`--quantity` bakes that quantity instead of the default; `--pairs N` random pairs.)
+//! `cargo run --release --example model_fidelity -- [--quantity fr|fr_cos_cos] [--target E] SPEC...`
+//! (`--quantity` bakes that quantity instead of the default; `--target E` the smallest adaptive
+//! table within error E, calibrated, instead of the default preset; `--pairs N` random pairs.)
 
 use brdftab::analysis::fidelity::{self, FidelityOptions};
 use brdftab::bake::BakeRequest;
