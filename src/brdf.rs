@@ -246,12 +246,14 @@ pub trait Brdf: Send + Sync {
     /// Draws an incident direction `wi` for the outgoing direction `wo` from two uniform numbers
     /// `u` in [0,1)², writing the per-channel weight f_r·cos θi / pdf (for delta samples the
     /// lobe's reflectance) into `weight`. Returns `None` when no direction can be drawn (e.g. `wo`
-    /// below the horizon, total internal reflection) — the weight is then unspecified.
+    /// below the horizon, total internal reflection) and for a non-finite `u` (as
+    /// [`Brdf::sample_batch`] does, whether or not the sampler uses `u`) — the weight is then
+    /// unspecified.
     ///
     /// The default draws cosine-weighted directions; models override with importance sampling.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 {
+        if wo.z <= 0.0 || !u.is_finite() {
             return None;
         }
         let wi = geometry::cosine_hemisphere(u);

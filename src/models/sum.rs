@@ -588,6 +588,9 @@ impl Brdf for Sum {
     }
 
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
+        if !u.is_finite() {
+            return None;
+        }
         if let ([a, b], 3) = (self.terms.as_slice(), self.channels.len()) {
             return self.sample_pair_rgb([a.as_ref(), b.as_ref()], wo, u, weight);
         }

@@ -313,7 +313,8 @@ fn batches(brdf: &dyn Brdf, opts: &Contract, pairs: &[(DVec3, DVec3)], log: &mut
     }
 }
 
-/// Below the horizon, NaN, infinite and zero directions: f = 0, pdf = 0, no sample.
+/// Below the horizon, NaN, infinite and zero directions: f = 0, pdf = 0, no sample; no sample
+/// for a non-finite `u` either.
 fn bad_input<B: Brdf + ?Sized>(brdf: &B, log: &mut Log) {
     let c = brdf.channels().len();
     let up = DVec3::new(0.2, 0.1, 1.0);
@@ -347,6 +348,19 @@ fn bad_input<B: Brdf + ?Sized>(brdf: &B, log: &mut Log) {
         let mut w = [0.0f32; MAX_CHANNELS];
         if let Some(s) = brdf.sample(b, DVec2::new(0.3, 0.6), &mut w[..c]) {
             log.fail("horizon", || format!("sample(wo = {b}) gave {s:?}"));
+        }
+    }
+    // A non-finite u has no sample, as in `sample_batch` (a sampler that ignores u included).
+    for u in [
+        DVec2::new(f64::NAN, 0.6),
+        DVec2::new(0.3, f64::NAN),
+        DVec2::new(f64::INFINITY, 0.6),
+    ] {
+        let mut w = [0.0f32; MAX_CHANNELS];
+        if let Some(s) = brdf.sample(up, u, &mut w[..c]) {
+            log.fail("horizon", || {
+                format!("sample(wo = {up}, u = {u}) gave {s:?}")
+            });
         }
     }
 }
@@ -505,7 +519,7 @@ mod tests {
         }
         fn sample(&self, wo: DVec3, u: DVec2, w: &mut [f32]) -> Option<BrdfSample> {
             let o = geometry::unit(wo)?;
-            if o.z <= 0.0 {
+            if o.z <= 0.0 || !u.is_finite() {
                 return None;
             }
             let wi = geometry::cosine_hemisphere(u);
