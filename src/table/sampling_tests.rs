@@ -223,6 +223,35 @@ fn weight_is_f_cos_over_pdf_and_pdf_matches_the_sampler() {
     }
 }
 
+/// At the mirror direction of wo (half vector on the normal) the density is its finite limit,
+/// not 0/0 read as 0: `pdf` there is positive and equals the density of the draws from the
+/// square's edge s = 0, which land on that direction.
+#[test]
+fn pdf_at_the_mirror_direction_is_the_samplers_density() {
+    let all: [&dyn Brdf; 3] = [cook_torrance(), rgl_native(), merl_native()];
+    for b in all {
+        for wo in [DVec3::Z, geometry::spherical(0.4, 0.7)] {
+            let mirror = DVec3::new(-wo.x, -wo.y, wo.z);
+            let p = b.pdf(mirror, wo);
+            assert!(p > 0.0 && p.is_finite(), "{}: pdf = {p}", b.describe());
+            for ux in [0.0, 1e-300, 1e-100] {
+                let mut w = [0.0f32; MAX_CHANNELS];
+                let c = b.channels().len();
+                let Some(s) = b.sample(wo, glam::DVec2::new(ux, 0.25), &mut w[..c]) else {
+                    continue;
+                };
+                let q = b.pdf(s.wi, wo);
+                assert!(
+                    (s.pdf - q).abs() <= 1e-7 * q,
+                    "{}: wo {wo}, u.x {ux}: sample's pdf {} vs pdf() {q}",
+                    b.describe(),
+                    s.pdf
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn invalid_inputs_give_no_sample_and_zero_pdf() {
     crate::models::test_util::check_invalid_inputs_give_zero(phong());
