@@ -48,6 +48,13 @@ fn ser_pair<S: serde::Serializer>(
 
 const BLOCK: usize = 4096;
 
+/// The most pair × channel samples one comparison takes (2^24: about 1 GiB of kept samples,
+/// 64 bytes each — the maximum relative error is found once every sample's floor is known).
+/// The default 200 000 pairs fit with every channel count the library allows (64); a larger
+/// count is an [`Error::InvalidArgument`] naming `pairs`, never an allocation that aborts the
+/// process (`convert --pairs 1e18` through any host).
+pub const MAX_SAMPLES: usize = 1 << 24;
+
 /// Compares `approx` against `reference` over `pairs` random pairs with seed `seed`.
 pub fn compare(
     approx: &dyn Brdf,
@@ -173,6 +180,16 @@ pub fn compare_region(
             format!("{} vs {} channels", approx.channels().len(), c),
         ));
     }
+    if pairs.checked_mul(c).is_none_or(|n| n > MAX_SAMPLES) {
+        return Err(Error::arg(
+            "pairs",
+            format!(
+                "{pairs} pairs × {c} channels: at most {MAX_SAMPLES} samples are compared \
+                 ({} pairs of {c} channels)",
+                MAX_SAMPLES / c.max(1)
+            ),
+        ));
+    }
     let blocks = pairs.div_ceil(BLOCK);
     // Per block: (Σ err² per channel, Σ ref² per channel, Σ f² unweighted, samples (|err|, |f|, wi, wo)).
     type Block = (Vec<f64>, Vec<f64>, f64, Vec<(f64, f64, DVec3, DVec3)>);
@@ -250,4 +267,32 @@ pub fn compare_region(
         max_rel_at: at,
         per_channel: (0..c).map(|k| ratio(e2[k], r2[k])).collect(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spec::ModelSpec;
+    use crate::spectrum::Channels;
+
+    #[test]
+    fn a_pair_count_beyond_the_bound_is_an_argument_error_not_an_abort() {
+        let rgb = Channels::Rgb;
+        let a = ModelSpec::parse(r#"{"model":"lambert","kd":0.5}"#)
+            .unwrap()
+            .build(&rgb)
+            .unwrap();
+        // 2^62 pairs asked for 2^62 × 3 × 64 bytes of samples: the allocation aborted.
+        for pairs in [1 << 62, usize::MAX, MAX_SAMPLES / 3 + 1] {
+            let e = compare(a.as_ref(), a.as_ref(), pairs, 1).unwrap_err();
+            assert!(
+                matches!(e, Error::InvalidArgument { ref name, .. } if name == "pairs"),
+                "{pairs}: {e}"
+            );
+        }
+        assert_eq!(
+            compare(a.as_ref(), a.as_ref(), 1000, 1).unwrap().rel_rmse,
+            0.0
+        );
+    }
 }

@@ -65,6 +65,12 @@ pub use params::{Bounds, ColorMode, Param, ParamRequest, Scale};
 /// Number of uniform pairs on which the final `rmse` is measured.
 pub const ACCURACY_PAIRS: usize = 20_000;
 
+/// The most residuals (pairs × channels) a fit takes: 2^22, a Jacobian of a few hundred MB
+/// for the models' parameter counts. The default 4000 pairs fit with every channel count
+/// the library allows (64); more is an [`Error::InvalidArgument`] naming `pairs`, never an
+/// allocation that aborts the process or overflows.
+pub const MAX_RESIDUALS: usize = 1 << 22;
+
 /// Options of a fit. `Default` gives 4000 pairs (30% specular), linear residuals, 8 starts,
 /// every parameter with default bounds, per-channel colours.
 #[derive(Debug, Clone, PartialEq)]
@@ -312,6 +318,18 @@ pub fn fit_with_progress(
     let clock = Instant::now();
     if opts.pairs == 0 {
         return Err(Error::arg("pairs", "at least one pair is needed"));
+    }
+    let c = source.channels().len();
+    if opts.pairs.checked_mul(c).is_none_or(|n| n > MAX_RESIDUALS) {
+        return Err(Error::arg(
+            "pairs",
+            format!(
+                "{} pairs × {c} channels: at most {MAX_RESIDUALS} residuals ({} pairs of {c} \
+                 channels)",
+                opts.pairs,
+                MAX_RESIDUALS / c.max(1)
+            ),
+        ));
     }
     if opts.starts == 0 {
         return Err(Error::arg("starts", "at least one start is needed"));
@@ -665,6 +683,20 @@ mod tests {
             pairs: 400,
             starts: 3,
             ..Default::default()
+        }
+    }
+
+    #[test]
+    fn a_pair_count_beyond_the_bound_is_an_argument_error_not_an_abort() {
+        // 10^10 pairs allocated 240 GB (an abort); usize::MAX overflowed (a panic).
+        let src = build(r#"{"model": "lambert", "kd": 0.5}"#);
+        for pairs in [10_000_000_000, usize::MAX, MAX_RESIDUALS / 3 + 1] {
+            let opts = FitOptions { pairs, ..quick() };
+            let e = fit(src.as_ref(), &preset("lambert").unwrap(), &opts).unwrap_err();
+            assert!(
+                matches!(e, Error::InvalidArgument { ref name, .. } if name == "pairs"),
+                "{pairs}: {e}"
+            );
         }
     }
 

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::bake::BakeSettings;
+use crate::analysis::accuracy::MAX_SAMPLES;
 use crate::bake::{self, BakeReport, BakeTarget, Converted};
 use crate::error::Result;
 use crate::measured::rgl_write;
@@ -77,6 +78,14 @@ pub fn convert(
 ) -> Result<ConvertOutput> {
     let mut req = settings.bake.request(source)?;
     let pairs = settings.pairs.unwrap_or(DEFAULT_PAIRS);
+    // Checked before the bake, not after it: the comparison's own check (per channel count)
+    // would refuse a count beyond this only once the table is written.
+    if pairs > MAX_SAMPLES {
+        return Err(crate::Error::arg(
+            "pairs",
+            format!("{pairs}: at most {MAX_SAMPLES} pairs (fewer with many channels)"),
+        ));
+    }
     match classify(output) {
         SourceKind::Merl => Ok(ConvertOutput::Merl(
             req.run_with(&BakeTarget::Merl(output.to_owned()), progress)?,

@@ -236,6 +236,10 @@ fn requests_with_json_settings_do_what_the_rust_request_layer_does() {
         ("error bad-value:", "supersample"),
         ("error fit-unknown:", "strats"),
         ("error open-interp:", "interp"),
+        ("error convert-pairs-bsdf:", "pairs"),
+        ("error convert-pairs-table:", "pairs"),
+        ("error fit-pairs:", "pairs"),
+        ("error fit-pairs-overflow:", "pairs"),
     ] {
         assert!(line(label).contains(field), "{label} {}", line(label));
     }

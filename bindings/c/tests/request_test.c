@@ -61,6 +61,12 @@ int main(int argc, char **argv) {
         failures++;
     }
     print_normal("bsdf", bsdf, "");
+    /* A count of accuracy pairs no memory holds: -1 naming `pairs`, before any bake, never
+     * an allocation failure that aborts the host (every output kind). */
+    expect_error(brdftab_convert(LAMBERT, bsdf, "{\"pairs\": 4611686018427387904}"),
+                 "convert-pairs-bsdf", "pairs");
+    expect_error(brdftab_convert(LAMBERT, table, "{\"pairs\": 18446744073709551615}"),
+                 "convert-pairs-table", "pairs");
 
     char *fit = brdftab_fit("{\"model\":\"lambert\",\"kd\":0.3}", "lambert",
                             "{\"pairs\": 300, \"starts\": 2}");
@@ -73,6 +79,11 @@ int main(int argc, char **argv) {
     }
     if (brdftab_fit(LAMBERT, "lambert", "{\"strats\": 2}") != NULL) failures++;
     expect_error(-1, "fit-unknown", "strats");
+    /* As many fit pairs as memory cannot hold, or whose residual count overflows. */
+    if (brdftab_fit(LAMBERT, "lambert", "{\"pairs\": 10000000000}") != NULL) failures++;
+    expect_error(-1, "fit-pairs", "pairs");
+    if (brdftab_fit(LAMBERT, "lambert", "{\"pairs\": 9223372036854775807}") != NULL) failures++;
+    expect_error(-1, "fit-pairs-overflow", "pairs");
     brdftab_free_string(NULL);
     print_normal("lambert", LAMBERT, NULL);
     if (brdftab_flags(NULL) != 0) failures++;

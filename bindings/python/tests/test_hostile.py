@@ -126,3 +126,28 @@ def test_an_error_about_a_huge_spec_is_short(tmp_path):
         with pytest.raises(brdftab.Error) as e:
             brdftab.open(spec)
         assert len(str(e.value)) < 2000
+
+
+# Counts no memory holds: each used to abort the interpreter (a failed allocation of
+# `pairs` × channels samples) or raise "internal error (please report)" (an overflow). Run in a
+# child so that a regression fails this test instead of killing pytest.
+@pytest.mark.parametrize("call", [
+    "brdftab.convert(LAMBERT, d + '/c.btdb', preset='small', pairs=2**62)",
+    "brdftab.convert(LAMBERT, d + '/c.bsdf', pairs=2**62)",
+    "brdftab.convert(LAMBERT, d + '/c.btdb', preset='small', pairs=2**64 - 1)",
+    "brdftab.fit(LAMBERT, 'ggx', pairs=10**10, starts=1)",
+    "brdftab.fit(LAMBERT, 'ggx', pairs=2**63 - 1, starts=1)",
+])
+def test_a_count_of_pairs_beyond_memory_is_a_value_error(tmp_path, call):
+    code = (
+        "import brdftab\n"
+        f"d = {str(tmp_path)!r}\n"
+        "LAMBERT = '{\"model\": \"lambert\", \"kd\": 0.5}'\n"
+        "try:\n"
+        f"    {call}\n"
+        "except ValueError as e:\n"
+        "    assert 'pairs' in str(e), e\n"
+        "    print('refused')\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and r.stdout.strip() == "refused", (r.returncode, r.stdout, r.stderr[-2000:])
