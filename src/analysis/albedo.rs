@@ -48,6 +48,20 @@ pub fn quadrature<B: Brdf + ?Sized>(brdf: &B, wi: DVec3, out: &mut [f64]) {
     out[..c].copy_from_slice(&est.value[..c]);
 }
 
+/// The incident direction of polar angle `theta` (radians, azimuth 0) at which hosts ask for an
+/// albedo: `theta` must lie in [0, π/2] (beyond it the light is below the horizon, and a
+/// negative angle would silently mean its mirror image); otherwise an
+/// [`Error::InvalidArgument`](crate::Error::InvalidArgument) naming `theta`.
+pub fn incidence(theta: f64) -> crate::Result<DVec3> {
+    if !(0.0..=std::f64::consts::FRAC_PI_2).contains(&theta) {
+        return Err(crate::Error::arg(
+            "theta",
+            format!("{theta} is outside [0, π/2] (radians)"),
+        ));
+    }
+    Ok(geometry::spherical(theta, 0.0))
+}
+
 /// The albedo a(θ) at incidence angles `thetas` (radians, azimuth φ = 0) per channel, using
 /// [`Brdf::albedo`] (so closed forms are used where a model has one): `curve[k][channel]`.
 pub fn albedo_curve<B: Brdf + ?Sized>(brdf: &B, thetas: &[f64]) -> Vec<Vec<f64>> {

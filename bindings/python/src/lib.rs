@@ -543,13 +543,8 @@ impl PyBrdf {
                 )));
             }
             let t: Vec<f64> = a.as_array().iter().copied().collect();
-            if let Some(x) = t
-                .iter()
-                .find(|x| !(0.0..=std::f64::consts::FRAC_PI_2).contains(*x))
-            {
-                return Err(PyValueError::new_err(format!(
-                    "theta: {x} is outside [0, π/2] (radians)"
-                )));
+            for &x in &t {
+                brdftab::analysis::albedo::incidence(x).map_err(lib_err)?;
             }
             let brdf = &self.inner;
             let k = t.len();
