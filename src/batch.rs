@@ -45,11 +45,13 @@ pub struct SampleOut<'a> {
     pub weight: &'a mut [f32],
 }
 
-/// Whether a pair may have a sample: non-finite input has none (the NaN rule of every host),
-/// whatever the source.
+/// Whether a pair may have a sample: a non-finite `wo` has none (the NaN rule of every host),
+/// and neither has a `u` outside [0, 1)² (NaN included), whatever the source — samplers map
+/// only that square (beyond it Blinn-Phong drew directions of length 1.009 and Ward's density
+/// was 20 % off).
 #[inline]
 pub fn drawable(wo: DVec3, u: DVec2) -> bool {
-    wo.is_finite() && u.is_finite()
+    wo.is_finite() && (0.0..1.0).contains(&u.x) && (0.0..1.0).contains(&u.y)
 }
 
 /// The outputs of a pair without a sample: zeros.

@@ -202,7 +202,8 @@ pub trait Brdf: Send + Sync {
     }
 
     /// Draws `wi` for every `wo[k]` from `u[k]` into `out` (wi, pdf, and `c` weights per pair).
-    /// A pair with no sample — `wo` below the horizon, a non-finite `wo` or `u`, a zero lobe —
+    /// A pair with no sample — `wo` below the horizon, a non-finite `wo`, a `u` outside
+    /// [0, 1)² ([`crate::batch::drawable`]), a zero lobe —
     /// gets wi = 0, pdf = 0 and weights 0. On the library's pool from
     /// [`crate::batch::PARALLEL`] pairs on.
     ///

@@ -26,7 +26,7 @@
  *
  * NaN: a direction with a NaN or infinite component, or a zero vector, is not an error: f_r and
  * pdf are 0 for it and sample gives wi = 0, pdf = 0, weight = 0 (as the library does); a NaN
- * in u gives no sample either. A theta outside [0, pi/2] in brdftab_albedo (NaN included) is an
+ * in u, or a u outside [0, 1), gives no sample either. A theta outside [0, pi/2] in brdftab_albedo (NaN included) is an
  * error (-1).
  * Thread safety: eval, pdf, sample and albedo may run concurrently on one handle.
  */

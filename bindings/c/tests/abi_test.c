@@ -102,6 +102,17 @@ int main(int argc, char **argv) {
     CHECK(brdftab_eval(b, n, wi, wo, f) == 0, "eval");
     CHECK(brdftab_pdf(b, n, wi, wo, pdf) == 0, "pdf");
     CHECK(brdftab_sample(b, n, wo, u, swi, spdf, w) == 0, "sample");
+    {
+        /* u outside [0, 1) has no sample, like a NaN in u (u = -3 drew one before). */
+        double wo1[3] = {0.3, 0.0, 0.95}, bad[4][2] = {{-3.0, 0.5}, {1.5, 0.2}, {1.0, 0.0}, {0.5, 0.25}};
+        double wi1[3], p1;
+        float w1[64];
+        for (int k = 0; k < 4; k++) {
+            CHECK(brdftab_sample(b, 1, wo1, bad[k], wi1, &p1, w1) == 0, "sample call");
+            CHECK((k < 3) == (p1 == 0.0 && wi1[0] == 0.0 && wi1[1] == 0.0 && wi1[2] == 0.0),
+                  "u outside [0, 1) has no sample; u inside has one");
+        }
+    }
     CHECK(brdftab_albedo(b, 30.0 * BRDFTAB_PI / 180.0, alb) == 0, "albedo");
 
     /* Two threads on one handle give what one thread gave, bit for bit. */
