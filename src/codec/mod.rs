@@ -69,10 +69,30 @@ impl Quant {
         match name {
             "f32" => Ok(Quant::F32),
             "f16" => Ok(Quant::F16),
-            "log16" => Ok(Quant::Log16 {
-                tolerance: tolerance.unwrap_or(1e-3),
-                floor,
-            }),
+            "log16" => {
+                // Checked here, before any bake, as well as where a chunk is encoded: a bad
+                // tolerance or floor used to surface only after the bake, as an encode error.
+                let tolerance = tolerance.unwrap_or(1e-3);
+                if !(tolerance.is_finite() && (log16::MIN_TOL..=0.5).contains(&tolerance)) {
+                    return Err(Error::arg(
+                        "codec_tolerance",
+                        format!(
+                            "log16 tolerance {tolerance} is outside [{}, 0.5]; use codec f32 \
+                             for lossless storage",
+                            log16::MIN_TOL
+                        ),
+                    ));
+                }
+                if let Some(f) = floor
+                    && !(f.is_finite() && f > 0.0)
+                {
+                    return Err(Error::arg(
+                        "floor",
+                        format!("log16 floor {f} must be a positive number"),
+                    ));
+                }
+                Ok(Quant::Log16 { tolerance, floor })
+            }
             _ => Err(Error::arg(
                 "codec",
                 format!("unknown codec `{name}` (expected f32, f16 or log16)"),
@@ -636,6 +656,36 @@ mod tests {
             level: 1,
             ..Codec::default()
         }
+    }
+
+    /// A log16 tolerance or floor out of range is an argument error when the codec is named,
+    /// not an encode error after the bake (`codec="log16:0"` failed only once the table was
+    /// baked).
+    #[test]
+    fn log16_settings_are_checked_when_parsed() {
+        let named = |r: Result<Quant>| match r {
+            Err(Error::InvalidArgument { name, .. }) => name,
+            other => panic!("{other:?}"),
+        };
+        for t in [0.0, -1e-3, 0.6, f64::NAN, f64::INFINITY] {
+            assert_eq!(
+                named(Quant::parse("log16", Some(t), None)),
+                "codec_tolerance"
+            );
+        }
+        for f in [0.0, -1.0, f64::NAN] {
+            assert_eq!(named(Quant::parse("log16", None, Some(f))), "floor");
+        }
+        assert!(Quant::parse("log16", Some(log16::MIN_TOL), Some(1e-9)).is_ok());
+        assert!(Quant::parse("log16", Some(0.5), None).is_ok());
+        let req = crate::request::BakeSettings {
+            codec: Some("log16:0".into()),
+            ..Default::default()
+        };
+        assert!(matches!(
+            req.request("x.json"),
+            Err(Error::InvalidArgument { ref name, .. }) if name == "codec_tolerance"
+        ));
     }
 
     /// Adversarial values: tiny, huge, zeros, negatives, spikes, constants.
