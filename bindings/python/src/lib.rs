@@ -792,16 +792,38 @@ where
     })
 }
 
+/// A SOURCE or OUTPUT argument: a `str` (a spec, a path, `DB#NAME`) or an `os.PathLike`
+/// whose `os.fspath` is a `str` (a `pathlib.Path`); anything else is a `TypeError`.
+fn text_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<String> {
+    use pyo3::types::PyString;
+    if obj.is_instance_of::<PyString>() {
+        return obj.extract::<String>();
+    }
+    if obj.hasattr("__fspath__")? {
+        let p = obj.py().import("os")?.call_method1("fspath", (obj,))?;
+        return p.extract::<String>().map_err(|_| {
+            PyTypeError::new_err(format!("{what}: a bytes path is not supported; pass a str"))
+        });
+    }
+    Err(PyTypeError::new_err(format!(
+        "{what}: expected a str or an os.PathLike, got {}",
+        obj.get_type().name()?
+    )))
+}
+
 /// Opens SOURCE (a spec, table, `DB#NAME`, MERL `.binary` or RGL `.bsdf`) as a `Brdf`.
 #[pyfunction]
 #[pyo3(signature = (source, *, interp = "auto", wavelengths = None, eager = true))]
 fn open(
-    source: &str,
+    source: &Bound<'_, PyAny>,
     interp: &str,
     wavelengths: Option<&Bound<'_, PyAny>>,
     eager: bool,
 ) -> PyResult<PyBrdf> {
-    guard(|| PyBrdf::open(source, interp, channels_of(wavelengths)?, eager))
+    guard(|| {
+        let source = text_arg(source, "source")?;
+        PyBrdf::open(&source, interp, channels_of(wavelengths)?, eager)
+    })
 }
 
 /// Unpickling: reopens a `Brdf` from its source and options.
@@ -827,10 +849,12 @@ fn _reopen(
 #[pyo3(signature = (source, *, wavelengths = None))]
 fn check(
     py: Python<'_>,
-    source: &str,
+    source: &Bound<'_, PyAny>,
     wavelengths: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
+        let source = text_arg(source, "source")?;
+        let source = source.as_str();
         let opts = OpenOptions {
             channels: channels_of(wavelengths)?,
             ..OpenOptions::default()
@@ -848,8 +872,10 @@ fn check(
 
 /// What `brdftab info --json` reports of a brdftab file (`FILE`) or one table (`DB#NAME`).
 #[pyfunction]
-fn info(py: Python<'_>, source: &str) -> PyResult<Py<PyAny>> {
+fn info(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
     guard(|| {
+        let source = text_arg(source, "source")?;
+        let source = source.as_str();
         to_py(
             py,
             &brdftab::store::info::file_info(source).map_err(lib_err)?,
@@ -919,11 +945,13 @@ fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyA
 #[pyo3(signature = (source, output, **options))]
 fn bake(
     py: Python<'_>,
-    source: &str,
-    output: &str,
+    source: &Bound<'_, PyAny>,
+    output: &Bound<'_, PyAny>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
+        let (source, output) = (text_arg(source, "source")?, text_arg(output, "output")?);
+        let (source, output) = (source.as_str(), output.as_str());
         let settings: BakeSettings = settings_of(options)?;
         let r = unlocked(py, || {
             request::bake(source, output, &settings, &brdftab::progress::Silent)
@@ -943,12 +971,14 @@ fn bake(
 #[pyo3(signature = (source, cache_dir=None, refresh=false, **options))]
 fn bake_cached(
     py: Python<'_>,
-    source: &str,
+    source: &Bound<'_, PyAny>,
     cache_dir: Option<std::path::PathBuf>,
     refresh: bool,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
+        let source = text_arg(source, "source")?;
+        let source = source.as_str();
         let settings: BakeSettings = settings_of(options)?;
         let c = unlocked(py, || {
             brdftab::cache::bake_cached(source, &settings, cache_dir.as_deref(), refresh)
@@ -966,11 +996,13 @@ fn bake_cached(
 #[pyo3(signature = (source, output, **options))]
 fn convert(
     py: Python<'_>,
-    source: &str,
-    output: &str,
+    source: &Bound<'_, PyAny>,
+    output: &Bound<'_, PyAny>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
+        let (source, output) = (text_arg(source, "source")?, text_arg(output, "output")?);
+        let (source, output) = (source.as_str(), output.as_str());
         let settings: ConvertSettings = settings_of(options)?;
         let out = unlocked(py, || {
             request::convert(source, output, &settings, &brdftab::progress::Silent)
@@ -1028,11 +1060,13 @@ fn convert(
 #[pyo3(signature = (source, model, **options))]
 fn fit(
     py: Python<'_>,
-    source: &str,
+    source: &Bound<'_, PyAny>,
     model: &str,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
+        let source = text_arg(source, "source")?;
+        let source = source.as_str();
         let settings: FitSettings = settings_of(options)?;
         let result = unlocked(py, || {
             request::fit(source, model, &settings, &brdftab::progress::Silent)

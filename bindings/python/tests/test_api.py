@@ -175,6 +175,32 @@ def test_bake_target_error_matches_the_cli(tmp_path, cli):
         brdftab.bake(GGX, a, preset="small", target_error=0.01)
 
 
+def test_paths_may_be_pathlike(tmp_path, paper):
+    # Sources and outputs are str or os.PathLike (a pathlib.Path was a TypeError).
+    out = tmp_path / "lam.btdb"
+    info = brdftab.bake(LAMBERT, out, preset="small")
+    assert info == brdftab.info(out) == brdftab.info(str(out))
+    wi, wo = upper(50, 3), upper(50, 4)
+    assert np.array_equal(brdftab.open(out).eval(wi, wo), brdftab.open(str(out)).eval(wi, wo))
+    assert brdftab.check(out)["positive"]
+    conv = brdftab.convert(pathlib.Path(paper), tmp_path / "p.btdb", preset="small")
+    assert conv["format"] == "table" and (tmp_path / "p.btdb").exists()
+    with pytest.raises(TypeError, match="source"):
+        brdftab.open(42)
+    with pytest.raises(TypeError, match="bytes"):
+        brdftab.open(_BytesPath(paper))
+
+
+class _BytesPath:
+    """An os.PathLike whose path is bytes (not supported: sources are text)."""
+
+    def __init__(self, p):
+        self.p = str(p).encode()
+
+    def __fspath__(self):
+        return self.p
+
+
 def test_database(tmp_path):
     db = brdftab.Database(tmp_path / "m.btdb")
     db.add(LAMBERT, "matte", preset="small")

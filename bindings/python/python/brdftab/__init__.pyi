@@ -88,15 +88,19 @@ class Table:
     def __len__(self) -> int: ...
 
 def open(
-    source: str, *, interp: str = "auto", wavelengths: Wavelengths = None, eager: bool = True
+    source: str | PathLike[str],
+    *,
+    interp: str = "auto",
+    wavelengths: Wavelengths = None,
+    eager: bool = True,
 ) -> Brdf:
     """Opens SOURCE. interp: "auto" (nearest on tables of MERL cells, linear otherwise),
     "nearest" or "linear"."""
-def check(source: str, *, wavelengths: Wavelengths = None) -> dict[str, Any]: ...
-def info(source: str) -> dict[str, Any]: ...
+def check(source: str | PathLike[str], *, wavelengths: Wavelengths = None) -> dict[str, Any]: ...
+def info(source: str | PathLike[str]) -> dict[str, Any]: ...
 def bake(
-    source: str,
-    output: str,
+    source: str | PathLike[str],
+    output: str | PathLike[str],
     *,
     preset: str | None = ...,
     grid: str | None = ...,
@@ -119,7 +123,7 @@ def bake(
     """Bakes SOURCE into OUTPUT (a .btdb file or DB#NAME); the keywords are the CLI's bake flags,
     snake_cased, validated by the library's request layer. Returns `brdftab info --json`."""
 def bake_cached(
-    source: str,
+    source: str | PathLike[str],
     cache_dir: str | PathLike[str] | None = None,
     refresh: bool = False,
     **options: Any,
@@ -128,8 +132,8 @@ def bake_cached(
     baked tables (keyed by the source's content, the settings and the library's version) or
     baked into it now. Returns {"path": str, "hit": bool}."""
 def convert(
-    source: str,
-    output: str,
+    source: str | PathLike[str],
+    output: str | PathLike[str],
     *,
     pairs: int | None = ...,
     interp: str | None = ...,
@@ -143,7 +147,7 @@ def convert(
     Mitsuba 3 load it), a MERL .binary, DB#NAME, a .btdb file or a raw table. Takes the keywords
     of `bake` plus these; returns {"output", "format", "source", ...}."""
 def fit(
-    source: str,
+    source: str | PathLike[str],
     model: str,
     *,
     params: str | Sequence[str] | None = ...,
