@@ -55,7 +55,12 @@ impl Beckmann {
         }
         let c2 = cos_a * cos_a;
         let tan2 = (1.0 - c2) / c2;
-        (-tan2 * self.inv_m2).exp() * self.inv_pi_m2 / (c2 * c2)
+        let e = (-tan2 * self.inv_m2).exp();
+        if e == 0.0 {
+            // exp underflows long before c2² does (cos α ~ 1e-77): D = 0 there, not 0/0.
+            return 0.0;
+        }
+        e * self.inv_pi_m2 / (c2 * c2)
     }
 
     /// A facet normal drawn with density D(H) cos α (per solid angle of H) from `u` in [0,1)².

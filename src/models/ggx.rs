@@ -134,6 +134,25 @@ impl Ggx {
         (s2, 2.0 * w.z * (r + w.z))
     }
 
+    /// D(h/|h|) of a tiny unnormalized `h`, scaled to a largest component of 1 first; out of
+    /// line, so that the common path does not compute it as a select.
+    #[cold]
+    #[inline(never)]
+    fn ndf_scaled(&self, h: DVec3) -> f64 {
+        let hs = h / h.abs().max_element();
+        let (x, y) = (hs.x * self.inv_alpha.0, hs.y * self.inv_alpha.1);
+        let t = hs.length_squared() / (x * x + y * y + hs.z * hs.z);
+        self.inv_pi_axay * (t * t)
+    }
+
+    /// Λ(w)'s parts with the cosine taken out of q: (s², q / w_z = 2 (√(w_z² + s²) + w_z)).
+    #[inline]
+    fn lambda_parts_per_cos(&self, w: DVec3) -> (f64, f64) {
+        let s2 = (self.alpha_x * w.x).powi(2) + (self.alpha_y * w.y).powi(2);
+        let r = (w.z * w.z + s2).sqrt();
+        (s2, 2.0 * (r + w.z))
+    }
+
     /// Smith's masking G1(w) = 1 / (1 + Λ(w)) (0 below the horizon).
     #[inline]
     pub fn g1(&self, w: DVec3) -> f64 {
@@ -157,8 +176,10 @@ impl Ggx {
     /// Written with the half vector unnormalized, h = l + v for unit l, v: D(h/|h|) =
     /// |h|⁴ / (π α_x α_y e²) with e = (h_x/α_x)² + (h_y/α_y)² + h_z², l·h/|h| = |h|/2, and
     /// G2 = q_l q_v / (q_l q_v + s_l q_v + s_v q_l) from Λ = s/q ([`Ggx::lambda`]), so each
-    /// output costs one division. Every product is formed symmetrically in (l, v), so
-    /// reciprocity holds bit for bit.
+    /// output costs one division. Each q = w_z q′ carries its cosine, q′ = 2 (√(w_z² + s²) + w_z),
+    /// which cancels against 4 cos θi cos θo, so a pair within 1e-100 of the horizon (f_r grows
+    /// like 1/cos θ there) neither underflows to 0/0 nor loses its value. Every product is formed
+    /// symmetrically in (l, v), so reciprocity holds bit for bit.
     #[inline(always)]
     fn lobe(&self, wi: DVec3, wo: DVec3) -> Option<Lobe> {
         let (l, v) = super::unit_upper_pair(wi, wo)?;
@@ -166,16 +187,23 @@ impl Ggx {
         let hh = h.length_squared();
         let (x, y) = (h.x * self.inv_alpha.0, h.y * self.inv_alpha.1);
         let e = x * x + y * y + h.z * h.z;
-        let (sl, ql) = self.lambda_parts(l);
-        let (sv, qv) = self.lambda_parts(v);
-        let d_num = self.inv_pi_axay * (hh * hh);
-        let e2 = e * e;
-        let qq = ql * qv;
-        let g_den = qq + (sl * qv + sv * ql);
+        // D's |h|⁴/e² is scale-free; near the mirror configuration at grazing both |h|² and e
+        // are ~4 cos², whose squares underflow below cos ~ 1e-77 (and they themselves below
+        // ~1e-154): there take the ratio of h scaled to a largest component of 1.
+        let (d_num, e2) = if e > TINY_E {
+            (self.inv_pi_axay * (hh * hh), e * e)
+        } else {
+            (self.ndf_scaled(h), 1.0)
+        };
+        let (sl, pl) = self.lambda_parts_per_cos(l);
+        let (sv, pv) = self.lambda_parts_per_cos(v);
+        // G2 / (4 cos θi cos θo) = p_l p_v / (4 g), g = cos θi cos θo p_l p_v + s_l cos θo p_v
+        // + s_v cos θi p_l (q = cos θ p).
+        let g = (l.z * v.z) * (pl * pv) + (sl * (v.z * pv) + sv * (l.z * pl));
         Some(Lobe {
-            dg: d_num * qq / (e2 * g_den * (4.0 * (l.z * v.z))),
+            dg: d_num * (pl * pv) / (e2 * g * 4.0),
             l_dot_h: 0.5 * hh.sqrt(),
-            pdf: d_num * qv / (e2 * (qv + sv) * (4.0 * v.z)),
+            pdf: d_num * pv / (e2 * (v.z * pv + sv) * 4.0),
         })
     }
 
@@ -238,6 +266,10 @@ impl Ggx {
         self.g1(wo) * wo.dot(h).max(0.0) * self.ndf(h) / wo.z
     }
 }
+
+/// Below this e (the NDF's quadratic form of the unnormalized half vector, ~4 cos² θ at the
+/// mirror configuration) [`Ggx::lobe`] forms D from |h|²/e rather than |h|⁴ and e² apart.
+const TINY_E: f64 = 1e-100;
 
 /// What [`Ggx::lobe`] computes for a pair.
 struct Lobe {
@@ -686,6 +718,39 @@ mod tests {
         };
         let r = test(&wrong, DVec3::Z, &o);
         assert!(!r.passes(0.01), "{r:?}");
+    }
+
+    #[test]
+    fn pairs_a_hair_above_the_horizon_keep_their_limit() {
+        // At grazing G2 ~ cos θ / α and f_r ~ 1/cos θ (height-correlated Smith), so f_r cos θ and
+        // the density G1(wo) D / (4 cos θo) have finite limits as both cosines go to 0, which a
+        // pair at cos 1e-300 must reproduce (the quadratic terms are below 1e-20 of them there).
+        let m = Ggx::new(0.1, 0.3, Value::Grey(0.9), conductor(), &Channels::Rgb).unwrap();
+        let pair = |z: f64, o: DVec3| {
+            let r = (1.0 - z * z).sqrt();
+            (DVec3::new(0.0, r, z), DVec3::new(o.x * r, o.y * r, z))
+        };
+        for o in [DVec3::new(0.0, -1.0, 0.0), DVec3::new(-0.6, -0.8, 0.0)] {
+            let (wi, wo) = pair(1e-20, o);
+            let (f_ref, p_ref) = (m.eval_wavelength(wi, wo, 550.0) * 1e-20, m.pdf(wi, wo));
+            assert!(f_ref > 0.0 && f_ref.is_finite() && p_ref > 0.0 && p_ref.is_finite());
+            for z in [1e-60, 1e-100, 1e-160, 1e-200, 1e-300] {
+                let (wi, wo) = pair(z, o);
+                let (f, p) = (m.eval_wavelength(wi, wo, 550.0) * z, m.pdf(wi, wo));
+                assert!(
+                    (f / f_ref - 1.0).abs() < 1e-12,
+                    "{o} z={z:e}: f cos {f:e} vs {f_ref:e}"
+                );
+                assert!(
+                    (p / p_ref - 1.0).abs() < 1e-12,
+                    "{o} z={z:e}: pdf {p:e} vs {p_ref:e}"
+                );
+                // The f32 value overflows (f_r really is beyond f32 there), but is never NaN.
+                let mut out = [0f32; 3];
+                m.eval(wi, wo, &mut out);
+                assert!(out.iter().all(|x| *x > 0.0), "{o} z={z:e}: {out:?}");
+            }
+        }
     }
 
     proptest! {

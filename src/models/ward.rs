@@ -77,6 +77,21 @@ impl Ward {
     /// tan²θh (cos²φh/α_x² + sin²φh/α_y²) for a (possibly unnormalized) half vector with z > 0.
     #[inline]
     fn exponent(&self, s: DVec3) -> f64 {
+        let z2 = s.z * s.z;
+        // Scale-free: where s_z² nears underflow (the mirror pair within 1e-100 of the horizon,
+        // s ≈ (0, 0, 2 cos θ)), s is scaled to a largest component of 1 first, or 0/0 follows.
+        if z2 > TINY_Z2 {
+            ((s.x / self.alpha_x).powi(2) + (s.y / self.alpha_y).powi(2)) / z2
+        } else {
+            self.exponent_scaled(s)
+        }
+    }
+
+    /// [`Ward::exponent`] of a vector scaled to a largest component of 1 (out of line: rare).
+    #[cold]
+    #[inline(never)]
+    fn exponent_scaled(&self, s: DVec3) -> f64 {
+        let s = s / s.abs().max_element();
         ((s.x / self.alpha_x).powi(2) + (s.y / self.alpha_y).powi(2)) / (s.z * s.z)
     }
 
@@ -84,7 +99,9 @@ impl Ward {
     #[inline]
     fn lobe(&self, wi: DVec3, wo: DVec3) -> f64 {
         let s = wi + wo;
-        (-self.exponent(s)).exp() / (4.0 * PI * self.alpha_x * self.alpha_y * (wi.z * wo.z).sqrt())
+        // √cos θi √cos θo rather than √(cos θi cos θo), whose product underflows below 1e-154.
+        (-self.exponent(s)).exp()
+            / (4.0 * PI * self.alpha_x * self.alpha_y * (wi.z.sqrt() * wo.z.sqrt()))
     }
 
     /// The density of sampled half vectors (solid angle), exp(−tan²θh (…)) / (π α_x α_y cos³θh);
@@ -94,7 +111,12 @@ impl Ward {
         if h.z.is_nan() || h.z <= 0.0 {
             return 0.0;
         }
-        (-self.exponent(h)).exp() / (PI * self.alpha_x * self.alpha_y * h.z * h.z * h.z)
+        let e = (-self.exponent(h)).exp();
+        if e == 0.0 {
+            // Below h_z ~ 1e-100, where h_z³ underflows too: D = 0, not 0/0.
+            return 0.0;
+        }
+        e / (PI * self.alpha_x * self.alpha_y * h.z * h.z * h.z)
     }
 
     /// Draws a half vector with density [`Ward::pdf_half_vector`].
@@ -106,6 +128,9 @@ impl Ward {
         DVec3::new(-self.alpha_x * r * cp, -self.alpha_y * r * sp, 1.0).normalize()
     }
 }
+
+/// Below this s_z² [`Ward`]'s exponent scales its vector before dividing (see `exponent`).
+const TINY_Z2: f64 = 1e-200;
 
 impl Brdf for Ward {
     fn channels(&self) -> &Channels {

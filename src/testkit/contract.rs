@@ -350,6 +350,45 @@ fn bad_input<B: Brdf + ?Sized>(brdf: &B, log: &mut Log) {
             log.fail("horizon", || format!("sample(wo = {b}) gave {s:?}"));
         }
     }
+    // A hair above the horizon (cosines a renderer's f64 directions can carry, down to 1e-300):
+    // values may overflow (f_r grows like 1/cos θ there for many lobes) but are never NaN or
+    // negative — an underflowed product must not turn into 0/0.
+    for z in [1e-20f64, 1e-100, 1e-200, 1e-300] {
+        let r = (1.0 - z * z).sqrt();
+        let g = |x: f64, y: f64| DVec3::new(x * r, y * r, z);
+        let pairs = [
+            (g(0.0, 1.0), g(0.0, -1.0)),
+            (g(0.0, 1.0), g(-0.6, -0.8)),
+            (g(0.6, 0.8), g(0.6, 0.8)),
+            (g(1.0, 0.0), up),
+            (up, g(1.0, 0.0)),
+        ];
+        for (k, (wi, wo)) in pairs.into_iter().enumerate() {
+            let mut f = [0.0f32; MAX_CHANNELS];
+            brdf.eval(wi, wo, &mut f[..c]);
+            let nm = brdf.channels().wavelength(0);
+            let (fw, p) = (brdf.eval_wavelength(wi, wo, nm), brdf.pdf(wi, wo));
+            if !(f[..c].iter().all(|&x| x >= 0.0) && fw >= 0.0 && p >= 0.0) {
+                log.fail("horizon", || {
+                    format!(
+                        "a hair above it, cos {z:e}, pair {k}: eval = {:?}, at {nm} nm {fw}, pdf {p}",
+                        &f[..c]
+                    )
+                });
+            }
+        }
+        let mut w = [0.0f32; MAX_CHANNELS];
+        if let Some(s) = brdf.sample(g(0.6, 0.8), DVec2::new(0.3, 0.6), &mut w[..c])
+            && !(s.pdf > 0.0 && w[..c].iter().all(|&x| x >= 0.0))
+        {
+            log.fail("horizon", || {
+                format!(
+                    "a hair above it, cos {z:e}: sample gave {s:?} {:?}",
+                    &w[..c]
+                )
+            });
+        }
+    }
     // A non-finite u has no sample, as in `sample_batch` (a sampler that ignores u included).
     for u in [
         DVec2::new(f64::NAN, 0.6),
