@@ -446,3 +446,57 @@ fn merl_grid_nodes_are_cell_centres() {
         );
     }
 }
+
+/// An anisotropic test lobe f_r = a + b cos²φh (φh the azimuth of the half vector): reciprocal
+/// and bilateral, not isotropic. Its mean over φh is a + b/2 at every (θh, θd, φd).
+struct CosSquaredPhiH(brdftab::Channels);
+
+impl Brdf for CosSquaredPhiH {
+    fn channels(&self) -> &brdftab::Channels {
+        &self.0
+    }
+    fn eval(&self, wi: glam::DVec3, wo: glam::DVec3, out: &mut [f32]) {
+        let v = if wi.z > 0.0 && wo.z > 0.0 {
+            let h = wi.normalize() + wo.normalize();
+            let r2 = h.x * h.x + h.y * h.y;
+            let cos2 = if r2 > 0.0 { h.x * h.x / r2 } else { 0.5 };
+            0.2 + 0.1 * cos2
+        } else {
+            0.0
+        };
+        out[..3].fill(v as f32);
+    }
+    fn flags(&self) -> brdftab::brdf::Flags {
+        brdftab::brdf::Flags {
+            isotropic: false,
+            ..brdftab::brdf::Flags::SMOOTH_SYMMETRIC
+        }
+    }
+    fn describe(&self) -> String {
+        "a + b cos²φh".into()
+    }
+}
+
+/// A MERL cell spans every φh (the format is isotropic), so the file written from an
+/// anisotropic source holds its mean over φh too. The cells used to be filled at φh = 0 only:
+/// the file of `a + b cos²φh` held a + b = 0.3 everywhere instead of a + b/2 = 0.25, and the
+/// file of GGX with α = (0.1, 0.4) was the α = 0.1 slice, a third of the φh-mean at θh = 8.6°.
+/// The mean over m equally spaced φh of cos²φh is 1/2 exactly for m ≥ 3, whatever the offset,
+/// so every cell holds 0.25 to the f32 rounding of the evaluations.
+#[test]
+fn a_merl_file_of_an_anisotropic_source_holds_its_mean_over_phi_h() {
+    let src = CosSquaredPhiH(brdftab::Channels::Rgb);
+    for ith in (0..90).step_by(7) {
+        for itd in (0..90).step_by(7) {
+            for ipd in (0..180).step_by(11) {
+                let Some(m) = brdftab::measured::merl_resample::cell_mean(&src, ith, itd, ipd)
+                else {
+                    continue;
+                };
+                for v in m {
+                    assert!((v - 0.25).abs() < 1e-6, "{ith} {itd} {ipd}: {m:?}");
+                }
+            }
+        }
+    }
+}

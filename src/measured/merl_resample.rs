@@ -18,7 +18,8 @@
 //!   its reciprocal (ωo, ωi), so one value stands for f_r of both. For a source not flagged
 //!   reciprocal (a measurement) each point is evaluated both ways.
 //! - **Weights.** Over the pairs, dωi dωo = 4 cos θd dωh dωd (Rusinkiewicz 1998); a cell spans
-//!   every φh (the reader ignores it, and nothing below depends on it), and θh = (π/2)(u/90)²
+//!   every φh (the reader ignores it: an isotropic source is evaluated at φh = 0, an anisotropic
+//!   one at [`PHI_H_POINTS`] azimuths per point, its mean over φh), and θh = (π/2)(u/90)²
 //!   on the index u. Each evaluation f_r(ωi, ωo) weighs cos θo of its own orientation — its
 //!   share of the directional albedo a(ωi) = ∫ f_r cos θo dωo —, so the weight of a point is
 //!   cos θd sin θd sin θh · u · cos θo (and cos θi for the reciprocal orientation). Weighting
@@ -40,7 +41,7 @@
 //! (α = 0.3), whose albedo grows without bound towards 90°, comes out 13 % high at θ′ = 89°
 //! (centre samples: 4.4 %), while its whole-hemisphere and grazing-band figures improve.
 
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use rayon::prelude::*;
 
@@ -56,7 +57,7 @@ use super::merl::{MerlBrdf, RES_PHI_D, RES_THETA_D, RES_THETA_H, SAMPLES, SCALE,
 impl MerlBrdf {
     /// Resamples any BRDF onto the MERL grid and stores f_r / scale.
     ///
-    /// A source that stores a value at the cell centre ([`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node): a MERL
+    /// An isotropic source that stores a value at the cell centre ([`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node): a MERL
     /// measurement, a `halfdiff` table on the MERL grid) gives it as stored, so MERL → MERL and
     /// MERL → table → MERL keep every cell — to f32 precision, the precision of
     /// [`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node) — and every unmeasured cell: a negative stored value is written as
@@ -64,7 +65,8 @@ impl MerlBrdf {
     /// ([`merl_resample::cell_mean`](super::merl_resample::cell_mean): both orientations of
     /// every pair, weighted for the directional albedos; RGB channels by `eval`, other channel
     /// sets by [`Brdf::eval_wavelength`] at the representative RGB wavelengths); a cell with no
-    /// point above the horizon is stored as −1 (unmeasured), as in the database. Runs in
+    /// point above the horizon is stored as −1 (unmeasured), as in the database. The format is
+    /// isotropic: an anisotropic source's cells hold its mean over φh as well. Runs in
     /// parallel.
     ///
     /// ```
@@ -89,7 +91,8 @@ impl MerlBrdf {
         let _stage = Stage::begin(progress, "resampling on the MERL grid", RES_THETA_H as u64);
         let done = AtomicUsize::new(0);
         let rgb = *brdf.channels() == Channels::Rgb;
-        let stored = rgb;
+        // A stored node is one φh of its cell: only an isotropic source's is the cell's value.
+        let stored = rgb && brdf.flags().isotropic;
         let plane = RES_THETA_D * RES_PHI_D;
         let mut cells = vec![[0.0f64; 3]; SAMPLES];
         crate::par::install(|| {
@@ -152,6 +155,28 @@ impl MerlBrdf {
 /// RGL measurements two and three gave the same figures (BENCHMARKS.md).
 pub const POINTS_PER_AXIS: usize = 3;
 
+/// Azimuths φh of the half vector at which an anisotropic source (one not flagged isotropic) is
+/// evaluated per point: a MERL cell spans every φh and the reader ignores it, so the file holds
+/// the mean over φh. Equally spaced nodes are the trapezoidal rule of a periodic function, exact
+/// for its harmonics below this order (the cos 2φh and cos 4φh of an elliptical lobe); each
+/// point rotates them by its own offset. (Cells were filled at φh = 0 alone: the file of GGX
+/// with α = (0.1, 0.4) was its α_x slice, a third of the φh-mean at θh = 8.6°.)
+pub const PHI_H_POINTS: usize = 8;
+
+/// The φh nodes of [`PHI_H_POINTS`], from 0.
+const PHI_H_UNIT: [f64; PHI_H_POINTS] = {
+    let mut a = [0.0; PHI_H_POINTS];
+    let mut j = 0;
+    while j < PHI_H_POINTS {
+        a[j] = TAU * j as f64 / PHI_H_POINTS as f64;
+        j += 1;
+    }
+    a
+};
+
+/// The golden ratio's fractional part, the step of the points' φh offsets.
+const GOLDEN: f64 = 0.618_033_988_749_894_8;
+
 /// The mean of `brdf`'s f_r over MERL cell (`ith`, `itd`, `ipd`) (see the module docs), per
 /// RGB channel, or `None` when no point of the cell has both directions above the horizon.
 pub fn cell_mean(brdf: &dyn Brdf, ith: usize, itd: usize, ipd: usize) -> Option<[f64; 3]> {
@@ -166,6 +191,13 @@ pub fn cell_mean(brdf: &dyn Brdf, ith: usize, itd: usize, ipd: usize) -> Option<
                 f[c] = brdf.eval_wavelength(wi, wo, *nm) as f32;
             }
         }
+    };
+    // A cell spans every φh: an isotropic source is the same at all of them, an anisotropic one
+    // is averaged over PHI_H_POINTS equally spaced φh per point (rotated from point to point).
+    let phi_h: &[f64] = if brdf.flags().isotropic {
+        &[0.0]
+    } else {
+        &PHI_H_UNIT
     };
     let (mut sum, mut weight) = ([0.0f64; 3], 0.0f64);
     let mut add = |w: f64, f: [f32; 3]| {
@@ -186,24 +218,30 @@ pub fn cell_mean(brdf: &dyn Brdf, ith: usize, itd: usize, ipd: usize) -> Option<
             let measure = theta_d.cos() * theta_d.sin() * theta_h.sin() * uh;
             for c in 0..n {
                 let phi_d = at(ipd, c) / RES_PHI_D as f64 * PI;
-                let hd = HalfDiff {
-                    theta_h,
-                    phi_h: 0.0,
-                    theta_d,
-                    phi_d,
-                };
-                let (wi, wo) = geometry::from_half_diff(hd);
-                if !(wi.z > 0.0 && wo.z > 0.0 && measure > 0.0) {
-                    continue;
-                }
-                eval(wi, wo, &mut f);
-                if reciprocal {
-                    // Both orientations have this f_r: their weights cos θo and cos θi at once.
-                    add(measure * (wo.z + wi.z), f);
-                } else {
-                    add(measure * wo.z, f);
-                    eval(wo, wi, &mut f);
-                    add(measure * wi.z, f);
+                // The point's own rotation of the φh nodes (a golden-ratio sequence over the
+                // points), so that a cell sees n³ · PHI_H_POINTS distinct φh.
+                let k = (a * n + b) * n + c;
+                let shift = (k as f64 * GOLDEN).fract() * TAU / PHI_H_POINTS as f64;
+                for &phi_h in phi_h {
+                    let hd = HalfDiff {
+                        theta_h,
+                        phi_h: phi_h + shift,
+                        theta_d,
+                        phi_d,
+                    };
+                    let (wi, wo) = geometry::from_half_diff(hd);
+                    if !(wi.z > 0.0 && wo.z > 0.0 && measure > 0.0) {
+                        continue;
+                    }
+                    eval(wi, wo, &mut f);
+                    if reciprocal {
+                        // Both orientations have this f_r: their weights cos θo and cos θi at once.
+                        add(measure * (wo.z + wi.z), f);
+                    } else {
+                        add(measure * wo.z, f);
+                        eval(wo, wi, &mut f);
+                        add(measure * wi.z, f);
+                    }
                 }
             }
         }
