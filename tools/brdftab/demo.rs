@@ -15,12 +15,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use brdftab::analysis::accuracy::Weight;
 use brdftab::analysis::{fidelity, plausibility};
 use brdftab::bake::{BakeRequest, BakeTarget, SymmetryChoice};
 use brdftab::store;
+use brdftab::table::TabulatedBrdf;
 use brdftab::table::presets::Preset;
-use brdftab::table::{Quantity, TabulatedBrdf};
 use brdftab::{Brdf, Channels, Error, Result};
 use brdftab_tools::report::suite::{self, MetricOptions};
 use clap::Args;
@@ -130,13 +129,9 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         let bytes = stored.compressed_bytes();
         let tab = TabulatedBrdf::from_table(stored.to_table()?);
         let f32_bytes = tab.grid().stored_values() as f64 * 4.0;
-        // Measured data (stored as f_r·cos θo) has f_r ∝ 1/cos θo at grazing: compare within 80°
-        // of the normal, as Ngan et al. (2005) do, weighted by cos θi cos θo as the measured
-        // benchmark (`bench --measured`) is; models over the whole hemisphere, by cos θi —
-        // except those stored as f_r cos θi cos θo (Ward, f_r ∝ 1/√(cos θi cos θo)): their
-        // f_r cos θi has no finite RMS over the hemisphere (∫ dcos θo / cos θo diverges), so
-        // the pair nearest the horizon would set the figure; weighted by cos θi cos θo.
-        let cos_cos = s.measured || tab.grid().quantity() == Quantity::FrCosCos;
+        // Measured data within 80° of the normal and tables of f_r cos θi cos θo weighted by
+        // cos θi cos θo, as the accuracy suite's rows (`suite::rmse_weighting`).
+        let (cap, weight) = suite::rmse_weighting(s.measured, tab.grid().quantity());
         let opts = MetricOptions {
             pairs: ACCURACY_PAIRS,
             seed: 1,
@@ -145,12 +140,8 @@ pub fn demo(a: DemoArgs) -> Result<()> {
             } else {
                 thetas.clone()
             },
-            cap: s.measured.then(|| 80f64.to_radians()),
-            weight: if cos_cos {
-                Weight::CosInCosOut
-            } else {
-                Weight::CosIn
-            },
+            cap,
+            weight,
         };
         let src_albedo = suite::albedos(s.brdf.as_ref(), &opts.albedo_thetas);
         let m = suite::metrics(&tab, s.brdf.as_ref(), &src_albedo, &opts)?;

@@ -12,7 +12,9 @@
 //!    measured on the *decoded* table, quantization error included;
 //! 4. measures, against the source:
 //!    - `rel_rmse`, `max_rel`: [`analysis::accuracy::compare`](brdftab::analysis::accuracy::compare) over `pairs` uniform random pairs
-//!      (cosine-weighted relative RMSE; max relative error with a 1 %-of-RMS floor);
+//!      (cosine-weighted relative RMSE; max relative error with a 1 %-of-RMS floor), weighted
+//!      and capped as [`rmse_weighting`] says: by cos θi, or by cos θi cos θo for a table of
+//!      f_r cos θi cos θo and (within 80°) for measured data, whose f_r cos θi has no finite RMS;
 //!    - `albedo_err`: max over the incidence angles `albedo_thetas` and channels of
 //!      |a_table − a_source| / a_source (denominator floored at 1e-3 × the largest source
 //!      albedo), both albedos by the same adaptive quadrature ([`albedo::integrate`]) with
@@ -49,7 +51,7 @@ use brdftab::progress::{Progress, Silent, Stage};
 use brdftab::spec::ModelSpec;
 use brdftab::spectrum::{Channels, MAX_CHANNELS};
 use brdftab::table::presets::Preset;
-use brdftab::table::{Param, Symmetry, Table, TabulatedBrdf};
+use brdftab::table::{Param, Quantity, Symmetry, Table, TabulatedBrdf};
 
 /// Quadrature settings of the albedo metric: the library's settings for data (a 1e-4 target
 /// with bounded interval counts, so a piecewise-linear table, whose kinks defeat a 1e-6
@@ -651,6 +653,22 @@ pub struct MetricOptions {
     pub weight: accuracy::Weight,
 }
 
+/// The cap and weight of a table's `rel_rmse` (the suite's rows and the demo's): measured data
+/// (stored as f_r cos θo, f_r ∝ 1/cos θo at grazing) within 80° of the normal, weighted by
+/// cos θi cos θo as `brdftab bench --measured` (Ngan et al. 2005); a table of f_r cos θi cos θo
+/// (Ward, f_r ∝ 1/√(cos θi cos θo)) over the whole hemisphere weighted by cos θi cos θo; every
+/// other table over the whole hemisphere by cos θi. Weighted by cos θi alone, the first two
+/// have no finite RMS (∫ dcos θo / cos θo diverges): the pairs nearest the horizon would set the
+/// figure (Ward's small table read 115 %, where its whole-domain error is 2 %).
+pub fn rmse_weighting(measured: bool, quantity: Quantity) -> (Option<f64>, accuracy::Weight) {
+    let weight = if measured || quantity == Quantity::FrCosCos {
+        accuracy::Weight::CosInCosOut
+    } else {
+        accuracy::Weight::CosIn
+    };
+    (measured.then(|| 80f64.to_radians()), weight)
+}
+
 /// `table` against `source`: the suite's metrics, for one table (the demo's rows use it too).
 /// `source_albedo` is [`albedos`] of the source at `opts.albedo_thetas` (computed once by
 /// callers that measure several tables of one source).
@@ -789,7 +807,13 @@ pub fn run(cfg: &SuiteConfig, progress: &dyn Progress) -> Result<Report> {
                             row.bytes = bytes;
                             row.bits_per_value = 8.0 * bytes as f64 / values.max(1) as f64;
                             let tab = TabulatedBrdf::from_table(decoded);
-                            match metrics(&tab, src.as_ref(), &src_albedo, &metric_opts) {
+                            let (cap, weight) = rmse_weighting(measured, tab.grid().quantity());
+                            let opts = MetricOptions {
+                                cap,
+                                weight,
+                                ..metric_opts.clone()
+                            };
+                            match metrics(&tab, src.as_ref(), &src_albedo, &opts) {
                                 Ok(m) => {
                                     row.rel_rmse = m.rel_rmse;
                                     row.max_rel = m.max_rel;
