@@ -2,7 +2,7 @@
 //! `measured::info` say it; this prints).
 
 use brdftab::Result;
-use brdftab::store::{info, tables};
+use brdftab::store::{db, info, tables};
 use clap::Args;
 
 use crate::source;
@@ -27,7 +27,7 @@ pub fn info(a: InfoArgs) -> Result<()> {
         return print_out(&brdftab::measured::info::describe(&a.file)?);
     }
     let (v, text): (_, fn(&serde_json::Value) -> String) =
-        if tables::is_store_file(brdftab::store::name::path_of(&a.file)) {
+        if tables::is_store_file(db::split_source(&a.file)?.0) {
             (info::file_info(&a.file)?, info::file_text)
         } else {
             (info::raw_info(&a.file)?, info::raw_text)
