@@ -895,6 +895,13 @@ fn db_names(path: &str) -> PyResult<Vec<String>> {
     })
 }
 
+/// Checks a table name against the library's rule ([`brdftab::store::name::check`]):
+/// `ValueError` naming `name` for an empty name or one with `#`, `/` or a control character.
+#[pyfunction]
+fn _check_table_name(name: &str) -> PyResult<()> {
+    guard(|| brdftab::store::name::check("name", name).map_err(lib_err))
+}
+
 /// Removes table `name` from database `path`.
 #[pyfunction]
 fn db_remove(path: &str, name: &str) -> PyResult<()> {
@@ -1088,6 +1095,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(db_names, m)?)?;
     m.add_function(wrap_pyfunction!(db_remove, m)?)?;
+    m.add_function(wrap_pyfunction!(_check_table_name, m)?)?;
     m.add_function(wrap_pyfunction!(db_import, m)?)?;
     m.add_function(wrap_pyfunction!(bake, m)?)?;
     m.add_function(wrap_pyfunction!(bake_cached, m)?)?;
