@@ -18,11 +18,13 @@ const _: () = assert!(std::mem::size_of::<DVec3>() == 24 && std::mem::align_of::
 const _: () = assert!(std::mem::size_of::<DVec2>() == 16 && std::mem::align_of::<DVec2>() == 8);
 
 /// A float64 view of an array-like (numpy array, list, tuple); non-numeric dtypes are a
-/// `TypeError`. A float64 array is borrowed as it is; anything else is converted once.
+/// `TypeError`, a masked array with masked entries a `ValueError` (below). A float64 array is
+/// borrowed as it is; anything else is converted once.
 pub(crate) fn f64_array<'py>(
     obj: &Bound<'py, PyAny>,
     name: &str,
 ) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+    refuse_masked(obj, name)?;
     if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'py, f64>>() {
         return Ok(a);
     }
@@ -54,6 +56,27 @@ pub(crate) fn f64_array<'py>(
         .map_err(|e| PyTypeError::new_err(format!("{name}: not an array of real numbers ({e})")))?;
     arr.extract::<PyReadonlyArrayDyn<'py, f64>>()
         .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))
+}
+
+/// A `numpy.ma.MaskedArray` is an ndarray whose data under a masked entry is whatever was
+/// there: read as an array it would be evaluated as if valid. One with masked entries is a
+/// `ValueError` (the caller fills or drops them: the library has no "no value" for a pair);
+/// one without is read as its data. A plain ndarray (the fast path) is not looked at.
+fn refuse_masked(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
+    use numpy::PyUntypedArray;
+    if obj.is_exact_instance_of::<PyUntypedArray>() || !obj.is_instance_of::<PyUntypedArray>() {
+        return Ok(());
+    }
+    let ma = obj.py().import("numpy.ma")?;
+    if obj.is_instance(&ma.getattr("MaskedArray")?)?
+        && ma.call_method1("is_masked", (obj,))?.is_truthy()?
+    {
+        return Err(PyValueError::new_err(format!(
+            "{name}: a masked array with masked entries (numpy.ma): they have no value to \
+             evaluate; fill them ({name}.filled(...)) or drop them first"
+        )));
+    }
+    Ok(())
 }
 
 /// `(a,)` or `(a, b, ...)` as Python prints a shape.

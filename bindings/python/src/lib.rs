@@ -214,7 +214,9 @@ fn ser<T: serde::Serialize>(py: Python<'_>, x: &T) -> PyResult<Py<PyAny>> {
 /// A BRDF opened from a SOURCE: an analytic model spec, a table (`FILE`, `DB#NAME`), a MERL
 /// `.binary` or an RGL `.bsdf` file. Directions are in the local frame (z = normal), both
 /// pointing away from the surface; `wi` is the direction to the light, `wo` to the viewer.
-/// Pickles by its source and options.
+/// Array arguments are anything numpy reads as real numbers; a `numpy.ma` masked array with
+/// masked entries is a `ValueError` (fill or drop them first). Pickles by its source and
+/// options.
 #[pyclass(name = "Brdf", module = "brdftab", frozen)]
 struct PyBrdf {
     inner: Arc<dyn Brdf + Send + Sync>,

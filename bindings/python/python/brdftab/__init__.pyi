@@ -15,7 +15,12 @@ class Error(Exception):
     """An error of the brdftab library; the message is the library's."""
 
 class Brdf:
-    """A BRDF opened from a SOURCE (spec, table, DB#NAME, MERL .binary, RGL .bsdf)."""
+    """A BRDF opened from a SOURCE (spec, table, DB#NAME, MERL .binary, RGL .bsdf).
+
+    Array arguments are anything numpy reads as real numbers (any float, int or bool dtype,
+    either byte order, any strides; complex, object and string dtypes are a TypeError). A
+    numpy.ma masked array with masked entries is a ValueError (fill or drop them first); one
+    without is read as its data."""
 
     def device_layout(self) -> dict[str, Any]:
         """A table SOURCE's device layout for its interpolation (`Table.device_layout`), the

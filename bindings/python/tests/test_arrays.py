@@ -1,0 +1,57 @@
+"""What numpy users pass to the array-taking calls (eval, eval_spectral, pdf, sample, albedo):
+masked arrays. Each is read as numpy reads it or refused with a ValueError naming the argument;
+none is silently wrong."""
+
+import numpy as np
+import pytest
+
+import brdftab
+
+GGX = '{"model": "ggx", "alpha": 0.3, "fresnel": {"conductor": "Cu"}}'
+WI = np.array([[0.3, 0.1, 0.9], [0.0, 0.0, 1.0], [-0.4, 0.2, 0.8]])
+WO = np.array([[0.0, 0.0, 1.0], [0.2, 0.0, 0.9], [0.5, -0.5, 0.7]])
+U = np.array([[0.1, 0.2], [0.5, 0.5], [0.9, 0.3]])
+NM = np.array([450.0, 550.0, 650.0])
+THETA = np.array([0.1, 0.7, 1.2])
+
+
+def masked(a, row):
+    """`a` as a masked array with one entry of `row` masked (its data left as it is)."""
+    mask = np.zeros(a.shape, bool)
+    mask[row if a.ndim == 1 else (row, 0)] = True
+    return np.ma.masked_array(a, mask=mask)
+
+
+# Every array argument of every call: (call, the position of the argument, its name).
+CALLS = [
+    ("eval", (WI, WO), 0, "wi"),
+    ("eval", (WI, WO), 1, "wo"),
+    ("eval_spectral", (WI, WO, NM), 0, "wi"),
+    ("eval_spectral", (WI, WO, NM), 2, "nm"),
+    ("pdf", (WI, WO), 1, "wo"),
+    ("sample", (WO, U), 0, "wo"),
+    ("sample", (WO, U), 1, "u"),
+    ("albedo", (THETA,), 0, "theta"),
+]
+
+
+@pytest.mark.parametrize("call,args,k,name", CALLS)
+def test_a_masked_array_with_masked_entries_is_refused(call, args, k, name):
+    """Masked entries used to be evaluated as if valid (the mask was ignored)."""
+    b = brdftab.open(GGX)
+    args = list(args)
+    args[k] = masked(args[k], 1)
+    with pytest.raises(ValueError, match=f"{name}: a masked array with masked entries"):
+        getattr(b, call)(*args)
+
+
+@pytest.mark.parametrize("call,args,k,name", CALLS)
+def test_a_masked_array_without_masked_entries_is_its_data(call, args, k, name):
+    b = brdftab.open(GGX)
+    ref = getattr(b, call)(*args)
+    for m in (np.ma.masked_array(args[k]), np.ma.masked_array(args[k], mask=False)):
+        got = getattr(b, call)(*[m if i == k else a for i, a in enumerate(args)])
+        for x, y in zip(ref if isinstance(ref, tuple) else [ref],
+                        got if isinstance(got, tuple) else [got]):
+            assert type(y) is np.ndarray
+            np.testing.assert_array_equal(x, y)
