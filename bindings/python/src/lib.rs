@@ -365,7 +365,9 @@ impl PyBrdf {
     }
 
     /// f_r(wi, wo) at wavelengths `nm` (shape (k,) for every pair, or (n, k)): float32 (n, k).
-    /// Spectral channels are interpolated; analytic models use their spectral data.
+    /// Spectral channels are interpolated; analytic models use their spectral data. A
+    /// wavelength must be finite and > 0 (the library's rule, as for `wavelengths=`): any
+    /// other is a `ValueError`.
     fn eval_spectral(
         &self,
         py: Python<'_>,
@@ -389,8 +391,10 @@ impl PyBrdf {
                 }
             };
             let nm: Vec<f64> = l.as_array().iter().copied().collect();
-            if nm.iter().any(|x| !x.is_finite()) {
-                return Err(PyValueError::new_err("nm: non-finite wavelength"));
+            if let Some(x) = nm.iter().find(|&&x| !brdftab::spectrum::is_wavelength(x)) {
+                return Err(PyValueError::new_err(format!(
+                    "nm: {x} is not a wavelength (a finite number of nm > 0)"
+                )));
             }
             let shape: &[usize] = if p.single { &[k] } else { &[n, k] };
             let out = arrays::zeros::<f32>(py, shape);

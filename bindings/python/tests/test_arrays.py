@@ -1,6 +1,6 @@
 """What numpy users pass to the array-taking calls (eval, eval_spectral, pdf, sample, albedo):
-masked arrays. Each is read as numpy reads it or refused with a ValueError naming the argument;
-none is silently wrong."""
+masked arrays, wavelengths that are none. Each is read as numpy reads it or refused with a
+ValueError naming the argument; none is silently wrong."""
 
 import numpy as np
 import pytest
@@ -55,3 +55,13 @@ def test_a_masked_array_without_masked_entries_is_its_data(call, args, k, name):
                         got if isinstance(got, tuple) else [got]):
             assert type(y) is np.ndarray
             np.testing.assert_array_equal(x, y)
+
+
+def test_a_wavelength_that_is_none_is_a_value_error():
+    """nm <= 0 was evaluated (at the first channel); the library's rule for a wavelength is
+    the one `wavelengths=` keeps: finite and > 0."""
+    b = brdftab.open(GGX)
+    for bad in ([0.0], [550.0, -5.0], [[500.0], [0.0], [600.0]], [np.nan], [np.inf]):
+        with pytest.raises(ValueError, match="nm: .* is not a wavelength"):
+            b.eval_spectral(WI, WO, bad)
+    assert b.eval_spectral(WI, WO, [1e-3, 550.0, 1e6]).shape == (3, 3)

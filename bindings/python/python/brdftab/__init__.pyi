@@ -44,7 +44,8 @@ class Brdf:
 
         NaN, infinite or zero directions give 0 (not an error), as in every host."""
     def eval_spectral(self, wi: ArrayLike, wo: ArrayLike, nm: ArrayLike) -> npt.NDArray[np.float32]:
-        """f_r at wavelengths nm ((k,) or (n, k)): (n, k) float32."""
+        """f_r at wavelengths nm ((k,) or (n, k); each finite and > 0, else ValueError):
+        (n, k) float32."""
     def pdf(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float64]:
         """Density of `sample` drawing wi given wo: (n,) float64."""
     def sample(
