@@ -8,7 +8,6 @@
 
 use brdftab::batch::{BLOCK, blocks};
 use glam::{DVec2, DVec3};
-use numpy::ndarray::IxDyn;
 use numpy::{Element, PyArrayDyn, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -279,12 +278,33 @@ impl<'a, A: Row, B: Row> Pairs<'a, A, B> {
     }
 }
 
-/// A new zero-filled numpy array of `shape` (numpy's `zeros`: calloc'ed pages).
+/// A new zero-filled numpy array of `shape` (numpy's `zeros`: calloc'ed pages). A shape
+/// beyond memory is numpy's `MemoryError` (beyond the address space its `ValueError`), not a
+/// panic: `PyArray::zeros` panics when numpy fails.
 pub(crate) fn zeros<'py, T: Element>(
     py: Python<'py>,
     shape: &[usize],
-) -> Bound<'py, PyArrayDyn<T>> {
-    PyArrayDyn::<T>::zeros(py, IxDyn(shape), false)
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+    use numpy::npyffi::{PY_ARRAY_API, npy_intp};
+    use numpy::{PyArrayDescrMethods, dtype};
+    let mut dims = shape
+        .iter()
+        .map(|&d| npy_intp::try_from(d))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|_| PyValueError::new_err(format!("shape {} is too large", shape_str(shape))))?;
+    // SAFETY: `dims` holds `dims.len()` dimensions; the dtype reference is stolen by numpy;
+    // the result is a new reference to a C-ordered array of `T` (or NULL with an exception
+    // set, turned into the `PyErr`).
+    unsafe {
+        let ptr = PY_ARRAY_API.PyArray_Zeros(
+            py,
+            dims.len() as std::ffi::c_int,
+            dims.as_mut_ptr(),
+            dtype::<T>(py).into_dtype_ptr(),
+            0,
+        );
+        Ok(Bound::from_owned_ptr_or_err(py, ptr)?.cast_into_unchecked())
+    }
 }
 
 /// A fresh `(n, 3)` float64 output array's numbers as `[DVec3]` (numpy's allocations are

@@ -1,6 +1,10 @@
 """What numpy users pass to the array-taking calls (eval, eval_spectral, pdf, sample, albedo):
-masked arrays, wavelengths that are none. Each is read as numpy reads it or refused with a
-ValueError naming the argument; none is silently wrong."""
+masked arrays, broadcast views of any length, wavelengths that are none. Each is read as
+numpy reads it or refused with a ValueError/MemoryError naming the argument; none is silently
+wrong and none aborts the interpreter."""
+
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -65,3 +69,43 @@ def test_a_wavelength_that_is_none_is_a_value_error():
         with pytest.raises(ValueError, match="nm: .* is not a wavelength"):
             b.eval_spectral(WI, WO, bad)
     assert b.eval_spectral(WI, WO, [1e-3, 550.0, 1e6]).shape == (3, 3)
+
+
+# Run in a child: a regression aborts it (a failed allocation in Rust) instead of pytest.
+@pytest.mark.parametrize("call", [
+    # theta and nm of 2^40 entries without memory (zero strides): were copied into a Vec and
+    # aborted the interpreter ("memory allocation of 8796093022208 bytes failed").
+    "b.albedo(np.broadcast_to(0.5, (2**40,)))",
+    "b.eval_spectral(WI, WO, np.broadcast_to(550.0, (2**40,)))",
+    # A result beyond memory (n 10^6 × k 10^7 float32): was "internal error in brdftab
+    # (please report): Python API call failed" (a panic where numpy had refused).
+    "b.eval_spectral(np.tile(WI, (333334, 1)), WO[0], np.broadcast_to(550.0, (10**7,)))",
+])
+def test_a_result_beyond_memory_is_a_memory_error(call):
+    code = (
+        "import numpy as np, brdftab\n"
+        f"b = brdftab.open({GGX!r})\n"
+        f"WI = np.array({WI.tolist()}); WO = np.array({WO.tolist()})\n"
+        "try:\n"
+        f"    {call}\n"
+        "except MemoryError as e:\n"
+        "    print('refused')\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and r.stdout.strip() == "refused", (r.returncode, r.stdout,
+                                                                 r.stderr[-2000:])
+
+
+def test_broadcast_views_are_read_in_place():
+    """A zero-stride nm or theta (numpy.broadcast_to) gives what its copy gives."""
+    b = brdftab.open(GGX)
+    nm = np.broadcast_to(550.0, (4,))
+    np.testing.assert_array_equal(b.eval_spectral(WI, WO, nm),
+                                  b.eval_spectral(WI, WO, np.full(4, 550.0)))
+    per_row = np.broadcast_to(NM[:, None], (3, 2))
+    np.testing.assert_array_equal(b.eval_spectral(WI, WO, per_row),
+                                  b.eval_spectral(WI, WO, per_row.copy()))
+    th = np.broadcast_to(0.7, (3,))
+    np.testing.assert_array_equal(b.albedo(th), b.albedo(np.full(3, 0.7)))
+    np.testing.assert_array_equal(b.albedo(THETA[::-1]), b.albedo(THETA.copy()[::-1].copy()))
+    assert b.albedo(0.7).shape == (3,) and b.albedo([]).shape == (0, 3)

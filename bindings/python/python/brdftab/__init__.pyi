@@ -20,7 +20,7 @@ class Brdf:
     Array arguments are anything numpy reads as real numbers (any float, int or bool dtype,
     either byte order, any strides; complex, object and string dtypes are a TypeError). A
     numpy.ma masked array with masked entries is a ValueError (fill or drop them first); one
-    without is read as its data."""
+    without is read as its data. A result beyond memory is numpy's MemoryError."""
 
     def device_layout(self) -> dict[str, Any]:
         """A table SOURCE's device layout for its interpolation (`Table.device_layout`), the
