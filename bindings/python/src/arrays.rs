@@ -9,7 +9,7 @@
 use brdftab::batch::{BLOCK, blocks};
 use glam::{DVec2, DVec3};
 use numpy::{Element, PyArrayDyn, PyReadonlyArrayDyn, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 // `[f64; 3k]` is read as `[DVec3; k]` and `[f64; 2k]` as `[DVec2; k]`.
@@ -156,8 +156,16 @@ impl<'py, T: Row> Rows<'py, T> {
         let (owned, ptr) = if aligned {
             (Vec::new(), flat.as_ptr() as *const T)
         } else {
-            // A misaligned buffer (e.g. a view into bytes): copied, once.
-            let v: Vec<T> = flat.chunks_exact(w).map(T::from).collect();
+            // A misaligned buffer (e.g. a view into bytes): copied, once; a copy beyond memory
+            // is a `MemoryError`, not an abort.
+            let mut v: Vec<T> = Vec::new();
+            v.try_reserve_exact(flat.len() / w).map_err(|_| {
+                PyMemoryError::new_err(format!(
+                    "{name}: no memory for an aligned copy of {} rows",
+                    flat.len() / w
+                ))
+            })?;
+            v.extend(flat.chunks_exact(w).map(T::from));
             let p = v.as_ptr();
             (v, p)
         };

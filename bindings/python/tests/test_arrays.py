@@ -109,3 +109,30 @@ def test_broadcast_views_are_read_in_place():
     np.testing.assert_array_equal(b.albedo(th), b.albedo(np.full(3, 0.7)))
     np.testing.assert_array_equal(b.albedo(THETA[::-1]), b.albedo(THETA.copy()[::-1].copy()))
     assert b.albedo(0.7).shape == (3,) and b.albedo([]).shape == (0, 3)
+
+
+def test_a_misaligned_input_beyond_memory_is_a_memory_error():
+    """A misaligned float64 view (of bytes at an odd offset) is copied into aligned rows; with
+    no memory left for the copy the interpreter aborted ("memory allocation of 480000000 bytes
+    failed"). Run in a child under an address-space limit that holds the input, not a copy."""
+    code = (
+        "import resource, numpy as np, brdftab\n"
+        f"b = brdftab.open({GGX!r})\n"
+        "n = 20_000_000\n"
+        "raw = np.zeros(n * 24 + 1, np.uint8)\n"
+        "wi = np.frombuffer(raw.data, np.float64, count=n * 3, offset=1).reshape(n, 3)\n"
+        "assert wi.ctypes.data % 8 != 0\n"
+        "b.eval(wi[:20000], wi[:20000])  # the library's threads exist before the limit\n"
+        "vm = next(int(l.split()[1]) * 1024 for l in open('/proc/self/status')\n"
+        "          if l.startswith('VmSize:'))\n"
+        "hard = resource.getrlimit(resource.RLIMIT_AS)[1]\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (vm + (200 << 20), hard))\n"
+        "try:\n"
+        "    b.eval(wi, [0, 0, 1])\n"
+        "except MemoryError as e:\n"
+        "    assert 'wi' in str(e), e\n"
+        "    print('refused')\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and r.stdout.strip() == "refused", (r.returncode, r.stdout,
+                                                                 r.stderr[-2000:])
