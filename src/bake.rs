@@ -224,17 +224,19 @@ impl BakeTarget {
     /// Reads an output string the way `convert` does: `DB#NAME` is a database entry, a `.btdb`
     /// file a single-table file (or, with `name`, an entry of that database), anything else a
     /// raw table file.
-    pub fn parse(output: &str, name: Option<&str>, replace: bool) -> BakeTarget {
-        let (path, entry) = db::split_source(output);
-        match (entry.or(name), path.to_ascii_lowercase().ends_with(".btdb")) {
-            (Some(n), _) => BakeTarget::Db {
-                path: path.into(),
-                name: n.into(),
-                replace,
+    pub fn parse(output: &str, name: Option<&str>, replace: bool) -> Result<BakeTarget> {
+        let (path, entry) = crate::store::name::parse_source("output", output)?;
+        Ok(
+            match (entry.or(name), path.to_ascii_lowercase().ends_with(".btdb")) {
+                (Some(n), _) => BakeTarget::Db {
+                    path: path.into(),
+                    name: n.into(),
+                    replace,
+                },
+                (None, true) => BakeTarget::File(path.into()),
+                (None, false) => BakeTarget::Raw(path.into()),
             },
-            (None, true) => BakeTarget::File(path.into()),
-            (None, false) => BakeTarget::Raw(path.into()),
-        }
+        )
     }
 
     /// The file written.
@@ -732,6 +734,16 @@ impl BakeRequest {
     /// [`run`](Self::run), reporting progress.
     pub fn run_with(&self, target: &BakeTarget, progress: &dyn Progress) -> Result<BakeReport> {
         self.refuse_overwrite(target)?;
+        let name = match (target, &self.name) {
+            (BakeTarget::Db { name, .. }, _) => name.clone(),
+            (_, Some(n)) => n.clone(),
+            (t, None) => stem(t.path()),
+        };
+        // Before any work (and before a `File` target's old file is removed): a table name
+        // the store would refuse ([`crate::store::name`]).
+        if matches!(target, BakeTarget::File(_) | BakeTarget::Db { .. }) {
+            crate::store::name::check("name", &name)?;
+        }
         let src = self.open_source()?;
         if let BakeTarget::Merl(path) = target {
             let t0 = Instant::now();
@@ -745,11 +757,6 @@ impl BakeRequest {
             return Ok(report);
         }
         let provenance = source::provenance(&self.source, src.as_ref())?;
-        let name = match (target, &self.name) {
-            (BakeTarget::Db { name, .. }, _) => name.clone(),
-            (_, Some(n)) => n.clone(),
-            (t, None) => stem(t.path()),
-        };
         let (mut report, table) = match target {
             BakeTarget::Raw(path) => {
                 let (table, r) = self.table_of(src.as_ref(), progress)?;
@@ -805,7 +812,7 @@ impl BakeRequest {
     /// database a `DB#NAME` source reads is fine (the source entry is kept as it is).
     fn refuse_overwrite(&self, target: &BakeTarget) -> Result<()> {
         if let BakeTarget::Db { name, .. } = target
-            && let (_, Some(entry)) = db::split_source(&self.source)
+            && let Ok((_, Some(entry))) = db::split_source(&self.source)
             && entry != name
         {
             return Ok(());
@@ -1022,7 +1029,7 @@ impl Accuracy {
 
 /// A file name's stem (`table` when it has none).
 pub fn stem(path: &str) -> String {
-    Path::new(db::split_source(path).0)
+    Path::new(crate::store::name::path_of(path))
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "table".into())
@@ -1127,17 +1134,21 @@ mod tests {
     #[test]
     fn targets_parse_like_convert() {
         assert_eq!(
-            BakeTarget::parse("a.btdb#x", None, false),
+            BakeTarget::parse("a.btdb#x", None, false).unwrap(),
             BakeTarget::db("a.btdb", "x")
         );
         assert_eq!(
-            BakeTarget::parse("a.btdb", None, false),
+            BakeTarget::parse("a.btdb", None, false).unwrap(),
             BakeTarget::file("a.btdb")
         );
         assert_eq!(
-            BakeTarget::parse("a.tbl", None, false),
+            BakeTarget::parse("a.tbl", None, false).unwrap(),
             BakeTarget::Raw("a.tbl".into())
         );
+        assert!(matches!(
+            BakeTarget::parse("a.btdb#", None, false),
+            Err(Error::InvalidArgument { ref name, .. }) if name == "output"
+        ));
     }
 
     #[test]

@@ -91,7 +91,7 @@ pub fn key(source: &str, settings: &BakeSettings) -> Result<String> {
         part(source.trim().as_bytes());
     } else {
         let (file, name) = match kind {
-            SourceKind::Table => crate::store::db::split_source(source),
+            SourceKind::Table => crate::store::db::split_source(source)?,
             _ => (source, None),
         };
         part(&content_hash(Path::new(file))?.to_le_bytes());

@@ -85,15 +85,7 @@ pub fn source_file(source: &str) -> Option<&str> {
     if source.trim_start().starts_with('{') {
         return None;
     }
-    Some(split_source(source))
-}
-
-/// The path part of `DB#NAME` (as [`crate::store::db::split_source`] splits it).
-fn split_source(source: &str) -> &str {
-    match source.rsplit_once('#') {
-        Some((p, n)) if !n.is_empty() && !n.contains('/') => p,
-        _ => source,
-    }
+    Some(crate::store::name::path_of(source))
 }
 
 /// Refuses to write `output` when it is the file one of `inputs` (SOURCE strings or paths)

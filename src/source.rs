@@ -195,7 +195,9 @@ pub fn open(source: &str) -> Result<Box<dyn Brdf + Send + Sync>> {
 /// Opens SOURCE as `opts` say (see [`open`] for the kinds).
 pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send + Sync>> {
     // Stat before any open: a FIFO, socket, device or directory is refused at once.
-    if let Some(f) = crate::files::source_file(source) {
+    // `x.btdb#` or a control character in NAME is an argument error, not a path to stat.
+    if crate::files::source_file(source).is_some() {
+        let (f, _) = crate::store::name::parse_source("source", source)?;
         crate::files::require_regular(f)?;
     }
     let fixed_channels = |brdf: Box<dyn Brdf + Send + Sync>| match &opts.channels {
@@ -225,7 +227,7 @@ pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send
 
 /// Opens a table SOURCE (`FILE`, `DB#NAME` or a raw table) as a [`TabulatedBrdf`].
 pub fn open_table(source: &str, opts: &OpenOptions) -> Result<TabulatedBrdf> {
-    let path = crate::store::db::split_source(source).0;
+    let path = crate::store::db::split_source(source)?.0;
     crate::files::require_regular(path)?;
     let brdf = if crate::store::tables::is_store_file(path) {
         crate::store::tables::open_brdf(source, opts.eager)?

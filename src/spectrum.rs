@@ -51,7 +51,7 @@ impl Channels {
             ));
         }
         for (i, &w) in nm.iter().enumerate() {
-            if !(w.is_finite() && w > 0.0) {
+            if !is_wavelength(w) {
                 return Err(Error::arg("wavelengths", format!("wavelength {i} is {w}")));
             }
             if i > 0 && w <= nm[i - 1] {
@@ -120,6 +120,12 @@ impl Channels {
             Channels::Wavelengths(w) => lerp_sorted(w, nm, |k| k),
         }
     }
+}
+
+/// Whether `nm` can be a wavelength: finite and positive. The rule of
+/// [`Channels::wavelengths`], and of every wavelength a host evaluates at.
+pub fn is_wavelength(nm: f64) -> bool {
+    nm.is_finite() && nm > 0.0
 }
 
 fn lerp_sorted(w: &[f64], nm: f64, map: impl Fn(usize) -> usize) -> (usize, usize, f64) {

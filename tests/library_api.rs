@@ -84,6 +84,64 @@ fn a_taken_name_is_a_duplicate_error_naming_no_flag() {
     assert!(!e.to_string().contains("--"), "{e}");
 }
 
+/// The field an argument error names (panics on any other error).
+fn field(r: Result<impl std::fmt::Debug, Error>) -> String {
+    match r {
+        Err(Error::InvalidArgument { name, .. }) => name,
+        r => panic!("not an argument error: {r:?}"),
+    }
+}
+
+#[test]
+fn empty_table_names_and_control_characters_are_argument_errors_on_every_road() {
+    use brdftab::request::{self, BakeSettings};
+    let d = TempDir::new("api-names");
+    let db = d.file("m.btdb");
+    let settings = BakeSettings {
+        preset: Some("small".into()),
+        ..BakeSettings::default()
+    };
+    // `DB#` with nothing after the `#` was written as a file named `m.btdb#`.
+    let out = format!("{db}#");
+    assert_eq!(
+        field(request::bake(LAMBERT, &out, &settings, &Silent)),
+        "output"
+    );
+    assert!(!d.join("m.btdb#").exists() && !d.join("m.btdb").exists());
+    // A NUL, a tab or an escape in NAME was stored as given.
+    for name in ["\0", "a\tb", "\u{1b}[31m"] {
+        let out = format!("{db}#{name}");
+        assert_eq!(
+            field(request::bake(LAMBERT, &out, &settings, &Silent)),
+            "output"
+        );
+        let named = BakeSettings {
+            name: Some(name.into()),
+            ..settings.clone()
+        };
+        assert_eq!(field(request::bake(LAMBERT, &db, &named, &Silent)), "name");
+    }
+    assert!(!d.join("m.btdb").exists());
+    // Reading: `m.btdb#` is no path to a file of that name, even when one exists.
+    std::fs::write(d.join("m.btdb#"), b"not read").unwrap();
+    assert_eq!(field(brdftab::open(&out).map(|_| ())), "source");
+    assert_eq!(field(info::file_info(&out)), "source");
+    // The store's own entry points keep the same rule.
+    request::bake(LAMBERT, &format!("{db}#ok"), &settings, &Silent).unwrap();
+    let s = brdftab::store::Store::open(&db).unwrap();
+    let e = brdftab::store::db::import(d.join("n.btdb"), &s, "ok", "\0", false);
+    assert_eq!(field(e), "name");
+    assert!(!d.join("n.btdb").exists());
+    // A default name (the output file's stem) is checked before the old file is replaced.
+    let stem = d.file("a\u{7}b.btdb");
+    std::fs::write(&stem, b"kept").unwrap();
+    assert_eq!(
+        field(request::bake(LAMBERT, &stem, &settings, &Silent)),
+        "name"
+    );
+    assert_eq!(std::fs::read(&stem).unwrap(), b"kept");
+}
+
 #[test]
 fn library_argument_errors_name_settings_not_flags() {
     let errors = [

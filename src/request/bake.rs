@@ -118,6 +118,9 @@ impl BakeSettings {
             self.level,
             self.exhaustive,
         )?;
+        if let Some(n) = &self.name {
+            crate::store::name::check("name", n)?;
+        }
         r.name = self.name.clone();
         if let Some(k) = self.supersample {
             if !(1..=fill::MAX_SUPERSAMPLE).contains(&k) {
@@ -156,19 +159,20 @@ pub fn bake(
     progress: &dyn Progress,
 ) -> Result<BakeReport> {
     let req = settings.request(source)?;
-    req.run_with(&target(output, settings.replace), progress)
+    req.run_with(&target(output, settings.replace)?, progress)
 }
 
-/// Where [`bake`] writes `output`.
-pub fn target(output: &str, replace: bool) -> BakeTarget {
-    match crate::store::db::split_source(output) {
+/// Where [`bake`] writes `output`; a `DB#NAME` with an empty or invalid name is an argument
+/// error naming `output` ([`crate::store::name`]).
+pub fn target(output: &str, replace: bool) -> Result<BakeTarget> {
+    Ok(match crate::store::name::parse_source("output", output)? {
         (path, Some(name)) => BakeTarget::Db {
             path: path.into(),
             name: name.into(),
             replace,
         },
         (path, None) => BakeTarget::File(path.into()),
-    }
+    })
 }
 
 /// The same error naming `field` (a parser names what it parses, e.g. `preset` for a grid).
@@ -182,6 +186,20 @@ fn rename(e: Error, field: &str) -> Error {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_output_with_an_empty_or_control_character_name_is_an_output_error() {
+        for out in ["x.btdb#", "x.btdb#\0", "x.btdb#a\u{1b}b"] {
+            match target(out, false) {
+                Err(Error::InvalidArgument { ref name, .. }) => assert_eq!(name, "output"),
+                r => panic!("{out:?}: {r:?}"),
+            }
+        }
+        assert_eq!(
+            target("x.btdb#m", false).unwrap(),
+            BakeTarget::db("x.btdb", "m")
+        );
+    }
 
     #[test]
     fn defaults_are_the_requests_defaults_and_bad_values_name_their_field() {
@@ -203,6 +221,9 @@ mod tests {
             (r#"{"level": 30}"#, "level"),
             (r#"{"target_error": "-1%"}"#, "target_error"),
             (r#"{"wavelengths": [500, 400]}"#, "wavelengths"),
+            (r#"{"name": ""}"#, "name"),
+            (r#"{"name": "\u0000"}"#, "name"),
+            (r#"{"name": "a\tb"}"#, "name"),
         ] {
             let e = super::super::from_json::<BakeSettings>(json)
                 .and_then(|s| s.request(spec))

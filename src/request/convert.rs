@@ -113,7 +113,7 @@ pub fn convert(
                 req.accuracy_interp = i.parse()?;
             }
             let replace = settings.bake.replace;
-            let target = match BakeTarget::parse(output, None, replace) {
+            let target = match BakeTarget::parse(output, None, replace)? {
                 BakeTarget::File(path) => BakeTarget::Db {
                     path,
                     name: req.name.clone().unwrap_or_else(|| bake::stem(source)),

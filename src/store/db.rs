@@ -93,6 +93,8 @@ pub fn put(
     write: impl FnOnce(&mut Writer) -> Result<()>,
 ) -> Result<()> {
     let path = path.as_ref();
+    // Before the lock file or the database is touched.
+    super::name::check("name", &header.name)?;
     let _lock = lock(path)?;
     let old = existing(path)?;
     let name = header.name.clone();
@@ -175,10 +177,8 @@ pub fn verify(path: impl AsRef<Path>) -> Result<usize> {
     Store::open(path)?.verify()
 }
 
-/// Splits `DB#NAME` into the path and the optional table name.
-pub fn split_source(source: &str) -> (&str, Option<&str>) {
-    match source.rsplit_once('#') {
-        Some((p, n)) if !n.is_empty() && !n.contains('/') => (p, Some(n)),
-        _ => (source, None),
-    }
+/// Splits SOURCE `DB#NAME` into the path and the optional table name; an empty name
+/// (`x.btdb#`) or one [`super::name::check`] refuses is an argument error naming `source`.
+pub fn split_source(source: &str) -> Result<(&str, Option<&str>)> {
+    super::name::parse_source("source", source)
 }

@@ -60,7 +60,7 @@ pub fn list(path: &str) -> Result<Vec<Value>> {
 
 /// What `info` reports of `FILE` (every table) or `DB#NAME` (that table).
 pub fn file_info(source: &str) -> Result<Value> {
-    let (path, name) = db::split_source(source);
+    let (path, name) = db::split_source(source)?;
     let s = Store::open(path)?;
     let names: Vec<String> = match name {
         Some(n) => vec![n.to_owned()],

@@ -49,6 +49,7 @@ pub mod db;
 pub mod export;
 pub mod format;
 pub mod info;
+pub mod name;
 pub mod tables;
 mod writer;
 

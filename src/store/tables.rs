@@ -222,7 +222,7 @@ pub fn is_store_file(path: impl AsRef<Path>) -> bool {
 /// [`TabulatedBrdf`](crate::table::TabulatedBrdf). With `eager`, every chunk is decoded now (in
 /// parallel) and checked.
 pub fn open_brdf(source: &str, eager: bool) -> Result<crate::table::TabulatedBrdf> {
-    let (path, name) = db::split_source(source);
+    let (path, name) = db::split_source(source)?;
     let store = super::Store::open(path)?;
     let t = match name {
         Some(n) => store.table(n)?,

@@ -86,15 +86,7 @@ impl Writer {
         if self.table.is_some() {
             return Err(Error::arg("table", "the previous table was not ended"));
         }
-        if header.name.is_empty() || header.name.contains('#') {
-            return Err(Error::arg(
-                "name",
-                format!(
-                    "table name `{}` must be non-empty and contain no `#`",
-                    header.name
-                ),
-            ));
-        }
+        super::name::check("name", &header.name)?;
         if self.names().any(|n| n == header.name) {
             return Err(Error::Duplicate {
                 container: self.path.display().to_string(),

@@ -31,7 +31,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
             "give --npy OUT and/or --exr OUT --slice ...",
         ));
     }
-    let (path, name) = db::split_source(&a.file);
+    let (path, name) = db::split_source(&a.file)?;
     let s = Store::open(path)?;
     let t = match name {
         Some(n) => s.table(n)?,

@@ -27,7 +27,7 @@ pub fn info(a: InfoArgs) -> Result<()> {
         return print_out(&brdftab::measured::info::describe(&a.file)?);
     }
     let (v, text): (_, fn(&serde_json::Value) -> String) =
-        if tables::is_store_file(db::split_source(&a.file).0) {
+        if tables::is_store_file(db::split_source(&a.file)?.0) {
             (info::file_info(&a.file)?, info::file_text)
         } else {
             (info::raw_info(&a.file)?, info::raw_text)

@@ -113,6 +113,30 @@ static void corrupt_table(const char *path) {
           "an eager open of a corrupt table fails");
 }
 
+/* Table names (the library's store::name rule): `DB#` with nothing after the '#' and names with
+ * control characters are -1 naming the field; `x.btdb#` was baked into a file of that name. */
+static void table_names(const char *near) {
+    const char *spec = "{\"model\": \"lambert\", \"kd\": 0.5}";
+    char out[4096];
+    snprintf(out, sizeof out, "%s.names.btdb#", near);
+    CHECK(brdftab_bake(spec, out, "{\"preset\": \"small\"}") == -1 &&
+              strstr(brdftab_last_error(), "output"),
+          "bake to DB# (no name) is -1 naming output");
+    FILE *f = fopen(out, "rb");
+    CHECK(f == NULL, "no file named DB# written");
+    if (f) fclose(f);
+    CHECK(brdftab_open(out) == NULL && strstr(brdftab_last_error(), "source"),
+          "open DB# (no name) is NULL naming source");
+    snprintf(out, sizeof out, "%s.names.btdb#a\tb", near);
+    CHECK(brdftab_bake(spec, out, "{\"preset\": \"small\"}") == -1 &&
+              strstr(brdftab_last_error(), "control character"),
+          "bake to DB#NAME with a tab in NAME is -1");
+    snprintf(out, sizeof out, "%s.names.btdb", near);
+    CHECK(brdftab_bake(spec, out, "{\"preset\": \"small\", \"name\": \"a\\u0001b\"}") == -1 &&
+              strstr(brdftab_last_error(), "name"),
+          "a name setting with a control character is -1 naming name");
+}
+
 int main(int argc, char **argv) {
     if (argc != 3) {
         fprintf(stderr, "usage: %s GOOD BAD\n", argv[0]);
@@ -127,5 +151,6 @@ int main(int argc, char **argv) {
     non_finite_directions(b);
     brdftab_close(b);
     corrupt_table(argv[2]);
+    table_names(argv[2]);
     return failures ? 1 : 0;
 }

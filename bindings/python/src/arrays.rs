@@ -8,9 +8,8 @@
 
 use brdftab::batch::{BLOCK, blocks};
 use glam::{DVec2, DVec3};
-use numpy::ndarray::IxDyn;
 use numpy::{Element, PyArrayDyn, PyReadonlyArrayDyn, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 // `[f64; 3k]` is read as `[DVec3; k]` and `[f64; 2k]` as `[DVec2; k]`.
@@ -18,11 +17,13 @@ const _: () = assert!(std::mem::size_of::<DVec3>() == 24 && std::mem::align_of::
 const _: () = assert!(std::mem::size_of::<DVec2>() == 16 && std::mem::align_of::<DVec2>() == 8);
 
 /// A float64 view of an array-like (numpy array, list, tuple); non-numeric dtypes are a
-/// `TypeError`. A float64 array is borrowed as it is; anything else is converted once.
+/// `TypeError`, a masked array with masked entries a `ValueError` (below). A float64 array is
+/// borrowed as it is; anything else is converted once.
 pub(crate) fn f64_array<'py>(
     obj: &Bound<'py, PyAny>,
     name: &str,
 ) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+    refuse_masked(obj, name)?;
     if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'py, f64>>() {
         return Ok(a);
     }
@@ -54,6 +55,27 @@ pub(crate) fn f64_array<'py>(
         .map_err(|e| PyTypeError::new_err(format!("{name}: not an array of real numbers ({e})")))?;
     arr.extract::<PyReadonlyArrayDyn<'py, f64>>()
         .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))
+}
+
+/// A `numpy.ma.MaskedArray` is an ndarray whose data under a masked entry is whatever was
+/// there: read as an array it would be evaluated as if valid. One with masked entries is a
+/// `ValueError` (the caller fills or drops them: the library has no "no value" for a pair);
+/// one without is read as its data. A plain ndarray (the fast path) is not looked at.
+fn refuse_masked(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
+    use numpy::PyUntypedArray;
+    if obj.is_exact_instance_of::<PyUntypedArray>() || !obj.is_instance_of::<PyUntypedArray>() {
+        return Ok(());
+    }
+    let ma = obj.py().import("numpy.ma")?;
+    if obj.is_instance(&ma.getattr("MaskedArray")?)?
+        && ma.call_method1("is_masked", (obj,))?.is_truthy()?
+    {
+        return Err(PyValueError::new_err(format!(
+            "{name}: a masked array with masked entries (numpy.ma): they have no value to \
+             evaluate; fill them ({name}.filled(...)) or drop them first"
+        )));
+    }
+    Ok(())
 }
 
 /// `(a,)` or `(a, b, ...)` as Python prints a shape.
@@ -134,8 +156,16 @@ impl<'py, T: Row> Rows<'py, T> {
         let (owned, ptr) = if aligned {
             (Vec::new(), flat.as_ptr() as *const T)
         } else {
-            // A misaligned buffer (e.g. a view into bytes): copied, once.
-            let v: Vec<T> = flat.chunks_exact(w).map(T::from).collect();
+            // A misaligned buffer (e.g. a view into bytes): copied, once; a copy beyond memory
+            // is a `MemoryError`, not an abort.
+            let mut v: Vec<T> = Vec::new();
+            v.try_reserve_exact(flat.len() / w).map_err(|_| {
+                PyMemoryError::new_err(format!(
+                    "{name}: no memory for an aligned copy of {} rows",
+                    flat.len() / w
+                ))
+            })?;
+            v.extend(flat.chunks_exact(w).map(T::from));
             let p = v.as_ptr();
             (v, p)
         };
@@ -256,12 +286,33 @@ impl<'a, A: Row, B: Row> Pairs<'a, A, B> {
     }
 }
 
-/// A new zero-filled numpy array of `shape` (numpy's `zeros`: calloc'ed pages).
+/// A new zero-filled numpy array of `shape` (numpy's `zeros`: calloc'ed pages). A shape
+/// beyond memory is numpy's `MemoryError` (beyond the address space its `ValueError`), not a
+/// panic: `PyArray::zeros` panics when numpy fails.
 pub(crate) fn zeros<'py, T: Element>(
     py: Python<'py>,
     shape: &[usize],
-) -> Bound<'py, PyArrayDyn<T>> {
-    PyArrayDyn::<T>::zeros(py, IxDyn(shape), false)
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+    use numpy::npyffi::{PY_ARRAY_API, npy_intp};
+    use numpy::{PyArrayDescrMethods, dtype};
+    let mut dims = shape
+        .iter()
+        .map(|&d| npy_intp::try_from(d))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|_| PyValueError::new_err(format!("shape {} is too large", shape_str(shape))))?;
+    // SAFETY: `dims` holds `dims.len()` dimensions; the dtype reference is stolen by numpy;
+    // the result is a new reference to a C-ordered array of `T` (or NULL with an exception
+    // set, turned into the `PyErr`).
+    unsafe {
+        let ptr = PY_ARRAY_API.PyArray_Zeros(
+            py,
+            dims.len() as std::ffi::c_int,
+            dims.as_mut_ptr(),
+            dtype::<T>(py).into_dtype_ptr(),
+            0,
+        );
+        Ok(Bound::from_owned_ptr_or_err(py, ptr)?.cast_into_unchecked())
+    }
 }
 
 /// A fresh `(n, 3)` float64 output array's numbers as `[DVec3]` (numpy's allocations are

@@ -214,7 +214,9 @@ fn ser<T: serde::Serialize>(py: Python<'_>, x: &T) -> PyResult<Py<PyAny>> {
 /// A BRDF opened from a SOURCE: an analytic model spec, a table (`FILE`, `DB#NAME`), a MERL
 /// `.binary` or an RGL `.bsdf` file. Directions are in the local frame (z = normal), both
 /// pointing away from the surface; `wi` is the direction to the light, `wo` to the viewer.
-/// Pickles by its source and options.
+/// Array arguments are anything numpy reads as real numbers; a `numpy.ma` masked array with
+/// masked entries is a `ValueError` (fill or drop them first). Pickles by its source and
+/// options.
 #[pyclass(name = "Brdf", module = "brdftab", frozen)]
 struct PyBrdf {
     inner: Arc<dyn Brdf + Send + Sync>,
@@ -273,11 +275,6 @@ impl PyBrdf {
             .health()
             .map_err(|e| Error::new_err(format!("{}: {e}", self.source)))
     }
-}
-
-fn shaped_f64(py: Python<'_>, v: Vec<f64>, shape: &[usize]) -> PyResult<Py<PyAny>> {
-    let a = ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| Error::new_err(e.to_string()))?;
-    Ok(a.into_pyarray(py).into_any().unbind())
 }
 
 #[pymethods]
@@ -349,7 +346,7 @@ impl PyBrdf {
             let p = Pairs::new(&a, "wi", &b, "wo")?;
             let c = self.c();
             let shape: &[usize] = if p.single { &[c] } else { &[p.n, c] };
-            let out = arrays::zeros::<f32>(py, shape);
+            let out = arrays::zeros::<f32>(py, shape)?;
             let mut w = out.readwrite();
             let o = w
                 .as_slice_mut()
@@ -363,7 +360,9 @@ impl PyBrdf {
     }
 
     /// f_r(wi, wo) at wavelengths `nm` (shape (k,) for every pair, or (n, k)): float32 (n, k).
-    /// Spectral channels are interpolated; analytic models use their spectral data.
+    /// Spectral channels are interpolated; analytic models use their spectral data. A
+    /// wavelength must be finite and > 0 (the library's rule, as for `wavelengths=`): any
+    /// other is a `ValueError`.
     fn eval_spectral(
         &self,
         py: Python<'_>,
@@ -386,12 +385,18 @@ impl PyBrdf {
                     )));
                 }
             };
-            let nm: Vec<f64> = l.as_array().iter().copied().collect();
-            if nm.iter().any(|x| !x.is_finite()) {
-                return Err(PyValueError::new_err("nm: non-finite wavelength"));
-            }
+            // Read in place: a broadcast `nm` (numpy.broadcast_to) of any length is no copy,
+            // and the output is allocated (or refused by numpy) before its entries are checked.
+            let nm = l.as_array();
             let shape: &[usize] = if p.single { &[k] } else { &[n, k] };
-            let out = arrays::zeros::<f32>(py, shape);
+            let out = arrays::zeros::<f32>(py, shape)?;
+            if n > 0
+                && let Some(x) = nm.iter().find(|&&x| !brdftab::spectrum::is_wavelength(x))
+            {
+                return Err(PyValueError::new_err(format!(
+                    "nm: {x} is not a wavelength (a finite number of nm > 0)"
+                )));
+            }
             let mut w = out.readwrite();
             let o = w
                 .as_slice_mut()
@@ -402,10 +407,10 @@ impl PyBrdf {
                     let (a, b) = p.block(s, o.len() / k.max(1));
                     for (r, o) in o.chunks_exact_mut(k.max(1)).enumerate() {
                         let l = match per_row {
-                            true => &nm[(s + r) * k..(s + r + 1) * k],
-                            false => &nm[..],
+                            true => nm.index_axis(numpy::ndarray::Axis(0), s + r),
+                            false => nm.view(),
                         };
-                        for (o, &x) in o.iter_mut().zip(l) {
+                        for (o, &x) in o.iter_mut().zip(l.iter()) {
                             *o = brdf.eval_wavelength(a[r], b[r], x) as f32;
                         }
                     }
@@ -428,7 +433,7 @@ impl PyBrdf {
             let (a, b) = (Rows::<DVec3>::new(wi, "wi")?, Rows::<DVec3>::new(wo, "wo")?);
             let p = Pairs::new(&a, "wi", &b, "wo")?;
             let shape: &[usize] = if p.single { &[] } else { &[p.n] };
-            let out = arrays::zeros::<f64>(py, shape);
+            let out = arrays::zeros::<f64>(py, shape)?;
             let mut w = out.readwrite();
             let o = w
                 .as_slice_mut()
@@ -469,9 +474,9 @@ impl PyBrdf {
                 false => (&[n, 3], &[n], &[n, c]),
             };
             let (wi, pdf, weight) = (
-                arrays::zeros::<f64>(py, s3),
-                arrays::zeros::<f64>(py, s1),
-                arrays::zeros::<f32>(py, sc),
+                arrays::zeros::<f64>(py, s3)?,
+                arrays::zeros::<f64>(py, s1)?,
+                arrays::zeros::<f32>(py, sc)?,
             );
             let (mut wi_w, mut pdf_w, mut w_w) =
                 (wi.readwrite(), pdf.readwrite(), weight.readwrite());
@@ -542,20 +547,32 @@ impl PyBrdf {
                     arrays::shape_str(a.shape())
                 )));
             }
-            let t: Vec<f64> = a.as_array().iter().copied().collect();
-            for &x in &t {
-                brdftab::analysis::albedo::incidence(x).map_err(lib_err)?;
+            // Read in place and written into the numpy result, allocated (or refused by numpy)
+            // before the angles are checked: a broadcast `theta` of any length is no copy.
+            let t = a.as_array();
+            let (k, c) = (t.len(), self.c());
+            let shape: &[usize] = if single { &[c] } else { &[k, c] };
+            let out = arrays::zeros::<f64>(py, shape)?;
+            use brdftab::analysis::albedo::incidence;
+            for &x in t.iter() {
+                incidence(x).map_err(lib_err)?;
             }
+            let mut w = out.readwrite();
+            let o = w
+                .as_slice_mut()
+                .map_err(|e| Error::new_err(e.to_string()))?;
             let brdf = &self.inner;
-            let k = t.len();
-            let curve = unlocked(py, || {
-                brdftab::analysis::albedo::albedo_curve(brdf.as_ref(), &t)
+            // What `albedo::albedo_curve` computes, angle by angle into the result.
+            unlocked(py, || {
+                for (row, &x) in o.chunks_exact_mut(c.max(1)).zip(t.iter()) {
+                    if let Ok(wi) = incidence(x) {
+                        brdf.albedo(wi, row);
+                    }
+                }
             })?;
+            drop(w);
             self.check_loaded()?;
-            let c = self.c();
-            let flat: Vec<f64> = curve.into_iter().flatten().collect();
-            let shape: Vec<usize> = if single { vec![c] } else { vec![k, c] };
-            shaped_f64(py, flat, &shape)
+            Ok(out.into_any().unbind())
         })
     }
 
@@ -895,6 +912,13 @@ fn db_names(path: &str) -> PyResult<Vec<String>> {
     })
 }
 
+/// Checks a table name against the library's rule ([`brdftab::store::name::check`]):
+/// `ValueError` naming `name` for an empty name or one with `#`, `/` or a control character.
+#[pyfunction]
+fn _check_table_name(name: &str) -> PyResult<()> {
+    guard(|| brdftab::store::name::check("name", name).map_err(lib_err))
+}
+
 /// Removes table `name` from database `path`.
 #[pyfunction]
 fn db_remove(path: &str, name: &str) -> PyResult<()> {
@@ -1088,6 +1112,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(db_names, m)?)?;
     m.add_function(wrap_pyfunction!(db_remove, m)?)?;
+    m.add_function(wrap_pyfunction!(_check_table_name, m)?)?;
     m.add_function(wrap_pyfunction!(db_import, m)?)?;
     m.add_function(wrap_pyfunction!(bake, m)?)?;
     m.add_function(wrap_pyfunction!(bake_cached, m)?)?;

@@ -224,6 +224,29 @@ def test_database(tmp_path):
     assert pickle.loads(pickle.dumps(db)).names() == ["shiny"]
 
 
+def test_table_names_follow_the_librarys_rule(tmp_path):
+    """An empty name, `DB#` with nothing after the `#`, and names with control characters were
+    stored as given (a table named "\\0", a file named `n.btdb#`); the library's one rule
+    refuses them, naming the field."""
+    db = brdftab.Database(tmp_path / "n.btdb")
+    for name in ["", "\0", "a\tb", "red\x1b[0m", "a/b", "a#b"]:
+        with pytest.raises(ValueError, match="name"):
+            db.add(LAMBERT, name, preset="small")
+        with pytest.raises(ValueError, match="name"):
+            brdftab.bake(LAMBERT, tmp_path / "n.btdb", preset="small", name=name)
+    with pytest.raises(ValueError, match="output"):
+        brdftab.bake(LAMBERT, f"{tmp_path}/n.btdb#", preset="small")
+    with pytest.raises(ValueError, match="output"):
+        brdftab.bake(LAMBERT, f"{tmp_path}/n.btdb#a\nb", preset="small")
+    assert not list(tmp_path.iterdir())
+    # `x.btdb#` names no table, even when a file of that name exists.
+    (tmp_path / "x.btdb#").write_bytes(b"")
+    with pytest.raises(ValueError, match="source"):
+        brdftab.open(f"{tmp_path}/x.btdb#")
+    db.add(LAMBERT, "ok", preset="small")
+    assert db.names() == ["ok"]
+
+
 def test_convert(tmp_path, paper):
     r = brdftab.convert(paper, str(tmp_path / "rgl.btdb"), preset="small", pairs=2000)
     assert r["output"].endswith("#paper_white_rgb")

@@ -89,3 +89,25 @@ fn bake_info_db_eval_export() {
         r.stderr
     );
 }
+
+/// `DB#` with no name was a path: `bake -o x.btdb#` wrote a file of that name, and `info x.btdb#`
+/// went looking for one. Both are argument errors now (the library's `store::name`), and no file
+/// is written.
+#[test]
+fn an_empty_table_name_after_the_hash_is_an_argument_error() {
+    let d = TempDir::new("cli-store-names");
+    let out = format!("{}#", d.file("x.btdb"));
+    let r = brdftab(&["bake", r#"{"model": "lambert", "kd": 0.5}"#, "-o", &out]);
+    assert!(
+        !r.ok && r.stderr.contains("no table name after `#`"),
+        "{}",
+        r.stderr
+    );
+    assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 0);
+    let r = brdftab(&["info", &out]);
+    assert!(
+        !r.ok && r.stderr.contains("no table name after `#`"),
+        "{}",
+        r.stderr
+    );
+}

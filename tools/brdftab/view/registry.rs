@@ -79,7 +79,7 @@ impl Registry {
 
 /// The (name, SOURCE, store summary) of every material SOURCE `s` holds.
 fn entries(s: &str) -> Result<Vec<(String, String, Option<Value>)>> {
-    let (path, name) = db::split_source(s);
+    let (path, name) = db::split_source(s)?;
     if classify(s) != SourceKind::Table || !tables::is_store_file(path) {
         return Ok(vec![(display_name(s), s.to_owned(), None)]);
     }
@@ -140,7 +140,7 @@ fn material(name: &str, source: &str, summary: Option<Value>) -> Result<Material
         info["ratio"] = s["ratio_to_f32"].clone();
         info["codec"] = s["codec"].clone();
         info["provenance"] = s["source"].clone();
-        let dir = Path::new(db::split_source(source).0).parent();
+        let dir = Path::new(brdftab::store::name::path_of(source)).parent();
         (paired, measured_source) = provenance_source(&s["source"], dir);
     }
     info["has_source"] = json!(paired.is_some());

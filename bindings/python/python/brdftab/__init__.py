@@ -109,5 +109,6 @@ class Database:
 def _check_name(name):
     if not isinstance(name, str):
         raise TypeError(f"name: expected a string, got {type(name).__name__}")
-    if not name or "#" in name:
-        raise ValueError(f"name: {name!r}: a table name is non-empty and has no '#'")
+    # The library's rule (non-empty; no '#', '/' or control characters): ValueError naming
+    # `name`, in the words the CLI and the C ABI use.
+    _native._check_table_name(name)

@@ -15,7 +15,12 @@ class Error(Exception):
     """An error of the brdftab library; the message is the library's."""
 
 class Brdf:
-    """A BRDF opened from a SOURCE (spec, table, DB#NAME, MERL .binary, RGL .bsdf)."""
+    """A BRDF opened from a SOURCE (spec, table, DB#NAME, MERL .binary, RGL .bsdf).
+
+    Array arguments are anything numpy reads as real numbers (any float, int or bool dtype,
+    either byte order, any strides; complex, object and string dtypes are a TypeError). A
+    numpy.ma masked array with masked entries is a ValueError (fill or drop them first); one
+    without is read as its data. A result beyond memory is numpy's MemoryError."""
 
     def device_layout(self) -> dict[str, Any]:
         """A table SOURCE's device layout for its interpolation (`Table.device_layout`), the
@@ -39,7 +44,8 @@ class Brdf:
 
         NaN, infinite or zero directions give 0 (not an error), as in every host."""
     def eval_spectral(self, wi: ArrayLike, wo: ArrayLike, nm: ArrayLike) -> npt.NDArray[np.float32]:
-        """f_r at wavelengths nm ((k,) or (n, k)): (n, k) float32."""
+        """f_r at wavelengths nm ((k,) or (n, k); each finite and > 0, else ValueError):
+        (n, k) float32."""
     def pdf(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float64]:
         """Density of `sample` drawing wi given wo: (n,) float64."""
     def sample(

@@ -1,0 +1,138 @@
+"""What numpy users pass to the array-taking calls (eval, eval_spectral, pdf, sample, albedo):
+masked arrays, broadcast views of any length, wavelengths that are none. Each is read as
+numpy reads it or refused with a ValueError/MemoryError naming the argument; none is silently
+wrong and none aborts the interpreter."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import brdftab
+
+GGX = '{"model": "ggx", "alpha": 0.3, "fresnel": {"conductor": "Cu"}}'
+WI = np.array([[0.3, 0.1, 0.9], [0.0, 0.0, 1.0], [-0.4, 0.2, 0.8]])
+WO = np.array([[0.0, 0.0, 1.0], [0.2, 0.0, 0.9], [0.5, -0.5, 0.7]])
+U = np.array([[0.1, 0.2], [0.5, 0.5], [0.9, 0.3]])
+NM = np.array([450.0, 550.0, 650.0])
+THETA = np.array([0.1, 0.7, 1.2])
+
+
+def masked(a, row):
+    """`a` as a masked array with one entry of `row` masked (its data left as it is)."""
+    mask = np.zeros(a.shape, bool)
+    mask[row if a.ndim == 1 else (row, 0)] = True
+    return np.ma.masked_array(a, mask=mask)
+
+
+# Every array argument of every call: (call, the position of the argument, its name).
+CALLS = [
+    ("eval", (WI, WO), 0, "wi"),
+    ("eval", (WI, WO), 1, "wo"),
+    ("eval_spectral", (WI, WO, NM), 0, "wi"),
+    ("eval_spectral", (WI, WO, NM), 2, "nm"),
+    ("pdf", (WI, WO), 1, "wo"),
+    ("sample", (WO, U), 0, "wo"),
+    ("sample", (WO, U), 1, "u"),
+    ("albedo", (THETA,), 0, "theta"),
+]
+
+
+@pytest.mark.parametrize("call,args,k,name", CALLS)
+def test_a_masked_array_with_masked_entries_is_refused(call, args, k, name):
+    """Masked entries used to be evaluated as if valid (the mask was ignored)."""
+    b = brdftab.open(GGX)
+    args = list(args)
+    args[k] = masked(args[k], 1)
+    with pytest.raises(ValueError, match=f"{name}: a masked array with masked entries"):
+        getattr(b, call)(*args)
+
+
+@pytest.mark.parametrize("call,args,k,name", CALLS)
+def test_a_masked_array_without_masked_entries_is_its_data(call, args, k, name):
+    b = brdftab.open(GGX)
+    ref = getattr(b, call)(*args)
+    for m in (np.ma.masked_array(args[k]), np.ma.masked_array(args[k], mask=False)):
+        got = getattr(b, call)(*[m if i == k else a for i, a in enumerate(args)])
+        for x, y in zip(ref if isinstance(ref, tuple) else [ref],
+                        got if isinstance(got, tuple) else [got]):
+            assert type(y) is np.ndarray
+            np.testing.assert_array_equal(x, y)
+
+
+def test_a_wavelength_that_is_none_is_a_value_error():
+    """nm <= 0 was evaluated (at the first channel); the library's rule for a wavelength is
+    the one `wavelengths=` keeps: finite and > 0."""
+    b = brdftab.open(GGX)
+    for bad in ([0.0], [550.0, -5.0], [[500.0], [0.0], [600.0]], [np.nan], [np.inf]):
+        with pytest.raises(ValueError, match="nm: .* is not a wavelength"):
+            b.eval_spectral(WI, WO, bad)
+    assert b.eval_spectral(WI, WO, [1e-3, 550.0, 1e6]).shape == (3, 3)
+
+
+# Run in a child: a regression aborts it (a failed allocation in Rust) instead of pytest.
+@pytest.mark.parametrize("call", [
+    # theta and nm of 2^40 entries without memory (zero strides): were copied into a Vec and
+    # aborted the interpreter ("memory allocation of 8796093022208 bytes failed").
+    "b.albedo(np.broadcast_to(0.5, (2**40,)))",
+    "b.eval_spectral(WI, WO, np.broadcast_to(550.0, (2**40,)))",
+    # A result beyond memory (n 10^6 × k 10^7 float32): was "internal error in brdftab
+    # (please report): Python API call failed" (a panic where numpy had refused).
+    "b.eval_spectral(np.tile(WI, (333334, 1)), WO[0], np.broadcast_to(550.0, (10**7,)))",
+])
+def test_a_result_beyond_memory_is_a_memory_error(call):
+    code = (
+        "import numpy as np, brdftab\n"
+        f"b = brdftab.open({GGX!r})\n"
+        f"WI = np.array({WI.tolist()}); WO = np.array({WO.tolist()})\n"
+        "try:\n"
+        f"    {call}\n"
+        "except MemoryError as e:\n"
+        "    print('refused')\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and r.stdout.strip() == "refused", (r.returncode, r.stdout,
+                                                                 r.stderr[-2000:])
+
+
+def test_broadcast_views_are_read_in_place():
+    """A zero-stride nm or theta (numpy.broadcast_to) gives what its copy gives."""
+    b = brdftab.open(GGX)
+    nm = np.broadcast_to(550.0, (4,))
+    np.testing.assert_array_equal(b.eval_spectral(WI, WO, nm),
+                                  b.eval_spectral(WI, WO, np.full(4, 550.0)))
+    per_row = np.broadcast_to(NM[:, None], (3, 2))
+    np.testing.assert_array_equal(b.eval_spectral(WI, WO, per_row),
+                                  b.eval_spectral(WI, WO, per_row.copy()))
+    th = np.broadcast_to(0.7, (3,))
+    np.testing.assert_array_equal(b.albedo(th), b.albedo(np.full(3, 0.7)))
+    np.testing.assert_array_equal(b.albedo(THETA[::-1]), b.albedo(THETA.copy()[::-1].copy()))
+    assert b.albedo(0.7).shape == (3,) and b.albedo([]).shape == (0, 3)
+
+
+def test_a_misaligned_input_beyond_memory_is_a_memory_error():
+    """A misaligned float64 view (of bytes at an odd offset) is copied into aligned rows; with
+    no memory left for the copy the interpreter aborted ("memory allocation of 480000000 bytes
+    failed"). Run in a child under an address-space limit that holds the input, not a copy."""
+    code = (
+        "import resource, numpy as np, brdftab\n"
+        f"b = brdftab.open({GGX!r})\n"
+        "n = 20_000_000\n"
+        "raw = np.zeros(n * 24 + 1, np.uint8)\n"
+        "wi = np.frombuffer(raw.data, np.float64, count=n * 3, offset=1).reshape(n, 3)\n"
+        "assert wi.ctypes.data % 8 != 0\n"
+        "b.eval(wi[:20000], wi[:20000])  # the library's threads exist before the limit\n"
+        "vm = next(int(l.split()[1]) * 1024 for l in open('/proc/self/status')\n"
+        "          if l.startswith('VmSize:'))\n"
+        "hard = resource.getrlimit(resource.RLIMIT_AS)[1]\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (vm + (200 << 20), hard))\n"
+        "try:\n"
+        "    b.eval(wi, [0, 0, 1])\n"
+        "except MemoryError as e:\n"
+        "    assert 'wi' in str(e), e\n"
+        "    print('refused')\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and r.stdout.strip() == "refused", (r.returncode, r.stdout,
+                                                                 r.stderr[-2000:])

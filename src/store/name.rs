@@ -1,0 +1,122 @@
+//! Table names and `DB#NAME` sources: the one rule every host and every writer keeps.
+//!
+//! Why a module of its own: a name reaches the library by many roads — the `NAME` of a
+//! `DB#NAME` source or output, a bake's `name` setting, a file's stem, a table imported under
+//! another name — and the CLI, Python and the C ABI must all refuse the same names with the
+//! same words. It depends on nothing but the error type, so the file helpers
+//! ([`crate::files`]) and the store share it without an import circle.
+//!
+//! A table name is non-empty and holds no `#` (it ends the path of `DB#NAME`), no `/` (a
+//! `DB#NAME` whose name part has a `/` is read as a path with a `#` in a directory, so such a
+//! table could be written but never opened by name) and no control character (NUL, tab,
+//! newline, ...: invisible or cut short in listings, C strings and terminals).
+
+use crate::error::{Error, Result};
+
+/// Checks a table name against the rule above; the error names `field` (`name`, or the
+/// `source`/`output` the name was read from).
+pub fn check(field: &str, name: &str) -> Result<()> {
+    let bad = if name.is_empty() {
+        Some("is empty")
+    } else if name.contains('#') {
+        Some("contains `#`")
+    } else if name.contains('/') {
+        Some("contains `/`")
+    } else if name.chars().any(char::is_control) {
+        Some("contains a control character")
+    } else {
+        None
+    };
+    match bad {
+        None => Ok(()),
+        Some(why) => Err(Error::arg(
+            field,
+            format!(
+                "table name {name:?} {why}: a table name is non-empty, without `#`, `/` or \
+                 control characters"
+            ),
+        )),
+    }
+}
+
+/// Splits a SOURCE or output string `DB#NAME` into the path and the table name (`None` for a
+/// plain path). The name is what follows the last `#`, unless it holds a `/` (then the whole
+/// string is a path with a `#` in a directory name). An empty name (`x.btdb#`) or one that
+/// breaks [`check`] is an [`Error::InvalidArgument`] naming `field`.
+pub fn parse_source<'a>(field: &str, source: &'a str) -> Result<(&'a str, Option<&'a str>)> {
+    match source.rsplit_once('#') {
+        Some((_, n)) if n.contains('/') => Ok((source, None)),
+        Some((p, n)) => {
+            if n.is_empty() {
+                return Err(Error::arg(
+                    field,
+                    format!("{source:?}: no table name after `#` (DB#NAME)"),
+                ));
+            }
+            check(field, n)?;
+            Ok((p, Some(n)))
+        }
+        None => Ok((source, None)),
+    }
+}
+
+/// The path part of a SOURCE or output string, for callers that only look (which file a string
+/// reads, a default name): a string [`parse_source`] refuses is taken as a plain path, and the
+/// call that opens or writes it reports the error.
+pub fn path_of(source: &str) -> &str {
+    parse_source("source", source).map_or(source, |(p, _)| p)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn field_of(e: Error) -> String {
+        match e {
+            Error::InvalidArgument { name, .. } => name,
+            e => panic!("not an argument error: {e}"),
+        }
+    }
+
+    #[test]
+    fn empty_names_and_control_characters_are_argument_errors_naming_the_field() {
+        for name in [
+            "", "\0", "a\0b", "a\tb", "line\n", "\u{7f}", "\u{85}", "a#b", "a/b",
+        ] {
+            let e = check("name", name).unwrap_err();
+            assert_eq!(field_of(e), "name", "{name:?}");
+        }
+        for name in ["matte", "gold 2", "kupfer-ü", "x.y_z"] {
+            check("name", name).unwrap();
+        }
+    }
+
+    #[test]
+    fn a_source_with_an_empty_or_bad_name_is_refused_not_read_as_a_path() {
+        for s in ["x.btdb#", "x.btdb#\0", "x.btdb#a\nb", "dir/x.btdb#\t"] {
+            let e = parse_source("output", s).unwrap_err();
+            assert_eq!(field_of(e), "output", "{s:?}");
+            assert!(e_msg(s).contains("table name"), "{s:?}: {}", e_msg(s));
+        }
+        assert_eq!(
+            parse_source("source", "x.btdb#m").unwrap(),
+            ("x.btdb", Some("m"))
+        );
+        assert_eq!(
+            parse_source("source", "a#b.btdb#m").unwrap(),
+            ("a#b.btdb", Some("m"))
+        );
+        // A `#` in a directory: the whole string is a path.
+        assert_eq!(
+            parse_source("source", "d#1/x.btdb").unwrap(),
+            ("d#1/x.btdb", None)
+        );
+        assert_eq!(parse_source("source", "x.btdb").unwrap(), ("x.btdb", None));
+        assert_eq!(path_of("x.btdb#"), "x.btdb#");
+        assert_eq!(path_of("x.btdb#m"), "x.btdb");
+    }
+
+    fn e_msg(s: &str) -> String {
+        parse_source("output", s).unwrap_err().to_string()
+    }
+}
