@@ -4,7 +4,7 @@
 //! `DB#NAME` source or output, a bake's `name` setting, a file's stem, a table imported under
 //! another name — and the CLI, Python and the C ABI must all refuse the same names with the
 //! same words. It depends on nothing but the error type, so the file helpers
-//! ([`crate::files`]) and the store share it without an import circle.
+//! (`files`) and the store share it without an import circle.
 //!
 //! A table name is non-empty and holds no `#` (it ends the path of `DB#NAME`), no `/` (a
 //! `DB#NAME` whose name part has a `/` is read as a path with a `#` in a directory, so such a
