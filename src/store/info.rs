@@ -4,8 +4,11 @@
 //! entry of the table it wrote, and the Python package hands them out as dicts — so the keys are
 //! an interface: `name`, `source`, `parameterization`, `symmetry`, `channels`, `units`, `codec`,
 //! `tool`, `shape`, `values`, `chunks`, `bytes`, `ratio_to_f32`, `sampling_bytes` (the importance
-//! sampler's structure, built in memory on the first `sample`/`pdf`) per table; `file`, `format`,
-//! `bytes`, `ratio_to_f32`, `tables` per file.
+//! sampler's structure, built in memory on the first `sample`/`pdf`), `quantity` (what the
+//! stored values are: `fr`, `fr_cos_out` or `fr_cos_cos`, [`crate::table::Quantity::name`]) and
+//! `calibrated` (whether lookups multiply them by an albedo calibration's k_in(θi) k_out(θo))
+//! per table; `file`, `format`, `bytes`, `ratio_to_f32`, `tables` per file. The last two say
+//! how the raw values (`export`, Python's `Table.values`) become f_r.
 
 use std::fmt::Write as _;
 
@@ -13,7 +16,7 @@ use serde_json::{Value, json};
 
 use super::{Store, db};
 use crate::error::{Error, Result};
-use crate::table::{SamplingResolution, Table};
+use crate::table::{Quantity, SamplingResolution, Table};
 
 /// The summary of table `name` of an open store.
 pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
@@ -23,9 +26,12 @@ pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
     let isotropic = h.symmetry.split('+').any(|p| p == "isotropic");
     // The sampler a table builds when opened with its default lookup: nearest on a grid of
     // cells (TabulatedBrdf::default_interp).
-    let cells = t
-        .grid()
-        .is_ok_and(|g| crate::table::Interp::default_for(&g) == crate::table::Interp::Nearest);
+    let grid = t.grid().ok();
+    let cells = grid
+        .as_ref()
+        .is_some_and(|g| crate::table::Interp::default_for(g) == crate::table::Interp::Nearest);
+    let quantity = grid.as_ref().map_or(Quantity::Fr, |g| g.quantity());
+    let calibrated = grid.as_ref().is_some_and(|g| g.calibration().is_some());
     Ok(json!({
         "name": h.name,
         "source": h.source,
@@ -41,6 +47,8 @@ pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
         "bytes": bytes,
         "ratio_to_f32": (h.values as f64 * 4.0) / (bytes.max(1) as f64),
         "sampling_bytes": SamplingResolution::for_lookup(isotropic, cells).memory_bytes(isotropic),
+        "quantity": quantity.name(),
+        "calibrated": calibrated,
     }))
 }
 
@@ -200,6 +208,17 @@ pub fn file_text(v: &Value) -> String {
             "  sampling: {} bytes in memory once sampled",
             t["sampling_bytes"]
         );
+        let stores = match t["quantity"].as_str() {
+            Some("fr_cos_cos") => "f_r cos θi cos θo (lookups divide by both cosines)",
+            Some("fr_cos_out") => "f_r cos θo (lookups divide by cos θo)",
+            _ => "f_r",
+        };
+        let calibrated = if t["calibrated"].as_bool() == Some(true) {
+            ", times an albedo calibration k_in(θi) k_out(θo) at lookup"
+        } else {
+            ""
+        };
+        let _ = writeln!(o, "  stores:   {stores}{calibrated}");
         let _ = writeln!(
             o,
             "  units:    {}   tool: {}",

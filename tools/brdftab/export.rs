@@ -9,7 +9,8 @@ use clap::Args;
 pub struct ExportArgs {
     /// The table: a brdftab file, or `DB#NAME`.
     file: String,
-    /// Write the dense table as .npy (shape = stored grid dims + channels, float32).
+    /// Write the dense table as .npy (shape = stored grid dims + channels, float32): the stored
+    /// quantity as `info` names it (f_r, f_r cos θo or f_r cos θi cos θo; before a calibration).
     #[arg(long)]
     npy: Option<String>,
     /// Write a 2D slice as OpenEXR (channels as EXR channels).
@@ -47,15 +48,31 @@ pub fn run(a: ExportArgs) -> Result<()> {
     let off_ref: export::NodeOffset<'_> = off
         .as_ref()
         .map(|f| f as &(dyn Fn(&[usize]) -> Option<usize> + Sync));
+    // What the raw values are (as `info` says): not f_r for tables of f_r cos θo or
+    // f_r cos θi cos θo, and without a calibration's factors.
+    let stored = match &grid {
+        Some(g) => {
+            let calibrated = if g.calibration().is_some() {
+                ", before the albedo calibration's factors"
+            } else {
+                ""
+            };
+            format!("{}{calibrated}", g.quantity().name())
+        }
+        None => "fr".to_owned(),
+    };
     if let Some(out) = &a.npy {
         export::npy(&t, out, off_ref)?;
-        eprintln!("wrote {out} (shape {:?}, float32)", t.header().shape);
+        eprintln!(
+            "wrote {out} (shape {:?}, float32; stored values: {stored})",
+            t.header().shape
+        );
     }
     if let Some(out) = &a.exr {
         let axes = t.header().shape.len().saturating_sub(1);
         let sl = export::Slice::parse(a.slice.as_deref().unwrap_or(""), axes)?;
         export::exr(&t, &sl, off_ref, out, a.half)?;
-        eprintln!("wrote {out}");
+        eprintln!("wrote {out} (stored values: {stored})");
     }
     Ok(())
 }

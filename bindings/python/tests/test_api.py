@@ -164,6 +164,16 @@ def test_bake_returns_info(tmp_path, cli):
     assert info["tables"][0]["parameterization"] == "inout"
 
 
+def test_info_names_what_the_values_are(tmp_path):
+    # Ward's table stores f_r cos θi cos θo: Table.values are that, and info says so.
+    out = str(tmp_path / "ward.btdb")
+    ward = '{"model": "ward", "ks": 0.5, "alpha_x": 0.1, "alpha_y": 0.3}'
+    (t,) = brdftab.bake(ward, out, preset="small")["tables"]
+    assert (t["quantity"], t["calibrated"]) == ("fr_cos_cos", False)
+    (t,) = brdftab.bake(GGX, out, preset="small")["tables"]
+    assert (t["quantity"], t["calibrated"]) == ("fr", False)
+
+
 def test_bake_target_error_matches_the_cli(tmp_path, cli):
     # the same request from Python and the CLI picks the same adaptive grid
     a, b = str(tmp_path / "a.btdb"), str(tmp_path / "b.btdb")

@@ -111,3 +111,61 @@ fn an_empty_table_name_after_the_hash_is_an_argument_error() {
         r.stderr
     );
 }
+
+/// `info` and `export` say what the raw values are: a Ward table stores f_r cos θi cos θo (the
+/// exported array was silently that, negative beyond the horizon), an adaptive model table is
+/// multiplied by an albedo calibration at lookup, a plain preset table stores f_r.
+#[test]
+fn info_and_export_name_the_stored_quantity_and_calibration() {
+    let d = TempDir::new("cli-quantity");
+    let p = |f: &str| d.file(f);
+    let cases = [
+        (
+            r#"{"model": "ward", "ks": 0.5, "alpha_x": 0.1, "alpha_y": 0.3}"#,
+            "small",
+            "fr_cos_cos",
+            false,
+            "f_r cos θi cos θo",
+        ),
+        (
+            r#"{"model": "ggx", "alpha": 0.3}"#,
+            "adaptive:24x12x7",
+            "fr",
+            true,
+            "albedo calibration",
+        ),
+        (
+            r#"{"model": "lambert", "kd": 0.5}"#,
+            "small",
+            "fr",
+            false,
+            "stores:   f_r\n",
+        ),
+    ];
+    for (k, (spec, grid, quantity, calibrated, text)) in cases.into_iter().enumerate() {
+        let t = p(&format!("t{k}.btdb"));
+        let how = if grid == "small" {
+            "--preset"
+        } else {
+            "--grid"
+        };
+        let r = brdftab(&["bake", spec, "-o", &t, how, grid]);
+        assert!(r.ok, "{}", r.stderr);
+        let r = brdftab(&["info", &t, "--json"]);
+        let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+        assert_eq!(v["tables"][0]["quantity"], quantity, "{spec}: {}", r.stdout);
+        assert_eq!(
+            v["tables"][0]["calibrated"], calibrated,
+            "{spec}: {}",
+            r.stdout
+        );
+        let r = brdftab(&["info", &t]);
+        assert!(r.stdout.contains(text), "{spec}: {}", r.stdout);
+        let r = brdftab(&["export", &t, "--npy", &p(&format!("t{k}.npy"))]);
+        assert!(
+            r.ok && r.stderr.contains(&format!("stored values: {quantity}")),
+            "{spec}: {}",
+            r.stderr
+        );
+    }
+}

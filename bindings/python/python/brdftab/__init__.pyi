@@ -79,7 +79,9 @@ class Brdf:
 
 class Table:
     """A decoded table: `values` shares its memory (read-only float32, stored axes + channels,
-    λ innermost; flat when packed), `grid` describes it."""
+    λ innermost; flat when packed), `grid` describes it. The values are the stored quantity
+    (`info(...)["tables"][k]["quantity"]`: "fr", "fr_cos_out" or "fr_cos_cos", i.e. f_r, f_r cos θo
+    or f_r cos θi cos θo), before any albedo calibration (`"calibrated"`) a lookup applies."""
     @property
     def values(self) -> npt.NDArray[np.float32]: ...
     @property
@@ -103,7 +105,11 @@ def open(
     """Opens SOURCE. interp: "auto" (nearest on tables of MERL cells, linear otherwise),
     "nearest" or "linear"."""
 def check(source: str | PathLike[str], *, wavelengths: Wavelengths = None) -> dict[str, Any]: ...
-def info(source: str | PathLike[str]) -> dict[str, Any]: ...
+def info(source: str | PathLike[str]) -> dict[str, Any]:
+    """What `brdftab info` reports of a table file: "file", "format", "bytes", "ratio_to_f32"
+    and "tables", one dict per table with "name", "source", "parameterization", "symmetry",
+    "channels", "units", "codec", "tool", "shape", "values", "chunks", "bytes", "ratio_to_f32",
+    "sampling_bytes", "quantity" (what the stored values are) and "calibrated"."""
 def bake(
     source: str | PathLike[str],
     output: str | PathLike[str],
