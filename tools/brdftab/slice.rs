@@ -75,8 +75,14 @@ pub fn slice(a: SliceArgs) -> Result<()> {
     // A source that failed while it was read (a corrupt table chunk) drew zeros.
     brdf.health()?;
     let what = match a.kind {
-        SliceKind::Halfdiff => format!(
+        // An isotropic BRDF is the same at every φh; an anisotropic one shows its φh = 0 slice.
+        SliceKind::Halfdiff if brdf.flags().isotropic => format!(
             "f_r, x = θh 0..90°, y = θd 0..90° (top to bottom), φd = {}°",
+            a.phi_d
+        ),
+        SliceKind::Halfdiff => format!(
+            "f_r, x = θh 0..90°, y = θd 0..90° (top to bottom), φd = {}°, φh = 0° (anisotropic: \
+             the half vector in the x–z plane)",
             a.phi_d
         ),
         SliceKind::Polar => format!(

@@ -61,8 +61,9 @@ fn render(
     }
 }
 
-/// f_r over θh (x) × θd (y) at azimuth difference `phi_d` (radians), `size × size` pixels at
-/// pixel centres, angles linear in 0..90°.
+/// f_r over θh (x) × θd (y) at azimuth difference `phi_d` (radians) and half-vector azimuth
+/// φh = 0 (all one for an isotropic BRDF), `size × size` pixels at pixel centres, angles linear
+/// in 0..90°.
 pub fn halfdiff(brdf: &dyn Brdf, size: usize, phi_d: f64) -> Image {
     render(brdf, size, size, |x, y| {
         let theta_h = (x as f64 + 0.5) / size as f64 * FRAC_PI_2;

@@ -262,3 +262,18 @@ fn demo_bakes_into_a_database_and_prints_where() {
     assert!(o.stdout.contains("demo.btdb"), "{}", o.stdout);
     assert!(dir.join("demo.btdb").is_file());
 }
+
+/// A half/diff slice is at φh = 0: all of an isotropic BRDF, one slice of an anisotropic one,
+/// which the printed description says (it named only φd).
+#[test]
+fn a_halfdiff_slice_says_which_phi_h_it_shows_of_an_anisotropic_source() {
+    let d = TempDir::new("cli-slice-aniso");
+    let png = d.file("s.png");
+    let aniso = r#"{"model": "ward", "ks": 0.5, "alpha_x": 0.1, "alpha_y": 0.3}"#;
+    let iso = r#"{"model": "ward", "ks": 0.5, "alpha_x": 0.2, "alpha_y": 0.2}"#;
+    for (spec, named) in [(aniso, true), (iso, false)] {
+        let r = brdftab(&["slice", spec, "-o", &png, "--size", "16"]);
+        assert!(r.ok, "{}", r.stderr);
+        assert_eq!(r.stdout.contains("φh = 0°"), named, "{spec}: {}", r.stdout);
+    }
+}
