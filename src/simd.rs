@@ -45,11 +45,13 @@ impl F4 {
             )
         }
     }
-    /// The first four f16 values of `v` (bits), which must each be ±0 or a normal f16 (as
-    /// [`crate::table::kernel::Packed`] stores them), in SSE2 integer operations: the magnitude
-    /// bits shifted into an f32's exponent and mantissa, times 2^112 (the exponent bias
-    /// difference), the sign bit moved to the f32's; exact for those values. `None` if `v` holds
-    /// fewer than four.
+    /// The first four f16 values of `v` (bits), which must each be finite — ±0, normal or
+    /// subnormal (as [`crate::table::kernel::Packed`] stores them) — in SSE2 integer operations:
+    /// the magnitude bits shifted into an f32's exponent and mantissa, times 2^112 (the exponent
+    /// bias difference; a subnormal's bits are then an f32 subnormal, which the product makes
+    /// the normal value), the sign bit moved to the f32's; exact for those values (unless the
+    /// thread treats subnormal inputs as zero, then those read 0). `None` if `v` holds fewer
+    /// than four.
     #[inline(always)]
     pub fn from_f16_normal(v: &[u16]) -> Option<F4> {
         use std::arch::x86_64::*;
@@ -376,10 +378,11 @@ mod tests {
     }
 
     #[test]
-    fn f16_lanes_are_exact_on_positive_normals_and_zero() {
+    fn f16_lanes_are_exact_on_every_finite_f16() {
         assert_eq!(F16_BIAS, 2f32.powi(112));
-        // Every positive normal f16 and zero, four at a time against the half crate.
-        let bits: Vec<u16> = std::iter::once(0).chain(0x0400..0x7c00).collect();
+        // Every finite f16 — zero, subnormals, normals, both signs — four at a time against the
+        // half crate.
+        let bits: Vec<u16> = (0..0x7c00).chain(0x8000..0xfc00).collect();
         for q in bits.chunks(4).filter(|q| q.len() == 4) {
             let want: Vec<f32> = q
                 .iter()
