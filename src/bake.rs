@@ -47,7 +47,10 @@ pub enum GridChoice {
     /// The source's natural grid: a MERL file's own cells for MERL sources, for RGL files the
     /// smallest adaptive grid ([`GridChoice::Adaptive`]) that meets [`MEASURED_TARGET_ERROR`]
     /// (the medium preset when the file is not isotropic and bilateral within
-    /// [`MEASURED_BILATERAL_TOLERANCE`]), the medium preset otherwise. With an error target
+    /// [`MEASURED_BILATERAL_TOLERANCE`]), the medium preset otherwise — but for an isotropic,
+    /// bilateral model whose medium table misses its albedo by more than
+    /// [`PRESET_ALBEDO_TOLERANCE`], the adaptive grid of [`MODEL_FALLBACK_TARGET_ERROR`],
+    /// calibrated. With an error target
     /// ([`BakeRequest::target_error`]) any source gets the adaptive grid that meets it.
     #[default]
     Default,
@@ -134,6 +137,31 @@ pub const MEASURED_BILATERAL_TOLERANCE: f64 = 0.02;
 /// random-pair checks, and every table file smaller than its RGL file.
 pub const MEASURED_TARGET_ERROR: f64 = 0.007;
 
+/// How far a model's default (medium preset) table may miss the source's directional albedo
+/// (worst over [`PRESET_CHECK_THETAS_DEG`], a channel darker than 0.02 judged against 0.02) before
+/// the default bake takes the adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`]
+/// instead: the fidelity bar of measured tables, 1 %. Sharp lobes need it — on the medium preset
+/// GGX α = 0.002 was 13.8 % off at 89° (and gained energy: albedo 1.077 at 55°), α = 0.01 4.7 %,
+/// α = 0.02 2.4 % — while GGX α ≥ 0.1, Cook-Torrance gold, Oren-Nayar and the lecture's Phong
+/// family at n = 50 keep their preset tables (the max-Phong's too: 1.5 % off at 89°, but its
+/// adaptive table is 6 % off over random pairs where the preset is 0.8 %).
+pub const PRESET_ALBEDO_TOLERANCE: f64 = 0.01;
+
+/// The incidence angles (degrees) at which [`PRESET_ALBEDO_TOLERANCE`] is checked: the
+/// preset's errors grow towards grazing, and a sharp lobe's show at every angle.
+pub const PRESET_CHECK_THETAS_DEG: [f64; 6] = [1.0, 30.0, 60.0, 80.0, 85.0, 89.0];
+
+/// Random pairs on which a model's adaptive default table must not be worse than its preset's
+/// ([`PRESET_ALBEDO_TOLERANCE`]).
+pub const PRESET_CHECK_PAIRS: usize = 20_000;
+
+/// The error target of a model's default bake when its preset table misses the albedo
+/// ([`PRESET_ALBEDO_TOLERANCE`]): 0.2 % relative RMSE, as the Mitsuba plugin's JIT tables of
+/// models (`brdftab.mitsuba.MODEL_TARGET_ERROR`), calibrated. A lobe too sharp for it gets the
+/// largest adaptive grid (GGX α = 0.002: 2.2 % within 80°, 0.4 % albedo, against the preset's
+/// 26 % and 14 %).
+pub const MODEL_FALLBACK_TARGET_ERROR: f64 = 0.002;
+
 /// The error-target search also judges the grazing band (a direction beyond 80°), against this
 /// multiple of the target — for every table but one of a measurement's own f_r: the fidelity
 /// bars are 1 % within 80° and 3 % in the band.
@@ -157,6 +185,14 @@ pub struct Plan {
     /// The source's albedo the table is calibrated to, when it is
     /// ([`crate::table::calibration`]).
     pub albedo: Option<AlbedoReference>,
+}
+
+/// `why` before the bake's own note, if it has one.
+fn with_note(why: String, note: Option<String>) -> String {
+    match note {
+        Some(n) => format!("{why}; {n}"),
+        None => why,
+    }
 }
 
 /// The symmetry a bake reduces by.
@@ -509,6 +545,74 @@ impl BakeRequest {
         })
     }
 
+    /// Why a model's default table is not the medium preset: `Some(reason)` when the request
+    /// leaves the grid to the library, the source is an isotropic, bilateral model spec whose
+    /// f_r the table stores, and the preset's table misses the source's albedo by more than
+    /// [`PRESET_ALBEDO_TOLERANCE`] at one of [`PRESET_CHECK_THETAS_DEG`] (a bake of the preset
+    /// and twelve mirror-centred albedos, ~0.3 s) and the adaptive table misses it by less,
+    /// without a larger error over random pairs (one more bake, ~1 s, only then).
+    fn preset_misses(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<Option<String>> {
+        if !(self.grid == GridChoice::Default
+            && self.target_error.is_none()
+            && self.calibrate
+            && self.supersample == 1
+            && self.param.is_none_or(|p| p == Param::HalfDiff)
+            && source::classify(&self.source) == SourceKind::Spec
+            && self.effective_quantity(src) == Quantity::Fr)
+        {
+            return Ok(None);
+        }
+        let (sym, _) = self.resolve_symmetry(src);
+        if !(sym.isotropic && sym.bilateral) {
+            return Ok(None);
+        }
+        let _stage = Stage::begin(progress, "checking the preset's albedo", 0);
+        let grid = Preset::Medium.grid(Some(Param::HalfDiff), sym, src.channels().clone())?;
+        let opts = BakeOptions {
+            tolerance: self.symmetry_tolerance,
+            ..BakeOptions::default()
+        };
+        let (table, _) = crate::table::bake(src, &grid, &opts)?;
+        let table = TabulatedBrdf::from_table(table);
+        let fid = crate::analysis::fidelity::FidelityOptions {
+            albedo_thetas_deg: PRESET_CHECK_THETAS_DEG.to_vec(),
+            albedo_phi: 64,
+            albedo_order: 6,
+            ..Default::default()
+        };
+        let e = crate::analysis::fidelity::albedo_error(&table, src, &fid)?;
+        if e.worst <= PRESET_ALBEDO_TOLERANCE {
+            return Ok(None);
+        }
+        // The adaptive table must do better on the same rule: a lobe whose f_r spikes at the
+        // grazing mirror pair (the max-Phong's 1/max(cos θi, cos θo)) is served worse by it
+        // (5.4 % at 89° against the preset's 1.5 %), and keeps the preset.
+        let (adaptive, _) = self
+            .clone()
+            .target_error(MODEL_FALLBACK_TARGET_ERROR)
+            .table_of(src, &Silent)?;
+        let adaptive = TabulatedBrdf::from_table(adaptive);
+        let a = crate::analysis::fidelity::albedo_error(&adaptive, src, &fid)?;
+        // Nor worse over random pairs (f_r cos θi, the same pairs for both; beyond 1 %): the
+        // max-Phong's f_r spikes like 1/max(cos θi, cos θo) at the grazing mirror pair, which
+        // the preset's 180 θd nodes follow and the adaptive grid does not (0.78 → 6.0 %).
+        let rmse = |t: &dyn Brdf| {
+            crate::analysis::accuracy::compare(t, src, PRESET_CHECK_PAIRS, 1).map(|a| a.rel_rmse)
+        };
+        let (rp, ra) = (rmse(&table)?, rmse(&adaptive)?);
+        Ok((a.worst < e.worst && ra <= rp.max(0.01)).then(|| {
+            format!(
+                "the medium preset's table missed the albedo by {:.1} % at {}°: baked to an error \
+                 target of {} % instead ({:.2} % at {}°)",
+                100.0 * e.worst,
+                e.theta_deg,
+                100.0 * MODEL_FALLBACK_TARGET_ERROR,
+                100.0 * a.worst,
+                a.theta_deg
+            )
+        }))
+    }
+
     /// The error target this request bakes to: its own, or [`MEASURED_TARGET_ERROR`] for an
     /// RGL file on the default grid.
     pub fn effective_target(&self) -> Option<f64> {
@@ -649,6 +753,14 @@ impl BakeRequest {
 
     /// Bakes an already opened source (for callers that also use it, e.g. to compare).
     pub fn table_of(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<(Table, BakeReport)> {
+        if let Some(why) = self.preset_misses(src, progress)? {
+            let (table, mut report) = self
+                .clone()
+                .target_error(MODEL_FALLBACK_TARGET_ERROR)
+                .table_of(src, progress)?;
+            report.symmetry_note = Some(with_note(why, report.symmetry_note));
+            return Ok((table, report));
+        }
         let t0 = Instant::now();
         if self.keeps_merl_cells() {
             let table = crate::measured::MerlBrdf::open(&self.source)?.to_table();
@@ -745,6 +857,18 @@ impl BakeRequest {
             crate::store::name::check("name", &name)?;
         }
         let src = self.open_source()?;
+        // A model the medium preset misses is baked as the request with an error target would
+        // be (the whole path: calibrated, built whole).
+        if !matches!(target, BakeTarget::Merl(_))
+            && let Some(why) = self.preset_misses(src.as_ref(), progress)?
+        {
+            let mut report = self
+                .clone()
+                .target_error(MODEL_FALLBACK_TARGET_ERROR)
+                .run_with(target, progress)?;
+            report.symmetry_note = Some(with_note(why, report.symmetry_note));
+            return Ok(report);
+        }
         if let BakeTarget::Merl(path) = target {
             let t0 = Instant::now();
             let merl = crate::measured::MerlBrdf::from_brdf_with(src.as_ref(), progress);

@@ -38,7 +38,8 @@ pub struct DemoArgs {
     #[arg(long, default_value = "demo-out")]
     out: PathBuf,
     /// Grid preset of every table: small, medium, large (default: what `brdftab bake` does with
-    /// no options — the medium preset for models, the adaptive default grid for RGL files).
+    /// no options — the medium preset for models, or their adaptive table where the preset's
+    /// albedo is off by over 1 %, the adaptive default grid for RGL files).
     #[arg(long)]
     preset: Option<String>,
     /// Directory of RGL-EPFL `.bsdf` files (default: $BRDFTAB_RGL_DIR, else the shipped
@@ -83,9 +84,10 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     print_out(&format!(
         "\nBaking {} sources (grids: {}) into {}\n",
         sources.len(),
-        a.preset
-            .as_deref()
-            .unwrap_or("the defaults: medium preset for models, adaptive for RGL files"),
+        a.preset.as_deref().unwrap_or(
+            "the defaults: medium preset for models (adaptive where its albedo is off by over \
+                 1 %), adaptive for RGL files",
+        ),
         db.display()
     ))?;
     let bar = crate::progress::Bar::values();
