@@ -271,7 +271,8 @@ def _packed_codes(values, channels):
 
     Returns (words, scale): a lookup gathers node n's word, moves each code's bits into a
     float32's (sign to bit 31, exponent and mantissa shifted by 13: the code's value times
-    2⁻¹¹², exact for every finite code, subnormal ones included) and multiplies by ``scale`` =
+    2⁻¹¹², exact for every normal code; a subnormal code, which that would make a float32
+    subnormal the backend flushes, is read as its mantissa times 2⁻²⁴) and multiplies by ``scale`` =
     2¹¹² × the table's power of two, also exact: the values the lookup blends are bit for bit the
     float32 values of the layout. Why: gathers of float32 channels (3 per node, 24 per lookup)
     and their 12 bytes per node were most of a lookup's time in a render (BENCHMARKS.md).
@@ -760,12 +761,22 @@ class JitTable:
             words, scale = packed
             W = type(words)
 
+            # A subnormal code's bits moved into a float32 are a float32 subnormal, which the
+            # LLVM backend flushes to 0 as an input: such a code is its mantissa times 2^-24
+            # instead (times the same power of two; exact), chosen by its exponent bits.
+            sub_scale = scale * 2.0**-136
+
+            def value(h):
+                normal = dr.reinterpret_array(Fl, ((h & 0x7FFF) << 13) | ((h & 0x8000) << 16))
+                sub = Fl(h & 0x3FF) * sub_scale
+                sub = dr.select((h & 0x8000) != 0, -sub, sub)
+                return dr.select((h & 0x7C00) == 0, sub, normal * scale)
+
             def corner(n):
                 q = dr.gather(W, words, n, ok)
                 lo, hi = U(q & 0xFFFFFFFF), U(q >> 32)
                 codes = [lo & 0xFFFF, lo >> 16, hi & 0xFFFF, hi >> 16][:c]
-                return [dr.reinterpret_array(Fl, ((h & 0x7FFF) << 13) | ((h & 0x8000) << 16))
-                        * scale for h in codes]
+                return [value(h) for h in codes]
         else:
             def corner(n):
                 return [dr.gather(Fl, kv, n * c + ch, ok) for ch in range(c)]
