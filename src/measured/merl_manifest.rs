@@ -1,6 +1,6 @@
 //! The 100 files of the MERL BRDF database (Matusik et al. 2003): material name and SHA-256.
 //!
-//! Generated from `data/measured/merl/merl_expected_files.tsv` (every file is 34,992,012 bytes).
+//! Generated from `data/merl/merl_expected_files.tsv` (every file is 34,992,012 bytes).
 //! Facts only — no measurement data — so that `brdftab info X.binary` can name a material
 //! without the manifest at run time. `tests/merl.rs` checks this table against the TSV.
 

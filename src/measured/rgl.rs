@@ -58,7 +58,7 @@ fn warp_of(planes: Planes, file: &TensorFile, field: &Field) -> Result<Warp> {
     })
 }
 
-/// Interval index `i` (clamped to [0, n−2]) with values[i] ≤ x, and the weight of `i + 1`
+/// Interval index `i` (clamped to [0, n−2]) with `values[i]` ≤ x, and the weight of `i + 1`
 /// (clamped to [0, 1]). A single value gives (0, 0) — no interpolation.
 #[inline]
 fn param_weight(values: &[f32], x: f64) -> (usize, usize, f64) {

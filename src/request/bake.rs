@@ -163,7 +163,7 @@ pub fn bake(
     req.run_with(&target(output, settings.replace)?, progress)
 }
 
-/// Where [`bake`] writes `output`; a `DB#NAME` with an empty or invalid name is an argument
+/// Where [`bake()`] writes `output`; a `DB#NAME` with an empty or invalid name is an argument
 /// error naming `output` ([`crate::store::name`]).
 pub fn target(output: &str, replace: bool) -> Result<BakeTarget> {
     Ok(match crate::store::name::parse_source("output", output)? {

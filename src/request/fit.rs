@@ -1,4 +1,4 @@
-//! [`FitSettings`] and [`fit`]: a model fit to any SOURCE, as every host asks for it.
+//! [`FitSettings`] and [`fit()`]: a model fit to any SOURCE, as every host asks for it.
 
 use serde::{Deserialize, Serialize};
 

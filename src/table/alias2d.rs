@@ -18,14 +18,14 @@
 //! Within a slice, on the strip between node rows j and j + 1 (t ∈ [0, 1] across it) the
 //! bilinear density is p(x, t) = (1 − t) r_j(x) + t r_{j+1}(x), with r_j the row's
 //! piecewise-linear interpolant and T_j its integral. That is a mixture of two products:
-//! T_j/2 · [2(1 − t)] · [r_j(x)/T_j] and T_{j+1}/2 · [2t] · [r_{j+1}(x)/T_{j+1}]. So:
+//! T_j/2 · [2(1 − t)] · [r_j(x)/T_j] and T_{j+1}/2 · \[2t\] · [r_{j+1}(x)/T_{j+1}]. So:
 //! 1. one alias table per slice over the 2(ny − 1) *half-strips* (masses T_j/2, T_{j+1}/2)
 //!    gives the strip j and the row r (j or j + 1);
 //! 2. t from 2(1 − t) (t = 1 − √(1 − v)) or from 2t (t = √v);
 //! 3. x from row r alone: one alias table per row over its nx − 1 cells (masses
-//!    (r[c] + r[c + 1])/2) gives the cell c; the row's linear piece there,
-//!    (1 − f) r[c] + f r[c + 1], is again a mixture of 2(1 − f) and 2f with masses r[c]/2 and
-//!    r[c + 1]/2: a coin between them, then f = 1 − √(1 − v) or √v.
+//!    (r\[c\] + r\[c + 1\])/2) gives the cell c; the row's linear piece there,
+//!    (1 − f) r\[c\] + f r\[c + 1\], is again a mixture of 2(1 − f) and 2f with masses r\[c\]/2 and
+//!    r\[c + 1\]/2: a coin between them, then f = 1 − √(1 − v) or √v.
 //!
 //! Steps 2 and 3 do not depend on each other, so the chain of a draw is the slice choice, three
 //! loads and a square root; no quadratic, no search. (Alias tables over half-cells would save

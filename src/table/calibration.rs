@@ -529,7 +529,7 @@ fn node_albedos(brdf: &dyn Brdf, opts: &CalibrationOptions) -> Vec<f64> {
 /// The transport of `brdf` from each node's direction onto the axis: `m[(i·nodes + j)·c + k]`
 /// = ∫ f_r cos θo · hat_j(t_o) dωo for wi at node i, where hat_j is node j's linear
 /// interpolation weight (what a factor on node j multiplies). Summed over j it is node i's
-/// albedo; with k_out applied, node i's albedo is Σ_j m[i][j] k_out[j]. The mean over
+/// albedo; with k_out applied, node i's albedo is `Σ_j m[i][j] k_out[j]`. The mean over
 /// [`azimuths`], as the reference's albedos.
 fn transport(brdf: &dyn Brdf, opts: &CalibrationOptions) -> Vec<f64> {
     let c = brdf.channels().len();
@@ -596,10 +596,10 @@ fn balance(k: &mut [f32], m: &[f64], other: &[f32], reference: &[f64], c: usize)
     most
 }
 
-/// One round of the symmetric fit: with the sums Σ_j m[i][j] k[j] of the current `k`,
+/// One round of the symmetric fit: with the sums `Σ_j m[i][j] k[j]` of the current `k`,
 /// `k[i] ← √(k[i] · reference[i] / Σ_j m[i][j] k[j])` per channel (kept where either side is 0),
 /// within [1/[`FIT_LIMIT`], [`FIT_LIMIT`]]; returns the largest relative change. Its fixed
-/// point is k[i] Σ_j m[i][j] k[j] = reference[i]: the albedo of a table multiplied by
+/// point is `k[i] Σ_j m[i][j] k[j] = reference[i]`: the albedo of a table multiplied by
 /// k(θi) k(θo).
 fn balance_symmetric(k: &mut [f32], m: &[f64], reference: &[f64], c: usize) -> f64 {
     let n = k.len() / c;

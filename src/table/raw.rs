@@ -1,6 +1,8 @@
 //! A simple table file: a JSON header and raw little-endian f32 values.
 //!
-//! Stop-gap until the store's compressed chunked format lands (it replaces this). Layout:
+//! The uncompressed format beside the store's compressed, chunked one ([`crate::store`]):
+//! `convert` writes it for an output named neither `.btdb` nor `DB#NAME`
+//! ([`crate::bake::BakeTarget::Raw`]), and every host opens it as a SOURCE. Layout:
 //!
 //! ```text
 //! magic   b"BRDFTAB-RAW\n"   (12 bytes)

@@ -8,7 +8,8 @@ use clap::Args;
 /// Arguments of `brdftab albedo`.
 #[derive(Args)]
 pub struct AlbedoArgs {
-    /// A model spec (inline JSON starting with `{`, or a .json file).
+    /// Any SOURCE: a model spec (inline JSON starting with `{`, or a .json file), a table
+    /// (`FILE.btdb`, `DB#NAME`), a MERL `.binary` or an RGL `.bsdf`.
     source: String,
     /// Incidence angles θ′ in degrees, comma separated.
     #[arg(
@@ -25,7 +26,8 @@ pub struct AlbedoArgs {
 /// Arguments of `brdftab check`.
 #[derive(Args)]
 pub struct CheckArgs {
-    /// A model spec (inline JSON starting with `{`, or a .json file).
+    /// Any SOURCE: a model spec (inline JSON starting with `{`, or a .json file), a table
+    /// (`FILE.btdb`, `DB#NAME`), a MERL `.binary` or an RGL `.bsdf`.
     source: String,
     /// Print the report as one JSON object.
     #[arg(long)]

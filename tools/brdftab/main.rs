@@ -60,7 +60,8 @@ enum Command {
     Albedo(analysis::AlbedoArgs),
     /// Physical plausibility: positivity, reciprocity, energy conservation.
     Check(analysis::CheckArgs),
-    /// The lecture's models side by side (plausibility table).
+    /// The tour: the lecture's models' plausibility, tables baked and measured against their
+    /// sources, preview renders and a rate–distortion sweep.
     Demo(demo::DemoArgs),
     /// Accuracy suite: tables of every source per grid and codec vs the source; CSV, Markdown, plots.
     Accuracy(accuracy::AccuracyArgs),

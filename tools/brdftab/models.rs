@@ -10,7 +10,8 @@ use clap::Args;
 /// Arguments of `brdftab eval`.
 #[derive(Args)]
 pub struct EvalArgs {
-    /// A model spec (inline JSON starting with `{`, or a .json file), or a table file.
+    /// Any SOURCE: a model spec (inline JSON starting with `{`, or a .json file), a table
+    /// (`FILE.btdb`, `DB#NAME`), a MERL `.binary` or an RGL `.bsdf`.
     source: String,
     #[command(flatten)]
     open: brdftab::request::OpenSettings,

@@ -11,7 +11,8 @@ use crate::text::print_out;
 /// Arguments of `brdftab info`.
 #[derive(Args)]
 pub struct InfoArgs {
-    /// A table file.
+    /// A brdftab file (`FILE.btdb`, or one table of it as `DB#NAME`), a raw table file, a MERL
+    /// `.binary` or an RGL `.bsdf`.
     file: String,
     /// Print JSON.
     #[arg(long)]

@@ -92,7 +92,8 @@ int brdftab_albedo(const brdftab_brdf *b, double theta, double *albedo);
  * unknown field is an error. */
 /* Opens SOURCE with {"interp": "auto"|"nearest"|"linear", "wavelengths": [..], "eager": bool}. */
 brdftab_brdf *brdftab_open_json(const char *source, const char *settings_json);
-/* Bakes SOURCE into OUTPUT (.btdb file, DB#NAME, raw table) like `brdftab bake`. 0 or -1. */
+/* Bakes SOURCE into OUTPUT like `brdftab bake`: DB#NAME is a table of that database, any other
+ * name a brdftab (.btdb) file. 0 or -1. */
 int brdftab_bake(const char *source, const char *output, const char *settings_json);
 /* Converts SOURCE into OUTPUT (.bsdf, MERL .binary, DB#NAME, .btdb, raw table, by its name)
  * like `brdftab convert`. 0 or -1. */

@@ -43,8 +43,8 @@ pub unsafe extern "C" fn brdftab_open_json(
     })
 }
 
-/// Bakes SOURCE into OUTPUT (a `.btdb` file, `DB#NAME` or a raw table) with bake settings as
-/// JSON (the fields of `brdftab bake`'s flags). 0 on success, -1 on failure.
+/// Bakes SOURCE into OUTPUT (`DB#NAME`, or a brdftab `.btdb` file under any other name) with
+/// bake settings as JSON (the fields of `brdftab bake`'s flags). 0 on success, -1 on failure.
 ///
 /// # Safety
 /// The three arguments are NULL or NUL-terminated strings (`source` and `output` must not be

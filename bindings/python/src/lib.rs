@@ -137,7 +137,8 @@ impl PyTable {
     }
 
     /// The grid: parameterization, full axes, symmetry, stored axes with their mappings and
-    /// node placement, stored_shape, packed, channel_names, description.
+    /// node placement, stored_shape, packed, channels, channel_names, quantity, calibration,
+    /// description.
     #[getter]
     fn grid(&self, py: Python<'_>) -> Py<PyAny> {
         self.grid.clone_ref(py)

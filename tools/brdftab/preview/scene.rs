@@ -26,7 +26,7 @@ use brdftab::error::{Error, Result};
 #[derive(Debug, Clone)]
 struct Distribution1D {
     func: Vec<f64>,
-    /// cdf[i] = ∫₀^{i/n} (normalized), cdf[n] = 1.
+    /// `cdf[i]` = ∫₀^{i/n} (normalized), `cdf[n]` = 1.
     cdf: Vec<f64>,
     /// ∫₀¹ func.
     integral: f64,

@@ -20,25 +20,32 @@ class Brdf:
     Array arguments are anything numpy reads as real numbers (any float, int or bool dtype,
     either byte order, any strides; complex, object and string dtypes are a TypeError). A
     numpy.ma masked array with masked entries is a ValueError (fill or drop them first); one
-    without is read as its data. A result beyond memory is numpy's MemoryError."""
+    without is read as its data. A result beyond memory is numpy's MemoryError. Pickles by its
+    source and options."""
 
     def device_layout(self) -> dict[str, Any]:
         """A table SOURCE's device layout for its interpolation (`Table.device_layout`), the
         decoded table moved into it; brdftab.Error for any other source."""
 
     @property
-    def channels(self) -> list[str]: ...
+    def channels(self) -> list[str]:
+        """Channel names as the CLI prints them: ["R", "G", "B"] or ["450nm", ...]."""
     @property
-    def wavelengths(self) -> list[float] | None: ...
+    def wavelengths(self) -> list[float] | None:
+        """Wavelengths in nm of a spectral BRDF, or None for RGB."""
     @property
     def flags(self) -> dict[str, Any]:
         """{"delta", "reciprocal", "isotropic", "bilateral", "transmission": bool,
         "lobes": {"diffuse", "glossy", "delta": bool}}."""
     @property
-    def source(self) -> str: ...
+    def source(self) -> str:
+        """The SOURCE string this BRDF was opened from."""
     @property
-    def interp(self) -> str: ...
-    def describe(self) -> str: ...
+    def interp(self) -> str:
+        """The interpolation of a table ("linear" or "nearest"; with interp="auto", the one the
+        table's grid chose), or the interpolation asked for when the source is no table."""
+    def describe(self) -> str:
+        """A one-line description (model and parameters, or table and source)."""
     def eval(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float32]:
         """f_r(wi, wo) in 1/sr: (n, c) float32, or (c,) for one pair of shape (3,).
 
@@ -83,17 +90,24 @@ class Table:
     (`info(...)["tables"][k]["quantity"]`: "fr", "fr_cos_out" or "fr_cos_cos", i.e. f_r, f_r cos θo
     or f_r cos θi cos θo), before any albedo calibration (`"calibrated"`) a lookup applies."""
     @property
-    def values(self) -> npt.NDArray[np.float32]: ...
+    def values(self) -> npt.NDArray[np.float32]:
+        """float32 values shaped by the stored axes and the channels (grid["stored_shape"] +
+        [c], λ innermost), or flat for a packed layout; read-only, no copy."""
     @property
-    def grid(self) -> dict[str, Any]: ...
+    def grid(self) -> dict[str, Any]:
+        """{"param", "theta1", "phi1", "theta2", "phi2" (the full axes), "symmetry",
+        "stored_axes" (their mappings and node placement), "stored_shape", "packed",
+        "channels", "channel_names", "quantity", "calibration", "description"}."""
     def device_layout(self, interp: str = "linear") -> dict[str, Any]:
         """The table as a GPU or JIT host evaluates it for lookups with `interp` ("linear",
         "nearest", or "auto": nearest on a grid of MERL cells, linear otherwise): the library's
         device layout, a dict with "version", "kind" ("kernel" or "grid"), "channels",
         "channel_names", "quantity", "calibration", "kernel" and "grid" (None or the layout's
         fields, each with its float32 "values")."""
-    def __iter__(self) -> Iterator[Any]: ...
-    def __len__(self) -> int: ...
+    def __iter__(self) -> Iterator[Any]:
+        """Yields values, then grid: `values, grid = b.table()`."""
+    def __len__(self) -> int:
+        """2 (values and grid)."""
 
 def open(
     source: str | PathLike[str],
@@ -104,9 +118,10 @@ def open(
 ) -> Brdf:
     """Opens SOURCE. interp: "auto" (nearest on tables of MERL cells, linear otherwise),
     "nearest" or "linear"."""
-def check(source: str | PathLike[str], *, wavelengths: Wavelengths = None) -> dict[str, Any]: ...
+def check(source: str | PathLike[str], *, wavelengths: Wavelengths = None) -> dict[str, Any]:
+    """The plausibility report of SOURCE as a dict with the keys of `brdftab check --json`."""
 def info(source: str | PathLike[str]) -> dict[str, Any]:
-    """What `brdftab info` reports of a table file: "file", "format", "bytes", "ratio_to_f32"
+    """What `brdftab info --json` reports of a table file (or, for DB#NAME, of one table): "file", "format", "bytes", "ratio_to_f32"
     and "tables", one dict per table with "name", "source", "parameterization", "symmetry",
     "channels", "units", "codec", "tool", "shape", "values", "chunks", "bytes", "ratio_to_f32",
     "sampling_bytes", "quantity" (what the stored values are) and "calibrated"."""
@@ -126,7 +141,7 @@ def bake(
     level: int | None = ...,
     exhaustive: bool = ...,
     name: str | None = ...,
-    supersample: int = ...,
+    supersample: int | None = ...,
     wavelengths: Wavelengths = ...,
     target_error: float | str | None = ...,
     calibrate: bool | None = ...,
@@ -164,27 +179,42 @@ def fit(
     *,
     params: str | Sequence[str] | None = ...,
     log: bool = ...,
-    starts: int = ...,
-    pairs: int = ...,
-    max_theta_deg: float = ...,
-    seed: int = ...,
+    starts: int | None = ...,
+    pairs: int | None = ...,
+    max_theta_deg: float | None = ...,
+    seed: int | None = ...,
     fresnel: str | None = ...,
     grey: bool = ...,
     wavelengths: Wavelengths = ...,
-    specular_fraction: float = ...,
-    max_iterations: int = ...,
-) -> dict[str, Any]: ...
+    specular_fraction: float | None = ...,
+    max_iterations: int | None = ...,
+) -> dict[str, Any]:
+    """Fits `model` (a name such as "ggx", a sum "lambert+ggx", or a JSON spec) to SOURCE; the
+    keywords are the CLI's fit flags, snake_cased. Returns the dict of `brdftab fit --json`."""
 
 class Database:
+    """A brdftab database: many named tables in one .btdb file. Pickles by its path."""
+
     path: str
     def __init__(self, path: Union[str, PathLike[str]]) -> None: ...
-    def names(self) -> list[str]: ...
+    def __repr__(self) -> str: ...
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+    def names(self) -> list[str]:
+        """The table names, in file order."""
     def __contains__(self, name: str) -> bool: ...
-    def add(self, source: str, name: str, *, replace: bool = False, **options: Any) -> dict[str, Any]: ...
+    def add(
+        self, source: str | PathLike[str], name: str, *, replace: bool = False, **options: Any
+    ) -> dict[str, Any]:
+        """Bakes SOURCE into table NAME (the database is created if absent); takes the keywords
+        of `bake`. Returns what `brdftab info --json DB#NAME` reports."""
     def add_bytes(self, name: str, data: bytes, *, replace: bool = False) -> None:
         """Adds the table in a single-table .btdb file's bytes as NAME (chunks copied as they
         are); an existing NAME is an error unless replace."""
-    def remove(self, name: str) -> None: ...
-    def open(self, name: str, **options: Any) -> Brdf: ...
-    def source(self, name: str) -> str: ...
-    def info(self) -> dict[str, Any]: ...
+    def remove(self, name: str) -> None:
+        """Removes table NAME."""
+    def open(self, name: str, **options: Any) -> Brdf:
+        """Opens table NAME as a Brdf (the keywords of `open`)."""
+    def source(self, name: str) -> str:
+        """The SOURCE string of table NAME ("DB#NAME"), e.g. for worker processes."""
+    def info(self) -> dict[str, Any]:
+        """What `brdftab info --json DB` reports: the file and every table."""

@@ -114,6 +114,7 @@ def _flags(brdf, source):
 
 
 def brdftab_kind(source):
+    """The kind of SOURCE by its name, as the plugin needs it: "spec", "merl", "rgl" or "table"."""
     s = source.strip()
     low = s.lower()
     if s.startswith("{") or low.endswith(".json"):
