@@ -71,6 +71,31 @@ fn bake_reports_its_values_and_the_report_reads_as_text() {
 }
 
 #[test]
+fn a_files_ratio_counts_every_table_also_when_one_is_asked_for() {
+    let d = TempDir::new("api-ratio");
+    let db = d.join("two.btdb");
+    let db = db.to_str().unwrap();
+    for name in ["a", "b"] {
+        BakeRequest::new(LAMBERT)
+            .preset(Preset::Small)
+            .run_with(&BakeTarget::db(db, name), &Silent)
+            .unwrap();
+    }
+    let whole = info::file_info(db).unwrap();
+    let one = info::file_info(&format!("{db}#a")).unwrap();
+    let tables = whole["tables"].as_array().unwrap();
+    let values: u64 = tables.iter().map(|t| t["values"].as_u64().unwrap()).sum();
+    let bytes = whole["bytes"].as_u64().unwrap();
+    assert_eq!(tables.len(), 2);
+    // The file's figures are the file's, whichever tables are listed.
+    assert_eq!(one["tables"].as_array().unwrap().len(), 1);
+    assert_eq!(one["bytes"], whole["bytes"]);
+    assert_eq!(one["ratio_to_f32"], whole["ratio_to_f32"]);
+    let ratio = whole["ratio_to_f32"].as_f64().unwrap();
+    assert_eq!(ratio, values as f64 * 4.0 / bytes as f64);
+}
+
+#[test]
 fn a_taken_name_is_a_duplicate_error_naming_no_flag() {
     let d = TempDir::new("api-dup");
     let db = d.join("x.btdb").display().to_string();

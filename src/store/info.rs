@@ -78,10 +78,13 @@ pub fn file_info(source: &str) -> Result<Value> {
         .iter()
         .map(|n| table_summary(&s, n))
         .collect::<Result<_>>()?;
-    let values: u64 = tables
+    // The file's ratio compares the whole file with every table it holds, also when one table
+    // is asked for (`DB#NAME`): against that table alone it read "0.6x smaller than f32".
+    let values = s
+        .tables()
         .iter()
-        .map(|t| t["values"].as_u64().unwrap_or(0))
-        .sum();
+        .map(|e| s.table(&e.name).map(|t| t.header().values))
+        .sum::<Result<u64>>()?;
     Ok(json!({
         "file": path,
         "format": "btdb",
