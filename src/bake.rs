@@ -1215,10 +1215,8 @@ pub fn to_rgl(
 mod tests {
     use super::*;
 
-    fn tmp(name: &str) -> std::path::PathBuf {
-        let d = std::env::temp_dir().join(format!("brdftab-bake-{}-{name}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    fn tmp(name: &str) -> crate::testkit::TempDir {
+        crate::testkit::TempDir::new(&format!("bake-{name}"))
     }
 
     #[test]
@@ -1315,7 +1313,6 @@ mod tests {
             replace: true,
         };
         req.run(&replace).unwrap();
-        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
@@ -1333,7 +1330,6 @@ mod tests {
         assert_eq!(acc.pairs, 2000);
         // log16 ≤ 1e-3 relative on a constant: the error is the codec's bound at most.
         assert!(acc.max_rel <= 1e-3, "{acc:?}");
-        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
@@ -1353,6 +1349,5 @@ mod tests {
         forced.force = true;
         let r = forced.run(&BakeTarget::file(&out)).unwrap();
         assert!(r.forced.is_some());
-        std::fs::remove_dir_all(&d).unwrap();
     }
 }

@@ -322,14 +322,12 @@ mod tests {
             parse_wavelengths("400, x"),
             Err(Error::InvalidArgument { .. })
         ));
-        let dir = std::env::temp_dir().join(format!("brdftab-src-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::testkit::TempDir::new("src");
         let junk = dir.join("junk.tbl");
         std::fs::write(&junk, b"not a table at all").unwrap();
         assert!(matches!(
             open(junk.to_str().unwrap()),
             Err(Error::Unsupported(_))
         ));
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
