@@ -534,7 +534,8 @@ impl PyBrdf {
         })
     }
 
-    /// Directional albedo ∫ f_r cos θo dωo at incidence angles θ′ (radians, in [0, π/2]):
+    /// Directional albedo ∫ f_r cos θo dωo at incidence angles θ′ (radians, in [0, π/2): light
+    /// above the horizon; else ValueError naming theta):
     /// float64 (k, c) (or (c,) for a scalar θ′). A closed form where the model has one, else
     /// adaptive quadrature: 1e-6 relative for models, 1e-4 for tables and measured data.
     fn albedo(&self, py: Python<'_>, theta: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {

@@ -132,6 +132,17 @@ def test_albedo():
     assert b.albedo(0.3).shape == (3,)
 
 
+def test_albedo_is_for_light_above_the_horizon():
+    """θ′ = π/2 is refused like the CLI's 90°: cos(π/2) in float64 is 6e-17 > 0, so it used to be
+    evaluated as a light just above the horizon, and Ward's albedo (which diverges there) came
+    out as 3.5e5."""
+    ward = brdftab.open('{"model": "ward", "ks": 0.1, "alpha_x": 0.2, "alpha_y": 0.2}')
+    for t in [np.pi / 2, np.radians(90.0)]:
+        with pytest.raises(ValueError, match="theta.*above the horizon"):
+            ward.albedo([0.0, t])
+    assert np.isfinite(ward.albedo(np.nextafter(np.pi / 2, 0))).all()
+
+
 def test_albedo_matches_cli(cli):
     b = brdftab.open(GGX)
     got = b.albedo(np.radians([0, 30, 60]))

@@ -53,7 +53,8 @@ class Brdf:
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32]]:
         """(wi (n, 3), pdf (n,), weight = f cos θi / pdf (n, c)) for u in [0, 1)² of shape (n, 2)."""
     def albedo(self, theta: ArrayLike) -> npt.NDArray[np.float64]:
-        """Directional albedo at θ′ in radians: (k, c) float64.
+        """Directional albedo at θ′ in radians, 0 ≤ θ′ < π/2 (light above the horizon; else
+        ValueError naming theta): (k, c) float64.
 
         A closed form where the model has one, else adaptive quadrature: 1e-6 relative for
         models, 1e-4 for tables and measured data.
