@@ -1151,11 +1151,13 @@ impl Accuracy {
     }
 }
 
-/// A file name's stem (`table` when it has none).
+/// A file name's stem, the default name of a table (`table` when it has none). `path` is a
+/// path, not a `DB#NAME` (a SOURCE's file is [`crate::store::name::path_of`]); a `#` in the stem
+/// (a file named `scan#2.bsdf`), which a table name cannot hold, becomes `_`.
 pub fn stem(path: &str) -> String {
-    Path::new(crate::store::name::path_of(path))
+    Path::new(path)
         .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
+        .map(|s| s.to_string_lossy().replace('#', "_"))
         .unwrap_or_else(|| "table".into())
 }
 
