@@ -331,10 +331,8 @@ fn main() {
     );
 
     // Open a 100-table database and do a first lookup.
-    let dir = std::env::temp_dir().join(format!("brdftab-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = brdftab::testkit::TempDir::new("bench-codec");
     let p = dir.join("db100.btdb");
-    let _ = std::fs::remove_file(&p);
     let small = cook_torrance_table(Some([32, 64, 32, 64]));
     let mut wtr = brdftab::store::Writer::create(&p).unwrap();
     let codec = Codec {
@@ -383,7 +381,6 @@ fn main() {
         f
     });
     println!("open 100-table db + lazy TabulatedBrdf + first eval: {t:.2?} (f = {f:?})");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 fn bytemuck(v: &[f32]) -> &[u8] {

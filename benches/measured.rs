@@ -109,8 +109,7 @@ fn main() {
     }
 
     // MERL: a synthetic file of random values.
-    let dir = std::env::temp_dir().join(format!("brdftab-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = brdftab::testkit::TempDir::new("bench-measured");
     let path = dir.join("synthetic.binary");
     let mut rng = Pcg32::new(7);
     let data: Vec<f64> = (0..3 * merl::SAMPLES)
@@ -143,7 +142,7 @@ fn main() {
         "merl nearest eval                               {:7.1} ns/eval",
         ns_per_eval(&m, &p)
     );
-    std::fs::remove_dir_all(&dir).ok();
+    drop(dir);
 
     // The RGL material baked into tables (halfdiff, sqrt θh, isotropic) and the MERL grid.
     use brdftab::table::presets::Preset;

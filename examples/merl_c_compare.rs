@@ -30,8 +30,7 @@ fn main() -> Result<()> {
         .nth(1)
         .and_then(|s| s.parse().ok())
         .unwrap_or(5);
-    let dir = std::env::temp_dir().join(format!("brdftab-merl-c-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(io)?;
+    let dir = brdftab::testkit::TempDir::new("merl-c");
     let (table, _) = BakeRequest::new(SPEC)
         .grid(GridChoice::Sizes([90, 1, 90, 180]))
         .param(Param::HalfDiff)
@@ -123,6 +122,5 @@ fn main() -> Result<()> {
         med(&mut rn),
         med(&mut ra)
     );
-    std::fs::remove_dir_all(&dir).map_err(io)?;
     Ok(())
 }

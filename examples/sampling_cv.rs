@@ -174,8 +174,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         VIEWS.map(|v| format!("{v}°")).join(" | ")
     );
     println!("|---|{}---|---|---|---|", "---|".repeat(VIEWS.len()));
-    let dir = std::env::temp_dir().join(format!("brdftab-sampling-cv-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
+    let dir = brdftab::testkit::TempDir::new("sampling-cv");
     for (i, s) in sources.iter().enumerate() {
         let name = std::path::Path::new(s)
             .file_stem()
@@ -215,6 +214,5 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             row(&format!("{name} table"), &b, samples);
         }
     }
-    let _ = std::fs::remove_dir_all(&dir);
     Ok(())
 }

@@ -1151,11 +1151,13 @@ impl Accuracy {
     }
 }
 
-/// A file name's stem (`table` when it has none).
+/// A file name's stem, the default name of a table (`table` when it has none). `path` is a
+/// path, not a `DB#NAME` (a SOURCE's file is [`crate::store::name::path_of`]); a `#` in the stem
+/// (a file named `scan#2.bsdf`), which a table name cannot hold, becomes `_`.
 pub fn stem(path: &str) -> String {
-    Path::new(crate::store::name::path_of(path))
+    Path::new(path)
         .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
+        .map(|s| s.to_string_lossy().replace('#', "_"))
         .unwrap_or_else(|| "table".into())
 }
 
@@ -1215,10 +1217,8 @@ pub fn to_rgl(
 mod tests {
     use super::*;
 
-    fn tmp(name: &str) -> std::path::PathBuf {
-        let d = std::env::temp_dir().join(format!("brdftab-bake-{}-{name}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    fn tmp(name: &str) -> crate::testkit::TempDir {
+        crate::testkit::TempDir::new(&format!("bake-{name}"))
     }
 
     #[test]
@@ -1315,7 +1315,6 @@ mod tests {
             replace: true,
         };
         req.run(&replace).unwrap();
-        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
@@ -1333,7 +1332,6 @@ mod tests {
         assert_eq!(acc.pairs, 2000);
         // log16 ≤ 1e-3 relative on a constant: the error is the codec's bound at most.
         assert!(acc.max_rel <= 1e-3, "{acc:?}");
-        std::fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
@@ -1353,6 +1351,5 @@ mod tests {
         forced.force = true;
         let r = forced.run(&BakeTarget::file(&out)).unwrap();
         assert!(r.forced.is_some());
-        std::fs::remove_dir_all(&d).unwrap();
     }
 }

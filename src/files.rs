@@ -208,16 +208,14 @@ mod tests {
 
     #[test]
     fn the_same_file_under_two_names_is_caught() {
-        let d = std::env::temp_dir().join(format!("brdftab-paths-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
+        let d = crate::testkit::TempDir::new("paths");
         let a = d.join("a.btdb");
         std::fs::write(&a, b"x").unwrap();
-        let other = d.join(".").join("a.btdb");
+        let other = d.path().join(".").join("a.btdb");
         assert!(same_file(&a, &other));
         let src = format!("{}#t", other.display());
         assert!(refuse_input(&a, &[&src]).is_err());
         assert!(refuse_input(&d.join("b.btdb"), &[&src]).is_ok());
         assert!(refuse_input(&a, &[r#"{"model": "lambert"}"#]).is_ok());
-        std::fs::remove_dir_all(&d).unwrap();
     }
 }

@@ -138,6 +138,9 @@ impl OpenOptions {
 /// Opens SOURCE with the default [`OpenOptions`] (interpolation chosen per table, the
 /// source's own channels).
 ///
+/// `DB#NAME` is split at the last `#`, unless the whole string names an existing file: then it is
+/// that file (`a#b.btdb` opens as itself; [`crate::store::name`]).
+///
 /// An analytic model, inline:
 /// ```
 /// use glam::DVec3;
@@ -197,7 +200,7 @@ pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send
     // Stat before any open: a FIFO, socket, device or directory is refused at once.
     // `x.btdb#` or a control character in NAME is an argument error, not a path to stat.
     if crate::files::source_file(source).is_some() {
-        let (f, _) = crate::store::name::parse_source("source", source)?;
+        let (f, _) = crate::store::name::parse_input("source", source)?;
         crate::files::require_regular(f)?;
     }
     let fixed_channels = |brdf: Box<dyn Brdf + Send + Sync>| match &opts.channels {
@@ -322,14 +325,12 @@ mod tests {
             parse_wavelengths("400, x"),
             Err(Error::InvalidArgument { .. })
         ));
-        let dir = std::env::temp_dir().join(format!("brdftab-src-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::testkit::TempDir::new("src");
         let junk = dir.join("junk.tbl");
         std::fs::write(&junk, b"not a table at all").unwrap();
         assert!(matches!(
             open(junk.to_str().unwrap()),
             Err(Error::Unsupported(_))
         ));
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

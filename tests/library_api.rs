@@ -147,10 +147,16 @@ fn empty_table_names_and_control_characters_are_argument_errors_on_every_road() 
         assert_eq!(field(request::bake(LAMBERT, &db, &named, &Silent)), "name");
     }
     assert!(!d.join("m.btdb").exists());
-    // Reading: `m.btdb#` is no path to a file of that name, even when one exists.
-    std::fs::write(d.join("m.btdb#"), b"not read").unwrap();
+    // Reading: `m.btdb#` names no table; and a file of that name, when one exists, is read as
+    // that file (a file on disk wins: `store::name`), here one brdftab cannot read.
     assert_eq!(field(brdftab::open(&out).map(|_| ())), "source");
     assert_eq!(field(info::file_info(&out)), "source");
+    std::fs::write(d.join("m.btdb#"), b"not read").unwrap();
+    let e = brdftab::open(&out).map(|_| ()).unwrap_err();
+    assert!(
+        matches!(e, Error::Unsupported(ref m) if m.contains("m.btdb#")),
+        "{e}"
+    );
     // The store's own entry points keep the same rule.
     request::bake(LAMBERT, &format!("{db}#ok"), &settings, &Silent).unwrap();
     let s = brdftab::store::Store::open(&db).unwrap();
@@ -165,6 +171,55 @@ fn empty_table_names_and_control_characters_are_argument_errors_on_every_road() 
         "name"
     );
     assert_eq!(std::fs::read(&stem).unwrap(), b"kept");
+}
+
+/// A `#` in a file's own name: `a#b.btdb` was split into table `b.btdb` of a database `a` and
+/// could not be opened. A string that names an existing file as a whole is that file; otherwise
+/// it is `DB#NAME` as before.
+#[test]
+fn a_file_with_a_hash_in_its_name_opens_as_that_file() {
+    let d = TempDir::new("api-hash");
+    std::fs::create_dir(d.join("scan#2")).unwrap();
+    let req = BakeRequest::new(LAMBERT).preset(Preset::Small);
+    let plain = d.file("plain.btdb");
+    req.run(&BakeTarget::file(&plain)).unwrap();
+    let lambert_at = |b: &dyn brdftab::Brdf| {
+        let mut f = [0.0f32; 3];
+        b.eval(glam::DVec3::Z, glam::DVec3::Z, &mut f);
+        f
+    };
+    let want = lambert_at(brdftab::open(&plain).unwrap().as_ref());
+    for f in ["a#b.btdb", "scan#2/x#y.btdb"] {
+        let whole = d.file(f);
+        assert!(brdftab::open(&whole).is_err(), "{f}: nothing there yet");
+        std::fs::copy(&plain, &whole).unwrap();
+        let b = brdftab::open(&whole).unwrap_or_else(|e| panic!("{f}: {e}"));
+        assert_eq!(lambert_at(b.as_ref()), want, "{f}");
+        assert_eq!(
+            info::file_info(&whole).unwrap()["tables"][0]["name"],
+            "plain"
+        );
+        assert!(brdftab::source::open_table(&whole, &Default::default()).is_ok());
+    }
+    // DB#NAME still opens a table when no file has the whole string as its name; a file that
+    // does wins over the database.
+    let db = d.file("lib.btdb");
+    let glossy = r#"{"model": "ggx", "alpha": 0.3}"#;
+    BakeRequest::new(glossy)
+        .preset(Preset::Small)
+        .run(&BakeTarget::db(&db, "g"))
+        .unwrap();
+    let entry = format!("{db}#g");
+    let g = lambert_at(brdftab::open(&entry).unwrap().as_ref());
+    assert_ne!(g, want);
+    std::fs::copy(&plain, &entry).unwrap();
+    assert_eq!(lambert_at(brdftab::open(&entry).unwrap().as_ref()), want);
+    // An output keeps the DB#NAME rule whatever exists: table `b.btdb` of the database `a`.
+    let out = d.file("a#b.btdb");
+    assert_eq!(
+        BakeTarget::parse(&out, None, false).unwrap(),
+        BakeTarget::db(d.file("a"), "b.btdb")
+    );
 }
 
 #[test]

@@ -49,14 +49,22 @@ pub fn quadrature<B: Brdf + ?Sized>(brdf: &B, wi: DVec3, out: &mut [f64]) {
 }
 
 /// The incident direction of polar angle `theta` (radians, azimuth 0) at which hosts ask for an
-/// albedo: `theta` must lie in [0, π/2] (beyond it the light is below the horizon, and a
-/// negative angle would silently mean its mirror image); otherwise an
+/// albedo: `theta` must lie in [0, π/2), light above the horizon; otherwise an
 /// [`Error::InvalidArgument`](crate::Error::InvalidArgument) naming `theta`.
+///
+/// Why π/2 itself is refused: light at the horizon reaches the surface with cos θ′ = 0, where the
+/// albedo is at best a limit, and not always a finite one (Ward's and the original Phong's f_r
+/// grow like 1/cos θ′, and so does their albedo). The direction computed for θ′ = π/2 is not at
+/// the horizon either: cos(π/2) in f64 is 6e-17 > 0, so it was evaluated as a light just above it,
+/// and Ward's albedo came out as 3.5e5. A negative angle would silently mean its mirror image.
 pub fn incidence(theta: f64) -> crate::Result<DVec3> {
-    if !(0.0..=std::f64::consts::FRAC_PI_2).contains(&theta) {
+    if !(0.0..std::f64::consts::FRAC_PI_2).contains(&theta) {
         return Err(crate::Error::arg(
             "theta",
-            format!("{theta} is outside [0, π/2] (radians)"),
+            format!(
+                "{theta} is outside [0, π/2) (radians): the albedo is defined for light above \
+                 the horizon"
+            ),
         ));
     }
     Ok(geometry::spherical(theta, 0.0))
@@ -64,16 +72,23 @@ pub fn incidence(theta: f64) -> crate::Result<DVec3> {
 
 /// The albedo a(θ) at incidence angles `thetas` (radians, azimuth φ = 0) per channel, using
 /// [`Brdf::albedo`] (so closed forms are used where a model has one): `curve[k][channel]`.
-pub fn albedo_curve<B: Brdf + ?Sized>(brdf: &B, thetas: &[f64]) -> Vec<Vec<f64>> {
+///
+/// Every angle must lie in [0, π/2) ([`incidence`]), or the whole curve is an
+/// [`Error::InvalidArgument`](crate::Error::InvalidArgument) naming `theta`.
+pub fn albedo_curve<B: Brdf + ?Sized>(brdf: &B, thetas: &[f64]) -> crate::Result<Vec<Vec<f64>>> {
     let c = brdf.channels().len().min(MAX_CHANNELS);
-    thetas
+    let dirs = thetas
         .iter()
-        .map(|&t| {
+        .map(|&t| incidence(t))
+        .collect::<crate::Result<Vec<_>>>()?;
+    Ok(dirs
+        .into_iter()
+        .map(|wi| {
             let mut a = vec![0.0; c];
-            brdf.albedo(geometry::spherical(t, 0.0), &mut a);
+            brdf.albedo(wi, &mut a);
             a
         })
-        .collect()
+        .collect())
 }
 
 /// Directional albedo with explicit accuracy settings, returning the error estimate and cost.
@@ -474,11 +489,43 @@ mod tests {
     #[test]
     fn albedo_curve_uses_the_model_and_has_one_row_per_angle() {
         let l = Lambert::new(Value::Grey(0.25), &Channels::Rgb).unwrap();
-        let curve = albedo_curve(&l, &[0.0, 0.5, 1.5]);
+        let curve = albedo_curve(&l, &[0.0, 0.5, 1.5]).unwrap();
         assert_eq!(curve.len(), 3);
         for row in curve {
             assert_eq!(row.len(), 3);
             assert!(rel(row[0], 0.25 * PI) < 1e-7);
         }
+    }
+
+    #[test]
+    fn the_albedo_is_asked_for_light_above_the_horizon_only() {
+        use std::f64::consts::FRAC_PI_2;
+        // Ward's albedo grows without bound towards the horizon: at θ′ = π/2 the f64 direction
+        // (cos = 6e-17) gave 3.5e5 instead of an error.
+        let ward = crate::open(r#"{"model":"ward","ks":0.1,"alpha_x":0.2,"alpha_y":0.2}"#).unwrap();
+        let l = Lambert::new(Value::Grey(0.25), &Channels::Rgb).unwrap();
+        for t in [
+            FRAC_PI_2,
+            90f64.to_radians(),
+            2.0,
+            -0.1,
+            f64::NAN,
+            f64::INFINITY,
+        ] {
+            let e = incidence(t).unwrap_err();
+            assert!(
+                matches!(&e, crate::Error::InvalidArgument { name, .. } if name == "theta"),
+                "{t}: {e}"
+            );
+            assert!(e.to_string().contains("above the horizon"), "{e}");
+            assert!(albedo_curve(&*ward, &[0.0, t]).is_err(), "{t}");
+            assert!(albedo_curve(&l, &[t]).is_err(), "{t}");
+        }
+        // Just below π/2 is a direction above the horizon: a finite (if large) albedo.
+        let below = FRAC_PI_2 - 1e-6;
+        assert!(incidence(below).unwrap().z > 0.0);
+        let a = albedo_curve(&*ward, &[below]).unwrap();
+        assert!(a[0][0].is_finite() && a[0][0] > 1.0, "{a:?}");
+        assert!(rel(albedo_curve(&l, &[below]).unwrap()[0][0], 0.25 * PI) < 1e-7);
     }
 }

@@ -116,7 +116,10 @@ pub fn convert(
             let target = match BakeTarget::parse(output, None, replace)? {
                 BakeTarget::File(path) => BakeTarget::Db {
                     path,
-                    name: req.name.clone().unwrap_or_else(|| bake::stem(source)),
+                    name: req
+                        .name
+                        .clone()
+                        .unwrap_or_else(|| bake::stem(crate::store::name::path_of(source))),
                     replace,
                 },
                 t => t,

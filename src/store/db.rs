@@ -178,7 +178,9 @@ pub fn verify(path: impl AsRef<Path>) -> Result<usize> {
 }
 
 /// Splits SOURCE `DB#NAME` into the path and the optional table name; an empty name
-/// (`x.btdb#`) or one [`super::name::check`] refuses is an argument error naming `source`.
+/// (`x.btdb#`) or one [`super::name::check`] refuses is an argument error naming `source`. A
+/// string that names an existing file as a whole (`a#b.btdb`) is that file
+/// ([`super::name::parse_input`]).
 pub fn split_source(source: &str) -> Result<(&str, Option<&str>)> {
-    super::name::parse_source("source", source)
+    super::name::parse_input("source", source)
 }

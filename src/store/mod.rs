@@ -132,12 +132,19 @@ impl Store {
         Self::from_backing(path, name, Backing::Map(map), opts)
     }
 
-    /// Opens a file held in memory (`name` is used in error messages). Used by the fuzz target.
-    pub fn from_bytes(name: &str, bytes: Vec<u8>, opts: StoreOptions) -> Result<Store> {
+    /// Opens a file held in memory (`name` is used in error messages): a `Vec<u8>`, or a buffer
+    /// a host owns, read where it is (Python's `Database.add_bytes` hands over the `bytes`
+    /// object itself, so a table as large as memory allows needs no second copy). Used by the
+    /// fuzz target too.
+    pub fn from_bytes(
+        name: &str,
+        bytes: impl AsRef<[u8]> + Send + Sync + 'static,
+        opts: StoreOptions,
+    ) -> Result<Store> {
         Self::from_backing(
             PathBuf::from(name),
             name.to_owned(),
-            Backing::Bytes(bytes),
+            Backing::Bytes(Box::new(bytes)),
             opts,
         )
     }
@@ -300,8 +307,8 @@ impl Store {
 pub enum Backing {
     /// A memory-mapped file.
     Map(memmap2::Mmap),
-    /// Bytes in memory.
-    Bytes(Vec<u8>),
+    /// Bytes in memory, owned by the store (a `Vec<u8>`) or by a host (a Python `bytes`).
+    Bytes(Box<dyn AsRef<[u8]> + Send + Sync>),
 }
 
 impl std::ops::Deref for Backing {
@@ -309,7 +316,7 @@ impl std::ops::Deref for Backing {
     fn deref(&self) -> &[u8] {
         match self {
             Backing::Map(m) => m,
-            Backing::Bytes(b) => b,
+            Backing::Bytes(b) => (**b).as_ref(),
         }
     }
 }

@@ -10,6 +10,20 @@
 //! `DB#NAME` whose name part has a `/` is read as a path with a `#` in a directory, so such a
 //! table could be written but never opened by name) and no control character (NUL, tab,
 //! newline, ...: invisible or cut short in listings, C strings and terminals).
+//!
+//! # A `#` in a file's own name
+//!
+//! A string is split at its last `#` into `DB` and `NAME` ([`parse_source`]), which alone would
+//! make a file named `a#b.btdb` (or `scans/x#2.bsdf`) impossible to open: it would be read as
+//! table `b.btdb` of a database `a`. So a string that is **read** is first looked up whole: if
+//! something exists on disk under the whole string, that is the file read, and only otherwise is
+//! it split ([`parse_input`]; [`path_of`] and `store::db::split_source` follow it, and so does
+//! every host's open). A file on disk wins even over a database of the split's name holding such
+//! a table. An **output** keeps the string rule ([`parse_source`]): `-o a#b.btdb` writes table
+//! `b.btdb` into the database `a`, the documented `DB#NAME` output, whatever exists — where a
+//! bake writes must not depend on which files happen to be there.
+
+use std::path::Path;
 
 use crate::error::{Error, Result};
 
@@ -40,8 +54,9 @@ pub fn check(field: &str, name: &str) -> Result<()> {
 }
 
 /// Splits a SOURCE or output string `DB#NAME` into the path and the table name (`None` for a
-/// plain path). The name is what follows the last `#`, unless it holds a `/` (then the whole
-/// string is a path with a `#` in a directory name). An empty name (`x.btdb#`) or one that
+/// plain path), by the string alone: the rule of outputs (a SOURCE that is read goes through
+/// [`parse_input`]). The name is what follows the last `#`, unless it holds a `/` (then the
+/// whole string is a path with a `#` in a directory name). An empty name (`x.btdb#`) or one that
 /// breaks [`check`] is an [`Error::InvalidArgument`] naming `field`.
 pub fn parse_source<'a>(field: &str, source: &'a str) -> Result<(&'a str, Option<&'a str>)> {
     match source.rsplit_once('#') {
@@ -60,11 +75,21 @@ pub fn parse_source<'a>(field: &str, source: &'a str) -> Result<(&'a str, Option
     }
 }
 
-/// The path part of a SOURCE or output string, for callers that only look (which file a string
-/// reads, a default name): a string [`parse_source`] refuses is taken as a plain path, and the
-/// call that opens or writes it reports the error.
+/// Splits a SOURCE that is read: the whole string when something exists on disk under it (a
+/// file named `a#b.btdb`: see the module docs), else [`parse_source`]'s split, whose errors name
+/// `field`.
+pub fn parse_input<'a>(field: &str, source: &'a str) -> Result<(&'a str, Option<&'a str>)> {
+    if source.contains('#') && std::fs::metadata(Path::new(source)).is_ok() {
+        return Ok((source, None));
+    }
+    parse_source(field, source)
+}
+
+/// The path part of a SOURCE string, for callers that only look (which file a string reads, a
+/// default name): [`parse_input`]'s path, and a string it refuses is taken as a plain path (the
+/// call that opens it reports the error).
 pub fn path_of(source: &str) -> &str {
-    parse_source("source", source).map_or(source, |(p, _)| p)
+    parse_input("source", source).map_or(source, |(p, _)| p)
 }
 
 #[cfg(test)]
@@ -114,6 +139,34 @@ mod tests {
         assert_eq!(parse_source("source", "x.btdb").unwrap(), ("x.btdb", None));
         assert_eq!(path_of("x.btdb#"), "x.btdb#");
         assert_eq!(path_of("x.btdb#m"), "x.btdb");
+    }
+
+    #[test]
+    fn a_string_that_names_a_file_as_a_whole_is_read_as_that_file() {
+        let d = crate::testkit::TempDir::new("name-hash");
+        std::fs::create_dir(d.join("scan#2")).unwrap();
+        for f in ["a#b.btdb", "scan#2/x#y.bsdf", "m.btdb#"] {
+            let whole = d.file(f);
+            // Not there yet: split as DB#NAME (or refused), as an output always is.
+            let split = parse_source("source", &whole);
+            assert_eq!(
+                parse_input("source", &whole).ok(),
+                split.as_ref().ok().copied()
+            );
+            std::fs::write(&whole, b"x").unwrap();
+            assert_eq!(
+                parse_input("source", &whole).unwrap(),
+                (whole.as_str(), None)
+            );
+            assert_eq!(path_of(&whole), whole);
+            // An output keeps the string rule whatever exists.
+            assert_eq!(parse_source("output", &whole).ok(), split.ok());
+        }
+        // A database and a table of the split's name: the plain split when no such file exists.
+        let db = d.file("db.btdb");
+        std::fs::write(&db, b"x").unwrap();
+        let s = format!("{db}#t");
+        assert_eq!(parse_input("source", &s).unwrap(), (db.as_str(), Some("t")));
     }
 
     fn e_msg(s: &str) -> String {

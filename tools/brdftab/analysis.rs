@@ -41,7 +41,12 @@ pub fn albedo(a: AlbedoArgs) -> Result<()> {
     let thetas = parse_degrees(&a.theta)?;
     let brdf = brdftab::request::open(&a.source, &a.open)?;
     let radians: Vec<f64> = thetas.iter().map(|t| t.to_radians()).collect();
-    let curve = albedo::albedo_curve(&*brdf, &radians);
+    // The library's rule, [0, π/2) in radians; `parse_degrees` has said it in degrees already,
+    // unless a degree just below 90 rounded to π/2.
+    let curve = albedo::albedo_curve(&*brdf, &radians).map_err(|e| match e {
+        Error::InvalidArgument { msg, .. } => Error::arg("--theta", msg),
+        e => e,
+    })?;
     brdf.health()?;
     let mut text = String::new();
     for (t, row) in thetas.iter().zip(curve) {
@@ -65,7 +70,8 @@ pub fn check(a: CheckArgs) -> Result<()> {
     }
 }
 
-/// Parses `0,30,60` as degrees in [0, 90].
+/// Parses `0,30,60` as degrees in [0, 90): the albedo is defined for light above the horizon
+/// ([`albedo::incidence`]).
 fn parse_degrees(s: &str) -> Result<Vec<f64>> {
     s.split(',')
         .map(|x| {
@@ -73,8 +79,11 @@ fn parse_degrees(s: &str) -> Result<Vec<f64>> {
                 .trim()
                 .parse()
                 .map_err(|_| Error::arg("--theta", format!("`{x}` is not a number")))?;
-            if !(0.0..=90.0).contains(&t) {
-                return Err(Error::arg("--theta", format!("{t}° is outside [0°, 90°]")));
+            if !(0.0..90.0).contains(&t) {
+                return Err(Error::arg(
+                    "--theta",
+                    format!("{t}° is outside [0°, 90°): the albedo is defined for light above the horizon"),
+                ));
             }
             Ok(t)
         })

@@ -40,8 +40,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
-    let dir = std::env::temp_dir().join(format!("brdftab-c-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = brdftab::testkit::TempDir::new("c-bench");
     let path = dir.join("ct.btdb").to_str().unwrap().to_owned();
     let spec = r#"{"model":"cook_torrance","m":0.3,"fresnel":{"conductor":"Au"}}"#;
     BakeRequest::new(spec)
@@ -127,5 +126,4 @@ fn main() {
         oc - or
     );
     unsafe { brdftab_close(h) };
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -26,7 +26,7 @@
  *
  * NaN: a direction with a NaN or infinite component, or a zero vector, is not an error: f_r and
  * pdf are 0 for it and sample gives wi = 0, pdf = 0, weight = 0 (as the library does); a NaN
- * in u, or a u outside [0, 1), gives no sample either. A theta outside [0, pi/2] in brdftab_albedo (NaN included) is an
+ * in u, or a u outside [0, 1), gives no sample either. A theta outside [0, pi/2) in brdftab_albedo (NaN included) is an
  * error (-1).
  * Thread safety: eval, pdf, sample and albedo may run concurrently on one handle.
  */
@@ -82,8 +82,8 @@ int brdftab_pdf(const brdftab_brdf *b, size_t n, const double *wi, const double 
  * with no sample gets wi = 0, pdf = 0, weight = 0. */
 int brdftab_sample(const brdftab_brdf *b, size_t n, const double *wo, const double *u,
                    double *wi, double *pdf, float *weight);
-/* Directional albedo for light at polar angle theta in [0, pi/2] (radians; anything else is an
- * error, -1): one double per channel (a closed
+/* Directional albedo for light at polar angle theta in [0, pi/2) (radians, light above the
+ * horizon; anything else, pi/2 included, is an error, -1): one double per channel (a closed
  * form where the model has one, else adaptive quadrature: 1e-6 relative for models, 1e-4 for
  * tables and measured data). */
 int brdftab_albedo(const brdftab_brdf *b, double theta, double *albedo);

@@ -22,7 +22,7 @@
 //!
 //! **NaN.** A direction with a NaN or infinite component (or a zero vector) is not an error: its
 //! f_r and pdf are 0 and it has no sample (wi = 0, pdf = 0, weight = 0), as in the library; a
-//! `theta` outside [0, π/2] in `brdftab_albedo` (NaN included) is an error. Batch calls allocate
+//! `theta` outside [0, π/2) in `brdftab_albedo` (NaN included) is an error. Batch calls allocate
 //! nothing beyond what the library's own `eval_batch` does: the caller's `double[n][3]` arrays
 //! are read in place as `DVec3` slices.
 
@@ -427,7 +427,7 @@ pub unsafe extern "C" fn brdftab_sample(
 
 /// Directional albedo a(θ′) = ∫ f_r cos θ dω for light incident at polar angle `theta` (radians,
 /// azimuth 0), one double per channel into `albedo`. 0 on success, -1 on failure (a `theta`
-/// outside [0, π/2]: [`brdftab::analysis::albedo::incidence`]).
+/// outside [0, π/2), light at or below the horizon: [`brdftab::analysis::albedo::incidence`]).
 ///
 /// # Safety
 /// `albedo` points to `brdftab_channels(b)` doubles.

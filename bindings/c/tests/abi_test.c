@@ -88,11 +88,14 @@ int main(int argc, char **argv) {
     CHECK(brdftab_pdf(b, 1, wi, wo, NULL) == -1, "NULL pdf");
     CHECK(brdftab_sample(b, 1, wo, NULL, swi, spdf, w) == -1, "NULL u");
     CHECK(brdftab_albedo(b, NAN, alb) == -1, "NaN theta");
-    /* Outside [0, pi/2]: -1 (theta = -1 gave the albedo at 1 rad, theta = 3 gave 0). */
+    /* Outside [0, pi/2): -1 (theta = -1 gave the albedo at 1 rad, theta = 3 gave 0, theta = pi/2
+     * a light 6e-17 above the horizon, where Ward's albedo diverges). */
     CHECK(brdftab_albedo(b, -1.0, alb) == -1, "negative theta");
     CHECK(brdftab_albedo(b, 3.0, alb) == -1, "theta beyond pi/2");
     CHECK(strstr(brdftab_last_error(), "theta") != NULL, "theta named in the error");
-    CHECK(brdftab_albedo(b, BRDFTAB_PI / 2.0, alb) == 0, "theta = pi/2 is allowed");
+    CHECK(brdftab_albedo(b, BRDFTAB_PI / 2.0, alb) == -1, "theta = pi/2 is refused");
+    CHECK(strstr(brdftab_last_error(), "horizon") != NULL, "the horizon named in the error");
+    CHECK(brdftab_albedo(b, nextafter(BRDFTAB_PI / 2.0, 0.0), alb) == 0, "just below pi/2");
     CHECK(brdftab_albedo(NULL, 0.5, alb) == -1, "NULL albedo handle");
     CHECK(brdftab_eval(b, 0, NULL, NULL, NULL) == 0, "n = 0");
     CHECK(brdftab_eval(NULL, 0, NULL, NULL, NULL) == 0, "n = 0, NULL handle");

@@ -112,15 +112,15 @@ def main():
         p for p in [ROOT / "data" / "rgl", ROOT.parent / "shared" / "data" / "measured" / "rgl"]
         if p.is_dir())
     rgl_file = str(rgl / a.file)
-    d = tempfile.mkdtemp()
-    table = os.path.join(d, "rgl.btdb")
-    brdftab.bake(rgl_file, table, preset="medium")
-    py_rate, cli_out, one = python_vs_cli(table, a.cli)
-    print(f"brdftab bench: {json.dumps(cli_out)}")
-    print(f"python batch eval 1e6 pairs: {py_rate / 1e6:.2f} M pairs/s")
-    print(f"one-pair eval call: {one * 1e6:.2f} us")
-    sys.stdout.flush()
-    res, diff = render_times(rgl_file, table, a.png)
+    with tempfile.TemporaryDirectory(prefix="brdftab-bench-") as d:
+        table = os.path.join(d, "rgl.btdb")
+        brdftab.bake(rgl_file, table, preset="medium")
+        py_rate, cli_out, one = python_vs_cli(table, a.cli)
+        print(f"brdftab bench: {json.dumps(cli_out)}")
+        print(f"python batch eval 1e6 pairs: {py_rate / 1e6:.2f} M pairs/s")
+        print(f"one-pair eval call: {one * 1e6:.2f} us")
+        sys.stdout.flush()
+        res, diff = render_times(rgl_file, table, a.png)
     print(f"llvm_ad_rgb 256x256 64spp: plugin {res['plugin']:.2f} s, measured {res['measured']:.2f} s "
           f"(ratio {res['plugin'] / res['measured']:.2f}); mean image difference {diff:.2%}")
 

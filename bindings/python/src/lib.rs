@@ -29,7 +29,7 @@ use numpy::ndarray::{ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyException, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::{PyBytes, PyDict, PyTuple};
 use rayon::prelude::*;
 
 pyo3::create_exception!(
@@ -535,7 +535,8 @@ impl PyBrdf {
         })
     }
 
-    /// Directional albedo ∫ f_r cos θo dωo at incidence angles θ′ (radians, in [0, π/2]):
+    /// Directional albedo ∫ f_r cos θo dωo at incidence angles θ′ (radians, in [0, π/2): light
+    /// above the horizon; else ValueError naming theta):
     /// float64 (k, c) (or (c,) for a scalar θ′). A closed form where the model has one, else
     /// adaptive quadrature: 1e-6 relative for models, 1e-4 for tables and measured data.
     fn albedo(&self, py: Python<'_>, theta: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
@@ -928,14 +929,26 @@ fn db_remove(path: &str, name: &str) -> PyResult<()> {
 
 /// Adds the table of a single-table file's bytes (what `bake` writes to a `.btdb` path) to
 /// database `path` as `name`, copying its encoded chunks (no re-encoding; checksums checked).
+///
+/// `data` is read where it is: a `bytes` object is immutable, and the `PyBackedBytes` keeps it
+/// alive while the store reads it. (It was extracted into a `Vec<u8>`, a copy whose allocation
+/// failure aborts the process rather than raising MemoryError: a table near the size of memory
+/// killed the interpreter.) Anything else is the wrapper's to turn into `bytes`.
 #[pyfunction]
 #[pyo3(signature = (path, name, data, replace=false))]
-fn db_import(py: Python<'_>, path: &str, name: &str, data: Vec<u8>, replace: bool) -> PyResult<()> {
+fn db_import(
+    py: Python<'_>,
+    path: &str,
+    name: &str,
+    data: Bound<'_, PyBytes>,
+    replace: bool,
+) -> PyResult<()> {
     guard(|| {
         let opts = brdftab::store::StoreOptions {
             eager: false,
             ..Default::default()
         };
+        let data = pyo3::pybacked::PyBackedBytes::from(data);
         unlocked(py, || {
             let s = brdftab::store::Store::from_bytes("<bytes>", data, opts)?;
             let from = s.single()?.header().name.clone();

@@ -4,6 +4,7 @@ import json
 import multiprocessing
 import pathlib
 import pickle
+import shutil
 
 import numpy as np
 import pytest
@@ -132,6 +133,17 @@ def test_albedo():
     assert b.albedo(0.3).shape == (3,)
 
 
+def test_albedo_is_for_light_above_the_horizon():
+    """θ′ = π/2 is refused like the CLI's 90°: cos(π/2) in float64 is 6e-17 > 0, so it used to be
+    evaluated as a light just above the horizon, and Ward's albedo (which diverges there) came
+    out as 3.5e5."""
+    ward = brdftab.open('{"model": "ward", "ks": 0.1, "alpha_x": 0.2, "alpha_y": 0.2}')
+    for t in [np.pi / 2, np.radians(90.0)]:
+        with pytest.raises(ValueError, match="theta.*above the horizon"):
+            ward.albedo([0.0, t])
+    assert np.isfinite(ward.albedo(np.nextafter(np.pi / 2, 0))).all()
+
+
 def test_albedo_matches_cli(cli):
     b = brdftab.open(GGX)
     got = b.albedo(np.radians([0, 30, 60]))
@@ -249,12 +261,29 @@ def test_table_names_follow_the_librarys_rule(tmp_path):
     with pytest.raises(ValueError, match="output"):
         brdftab.bake(LAMBERT, f"{tmp_path}/n.btdb#a\nb", preset="small")
     assert not list(tmp_path.iterdir())
-    # `x.btdb#` names no table, even when a file of that name exists.
-    (tmp_path / "x.btdb#").write_bytes(b"")
+    # `x.btdb#` names no table; a file of that name, when one exists, is read as that file.
     with pytest.raises(ValueError, match="source"):
+        brdftab.open(f"{tmp_path}/x.btdb#")
+    (tmp_path / "x.btdb#").write_bytes(b"")
+    with pytest.raises(brdftab.Error, match="not a file brdftab can read"):
         brdftab.open(f"{tmp_path}/x.btdb#")
     db.add(LAMBERT, "ok", preset="small")
     assert db.names() == ["ok"]
+
+
+def test_a_file_with_a_hash_in_its_name_opens_as_that_file(tmp_path):
+    """`a#b.btdb` was split as DB#NAME (table `b.btdb` of a database `a`) and could not be
+    opened; a string that names an existing file is that file, else DB#NAME as before."""
+    brdftab.bake(LAMBERT, tmp_path / "plain.btdb", preset="small")
+    (tmp_path / "scan#2").mkdir()
+    want = brdftab.open(tmp_path / "plain.btdb").eval([0, 0, 1], [0, 0, 1])
+    for f in ["a#b.btdb", "scan#2/x#y.btdb"]:
+        shutil.copy(tmp_path / "plain.btdb", tmp_path / f)
+        np.testing.assert_array_equal(brdftab.open(tmp_path / f).eval([0, 0, 1], [0, 0, 1]), want)
+        np.testing.assert_array_equal(brdftab.open(str(tmp_path / f)).eval([0, 0, 1], [0, 0, 1]), want)
+    db = brdftab.Database(tmp_path / "lib.btdb")
+    db.add(LAMBERT, "m", preset="small")
+    assert brdftab.open(f"{tmp_path}/lib.btdb#m").channels == ["R", "G", "B"]
 
 
 def test_convert(tmp_path, paper):

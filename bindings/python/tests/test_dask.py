@@ -4,6 +4,8 @@ one a local bake makes."""
 
 import importlib.util
 import pathlib
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -73,3 +75,55 @@ def test_add_bytes_refuses_a_damaged_table(tmp_path):
     assert db.names() == ["ok"]
     with pytest.raises(ValueError):
         db.add_bytes("a#b", t.read_bytes())
+
+
+def test_add_bytes_takes_any_buffer_and_refuses_other_types(tmp_path):
+    t = tmp_path / "t.btdb"
+    brdftab.bake('{"model": "lambert", "kd": 0.5}', str(t), preset="small")
+    data = t.read_bytes()
+    db = brdftab.Database(tmp_path / "db.btdb")
+    db.add_bytes("b", data)
+    db.add_bytes("ba", bytearray(data))
+    db.add_bytes("mv", memoryview(data))
+    db.add_bytes("slice", memoryview(b"xx" + data)[2:])
+    assert db.names() == ["b", "ba", "mv", "slice"]
+    one = db.open("b").eval([0, 0, 1], [0, 0, 1])
+    for n in ["ba", "mv", "slice"]:
+        np.testing.assert_array_equal(db.open(n).eval([0, 0, 1], [0, 0, 1]), one)
+    for bad in [str(t), len(data), None]:
+        with pytest.raises(TypeError):
+            db.add_bytes("bad", bad)
+    assert db.names() == ["b", "ba", "mv", "slice"]
+
+
+# Run in a fresh interpreter: ru_maxrss is the process's high-water mark, which a bake in the
+# same process would already have raised above what the import needs.
+_PEAK = """
+import resource, sys
+import brdftab
+big, small, path = sys.argv[1:4]
+data = open(big, "rb").read()
+db = brdftab.Database(path)
+db.add_bytes("warm", open(small, "rb").read())
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+db.add_bytes("big", data)
+print(len(data), (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) * 1024)
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="ru_maxrss in KiB is Linux's")
+def test_add_bytes_reads_bytes_in_place(tmp_path):
+    """The bytes were extracted into a Rust Vec: a second copy of the whole table, whose failed
+    allocation aborts the interpreter instead of raising MemoryError. Read in place, importing a
+    5 MB table raises the peak by the writer's 1 MiB buffer, not by another 5 MB (it was 6.3)."""
+    big, small = tmp_path / "big.btdb", tmp_path / "small.btdb"
+    brdftab.bake('{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.4}', str(big),
+                 grid="48x96x48x96", codec="f32", level=1)
+    brdftab.bake('{"model": "lambert", "kd": 0.5}', str(small), preset="small")
+    out = subprocess.run([sys.executable, "-c", _PEAK, str(big), str(small),
+                          str(tmp_path / "db.btdb")],
+                         capture_output=True, text=True, check=True).stdout
+    size, growth = map(int, out.split())
+    assert size > 4_000_000
+    assert growth < size / 2, f"the import of {size} bytes raised the peak by {growth}"
+    assert brdftab.Database(tmp_path / "db.btdb").names() == ["warm", "big"]

@@ -307,8 +307,7 @@ fn database_spacing_for_eight_elevations_and_write_to_disk() {
         resolution: Some(32),
         ..Options::default()
     };
-    let dir = std::env::temp_dir().join(format!("brdftab-rglw-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::testkit::TempDir::new("rglw");
     let path = dir.join("cu.bsdf");
     struct Count(std::sync::atomic::AtomicUsize, std::sync::atomic::AtomicU64);
     impl crate::progress::Progress for Count {
@@ -327,7 +326,6 @@ fn database_spacing_for_eight_elevations_and_write_to_disk() {
     assert_eq!(std::fs::metadata(&path).unwrap().len() as usize, w.bytes);
     let back = RglBrdf::open(&path).unwrap();
     assert!(report(&back, &*src, PAIRS, 3).unwrap().rel_rmse < 0.02);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The shipped RGL files (`data/rgl`, through the library's locator). Panics (fails the test)

@@ -662,10 +662,11 @@ pub fn false_color(img: &Image, opts: &FalseColor) -> (Image, String) {
 mod tests {
     use super::*;
 
-    fn tmp(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("brdftab-image-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+    /// `name` in a fresh scratch directory, removed when the returned guard drops.
+    fn tmp(name: &str) -> (brdftab::testkit::TempDir, std::path::PathBuf) {
+        let dir = brdftab::testkit::TempDir::new("image");
+        let p = dir.join(name);
+        (dir, p)
     }
 
     fn ramp(w: usize, h: usize, c: usize) -> Image {
@@ -679,7 +680,7 @@ mod tests {
     #[test]
     fn exr_f32_round_trip_is_exact_and_keeps_channel_order() {
         let img = ramp(7, 5, 3);
-        let p = tmp("rt32.exr");
+        let (_dir, p) = tmp("rt32.exr");
         write_exr(&img, &p, ExrPrecision::F32).unwrap();
         let back = read_exr(&p).unwrap();
         assert_eq!(back.names, ["R", "G", "B"]);
@@ -689,7 +690,7 @@ mod tests {
     #[test]
     fn exr_f16_round_trip_within_half_precision() {
         let img = ramp(6, 4, 4);
-        let p = tmp("rt16.exr");
+        let (_dir, p) = tmp("rt16.exr");
         write_exr(&img, &p, ExrPrecision::F16).unwrap();
         let back = read_exr(&p).unwrap();
         assert_eq!(back.names, ["R", "G", "B", "A"]);
@@ -702,7 +703,7 @@ mod tests {
     #[test]
     fn exr_arbitrary_channel_names() {
         let img = ramp(3, 2, 2).with_names(&["theta", "value"]).unwrap();
-        let p = tmp("named.exr");
+        let (_dir, p) = tmp("named.exr");
         write_exr(&img, &p, ExrPrecision::F32).unwrap();
         let back = read_exr(&p).unwrap();
         assert_eq!(back.names, ["theta", "value"]);
@@ -713,16 +714,17 @@ mod tests {
     fn exr_f16_overflow_is_an_error_not_infinity() {
         let mut img = Image::new(2, 2, 1);
         img.data[3] = 1e6;
+        let (_dir, p) = tmp("big.exr");
         assert!(matches!(
-            write_exr(&img, tmp("big.exr"), ExrPrecision::F16),
+            write_exr(&img, &p, ExrPrecision::F16),
             Err(Error::Encode { .. })
         ));
     }
 
     #[test]
     fn read_missing_or_garbage_exr_is_an_error() {
-        assert!(read_exr(tmp("does-not-exist.exr")).is_err());
-        let p = tmp("garbage.exr");
+        let (_dir, p) = tmp("garbage.exr");
+        assert!(read_exr(&p).is_err()); // not there yet
         std::fs::write(&p, b"not an exr file at all").unwrap();
         assert!(read_exr(&p).is_err());
     }
@@ -733,7 +735,7 @@ mod tests {
         img.pixel_mut(0, 0).copy_from_slice(&[0.0, 0.5, 1.0]);
         img.pixel_mut(1, 0).copy_from_slice(&[2.0, -1.0, f32::NAN]);
         img.pixel_mut(2, 0).copy_from_slice(&[0.25, 0.25, 0.25]);
-        let p = tmp("rgb.png");
+        let (_dir, p) = tmp("rgb.png");
         write_png(&img, &p, 0.0).unwrap();
         let dec = png::Decoder::new(File::open(&p).unwrap());
         let mut reader = dec.read_info().unwrap();

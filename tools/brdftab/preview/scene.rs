@@ -627,7 +627,8 @@ mod exr_env_tests {
     fn exr_lat_long_map_loads_with_orientation() {
         // Bright top half (sky), dark bottom half: the zenith is bright, the nadir dark.
         let img = Image::from_fn(16, 8, 3, |_, y, o| o.fill(if y < 4 { 2.0 } else { 0.5 }));
-        let p = std::env::temp_dir().join(format!("brdftab-env-{}.exr", std::process::id()));
+        let dir = brdftab::testkit::TempDir::new("env");
+        let p = dir.join("env.exr");
         crate::preview::image::write_exr(&img, &p, crate::preview::image::ExrPrecision::F16)
             .unwrap();
         let env = Environment::from_exr(&p).unwrap();

@@ -182,8 +182,7 @@ mod tests {
     fn writes_exr_and_png() {
         let l = Lambert::new(Value::Rgb([0.1, 0.2, 0.3]), &Channels::Rgb).unwrap();
         let img = polar(&l, 16, DVec3::Z);
-        let dir = std::env::temp_dir().join(format!("brdftab-slice-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = brdftab::testkit::TempDir::new("slice");
         let legend = write(&img, None, dir.join("a.png")).unwrap();
         assert!(legend.contains("log10"), "{legend}");
         write(&img, None, dir.join("a.exr")).unwrap();
@@ -193,6 +192,5 @@ mod tests {
         write(&img, Some(2), dir.join("b.exr")).unwrap();
         assert_eq!(image::read_exr(dir.join("b.exr")).unwrap().channels, 1);
         assert!(write(&img, None, dir.join("a.tiff")).is_err());
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

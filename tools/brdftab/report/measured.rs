@@ -100,21 +100,33 @@ pub struct MeasuredRow {
 pub use brdftab::measured::data::rgl_files;
 
 /// Bakes every file with the defaults and measures it against its native evaluation.
+///
+/// The tables go to `opts.dir`, which is removed afterwards unless `opts.keep` — also when a
+/// file fails.
 pub fn run(
     files: &[PathBuf],
     opts: &MeasuredOptions,
     progress: &dyn Progress,
 ) -> Result<Vec<MeasuredRow>> {
     std::fs::create_dir_all(&opts.dir).map_err(|e| Error::io(&opts.dir, e))?;
+    let rows = rows(files, opts, progress);
+    if !opts.keep {
+        let _ = std::fs::remove_dir_all(&opts.dir);
+    }
+    rows
+}
+
+fn rows(
+    files: &[PathBuf],
+    opts: &MeasuredOptions,
+    progress: &dyn Progress,
+) -> Result<Vec<MeasuredRow>> {
     let _stage = Stage::begin(progress, "measuring", files.len() as u64);
     let mut rows = Vec::with_capacity(files.len());
     for (k, f) in files.iter().enumerate() {
         let r = row(f, opts);
         progress.set(k as u64 + 1);
         rows.push(r?);
-    }
-    if !opts.keep {
-        let _ = std::fs::remove_dir_all(&opts.dir);
     }
     Ok(rows)
 }
@@ -268,9 +280,20 @@ mod tests {
 
     #[test]
     fn a_directory_without_rgl_files_is_an_error() {
-        let d = std::env::temp_dir().join(format!("brdftab-empty-{}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        assert!(matches!(rgl_files(&d), Err(Error::NotFound(_))));
-        let _ = std::fs::remove_dir_all(&d);
+        let d = brdftab::testkit::TempDir::new("empty");
+        assert!(matches!(rgl_files(d.path()), Err(Error::NotFound(_))));
+    }
+
+    #[test]
+    fn a_failed_run_removes_its_tables_directory() {
+        let d = brdftab::testkit::TempDir::new("measured-fail");
+        let junk = d.join("junk.bsdf");
+        std::fs::write(&junk, b"not a tensor file").unwrap();
+        let opts = MeasuredOptions {
+            dir: d.join("tables"),
+            ..MeasuredOptions::default()
+        };
+        assert!(run(&[junk], &opts, &brdftab::progress::Silent).is_err());
+        assert!(!opts.dir.exists(), "{} left behind", opts.dir.display());
     }
 }

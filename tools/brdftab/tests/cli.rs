@@ -125,6 +125,22 @@ fn bad_arguments_are_errors() {
 }
 
 #[test]
+fn albedo_is_for_light_above_the_horizon() {
+    // cos(90°) in f64 is 6e-17 > 0: 90 was evaluated as a light just above the horizon, where
+    // Ward's albedo diverges (it printed 386351.9). Refused, like every θ′ outside [0, 90).
+    let ward = r#"{"model":"ward","ks":0.1,"alpha_x":0.2,"alpha_y":0.2}"#;
+    for t in ["90", "0,90", "90.0"] {
+        let o = brdftab(&["albedo", ward, "--theta", t]);
+        assert_error(&o, "--theta");
+        assert_error(&o, "above the horizon");
+        assert!(o.stdout.is_empty(), "{}", o.stdout);
+    }
+    let o = brdftab(&["albedo", ward, "--theta", "89.999"]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(numbers(o.stdout.trim())[1].is_finite());
+}
+
+#[test]
 fn bake_target_error_reports_the_search_and_names_its_flag() {
     let dir = TempDir::new("cli-target");
     let out = dir.file("t.btdb");

@@ -169,3 +169,48 @@ fn info_and_export_name_the_stored_quantity_and_calibration() {
         );
     }
 }
+
+/// A file named `a#b.btdb` (or a `.bsdf` in `scan#2/`) was split as DB#NAME (table `b.btdb` of a
+/// database `a`): `eval` said `a: no such file`, `info` that it was no raw table. The whole
+/// string names a file, so it is that file; and a convert from `p#w.bsdf` names its table `p_w`.
+#[test]
+fn files_with_a_hash_in_their_names_open_as_files() {
+    let d = TempDir::new("cli-store-hash");
+    let lambert = r#"{"model": "lambert", "kd": 0.5}"#;
+    let plain = d.file("plain.btdb");
+    let r = brdftab(&["bake", lambert, "-o", &plain, "--preset", "small"]);
+    assert!(r.ok, "{}", r.stderr);
+    std::fs::create_dir(d.join("scan#2")).unwrap();
+    for f in ["a#b.btdb", "scan#2/x#y.btdb"] {
+        let whole = d.file(f);
+        std::fs::copy(&plain, &whole).unwrap();
+        let r = brdftab_with_stdin(&["eval", &whole], "0 0 1 0 0 1\n");
+        assert!(r.ok, "{f}: {}", r.stderr);
+        assert!(r.stdout.starts_with("5e-1 "), "{f}: {}", r.stdout);
+        let r = brdftab(&["info", &whole, "--json"]);
+        assert!(r.ok, "{f}: {}", r.stderr);
+    }
+    // Relative to the working directory, as a user types it.
+    let mut c = common::command(&["info", "a#b.btdb"]);
+    c.current_dir(d.path());
+    let r = common::run(c, "");
+    assert!(r.ok, "{}", r.stderr);
+    let rgl = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../data/rgl/paper_white_rgb.bsdf"
+    );
+    let hashed = d.file("scan#2/p#w.bsdf");
+    std::fs::copy(rgl, &hashed).unwrap();
+    let out = d.file("out.btdb");
+    let r = brdftab(&[
+        "convert", &hashed, &out, "--preset", "small", "--pairs", "1000",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let r = brdftab(&["db", "list", &out]);
+    assert!(
+        r.ok && r.stdout.contains("p_w"),
+        "{} {}",
+        r.stdout,
+        r.stderr
+    );
+}

@@ -84,9 +84,15 @@ class Database:
         :func:`bake` writes one — as table NAME, copying its compressed chunks unchanged
         (checksums checked). This is how tables baked elsewhere (worker processes, other
         machines: see ``bindings/python/examples/dask_bake.py``) are gathered into one
-        database; without ``replace`` an existing NAME is an error, so nothing is duplicated."""
+        database; without ``replace`` an existing NAME is an error, so nothing is duplicated.
+
+        ``bytes`` are read in place, without a copy; any other buffer (``bytearray``,
+        ``memoryview``, ``mmap``) is copied into ``bytes`` first (MemoryError if that does not
+        fit); anything else is a TypeError."""
         _check_name(name)
-        _native.db_import(self.path, name, bytes(data), replace)
+        if type(data) is not bytes:
+            data = bytes(memoryview(data))
+        _native.db_import(self.path, name, data, replace)
 
     def remove(self, name):
         """Removes table NAME."""

@@ -60,7 +60,8 @@ class Brdf:
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32]]:
         """(wi (n, 3), pdf (n,), weight = f cos θi / pdf (n, c)) for u in [0, 1)² of shape (n, 2)."""
     def albedo(self, theta: ArrayLike) -> npt.NDArray[np.float64]:
-        """Directional albedo at θ′ in radians: (k, c) float64.
+        """Directional albedo at θ′ in radians, 0 ≤ θ′ < π/2 (light above the horizon; else
+        ValueError naming theta): (k, c) float64.
 
         A closed form where the model has one, else adaptive quadrature: 1e-6 relative for
         models, 1e-4 for tables and measured data.
@@ -207,9 +208,12 @@ class Database:
     ) -> dict[str, Any]:
         """Bakes SOURCE into table NAME (the database is created if absent); takes the keywords
         of `bake`. Returns what `brdftab info --json DB#NAME` reports."""
-    def add_bytes(self, name: str, data: bytes, *, replace: bool = False) -> None:
+    def add_bytes(
+        self, name: str, data: Union[bytes, bytearray, memoryview], *, replace: bool = False
+    ) -> None:
         """Adds the table in a single-table .btdb file's bytes as NAME (chunks copied as they
-        are); an existing NAME is an error unless replace."""
+        are); an existing NAME is an error unless replace. bytes are read in place; another
+        buffer is copied into bytes first (MemoryError if that does not fit)."""
     def remove(self, name: str) -> None:
         """Removes table NAME."""
     def open(self, name: str, **options: Any) -> Brdf:
