@@ -54,7 +54,10 @@ impl SourceKind {
     }
 }
 
-/// Classifies a SOURCE string without touching the file system.
+/// Classifies a SOURCE that is read: inline JSON is a spec; `DB#NAME` is a table of a database
+/// whatever NAME ends in (`materials.btdb#paper.bsdf` too); otherwise the file name's extension
+/// decides. The file system is looked at only for a string with a `#`, as opening does
+/// ([`crate::store::name::parse_input`]: a file of the whole name, `a#b.bsdf`, is that file).
 ///
 /// ```
 /// use brdftab::source::{classify, SourceKind};
@@ -65,6 +68,27 @@ impl SourceKind {
 /// assert_eq!(classify("materials.btdb#gold"), SourceKind::Table);
 /// ```
 pub fn classify(source: &str) -> SourceKind {
+    if source.trim_start().starts_with('{') {
+        return SourceKind::Spec;
+    }
+    match crate::store::name::parse_input("source", source) {
+        Ok((_, Some(_))) => SourceKind::Table,
+        _ => classify_name(source),
+    }
+}
+
+/// Classifies an output string by its characters alone, as writing splits it
+/// ([`crate::store::name::parse_source`]): `DB#NAME` is a table of a database, otherwise the
+/// extension decides (`.binary`: a MERL file, `.bsdf`: an RGL file, other names: a table).
+pub fn classify_output(output: &str) -> SourceKind {
+    match crate::store::name::parse_source("output", output) {
+        Ok((_, Some(_))) => SourceKind::Table,
+        _ => classify_name(output),
+    }
+}
+
+/// By the string's form and extension only.
+fn classify_name(source: &str) -> SourceKind {
     let s = source.trim_start();
     let lower = s.to_ascii_lowercase();
     if s.starts_with('{') || lower.ends_with(".json") {
@@ -296,6 +320,16 @@ mod tests {
         assert_eq!(classify("x.Bsdf"), SourceKind::Rgl);
         assert_eq!(classify("x.btdb"), SourceKind::Table);
         assert_eq!(classify("x.tbl"), SourceKind::Table);
+        // A table of a database is a table whatever its name ends in.
+        for kind in ["json", "binary", "bsdf"] {
+            assert_eq!(classify(&format!("db.btdb#t.{kind}")), SourceKind::Table);
+            assert_eq!(
+                classify_output(&format!("db.btdb#t.{kind}")),
+                SourceKind::Table
+            );
+        }
+        assert_eq!(classify_output("x.bsdf"), SourceKind::Rgl);
+        assert_eq!(classify_output("x.binary"), SourceKind::Merl);
     }
 
     #[test]

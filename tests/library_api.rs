@@ -96,6 +96,33 @@ fn a_files_ratio_counts_every_table_also_when_one_is_asked_for() {
 }
 
 #[test]
+fn a_table_named_like_a_measured_file_opens_as_the_table() {
+    let d = TempDir::new("api-kind");
+    let db = d.join("m.btdb");
+    let db = db.to_str().unwrap();
+    for name in ["paper.bsdf", "gold.binary", "spec.json"] {
+        BakeRequest::new(LAMBERT)
+            .preset(Preset::Small)
+            .run_with(&BakeTarget::db(db, name), &Silent)
+            .unwrap();
+        let source = format!("{db}#{name}");
+        assert_eq!(brdftab::classify(&source), brdftab::SourceKind::Table);
+        let (b, model) = (
+            brdftab::open(&source).unwrap(),
+            brdftab::open(LAMBERT).unwrap(),
+        );
+        let (mut f, mut want) = ([0f32; 3], [0f32; 3]);
+        b.eval(glam::DVec3::Z, glam::DVec3::Z, &mut f);
+        model.eval(glam::DVec3::Z, glam::DVec3::Z, &mut want);
+        // The table of the model (its values within the codec's rounding, 2^-11).
+        assert!(
+            (f[0] - want[0]).abs() <= want[0] * 1e-3,
+            "{name}: {f:?} vs {want:?}"
+        );
+    }
+}
+
+#[test]
 fn a_taken_name_is_a_duplicate_error_naming_no_flag() {
     let d = TempDir::new("api-dup");
     let db = d.join("x.btdb").display().to_string();

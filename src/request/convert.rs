@@ -9,7 +9,7 @@ use crate::bake::{self, BakeReport, BakeTarget, Converted};
 use crate::error::Result;
 use crate::measured::rgl_write;
 use crate::progress::Progress;
-use crate::source::{SourceKind, classify};
+use crate::source::{SourceKind, classify_output};
 use crate::table::Interp;
 
 /// The settings of a conversion: a bake's (for table and MERL outputs; `wavelengths` for every
@@ -86,7 +86,7 @@ pub fn convert(
             format!("{pairs}: at most {MAX_SAMPLES} pairs (fewer with many channels)"),
         ));
     }
-    match classify(output) {
+    match classify_output(output) {
         SourceKind::Merl => Ok(ConvertOutput::Merl(
             req.run_with(&BakeTarget::Merl(output.to_owned()), progress)?,
         )),
