@@ -34,7 +34,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::fidelity::{Reversed, mirror_albedo};
+use crate::analysis::fidelity::{Reversed, Turned, light_azimuths, mirror_albedo};
 use crate::analysis::pair_rule::mirror_rule;
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
@@ -472,33 +472,11 @@ pub const ANISOTROPIC_AZIMUTHS: usize = 8;
 /// The azimuths at which `brdf`'s albedos are taken: 0 alone for an isotropic BRDF, else
 /// [`ANISOTROPIC_AZIMUTHS`] equally spaced.
 fn azimuths(brdf: &dyn Brdf) -> Vec<f64> {
-    if brdf.flags().isotropic {
-        return vec![0.0];
-    }
-    (0..ANISOTROPIC_AZIMUTHS)
-        .map(|k| std::f64::consts::TAU * k as f64 / ANISOTROPIC_AZIMUTHS as f64)
-        .collect()
-}
-
-/// `brdf` with both directions turned by `phi` about the normal: its albedo at azimuth 0 is
-/// `brdf`'s at azimuth `phi`.
-struct Turned<'a>(&'a dyn Brdf, f64);
-
-impl Brdf for Turned<'_> {
-    fn channels(&self) -> &crate::spectrum::Channels {
-        self.0.channels()
-    }
-    fn eval(&self, wi: glam::DVec3, wo: glam::DVec3, out: &mut [f32]) {
-        let (s, c) = self.1.sin_cos();
-        let turn = |v: glam::DVec3| glam::DVec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
-        self.0.eval(turn(wi), turn(wo), out)
-    }
-    fn flags(&self) -> crate::brdf::Flags {
-        self.0.flags()
-    }
-    fn describe(&self) -> String {
-        format!("{} (turned by {} rad)", self.0.describe(), self.1)
-    }
+    light_azimuths(if brdf.flags().isotropic {
+        1
+    } else {
+        ANISOTROPIC_AZIMUTHS
+    })
 }
 
 /// Per node of `opts`, the albedo of `brdf` per channel (nodes × channels), the mean over
