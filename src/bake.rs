@@ -51,10 +51,10 @@ pub enum GridChoice {
     /// The source's natural grid: a MERL file's own cells for MERL sources, for RGL files the
     /// smallest adaptive grid ([`GridChoice::Adaptive`]) that meets [`MEASURED_TARGET_ERROR`]
     /// (the medium preset when the file is not isotropic and bilateral within
-    /// [`MEASURED_BILATERAL_TOLERANCE`]), the medium preset otherwise — but for an isotropic,
-    /// bilateral model whose medium table misses its albedo by more than
-    /// [`PRESET_ALBEDO_TOLERANCE`], the adaptive grid of [`MODEL_FALLBACK_TARGET_ERROR`],
-    /// calibrated. With an error target
+    /// [`MEASURED_BILATERAL_TOLERANCE`]), the medium preset otherwise — but for a model whose
+    /// medium table misses its albedo by more than [`PRESET_ALBEDO_TOLERANCE`], the adaptive
+    /// grid of [`MODEL_FALLBACK_TARGET_ERROR`], calibrated (isotropic, bilateral models), or
+    /// the medium table calibrated, whichever the check takes. With an error target
     /// ([`BakeRequest::target_error`]) any source gets the adaptive grid that meets it.
     #[default]
     Default,
@@ -142,13 +142,16 @@ pub const MEASURED_BILATERAL_TOLERANCE: f64 = 0.02;
 pub const MEASURED_TARGET_ERROR: f64 = 0.007;
 
 /// How far a model's default (medium preset) table may miss the source's directional albedo
-/// (worst over [`PRESET_CHECK_THETAS_DEG`], a channel darker than 0.02 judged against 0.02) before
-/// the default bake takes the adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`]
-/// instead: the fidelity bar of measured tables, 1 %. Sharp lobes need it — on the medium preset
-/// GGX α = 0.002 was 13.8 % off at 89° (and gained energy: albedo 1.077 at 55°), α = 0.01 4.7 %,
-/// α = 0.02 2.4 % — while GGX α ≥ 0.1, Cook-Torrance gold, Oren-Nayar and the lecture's Phong
-/// family at n = 50 keep their preset tables (the max-Phong's too: 1.5 % off at 89°, but its
-/// adaptive table is 6 % off over random pairs where the preset is 0.8 %).
+/// (worst over [`PRESET_CHECK_THETAS_DEG`], a channel darker than 0.02 judged against 0.02; an
+/// anisotropic source's albedo the mean over the light's [`ANISOTROPIC_AZIMUTHS`]) before the
+/// default bake takes the adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`] or the
+/// medium table calibrated instead: the fidelity bar of measured tables, 1 %. Sharp lobes need
+/// the adaptive table — on the medium preset GGX α = 0.002 was 13.8 % off at 89° (and gained
+/// energy: albedo 1.077 at 55°), α = 0.01 4.7 %, α = 0.02 2.4 % —, the max-Phong at n = 50
+/// (1.5 % off at 89°, its adaptive table 6 % off over random pairs where the preset is 0.8 %)
+/// and the anisotropic models (Ward α = (0.1, 0.3) 4.8 %, GGX (0.1, 0.4) 2.9 % at 89°: no
+/// adaptive grid serves them) the calibration; GGX α ≥ 0.1, Cook-Torrance gold, Oren-Nayar and
+/// the rest of the lecture's Phong family at n = 50 keep their preset tables.
 pub const PRESET_ALBEDO_TOLERANCE: f64 = 0.01;
 
 /// The incidence angles (degrees) at which [`PRESET_ALBEDO_TOLERANCE`] is checked: the
@@ -341,8 +344,9 @@ pub struct BakeRequest {
     pub quantity: Option<Quantity>,
     /// Pin the table's directional albedo to the source's ([`crate::table::calibration`]) on
     /// tables that store a projected quantity and do not fold by reciprocity (measured sources
-    /// by default) and on adaptive tables of models (one symmetric factor: they stay
-    /// reciprocal). True by default.
+    /// by default), on adaptive tables of models (one symmetric factor: they stay reciprocal)
+    /// and on a model's default medium table where it misses the albedo
+    /// ([`PRESET_ALBEDO_TOLERANCE`]). True by default; false also turns that check off.
     pub calibrate: bool,
 }
 
@@ -752,7 +756,8 @@ impl BakeRequest {
     /// above the horizon little, and the directional albedo there escaped it (GGX copper
     /// α = 0.1 at a 0.2 % target: 1.6 % at 88°, the medium preset 0.35 %). A symmetric
     /// calibration (k(θi) k(θo), [`crate::table::calibration`]) pins it and keeps the table
-    /// reciprocal. Presets stay uncalibrated: their albedo is within 0.5 % already.
+    /// reciprocal. Presets stay uncalibrated (their albedo is within 0.5 % already) but where
+    /// a model's default check finds one off ([`PRESET_ALBEDO_TOLERANCE`]).
     fn calibrates_model_table(&self) -> bool {
         self.calibrate && self.adaptive() && !source::classify(&self.source).is_measured()
     }

@@ -24,8 +24,10 @@
 //! projected quantities of measured sources, [`super::Quantity::FrCosOut`]) carry them. A table
 //! that folds by reciprocity — a model's adaptive table, whose error target judges f_r's RMSE
 //! and lets the albedo of the last degrees above the horizon drift (GGX copper α = 0.1 at a
-//! 0.2 % target: 1.6 % at 88°) — gets one factor for both directions, k(θi) k(θo), fitted by the
-//! symmetric scaling k ← √(k · a / (M k)); the table stays reciprocal.
+//! 0.2 % target: 1.6 % at 88°), or a model's default medium table that misses the albedo
+//! (Ward's f_r cos θi cos θo, whose √cos θi edge at the horizon no grid follows: 4.8 % at
+//! 89°) — gets one factor for both directions, k(θi) k(θo), fitted by the symmetric scaling
+//! k ← √(k · a / (M k)); the table stays reciprocal.
 //!
 //! The axis is uniform in t = √(1 − cos θ) = √2 sin(θ/2): nearly uniform in θ (node spacing
 //! 0.32° at the normal, 0.45° at the horizon for 257 nodes) and computed from cos θ with one
