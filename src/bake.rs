@@ -23,6 +23,8 @@
 use std::path::Path;
 use std::time::Instant;
 
+use crate::analysis::accuracy::{Region, Weight, compare_region};
+use crate::analysis::fidelity::AlbedoError;
 use crate::brdf::Brdf;
 use crate::codec::{Codec, Quant};
 use crate::error::{Error, Result};
@@ -32,7 +34,9 @@ use crate::source::{self, OpenOptions, SourceKind};
 use crate::spectrum::Channels;
 use crate::store::{TableHeader, Writer, db, tables};
 use crate::table::adaptive;
-use crate::table::calibration::{AlbedoReference, CalibrationOptions, calibrate};
+use crate::table::calibration::{
+    ANISOTROPIC_AZIMUTHS, AlbedoReference, CalibrationOptions, calibrate,
+};
 use crate::table::presets::Preset;
 use crate::table::target::{self, TargetSearch};
 use crate::table::warp::WarpVar;
@@ -47,10 +51,10 @@ pub enum GridChoice {
     /// The source's natural grid: a MERL file's own cells for MERL sources, for RGL files the
     /// smallest adaptive grid ([`GridChoice::Adaptive`]) that meets [`MEASURED_TARGET_ERROR`]
     /// (the medium preset when the file is not isotropic and bilateral within
-    /// [`MEASURED_BILATERAL_TOLERANCE`]), the medium preset otherwise — but for an isotropic,
-    /// bilateral model whose medium table misses its albedo by more than
-    /// [`PRESET_ALBEDO_TOLERANCE`], the adaptive grid of [`MODEL_FALLBACK_TARGET_ERROR`],
-    /// calibrated. With an error target
+    /// [`MEASURED_BILATERAL_TOLERANCE`]), the medium preset otherwise — but for a model whose
+    /// medium table misses its albedo by more than [`PRESET_ALBEDO_TOLERANCE`], the adaptive
+    /// grid of [`MODEL_FALLBACK_TARGET_ERROR`], calibrated (isotropic, bilateral models), or
+    /// the medium table calibrated, whichever the check takes. With an error target
     /// ([`BakeRequest::target_error`]) any source gets the adaptive grid that meets it.
     #[default]
     Default,
@@ -138,13 +142,16 @@ pub const MEASURED_BILATERAL_TOLERANCE: f64 = 0.02;
 pub const MEASURED_TARGET_ERROR: f64 = 0.007;
 
 /// How far a model's default (medium preset) table may miss the source's directional albedo
-/// (worst over [`PRESET_CHECK_THETAS_DEG`], a channel darker than 0.02 judged against 0.02) before
-/// the default bake takes the adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`]
-/// instead: the fidelity bar of measured tables, 1 %. Sharp lobes need it — on the medium preset
-/// GGX α = 0.002 was 13.8 % off at 89° (and gained energy: albedo 1.077 at 55°), α = 0.01 4.7 %,
-/// α = 0.02 2.4 % — while GGX α ≥ 0.1, Cook-Torrance gold, Oren-Nayar and the lecture's Phong
-/// family at n = 50 keep their preset tables (the max-Phong's too: 1.5 % off at 89°, but its
-/// adaptive table is 6 % off over random pairs where the preset is 0.8 %).
+/// (worst over [`PRESET_CHECK_THETAS_DEG`], a channel darker than 0.02 judged against 0.02; an
+/// anisotropic source's albedo the mean over the light's [`ANISOTROPIC_AZIMUTHS`]) before the
+/// default bake takes the adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`] or the
+/// medium table calibrated instead: the fidelity bar of measured tables, 1 %. Sharp lobes need
+/// the adaptive table — on the medium preset GGX α = 0.002 was 13.8 % off at 89° (and gained
+/// energy: albedo 1.077 at 55°), α = 0.01 4.7 %, α = 0.02 2.4 % —, the max-Phong at n = 50
+/// (1.5 % off at 89°, its adaptive table 6 % off over random pairs where the preset is 0.8 %)
+/// and the anisotropic models (Ward α = (0.1, 0.3) 4.8 %, GGX (0.1, 0.4) 2.9 % at 89°: no
+/// adaptive grid serves them) the calibration; GGX α ≥ 0.1, Cook-Torrance gold, Oren-Nayar and
+/// the rest of the lecture's Phong family at n = 50 keep their preset tables.
 pub const PRESET_ALBEDO_TOLERANCE: f64 = 0.01;
 
 /// The incidence angles (degrees) at which [`PRESET_ALBEDO_TOLERANCE`] is checked: the
@@ -185,6 +192,16 @@ pub struct Plan {
     /// The source's albedo the table is calibrated to, when it is
     /// ([`crate::table::calibration`]).
     pub albedo: Option<AlbedoReference>,
+}
+
+/// The table a model's default bake takes instead of the medium preset's
+/// ([`BakeRequest::preset_misses`]).
+enum Fallback {
+    /// The adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`]: the bake runs as the
+    /// request with that target would.
+    Adaptive,
+    /// The medium preset's table, calibrated (this one, as the check baked it).
+    CalibratedPreset(Box<Table>),
 }
 
 /// `why` before the bake's own note, if it has one.
@@ -327,8 +344,9 @@ pub struct BakeRequest {
     pub quantity: Option<Quantity>,
     /// Pin the table's directional albedo to the source's ([`crate::table::calibration`]) on
     /// tables that store a projected quantity and do not fold by reciprocity (measured sources
-    /// by default) and on adaptive tables of models (one symmetric factor: they stay
-    /// reciprocal). True by default.
+    /// by default), on adaptive tables of models (one symmetric factor: they stay reciprocal)
+    /// and on a model's default medium table where it misses the albedo
+    /// ([`PRESET_ALBEDO_TOLERANCE`]). True by default; false also turns that check off.
     pub calibrate: bool,
 }
 
@@ -545,71 +563,136 @@ impl BakeRequest {
         })
     }
 
-    /// Why a model's default table is not the medium preset: `Some(reason)` when the request
-    /// leaves the grid to the library, the source is an isotropic, bilateral model spec whose
-    /// f_r the table stores, and the preset's table misses the source's albedo by more than
-    /// [`PRESET_ALBEDO_TOLERANCE`] at one of [`PRESET_CHECK_THETAS_DEG`] (a bake of the preset
-    /// and twelve mirror-centred albedos, ~0.3 s) and the adaptive table misses it by less,
-    /// without a larger error over random pairs (one more bake, ~1 s, only then).
-    fn preset_misses(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<Option<String>> {
+    /// Why a model's default table is not the medium preset's, and which it is instead:
+    /// `Some` when the request leaves the grid to the library, the source is a model spec whose
+    /// preset table would not be calibrated anyway, and that table misses the source's albedo
+    /// by more than [`PRESET_ALBEDO_TOLERANCE`] at one of [`PRESET_CHECK_THETAS_DEG`] (for an
+    /// anisotropic source the mean over the light's [`ANISOTROPIC_AZIMUTHS`], which is what a
+    /// calibration can pin; a bake of the preset and its albedos, ~0.3 s). The candidates, in
+    /// this order, each kept only if its albedo is closer and its error over
+    /// [`PRESET_CHECK_PAIRS`] random pairs no larger (beyond 1 %): for an isotropic, bilateral
+    /// source the adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`] (one more bake,
+    /// ~1 s), then the preset's own table calibrated. The first within the tolerance is taken,
+    /// else the closest.
+    fn preset_misses(
+        &self,
+        src: &dyn Brdf,
+        progress: &dyn Progress,
+    ) -> Result<Option<(Fallback, String)>> {
+        let quantity = self.effective_quantity(src);
         if !(self.grid == GridChoice::Default
             && self.target_error.is_none()
             && self.calibrate
             && self.supersample == 1
             && self.param.is_none_or(|p| p == Param::HalfDiff)
-            && source::classify(&self.source) == SourceKind::Spec
-            && self.effective_quantity(src) == Quantity::Fr)
+            && source::classify(&self.source) == SourceKind::Spec)
         {
             return Ok(None);
         }
         let (sym, _) = self.resolve_symmetry(src);
-        if !(sym.isotropic && sym.bilateral) {
+        if quantity != Quantity::Fr && !sym.reciprocal {
+            // Calibrated by default already (`plan_with`): its albedo is pinned.
             return Ok(None);
         }
         let _stage = Stage::begin(progress, "checking the preset's albedo", 0);
-        let grid = Preset::Medium.grid(Some(Param::HalfDiff), sym, src.channels().clone())?;
+        let grid = Preset::Medium
+            .grid(Some(Param::HalfDiff), sym, src.channels().clone())?
+            .with_quantity(quantity)?;
         let opts = BakeOptions {
             tolerance: self.symmetry_tolerance,
+            force: self.force || self.symmetry == SymmetryChoice::Declared,
             ..BakeOptions::default()
         };
-        let (table, _) = crate::table::bake(src, &grid, &opts)?;
-        let table = TabulatedBrdf::from_table(table);
+        let (preset, _) = crate::table::bake(src, &grid, &opts)?;
         let fid = crate::analysis::fidelity::FidelityOptions {
             albedo_thetas_deg: PRESET_CHECK_THETAS_DEG.to_vec(),
             albedo_phi: 64,
             albedo_order: 6,
+            albedo_azimuths: if sym.isotropic {
+                1
+            } else {
+                ANISOTROPIC_AZIMUTHS
+            },
             ..Default::default()
         };
-        let e = crate::analysis::fidelity::albedo_error(&table, src, &fid)?;
+        let albedo = |t: &dyn Brdf| crate::analysis::fidelity::albedo_error(t, src, &fid);
+        // Over random pairs, the same pairs for every table: f_r cos θi, but f_r cos θi cos θo
+        // for a table that stores it (Ward's f_r ∝ 1/√(cos θi cos θo): f_r cos θi has no finite
+        // RMS, and the pairs nearest the horizon would decide).
+        let weight = if quantity == Quantity::FrCosCos {
+            Weight::CosInCosOut
+        } else {
+            Weight::CosIn
+        };
+        let rmse = |t: &dyn Brdf| {
+            let whole = Region::Cap(std::f64::consts::FRAC_PI_2);
+            compare_region(t, src, PRESET_CHECK_PAIRS, 1, whole, weight).map(|a| a.rel_rmse)
+        };
+        let plain = TabulatedBrdf::from_table(preset.clone());
+        let e = albedo(&plain)?;
         if e.worst <= PRESET_ALBEDO_TOLERANCE {
             return Ok(None);
         }
-        // The adaptive table must do better on the same rule: a lobe whose f_r spikes at the
-        // grazing mirror pair (the max-Phong's 1/max(cos θi, cos θo)) is served worse by it
-        // (5.4 % at 89° against the preset's 1.5 %), and keeps the preset.
-        let (adaptive, _) = self
-            .clone()
-            .target_error(MODEL_FALLBACK_TARGET_ERROR)
-            .table_of(src, &Silent)?;
-        let adaptive = TabulatedBrdf::from_table(adaptive);
-        let a = crate::analysis::fidelity::albedo_error(&adaptive, src, &fid)?;
-        // Nor worse over random pairs (f_r cos θi, the same pairs for both; beyond 1 %): the
-        // max-Phong's f_r spikes like 1/max(cos θi, cos θo) at the grazing mirror pair, which
-        // the preset's 180 θd nodes follow and the adaptive grid does not (0.78 → 6.0 %).
-        let rmse = |t: &dyn Brdf| {
-            crate::analysis::accuracy::compare(t, src, PRESET_CHECK_PAIRS, 1).map(|a| a.rel_rmse)
+        let rp = rmse(&plain)?;
+        drop(plain);
+        let mut best: Option<(Fallback, AlbedoError)> = None;
+        let mut consider = |f: Fallback, a: AlbedoError, r: f64| {
+            if a.worst < best.as_ref().map_or(e.worst, |b| b.1.worst) && r <= rp.max(0.01) {
+                best = Some((f, a));
+            }
+            best.as_ref()
+                .is_some_and(|b| b.1.worst <= PRESET_ALBEDO_TOLERANCE)
         };
-        let (rp, ra) = (rmse(&table)?, rmse(&adaptive)?);
-        Ok((a.worst < e.worst && ra <= rp.max(0.01)).then(|| {
-            format!(
-                "the medium preset's table missed the albedo by {:.1} % at {}°: baked to an error \
-                 target of {} % instead ({:.2} % at {}°)",
+        // The adaptive table first: it resolves a lobe the preset's nodes cannot (GGX
+        // α = 0.002: 2.2 % against 26 % within 80°), which a calibration would only rescale.
+        // A lobe whose f_r spikes at the grazing mirror pair (the max-Phong's
+        // 1/max(cos θi, cos θo)) is followed by the preset's 180 θd nodes and not by the
+        // adaptive grid (over random pairs 0.78 → 6.0 %), and is left to the calibration.
+        let mut done = false;
+        if sym.isotropic && sym.bilateral {
+            let (adaptive, _) = self
+                .clone()
+                .target_error(MODEL_FALLBACK_TARGET_ERROR)
+                .table_of(src, &Silent)?;
+            let adaptive = TabulatedBrdf::from_table(adaptive);
+            done = consider(Fallback::Adaptive, albedo(&adaptive)?, rmse(&adaptive)?);
+        }
+        if !done {
+            // A reciprocal table takes one factor, fitted to the light's albedo (the viewer's
+            // is the same for a reciprocal source).
+            let copts = CalibrationOptions {
+                two_sided: !sym.reciprocal,
+                ..CalibrationOptions::default()
+            };
+            let reference = AlbedoReference::new(src, &copts)?;
+            let calibrated = calibrate(preset, &reference)?;
+            let tab = TabulatedBrdf::from_table(calibrated.clone());
+            let (a, r) = (albedo(&tab)?, rmse(&tab)?);
+            drop(tab);
+            consider(Fallback::CalibratedPreset(Box::new(calibrated)), a, r);
+        }
+        Ok(best.map(|(f, a)| {
+            let instead = match f {
+                Fallback::Adaptive => format!(
+                    "baked to an error target of {} % instead",
+                    100.0 * MODEL_FALLBACK_TARGET_ERROR
+                ),
+                Fallback::CalibratedPreset(_) => "calibrated it".to_owned(),
+            };
+            let why = format!(
+                "the medium preset's table missed the albedo{} by {:.1} % at {}°: {instead} \
+                 ({:.2} % at {}°)",
+                if sym.isotropic {
+                    ""
+                } else {
+                    " (mean over the light's azimuths)"
+                },
                 100.0 * e.worst,
                 e.theta_deg,
-                100.0 * MODEL_FALLBACK_TARGET_ERROR,
                 100.0 * a.worst,
                 a.theta_deg
-            )
+            );
+            (f, why)
         }))
     }
 
@@ -673,7 +756,8 @@ impl BakeRequest {
     /// above the horizon little, and the directional albedo there escaped it (GGX copper
     /// α = 0.1 at a 0.2 % target: 1.6 % at 88°, the medium preset 0.35 %). A symmetric
     /// calibration (k(θi) k(θo), [`crate::table::calibration`]) pins it and keeps the table
-    /// reciprocal. Presets stay uncalibrated: their albedo is within 0.5 % already.
+    /// reciprocal. Presets stay uncalibrated (their albedo is within 0.5 % already) but where
+    /// a model's default check finds one off ([`PRESET_ALBEDO_TOLERANCE`]).
     fn calibrates_model_table(&self) -> bool {
         self.calibrate && self.adaptive() && !source::classify(&self.source).is_measured()
     }
@@ -753,14 +837,42 @@ impl BakeRequest {
 
     /// Bakes an already opened source (for callers that also use it, e.g. to compare).
     pub fn table_of(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<(Table, BakeReport)> {
-        if let Some(why) = self.preset_misses(src, progress)? {
-            let (table, mut report) = self
-                .clone()
-                .target_error(MODEL_FALLBACK_TARGET_ERROR)
-                .table_of(src, progress)?;
-            report.symmetry_note = Some(with_note(why, report.symmetry_note));
-            return Ok((table, report));
+        let t0 = Instant::now();
+        match self.preset_misses(src, progress)? {
+            Some((Fallback::Adaptive, why)) => {
+                let (table, mut report) = self
+                    .clone()
+                    .target_error(MODEL_FALLBACK_TARGET_ERROR)
+                    .table_of(src, progress)?;
+                report.symmetry_note = Some(with_note(why, report.symmetry_note));
+                Ok((table, report))
+            }
+            Some((Fallback::CalibratedPreset(table), why)) => {
+                let report = self.calibrated_preset_report(src, &table, why, t0);
+                Ok((*table, report))
+            }
+            None => self.table_unchecked(src, progress),
         }
+    }
+
+    /// The report of a default bake that took the medium preset's table, calibrated.
+    fn calibrated_preset_report(
+        &self,
+        src: &dyn Brdf,
+        table: &Table,
+        why: String,
+        t0: Instant,
+    ) -> BakeReport {
+        let (_, note) = self.resolve_symmetry(src);
+        self.report_for(src, table.grid(), Some(with_note(why, note)), t0, false)
+    }
+
+    /// [`table_of`](Self::table_of) without the preset's check.
+    fn table_unchecked(
+        &self,
+        src: &dyn Brdf,
+        progress: &dyn Progress,
+    ) -> Result<(Table, BakeReport)> {
         let t0 = Instant::now();
         if self.keeps_merl_cells() {
             let table = crate::measured::MerlBrdf::open(&self.source)?.to_table();
@@ -857,17 +969,26 @@ impl BakeRequest {
             crate::store::name::check("name", &name)?;
         }
         let src = self.open_source()?;
+        let t0 = Instant::now();
         // A model the medium preset misses is baked as the request with an error target would
-        // be (the whole path: calibrated, built whole).
-        if !matches!(target, BakeTarget::Merl(_))
-            && let Some(why) = self.preset_misses(src.as_ref(), progress)?
-        {
-            let mut report = self
-                .clone()
-                .target_error(MODEL_FALLBACK_TARGET_ERROR)
-                .run_with(target, progress)?;
-            report.symmetry_note = Some(with_note(why, report.symmetry_note));
-            return Ok(report);
+        // be (the whole path: calibrated, built whole), or gets the check's calibrated table.
+        let mut checked = None;
+        if !matches!(target, BakeTarget::Merl(_)) {
+            match self.preset_misses(src.as_ref(), progress)? {
+                Some((Fallback::Adaptive, why)) => {
+                    let mut report = self
+                        .clone()
+                        .target_error(MODEL_FALLBACK_TARGET_ERROR)
+                        .run_with(target, progress)?;
+                    report.symmetry_note = Some(with_note(why, report.symmetry_note));
+                    return Ok(report);
+                }
+                Some((Fallback::CalibratedPreset(table), why)) => {
+                    let report = self.calibrated_preset_report(src.as_ref(), &table, why, t0);
+                    checked = Some((*table, report));
+                }
+                None => {}
+            }
         }
         if let BakeTarget::Merl(path) = target {
             let t0 = Instant::now();
@@ -881,19 +1002,24 @@ impl BakeRequest {
             return Ok(report);
         }
         let provenance = source::provenance(&self.source, src.as_ref())?;
+        let built = |checked: Option<(Table, BakeReport)>| match checked {
+            Some(c) => Ok(c),
+            None => self.table_unchecked(src.as_ref(), progress),
+        };
         let (mut report, table) = match target {
             BakeTarget::Raw(path) => {
-                let (table, r) = self.table_of(src.as_ref(), progress)?;
+                let (table, r) = built(checked)?;
                 table.save_raw(path)?;
                 (r, Some(table))
             }
             // Tables built whole before they are written: MERL cells, and calibrated tables
             // (the calibration needs every value; measured and adaptive tables are small).
-            _ if self.keeps_merl_cells()
+            _ if checked.is_some()
+                || self.keeps_merl_cells()
                 || self.effective_quantity(src.as_ref()) != Quantity::Fr
                 || self.calibrates_model_table() =>
             {
-                let (table, r) = self.table_of(src.as_ref(), progress)?;
+                let (table, r) = built(checked)?;
                 let (path, replace) = match target {
                     BakeTarget::Db { path, replace, .. } => (path.as_str(), *replace),
                     t => (t.path(), true),

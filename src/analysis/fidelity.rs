@@ -10,7 +10,9 @@
 //! - the worst **directional albedo** error over θ′ = 1°, 2°, …, 89° and every channel, both
 //!   albedos computed with one quadrature on the same points (so the difference is the
 //!   table's, not the quadrature's), a channel darker than [`FidelityOptions::dark_floor`]
-//!   judged against the floor (a 10 % error of an albedo of 0.003 is invisible).
+//!   judged against the floor (a 10 % error of an albedo of 0.003 is invisible); for an
+//!   anisotropic source, optionally the mean over several azimuths of the light
+//!   ([`FidelityOptions::albedo_azimuths`]).
 //!
 //! The albedo quadrature is a fixed product rule in polar coordinates about the mirror direction
 //! (geometric α segments down to 0.25°, Gauss-Legendre in each, the horizon as the last
@@ -41,6 +43,13 @@ pub struct FidelityOptions {
     pub albedo_phi: usize,
     /// Gauss-Legendre nodes per α segment of the albedo quadrature.
     pub albedo_order: usize,
+    /// Azimuths of the light, equally spaced from φ′ = 0, over which each directional albedo
+    /// is averaged. 1 (the default) looks at φ′ = 0 alone, which an isotropic source's albedo
+    /// does not depend on; an anisotropic source's varies with φ′, and so does its table's
+    /// bias, so its figure is the mean over several (8 is what an albedo calibration pins,
+    /// `table::calibration::ANISOTROPIC_AZIMUTHS`: equally spaced, exact for the cos 2φ′ of an
+    /// elliptical lobe).
+    pub albedo_azimuths: usize,
     /// An albedo darker than this is judged against it.
     pub dark_floor: f64,
     /// The cap of the in-cap error and the start of the grazing band (degrees).
@@ -55,6 +64,7 @@ impl Default for FidelityOptions {
             albedo_thetas_deg: (1..=89).map(f64::from).collect(),
             albedo_phi: 128,
             albedo_order: 8,
+            albedo_azimuths: 1,
             dark_floor: 0.02,
             cap_deg: 80.0,
         }
@@ -180,28 +190,84 @@ impl<'a> FidelityReference<'a> {
     }
 }
 
-/// The albedo curve of `brdf` at [`FidelityOptions::albedo_thetas_deg`] ([`mirror_albedo`]).
+/// The albedo curve of `brdf` at [`FidelityOptions::albedo_thetas_deg`] ([`mirror_albedo`],
+/// the mean over [`FidelityOptions::albedo_azimuths`]).
 pub fn albedo_curve(brdf: &dyn Brdf, opts: &FidelityOptions) -> Result<AlbedoCurve> {
     let c = brdf.channels().len();
     if c > MAX_CHANNELS {
         return Err(Error::arg("channels", format!("{c} channels")));
     }
-    if opts.albedo_phi == 0 || opts.albedo_order == 0 {
-        return Err(Error::arg("albedo_phi", "needs at least one node"));
-    }
+    check_rule(opts)?;
+    let turns = light_azimuths(opts.albedo_azimuths);
+    let share = 1.0 / turns.len() as f64;
     Ok(opts
         .albedo_thetas_deg
         .par_iter()
         .map(|&t| {
-            mirror_albedo(brdf, t.to_radians(), opts.albedo_phi, opts.albedo_order)[..c].to_vec()
+            let mut a = vec![0.0; c];
+            for &phi in &turns {
+                let s = mirror_albedo(
+                    &Turned(brdf, phi),
+                    t.to_radians(),
+                    opts.albedo_phi,
+                    opts.albedo_order,
+                );
+                for (a, s) in a.iter_mut().zip(s) {
+                    *a += share * s;
+                }
+            }
+            a
         })
         .collect())
+}
+
+/// Refuses an albedo rule without nodes.
+fn check_rule(opts: &FidelityOptions) -> Result<()> {
+    if opts.albedo_phi == 0 || opts.albedo_order == 0 {
+        return Err(Error::arg("albedo_phi", "needs at least one node"));
+    }
+    if opts.albedo_azimuths == 0 {
+        return Err(Error::arg("albedo_azimuths", "needs at least one azimuth"));
+    }
+    Ok(())
+}
+
+/// `n` azimuths of the light equally spaced from 0 (radians).
+pub(crate) fn light_azimuths(n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|k| std::f64::consts::TAU * k as f64 / n as f64)
+        .collect()
+}
+
+/// `brdf` with both directions turned by `phi` (radians) about the normal: its albedo at the
+/// light's azimuth 0 is `brdf`'s at azimuth `phi`.
+pub(crate) struct Turned<'a>(pub &'a dyn Brdf, pub f64);
+
+impl Brdf for Turned<'_> {
+    fn channels(&self) -> &crate::spectrum::Channels {
+        self.0.channels()
+    }
+    fn eval(&self, wi: glam::DVec3, wo: glam::DVec3, out: &mut [f32]) {
+        if self.1 == 0.0 {
+            return self.0.eval(wi, wo, out);
+        }
+        let (s, c) = self.1.sin_cos();
+        let turn = |v: glam::DVec3| glam::DVec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
+        self.0.eval(turn(wi), turn(wo), out)
+    }
+    fn flags(&self) -> crate::brdf::Flags {
+        self.0.flags()
+    }
+    fn describe(&self) -> String {
+        format!("{} (turned by {} rad)", self.0.describe(), self.1)
+    }
 }
 
 /// Directional albedo per θ′ of [`FidelityOptions::albedo_thetas_deg`], per channel.
 pub type AlbedoCurve = Vec<Vec<f64>>;
 
-/// The albedo curves of `a` and `b` on one quadrature: `(a[θ][channel], b[θ][channel])`.
+/// The albedo curves of `a` and `b` on one quadrature: `(a[θ][channel], b[θ][channel])`, each
+/// the mean over [`FidelityOptions::albedo_azimuths`].
 pub fn albedo_pair(
     a: &dyn Brdf,
     b: &dyn Brdf,
@@ -214,16 +280,30 @@ pub fn albedo_pair(
             format!("{} vs {} channels", a.channels().len(), c),
         ));
     }
-    if opts.albedo_phi == 0 || opts.albedo_order == 0 {
-        return Err(Error::arg("albedo_phi", "needs at least one node"));
-    }
+    check_rule(opts)?;
     let (gx, gw) = gauss_legendre(opts.albedo_order);
+    let turns = light_azimuths(opts.albedo_azimuths);
+    let share = 1.0 / turns.len() as f64;
     let curves: Vec<(Vec<f64>, Vec<f64>)> = opts
         .albedo_thetas_deg
         .par_iter()
         .map(|&t| {
-            let (sa, sb) = mirror_quadrature(a, b, t.to_radians(), opts.albedo_phi, &gx, &gw);
-            (sa[..c].to_vec(), sb[..c].to_vec())
+            let (mut ma, mut mb) = (vec![0.0; c], vec![0.0; c]);
+            for &phi in &turns {
+                let (sa, sb) = mirror_quadrature(
+                    &Turned(a, phi),
+                    &Turned(b, phi),
+                    t.to_radians(),
+                    opts.albedo_phi,
+                    &gx,
+                    &gw,
+                );
+                for ch in 0..c {
+                    ma[ch] += share * sa[ch];
+                    mb[ch] += share * sb[ch];
+                }
+            }
+            (ma, mb)
         })
         .collect();
     Ok(curves.into_iter().unzip())
@@ -370,6 +450,64 @@ mod tests {
         let (a, _) = albedo_pair(p.as_ref(), p.as_ref(), &opts).unwrap();
         let want = std::f64::consts::TAU * 0.5 / 1002.0;
         assert!((a[0][0] - want).abs() < 1e-4 * want, "{} {want}", a[0][0]);
+    }
+
+    /// A diffuse lobe whose brightness follows the light's azimuth: (1 + ½ cos 2φ′)/π.
+    struct Azimuthal(Channels);
+
+    impl Brdf for Azimuthal {
+        fn channels(&self) -> &Channels {
+            &self.0
+        }
+        fn eval(&self, wi: glam::DVec3, wo: glam::DVec3, out: &mut [f32]) {
+            let c2 = (wi.x * wi.x - wi.y * wi.y) / (wi.x * wi.x + wi.y * wi.y).max(1e-300);
+            let f = if wi.z > 0.0 && wo.z > 0.0 {
+                (1.0 + 0.5 * c2) / std::f64::consts::PI
+            } else {
+                0.0
+            };
+            out.iter_mut().for_each(|o| *o = f as f32);
+        }
+        fn flags(&self) -> crate::brdf::Flags {
+            crate::brdf::Flags {
+                isotropic: false,
+                reciprocal: false,
+                ..Lambert::new(Value::Rgb([0.5; 3]), &self.0).unwrap().flags()
+            }
+        }
+        fn describe(&self) -> String {
+            "azimuthal".into()
+        }
+    }
+
+    #[test]
+    fn an_anisotropic_albedo_is_averaged_over_the_lights_azimuths() {
+        // Its albedo is 1 + ½ cos 2φ′ at every θ′: 1.5 at φ′ = 0, and the mean over four or
+        // more equally spaced azimuths is 1 (they sum cos 2φ′ to 0).
+        let b = Azimuthal(Channels::Rgb);
+        let l = Lambert::new(Value::Rgb([std::f64::consts::FRAC_1_PI; 3]), &Channels::Rgb).unwrap();
+        for (n, want) in [(1, 1.5), (4, 1.0), (8, 1.0)] {
+            let opts = FidelityOptions {
+                albedo_thetas_deg: vec![10.0, 60.0, 89.0],
+                albedo_azimuths: n,
+                ..Default::default()
+            };
+            let curve = albedo_curve(&b, &opts).unwrap();
+            let (a, _) = albedo_pair(&b, &l, &opts).unwrap();
+            // The rule's own error on a cosine lobe (the Lambert test above): 1e-4.
+            for (x, y) in curve.iter().zip(&a) {
+                assert!((x[0] - want).abs() < 1e-4 * want, "{n}: {x:?}");
+                assert_eq!(x, y);
+            }
+            // Against a Lambert lobe of albedo 1: the mean's error is the lobe's own.
+            let e = albedo_error(&b, &l, &opts).unwrap();
+            assert!((e.worst - (want - 1.0)).abs() < 2e-4, "{n}: {e:?}");
+        }
+        let none = FidelityOptions {
+            albedo_azimuths: 0,
+            ..Default::default()
+        };
+        assert!(albedo_curve(&b, &none).is_err());
     }
 
     #[test]

@@ -18,7 +18,7 @@ pub struct BakeSettings {
     /// Grid size preset: small, medium or large (default: a MERL file's own cells for MERL
     /// sources, for RGL files the smallest adaptive grid within 0.7 % (see target_error),
     /// medium otherwise — unless a model's medium table misses its albedo by over 1 %, then
-    /// the adaptive grid of a 0.2 % target).
+    /// the adaptive grid of a 0.2 % target or the medium table calibrated).
     #[cfg_attr(feature = "clap", arg(long))]
     pub preset: Option<String>,
     /// Full grid sizes θ1xφ1xθ2xφ2 (e.g. 90x360x90x360), `merl`, or `adaptive[:NHxNDxNP]`
@@ -75,7 +75,8 @@ pub struct BakeSettings {
     #[cfg_attr(feature = "clap", arg(long))]
     pub target_error: Option<ErrorTarget>,
     /// Pin the table's directional albedo to the source's (default true; tables of measured
-    /// sources that store f_r cos θo, and adaptive tables of models).
+    /// sources that store f_r cos θo, adaptive tables of models, and a model's default medium
+    /// table where it misses the albedo by over 1 %).
     #[cfg_attr(feature = "clap", arg(long))]
     pub calibrate: Option<bool>,
     /// Replace an existing table of that name (database outputs).

@@ -24,8 +24,10 @@
 //! projected quantities of measured sources, [`super::Quantity::FrCosOut`]) carry them. A table
 //! that folds by reciprocity — a model's adaptive table, whose error target judges f_r's RMSE
 //! and lets the albedo of the last degrees above the horizon drift (GGX copper α = 0.1 at a
-//! 0.2 % target: 1.6 % at 88°) — gets one factor for both directions, k(θi) k(θo), fitted by the
-//! symmetric scaling k ← √(k · a / (M k)); the table stays reciprocal.
+//! 0.2 % target: 1.6 % at 88°), or a model's default medium table that misses the albedo
+//! (Ward's f_r cos θi cos θo, whose √cos θi edge at the horizon no grid follows: 4.8 % at
+//! 89°) — gets one factor for both directions, k(θi) k(θo), fitted by the symmetric scaling
+//! k ← √(k · a / (M k)); the table stays reciprocal.
 //!
 //! The axis is uniform in t = √(1 − cos θ) = √2 sin(θ/2): nearly uniform in θ (node spacing
 //! 0.32° at the normal, 0.45° at the horizon for 257 nodes) and computed from cos θ with one
@@ -34,7 +36,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::fidelity::{Reversed, mirror_albedo};
+use crate::analysis::fidelity::{Reversed, Turned, light_azimuths, mirror_albedo};
 use crate::analysis::pair_rule::mirror_rule;
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
@@ -472,33 +474,11 @@ pub const ANISOTROPIC_AZIMUTHS: usize = 8;
 /// The azimuths at which `brdf`'s albedos are taken: 0 alone for an isotropic BRDF, else
 /// [`ANISOTROPIC_AZIMUTHS`] equally spaced.
 fn azimuths(brdf: &dyn Brdf) -> Vec<f64> {
-    if brdf.flags().isotropic {
-        return vec![0.0];
-    }
-    (0..ANISOTROPIC_AZIMUTHS)
-        .map(|k| std::f64::consts::TAU * k as f64 / ANISOTROPIC_AZIMUTHS as f64)
-        .collect()
-}
-
-/// `brdf` with both directions turned by `phi` about the normal: its albedo at azimuth 0 is
-/// `brdf`'s at azimuth `phi`.
-struct Turned<'a>(&'a dyn Brdf, f64);
-
-impl Brdf for Turned<'_> {
-    fn channels(&self) -> &crate::spectrum::Channels {
-        self.0.channels()
-    }
-    fn eval(&self, wi: glam::DVec3, wo: glam::DVec3, out: &mut [f32]) {
-        let (s, c) = self.1.sin_cos();
-        let turn = |v: glam::DVec3| glam::DVec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
-        self.0.eval(turn(wi), turn(wo), out)
-    }
-    fn flags(&self) -> crate::brdf::Flags {
-        self.0.flags()
-    }
-    fn describe(&self) -> String {
-        format!("{} (turned by {} rad)", self.0.describe(), self.1)
-    }
+    light_azimuths(if brdf.flags().isotropic {
+        1
+    } else {
+        ANISOTROPIC_AZIMUTHS
+    })
 }
 
 /// Per node of `opts`, the albedo of `brdf` per channel (nodes × channels), the mean over

@@ -38,8 +38,9 @@ pub struct DemoArgs {
     #[arg(long, default_value = "demo-out")]
     out: PathBuf,
     /// Grid preset of every table: small, medium, large (default: what `brdftab bake` does with
-    /// no options — the medium preset for models, or their adaptive table where the preset's
-    /// albedo is off by over 1 %, the adaptive default grid for RGL files).
+    /// no options — the medium preset for models, or their adaptive table or the preset's
+    /// calibrated where the preset's albedo is off by over 1 %, the adaptive default grid for
+    /// RGL files).
     #[arg(long)]
     preset: Option<String>,
     /// Directory of RGL-EPFL `.bsdf` files (default: $BRDFTAB_RGL_DIR, else the shipped
@@ -85,8 +86,8 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         "\nBaking {} sources (grids: {}) into {}\n",
         sources.len(),
         a.preset.as_deref().unwrap_or(
-            "the defaults: medium preset for models (adaptive where its albedo is off by over \
-                 1 %), adaptive for RGL files",
+            "the defaults: medium preset for models (adaptive or calibrated where its albedo \
+                 is off by over 1 %), adaptive for RGL files",
         ),
         db.display()
     ))?;
