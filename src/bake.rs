@@ -204,6 +204,17 @@ enum Fallback {
     CalibratedPreset(Box<Table>),
 }
 
+/// What the preset's check ([`BakeRequest::preset_misses`]) decided.
+enum Checked {
+    /// The check does not apply to this request.
+    Unchecked,
+    /// The preset's table meets the albedo: the table the check baked, and its bake's stats
+    /// (the bake takes it as its own instead of baking the same grid again).
+    Kept(Box<(Table, crate::table::fill::BakeStats)>),
+    /// Another table instead, and why.
+    Instead(Fallback, String),
+}
+
 /// `why` before the bake's own note, if it has one.
 fn with_note(why: String, note: Option<String>) -> String {
     match note {
@@ -574,11 +585,7 @@ impl BakeRequest {
     /// source the adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`] (one more bake,
     /// ~1 s), then the preset's own table calibrated. The first within the tolerance is taken,
     /// else the closest.
-    fn preset_misses(
-        &self,
-        src: &dyn Brdf,
-        progress: &dyn Progress,
-    ) -> Result<Option<(Fallback, String)>> {
+    fn preset_misses(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<Checked> {
         let quantity = self.effective_quantity(src);
         if !(self.grid == GridChoice::Default
             && self.target_error.is_none()
@@ -587,12 +594,12 @@ impl BakeRequest {
             && self.param.is_none_or(|p| p == Param::HalfDiff)
             && source::classify(&self.source) == SourceKind::Spec)
         {
-            return Ok(None);
+            return Ok(Checked::Unchecked);
         }
         let (sym, _) = self.resolve_symmetry(src);
         if quantity != Quantity::Fr && !sym.reciprocal {
             // Calibrated by default already (`plan_with`): its albedo is pinned.
-            return Ok(None);
+            return Ok(Checked::Unchecked);
         }
         let _stage = Stage::begin(progress, "checking the preset's albedo", 0);
         let grid = Preset::Medium
@@ -603,7 +610,7 @@ impl BakeRequest {
             force: self.force || self.symmetry == SymmetryChoice::Declared,
             ..BakeOptions::default()
         };
-        let (preset, _) = crate::table::bake(src, &grid, &opts)?;
+        let (preset, stats) = crate::table::bake(src, &grid, &opts)?;
         let fid = crate::analysis::fidelity::FidelityOptions {
             albedo_thetas_deg: PRESET_CHECK_THETAS_DEG.to_vec(),
             albedo_phi: 64,
@@ -631,7 +638,7 @@ impl BakeRequest {
         let plain = TabulatedBrdf::from_table(preset.clone());
         let e = albedo(&plain)?;
         if e.worst <= PRESET_ALBEDO_TOLERANCE {
-            return Ok(None);
+            return Ok(Checked::Kept(Box::new((preset, stats))));
         }
         let rp = rmse(&plain)?;
         drop(plain);
@@ -671,7 +678,11 @@ impl BakeRequest {
             drop(tab);
             consider(Fallback::CalibratedPreset(Box::new(calibrated)), a, r);
         }
-        Ok(best.map(|(f, a)| {
+        let Some((f, a)) = best else {
+            // The preset stays (its table was spent on the calibration's candidate).
+            return Ok(Checked::Unchecked);
+        };
+        {
             let instead = match f {
                 Fallback::Adaptive => format!(
                     "baked to an error target of {} % instead",
@@ -692,8 +703,31 @@ impl BakeRequest {
                 100.0 * a.worst,
                 a.theta_deg
             );
-            (f, why)
-        }))
+            Ok(Checked::Instead(f, why))
+        }
+    }
+
+    /// The preset's table the check baked ([`Checked::Kept`]) as this bake's table and report,
+    /// when it is what the bake would make — the planned grid, not calibrated, from the source
+    /// itself —, so the check's bake is not repeated (~0.2 s); `None` otherwise.
+    fn reuse_checked(
+        &self,
+        src: &dyn Brdf,
+        (table, stats): (Table, crate::table::fill::BakeStats),
+        progress: &dyn Progress,
+        t0: Instant,
+    ) -> Result<Option<(Table, BakeReport)>> {
+        if src.bake_source().and_then(|b| b.bake_view()).is_some() {
+            return Ok(None);
+        }
+        let plan = self.plan_with(src, progress)?;
+        if plan.albedo.is_some() || &plan.grid != table.grid() {
+            return Ok(None);
+        }
+        let mut report = self.report_for(src, &plan.grid, plan.note, t0, false);
+        report.forced = stats.forced.filter(|_| !plan.assumed);
+        report.target = plan.search;
+        Ok(Some((table, report)))
     }
 
     /// The error target this request bakes to: its own, or [`MEASURED_TARGET_ERROR`] for an
@@ -839,7 +873,7 @@ impl BakeRequest {
     pub fn table_of(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<(Table, BakeReport)> {
         let t0 = Instant::now();
         match self.preset_misses(src, progress)? {
-            Some((Fallback::Adaptive, why)) => {
+            Checked::Instead(Fallback::Adaptive, why) => {
                 let (table, mut report) = self
                     .clone()
                     .target_error(MODEL_FALLBACK_TARGET_ERROR)
@@ -847,11 +881,15 @@ impl BakeRequest {
                 report.symmetry_note = Some(with_note(why, report.symmetry_note));
                 Ok((table, report))
             }
-            Some((Fallback::CalibratedPreset(table), why)) => {
+            Checked::Instead(Fallback::CalibratedPreset(table), why) => {
                 let report = self.calibrated_preset_report(src, &table, why, t0);
                 Ok((*table, report))
             }
-            None => self.table_unchecked(src, progress),
+            Checked::Kept(kept) => match self.reuse_checked(src, *kept, progress, t0)? {
+                Some(built) => Ok(built),
+                None => self.table_unchecked(src, progress),
+            },
+            Checked::Unchecked => self.table_unchecked(src, progress),
         }
     }
 
@@ -971,11 +1009,12 @@ impl BakeRequest {
         let src = self.open_source()?;
         let t0 = Instant::now();
         // A model the medium preset misses is baked as the request with an error target would
-        // be (the whole path: calibrated, built whole), or gets the check's calibrated table.
+        // be (the whole path: calibrated, built whole), or gets the check's calibrated table;
+        // one the preset serves gets the table the check baked.
         let mut checked = None;
         if !matches!(target, BakeTarget::Merl(_)) {
             match self.preset_misses(src.as_ref(), progress)? {
-                Some((Fallback::Adaptive, why)) => {
+                Checked::Instead(Fallback::Adaptive, why) => {
                     let mut report = self
                         .clone()
                         .target_error(MODEL_FALLBACK_TARGET_ERROR)
@@ -983,11 +1022,14 @@ impl BakeRequest {
                     report.symmetry_note = Some(with_note(why, report.symmetry_note));
                     return Ok(report);
                 }
-                Some((Fallback::CalibratedPreset(table), why)) => {
+                Checked::Instead(Fallback::CalibratedPreset(table), why) => {
                     let report = self.calibrated_preset_report(src.as_ref(), &table, why, t0);
                     checked = Some((*table, report));
                 }
-                None => {}
+                Checked::Kept(kept) => {
+                    checked = self.reuse_checked(src.as_ref(), *kept, progress, t0)?;
+                }
+                Checked::Unchecked => {}
             }
         }
         if let BakeTarget::Merl(path) = target {

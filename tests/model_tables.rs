@@ -192,3 +192,45 @@ fn ward_and_the_max_phong_default_to_their_calibrated_presets() {
         assert!(now <= before.max(0.01), "{spec}: {now} against {before}");
     }
 }
+
+/// A model the medium preset serves gets exactly the preset's table from its default bake —
+/// the table the preset's check baked, not baked again — in memory and written to a file (the
+/// check's table takes the whole-table writer, an explicit preset the streaming one).
+#[test]
+fn a_default_bake_the_preset_serves_is_the_presets_table() {
+    use brdftab::bake::BakeTarget;
+    use brdftab::table::presets::Preset;
+    let spec = r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#;
+    let silent = &brdftab::progress::Silent;
+    let (default, report) = BakeRequest::new(spec).table(silent).unwrap();
+    let (preset, _) = BakeRequest::new(spec)
+        .preset(Preset::Medium)
+        .table(silent)
+        .unwrap();
+    assert_eq!(default.grid(), preset.grid());
+    assert_eq!(default.values(), preset.values());
+    assert!(report.symmetry_note.is_none_or(|n| !n.contains("missed")));
+    let d = brdftab::testkit::TempDir::new("model-default");
+    let files = ["default.btdb", "preset.btdb"].map(|f| d.join(f).to_str().unwrap().to_owned());
+    BakeRequest::new(spec)
+        .run(&BakeTarget::file(&files[0]))
+        .unwrap();
+    BakeRequest::new(spec)
+        .preset(Preset::Medium)
+        .run(&BakeTarget::file(&files[1]))
+        .unwrap();
+    let [a, b] = files.map(|f| brdftab::open(&f).unwrap());
+    let mut pairs = 0;
+    for k in 0..2000 {
+        let t = (k as f64 * 0.618).fract() * 1.5;
+        let p = (k as f64 * 0.377).fract() * std::f64::consts::TAU;
+        let wi = glam::DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+        let wo = glam::DVec3::new(-0.3, 0.2, 0.93).normalize();
+        let (mut x, mut y) = ([0f32; 3], [0f32; 3]);
+        a.eval(wi, wo, &mut x);
+        b.eval(wi, wo, &mut y);
+        assert_eq!(x, y, "{wi}");
+        pairs += (x[0] > 0.0) as usize;
+    }
+    assert!(pairs > 1000);
+}
