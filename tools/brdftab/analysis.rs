@@ -1,8 +1,8 @@
 //! `albedo` and `check`: directional albedo and the plausibility report of a SOURCE.
 
-use crate::text::print_out;
 use brdftab::analysis::{albedo, plausibility};
 use brdftab::{Error, Result};
+use brdftab_tools::text::print_out;
 use clap::Args;
 
 /// Arguments of `brdftab albedo`.

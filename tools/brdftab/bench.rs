@@ -7,7 +7,7 @@ use brdftab::analysis::timing;
 use clap::Args;
 
 use crate::bake::flag_named;
-use crate::text::print_out;
+use brdftab_tools::text::print_out;
 
 /// Arguments of `brdftab bench`.
 #[derive(Args)]

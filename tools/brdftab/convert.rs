@@ -7,7 +7,7 @@ use clap::Args;
 
 use crate::bake::flag;
 use crate::progress::Bar;
-use crate::text::outln;
+use brdftab_tools::outln;
 
 /// Arguments of `brdftab convert`.
 #[derive(Args)]

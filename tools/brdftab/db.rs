@@ -5,8 +5,8 @@ use brdftab::store::{self, db};
 use brdftab::{Error, Result};
 use clap::{Args, Subcommand};
 
-use crate::text::outln;
 use brdftab::request::BakeSettings;
+use brdftab_tools::outln;
 
 /// Arguments of `brdftab db`.
 #[derive(Args)]
@@ -97,7 +97,7 @@ fn list(path: &str, as_json: bool) -> Result<()> {
         let json = serde_json::to_string_pretty(&rows).unwrap_or_default();
         outln!("{json}")?;
     } else {
-        crate::text::print_out(&store::info::list_text(&rows))?;
+        brdftab_tools::text::print_out(&store::info::list_text(&rows))?;
     }
     Ok(())
 }

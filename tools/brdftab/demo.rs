@@ -26,7 +26,7 @@ use clap::Args;
 
 use crate::bake::flag_named;
 use crate::demo_extra::{BAKED_MODELS, plausibility_table, preview_renders, rate_distortion};
-use crate::text::print_out;
+use brdftab_tools::text::print_out;
 
 /// Arguments of `brdftab demo`.
 #[derive(Args)]

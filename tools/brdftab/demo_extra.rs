@@ -11,7 +11,7 @@ use brdftab::{Brdf, Error, Result};
 use brdftab_tools::preview::{self, EnvChoice, RenderOptions};
 use brdftab_tools::report::{plot, suite};
 
-use crate::text::print_out;
+use brdftab_tools::text::print_out;
 
 /// The models the demo bakes, as (table name, spec). Delta models (the mirror) cannot be
 /// tabulated and are left out.

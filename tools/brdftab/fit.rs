@@ -6,7 +6,7 @@ use brdftab::{Error, Result};
 use clap::Args;
 
 use crate::bake::flag;
-use crate::text::outln;
+use brdftab_tools::outln;
 
 /// Arguments of `brdftab fit`.
 #[derive(Args)]

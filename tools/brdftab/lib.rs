@@ -6,6 +6,8 @@
 //!   colour, and slice images of any `Brdf`;
 //! - [`report`]: the accuracy suite, the measured-table benchmark and their plots;
 //! - [`rng`]: the tools' random numbers;
+//! - [`text`]: the CLI's text input and output — lines of numbers from stdin (`eval`, `pdf`,
+//!   `sample`) and writes to stdout that fail instead of panicking on a closed pipe;
 //! - [`view`]: the `brdftab view` server (the BRDF explorer in the browser).
 
 // `!(x > 0.0)` rejects NaN together with non-positive values, as in the core library.
@@ -14,6 +16,7 @@
 pub mod preview;
 pub mod report;
 pub mod rng;
+pub mod text;
 // The directory holds both `view.rs` (the binary's command) and `view/` (this module).
 #[path = "view/mod.rs"]
 pub mod view;

@@ -18,7 +18,7 @@ mod sample;
 mod slice;
 mod source;
 mod table;
-mod text;
+
 // `view/` beside it is the library's server module (`brdftab_tools::view`).
 #[path = "view.rs"]
 mod view;
@@ -131,7 +131,7 @@ fn clap_exit(e: clap::Error) -> ExitCode {
     match e.kind() {
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
             // Help into a closed pipe (`brdftab --help | head -1`) is still a success.
-            let _ = text::print_out(&e.to_string());
+            let _ = brdftab_tools::text::print_out(&e.to_string());
             ExitCode::SUCCESS
         }
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {

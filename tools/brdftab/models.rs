@@ -2,9 +2,9 @@
 
 use std::io::Write;
 
-use crate::text::outln;
 use brdftab::spec::MODELS;
 use brdftab::{Error, Result};
+use brdftab_tools::outln;
 use clap::Args;
 
 /// Arguments of `brdftab eval`.
@@ -31,7 +31,7 @@ pub fn eval(a: EvalArgs) -> Result<()> {
     let c = brdf.channels().len();
     let mut f = vec![0.0f32; c];
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-    crate::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
+    brdftab_tools::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
         brdf.eval(wi, wo, &mut f);
         // A lazily read table whose chunk failed its checksum gave 0: stop with its error.
         brdf.health()?;

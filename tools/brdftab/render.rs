@@ -8,7 +8,7 @@ use brdftab_tools::preview::{self, EnvChoice, Image, LightChoice, Mode, RenderOp
 use clap::Args;
 
 use crate::bake::flag_named;
-use crate::text::outln;
+use brdftab_tools::outln;
 
 /// Arguments of `brdftab render`.
 #[derive(Args)]

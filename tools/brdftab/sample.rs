@@ -88,7 +88,7 @@ pub fn sample(a: SampleArgs) -> Result<()> {
 pub fn pdf(a: PdfArgs) -> Result<()> {
     let brdf = brdftab::request::open(&a.source, &a.open)?;
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-    crate::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
+    brdftab_tools::text::for_each_pair(std::io::stdin().lock(), "stdin", |wi, wo| {
         let p = brdf.pdf(wi, wo);
         brdf.health()?;
         writeln!(out, "{p}").map_err(out_err)

@@ -1,7 +1,7 @@
 //! `slice`: a slice image of any SOURCE.
 
-use crate::text::outln;
 use brdftab::{Brdf, Error, Result};
+use brdftab_tools::outln;
 use brdftab_tools::preview::slice;
 use clap::{Args, ValueEnum};
 

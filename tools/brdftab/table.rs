@@ -6,7 +6,7 @@ use brdftab::store::{db, info, tables};
 use clap::Args;
 
 use crate::source;
-use crate::text::print_out;
+use brdftab_tools::text::print_out;
 
 /// Arguments of `brdftab info`.
 #[derive(Args)]

@@ -22,12 +22,12 @@ pub fn print_out(text: &str) -> brdftab::Result<()> {
 }
 
 /// `println!` through [`print_out`]: evaluates to its `Result` (use `?`).
+#[macro_export]
 macro_rules! outln {
     ($($t:tt)*) => {
         $crate::text::print_out(&format!("{}\n", format_args!($($t)*)))
     };
 }
-pub(crate) use outln;
 
 /// Parses a line of exactly `N` numbers; `None` for blank and `#` lines. `name` and `lineno`
 /// go into the error.
