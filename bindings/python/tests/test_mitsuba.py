@@ -182,8 +182,10 @@ def test_jit_lookup_matches_rust(case, interp, tmp_path, rgl):
 
 def test_jit_tables_of_isotropic_models_are_adaptive_and_calibrated(tmp_path):
     """The JIT variants bake an isotropic model to MODEL_TARGET_ERROR (calibrated: its albedo
-    pinned with one symmetric factor), an anisotropic one on the medium preset; the plugin's
-    lookups are the library's table of that request."""
+    pinned with one symmetric factor), an anisotropic one as the library's default bake does
+    (Ward: the medium preset, calibrated — uncalibrated it is 4-5 % off in albedo at 89°), and
+    the medium preset when asked; the plugin's lookups are the library's table of that
+    request."""
     use("llvm_ad_rgb")
     from brdftab.mitsuba import MODEL_TARGET_ERROR
 
@@ -191,9 +193,12 @@ def test_jit_tables_of_isotropic_models_are_adaptive_and_calibrated(tmp_path):
     wi, wo = wi.astype(np.float32).astype(np.float64), wo.astype(np.float32).astype(np.float64)
     ggx = '{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}'
     ward = '{"model": "ward", "alpha_x": 0.2, "alpha_y": 0.4, "ks": 0.5}'
-    for src, opts, calibrated in ((ggx, dict(target_error=MODEL_TARGET_ERROR), True),
-                                  (ward, dict(preset="medium"), False)):
-        d = mi.load_dict({"type": "brdftab", "source": src, "cache_dir": str(tmp_path)})
+    # (source, the plugin's properties, the library bake that makes the same table, calibrated)
+    for src, props, opts, calibrated in (
+            (ggx, {}, dict(target_error=MODEL_TARGET_ERROR), True),
+            (ward, {}, dict(), True),
+            (ward, dict(preset="medium"), dict(preset="medium"), False)):
+        d = mi.load_dict({"type": "brdftab", "source": src, "cache_dir": str(tmp_path), **props})
         assert (d.table.calibration is not None) == calibrated
         out = str(tmp_path / "t.btdb")
         brdftab.bake(src, out, codec="f32", **opts)
@@ -206,7 +211,7 @@ def test_jit_tables_of_isotropic_models_are_adaptive_and_calibrated(tmp_path):
         back = np.stack([np.array(x) for x in d.table.lookup(mi.Vector3f(*wo.T),
                                                              mi.Vector3f(*wi.T))], -1)
         np.testing.assert_allclose(back, got, rtol=1e-5, atol=1e-6 * np.abs(want).max())
-        if calibrated:  # a small table: 288 k values against the medium preset's 4.4 M
+        if src == ggx:  # a small table: 288 k values against the medium preset's 4.4 M
             assert t.table().values.size < 1_000_000
             # its f16 codes read four to a word (the bit-equal lookups above)
             assert d.table.kernel["packed"] is not None

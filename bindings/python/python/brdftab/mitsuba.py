@@ -10,7 +10,8 @@ Properties: ``source`` (string, any SOURCE: spec, table, ``DB#NAME``, MERL, RGL)
 library reads them, linear otherwise; or ``"linear"`` or ``"nearest"``), and for JIT variants optional ``preset`` / ``grid``
 (the table a non-table source is baked on; default: for an isotropic model the smallest
 adaptive grid within :data:`MODEL_TARGET_ERROR`, calibrated to the model's albedo, for other
-models ``medium``; RGL files: the library's adaptive grid, MERL files: their own cells),
+models the library's default bake — the ``medium`` preset, calibrated where its albedo misses
+the model's by over 1 % (Ward's anisotropic lobes at the horizon); RGL files: the library's adaptive grid, MERL files: their own cells),
 ``sampling_res`` (the
 resolution of the sampling distributions: half-vector nodes per axis, default 64, 48 for
 anisotropic tables), ``cache`` (bool, default
@@ -860,13 +861,13 @@ class JitBrdftabBSDF(_Common):
         # MERL files keep their own cells, RGL files get the library's adaptive grid. Other
         # sources: given a preset or grid, that; else an isotropic bilateral source (every
         # isotropic model) the smallest adaptive grid within MODEL_TARGET_ERROR, calibrated to
-        # its albedo, and any other source the medium preset.
+        # its albedo, and any other source the library's default bake (the medium preset,
+        # calibrated where the preset misses the albedo: brdftab.bake's default).
         if brdftab_kind(self.source) not in ("merl", "rgl"):
             flags = self.brdf.flags
-            if ("preset" in options or "grid" in options
-                    or not (flags["isotropic"] and flags["bilateral"])):
+            if "preset" in options or "grid" in options:
                 options.setdefault("preset", "medium")
-            else:
+            elif flags["isotropic"] and flags["bilateral"]:
                 options.setdefault("target_error", MODEL_TARGET_ERROR)
         if options.get("preset") and options.get("grid"):
             options.pop("preset")
