@@ -229,6 +229,14 @@ fn check_rule(opts: &FidelityOptions) -> Result<()> {
     if opts.albedo_azimuths == 0 {
         return Err(Error::arg("albedo_azimuths", "needs at least one azimuth"));
     }
+    // As `albedo::incidence`: the light above the horizon (at 90° Ward's albedo has no finite
+    // limit, and a cosine of 6e-17 still counts as above).
+    if let Some(t) = (opts.albedo_thetas_deg.iter()).find(|t| !(0.0..90.0).contains(*t)) {
+        return Err(Error::arg(
+            "albedo_thetas_deg",
+            format!("{t}° is outside [0°, 90°): the albedo is defined for light above the horizon"),
+        ));
+    }
     Ok(())
 }
 
@@ -417,6 +425,25 @@ pub fn worst_albedo(a: &AlbedoCurve, r: &AlbedoCurve, opts: &FidelityOptions) ->
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn albedo_angles_outside_the_upper_hemisphere_are_refused() {
+        let l = crate::models::lambert::Lambert::new(
+            crate::spectrum::Value::Grey(0.3),
+            &crate::spectrum::Channels::Rgb,
+        )
+        .unwrap();
+        for bad in [90.0, 95.0, -1.0, f64::NAN] {
+            let opts = FidelityOptions {
+                albedo_thetas_deg: vec![10.0, bad],
+                ..Default::default()
+            };
+            match albedo_error(&l, &l, &opts) {
+                Err(Error::InvalidArgument { name, .. }) => assert_eq!(name, "albedo_thetas_deg"),
+                r => panic!("{bad}: {r:?}"),
+            }
+        }
+    }
+
     use super::*;
     use crate::models::lambert::Lambert;
     use crate::spec::ModelSpec;

@@ -66,11 +66,19 @@ pub fn slice(a: SliceArgs) -> Result<()> {
     };
     let img = match a.kind {
         SliceKind::Halfdiff => slice::halfdiff(&*brdf, a.size, a.phi_d.to_radians()),
-        SliceKind::Polar => slice::polar(
-            &*brdf,
-            a.size,
-            slice::incident(a.theta_in.to_radians(), a.phi_in.to_radians()),
-        ),
+        SliceKind::Polar => {
+            let wi =
+                slice::incident(a.theta_in.to_radians(), a.phi_in.to_radians()).map_err(|_| {
+                    Error::arg(
+                        "--theta-in",
+                        format!(
+                            "{}° is outside [0°, 90°): the light must be above the horizon",
+                            a.theta_in
+                        ),
+                    )
+                })?;
+            slice::polar(&*brdf, a.size, wi)
+        }
     };
     // A source that failed while it was read (a corrupt table chunk) drew zeros.
     brdf.health()?;

@@ -153,9 +153,16 @@ pub fn write(img: &Image, channel: Option<usize>, path: impl AsRef<Path>) -> Res
 }
 
 /// The incident direction of polar angle `theta` and azimuth `phi` (radians); a convenience for
-/// callers that take degrees at the edge.
-pub fn incident(theta: f64, phi: f64) -> DVec3 {
-    geometry::spherical(theta.clamp(0.0, FRAC_PI_2), phi.rem_euclid(2.0 * PI))
+/// callers that take degrees at the edge. `theta` outside [0, π/2) is an argument error (it
+/// was clamped into [0, π/2], so `--theta-in 120` drew the grazing slice without a word).
+pub fn incident(theta: f64, phi: f64) -> brdftab::Result<DVec3> {
+    if !(0.0..FRAC_PI_2).contains(&theta) {
+        return Err(brdftab::Error::arg(
+            "theta",
+            format!("{theta} is outside [0, π/2) (radians): the light must be above the horizon"),
+        ));
+    }
+    Ok(geometry::spherical(theta, phi.rem_euclid(2.0 * PI)))
 }
 
 #[cfg(test)]

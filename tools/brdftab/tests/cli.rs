@@ -141,6 +141,28 @@ fn albedo_is_for_light_above_the_horizon() {
 }
 
 #[test]
+fn a_polar_slice_is_for_light_above_the_horizon() {
+    // The incidence was clamped into [0°, 90°]: 120 and -5 drew the 90° and 0° slices silently.
+    let dir = TempDir::new("cli-slice-theta");
+    let png = dir.join("s.png");
+    let png = png.to_str().unwrap();
+    for t in ["90", "120", "-5"] {
+        let args = [
+            "slice", LAMBERT, "-o", png, "--kind", "polar", "--size", "8",
+        ];
+        let flag = format!("--theta-in={t}");
+        let o = brdftab(&[&args[..], &[flag.as_str()]].concat());
+        assert_error(&o, "--theta-in");
+        assert_error(&o, "above the horizon");
+    }
+    let args = [
+        "slice", LAMBERT, "-o", png, "--kind", "polar", "--size", "8",
+    ];
+    let o = brdftab(&[&args[..], &["--theta-in", "89.9"]].concat());
+    assert_eq!(o.code, 0, "{}", o.stderr);
+}
+
+#[test]
 fn bake_target_error_reports_the_search_and_names_its_flag() {
     let dir = TempDir::new("cli-target");
     let out = dir.file("t.btdb");
