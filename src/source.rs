@@ -12,8 +12,9 @@
 //! | an RGL-EPFL `.bsdf` file | `Rgl` | [`RglBrdf`](crate::measured::RglBrdf) (the native adaptive evaluation) |
 //! | a brdftab file, `DB#NAME` for one table of a database, or a raw table | `Table` | [`TabulatedBrdf`] |
 //!
-//! Classification looks at the string only ([`classify`]); opening reads the file and reports a
-//! typed [`Error`] (missing file, bad magic, unknown model, ...) with the path in it.
+//! Classification looks at the string ([`classify`]; for a string with a `#`, also whether a
+//! file of that whole name exists, as opening does); opening reads the file and reports a typed
+//! [`Error`] (missing file, bad magic, unknown model, ...) with the path in it.
 
 use std::path::Path;
 
