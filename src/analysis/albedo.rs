@@ -413,7 +413,7 @@ mod tests {
                 pairs: 100,
                 ..Default::default()
             };
-            let r = crate::analysis::plausibility::check(&b, &opts);
+            let r = crate::analysis::plausibility::check(&b, &opts).unwrap();
             let n = b.evals.load(std::sync::atomic::Ordering::Relaxed);
             assert!(
                 n <= 2 * opts.pairs + 2 * 90 * first_pass,

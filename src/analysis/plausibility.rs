@@ -21,7 +21,7 @@
 //! ```
 //! use brdftab::{analysis::plausibility, spec::ModelSpec, spectrum::Channels};
 //! let brdf = ModelSpec::parse(r#"{"model": "lambert", "kd": 0.5}"#)?.build(&Channels::Rgb)?;
-//! let report = plausibility::check(&*brdf, &plausibility::Options::default());
+//! let report = plausibility::check(&*brdf, &plausibility::Options::default())?;
 //! assert!(report.positive && report.reciprocal);
 //! assert!(!report.energy_conserving); // k_d > 1/π
 //! assert!((report.max_albedo - 0.5 * std::f64::consts::PI).abs() < 1e-6);
@@ -35,6 +35,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::brdf::{Brdf, Flags};
+use crate::error::{Error, Result};
 use crate::geometry;
 use crate::rng::Pcg32;
 use crate::spectrum::MAX_CHANNELS;
@@ -46,7 +47,9 @@ pub struct Options {
     pub pairs: usize,
     /// Seed of the pair generator (the report is deterministic for a given seed).
     pub seed: u64,
-    /// Incidence angles in degrees at which the albedo is computed.
+    /// Incidence angles in degrees at which the albedo is computed, each in [0°, 90°): light at
+    /// the horizon has an albedo only as a limit, and not always a finite one (Ward's grows
+    /// like 1/cos θ′), so [`check`] refuses 90° as the `albedo` command does.
     pub thetas_deg: Vec<f64>,
     /// Largest relative reciprocity error still called reciprocal.
     pub reciprocity_tolerance: f64,
@@ -153,7 +156,17 @@ impl Report {
 }
 
 /// Measures positivity, reciprocity and energy conservation of `brdf`.
-pub fn check(brdf: &dyn Brdf, opts: &Options) -> Report {
+///
+/// # Errors
+/// [`Error::InvalidArgument`] (`thetas_deg`) for an incidence angle outside [0°, 90°) or not a
+/// number.
+pub fn check(brdf: &dyn Brdf, opts: &Options) -> Result<Report> {
+    if let Some(t) = opts.thetas_deg.iter().find(|t| !(0.0..90.0).contains(*t)) {
+        return Err(Error::arg(
+            "thetas_deg",
+            format!("{t}° is outside [0°, 90°): the albedo is defined for light above the horizon"),
+        ));
+    }
     let channels = brdf.channels();
     let c = channels.len().min(MAX_CHANNELS);
     let declared = brdf.flags();
@@ -233,7 +246,7 @@ pub fn check(brdf: &dyn Brdf, opts: &Options) -> Report {
         }
     }
     let names = channels.names();
-    Report {
+    Ok(Report {
         source: brdf.describe(),
         channels: names.clone(),
         declared,
@@ -252,7 +265,7 @@ pub fn check(brdf: &dyn Brdf, opts: &Options) -> Report {
         max_albedo_channel: names.get(max_ch).cloned().unwrap_or_default(),
         albedo_tolerance: opts.albedo_tolerance,
         albedo_curve: curve,
-    }
+    })
 }
 
 /// The k-th random pair: uniform, near-mirror or near-grazing, in turn.
@@ -439,7 +452,13 @@ pub fn lecture_table() -> String {
                 continue;
             }
         };
-        let r = check(&*brdf, &Options::default());
+        let r = match check(&*brdf, &Options::default()) {
+            Ok(r) => r,
+            Err(e) => {
+                skipped.push(format!("{label}: {e}"));
+                continue;
+            }
+        };
         let yn = |b: bool| if b { "yes" } else { "NO" };
         text += &format!(
             "{:<26} {:<9} {:<22} {} ({:.4} @ {}°)\n",
@@ -463,6 +482,11 @@ pub fn lecture_table() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`super::check`] with angles every test gives inside [0°, 90°).
+    fn check(brdf: &dyn Brdf, opts: &Options) -> Report {
+        super::check(brdf, opts).unwrap()
+    }
     use crate::models::lambert::Lambert;
     use crate::spectrum::{Channels, Value};
 
@@ -552,6 +576,35 @@ mod tests {
             thetas_deg: vec![0.0, 30.0, 60.0, 80.0, 89.0],
             ..Options::default()
         }
+    }
+
+    #[test]
+    fn albedo_angles_at_or_beyond_the_horizon_are_refused() {
+        // Ward's albedo at θ′ = 90° has no finite limit: a report with it would be a number
+        // of the quadrature, not of the model.
+        let ward = crate::spec::ModelSpec::parse(
+            r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}"#,
+        )
+        .unwrap()
+        .build(&Channels::Rgb)
+        .unwrap();
+        for bad in [90.0, 120.0, -1.0, f64::NAN] {
+            let opts = Options {
+                pairs: 10,
+                thetas_deg: vec![10.0, bad],
+                ..Options::default()
+            };
+            match super::check(&*ward, &opts) {
+                Err(Error::InvalidArgument { name, .. }) => assert_eq!(name, "thetas_deg"),
+                other => panic!("{bad}: {other:?}"),
+            }
+        }
+        let edge = Options {
+            pairs: 10,
+            thetas_deg: vec![0.0, 89.9],
+            ..Options::default()
+        };
+        assert!(super::check(&*ward, &edge).unwrap().max_albedo.is_finite());
     }
 
     #[test]

@@ -59,7 +59,7 @@ pub fn albedo(a: AlbedoArgs) -> Result<()> {
 /// Prints the plausibility report (text or JSON).
 pub fn check(a: CheckArgs) -> Result<()> {
     let brdf = brdftab::request::open(&a.source, &a.open)?;
-    let report = plausibility::check(&*brdf, &plausibility::Options::default());
+    let report = plausibility::check(&*brdf, &plausibility::Options::default())?;
     brdf.health()?;
     if a.json {
         let json = serde_json::to_string(&report)

@@ -148,7 +148,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         };
         let src_albedo = suite::albedos(s.brdf.as_ref(), &opts.albedo_thetas);
         let m = suite::metrics(&tab, s.brdf.as_ref(), &src_albedo, &opts)?;
-        let r = plausibility::check(&tab, &fast_plausibility());
+        let r = plausibility::check(&tab, &fast_plausibility())?;
         let yn = |b: bool| if b { "y" } else { "N" };
         let shape = tab.grid().stored_shape().map(|x| x.to_string()).join("×");
         print_out(&format!(

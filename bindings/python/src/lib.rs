@@ -884,7 +884,8 @@ fn check(
                 brdf.as_ref(),
                 &brdftab::analysis::plausibility::Options::default(),
             )
-        })?;
+        })?
+        .map_err(lib_err)?;
         ser(py, &report)
     })
 }

@@ -181,10 +181,14 @@ pub fn plausibility(reg: &Registry, q: &Query) -> Result<Response, Response> {
             albedo: Some(suite::ALBEDO_OPTIONS),
             ..Default::default()
         };
-        let r = plausibility::check(b, &opts);
-        let mut v = serde_json::to_value(&r).unwrap_or_default();
-        v["plausible"] = json!(r.plausible());
-        v.to_string()
+        match plausibility::check(b, &opts) {
+            Ok(r) => {
+                let mut v = serde_json::to_value(&r).unwrap_or_default();
+                v["plausible"] = json!(r.plausible());
+                v.to_string()
+            }
+            Err(e) => json!({ "error": e.to_string() }).to_string(),
+        }
     })
 }
 
