@@ -33,10 +33,21 @@ fn last_error() -> String {
     unsafe { CStr::from_ptr(brdftab_last_error()) }.to_string_lossy().into_owned()
 }
 
+/// Removes the input's temp file when the input is done, however it ends (a NULL open
+/// returns early), so a fuzzing run leaves nothing in the temp directory.
+struct Removed(std::path::PathBuf);
+
+impl Drop for Removed {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
 fuzz_target!(|data: &[u8]| {
     let Some((&mode, rest)) = data.split_first() else { return };
     let ext = ["btdb", "bsdf", "binary", "json"];
     let file;
+    let _removed;
     let source = if mode % 5 == 4 {
         match CString::new(rest) {
             Ok(s) => s,
@@ -48,6 +59,7 @@ fuzz_target!(|data: &[u8]| {
             std::process::id(),
             ext[(mode % 5) as usize]
         ));
+        _removed = Removed(file.clone());
         let mut f = std::fs::File::create(&file).expect("temp file");
         f.write_all(rest).expect("temp write");
         CString::new(file.to_str().expect("utf-8 temp path")).expect("no NUL")
