@@ -13,7 +13,7 @@
 //! `--azimuths` adds, for an anisotropic source, what a factor of θ cannot pin: the worst
 //! *single* azimuth of the light's directional albedo over the light's eight azimuths
 //! (φ′ = k·45°) at θ′ = 1, 30, 60, 80, 85, 89° and at 87, 88°, on a 256 × 12 mirror-centred
-//! rule, beside the worst mean over those eight azimuths (what the preset check and the
+//! rule (`--rule PHIxORDER` another), beside the worst mean over those eight azimuths (what the preset check and the
 //! calibration judge), and the relative RMSE over the check's 20 000 random pairs (weighted by
 //! cos θi, or cos θi cos θo for a table that stores f_r cos θi cos θo).
 
@@ -56,12 +56,16 @@ struct Azimuths {
     mean: (f64, f64),
 }
 
-fn azimuths(tab: &dyn Brdf, src: &dyn Brdf) -> Result<Azimuths, brdftab::Error> {
+fn azimuths(
+    tab: &dyn Brdf,
+    src: &dyn Brdf,
+    rule: (usize, usize),
+) -> Result<Azimuths, brdftab::Error> {
     let thetas = [1.0, 30.0, 60.0, 80.0, 85.0, 89.0, 87.0, 88.0];
     let opts = FidelityOptions {
         albedo_thetas_deg: thetas.to_vec(),
-        albedo_phi: 256,
-        albedo_order: 12,
+        albedo_phi: rule.0,
+        albedo_order: rule.1,
         albedo_azimuths: 1,
         ..Default::default()
     };
@@ -114,6 +118,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut preset: Option<Preset> = None;
     let mut per_azimuth = false;
     let mut table_file: Option<String> = None;
+    let mut rule = (256, 12);
     let mut sources = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -127,6 +132,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--preset" => preset = Some(args.next().unwrap_or_default().parse()?),
             "--azimuths" => per_azimuth = true,
             "--table" => table_file = args.next(),
+            "--rule" => {
+                let r = args.next().unwrap_or_default();
+                let (p, o) = r.split_once('x').ok_or("--rule PHIxORDER")?;
+                rule = (p.parse()?, o.parse()?);
+            }
             _ => sources.push((a, table_file.take())),
         }
     }
@@ -192,7 +202,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             };
             let whole = Region::Cap(std::f64::consts::FRAC_PI_2);
             let rp = compare_region(&tab, src.as_ref(), 20_000, 1, whole, weight)?;
-            let a = azimuths(&tab, src.as_ref())?;
+            let a = azimuths(&tab, src.as_ref(), rule)?;
             print!(
                 " {:.2} % | {:.2} % at {}° | {:.2} % at {}°, φ′ {}° | {:.2} % at {}°, φ′ {}° |",
                 100.0 * rp.rel_rmse,
