@@ -162,6 +162,14 @@ pub const PRESET_CHECK_THETAS_DEG: [f64; 6] = [1.0, 30.0, 60.0, 80.0, 85.0, 89.0
 /// ([`PRESET_ALBEDO_TOLERANCE`]).
 pub const PRESET_CHECK_PAIRS: usize = 20_000;
 
+/// How much larger (relative) than the preset's a candidate's error over
+/// [`PRESET_CHECK_PAIRS`] random pairs may be for the preset check to take it (any error up to
+/// 1 % passes): a calibration that brings an albedo 5 % off to within 0.1 % moves node values,
+/// and with them that error a little — Ward α = (0.05, 0.2): 1.59 → 1.67 %, which "no larger"
+/// refused, leaving its default 5.3 % off at 89° — while the candidates this guards against are
+/// several times worse (the max-Phong's adaptive table: 0.78 → 6.0 %).
+pub const PRESET_CHECK_RMSE_SLACK: f64 = 0.1;
+
 /// The error target of a model's default bake when its preset table misses the albedo
 /// ([`PRESET_ALBEDO_TOLERANCE`]): 0.2 % relative RMSE, as the Mitsuba plugin's JIT tables of
 /// models (`brdftab.mitsuba.MODEL_TARGET_ERROR`), calibrated. A lobe too sharp for it gets the
@@ -581,7 +589,8 @@ impl BakeRequest {
     /// anisotropic source the mean over the light's [`ANISOTROPIC_AZIMUTHS`], which is what a
     /// calibration can pin; a bake of the preset and its albedos, ~0.3 s). The candidates, in
     /// this order, each kept only if its albedo is closer and its error over
-    /// [`PRESET_CHECK_PAIRS`] random pairs no larger (beyond 1 %): for an isotropic, bilateral
+    /// [`PRESET_CHECK_PAIRS`] random pairs at most [`PRESET_CHECK_RMSE_SLACK`] larger (or within
+    /// 1 %): for an isotropic, bilateral
     /// source the adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`] (one more bake,
     /// ~1 s), then the preset's own table calibrated. The first within the tolerance is taken,
     /// else the closest.
@@ -644,7 +653,8 @@ impl BakeRequest {
         drop(plain);
         let mut best: Option<(Fallback, AlbedoError)> = None;
         let mut consider = |f: Fallback, a: AlbedoError, r: f64| {
-            if a.worst < best.as_ref().map_or(e.worst, |b| b.1.worst) && r <= rp.max(0.01) {
+            let bound = (rp * (1.0 + PRESET_CHECK_RMSE_SLACK)).max(0.01);
+            if a.worst < best.as_ref().map_or(e.worst, |b| b.1.worst) && r <= bound {
                 best = Some((f, a));
             }
             best.as_ref()

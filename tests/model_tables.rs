@@ -148,6 +148,12 @@ fn ward_and_the_max_phong_default_to_their_calibrated_presets() {
             r#"{"model": "max_phong", "ks": 0.5, "n": 50}"#,
             Weight::CosIn,
         ),
+        (
+            // Its calibrated table is 1.67 % off over random pairs against the preset's 1.59 %:
+            // the check refused it on "no larger" and kept the preset, 5.3 % off at 89°.
+            r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.05, "alpha_y": 0.2}"#,
+            Weight::CosInCosOut,
+        ),
     ]
     .into_iter()
     .enumerate()
@@ -189,7 +195,8 @@ fn ward_and_the_max_phong_default_to_their_calibrated_presets() {
                 .rel_rmse
         };
         let (now, before) = (rmse(table.as_ref()), rmse(&preset));
-        assert!(now <= before.max(0.01), "{spec}: {now} against {before}");
+        let bound = (before * (1.0 + brdftab::bake::PRESET_CHECK_RMSE_SLACK)).max(0.01);
+        assert!(now <= bound, "{spec}: {now} against {before}");
     }
 }
 
