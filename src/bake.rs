@@ -596,7 +596,11 @@ impl BakeRequest {
         {
             return Ok(Checked::Unchecked);
         }
-        let (sym, _) = self.resolve_symmetry(src);
+        let (mut sym, _) = self.resolve_symmetry(src);
+        if quantity == Quantity::FrCosOut {
+            // As `plan_with`: f_r cos θo cannot fold by reciprocity.
+            sym.reciprocal = false;
+        }
         if quantity != Quantity::Fr && !sym.reciprocal {
             // Calibrated by default already (`plan_with`): its albedo is pinned.
             return Ok(Checked::Unchecked);
@@ -1519,5 +1523,17 @@ mod tests {
         forced.force = true;
         let r = forced.run(&BakeTarget::file(&out)).unwrap();
         assert!(r.forced.is_some());
+    }
+
+    #[test]
+    fn a_model_asked_to_store_f_r_cos_out_bakes_on_the_default_grid() {
+        // f_r cos θo cannot fold by reciprocity: the plan drops the fold (and calibrates the
+        // table), and the preset's check must not bake a reciprocal grid of it first (it
+        // failed with "a grid storing it cannot fold by reciprocity").
+        let req = BakeRequest::new(r#"{"model": "lambert", "kd": 0.25}"#)
+            .quantity(Quantity::FrCosOut);
+        let (table, _) = req.table(&Silent).unwrap();
+        assert_eq!(table.grid().quantity(), Quantity::FrCosOut);
+        assert!(!table.grid().symmetry().reciprocal);
     }
 }
