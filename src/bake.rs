@@ -213,6 +213,9 @@ enum Checked {
     Kept(Box<(Table, crate::table::fill::BakeStats)>),
     /// Another table instead, and why.
     Instead(Fallback, String),
+    /// The preset's table misses the albedo and no other table was taken: the preset's table
+    /// is baked as without the check, and the note says by how much it misses.
+    Missed(String),
 }
 
 /// `why` before the bake's own note, if it has one.
@@ -584,7 +587,8 @@ impl BakeRequest {
     /// [`PRESET_CHECK_PAIRS`] random pairs no larger (beyond 1 %): for an isotropic, bilateral
     /// source the adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`] (one more bake,
     /// ~1 s), then the preset's own table calibrated. The first within the tolerance is taken,
-    /// else the closest.
+    /// else the closest; when neither is kept the preset's table stays ([`Checked::Missed`]:
+    /// the bake's note says by how much it misses).
     fn preset_misses(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<Checked> {
         let quantity = self.effective_quantity(src);
         if !(self.grid == GridChoice::Default
@@ -682,9 +686,20 @@ impl BakeRequest {
             drop(tab);
             consider(Fallback::CalibratedPreset(Box::new(calibrated)), a, r);
         }
+        let azimuths = if sym.isotropic {
+            ""
+        } else {
+            " (mean over the light's azimuths)"
+        };
         let Some((f, a)) = best else {
-            // The preset stays (its table was spent on the calibration's candidate).
-            return Ok(Checked::Unchecked);
+            // The preset stays (its table was spent on the calibration's candidate), but the
+            // bake says that it misses.
+            return Ok(Checked::Missed(format!(
+                "the medium preset's table missed the albedo{azimuths} by {:.1} % at {}°; no \
+                 other table was closer without a larger error over random pairs, so it stays",
+                100.0 * e.worst,
+                e.theta_deg
+            )));
         };
         {
             let instead = match f {
@@ -695,13 +710,8 @@ impl BakeRequest {
                 Fallback::CalibratedPreset(_) => "calibrated it".to_owned(),
             };
             let why = format!(
-                "the medium preset's table missed the albedo{} by {:.1} % at {}°: {instead} \
-                 ({:.2} % at {}°)",
-                if sym.isotropic {
-                    ""
-                } else {
-                    " (mean over the light's azimuths)"
-                },
+                "the medium preset's table missed the albedo{azimuths} by {:.1} % at {}°: \
+                 {instead} ({:.2} % at {}°)",
                 100.0 * e.worst,
                 e.theta_deg,
                 100.0 * a.worst,
@@ -893,6 +903,11 @@ impl BakeRequest {
                 Some(built) => Ok(built),
                 None => self.table_unchecked(src, progress),
             },
+            Checked::Missed(why) => {
+                let (table, mut report) = self.table_unchecked(src, progress)?;
+                report.symmetry_note = Some(with_note(why, report.symmetry_note));
+                Ok((table, report))
+            }
             Checked::Unchecked => self.table_unchecked(src, progress),
         }
     }
@@ -1016,6 +1031,7 @@ impl BakeRequest {
         // be (the whole path: calibrated, built whole), or gets the check's calibrated table;
         // one the preset serves gets the table the check baked.
         let mut checked = None;
+        let mut missed = None;
         if !matches!(target, BakeTarget::Merl(_)) {
             match self.preset_misses(src.as_ref(), progress)? {
                 Checked::Instead(Fallback::Adaptive, why) => {
@@ -1033,6 +1049,7 @@ impl BakeRequest {
                 Checked::Kept(kept) => {
                     checked = self.reuse_checked(src.as_ref(), *kept, progress, t0)?;
                 }
+                Checked::Missed(why) => missed = Some(why),
                 Checked::Unchecked => {}
             }
         }
@@ -1081,6 +1098,9 @@ impl BakeRequest {
                 None,
             ),
         };
+        if let Some(why) = missed {
+            report.symmetry_note = Some(with_note(why, report.symmetry_note.take()));
+        }
         report.name = name.clone();
         report.output = match target {
             BakeTarget::Db { path, .. } => format!("{path}#{name}"),
@@ -1530,10 +1550,27 @@ mod tests {
         // f_r cos θo cannot fold by reciprocity: the plan drops the fold (and calibrates the
         // table), and the preset's check must not bake a reciprocal grid of it first (it
         // failed with "a grid storing it cannot fold by reciprocity").
-        let req = BakeRequest::new(r#"{"model": "lambert", "kd": 0.25}"#)
-            .quantity(Quantity::FrCosOut);
+        let req =
+            BakeRequest::new(r#"{"model": "lambert", "kd": 0.25}"#).quantity(Quantity::FrCosOut);
         let (table, _) = req.table(&Silent).unwrap();
         assert_eq!(table.grid().quantity(), Quantity::FrCosOut);
         assert!(!table.grid().symmetry().reciprocal);
+    }
+
+    #[test]
+    fn a_default_bake_that_keeps_a_preset_missing_the_albedo_says_so() {
+        // GGX α = 3e-4: the medium preset's table is 52 % bright in albedo at 89°, and neither
+        // other candidate is taken (the adaptive table's and the calibrated preset's errors over
+        // random pairs are larger). The preset stays, but not without a word.
+        let spec = r#"{"model": "ggx", "alpha": 3e-4}"#;
+        let d = tmp("missed");
+        let req = BakeRequest::new(spec);
+        let (_, r) = req.table(&Silent).unwrap();
+        let note = r.symmetry_note.unwrap_or_default();
+        assert!(note.contains("missed the albedo"), "{note:?}");
+        let out = d.join("g.btdb").to_str().unwrap().to_owned();
+        let r = req.run(&BakeTarget::file(&out)).unwrap();
+        let note = r.symmetry_note.unwrap_or_default();
+        assert!(note.contains("missed the albedo"), "{note:?}");
     }
 }
