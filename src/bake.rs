@@ -221,6 +221,9 @@ enum Checked {
     Kept(Box<(Table, crate::table::fill::BakeStats)>),
     /// Another table instead, and why.
     Instead(Fallback, String),
+    /// The preset's table misses the albedo and no other table was taken: the preset's table
+    /// is baked as without the check, and the note says by how much it misses.
+    Missed(String),
 }
 
 /// `why` before the bake's own note, if it has one.
@@ -593,7 +596,8 @@ impl BakeRequest {
     /// 1 %): for an isotropic, bilateral
     /// source the adaptive, calibrated table of [`MODEL_FALLBACK_TARGET_ERROR`] (one more bake,
     /// ~1 s), then the preset's own table calibrated. The first within the tolerance is taken,
-    /// else the closest.
+    /// else the closest; when neither is kept the preset's table stays ([`Checked::Missed`]:
+    /// the bake's note says by how much it misses).
     fn preset_misses(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<Checked> {
         let quantity = self.effective_quantity(src);
         if !(self.grid == GridChoice::Default
@@ -605,7 +609,11 @@ impl BakeRequest {
         {
             return Ok(Checked::Unchecked);
         }
-        let (sym, _) = self.resolve_symmetry(src);
+        let (mut sym, _) = self.resolve_symmetry(src);
+        if quantity == Quantity::FrCosOut {
+            // As `plan_with`: f_r cos θo cannot fold by reciprocity.
+            sym.reciprocal = false;
+        }
         if quantity != Quantity::Fr && !sym.reciprocal {
             // Calibrated by default already (`plan_with`): its albedo is pinned.
             return Ok(Checked::Unchecked);
@@ -688,9 +696,20 @@ impl BakeRequest {
             drop(tab);
             consider(Fallback::CalibratedPreset(Box::new(calibrated)), a, r);
         }
+        let azimuths = if sym.isotropic {
+            ""
+        } else {
+            " (mean over the light's azimuths)"
+        };
         let Some((f, a)) = best else {
-            // The preset stays (its table was spent on the calibration's candidate).
-            return Ok(Checked::Unchecked);
+            // The preset stays (its table was spent on the calibration's candidate), but the
+            // bake says that it misses.
+            return Ok(Checked::Missed(format!(
+                "the medium preset's table missed the albedo{azimuths} by {:.1} % at {}°; no \
+                 other table was closer without a larger error over random pairs, so it stays",
+                100.0 * e.worst,
+                e.theta_deg
+            )));
         };
         {
             let instead = match f {
@@ -701,13 +720,8 @@ impl BakeRequest {
                 Fallback::CalibratedPreset(_) => "calibrated it".to_owned(),
             };
             let why = format!(
-                "the medium preset's table missed the albedo{} by {:.1} % at {}°: {instead} \
-                 ({:.2} % at {}°)",
-                if sym.isotropic {
-                    ""
-                } else {
-                    " (mean over the light's azimuths)"
-                },
+                "the medium preset's table missed the albedo{azimuths} by {:.1} % at {}°: \
+                 {instead} ({:.2} % at {}°)",
                 100.0 * e.worst,
                 e.theta_deg,
                 100.0 * a.worst,
@@ -899,6 +913,11 @@ impl BakeRequest {
                 Some(built) => Ok(built),
                 None => self.table_unchecked(src, progress),
             },
+            Checked::Missed(why) => {
+                let (table, mut report) = self.table_unchecked(src, progress)?;
+                report.symmetry_note = Some(with_note(why, report.symmetry_note));
+                Ok((table, report))
+            }
             Checked::Unchecked => self.table_unchecked(src, progress),
         }
     }
@@ -1022,6 +1041,7 @@ impl BakeRequest {
         // be (the whole path: calibrated, built whole), or gets the check's calibrated table;
         // one the preset serves gets the table the check baked.
         let mut checked = None;
+        let mut missed = None;
         if !matches!(target, BakeTarget::Merl(_)) {
             match self.preset_misses(src.as_ref(), progress)? {
                 Checked::Instead(Fallback::Adaptive, why) => {
@@ -1039,6 +1059,7 @@ impl BakeRequest {
                 Checked::Kept(kept) => {
                     checked = self.reuse_checked(src.as_ref(), *kept, progress, t0)?;
                 }
+                Checked::Missed(why) => missed = Some(why),
                 Checked::Unchecked => {}
             }
         }
@@ -1087,6 +1108,9 @@ impl BakeRequest {
                 None,
             ),
         };
+        if let Some(why) = missed {
+            report.symmetry_note = Some(with_note(why, report.symmetry_note.take()));
+        }
         report.name = name.clone();
         report.output = match target {
             BakeTarget::Db { path, .. } => format!("{path}#{name}"),
@@ -1529,5 +1553,34 @@ mod tests {
         forced.force = true;
         let r = forced.run(&BakeTarget::file(&out)).unwrap();
         assert!(r.forced.is_some());
+    }
+
+    #[test]
+    fn a_model_asked_to_store_f_r_cos_out_bakes_on_the_default_grid() {
+        // f_r cos θo cannot fold by reciprocity: the plan drops the fold (and calibrates the
+        // table), and the preset's check must not bake a reciprocal grid of it first (it
+        // failed with "a grid storing it cannot fold by reciprocity").
+        let req =
+            BakeRequest::new(r#"{"model": "lambert", "kd": 0.25}"#).quantity(Quantity::FrCosOut);
+        let (table, _) = req.table(&Silent).unwrap();
+        assert_eq!(table.grid().quantity(), Quantity::FrCosOut);
+        assert!(!table.grid().symmetry().reciprocal);
+    }
+
+    #[test]
+    fn a_default_bake_that_keeps_a_preset_missing_the_albedo_says_so() {
+        // GGX α = 3e-4: the medium preset's table is 52 % bright in albedo at 89°, and neither
+        // other candidate is taken (the adaptive table's and the calibrated preset's errors over
+        // random pairs are larger). The preset stays, but not without a word.
+        let spec = r#"{"model": "ggx", "alpha": 3e-4}"#;
+        let d = tmp("missed");
+        let req = BakeRequest::new(spec);
+        let (_, r) = req.table(&Silent).unwrap();
+        let note = r.symmetry_note.unwrap_or_default();
+        assert!(note.contains("missed the albedo"), "{note:?}");
+        let out = d.join("g.btdb").to_str().unwrap().to_owned();
+        let r = req.run(&BakeTarget::file(&out)).unwrap();
+        let note = r.symmetry_note.unwrap_or_default();
+        assert!(note.contains("missed the albedo"), "{note:?}");
     }
 }

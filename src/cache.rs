@@ -81,8 +81,9 @@ pub fn key(source: &str, settings: &BakeSettings) -> Result<String> {
         h.update(b);
     };
     // The tag names what a bake of given settings makes: it changes with that, so tables of
-    // an older rule are not served (2: adaptive tables of models calibrated, session 20).
-    part(b"brdftab bake cache 2");
+    // an older rule are not served (2: adaptive tables of models calibrated, session 20;
+    // 3: a model's default bake checks the medium preset's albedo, session 23).
+    part(b"brdftab bake cache 3");
     part(env!("CARGO_PKG_VERSION").as_bytes());
     let kind = source::classify(source);
     part(kind.name().as_bytes());
@@ -239,5 +240,16 @@ mod tests {
         let e = bake_cached(SPEC, &bad, Some(&d.path().join("sub")), false).unwrap_err();
         assert!(e.to_string().contains("preset"), "{e}");
         assert!(!d.path().join("sub").exists());
+    }
+
+    #[test]
+    fn tables_of_an_older_bake_rule_are_not_served() {
+        // Default bakes of models check the medium preset's albedo since session 23 (GGX
+        // α ≤ 0.02: the adaptive table of a 0.2 % target; Ward, the max-Phong, anisotropic GGX:
+        // the medium table calibrated). The plain medium table a cache of rule 2 holds for
+        // these settings must not be served: this was rule 2's key of Ward's default bake.
+        let ward = r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}"#;
+        let k = key(ward, &BakeSettings::default()).unwrap();
+        assert_ne!(k, "b7e31b3ad748f3bc4df40253ddd174f4");
     }
 }
