@@ -64,6 +64,12 @@ pub fn slice(a: SliceArgs) -> Result<()> {
                 })?,
         ),
     };
+    // An angle that is not a number drew an all-black image.
+    for (flag, x) in [("--phi-in", a.phi_in), ("--phi-d", a.phi_d)] {
+        if !x.is_finite() {
+            return Err(Error::arg(flag, format!("{x} is not an angle")));
+        }
+    }
     let img = match a.kind {
         SliceKind::Halfdiff => slice::halfdiff(&*brdf, a.size, a.phi_d.to_radians()),
         SliceKind::Polar => {

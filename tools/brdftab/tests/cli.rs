@@ -160,6 +160,13 @@ fn a_polar_slice_is_for_light_above_the_horizon() {
     ];
     let o = brdftab(&[&args[..], &["--theta-in", "89.9"]].concat());
     assert_eq!(o.code, 0, "{}", o.stderr);
+    // An azimuth that is not a number drew an all-black image with exit 0.
+    for (kind, flag) in [("polar", "--phi-in"), ("halfdiff", "--phi-d")] {
+        let args = ["slice", LAMBERT, "-o", png, "--kind", kind, "--size", "8"];
+        let bad = format!("{flag}=nan");
+        let o = brdftab(&[&args[..], &[bad.as_str()]].concat());
+        assert_error(&o, flag);
+    }
 }
 
 #[test]
