@@ -181,12 +181,17 @@ pub fn file_text(v: &Value) -> String {
         str_of(v, "file"),
         tables.len()
     );
-    let _ = writeln!(
-        o,
-        "bytes:   {} ({:.1}x smaller than f32)",
-        v["bytes"],
-        v["ratio_to_f32"].as_f64().unwrap_or(0.0)
-    );
+    if tables.is_empty() {
+        // No values to compare with (it read "0.0x smaller than f32").
+        let _ = writeln!(o, "bytes:   {} (no tables)", v["bytes"]);
+    } else {
+        let _ = writeln!(
+            o,
+            "bytes:   {} ({:.1}x smaller than f32)",
+            v["bytes"],
+            v["ratio_to_f32"].as_f64().unwrap_or(0.0)
+        );
+    }
     for t in &tables {
         let _ = writeln!(o, "table `{}`:", str_of(t, "name"));
         let _ = writeln!(o, "  source:   {}", t["source"]);

@@ -214,3 +214,25 @@ fn files_with_a_hash_in_their_names_open_as_files() {
         r.stderr
     );
 }
+
+#[test]
+fn info_of_an_empty_database_says_it_holds_no_tables() {
+    // It printed "0.0x smaller than f32": a ratio of no values.
+    let d = TempDir::new("cli-store-empty");
+    let db = d.file("empty.btdb");
+    let lambert = r#"{"model": "lambert", "kd": 0.5}"#;
+    let r = brdftab(&[
+        "db", "add", &db, lambert, "--name", "x", "--preset", "small",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let r = brdftab(&["db", "rm", &db, "x"]);
+    assert!(r.ok, "{}", r.stderr);
+    let r = brdftab(&["info", &db]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(
+        r.stdout.contains("0 tables") && r.stdout.contains("(no tables)"),
+        "{}",
+        r.stdout
+    );
+    assert!(!r.stdout.contains("smaller than f32"), "{}", r.stdout);
+}
