@@ -4,7 +4,8 @@ with their sources (issue 15).
 Metric: relative RMSE of f_r weighted by cos θi cos θo over random pairs with both directions
 within 80° of the normal, i.e. sqrt(Σ((m − f cos θo) cos θi)² / Σ(f cos θo cos θi)²) where m is
 Mitsuba's `eval` (f_r·cos θo, si.wi = brdftab's wi = the tensor's incident axis) and f is
-`brdftab eval SOURCE`. Bars: 2% for models and a MERL file, 1% for re-encoded RGL files.
+`brdftab eval SOURCE`. Bars: 2% for models and a MERL file; a re-encoded RGL file must evaluate
+in Mitsuba as its original does.
 
 Needs `mitsuba` and `numpy` (pip) and a built CLI: target/release/brdftab, or $BRDFTAB_BIN.
 """
@@ -165,11 +166,19 @@ def test_merl_written_from_a_model(tmp_path):
 
 @pytest.mark.parametrize("name", sorted(p.name for p in rgl_dir().glob("*.bsdf")))
 def test_rgl_reencoded(tmp_path, name):
+    """A re-encoded file is its original's table, so Mitsuba evaluates it as it evaluates the
+    original. (Against `brdftab eval` of the original the bar would not hold for every file:
+    Mitsuba's `measured` does not clip the interpolated values at 0 as brdftab's and the
+    reference reader do, and cg_sunflower and vch_golden_yellow hold negative values, so
+    Mitsuba on those *original* files differs from the readers by 1.9 % and 2.2 %.)"""
     src = rgl_dir() / name
     path = convert(str(src), tmp_path / name)
-    e = error(path, str(src))
-    print(f"{name}: Mitsuba (re-encoded) vs source {e:.4%}")
-    assert e < 0.01
+    wi, wo = pairs(PAIRS, 1)
+    re, orig = mitsuba_eval(path, wi, wo), mitsuba_eval(src, wi, wo)
+    w = wi[:, 2][:, None]
+    e = math.sqrt(np.sum(((re - orig) * w) ** 2) / np.sum((orig * w) ** 2))
+    print(f"{name}: Mitsuba, re-encoded vs original {e:.4%}")
+    assert e < 1e-6
 
 
 def test_mitsuba_agrees_with_brdftab_on_a_shipped_file():
