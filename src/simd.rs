@@ -6,8 +6,30 @@
 //! its three axes (θh, θd, φd) and on three colour channels; on one register that is a third
 //! of the instructions and one latency chain instead of three.
 
-/// 2^112: an f16's exponent bias (15) moved to an f32's (127).
-const F16_BIAS: f32 = 5.192_297e33;
+/// An f16's exponent bias (15) moved to an f32's (127), in an f32's exponent field.
+const REBIAS: u32 = 112 << 23;
+
+/// 2^-14, the smallest normal f16.
+const SUBNORMAL_MAGIC: f32 = 6.103_515_6e-5;
+
+/// A finite f16 (bits) as f32, exactly, with integer operations and one subtraction of normal
+/// numbers — so that a host thread that flushes subnormal inputs to zero (x86's DAZ, Arm's
+/// FZ: renderers set them for speed) still reads an f16 subnormal as its value. (The plain
+/// way, the magnitude bits as an f32 times 2^112, hands the multiplier an f32 subnormal for
+/// every f16 subnormal, and those read 0 under such a mode.) Normal f16s: the exponent
+/// rebiased in the bits. Subnormals and ±0 (exponent bits 0): the mantissa m as the bits of
+/// 2^-14 (1 + m 2^-10) minus 2^-14, which is m 2^-24 exactly.
+/// (The x86-64 lanes do the same in SSE2; this scalar form serves other targets and the tests.)
+#[cfg(any(test, not(target_arch = "x86_64")))]
+#[inline(always)]
+pub fn f16_bits_to_f32(h: u16) -> f32 {
+    let x = h as u32;
+    let mag = x & 0x7fff;
+    let sub = mag & 0x7c00 == 0;
+    let bits = (mag << 13) + REBIAS + if sub { 1 << 23 } else { 0 };
+    let v = f32::from_bits(bits) - if sub { SUBNORMAL_MAGIC } else { 0.0 };
+    f32::from_bits(v.to_bits() | ((x & 0x8000) << 16))
+}
 
 /// Four f32 lanes (see the module docs).
 #[derive(Clone, Copy, Debug)]
@@ -46,12 +68,9 @@ impl F4 {
         }
     }
     /// The first four f16 values of `v` (bits), which must each be finite — ±0, normal or
-    /// subnormal (as [`crate::table::kernel::Packed`] stores them) — in SSE2 integer operations:
-    /// the magnitude bits shifted into an f32's exponent and mantissa, times 2^112 (the exponent
-    /// bias difference; a subnormal's bits are then an f32 subnormal, which the product makes
-    /// the normal value), the sign bit moved to the f32's; exact for those values (unless the
-    /// thread treats subnormal inputs as zero, then those read 0). `None` if `v` holds fewer
-    /// than four.
+    /// subnormal (as [`crate::table::kernel::Packed`] stores them) — in SSE2 operations
+    /// ([`f16_bits_to_f32`] four at a time); exact for those values, whatever the thread's
+    /// denormal modes. `None` if `v` holds fewer than four.
     #[inline(always)]
     pub fn from_f16_normal(v: &[u16]) -> Option<F4> {
         use std::arch::x86_64::*;
@@ -62,9 +81,19 @@ impl F4 {
         unsafe {
             let h = _mm_loadl_epi64(v.as_ptr() as *const __m128i);
             let x = _mm_unpacklo_epi16(h, _mm_setzero_si128());
-            let mag = _mm_slli_epi32::<13>(_mm_and_si128(x, _mm_set1_epi32(0x7fff)));
+            let mag = _mm_and_si128(x, _mm_set1_epi32(0x7fff));
             let sign = _mm_slli_epi32::<16>(_mm_and_si128(x, _mm_set1_epi32(0x8000)));
-            let m = _mm_mul_ps(_mm_castsi128_ps(mag), _mm_set1_ps(F16_BIAS));
+            // All ones in the lanes of ±0 and subnormals (exponent bits 0).
+            let sub = _mm_cmpeq_epi32(
+                _mm_and_si128(mag, _mm_set1_epi32(0x7c00)),
+                _mm_setzero_si128(),
+            );
+            let bits = _mm_add_epi32(
+                _mm_add_epi32(_mm_slli_epi32::<13>(mag), _mm_set1_epi32(REBIAS as i32)),
+                _mm_and_si128(sub, _mm_set1_epi32(1 << 23)),
+            );
+            let magic = _mm_and_si128(sub, _mm_set1_epi32(SUBNORMAL_MAGIC.to_bits() as i32));
+            let m = _mm_sub_ps(_mm_castsi128_ps(bits), _mm_castsi128_ps(magic));
             Some(F4(_mm_or_ps(m, _mm_castsi128_ps(sign))))
         }
     }
@@ -221,11 +250,7 @@ impl F4 {
         if v.len() < 4 {
             return None;
         }
-        Some(F4(std::array::from_fn(|k| {
-            let x = v[k] as u32;
-            let m = f32::from_bits((x & 0x7fff) << 13) * F16_BIAS;
-            f32::from_bits(m.to_bits() | ((x & 0x8000) << 16))
-        })))
+        Some(F4(std::array::from_fn(|k| f16_bits_to_f32(v[k]))))
     }
     /// Every lane x.
     #[inline(always)]
@@ -377,9 +402,68 @@ mod tests {
         );
     }
 
+    /// Renderers set x86's DAZ and FTZ for speed (Embree asks for it, Cycles does): every f16
+    /// subnormal code must still read its value, on the SSE2 path as on F16C.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn f16_lanes_are_exact_when_the_thread_flushes_subnormals() {
+        let bits: Vec<u16> = (0..0x7c00).chain(0x8000..0xfc00).collect();
+        let want: Vec<f32> = bits
+            .iter()
+            .map(|&b| half::f16::from_bits(b).to_f32())
+            .collect();
+        let read_csr = || {
+            let mut v = 0u32;
+            // SAFETY: stmxcsr stores the 4-byte MXCSR at the address of `v`.
+            unsafe { std::arch::asm!("stmxcsr [{}]", in(reg) &mut v) };
+            v
+        };
+        let write_csr = |v: u32| {
+            // SAFETY: ldmxcsr loads MXCSR from `v`; only the DAZ/FTZ bits differ from the
+            // thread's own value, and the test restores it.
+            unsafe { std::arch::asm!("ldmxcsr [{}]", in(reg) &v) };
+        };
+        let old = read_csr();
+        write_csr(old | 0x8040); // FTZ | DAZ
+        // The mode is on: a subnormal input reads 0.
+        let flushed = std::hint::black_box(f32::from_bits(1)) * 2.0 == 0.0;
+        let mut got = Vec::with_capacity(bits.len());
+        let mut one = Vec::with_capacity(bits.len());
+        for q in bits.chunks(4).filter(|q| q.len() == 4) {
+            got.extend(
+                F4::from_f16_normal(std::hint::black_box(q))
+                    .unwrap()
+                    .to_array(),
+            );
+        }
+        for &b in &bits {
+            one.push(f16_bits_to_f32(std::hint::black_box(b)));
+        }
+        write_csr(old);
+        assert!(flushed, "DAZ did not take effect");
+        let n = got.len();
+        for k in 0..n {
+            assert_eq!(
+                got[k].to_bits(),
+                want[k].to_bits(),
+                "lanes, code {:#06x}",
+                bits[k]
+            );
+        }
+        for k in 0..bits.len() {
+            assert_eq!(
+                one[k].to_bits(),
+                want[k].to_bits(),
+                "scalar, code {:#06x}",
+                bits[k]
+            );
+        }
+    }
+
     #[test]
     fn f16_lanes_are_exact_on_every_finite_f16() {
-        assert_eq!(F16_BIAS, 2f32.powi(112));
+        assert_eq!(SUBNORMAL_MAGIC, 2f32.powi(-14));
+        assert_eq!(f32::from_bits(REBIAS + (127 << 23)), 2f32.powi(112));
         // Every finite f16 — zero, subnormals, normals, both signs — four at a time against the
         // half crate.
         let bits: Vec<u16> = (0..0x7c00).chain(0x8000..0xfc00).collect();

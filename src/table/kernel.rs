@@ -63,8 +63,8 @@ pub use x8::LANES;
 /// the tails of sharp lobes: an adaptive table of GGX α = 0.02 holds 3.7e6 at its grazing mirror
 /// nodes, so values below 0.014 vanished, and lookups near such nodes jumped between 0.0063 and
 /// 0.0108 — the model's 0.0098 — as values moved within their rounding.) Every code expands
-/// exactly with `F4::from_f16_normal` (its product by 2^112 turns a subnormal's f32 bits into
-/// the value; with flush-to-zero of subnormal inputs set in the host, such codes read 0) or F16C.
+/// exactly with `F4::from_f16_normal` or F16C, also in a host thread that flushes subnormal
+/// inputs to zero (`simd::f16_bits_to_f32`).
 /// Negative values are kept: a table of a [`Quantity`] other than f_r extrapolates its nodes beyond the
 /// horizon below 0 (`table::horizon`); an f_r table's negative values (unmeasured cells) are
 /// set aside by [`super::TabulatedBrdf`] before they reach here.
