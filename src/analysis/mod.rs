@@ -4,6 +4,7 @@ pub mod accuracy;
 pub mod albedo;
 pub mod chi2;
 pub mod fidelity;
+pub mod mirror_pairs;
 pub mod pair_rule;
 pub mod plausibility;
 pub mod timing;
