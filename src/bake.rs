@@ -23,7 +23,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use crate::analysis::accuracy::{Region, Weight};
+use crate::analysis::accuracy::{Region, Weight, compare_region};
 use crate::analysis::fidelity::AlbedoError;
 use crate::brdf::Brdf;
 use crate::codec::{Codec, Quant};
@@ -641,8 +641,8 @@ impl BakeRequest {
         };
         let albedo = |t: &dyn Brdf| crate::analysis::fidelity::albedo_error(t, src, &fid);
         // Over random pairs, the same pairs for every table (half near the mirror direction,
-        // weighted back to uniform: uniform pairs alone made a sharp lobe's figure depend on
-        // whether one landed on its peak): f_r cos θi, but f_r cos θi cos θo
+        // weighted back to uniform, `compare_region`: uniform pairs alone made a sharp lobe's
+        // figure depend on whether one landed on its peak): f_r cos θi, but f_r cos θi cos θo
         // for a table that stores it (Ward's f_r ∝ 1/√(cos θi cos θo): f_r cos θi has no finite
         // RMS, and the pairs nearest the horizon would decide).
         let weight = if quantity == Quantity::FrCosCos {
@@ -652,7 +652,7 @@ impl BakeRequest {
         };
         let rmse = |t: &dyn Brdf| {
             let whole = Region::Cap(std::f64::consts::FRAC_PI_2);
-            crate::analysis::mirror_pairs::rel_rmse(t, src, PRESET_CHECK_PAIRS, 1, whole, weight)
+            compare_region(t, src, PRESET_CHECK_PAIRS, 1, whole, weight).map(|a| a.rel_rmse)
         };
         let plain = TabulatedBrdf::from_table(preset.clone());
         let e = albedo(&plain)?;

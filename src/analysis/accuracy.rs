@@ -1,7 +1,9 @@
 //! Accuracy of one BRDF against another (a table against its source, a fit against data).
 //!
-//! Over N direction pairs drawn uniformly on the hemisphere (independently for wi and wo,
-//! deterministic seed):
+//! Over direction pairs uniform on the hemisphere (independently for wi and wo), estimated from
+//! N pairs of a deterministic seed — half of them drawn near the mirror direction and weighted
+//! back to uniform ([`MirrorMixture`]), so that a near-mirror peak does not decide the figure by
+//! whether a pair landed on it:
 //!
 //! - cosine-weighted relative RMSE: sqrt(Σ((f̂ − f) cos θi)² / Σ(f cos θi)²), summed over pairs
 //!   and channels;
@@ -17,9 +19,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::analysis::mirror_pairs::MirrorMixture;
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
-use crate::geometry;
 use crate::rng::Pcg32;
 use crate::spectrum::MAX_CHANNELS;
 
@@ -107,7 +109,8 @@ pub fn compare_weighted(
     )
 }
 
-/// Where [`compare_region`] draws its pairs (uniformly over the region's solid angle).
+/// Where [`compare_region`] draws its pairs (its figures are those of pairs uniform over the
+/// region's solid angle).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Region {
@@ -149,30 +152,7 @@ pub fn compare_region(
     region: Region,
     weight: Weight,
 ) -> Result<Accuracy> {
-    region.check()?;
-    let max_theta = match region {
-        Region::Cap(t) => t,
-        Region::Band(_) => std::f64::consts::FRAC_PI_2,
-    };
-    // Uniform on the cap: z uniform in [cos θmax, 1].
-    let span = 1.0 - max_theta.cos();
-    // (For θmax = π/2, span rounds to exactly 1 and z = u.x, the same pairs as before.)
-    let cap = |u: glam::DVec2| {
-        geometry::uniform_hemisphere(glam::DVec2::new((1.0 - span) + span * u.x, u.y))
-    };
-    // The band: pairs of the hemisphere drawn until one direction lies below cos θmin (a third
-    // of all pairs for 80°, so the rejection costs little).
-    let band_z = match region {
-        Region::Band(t) => t.cos(),
-        Region::Cap(_) => f64::INFINITY,
-    };
-    let draw = |rng: &mut Pcg32| loop {
-        let wi = cap(rng.next_dvec2());
-        let wo = cap(rng.next_dvec2());
-        if wi.z.min(wo.z) < band_z {
-            return (wi, wo);
-        }
-    };
+    let mixture = MirrorMixture::new(region)?;
     let c = reference.channels().len();
     if approx.channels().len() != c || c > MAX_CHANNELS {
         return Err(Error::arg(
@@ -191,8 +171,14 @@ pub fn compare_region(
         ));
     }
     let blocks = pairs.div_ceil(BLOCK);
-    // Per block: (Σ err² per channel, Σ ref² per channel, Σ f² unweighted, samples (|err|, |f|, wi, wo)).
-    type Block = (Vec<f64>, Vec<f64>, f64, Vec<(f64, f64, DVec3, DVec3)>);
+    // Per block: (Σ w err² per channel, Σ w ref² per channel, Σ w f² and Σ w without the
+    // cosines, samples (|err|, |f|, wi, wo)).
+    type Block = (
+        Vec<f64>,
+        Vec<f64>,
+        (f64, f64),
+        Vec<(f64, f64, DVec3, DVec3)>,
+    );
     let parts: Vec<Block> = crate::par::install(|| {
         (0..blocks)
             .into_par_iter()
@@ -201,12 +187,12 @@ pub fn compare_region(
                 let n = BLOCK.min(pairs - b * BLOCK);
                 let mut e2 = vec![0.0; c];
                 let mut r2 = vec![0.0; c];
-                let mut f2 = 0.0;
+                let mut f2 = (0.0, 0.0);
                 let mut worst = Vec::with_capacity(n * c);
                 let mut fa = [0.0f32; MAX_CHANNELS];
                 let mut fr = [0.0f32; MAX_CHANNELS];
                 for _ in 0..n {
-                    let (wi, wo) = draw(&mut rng);
+                    let (wi, wo, wt) = mixture.draw(&mut rng);
                     approx.eval(wi, wo, &mut fa[..c]);
                     reference.eval(wi, wo, &mut fr[..c]);
                     let w = match weight {
@@ -216,9 +202,10 @@ pub fn compare_region(
                     for k in 0..c {
                         let (a, r) = (fa[k] as f64, fr[k] as f64);
                         let err = a - r;
-                        e2[k] += (err * w).powi(2);
-                        r2[k] += (r * w).powi(2);
-                        f2 += r * r;
+                        e2[k] += wt * (err * w).powi(2);
+                        r2[k] += wt * (r * w).powi(2);
+                        f2.0 += wt * r * r;
+                        f2.1 += wt;
                         worst.push((err.abs(), r.abs(), wi, wo));
                     }
                 }
@@ -231,15 +218,17 @@ pub fn compare_region(
     reference.health()?;
     let mut e2 = vec![0.0; c];
     let mut r2 = vec![0.0; c];
-    let mut f2 = 0.0;
+    let mut f2 = (0.0, 0.0);
     for p in &parts {
         for k in 0..c {
             e2[k] += p.0[k];
             r2[k] += p.1[k];
         }
-        f2 += p.2;
+        f2.0 += p.2.0;
+        f2.1 += p.2.1;
     }
-    let floor = 0.01 * (f2 / (pairs * c).max(1) as f64).sqrt();
+    // 1 % of the RMS of f over the region's uniform pairs.
+    let floor = 0.01 * (f2.0 / f2.1.max(f64::MIN_POSITIVE)).sqrt();
     let mut max_rel = 0.0;
     let mut at = (DVec3::ZERO, DVec3::ZERO);
     for p in &parts {

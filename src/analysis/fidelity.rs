@@ -16,7 +16,7 @@
 //!
 //! The three relative RMSEs are those of pairs uniform in solid angle, estimated from pairs half
 //! of which are drawn near the mirror direction and weighted back to uniform
-//! ([`mirror_pairs`]): with uniform pairs alone a near-mirror peak made the figure a lottery
+//! ([`compare_region`]): with uniform pairs alone a near-mirror peak made the figure a lottery
 //! (`cg_sunflower`'s grazing band 1.5–5.0 % over five seeds of 100 000 pairs; now 1.75–1.94 %).
 //!
 //! The albedo quadrature is a fixed product rule in polar coordinates about the mirror direction
@@ -28,8 +28,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::analysis::accuracy::{Region, Weight};
-use crate::analysis::mirror_pairs;
+use crate::analysis::accuracy::{Region, Weight, compare_region};
 use crate::analysis::pair_rule::{PairRule, PairRuleOptions, RuleError, mirror_rule};
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
@@ -180,7 +179,7 @@ impl<'a> FidelityReference<'a> {
         let cap = opts.cap_deg.to_radians();
         let w = Weight::CosInCosOut;
         let rmse = |r: Region| -> Result<f64> {
-            mirror_pairs::rel_rmse(approx, self.reference, opts.pairs, opts.seed, r, w)
+            Ok(compare_region(approx, self.reference, opts.pairs, opts.seed, r, w)?.rel_rmse)
         };
         let in_cap = rmse(Region::Cap(cap))?;
         let whole = rmse(Region::Cap(std::f64::consts::FRAC_PI_2))?;
