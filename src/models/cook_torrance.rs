@@ -219,7 +219,7 @@ impl Brdf for CookTorrance {
     /// tests hold them equal).
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let v = geometry::unit(wo)?;
-        if v.z <= 0.0 || !u.is_finite() {
+        if v.z <= 0.0 || !geometry::in_unit_square(u) {
             return None;
         }
         let c = self.ks.len();

@@ -246,7 +246,7 @@ impl Brdf for Phong {
     /// at least half of it where something does.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 {
+        if wo.z <= 0.0 || !geometry::in_unit_square(u) {
             return None;
         }
         // cos ψ = u₀^{1/(n+1)} has density (n + 1) cos^n ψ on [0, 1]. At u₀ = 0 the draw is
