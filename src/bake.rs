@@ -1120,12 +1120,11 @@ impl BakeRequest {
             report.info = crate::store::info::table_info(target.path(), &name)?;
         }
         if self.accuracy_pairs > 0 {
+            // The written table by its path and name: a `DB#NAME` string would be looked up
+            // whole first, and a file of that name beside the output read instead.
             let tab = match table {
                 Some(t) => TabulatedBrdf::from_table(t),
-                None => source::open_table(
-                    &format!("{}#{name}", target.path()),
-                    &OpenOptions::default(),
-                )?,
+                None => crate::store::tables::open_brdf_at(target.path(), Some(&name), false)?,
             }
             .with_interp(self.accuracy_interp);
             report.accuracy = Some(Accuracy::measure(&tab, src.as_ref(), self.accuracy_pairs)?);
@@ -1534,6 +1533,34 @@ mod tests {
         assert_eq!(acc.pairs, 2000);
         // log16 ≤ 1e-3 relative on a constant: the error is the codec's bound at most.
         assert!(acc.max_rel <= 1e-3, "{acc:?}");
+    }
+
+    /// The accuracy report reads the table it wrote by the output's path and the table's name,
+    /// never through a `DB#NAME` string: such a string is looked up whole first (a file named
+    /// `l.btdb#l` is read as itself, `store::name`), so a file of that name beside the output —
+    /// here a table of kd = 0.9 — was what the report measured (relative error 2).
+    #[test]
+    fn the_accuracy_report_reads_the_written_table_by_its_path() {
+        let d = tmp("hash");
+        let path = |f: &str| d.join(f).to_str().unwrap().to_owned();
+        let decoy = path("decoy.btdb");
+        let other = BakeRequest::new(r#"{"model":"lambert","kd":0.9}"#).preset(Preset::Small);
+        other.run(&BakeTarget::file(&decoy)).unwrap();
+        let req = BakeRequest::new(r#"{"model":"lambert","kd":0.3}"#)
+            .preset(Preset::Small)
+            .accuracy(2000);
+        for (target, beside) in [
+            (BakeTarget::file(path("l.btdb")), "l.btdb#l"),
+            // A `#` in the output file's own name (table `x`).
+            (BakeTarget::file(path("x.btdb#x")), "x.btdb#x#x"),
+            (BakeTarget::db(path("db.btdb"), "m"), "db.btdb#m"),
+        ] {
+            std::fs::copy(&decoy, path(beside)).unwrap();
+            let r = req.run(&target).unwrap();
+            let acc = r.accuracy.unwrap();
+            // log16 ≤ 1e-3 relative on a constant, as above.
+            assert!(acc.max_rel <= 1e-3, "{target:?}: {acc:?}");
+        }
     }
 
     #[test]
