@@ -1014,6 +1014,7 @@ impl BakeRequest {
             accuracy: None,
             info: serde_json::Value::Null,
             target: None,
+            written: None,
         }
     }
 
@@ -1074,6 +1075,7 @@ impl BakeRequest {
                 self.report_for(src.as_ref(), &Grid::merl(Channels::Rgb), None, t0, true);
             report.name = stem(path);
             report.output = path.clone();
+            report.written = Some(target.clone());
             return Ok(report);
         }
         let provenance = source::provenance(&self.source, src.as_ref())?;
@@ -1118,16 +1120,16 @@ impl BakeRequest {
             BakeTarget::Db { path, .. } => format!("{path}#{name}"),
             t => t.path().to_owned(),
         };
+        report.written = Some(target.clone());
         if matches!(target, BakeTarget::File(_) | BakeTarget::Db { .. }) {
             report.info = crate::store::info::table_info(target.path(), &name)?;
         }
         if self.accuracy_pairs > 0 {
+            // The written table by its path and name: a `DB#NAME` string would be looked up
+            // whole first, and a file of that name beside the output read instead.
             let tab = match table {
                 Some(t) => TabulatedBrdf::from_table(t),
-                None => source::open_table(
-                    &format!("{}#{name}", target.path()),
-                    &OpenOptions::default(),
-                )?,
+                None => crate::store::tables::open_brdf_at(target.path(), Some(&name), false)?,
             }
             .with_interp(self.accuracy_interp);
             report.accuracy = Some(Accuracy::measure(&tab, src.as_ref(), self.accuracy_pairs)?);
@@ -1277,9 +1279,27 @@ pub struct BakeReport {
     pub info: serde_json::Value,
     /// The error-target search that chose the grid, if the request had a target.
     pub target: Option<TargetSearch>,
+    /// Where it was written (`None` for a table built in memory, [`BakeRequest::table`]): the
+    /// file's path as a path, which `output`, the display string, is not for a database entry
+    /// (`DB#NAME`).
+    pub written: Option<BakeTarget>,
 }
 
 impl BakeReport {
+    /// What `brdftab info --json` reports of the written brdftab file — every table of a
+    /// single-table file, the entry of a database — read from the path written (`Null` for a
+    /// raw or MERL file, or nothing written). Not `info::file_info(&output)`: a `DB#NAME` string
+    /// is looked up whole first, and a file named `db.btdb#m` beside the database would be read.
+    pub fn output_info(&self) -> Result<serde_json::Value> {
+        match &self.written {
+            Some(BakeTarget::File(path)) => crate::store::info::file_info_at(path, None),
+            Some(BakeTarget::Db { path, name, .. }) => {
+                crate::store::info::file_info_at(path, Some(name))
+            }
+            _ => Ok(serde_json::Value::Null),
+        }
+    }
+
     /// The grid line of a report: the grid's summary, and whether a MERL file's cells were kept.
     pub fn grid_line(&self) -> String {
         let cells = if self.merl_cells {
@@ -1536,6 +1556,59 @@ mod tests {
         assert_eq!(acc.pairs, 2000);
         // log16 ≤ 1e-3 relative on a constant: the error is the codec's bound at most.
         assert!(acc.max_rel <= 1e-3, "{acc:?}");
+    }
+
+    /// The accuracy report reads the table it wrote by the output's path and the table's name,
+    /// never through a `DB#NAME` string: such a string is looked up whole first (a file named
+    /// `l.btdb#l` is read as itself, `store::name`), so a file of that name beside the output —
+    /// here a table of kd = 0.9 — was what the report measured (relative error 2).
+    #[test]
+    fn the_accuracy_report_reads_the_written_table_by_its_path() {
+        let d = tmp("hash");
+        let path = |f: &str| d.join(f).to_str().unwrap().to_owned();
+        let decoy = path("decoy.btdb");
+        let other = BakeRequest::new(r#"{"model":"lambert","kd":0.9}"#).preset(Preset::Small);
+        other.run(&BakeTarget::file(&decoy)).unwrap();
+        let req = BakeRequest::new(r#"{"model":"lambert","kd":0.3}"#)
+            .preset(Preset::Small)
+            .accuracy(2000);
+        for (target, beside) in [
+            (BakeTarget::file(path("l.btdb")), "l.btdb#l"),
+            // A `#` in the output file's own name (table `x`).
+            (BakeTarget::file(path("x.btdb#x")), "x.btdb#x#x"),
+            (BakeTarget::db(path("db.btdb"), "m"), "db.btdb#m"),
+        ] {
+            std::fs::copy(&decoy, path(beside)).unwrap();
+            let r = req.run(&target).unwrap();
+            let acc = r.accuracy.unwrap();
+            // log16 ≤ 1e-3 relative on a constant, as above.
+            assert!(acc.max_rel <= 1e-3, "{target:?}: {acc:?}");
+        }
+    }
+
+    /// The report's file info (what Python's `bake` and `convert` return) is read from the path
+    /// written: a file named `db.btdb#m` beside the database is what the string `db.btdb#m`
+    /// names as a SOURCE (`info` of it reads that file), not the entry the bake wrote.
+    #[test]
+    fn the_reports_file_info_is_of_the_path_written() {
+        let d = tmp("info");
+        let path = |f: &str| d.join(f).to_str().unwrap().to_owned();
+        let req = BakeRequest::new(r#"{"model":"lambert","kd":0.3}"#).preset(Preset::Small);
+        req.run(&BakeTarget::file(path("decoy.btdb"))).unwrap();
+        std::fs::copy(path("decoy.btdb"), path("db.btdb#m")).unwrap();
+        let r = req.run(&BakeTarget::db(path("db.btdb"), "m")).unwrap();
+        assert_eq!(r.output, path("db.btdb#m"));
+        let as_source = crate::store::info::file_info(&r.output).unwrap();
+        assert_eq!(as_source["tables"][0]["name"], "decoy");
+        let info = r.output_info().unwrap();
+        assert_eq!(info["file"], path("db.btdb"));
+        assert_eq!(info["tables"][0]["name"], "m");
+        assert_eq!(info["tables"].as_array().map(Vec::len), Some(1));
+        // A single-table file: every table of it; a table built in memory: nothing.
+        let f = req.run(&BakeTarget::file(path("x.btdb#x"))).unwrap();
+        assert_eq!(f.output_info().unwrap()["file"], path("x.btdb#x"));
+        let (_, mem) = req.table(&Silent).unwrap();
+        assert!(mem.output_info().unwrap().is_null());
     }
 
     #[test]

@@ -51,7 +51,7 @@ pub struct SampleOut<'a> {
 /// was 20 % off).
 #[inline]
 pub fn drawable(wo: DVec3, u: DVec2) -> bool {
-    wo.is_finite() && (0.0..1.0).contains(&u.x) && (0.0..1.0).contains(&u.y)
+    wo.is_finite() && crate::geometry::in_unit_square(u)
 }
 
 /// The outputs of a pair without a sample: zeros.

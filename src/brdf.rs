@@ -246,15 +246,25 @@ pub trait Brdf: Send + Sync {
 
     /// Draws an incident direction `wi` for the outgoing direction `wo` from two uniform numbers
     /// `u` in [0,1)², writing the per-channel weight f_r·cos θi / pdf (for delta samples the
-    /// lobe's reflectance) into `weight`. Returns `None` when no direction can be drawn (e.g. `wo`
-    /// below the horizon, total internal reflection) and for a non-finite `u` (as
-    /// [`Brdf::sample_batch`] does, whether or not the sampler uses `u`) — the weight is then
-    /// unspecified.
+    /// lobe's reflectance) into `weight`.
+    ///
+    /// A `Some` is always a real draw: `wi` is a unit vector — above the horizon, or for a
+    /// refractor on the other side of the surface from `wo` — with a finite positive `pdf`,
+    /// the density [`Brdf::pdf`] gives for that pair up to rounding (delta samples: `pdf` 1 by
+    /// convention, [`Brdf::pdf`] 0), and finite weights ≥ 0.
+    ///
+    /// Returns `None` when no direction can be drawn (e.g. `wo` below the horizon or not finite,
+    /// total internal reflection) and for every `u` outside [0, 1)² — beyond an edge (1
+    /// included), infinite or NaN ([`geometry::in_unit_square`]) — whether or not the sampler
+    /// uses `u`, as [`Brdf::sample_batch`] does: samplers map only that square, and beyond it
+    /// their formulas give directions that are not unit or densities that are wrong. The weight
+    /// is then unspecified. Implementations check `u` first; the test kit's contract
+    /// (`testkit::check_contract`) holds every source to it.
     ///
     /// The default draws cosine-weighted directions; models override with importance sampling.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 || !u.is_finite() {
+        if wo.z <= 0.0 || !geometry::in_unit_square(u) {
             return None;
         }
         let wi = geometry::cosine_hemisphere(u);

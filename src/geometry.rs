@@ -48,6 +48,14 @@ pub fn is_upper(v: DVec3) -> bool {
     v.z > 0.0 && v.z < f64::INFINITY && v.x.is_finite() && v.y.is_finite()
 }
 
+/// True when `u` lies in [0, 1)², the square every sampler maps: false beyond its edges (1
+/// included), for an infinite or NaN coordinate. [`Brdf::sample`](crate::Brdf::sample) and
+/// [`Brdf::sample_batch`](crate::Brdf::sample_batch) draw nothing for any other `u`.
+#[inline]
+pub fn in_unit_square(u: DVec2) -> bool {
+    (0.0..1.0).contains(&u.x) && (0.0..1.0).contains(&u.y)
+}
+
 /// Normalizes a pair of directions and checks that both lie strictly above the horizon
 /// (z > 0). Returns `None` otherwise — the caller then returns 0 (see the `Brdf` conventions).
 #[inline]

@@ -155,7 +155,7 @@ impl Brdf for BlinnPhong {
 
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 {
+        if wo.z <= 0.0 || !geometry::in_unit_square(u) {
             return None;
         }
         let (h, pow_n) = self.sample_half_vector_pow(u);

@@ -46,6 +46,18 @@ use super::visible;
 /// of the drawn direction rather than from the drawn half vector (see `sample`).
 const GRAZING_VIEW: f64 = 1e-4;
 
+/// Above [`GRAZING_VIEW`], a visible-normal draw with V·H below this is refused. The draw
+/// reflects V to L = 2 (V·H) H − V, nearly −V, whose half vector with V,
+/// normalize(2 (V·H) H + rounding), is H only to ~ε / V·H: below 1e-6 `pdf` of the folded
+/// direction no longer finds the density the draw had (with D's steepest slope,
+/// d ln D / dα ≈ 600 at m = 0.01, 1e-10 rad is 6e-8 of it). Such draws lie at the rim of the
+/// visible facets, tan α tan θv cos φ′ = −1 (the edge u.y = 0 of a view with tan α tan θv > 1
+/// lands on it, V·H = 0 to rounding, and its density was 0.6–1.9× what `pdf` gives there).
+/// The azimuth's density vanishes linearly at that rim, so the refused share of the draws is
+/// ~MIN_VH² / (4π cos θv sin θv sin α): below 1e-9 from cos θv = 1e-4 on. (A grazing view's
+/// draws are weighed by `pdf` itself, see `sample`.)
+const MIN_VH: f64 = 1e-6;
+
 /// Cook-Torrance: k_s · D · G · F / (4 (N·V)(N·L)), normalized Beckmann D, V-cavity G, F at L·H.
 #[derive(Debug, Clone)]
 pub struct CookTorrance {
@@ -207,7 +219,7 @@ impl Brdf for CookTorrance {
     /// tests hold them equal).
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let v = geometry::unit(wo)?;
-        if v.z <= 0.0 || !u.is_finite() {
+        if v.z <= 0.0 || !geometry::in_unit_square(u) {
             return None;
         }
         let c = self.ks.len();
@@ -239,7 +251,7 @@ impl Brdf for CookTorrance {
         let d = one_minus * self.d.inv_pi_m2() * (inv_c2 * inv_c2);
         let h = visible::normal(cos_a, tan_a, v, u.y);
         let vh = v.dot(h);
-        if !(vh > 0.0) {
+        if !(vh > 0.0) || (vh < MIN_VH && v.z >= GRAZING_VIEW) {
             return None;
         }
         let p_drawn = d * cos_a / (2.0 * (vh + visible::partner_dot(v, h)));
@@ -451,6 +463,32 @@ mod tests {
                         (w[0] as f64 - want).abs() <= 1e-6 * want.max(1e-30),
                         "{w:?} {want}"
                     );
+                }
+            }
+        }
+    }
+
+    /// The edge u.y = 0 of a view with tan α tan θv > 1 draws the facet V just sees (V·H = 0 to
+    /// rounding), whose reflection's half vector is lost: no sample, rather than one whose
+    /// density `pdf` does not give (it was 0.6–1.9× of it). A draw that is kept agrees with `pdf`
+    /// to the contract's 1e-7 (both f64).
+    #[test]
+    fn the_rim_of_the_visible_facets_gives_no_sample_or_its_density() {
+        let ct =
+            CookTorrance::new(0.3, Value::Grey(0.8), &FresnelSpec::None, &Channels::Rgb).unwrap();
+        let mut w = [0.0f32; 3];
+        for deg in [50.0f64, 70.0, 80.0, 86.9, 89.0] {
+            for k in 0..16 {
+                let v = geometry::spherical(deg.to_radians(), 0.4 * k as f64);
+                for ux in (1..40).map(|j| j as f64 / 40.0) {
+                    if let Some(s) = ct.sample(v, DVec2::new(ux, 0.0), &mut w) {
+                        let p = ct.pdf(s.wi, v);
+                        assert!(
+                            (s.pdf - p).abs() <= 1e-7 * p,
+                            "{deg}° {k} u.x {ux}: {} vs {p}",
+                            s.pdf
+                        );
+                    }
                 }
             }
         }

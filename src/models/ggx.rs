@@ -339,7 +339,7 @@ impl Brdf for Ggx {
 
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 {
+        if wo.z <= 0.0 || !geometry::in_unit_square(u) {
             return None;
         }
         // The reflection about n = g/|g| needs only 1/|g|² (wi = 2 (wo·g)/|g|² g − wo, unit to

@@ -87,7 +87,7 @@ impl Brdf for Lambert {
     /// Cosine-weighted sampling, pdf cos θi / π: the weight f·cos θi / pdf = k_d π is constant.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         // Only the sign of cos θo matters, so `wo` is checked, not normalized.
-        if !(geometry::is_upper(wo) && u.is_finite()) {
+        if !(geometry::is_upper(wo) && geometry::in_unit_square(u)) {
             return None;
         }
         let wi = geometry::cosine_hemisphere(u);

@@ -104,7 +104,7 @@ impl Brdf for Mirror {
     /// The lecture's `ReflectDir`: L = 2 (N·V) N − V, weight k_r(N·V), pdf 1, delta.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 || !u.is_finite() {
+        if wo.z <= 0.0 || !geometry::in_unit_square(u) {
             return None;
         }
         let wi = geometry::reflect(wo, DVec3::Z);
@@ -233,7 +233,7 @@ impl Brdf for Refractor {
     /// The refraction direction of `wo`, weight k_t = 1 − F per channel, pdf 1, delta; `None` on
     /// total internal reflection.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        if !u.is_finite() {
+        if !geometry::in_unit_square(u) {
             return None;
         }
         let wi = self.refraction_dir(wo)?;

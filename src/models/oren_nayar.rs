@@ -115,7 +115,7 @@ impl Brdf for OrenNayar {
     /// trait's default strategy, with the factor taken directly from the (unit) directions.
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 || !u.is_finite() {
+        if wo.z <= 0.0 || !geometry::in_unit_square(u) {
             return None;
         }
         let wi = geometry::cosine_hemisphere(u);

@@ -588,7 +588,7 @@ impl Brdf for Sum {
     }
 
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        if !u.is_finite() {
+        if !geometry::in_unit_square(u) {
             return None;
         }
         if let ([a, b], 3) = (self.terms.as_slice(), self.channels.len()) {

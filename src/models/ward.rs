@@ -180,7 +180,7 @@ impl Brdf for Ward {
 
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 {
+        if wo.z <= 0.0 || !geometry::in_unit_square(u) {
             return None;
         }
         // Fused: the half vector in slope space, h′ = h / cos θh = (−α_x r cos φ, −α_y r sin φ, 1)

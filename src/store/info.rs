@@ -69,6 +69,12 @@ pub fn list(path: &str) -> Result<Vec<Value>> {
 /// What `info` reports of `FILE` (every table) or `DB#NAME` (that table).
 pub fn file_info(source: &str) -> Result<Value> {
     let (path, name) = db::split_source(source)?;
+    file_info_at(path, name)
+}
+
+/// [`file_info`] of the brdftab file at `path`, taken as a path (never split at a `#`): table
+/// `name`, or every table for `None`.
+pub fn file_info_at(path: &str, name: Option<&str>) -> Result<Value> {
     let s = Store::open(path)?;
     let names: Vec<String> = match name {
         Some(n) => vec![n.to_owned()],

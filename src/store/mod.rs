@@ -13,7 +13,8 @@
 //!   [`db`] builds add / replace / remove / verify on it.
 //! - [`tables`] connects the store to [`crate::table`]: headers from a `Grid`, saving a `Table`,
 //!   streaming `bake_chunks` into a [`Writer`] (`chunk_with` + [`tables::chunk_layout`]), and
-//!   [`tables::open_brdf`] (`FILE` or `DB#NAME`) giving a `TabulatedBrdf` whose
+//!   [`tables::open_brdf`] (`FILE` or `DB#NAME`; [`tables::open_brdf_at`] takes the path and
+//!   the name apart, for a writer reading back what it wrote) giving a `TabulatedBrdf` whose
 //!   `ChunkLoader` is the [`StoredTable`] (chunks decoded, checksum checked, on first touch; the
 //!   `TabulatedBrdf` keeps what it loaded, so the memory bound of [`StoreOptions::cache_bytes`]
 //!   applies to [`StoredTable::chunk`] users such as the exports, not to a `TabulatedBrdf`).

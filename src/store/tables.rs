@@ -223,6 +223,18 @@ pub fn is_store_file(path: impl AsRef<Path>) -> bool {
 /// parallel) and checked.
 pub fn open_brdf(source: &str, eager: bool) -> Result<crate::table::TabulatedBrdf> {
     let (path, name) = db::split_source(source)?;
+    open_brdf_at(path, name, eager)
+}
+
+/// [`open_brdf`] of table `name` (`None`: the file's single table) of the brdftab file at
+/// `path`, taken as a path: never split at a `#` nor looked up as a `DB#NAME` string. What a
+/// writer that knows both (a bake reading back its output) opens, whatever `#` the path holds
+/// and whatever files lie beside it.
+pub fn open_brdf_at(
+    path: &str,
+    name: Option<&str>,
+    eager: bool,
+) -> Result<crate::table::TabulatedBrdf> {
     let store = super::Store::open(path)?;
     let t = match name {
         Some(n) => store.table(n)?,

@@ -610,7 +610,7 @@ impl TableSampler {
     #[inline]
     pub fn draw_and(&self, wo: DVec3, u: DVec2, eval: impl FnOnce(DVec3, DVec3)) -> Option<Draw> {
         let wo = geometry::unit(wo)?;
-        if wo.z <= 0.0 || !u.is_finite() {
+        if wo.z <= 0.0 || !geometry::in_unit_square(u) {
             return None;
         }
         let (c, s) = self.frame(wo);

@@ -314,7 +314,7 @@ fn batches(brdf: &dyn Brdf, opts: &Contract, pairs: &[(DVec3, DVec3)], log: &mut
 }
 
 /// Below the horizon, NaN, infinite and zero directions: f = 0, pdf = 0, no sample; no sample
-/// for a non-finite `u` either.
+/// for a `u` outside [0, 1)² either (beyond an edge, infinite or NaN).
 fn bad_input<B: Brdf + ?Sized>(brdf: &B, log: &mut Log) {
     let c = brdf.channels().len();
     let up = DVec3::new(0.2, 0.1, 1.0);
@@ -389,11 +389,18 @@ fn bad_input<B: Brdf + ?Sized>(brdf: &B, log: &mut Log) {
             });
         }
     }
-    // A non-finite u has no sample, as in `sample_batch` (a sampler that ignores u included).
+    // A u outside [0, 1)² has no sample, as in `sample_batch` (a sampler that ignores u
+    // included): beyond it the samplers' maps leave the unit sphere or their densities.
     for u in [
         DVec2::new(f64::NAN, 0.6),
         DVec2::new(0.3, f64::NAN),
         DVec2::new(f64::INFINITY, 0.6),
+        DVec2::new(0.3, f64::NEG_INFINITY),
+        DVec2::new(1.0, 0.5),
+        DVec2::new(0.5, 1.0),
+        DVec2::new(1.5, -0.2),
+        DVec2::new(-1e-300, 0.6),
+        DVec2::new(0.3, 1.0 + f64::EPSILON),
     ] {
         let mut w = [0.0f32; MAX_CHANNELS];
         if let Some(s) = brdf.sample(up, u, &mut w[..c]) {
@@ -558,7 +565,12 @@ mod tests {
         }
         fn sample(&self, wo: DVec3, u: DVec2, w: &mut [f32]) -> Option<BrdfSample> {
             let o = geometry::unit(wo)?;
-            if o.z <= 0.0 || !u.is_finite() {
+            // "square": draws from any finite u, as the Phong family once did.
+            let drawable = match self.0 {
+                "square" => u.is_finite(),
+                _ => geometry::in_unit_square(u),
+            };
+            if o.z <= 0.0 || !drawable {
                 return None;
             }
             let wi = geometry::cosine_hemisphere(u);
@@ -589,11 +601,13 @@ mod tests {
             "horizon",
             "pdf",
             "weight",
+            "square",
         ] {
             let v = check_contract(&Flawed(flaw), &quick).expect_err(flaw);
             let check = match flaw {
                 "negative" => "positive",
                 "batch" => "eval_batch",
+                "square" => "horizon",
                 f => f,
             };
             assert!(v.iter().any(|m| m.starts_with(check)), "{flaw}: {v:?}");

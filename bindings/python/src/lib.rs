@@ -972,7 +972,9 @@ fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyA
             }],
         })
     } else {
-        brdftab::store::info::file_info(&r.output).map_err(lib_err)?
+        // From the path written: `output` is `DB#NAME` for a database entry, and such a string
+        // is looked up whole first (a file of that name beside the database would be read).
+        r.output_info().map_err(lib_err)?
     };
     to_py(py, &info)
 }
