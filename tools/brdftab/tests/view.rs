@@ -392,3 +392,35 @@ fn a_measured_table_is_paired_with_its_file_beside_the_database() {
     assert_eq!(get(&v, "/api/compare?m=0").0, 404);
     assert_eq!(get(&v, "/api/polar?m=0&of=source").0, 404);
 }
+
+#[test]
+fn a_database_entry_is_read_from_the_database_not_a_file_named_like_it() {
+    // A SOURCE string `lib.btdb#matte` is looked up as a whole file first; the viewer lists a
+    // database's entries and must open each from the database even when a file of that name
+    // lies beside it (here a table of another material).
+    let d = TempDir::new("view-decoy");
+    let db = database(&d);
+    let decoy = d.file("decoy.btdb");
+    let r = brdftab(&[
+        "bake",
+        r#"{"model": "lambert", "kd": 0.02}"#,
+        "-o",
+        &decoy,
+        "--preset",
+        "small",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    std::fs::copy(&decoy, format!("{db}#matte")).unwrap();
+    use brdftab::Brdf;
+    let reg = brdftab_tools::view::Registry::open(std::slice::from_ref(&db)).unwrap();
+    let matte = reg
+        .materials
+        .iter()
+        .find(|m| m.info["name"] == "matte")
+        .expect("the database's entry");
+    let (wi, wo) = (glam::DVec3::Z, glam::DVec3::new(0.6, 0.0, 0.8));
+    let mut f = [0.0f32; 3];
+    matte.brdf.eval(wi, wo, &mut f);
+    // Lambert kd = 0.2 (the entry), not 0.02 (the decoy): f_r = kd to the codec's 1e-3.
+    assert!((f[0] - 0.2).abs() < 1e-3, "{f:?}");
+}

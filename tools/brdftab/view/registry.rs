@@ -43,8 +43,8 @@ impl Registry {
     pub fn open(sources: &[String]) -> Result<Registry> {
         let mut materials = Vec::new();
         for s in sources {
-            for (name, source, summary) in entries(s)? {
-                materials.push(material(&name, &source, summary)?);
+            for (name, source, summary, at) in entries(s)? {
+                materials.push(material(&name, &source, summary, at.as_ref())?);
             }
         }
         if materials.is_empty() {
@@ -77,11 +77,15 @@ impl Registry {
     }
 }
 
-/// The (name, SOURCE, store summary) of every material SOURCE `s` holds.
-fn entries(s: &str) -> Result<Vec<(String, String, Option<Value>)>> {
+/// The (name, SOURCE, store summary, (file, table) of a store's entry) of every material
+/// SOURCE `s` holds.
+type Entry = (String, String, Option<Value>, Option<(String, String)>);
+
+/// The materials SOURCE `s` holds (a database: each of its tables, or the one it names).
+fn entries(s: &str) -> Result<Vec<Entry>> {
     let (path, name) = db::split_source(s)?;
     if classify(s) != SourceKind::Table || !tables::is_store_file(path) {
-        return Ok(vec![(display_name(s), s.to_owned(), None)]);
+        return Ok(vec![(display_name(s), s.to_owned(), None, None)]);
     }
     let rows = match name {
         Some(n) => vec![info::table_info(path, n)?],
@@ -91,7 +95,8 @@ fn entries(s: &str) -> Result<Vec<(String, String, Option<Value>)>> {
         .into_iter()
         .map(|r| {
             let n = r["name"].as_str().unwrap_or_default().to_owned();
-            (n.clone(), format!("{path}#{n}"), Some(r))
+            let at = (path.to_owned(), n.clone());
+            (n.clone(), format!("{path}#{n}"), Some(r), Some(at))
         })
         .collect())
 }
@@ -110,10 +115,19 @@ fn display_name(s: &str) -> String {
         .unwrap_or_else(|| s.to_owned())
 }
 
-/// Opens one material and describes it.
-fn material(name: &str, source: &str, summary: Option<Value>) -> Result<Material> {
+/// Opens one material and describes it; a store's entry by its file and table name (`at`), so
+/// that a file named like the `FILE#NAME` string beside it is not what opens.
+fn material(
+    name: &str,
+    source: &str,
+    summary: Option<Value>,
+    at: Option<&(String, String)>,
+) -> Result<Material> {
     let kind = classify(source);
-    let brdf: Shared = Arc::from(brdftab::open_with(source, &OpenOptions::new().eager(true))?);
+    let brdf: Shared = match at {
+        Some((file, table)) => Arc::new(tables::open_brdf_at(file, Some(table), true)?),
+        None => Arc::from(brdftab::open_with(source, &OpenOptions::new().eager(true))?),
+    };
     let mut info = json!({
         "name": name,
         "kind": kind.name(),
