@@ -59,7 +59,7 @@ fn bake_reports_its_values_and_the_report_reads_as_text() {
     let v = info::file_info(out.to_str().unwrap()).unwrap();
     let t = info::file_text(&v);
     assert!(
-        t.contains("table `l`:") && t.contains("brdftab format, 1 tables"),
+        t.contains("table `l`:") && t.contains("brdftab format, 1 table)"),
         "{t}"
     );
     let rows = info::list(out.to_str().unwrap()).unwrap();

@@ -183,9 +183,10 @@ pub fn file_text(v: &Value) -> String {
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "file:    {} (brdftab format, {} tables)",
+        "file:    {} (brdftab format, {} table{})",
         str_of(v, "file"),
-        tables.len()
+        tables.len(),
+        if tables.len() == 1 { "" } else { "s" }
     );
     if tables.is_empty() {
         // No values to compare with (it read "0.0x smaller than f32").
