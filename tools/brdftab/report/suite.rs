@@ -11,8 +11,9 @@
 //! 3. decodes those bytes back into a [`TabulatedBrdf`] (linear interpolation): every metric is
 //!    measured on the *decoded* table, quantization error included;
 //! 4. measures, against the source:
-//!    - `rel_rmse`, `max_rel`: [`analysis::accuracy::compare`](brdftab::analysis::accuracy::compare) over `pairs` uniform random pairs
-//!      (cosine-weighted relative RMSE; max relative error with a 1 %-of-RMS floor), weighted
+//!    - `rel_rmse`, `max_rel`: [`analysis::accuracy::compare`](brdftab::analysis::accuracy::compare) over `pairs` random pairs
+//!      (the figure of uniform pairs, half drawn near the mirror direction and weighted back;
+//!      cosine-weighted relative RMSE; max relative error with a 1 %-of-RMS floor), weighted
 //!      and capped as [`rmse_weighting`] says: by cos θi, or by cos θi cos θo for a table of
 //!      f_r cos θi cos θo and (within 80°) for measured data, whose f_r cos θi has no finite RMS;
 //!    - `albedo_err`: max over the incidence angles `albedo_thetas` and channels of
