@@ -139,8 +139,9 @@ pub trait Brdf: Send + Sync {
     /// A short human-readable description (model name and parameters, or table and source).
     fn describe(&self) -> String;
 
-    /// Whether f_r grows without bound as one direction nears the horizon — Ward's
-    /// 1/√(cos θi cos θo), the original Phong's 1/cos θi. Bounded f_r cos θi cos θo is then
+    /// Whether f_r grows without bound as its directions near the horizon — Ward's
+    /// 1/√(cos θi cos θo), the original Phong's 1/cos θi, Cook-Torrance's 1/cos² θ along the
+    /// grazing mirror (where its V-cavity hides nothing). Bounded f_r cos θi cos θo is then
     /// what a table of this BRDF should store (the bake's default for such sources): a table of
     /// f_r itself blends a node near the horizon, where f_r is huge, over a whole cell, which
     /// costs accuracy at grazing angles and gives its sampler a spike to follow. False by

@@ -208,6 +208,16 @@ impl Brdf for CookTorrance {
         Flags::SMOOTH_SYMMETRIC
     }
 
+    /// True: where both directions near the horizon in the mirror configuration, the facets
+    /// are those at the normal (H = N, D at its peak) and the V-cavity hides none of them
+    /// (V·H = N·V, so G = min(1, 2 N·H) = 1): f_r = k_s D(N) F / (4 cos θi cos θo) grows like
+    /// 1/cos² θ, and f_r cos θi like 1/cos θ — it has no finite RMS over the hemisphere. A
+    /// table of f_r cos θi cos θo (k_s D F G / 4, bounded) follows it; the medium preset's table
+    /// of f_r read 0.39× the source at 89.9° on the grazing mirror (gold, m = 0.3).
+    fn grows_at_horizon(&self) -> bool {
+        true
+    }
+
     fn describe(&self) -> String {
         format!(
             "cook_torrance m={} ks={} fresnel={}",
