@@ -717,7 +717,7 @@ mod tests {
             reciprocal: false,
             bilateral: true,
         };
-        // As a measured source's default grid (bake.rs): θh warped up to the horizon.
+        // As a measured source's default grid (bake/plan.rs): θh warped up to the horizon.
         let opts = AdaptiveOptions {
             nodes: [16, 12, 7],
             fine: [32, 16, 16],

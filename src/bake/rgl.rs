@@ -1,0 +1,60 @@
+//! Converting a SOURCE to an RGL `.bsdf` file ([`to_rgl`]): not a table bake, but the other
+//! file `convert` writes, here so that every host converts the same way.
+
+use crate::error::Result;
+use crate::measured::rgl_write;
+use crate::progress::Progress;
+use crate::source::{self, OpenOptions};
+use crate::spectrum::Channels;
+
+/// What [`to_rgl`] did: the file written, the source's description, the seconds it took and,
+/// when asked for, the error of the file read back against the source.
+#[derive(Debug, Clone)]
+pub struct Converted {
+    /// The file written.
+    pub written: rgl_write::Written,
+    /// The source's description.
+    pub source: String,
+    /// Wall-clock seconds of the encoding and writing.
+    pub seconds: f64,
+    /// The written file (through brdftab's reader) against the source, within 80°.
+    pub error: Option<rgl_write::Report>,
+}
+
+/// Opens SOURCE (with `channels`, `None` = its own), writes it to `output` as an RGL file (a
+/// `.bsdf` source keeps its own layout unless `opts` change it, see
+/// [`rgl_write::Options::reuse_source_file`]) and, with `pairs > 0`, reports the written file's error.
+pub fn to_rgl(
+    source: &str,
+    channels: Option<Channels>,
+    output: &str,
+    opts: &rgl_write::Options,
+    pairs: usize,
+    progress: &dyn Progress,
+) -> Result<Converted> {
+    let open = OpenOptions {
+        channels,
+        ..Default::default()
+    };
+    crate::files::refuse_input(std::path::Path::new(output), &[source])?;
+    let brdf = source::open_with(source, &open)?;
+    let opts = opts.clone().reuse_source_file(source)?;
+    let t = std::time::Instant::now();
+    let written = rgl_write::write(&*brdf, output, &opts, progress)?;
+    let seconds = t.elapsed().as_secs_f64();
+    let error = match pairs {
+        0 => None,
+        n => Some(rgl_write::report(
+            &crate::measured::RglBrdf::open(output)?,
+            &*brdf,
+            n,
+            1,
+        )?),
+    };
+    Ok(Converted {
+        written,
+        source: brdf.describe(),
+        seconds,
+        error,
+    })
+}

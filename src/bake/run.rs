@@ -1,0 +1,330 @@
+//! Baking to a file or a database entry: [`BakeRequest::run`] writes the table with its
+//! provenance — streaming chunks into the file where it can — and reports what it wrote;
+//! [`stem`] names a table after its file.
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::brdf::Brdf;
+use crate::error::{Error, Result};
+use crate::progress::{Progress, Silent, Stage};
+use crate::source;
+use crate::spectrum::Channels;
+use crate::store::{TableHeader, Writer, db, tables};
+use crate::table::{Grid, Quantity, Table, TabulatedBrdf, bake_chunks};
+
+use super::BakeRequest;
+use super::choices::BakeTarget;
+use super::plan::Plan;
+use super::preset_check::{Checked, Fallback, MODEL_FALLBACK_TARGET_ERROR, with_note};
+use super::report::{Accuracy, BakeReport};
+
+impl BakeRequest {
+    /// Bakes and writes to `target` with provenance; returns what the bake did and what `info`
+    /// reports of the written table. Chunks stream into the file as they are baked (bounded
+    /// memory), except for raw targets and MERL cells, which are built in memory.
+    pub fn run(&self, target: &BakeTarget) -> Result<BakeReport> {
+        self.run_with(target, &Silent)
+    }
+
+    /// [`run`](Self::run), reporting progress.
+    pub fn run_with(&self, target: &BakeTarget, progress: &dyn Progress) -> Result<BakeReport> {
+        self.refuse_overwrite(target)?;
+        let name = match (target, &self.name) {
+            (BakeTarget::Db { name, .. }, _) => name.clone(),
+            (_, Some(n)) => n.clone(),
+            (t, None) => stem(t.path()),
+        };
+        // Before any work (and before a `File` target's old file is removed): a table name
+        // the store would refuse ([`crate::store::name`]).
+        if matches!(target, BakeTarget::File(_) | BakeTarget::Db { .. }) {
+            crate::store::name::check("name", &name)?;
+        }
+        let src = self.open_source()?;
+        let t0 = Instant::now();
+        // A model the medium preset misses is baked as the request with an error target would
+        // be (the whole path: calibrated, built whole), or gets the check's calibrated table;
+        // one the preset serves gets the table the check baked.
+        let mut checked = None;
+        let mut missed = None;
+        if !matches!(target, BakeTarget::Merl(_)) {
+            match self.preset_misses(src.as_ref(), progress)? {
+                Checked::Instead(Fallback::Adaptive, why) => {
+                    let mut report = self
+                        .clone()
+                        .target_error(MODEL_FALLBACK_TARGET_ERROR)
+                        .run_with(target, progress)?;
+                    report.symmetry_note = Some(with_note(why, report.symmetry_note));
+                    return Ok(report);
+                }
+                Checked::Instead(Fallback::CalibratedPreset(table), why) => {
+                    let report = self.calibrated_preset_report(src.as_ref(), &table, why, t0);
+                    checked = Some((*table, report));
+                }
+                Checked::Kept(kept) => {
+                    checked = self.reuse_checked(src.as_ref(), *kept, progress, t0)?;
+                }
+                Checked::Missed(why) => missed = Some(why),
+                Checked::Unchecked => {}
+            }
+        }
+        if let BakeTarget::Merl(path) = target {
+            let t0 = Instant::now();
+            let merl = crate::measured::MerlBrdf::from_brdf_with(src.as_ref(), progress);
+            src.health()?;
+            merl.write(path)?;
+            let mut report =
+                self.report_for(src.as_ref(), &Grid::merl(Channels::Rgb), None, t0, true);
+            report.name = stem(path);
+            report.output = path.clone();
+            report.written = Some(target.clone());
+            return Ok(report);
+        }
+        let provenance = source::provenance(&self.source, src.as_ref())?;
+        let built = |checked: Option<(Table, BakeReport)>| match checked {
+            Some(c) => Ok(c),
+            None => self.table_unchecked(src.as_ref(), progress),
+        };
+        let (mut report, table) = match target {
+            BakeTarget::Raw(path) => {
+                let (table, r) = built(checked)?;
+                table.save_raw(path)?;
+                (r, Some(table))
+            }
+            // Tables built whole before they are written: MERL cells, and calibrated tables
+            // (the calibration needs every value; measured and adaptive tables are small).
+            _ if checked.is_some()
+                || self.keeps_merl_cells()
+                || self.effective_quantity(src.as_ref()) != Quantity::Fr
+                || self.calibrates_model_table() =>
+            {
+                let (table, r) = built(checked)?;
+                let (path, replace) = match target {
+                    BakeTarget::Db { path, replace, .. } => (path.as_str(), *replace),
+                    t => (t.path(), true),
+                };
+                if matches!(target, BakeTarget::File(_)) {
+                    let _ = std::fs::remove_file(path);
+                }
+                tables::save(path, &name, provenance, &table, self.codec, replace)?;
+                (r, Some(table))
+            }
+            _ => (
+                self.stream(src.as_ref(), target, &name, provenance, progress)?,
+                None,
+            ),
+        };
+        if let Some(why) = missed {
+            report.symmetry_note = Some(with_note(why, report.symmetry_note.take()));
+        }
+        report.name = name.clone();
+        report.output = match target {
+            BakeTarget::Db { path, .. } => format!("{path}#{name}"),
+            t => t.path().to_owned(),
+        };
+        report.written = Some(target.clone());
+        if matches!(target, BakeTarget::File(_) | BakeTarget::Db { .. }) {
+            report.info = crate::store::info::table_info(target.path(), &name)?;
+        }
+        if self.accuracy_pairs > 0 {
+            // The written table by its path and name: a `DB#NAME` string would be looked up
+            // whole first, and a file of that name beside the output read instead.
+            let tab = match table {
+                Some(t) => TabulatedBrdf::from_table(t),
+                None => crate::store::tables::open_brdf_at(target.path(), Some(&name), false)?,
+            }
+            .with_interp(self.accuracy_interp);
+            report.accuracy = Some(Accuracy::measure(&tab, src.as_ref(), self.accuracy_pairs)?);
+        }
+        Ok(report)
+    }
+
+    /// Refuses a target that is the source's own file (`convert p.bsdf p.bsdf`, `bake t.btdb
+    /// -o t.btdb`): the write would replace the source with its resample. Another entry of the
+    /// database a `DB#NAME` source reads is fine (the source entry is kept as it is).
+    fn refuse_overwrite(&self, target: &BakeTarget) -> Result<()> {
+        if let BakeTarget::Db { name, .. } = target
+            && let Ok((_, Some(entry))) = db::split_source(&self.source)
+            && entry != name
+        {
+            return Ok(());
+        }
+        crate::files::refuse_input(std::path::Path::new(target.path()), &[&self.source])
+    }
+
+    fn stream(
+        &self,
+        src: &dyn Brdf,
+        target: &BakeTarget,
+        name: &str,
+        provenance: crate::store::Source,
+        progress: &dyn Progress,
+    ) -> Result<BakeReport> {
+        let t0 = Instant::now();
+        // What the bake samples ([`BakeSource::bake_view`](crate::brdf::BakeSource::bake_view)).
+        let view = src.bake_source().and_then(|b| b.bake_view());
+        let bake_src: &dyn Brdf = view.as_deref().unwrap_or(src);
+        let Plan {
+            grid,
+            note,
+            force,
+            assumed,
+            search,
+            // Calibrated tables are built in memory (`run_with`), never streamed.
+            albedo: _,
+        } = self.plan_with(bake_src, progress)?;
+        let header = TableHeader::for_grid(name.to_owned(), provenance, &grid, self.codec);
+        let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
+        let set = |done: u64, _total: u64| progress.set(done);
+        let opts = self.bake_options(&set, force);
+        let mut baked = None;
+        let mut write = |w: &mut Writer| -> Result<()> {
+            baked = Some(bake_chunks(bake_src, &grid, &opts, |i, v| {
+                src.health()?; // a failed table source: stop before its zeros are written
+                w.chunk_with(v, tables::chunk_layout(&grid, i))
+            })?);
+            // Before the file is committed (an error here leaves the old file as it was).
+            src.health()
+        };
+        match target {
+            BakeTarget::Db { path, replace, .. } => db::put(path, header, *replace, write)?,
+            t => {
+                let mut w = Writer::create(t.path())?;
+                w.begin_table(header)?;
+                write(&mut w)?;
+                w.end_table()?;
+                w.finish()?;
+            }
+        }
+        let baked = baked.ok_or_else(|| Error::Unsupported("the bake wrote no table".into()))?;
+        let mut report = self.report_for(src, &grid, note, t0, false);
+        report.values = baked.values;
+        report.forced = baked.forced.filter(|_| !assumed);
+        report.target = search;
+        Ok(report)
+    }
+}
+
+/// A file name's stem, the default name of a table (`table` when it has none). `path` is a
+/// path, not a `DB#NAME` (a SOURCE's file is [`crate::store::name::path_of`]); a `#` in the stem
+/// (a file named `scan#2.bsdf`), which a table name cannot hold, becomes `_`.
+pub fn stem(path: &str) -> String {
+    Path::new(path)
+        .file_stem()
+        .map(|s| s.to_string_lossy().replace('#', "_"))
+        .unwrap_or_else(|| "table".into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bake::{SymmetryChoice, codec, tmp};
+    use crate::source::OpenOptions;
+    use crate::table::presets::Preset;
+
+    #[test]
+    fn file_db_and_raw_targets_give_the_same_table() {
+        let d = tmp("targets");
+        let spec = r#"{"model":"cook_torrance","m":0.4,"ks":0.5}"#;
+        let req = BakeRequest::new(spec)
+            .preset(Preset::Small)
+            .codec(codec("f32", None, None, None, false).unwrap());
+        let file = d.join("ct.btdb").to_str().unwrap().to_owned();
+        let dbp = d.join("many.btdb").to_str().unwrap().to_owned();
+        let raw = d.join("ct.tbl").to_str().unwrap().to_owned();
+        let r1 = req.run(&BakeTarget::file(&file)).unwrap();
+        let merl = d.join("ct.binary").to_str().unwrap().to_owned();
+        let rm = req.run(&BakeTarget::Merl(merl.clone())).unwrap();
+        assert!(rm.merl_cells && rm.output == merl);
+        assert!(crate::measured::MerlBrdf::open(&merl).is_ok());
+        let r2 = req.run(&BakeTarget::db(&dbp, "ct")).unwrap();
+        let r3 = req.run(&BakeTarget::Raw(raw.clone())).unwrap();
+        assert_eq!(r1.name, "ct");
+        assert_eq!(r2.output, format!("{dbp}#ct"));
+        assert_eq!(r1.info["values"], r2.info["values"]);
+        assert_eq!(r1.values, r3.values);
+        let a = crate::source::open_table(&file, &OpenOptions::default())
+            .unwrap()
+            .to_table()
+            .unwrap();
+        let b = crate::source::open_table(&format!("{dbp}#ct"), &OpenOptions::default())
+            .unwrap()
+            .to_table()
+            .unwrap();
+        let c = Table::open_raw(&raw).unwrap();
+        assert_eq!(a.values(), b.values());
+        assert_eq!(a.values(), c.values());
+        // A second add of the same name is refused; with replace it succeeds.
+        assert!(req.run(&BakeTarget::db(&dbp, "ct")).is_err());
+        let replace = BakeTarget::Db {
+            path: dbp.clone(),
+            name: "ct".into(),
+            replace: true,
+        };
+        req.run(&replace).unwrap();
+    }
+
+    #[test]
+    fn provenance_and_accuracy_are_reported() {
+        let d = tmp("prov");
+        let spec = r#"{"model":"lambert","kd":0.3}"#;
+        let out = d.join("l.btdb").to_str().unwrap().to_owned();
+        let r = BakeRequest::new(spec)
+            .preset(Preset::Small)
+            .accuracy(2000)
+            .run(&BakeTarget::file(&out))
+            .unwrap();
+        assert_eq!(r.info["source"]["kind"], "model");
+        let acc = r.accuracy.unwrap();
+        assert_eq!(acc.pairs, 2000);
+        // log16 ≤ 1e-3 relative on a constant: the error is the codec's bound at most.
+        assert!(acc.max_rel <= 1e-3, "{acc:?}");
+    }
+
+    /// The accuracy report reads the table it wrote by the output's path and the table's name,
+    /// never through a `DB#NAME` string: such a string is looked up whole first (a file named
+    /// `l.btdb#l` is read as itself, `store::name`), so a file of that name beside the output —
+    /// here a table of kd = 0.9 — was what the report measured (relative error 2).
+    #[test]
+    fn the_accuracy_report_reads_the_written_table_by_its_path() {
+        let d = tmp("hash");
+        let path = |f: &str| d.join(f).to_str().unwrap().to_owned();
+        let decoy = path("decoy.btdb");
+        let other = BakeRequest::new(r#"{"model":"lambert","kd":0.9}"#).preset(Preset::Small);
+        other.run(&BakeTarget::file(&decoy)).unwrap();
+        let req = BakeRequest::new(r#"{"model":"lambert","kd":0.3}"#)
+            .preset(Preset::Small)
+            .accuracy(2000);
+        for (target, beside) in [
+            (BakeTarget::file(path("l.btdb")), "l.btdb#l"),
+            // A `#` in the output file's own name (table `x`).
+            (BakeTarget::file(path("x.btdb#x")), "x.btdb#x#x"),
+            (BakeTarget::db(path("db.btdb"), "m"), "db.btdb#m"),
+        ] {
+            std::fs::copy(&decoy, path(beside)).unwrap();
+            let r = req.run(&target).unwrap();
+            let acc = r.accuracy.unwrap();
+            // log16 ≤ 1e-3 relative on a constant, as above.
+            assert!(acc.max_rel <= 1e-3, "{target:?}: {acc:?}");
+        }
+    }
+
+    #[test]
+    fn an_explicit_symmetry_the_source_breaks_is_refused_unless_forced() {
+        let d = tmp("sym");
+        // The original Phong is not reciprocal.
+        let spec = r#"{"model":"phong","ks":0.5,"n":20}"#;
+        let out = d.join("p.btdb").to_str().unwrap().to_owned();
+        let req = BakeRequest::new(spec)
+            .preset(Preset::Small)
+            .symmetry("isotropic,reciprocal".parse::<SymmetryChoice>().unwrap());
+        assert!(matches!(
+            req.run(&BakeTarget::file(&out)),
+            Err(Error::Symmetry { .. })
+        ));
+        let mut forced = req.clone();
+        forced.force = true;
+        let r = forced.run(&BakeTarget::file(&out)).unwrap();
+        assert!(r.forced.is_some());
+    }
+}
