@@ -1,0 +1,139 @@
+//! Values of f_r: `Brdf.eval` and `Brdf.eval_spectral` at direction pairs, written straight
+//! into the numpy results with the GIL released, and `Brdf.albedo` (f_r cos θo integrated).
+//!
+//! Why a module: these are the BRDF's values, as opposed to its sampler (`sample.rs`) and the
+//! tables a host takes away (`tables.rs`).
+
+use glam::DVec3;
+use numpy::{PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use super::PyBrdf;
+use crate::arrays::{self, Pairs, Rows};
+use crate::errors::{Error, batch, lib_err, unlocked};
+
+impl PyBrdf {
+    /// `Brdf.eval`'s body, run under `guard` (documented on the method, in `mod.rs`).
+    pub(super) fn eval_pairs(
+        &self,
+        py: Python<'_>,
+        wi: &Bound<'_, PyAny>,
+        wo: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        let (a, b) = (Rows::<DVec3>::new(wi, "wi")?, Rows::<DVec3>::new(wo, "wo")?);
+        let p = Pairs::new(&a, "wi", &b, "wo")?;
+        let c = self.c();
+        let shape: &[usize] = if p.single { &[c] } else { &[p.n, c] };
+        let out = arrays::zeros::<f32>(py, shape)?;
+        let mut w = out.readwrite();
+        let o = w
+            .as_slice_mut()
+            .map_err(|e| Error::new_err(e.to_string()))?;
+        let brdf = &self.inner;
+        batch(py, p.n, || p.run(o, c, |a, b, o| brdf.eval_batch(a, b, o)))?;
+        drop(w);
+        self.check_loaded()?;
+        Ok(out.into_any().unbind())
+    }
+
+    /// `Brdf.eval_spectral`'s body, run under `guard` (documented on the method, in `mod.rs`).
+    pub(super) fn eval_spectral_pairs(
+        &self,
+        py: Python<'_>,
+        wi: &Bound<'_, PyAny>,
+        wo: &Bound<'_, PyAny>,
+        nm: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        let (a, b) = (Rows::<DVec3>::new(wi, "wi")?, Rows::<DVec3>::new(wo, "wo")?);
+        let p = Pairs::new(&a, "wi", &b, "wo")?;
+        let n = p.n;
+        let l = arrays::f64_array(nm, "nm")?;
+        let (k, per_row) = match l.shape() {
+            [k] => (*k, false),
+            [m, k] if *m == n => (*k, true),
+            s => {
+                return Err(PyValueError::new_err(format!(
+                    "nm: expected shape (k,) or ({n}, k), got {}",
+                    arrays::shape_str(s)
+                )));
+            }
+        };
+        // Read in place: a broadcast `nm` (numpy.broadcast_to) of any length is no copy,
+        // and the output is allocated (or refused by numpy) before its entries are checked.
+        let nm = l.as_array();
+        let shape: &[usize] = if p.single { &[k] } else { &[n, k] };
+        let out = arrays::zeros::<f32>(py, shape)?;
+        if n > 0
+            && let Some(x) = nm.iter().find(|&&x| !brdftab::spectrum::is_wavelength(x))
+        {
+            return Err(PyValueError::new_err(format!(
+                "nm: {x} is not a wavelength (a finite number of nm > 0)"
+            )));
+        }
+        let mut w = out.readwrite();
+        let o = w
+            .as_slice_mut()
+            .map_err(|e| Error::new_err(e.to_string()))?;
+        let brdf = &self.inner;
+        batch(py, n * k, || {
+            brdftab::batch::blocks(o, k, |s, o| {
+                let (a, b) = p.block(s, o.len() / k.max(1));
+                for (r, o) in o.chunks_exact_mut(k.max(1)).enumerate() {
+                    let l = match per_row {
+                        true => nm.index_axis(numpy::ndarray::Axis(0), s + r),
+                        false => nm.view(),
+                    };
+                    for (o, &x) in o.iter_mut().zip(l.iter()) {
+                        *o = brdf.eval_wavelength(a[r], b[r], x) as f32;
+                    }
+                }
+            })
+        })?;
+        drop(w);
+        self.check_loaded()?;
+        Ok(out.into_any().unbind())
+    }
+
+    /// `Brdf.albedo`'s body, run under `guard` (documented on the method, in `mod.rs`).
+    pub(super) fn albedo_curve(
+        &self,
+        py: Python<'_>,
+        theta: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        let a = arrays::f64_array(theta, "theta")?;
+        let single = a.ndim() == 0;
+        if a.ndim() > 1 {
+            return Err(PyValueError::new_err(format!(
+                "theta: expected a number or a 1-d array, got shape {}",
+                arrays::shape_str(a.shape())
+            )));
+        }
+        // Read in place and written into the numpy result, allocated (or refused by numpy)
+        // before the angles are checked: a broadcast `theta` of any length is no copy.
+        let t = a.as_array();
+        let (k, c) = (t.len(), self.c());
+        let shape: &[usize] = if single { &[c] } else { &[k, c] };
+        let out = arrays::zeros::<f64>(py, shape)?;
+        use brdftab::analysis::albedo::incidence;
+        for &x in t.iter() {
+            incidence(x).map_err(lib_err)?;
+        }
+        let mut w = out.readwrite();
+        let o = w
+            .as_slice_mut()
+            .map_err(|e| Error::new_err(e.to_string()))?;
+        let brdf = &self.inner;
+        // What `albedo::albedo_curve` computes, angle by angle into the result.
+        unlocked(py, || {
+            for (row, &x) in o.chunks_exact_mut(c.max(1)).zip(t.iter()) {
+                if let Ok(wi) = incidence(x) {
+                    brdf.albedo(wi, row);
+                }
+            }
+        })?;
+        drop(w);
+        self.check_loaded()?;
+        Ok(out.into_any().unbind())
+    }
+}

@@ -1,0 +1,256 @@
+//! The `brdftab.Brdf` class: its state, how it is opened, and its Python surface — every
+//! method's docstring and signature — in one `#[pymethods]` block (PyO3 takes one per class
+//! without its `multiple-pymethods` feature). A method that computes runs its body, under
+//! `guard`, from the file of its concern: `eval.rs` (f_r at direction pairs, spectral f_r,
+//! albedo), `sample.rs` (the importance sampler: draws, their density, its node data for device
+//! hosts) or `tables.rs` (the decoded table and its device layout).
+
+mod eval;
+mod sample;
+mod tables;
+
+use std::sync::Arc;
+
+use brdftab::request::OpenSettings;
+use brdftab::source::{self, OpenOptions, SourceKind};
+use brdftab::table::TabulatedBrdf;
+use brdftab::{Brdf, Channels};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+use crate::errors::{Error, guard, lib_err};
+use crate::table::PyTable;
+use crate::values::{ser, wavelengths_of};
+
+/// A BRDF opened from a SOURCE: an analytic model spec, a table (`FILE`, `DB#NAME`), a MERL
+/// `.binary` or an RGL `.bsdf` file. Directions are in the local frame (z = normal), both
+/// pointing away from the surface; `wi` is the direction to the light, `wo` to the viewer.
+/// Array arguments are anything numpy reads as real numbers; a `numpy.ma` masked array with
+/// masked entries is a `ValueError` (fill or drop them first). Pickles by its source and
+/// options.
+#[pyclass(name = "Brdf", module = "brdftab", frozen)]
+pub(crate) struct PyBrdf {
+    inner: Arc<dyn Brdf + Send + Sync>,
+    table: Option<Arc<TabulatedBrdf>>,
+    source: String,
+    /// The interpolation asked for: auto, nearest or linear.
+    interp: String,
+    wavelengths: Option<Vec<f64>>,
+    eager: bool,
+}
+
+impl PyBrdf {
+    pub(crate) fn open(
+        source: &str,
+        interp: &str,
+        channels: Option<Channels>,
+        eager: bool,
+    ) -> PyResult<PyBrdf> {
+        let settings = OpenSettings {
+            interp: Some(interp.to_owned()),
+            wavelengths: None,
+            eager: Some(eager),
+        };
+        let opts = OpenOptions {
+            channels: channels.clone(),
+            ..settings.options().map_err(lib_err)?
+        };
+        let (inner, table): (Arc<dyn Brdf + Send + Sync>, _) =
+            if source::classify(source) == SourceKind::Table && channels.is_none() {
+                let t = Arc::new(source::open_table(source, &opts).map_err(lib_err)?);
+                (t.clone(), Some(t))
+            } else {
+                (
+                    Arc::from(brdftab::open_with(source, &opts).map_err(lib_err)?),
+                    None,
+                )
+            };
+        Ok(PyBrdf {
+            inner,
+            table,
+            source: source.to_owned(),
+            interp: interp.trim().to_ascii_lowercase(),
+            wavelengths: wavelengths_of(&channels),
+            eager,
+        })
+    }
+
+    fn c(&self) -> usize {
+        self.inner.channels().len()
+    }
+
+    /// A lazily decoded chunk that failed (corrupt data) is an error, not silent zeros
+    /// ([`Brdf::health`], sticky: the object stays failed).
+    fn check_loaded(&self) -> PyResult<()> {
+        self.inner
+            .health()
+            .map_err(|e| Error::new_err(format!("{}: {e}", self.source)))
+    }
+}
+
+#[pymethods]
+impl PyBrdf {
+    /// Channel names as the CLI prints them: ["R", "G", "B"] or ["450nm", ...].
+    #[getter]
+    fn channels(&self) -> Vec<String> {
+        self.inner.channels().names()
+    }
+
+    /// Wavelengths in nm of a spectral BRDF, or None for RGB.
+    #[getter]
+    fn wavelengths(&self) -> Option<Vec<f64>> {
+        match self.inner.channels() {
+            Channels::Wavelengths(w) => Some(w.clone()),
+            _ => None,
+        }
+    }
+
+    /// What the BRDF declares: {"delta", "reciprocal", "isotropic", "bilateral", "transmission",
+    /// "lobes": {"diffuse", "glossy", "delta"}} (hosts map the lobes to their own flags).
+    #[getter]
+    fn flags(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        ser(py, &self.inner.flags())
+    }
+
+    /// The SOURCE string this BRDF was opened from.
+    #[getter]
+    fn source(&self) -> String {
+        self.source.clone()
+    }
+
+    /// The interpolation of a table ("linear" or "nearest"; with `interp="auto"`, the one the
+    /// table's grid chose), or the interpolation asked for when the source is no table.
+    #[getter]
+    fn interp(&self) -> String {
+        match &self.table {
+            Some(t) => format!("{:?}", t.interp()).to_ascii_lowercase(),
+            None => self.interp.clone(),
+        }
+    }
+
+    /// A one-line description (model and parameters, or table and source).
+    fn describe(&self) -> String {
+        self.inner.describe()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<brdftab.Brdf {:?}: {}>",
+            self.source,
+            self.inner.describe()
+        )
+    }
+
+    /// f_r(wi, wo) in 1/sr (not times a cosine) as float32 of shape (n, c), or (c,) when both
+    /// wi and wo have shape (3,). Directions need not be normalized; below the horizon, and
+    /// for a direction with a NaN or infinite component or a zero vector, f_r = 0 (as in the
+    /// library and the C ABI). A lazily opened table (`eager=False`) whose chunk fails its
+    /// checksum raises `brdftab.Error`, then and on every later call.
+    fn eval(
+        &self,
+        py: Python<'_>,
+        wi: &Bound<'_, PyAny>,
+        wo: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| self.eval_pairs(py, wi, wo))
+    }
+
+    /// f_r(wi, wo) at wavelengths `nm` (shape (k,) for every pair, or (n, k)): float32 (n, k).
+    /// Spectral channels are interpolated; analytic models use their spectral data. A
+    /// wavelength must be finite and > 0 (the library's rule, as for `wavelengths=`): any
+    /// other is a `ValueError`.
+    fn eval_spectral(
+        &self,
+        py: Python<'_>,
+        wi: &Bound<'_, PyAny>,
+        wo: &Bound<'_, PyAny>,
+        nm: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| self.eval_spectral_pairs(py, wi, wo, nm))
+    }
+
+    /// The density (1/sr, solid angle) with which `sample(wo, u)` draws wi: float64 (n,).
+    fn pdf(
+        &self,
+        py: Python<'_>,
+        wi: &Bound<'_, PyAny>,
+        wo: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| self.pdf_pairs(py, wi, wo))
+    }
+
+    /// Draws wi for each wo from uniform numbers u in [0, 1)² (shape (n, 2)); returns
+    /// (wi (n, 3) float64, pdf (n,) float64, weight (n, c) float32) with
+    /// weight = f_r cos θi / pdf (`brdftab sample`'s conventions). Where no direction can be
+    /// drawn (wo below the horizon, NaN, infinite or zero) wi, pdf and weight are 0; `u`
+    /// outside [0, 1) (NaN included) is a `ValueError`.
+    fn sample(
+        &self,
+        py: Python<'_>,
+        wo: &Bound<'_, PyAny>,
+        u: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyTuple>> {
+        guard(|| self.sample_pairs(py, wo, u))
+    }
+
+    /// Directional albedo ∫ f_r cos θo dωo at incidence angles θ′ (radians, in [0, π/2): light
+    /// above the horizon; else ValueError naming theta):
+    /// float64 (k, c) (or (c,) for a scalar θ′). A closed form where the model has one, else
+    /// adaptive quadrature: 1e-6 relative for models, 1e-4 for tables and measured data.
+    fn albedo(&self, py: Python<'_>, theta: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+        guard(|| self.albedo_curve(py, theta))
+    }
+
+    /// A table SOURCE's device layout for this BRDF's interpolation (`Table.device_layout`),
+    /// without the copy `table().device_layout()` makes: the decoded table moves into it.
+    /// Raises `brdftab.Error` for any other source (bake it: `table(...).device_layout()`).
+    fn device_layout(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        guard(|| self.table_device_layout(py))
+    }
+
+    /// The node densities of the library's importance sampler (`brdftab.table.SamplingNodes`
+    /// in Rust): {"version": 2, "nx", "ny", "nt", "np", "isotropic", "data": float32 array
+    /// (nt·np, ny, nx), "alias": {...}} — g(s, y) of f_r cos θ over the half-vector square
+    /// (s → θh = (π/2)(0.1 s + 0.9 s²), y → φh = 2π y − π relative to the conditioning
+    /// direction's azimuth) at nt conditioning nodes uniform in t = sqrt(1 − cos θ) (times np
+    /// over φ for anisotropic sources), and the library's constant-time draw of them
+    /// (`brdftab.table.AliasTables`): {"other_bits", "pdf": float32 (nt·np, ny, nx)
+    /// normalized, "strips": uint32 (nt·np, 2(ny − 1)), "cells": uint32 (nt·np, ny, nx − 1)}.
+    /// `adjoint=True` conditions on wi and weights by cos θo (Mitsuba's convention: draw wo
+    /// given wi). For hosts that sample on a device (the Mitsuba plugin).
+    #[pyo3(signature = (adjoint=false, theta_h=64, phi_h=64, theta_o=32, phi_o=16))]
+    fn sampling_nodes(
+        &self,
+        py: Python<'_>,
+        adjoint: bool,
+        theta_h: usize,
+        phi_h: usize,
+        theta_o: usize,
+        phi_o: usize,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| self.sampling_nodes_dict(py, adjoint, theta_h, phi_h, theta_o, phi_o))
+    }
+
+    /// The decoded table as a `brdftab.Table`: `values` (float32, shaped by the stored axes
+    /// and the channels, λ innermost; flat for a packed `inout` reciprocal table) shares the
+    /// table's memory, read-only; `grid` describes it. Unpacks as `values, grid = b.table()`.
+    /// A table SOURCE gives its stored table; any other source is baked in memory with
+    /// `options` (the keywords of `brdftab.bake`).
+    #[pyo3(signature = (**options))]
+    fn table(&self, py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<PyTable> {
+        guard(|| self.decoded_table(py, options))
+    }
+
+    fn __reduce__(&self, py: Python<'_>) -> PyResult<Py<PyTuple>> {
+        let module = py.import("brdftab._native")?;
+        let f = module.getattr("_reopen")?;
+        let args = (
+            self.source.clone(),
+            self.interp.clone(),
+            self.wavelengths.clone(),
+            self.eager,
+        )
+            .into_pyobject(py)?;
+        Ok(PyTuple::new(py, [f, args.into_any()])?.unbind())
+    }
+}

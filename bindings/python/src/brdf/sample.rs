@@ -1,0 +1,190 @@
+//! The library's importance sampler: `Brdf.sample` (directions drawn from uniform numbers),
+//! `Brdf.pdf` (the density of those draws) and `Brdf.sampling_nodes` (the sampler's node
+//! densities and alias tables, for hosts that draw on a device).
+//!
+//! Why a module: everything about drawing directions is here, apart from f_r's values
+//! (`eval.rs`).
+
+use brdftab::Brdf;
+use brdftab::batch::{BLOCK, SampleOut};
+use glam::{DVec2, DVec3};
+use numpy::ndarray::{ArrayD, IxDyn};
+use numpy::{IntoPyArray, PyArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use rayon::prelude::*;
+
+use super::PyBrdf;
+use crate::arrays::{self, Pairs, Rows};
+use crate::errors::{Error, batch, unlocked};
+
+/// One block of `sample`'s outputs, numbered: (block, ((wi, pdf), weights)).
+type SampleBlock<'a> = (usize, ((&'a mut [DVec3], &'a mut [f64]), &'a mut [f32]));
+
+impl PyBrdf {
+    /// `Brdf.pdf`'s body, run under `guard` (documented on the method, in `mod.rs`).
+    pub(super) fn pdf_pairs(
+        &self,
+        py: Python<'_>,
+        wi: &Bound<'_, PyAny>,
+        wo: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        let (a, b) = (Rows::<DVec3>::new(wi, "wi")?, Rows::<DVec3>::new(wo, "wo")?);
+        let p = Pairs::new(&a, "wi", &b, "wo")?;
+        let shape: &[usize] = if p.single { &[] } else { &[p.n] };
+        let out = arrays::zeros::<f64>(py, shape)?;
+        let mut w = out.readwrite();
+        let o = w
+            .as_slice_mut()
+            .map_err(|e| Error::new_err(e.to_string()))?;
+        let brdf = &self.inner;
+        batch(py, p.n, || p.run(o, 1, |a, b, o| brdf.pdf_batch(a, b, o)))?;
+        drop(w);
+        self.check_loaded()?;
+        Ok(out.into_any().unbind())
+    }
+
+    /// `Brdf.sample`'s body, run under `guard` (documented on the method, in `mod.rs`).
+    pub(super) fn sample_pairs(
+        &self,
+        py: Python<'_>,
+        wo: &Bound<'_, PyAny>,
+        u: &Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyTuple>> {
+        let (a, b) = (Rows::<DVec3>::new(wo, "wo")?, Rows::<DVec2>::new(u, "u")?);
+        let uu = b.as_slice();
+        for (k, u) in uu.iter().enumerate() {
+            if let Some(x) = [u.x, u.y].into_iter().find(|x| !(0.0..1.0).contains(x)) {
+                return Err(PyValueError::new_err(format!(
+                    "u: row {k}: {x} is outside [0, 1)"
+                )));
+            }
+        }
+        let p = Pairs::new(&a, "wo", &b, "u")?;
+        let (n, c) = (p.n, self.c());
+        let (s3, s1, sc): (&[usize], &[usize], &[usize]) = match p.single {
+            true => (&[3], &[], &[c]),
+            false => (&[n, 3], &[n], &[n, c]),
+        };
+        let (wi, pdf, weight) = (
+            arrays::zeros::<f64>(py, s3)?,
+            arrays::zeros::<f64>(py, s1)?,
+            arrays::zeros::<f32>(py, sc)?,
+        );
+        let (mut wi_w, mut pdf_w, mut w_w) = (wi.readwrite(), pdf.readwrite(), weight.readwrite());
+        let slice_err = |e: numpy::NotContiguousError| Error::new_err(e.to_string());
+        let wi_s = wi_w.as_slice_mut().map_err(slice_err)?;
+        let pdf_s = pdf_w.as_slice_mut().map_err(slice_err)?;
+        let w_s = w_w.as_slice_mut().map_err(slice_err)?;
+        // wi as rows: a fresh C-contiguous float64 array, aligned by numpy's allocator.
+        let wi_s = arrays::as_rows_mut(wi_s)?;
+        let brdf = &self.inner;
+        batch(py, n, || match p.whole() {
+            Some((a, b)) => brdf.sample_batch(
+                a,
+                b,
+                SampleOut {
+                    wi: wi_s,
+                    pdf: pdf_s,
+                    weight: w_s,
+                },
+            ),
+            None => {
+                let cw = c.max(1);
+                let go = |(k, ((wi, pd), w)): SampleBlock<'_>| {
+                    let (a, b) = p.block(k * BLOCK, pd.len());
+                    brdf.sample_batch(
+                        a,
+                        b,
+                        SampleOut {
+                            wi,
+                            pdf: pd,
+                            weight: w,
+                        },
+                    )
+                };
+                if n >= brdftab::batch::PARALLEL {
+                    brdftab::par::install(|| {
+                        wi_s.par_chunks_mut(BLOCK)
+                            .zip(pdf_s.par_chunks_mut(BLOCK))
+                            .zip(w_s.par_chunks_mut(BLOCK * cw))
+                            .enumerate()
+                            .for_each(go)
+                    })
+                } else {
+                    wi_s.chunks_mut(BLOCK)
+                        .zip(pdf_s.chunks_mut(BLOCK))
+                        .zip(w_s.chunks_mut(BLOCK * cw))
+                        .enumerate()
+                        .for_each(go)
+                }
+            }
+        })?;
+        drop((wi_w, pdf_w, w_w));
+        self.check_loaded()?;
+        Ok(PyTuple::new(py, [wi.into_any(), pdf.into_any(), weight.into_any()])?.unbind())
+    }
+
+    /// `Brdf.sampling_nodes`'s body, run under `guard` (documented on the method, in `mod.rs`).
+    pub(super) fn sampling_nodes_dict(
+        &self,
+        py: Python<'_>,
+        adjoint: bool,
+        theta_h: usize,
+        phi_h: usize,
+        theta_o: usize,
+        phi_o: usize,
+    ) -> PyResult<Py<PyAny>> {
+        use brdftab::table::{Adjoint, SamplingNodes, SamplingResolution};
+        let nodes = [theta_h, phi_h, theta_o, phi_o]
+            .iter()
+            .try_fold(1usize, |a, &x| a.checked_mul(x.max(1)));
+        if nodes.is_none_or(|n| n > 1 << 26) {
+            return Err(PyValueError::new_err(
+                "theta_h·phi_h·theta_o·phi_o: at most 2^26 nodes",
+            ));
+        }
+        let res = SamplingResolution {
+            theta_h,
+            phi_h,
+            theta_o,
+            phi_o,
+            ..SamplingResolution::default()
+        };
+        let iso = self.inner.flags().isotropic;
+        let brdf: &dyn Brdf = self.inner.as_ref();
+        let n = unlocked(py, || match adjoint {
+            true => SamplingNodes::build_par(&Adjoint(brdf), iso, &res),
+            false => SamplingNodes::build_par(brdf, iso, &res),
+        })?;
+        self.check_loaded()?;
+        let a = unlocked(py, || n.alias())?;
+        let slices = n.nt * n.np;
+        let shape = [slices, n.ny, n.nx];
+        let array = |shape: &[usize], v: Vec<f32>| {
+            ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| Error::new_err(e.to_string()))
+        };
+        let entries = |shape: &[usize], v: Vec<u32>| {
+            ArrayD::from_shape_vec(IxDyn(shape), v).map_err(|e| Error::new_err(e.to_string()))
+        };
+        let alias = PyDict::new(py);
+        alias.set_item("other_bits", a.other_bits)?;
+        alias.set_item("pdf", array(&shape, a.pdf)?.into_pyarray(py))?;
+        let strips = entries(&[slices, 2 * (n.ny - 1)], a.strips)?;
+        alias.set_item("strips", strips.into_pyarray(py))?;
+        let cells = entries(&[slices, n.ny, n.nx - 1], a.cells)?;
+        alias.set_item("cells", cells.into_pyarray(py))?;
+        let data = array(&shape, n.data)?.into_pyarray(py);
+        let d = PyDict::new(py);
+        d.set_item("version", 2)?;
+        d.set_item("nx", n.nx)?;
+        d.set_item("ny", n.ny)?;
+        d.set_item("nt", n.nt)?;
+        d.set_item("np", n.np)?;
+        d.set_item("isotropic", n.isotropic)?;
+        d.set_item("data", data)?;
+        d.set_item("alias", alias)?;
+        Ok(d.into_any().unbind())
+    }
+}

@@ -1,0 +1,65 @@
+//! The database functions the pure-Python `brdftab.Database` wraps: list, check a name, remove,
+//! import a table.
+//!
+//! Why a module: these manage the tables of a database file; they open no BRDF.
+
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+
+use crate::errors::{guard, lib_err, unlocked};
+
+/// The names of the tables of database `path`, in file order.
+#[pyfunction]
+pub(crate) fn db_names(path: &str) -> PyResult<Vec<String>> {
+    guard(|| {
+        Ok(brdftab::store::db::list(path)
+            .map_err(lib_err)?
+            .into_iter()
+            .map(|(e, _)| e.name)
+            .collect())
+    })
+}
+
+/// Checks a table name against the library's rule ([`brdftab::store::name::check`]):
+/// `ValueError` naming `name` for an empty name or one with `#`, `/` or a control character.
+#[pyfunction]
+pub(crate) fn _check_table_name(name: &str) -> PyResult<()> {
+    guard(|| brdftab::store::name::check("name", name).map_err(lib_err))
+}
+
+/// Removes table `name` from database `path`.
+#[pyfunction]
+pub(crate) fn db_remove(path: &str, name: &str) -> PyResult<()> {
+    guard(|| brdftab::store::db::remove(path, name).map_err(lib_err))
+}
+
+/// Adds the table of a single-table file's bytes (what `bake` writes to a `.btdb` path) to
+/// database `path` as `name`, copying its encoded chunks (no re-encoding; checksums checked).
+///
+/// `data` is read where it is: a `bytes` object is immutable, and the `PyBackedBytes` keeps it
+/// alive while the store reads it. (It was extracted into a `Vec<u8>`, a copy whose allocation
+/// failure aborts the process rather than raising MemoryError: a table near the size of memory
+/// killed the interpreter.) Anything else is the wrapper's to turn into `bytes`.
+#[pyfunction]
+#[pyo3(signature = (path, name, data, replace=false))]
+pub(crate) fn db_import(
+    py: Python<'_>,
+    path: &str,
+    name: &str,
+    data: Bound<'_, PyBytes>,
+    replace: bool,
+) -> PyResult<()> {
+    guard(|| {
+        let opts = brdftab::store::StoreOptions {
+            eager: false,
+            ..Default::default()
+        };
+        let data = pyo3::pybacked::PyBackedBytes::from(data);
+        unlocked(py, || {
+            let s = brdftab::store::Store::from_bytes("<bytes>", data, opts)?;
+            let from = s.single()?.header().name.clone();
+            brdftab::store::db::import(path, &s, &from, name, replace)
+        })?
+        .map_err(lib_err)
+    })
+}

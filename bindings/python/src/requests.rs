@@ -1,0 +1,171 @@
+//! The request layer's long calls ([`brdftab::request`]): `bake`, `bake_cached`, `convert` and
+//! `fit`, whose keyword arguments are the fields of its settings, run with the GIL released;
+//! each returns a dict (what the CLI's `--json` prints).
+//!
+//! Why a module: the functions that take `**options` as settings and write files or fit
+//! models, with the dicts of their reports.
+
+use brdftab::request::{self, BakeSettings, ConvertOutput, ConvertSettings, FitSettings};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::{guard, lib_err, unlocked};
+use crate::values::{ser, settings_of, text_arg, to_py};
+
+fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyAny>> {
+    let info = if r.info.is_null() {
+        serde_json::json!({
+            "file": r.output,
+            "format": "raw",
+            "tables": [{
+                "name": r.name,
+                "shape": r.grid.stored_shape(),
+                "values": r.values,
+                "channels": r.grid.channels().names(),
+            }],
+        })
+    } else {
+        // From the path written: `output` is `DB#NAME` for a database entry, and such a string
+        // is looked up whole first (a file of that name beside the database would be read).
+        r.output_info().map_err(lib_err)?
+    };
+    to_py(py, &info)
+}
+
+/// Bakes SOURCE into OUTPUT: a `.btdb` file, or `DB#NAME` (a table of a database). The
+/// keywords are the fields of [`BakeSettings`] (the CLI's `bake` flags, snake_cased). Returns
+/// what `brdftab info --json OUTPUT` reports.
+#[pyfunction]
+#[pyo3(signature = (source, output, **options))]
+pub(crate) fn bake(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    output: &Bound<'_, PyAny>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        let (source, output) = (text_arg(source, "source")?, text_arg(output, "output")?);
+        let (source, output) = (source.as_str(), output.as_str());
+        let settings: BakeSettings = settings_of(options)?;
+        let r = unlocked(py, || {
+            request::bake(source, output, &settings, &brdftab::progress::Silent)
+        })?
+        .map_err(lib_err)?;
+        report_dict(py, &r)
+    })
+}
+
+/// The table of SOURCE baked with `options` (the keywords of `bake`), from the cache of baked
+/// tables or baked into it now ([`brdftab::cache`]): keyed by the source's content, the
+/// settings and the library's version, in `cache_dir` (default `$BRDFTAB_CACHE_DIR`, else
+/// `$XDG_CACHE_HOME/brdftab`, else `~/.cache/brdftab`). Safe under concurrent calls from many
+/// processes. `refresh=True` bakes again (for a cached file that failed to open). Returns
+/// `{"path": str, "hit": bool}`; open the table with `brdftab.open(path)`.
+#[pyfunction]
+#[pyo3(signature = (source, cache_dir=None, refresh=false, **options))]
+pub(crate) fn bake_cached(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    cache_dir: Option<std::path::PathBuf>,
+    refresh: bool,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        let source = text_arg(source, "source")?;
+        let source = source.as_str();
+        let settings: BakeSettings = settings_of(options)?;
+        let c = unlocked(py, || {
+            brdftab::cache::bake_cached(source, &settings, cache_dir.as_deref(), refresh)
+        })?
+        .map_err(lib_err)?;
+        let v = serde_json::json!({"path": c.path.to_string_lossy(), "hit": c.hit});
+        to_py(py, &v)
+    })
+}
+
+/// Converts SOURCE into OUTPUT as `brdftab convert` does ([`request::convert`]): an RGL
+/// `.bsdf`, a MERL `.binary`, `DB#NAME`, a `.btdb` file (a table named after the input) or a raw
+/// table. The keywords are the fields of [`ConvertSettings`].
+#[pyfunction]
+#[pyo3(signature = (source, output, **options))]
+pub(crate) fn convert(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    output: &Bound<'_, PyAny>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        let (source, output) = (text_arg(source, "source")?, text_arg(output, "output")?);
+        let (source, output) = (source.as_str(), output.as_str());
+        let settings: ConvertSettings = settings_of(options)?;
+        let out = unlocked(py, || {
+            request::convert(source, output, &settings, &brdftab::progress::Silent)
+        })?
+        .map_err(lib_err)?;
+        let d = match out {
+            ConvertOutput::Merl(r) => serde_json::json!({
+                "output": r.output,
+                "format": "merl",
+                "source": r.source,
+                "grid": "merl 90x90x180 cell means",
+                "seconds": r.seconds,
+            }),
+            ConvertOutput::Rgl(r) => {
+                let f = &r.written.fields;
+                serde_json::json!({
+                    "output": output,
+                    "format": "rgl",
+                    "source": r.source,
+                    "bytes": r.written.bytes,
+                    "resolution": f.n,
+                    "theta_i": f.theta_i.len(),
+                    "phi_i": f.phi_i.len(),
+                    "seconds": r.seconds,
+                    "error": r.error.map(|e| serde_json::json!({
+                        "pairs": e.pairs,
+                        "rel_rmse": e.rel_rmse,
+                        "per_channel": e.per_channel,
+                        "max_rel": e.max_rel,
+                    })),
+                })
+            }
+            ConvertOutput::Table { report: r, .. } => {
+                let d = serde_json::json!({
+                    "output": r.output,
+                    "format": "table",
+                    "source": r.source,
+                    "grid": r.grid.summary(),
+                    "values": r.values,
+                    "seconds": r.seconds,
+                    "accuracy": r.accuracy,
+                });
+                let d = to_py(py, &d)?;
+                d.bind(py).set_item("info", report_dict(py, &r)?)?;
+                return Ok(d);
+            }
+        };
+        to_py(py, &d)
+    })
+}
+
+/// Fits `model` (a name such as "ggx", a sum "lambert+ggx", or a JSON spec) to SOURCE; returns
+/// the dict of `brdftab fit --json`. The keywords are the fields of [`FitSettings`].
+#[pyfunction]
+#[pyo3(signature = (source, model, **options))]
+pub(crate) fn fit(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    model: &str,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        let source = text_arg(source, "source")?;
+        let source = source.as_str();
+        let settings: FitSettings = settings_of(options)?;
+        let result = unlocked(py, || {
+            request::fit(source, model, &settings, &brdftab::progress::Silent)
+        })?
+        .map_err(lib_err)?;
+        ser(py, &result)
+    })
+}

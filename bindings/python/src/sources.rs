@@ -1,0 +1,87 @@
+//! Module functions on a SOURCE: `open` (and `_reopen`, its unpickling twin) as a `Brdf`,
+//! `check` (the plausibility report) and `info` (what a brdftab file holds).
+//!
+//! Why a module: the entry points that take a SOURCE and open or describe it, apart from the
+//! database functions (`db.rs`) and the request layer's bakes, conversions and fits
+//! (`requests.rs`).
+
+use brdftab::Channels;
+use brdftab::source::OpenOptions;
+use pyo3::prelude::*;
+
+use crate::brdf::PyBrdf;
+use crate::errors::{guard, lib_err, unlocked};
+use crate::values::{channels_of, ser, text_arg, to_py};
+
+/// Opens SOURCE (a spec, table, `DB#NAME`, MERL `.binary` or RGL `.bsdf`) as a `Brdf`.
+#[pyfunction]
+#[pyo3(signature = (source, *, interp = "auto", wavelengths = None, eager = true))]
+pub(crate) fn open(
+    source: &Bound<'_, PyAny>,
+    interp: &str,
+    wavelengths: Option<&Bound<'_, PyAny>>,
+    eager: bool,
+) -> PyResult<PyBrdf> {
+    guard(|| {
+        let source = text_arg(source, "source")?;
+        PyBrdf::open(&source, interp, channels_of(wavelengths)?, eager)
+    })
+}
+
+/// Unpickling: reopens a `Brdf` from its source and options.
+#[pyfunction]
+#[pyo3(signature = (source, interp, wavelengths, eager = true))]
+pub(crate) fn _reopen(
+    source: &str,
+    interp: &str,
+    wavelengths: Option<Vec<f64>>,
+    eager: bool,
+) -> PyResult<PyBrdf> {
+    guard(|| {
+        let ch = wavelengths
+            .map(Channels::wavelengths)
+            .transpose()
+            .map_err(lib_err)?;
+        PyBrdf::open(source, interp, ch, eager)
+    })
+}
+
+/// The plausibility report of SOURCE as a dict with the keys of `brdftab check --json`.
+#[pyfunction]
+#[pyo3(signature = (source, *, wavelengths = None))]
+pub(crate) fn check(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    wavelengths: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        let source = text_arg(source, "source")?;
+        let source = source.as_str();
+        let opts = OpenOptions {
+            channels: channels_of(wavelengths)?,
+            ..OpenOptions::default()
+        };
+        let brdf = brdftab::open_with(source, &opts).map_err(lib_err)?;
+        let report = unlocked(py, || {
+            brdftab::analysis::plausibility::check(
+                brdf.as_ref(),
+                &brdftab::analysis::plausibility::Options::default(),
+            )
+        })?
+        .map_err(lib_err)?;
+        ser(py, &report)
+    })
+}
+
+/// What `brdftab info --json` reports of a brdftab file (`FILE`) or one table (`DB#NAME`).
+#[pyfunction]
+pub(crate) fn info(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+    guard(|| {
+        let source = text_arg(source, "source")?;
+        let source = source.as_str();
+        to_py(
+            py,
+            &brdftab::store::info::file_info(source).map_err(lib_err)?,
+        )
+    })
+}

@@ -1,0 +1,135 @@
+//! The `brdftab.Table` class (a decoded table: its values shared with numpy, its grid as a
+//! dict) and the dict of a device layout, which both `Table.device_layout` and
+//! `Brdf.device_layout` return.
+//!
+//! Why a module: these are what a host takes away to evaluate a table elsewhere (a GPU, a JIT):
+//! values, grid and layout, held apart from the `Brdf` that made them.
+
+use brdftab::Channels;
+use brdftab::table::device::DeviceLayout;
+use brdftab::table::{Interp, Table};
+use numpy::ndarray::IxDyn;
+use numpy::{IntoPyArray, PyArrayDyn};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+use crate::errors::{Error, guard, lib_err, unlocked};
+use crate::values::to_py;
+
+/// A decoded table (`Brdf.table()`): its values as a numpy array sharing the table's memory,
+/// and its grid.
+#[pyclass(name = "Table", module = "brdftab", frozen)]
+pub(crate) struct PyTable {
+    table: Table,
+    grid: Py<PyAny>,
+}
+
+impl PyTable {
+    /// `Brdf.table`'s result: `table` and its grid as the dict `grid` returns.
+    pub(crate) fn new(py: Python<'_>, table: Table) -> PyResult<PyTable> {
+        let grid = table.grid().clone();
+        let mut g = serde_json::to_value(&grid).map_err(|e| Error::new_err(e.to_string()))?;
+        g["stored_axes"] =
+            serde_json::to_value(grid.stored_axes()).map_err(|e| Error::new_err(e.to_string()))?;
+        g["stored_shape"] = serde_json::json!(grid.stored_shape());
+        g["packed"] = serde_json::json!(grid.layout().packed);
+        g["channel_names"] = serde_json::json!(grid.channels().names());
+        g["description"] = serde_json::json!(table.description());
+        Ok(PyTable {
+            grid: to_py(py, &g)?,
+            table,
+        })
+    }
+}
+
+#[pymethods]
+impl PyTable {
+    /// float32 values shaped by the stored axes and the channels (`grid["stored_shape"] +
+    /// [c]`, λ innermost), or flat for a packed layout; read-only, no copy (the array keeps
+    /// this table alive).
+    #[getter]
+    fn values<'py>(slf: Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        let t = &slf.get().table;
+        let shape: Vec<usize> = match t.shape() {
+            Some(s) => s.to_vec(),
+            None => vec![t.values().len()],
+        };
+        let view = numpy::ndarray::ArrayViewD::from_shape(IxDyn(&shape), t.values())
+            .map_err(|e| Error::new_err(e.to_string()))?;
+        // SAFETY: the array borrows the values of `slf`'s table, which is frozen (never mutated)
+        // and kept alive by the array's base object, `slf` itself.
+        let arr = unsafe { PyArrayDyn::borrow_from_array(&view, slf.clone().into_any()) };
+        let kw = PyDict::new(slf.py());
+        kw.set_item("write", false)?;
+        arr.call_method("setflags", (), Some(&kw))?;
+        Ok(arr.into_any())
+    }
+
+    /// The grid: parameterization, full axes, symmetry, stored axes with their mappings and
+    /// node placement, stored_shape, packed, channels, channel_names, quantity, calibration,
+    /// description.
+    #[getter]
+    fn grid(&self, py: Python<'_>) -> Py<PyAny> {
+        self.grid.clone_ref(py)
+    }
+
+    /// The table as a GPU or JIT host evaluates it, for lookups with `interp` ("linear",
+    /// "nearest", or "auto": the table's default, nearest on a grid of MERL cells): the
+    /// library's device layout (`brdftab::table::device`), a dict with
+    /// "version" (refuse any other than the one you implement), "kind" ("kernel" or "grid"),
+    /// "channels", "channel_names", "quantity", "calibration" (None or its factors), "kernel"
+    /// and "grid" (None or dicts of the layout's fields, each with its float32 "values").
+    #[pyo3(signature = (interp = "linear"))]
+    fn device_layout(&self, py: Python<'_>, interp: &str) -> PyResult<Py<PyAny>> {
+        guard(|| {
+            let t = &self.table;
+            let interp: Interp = if interp.trim().eq_ignore_ascii_case("auto") {
+                Interp::default_for(t.grid())
+            } else {
+                interp.parse().map_err(lib_err)?
+            };
+            let d = unlocked(py, || DeviceLayout::new(t, interp))?.map_err(lib_err)?;
+            layout_dict(py, d, t.grid().channels())
+        })
+    }
+
+    /// `values, grid = table`.
+    fn __iter__<'py>(slf: Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        let py = slf.py();
+        let grid = slf.get().grid.clone_ref(py);
+        let pair = PyTuple::new(py, [PyTable::values(slf)?.unbind(), grid])?;
+        pair.into_any().try_iter().map(Bound::into_any)
+    }
+
+    fn __len__(&self) -> usize {
+        2
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<brdftab.Table {}: {}>",
+            self.table.grid().summary(),
+            self.table.description()
+        )
+    }
+}
+
+/// A device layout as the dict `Table.device_layout` and `Brdf.device_layout` return: its
+/// fields as JSON values, "channel_names", and each value array moved into numpy (no copy).
+pub(crate) fn layout_dict(
+    py: Python<'_>,
+    d: DeviceLayout,
+    channels: &Channels,
+) -> PyResult<Py<PyAny>> {
+    let v = serde_json::to_value(&d).map_err(|e| Error::new_err(e.to_string()))?;
+    let out = to_py(py, &v)?;
+    let dict = out.bind(py).cast::<PyDict>()?;
+    dict.set_item("channel_names", channels.names())?;
+    if let (Some(k), Some(kd)) = (d.kernel, dict.get_item("kernel")?) {
+        kd.set_item("values", k.values.into_pyarray(py))?;
+    }
+    if let (Some(g), Some(gd)) = (d.grid, dict.get_item("grid")?) {
+        gd.set_item("values", g.values.into_pyarray(py))?;
+    }
+    Ok(out)
+}

@@ -1,0 +1,155 @@
+//! Python values in and out: arguments (SOURCE and OUTPUT strings or paths, `wavelengths=`,
+//! keyword arguments as the request layer's settings) to the library's values, and the
+//! library's serde results back to Python objects.
+//!
+//! Why a module: every function and method takes or returns some of these, and each conversion
+//! decides which bad value is a `TypeError` and which a `ValueError`; one place keeps them alike.
+
+use brdftab::Channels;
+use brdftab::source;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+use crate::errors::{Error, lib_err};
+
+/// A SOURCE or OUTPUT argument: a `str` (a spec, a path, `DB#NAME`) or an `os.PathLike`
+/// whose `os.fspath` is a `str` (a `pathlib.Path`); anything else is a `TypeError`.
+pub(crate) fn text_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<String> {
+    use pyo3::types::PyString;
+    if obj.is_instance_of::<PyString>() {
+        return obj.extract::<String>();
+    }
+    if obj.hasattr("__fspath__")? {
+        let p = obj.py().import("os")?.call_method1("fspath", (obj,))?;
+        return p.extract::<String>().map_err(|_| {
+            PyTypeError::new_err(format!("{what}: a bytes path is not supported; pass a str"))
+        });
+    }
+    Err(PyTypeError::new_err(format!(
+        "{what}: expected a str or an os.PathLike, got {}",
+        obj.get_type().name()?
+    )))
+}
+
+/// `wavelengths=`: None, a comma-separated string, or a sequence of numbers (nm).
+pub(crate) fn channels_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Channels>> {
+    let Some(o) = obj else { return Ok(None) };
+    if o.is_none() {
+        return Ok(None);
+    }
+    if let Ok(s) = o.extract::<String>() {
+        return source::parse_wavelengths(&s).map(Some).map_err(lib_err);
+    }
+    let nm: Vec<f64> = o.extract().map_err(|_| {
+        PyTypeError::new_err("wavelengths: expected a sequence of numbers (nm) or a string")
+    })?;
+    Channels::wavelengths(nm).map(Some).map_err(lib_err)
+}
+
+pub(crate) fn wavelengths_of(c: &Option<Channels>) -> Option<Vec<f64>> {
+    match c {
+        Some(Channels::Wavelengths(w)) => Some(w.clone()),
+        _ => None,
+    }
+}
+
+/// Keyword arguments as settings of the request layer ([`brdftab::request`]): the same field
+/// names and the same validation as the CLI's flags and the C ABI's JSON. An unknown keyword is
+/// a `TypeError`, as Python's own; a value of the wrong type a `TypeError` naming the field,
+/// any other bad value a `ValueError` naming it.
+pub(crate) fn settings_of<T>(options: Option<&Bound<'_, PyDict>>) -> PyResult<T>
+where
+    T: serde::de::DeserializeOwned + serde::Serialize + Default,
+{
+    let Some(opts) = options else {
+        return Ok(T::default());
+    };
+    let known = brdftab::request::field_names::<T>();
+    let mut map = serde_json::Map::new();
+    for (k, v) in opts.iter() {
+        let key: String = k.extract()?;
+        if !known.contains(&key) {
+            return Err(PyTypeError::new_err(format!(
+                "unexpected keyword argument '{key}'"
+            )));
+        }
+        map.insert(key.clone(), json_of(&key, &v)?);
+    }
+    brdftab::request::from_value(serde_json::Value::Object(map)).map_err(|e| match e {
+        brdftab::Error::InvalidArgument { ref msg, .. } if msg.starts_with("invalid type") => {
+            PyTypeError::new_err(e.to_string())
+        }
+        e => lib_err(e),
+    })
+}
+
+/// A Python value as JSON for the request layer: None, bools, ints, floats, strings, and lists,
+/// tuples, dicts and numpy arrays or scalars of those (through `tolist`).
+fn json_of(key: &str, v: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
+    use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyString};
+    use serde_json::Value;
+    if v.is_none() {
+        return Ok(Value::Null);
+    }
+    if v.is_instance_of::<PyBool>() {
+        return Ok(Value::Bool(v.extract()?));
+    }
+    if v.is_instance_of::<PyInt>() {
+        return match v.extract::<i64>() {
+            Ok(i) => Ok(Value::from(i)),
+            Err(_) => Ok(Value::from(v.extract::<u64>().map_err(|_| {
+                PyValueError::new_err(format!("{key}: integer out of range"))
+            })?)),
+        };
+    }
+    if v.is_instance_of::<PyFloat>() {
+        let x: f64 = v.extract()?;
+        return serde_json::Number::from_f64(x)
+            .map(Value::Number)
+            .ok_or_else(|| PyValueError::new_err(format!("{key}: {x}: expected a finite number")));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(Value::String(v.extract()?));
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        let mut m = serde_json::Map::new();
+        for (k, x) in d.iter() {
+            let k: String = k
+                .extract()
+                .map_err(|_| PyTypeError::new_err(format!("{key}: keys must be strings")))?;
+            let inner = json_of(&format!("{key}.{k}"), &x)?;
+            m.insert(k, inner);
+        }
+        return Ok(Value::Object(m));
+    }
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        return v
+            .try_iter()?
+            .enumerate()
+            .map(|(i, x)| json_of(&format!("{key}[{i}]"), &x?))
+            .collect::<PyResult<Vec<_>>>()
+            .map(Value::Array);
+    }
+    if v.hasattr("tolist")? {
+        let t = v.call_method0("tolist")?;
+        if !t.is(v) {
+            return json_of(key, &t);
+        }
+    }
+    Err(PyTypeError::new_err(format!(
+        "{key}: unsupported type {}",
+        v.get_type().name()?
+    )))
+}
+
+/// A serde_json value as a Python object (through `json.loads`: dicts, lists, floats, ...).
+pub(crate) fn to_py(py: Python<'_>, v: &serde_json::Value) -> PyResult<Py<PyAny>> {
+    let s = serde_json::to_string(v).map_err(|e| Error::new_err(e.to_string()))?;
+    Ok(py.import("json")?.call_method1("loads", (s,))?.unbind())
+}
+
+pub(crate) fn ser<T: serde::Serialize>(py: Python<'_>, x: &T) -> PyResult<Py<PyAny>> {
+    let v = serde_json::to_value(x).map_err(|e| Error::new_err(e.to_string()))?;
+    to_py(py, &v)
+}
