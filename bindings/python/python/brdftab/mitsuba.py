@@ -269,7 +269,8 @@ def _fast_atan2(y, x):
 def _packed_codes(values, channels):
     """A kernel table's values as f16 codes in 64-bit words, one word per node (channels
     padded to four), when they are f16 values scaled by one power of two — the kernel's
-    ``Packed`` (table/kernel.rs) of adaptive tables — and have at most four channels; else None.
+    ``Packed`` (table/kernel/packed.rs) of adaptive tables — and have at most four channels;
+    else None.
 
     Returns (words, scale): a lookup gathers node n's word, moves each code's bits into a
     float32's (sign to bit 31, exponent and mantissa shifted by 13: the code's value times
@@ -627,7 +628,7 @@ class JitTable:
         return [dr.select(valid & inside, x, 0.0) for x in out]
 
     def _grid_lookup(self, wi, wo, active):
-        """GridLayout::eval, then the quantity's projection in float64 (kernel.rs
+        """GridLayout::eval, then the quantity's projection in float64 (kernel/project.rs
         ``project_out``)."""
         import drjit as dr
 
@@ -661,7 +662,7 @@ class JitTable:
         return [dr.select(valid, o, 0.0) for o in out]
 
     def _project(self, wi, wo, out):
-        """f_r from an interpolated quantity (kernel.rs, ``project_out``): other than f_r,
+        """f_r from an interpolated quantity (kernel/project.rs, ``project_out``): other than f_r,
         divided by cos θo or cos θi cos θo of the unit directions (at least 1e-30) in float64,
         clamped at 0; then the calibration."""
         import drjit as dr
@@ -707,7 +708,7 @@ class JitTable:
 
     # -- KernelLayout --------------------------------------------------------------------------
     def _kernel_lookup(self, wi, wo, active):
-        """KernelLayout::vars and ::blend, then the projection in float32 (kernel.rs
+        """KernelLayout::vars and ::blend, then the projection in float32 (kernel/project.rs
         ``project_f32``). Returns (values, inside every cut, valid)."""
         import drjit as dr
         import mitsuba as mi
