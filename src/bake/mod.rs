@@ -46,7 +46,7 @@ pub use plan::{
 };
 pub use preset_check::{
     MODEL_FALLBACK_TARGET_ERROR, PRESET_ALBEDO_TOLERANCE, PRESET_CHECK_PAIRS,
-    PRESET_CHECK_RMSE_SLACK, PRESET_CHECK_THETAS_DEG,
+    PRESET_CHECK_RMSE_SLACK, PRESET_CHECK_THETAS_DEG, PRESET_RMSE_TOLERANCE,
 };
 pub use report::{Accuracy, BakeReport};
 pub use rgl::{Converted, to_rgl};
