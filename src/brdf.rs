@@ -139,16 +139,15 @@ pub trait Brdf: Send + Sync {
     /// A short human-readable description (model name and parameters, or table and source).
     fn describe(&self) -> String;
 
-    /// Whether f_r grows without bound as its directions near the horizon — Ward's
-    /// 1/√(cos θi cos θo), the original Phong's 1/cos θi, Cook-Torrance's 1/cos² θ along the
-    /// grazing mirror (where its V-cavity hides nothing). Bounded f_r cos θi cos θo is then
+    /// Whether f_r grows without bound as one direction nears the horizon — Ward's
+    /// 1/√(cos θi cos θo), the original Phong's 1/cos θi. Bounded f_r cos θi cos θo is then
     /// what a table of this BRDF should store (the bake's default for such sources): a table of
     /// f_r itself blends a node near the horizon, where f_r is huge, over a whole cell, which
     /// costs accuracy at grazing angles and gives its sampler a spike to follow. False by
-    /// default, and for growth as mild as the max- and mean-Phong's 1/cos θ along the grazing
-    /// mirror: their tables of f_r do better there than tables of f_r cos θi cos θo (grazing
-    /// band 0.17 against 0.50 %, n = 50, BENCHMARKS.md), where Cook-Torrance's do worse (0.54
-    /// against 0.36 %).
+    /// default, and for growth confined to the grazing mirror (the max- and mean-Phong's
+    /// 1/cos θ, Cook-Torrance's 1/cos² θ): a lookup of f_r cos θi cos θo divides by cos θo
+    /// wherever the view grazes, which amplifies the table's residual there for every light
+    /// direction, and their tables of f_r do better (BENCHMARKS.md, session 26).
     fn grows_at_horizon(&self) -> bool {
         false
     }

@@ -83,9 +83,8 @@ pub fn key(source: &str, settings: &BakeSettings) -> Result<String> {
     // The tag names what a bake of given settings makes: it changes with that, so tables of
     // an older rule are not served (2: adaptive tables of models calibrated, session 20;
     // 3: a model's default bake checks the medium preset's albedo, session 23; 4: that
-    // check's error over random pairs from mirror-mixture pairs, session 25; 5: Cook-Torrance
-    // tables store f_r cos θi cos θo, and the check also judges the preset's error over
-    // random pairs, session 26).
+    // check's error over random pairs from mirror-mixture pairs, session 25; 5: the check also
+    // judges the preset's error over random pairs, session 26).
     part(b"brdftab bake cache 5");
     part(env!("CARGO_PKG_VERSION").as_bytes());
     let kind = source::classify(source);

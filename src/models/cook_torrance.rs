@@ -208,14 +208,17 @@ impl Brdf for CookTorrance {
         Flags::SMOOTH_SYMMETRIC
     }
 
-    /// True: where both directions near the horizon in the mirror configuration, the facets
-    /// are those at the normal (H = N, D at its peak) and the V-cavity hides none of them
-    /// (V·H = N·V, so G = min(1, 2 N·H) = 1): f_r = k_s D(N) F / (4 cos θi cos θo) grows like
-    /// 1/cos² θ, and f_r cos θi like 1/cos θ — it has no finite RMS over the hemisphere. A
-    /// table of f_r cos θi cos θo (k_s D F G / 4, bounded) follows it; the medium preset's table
-    /// of f_r read 0.39× the source at 89.9° on the grazing mirror (gold, m = 0.3).
+    /// False, although f_r is unbounded in one corner: where both directions near the horizon
+    /// in the mirror configuration the V-cavity hides nothing (H = N, V·H = N·V, G = 1) and
+    /// f_r = k_s D(N) F / (4 cos θi cos θo) grows like 1/cos² θ. Everywhere else f_r stays
+    /// bounded at the horizon (G ≤ 2 (N·H)(N·V)/(V·H) cancels the 1/cos θo), and a table of
+    /// f_r cos θi cos θo, whose lookup divides by the cosines, turns its interpolation residual
+    /// at the horizon into f_r ∝ 1/cos θo for every light direction (gold, m = 0.3, θi = 42°:
+    /// +13 % at θo = 89.9°, +68 % at 89.99°, 10¹² at 90°, where the source is 0.80). The table
+    /// of f_r is off only in that corner (8 % at 89° on the mirror, 61 % low at 89.9°);
+    /// BENCHMARKS.md, session 26.
     fn grows_at_horizon(&self) -> bool {
-        true
+        false
     }
 
     fn describe(&self) -> String {

@@ -179,7 +179,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     print_out(
         "\nbytes: compressed size in the database (log16 ≤ 1e-3 relative + predictor + zstd); vs f32: that size \
          relative to the stored values as plain f32;\nrel RMSE: relative RMSE of f_r cos θi of \
-         the table read back from the database vs its source (50k random pairs;\nmeasured rows (rgl_*): of f_r cos θi cos θo with both directions within 80° of the normal, as `brdftab bench --measured`, since their f_r grows like 1/cos θo at grazing — see BENCHMARKS.md;\nward_aniso and cook_torrance_gold: of f_r cos θi cos θo over the whole hemisphere: their f_r grows without bound at the horizon (Ward's like 1/√(cos θi cos θo), Cook-Torrance's like 1/cos² θ on the grazing mirror), and f_r cos θi has no finite RMS);\nalbedo: max \
+         the table read back from the database vs its source (50k random pairs;\nmeasured rows (rgl_*): of f_r cos θi cos θo with both directions within 80° of the normal, as `brdftab bench --measured`, since their f_r grows like 1/cos θo at grazing — see BENCHMARKS.md;\nward_aniso: of f_r cos θi cos θo over the whole hemisphere: its f_r grows like 1/√(cos θi cos θo), and f_r cos θi has no finite RMS);\nalbedo: max \
          relative albedo error at θ′ = 0, 30, 60, 80° (measured rows: 2°, not 0°, where their reader is discontinuous; the accuracy suite's, floored at 1e-3 of the largest albedo); pos/rec/energy: plausibility of the stored \
          table (y = yes, N = no;\nmeasured data is not reciprocal, and the lecture's Lambert \
          kd = 0.5 is not energy conserving).\n",
