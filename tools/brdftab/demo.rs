@@ -132,9 +132,9 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         let bytes = stored.compressed_bytes();
         let tab = TabulatedBrdf::from_table(stored.to_table()?);
         let f32_bytes = tab.grid().stored_values() as f64 * 4.0;
-        // Measured data within 80° of the normal and tables of f_r cos θi cos θo weighted by
-        // cos θi cos θo, as the accuracy suite's rows (`suite::rmse_weighting`).
-        let (cap, weight) = suite::rmse_weighting(s.measured, tab.grid().quantity());
+        // Weighted by cos θi cos θo, measured data within 80° of the normal, as the accuracy
+        // suite's rows (`suite::rmse_weighting`).
+        let (cap, weight) = suite::rmse_weighting(s.measured);
         let opts = MetricOptions {
             pairs: ACCURACY_PAIRS,
             seed: 1,
@@ -178,8 +178,8 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     }
     print_out(
         "\nbytes: compressed size in the database (log16 ≤ 1e-3 relative + predictor + zstd); vs f32: that size \
-         relative to the stored values as plain f32;\nrel RMSE: relative RMSE of f_r cos θi of \
-         the table read back from the database vs its source (50k random pairs;\nmeasured rows (rgl_*): of f_r cos θi cos θo with both directions within 80° of the normal, as `brdftab bench --measured`, since their f_r grows like 1/cos θo at grazing — see BENCHMARKS.md;\nward_aniso: of f_r cos θi cos θo over the whole hemisphere: its f_r grows like 1/√(cos θi cos θo), and f_r cos θi has no finite RMS);\nalbedo: max \
+         relative to the stored values as plain f32;\nrel RMSE: relative RMSE of f_r cos θi cos θo of \
+         the table read back from the database vs its source (50k random pairs over the whole hemisphere;\nmeasured rows (rgl_*): with both directions within 80° of the normal, as `brdftab bench --measured`, since their f_r grows like 1/cos θo at grazing — see BENCHMARKS.md;\nweighted by cos θi alone the RMS is infinite for measured data, Ward and Cook-Torrance);\nalbedo: max \
          relative albedo error at θ′ = 0, 30, 60, 80° (measured rows: 2°, not 0°, where their reader is discontinuous; the accuracy suite's, floored at 1e-3 of the largest albedo); pos/rec/energy: plausibility of the stored \
          table (y = yes, N = no;\nmeasured data is not reciprocal, and the lecture's Lambert \
          kd = 0.5 is not energy conserving).\n",

@@ -173,7 +173,7 @@ fn materials_and_views_of_a_database() {
     assert!((a0 - 0.2 * std::f64::consts::PI).abs() < 5e-3, "{albedo}");
 
     // Error figures against the source: the matte table is exact up to its codec; gold's small
-    // grid misses Cook-Torrance's grazing growth (the cos θi weight leaves θo unweighted).
+    // grid blurs Cook-Torrance's lobe and misses its grazing growth.
     let err = |m: usize| {
         let c = get_json(&v, &format!("/api/compare?m={m}"));
         (

@@ -7,7 +7,7 @@
 
 use std::sync::Arc;
 
-use brdftab::analysis::{accuracy::Weight, plausibility};
+use brdftab::analysis::plausibility;
 use brdftab::spectrum::Channels;
 use serde_json::json;
 
@@ -216,16 +216,14 @@ pub fn compare(reg: &Registry, q: &Query) -> Result<Response, Response> {
         } else {
             &[0.0, 30.0, 60.0, 80.0]
         };
+        // As the demo's and the suite's rows (`suite::rmse_weighting`).
+        let (cap, weight) = suite::rmse_weighting(measured);
         let opts = MetricOptions {
             pairs: 20_000,
             seed: 1,
             albedo_thetas: thetas.iter().map(|t| t.to_radians()).collect(),
-            cap: measured.then(|| 80f64.to_radians()),
-            weight: if measured {
-                Weight::CosInCosOut
-            } else {
-                Weight::CosIn
-            },
+            cap,
+            weight,
         };
         let src_albedo = suite::albedos(source.as_ref(), &opts.albedo_thetas);
         match suite::metrics(table.as_ref(), source.as_ref(), &src_albedo, &opts) {
@@ -234,7 +232,7 @@ pub fn compare(reg: &Registry, q: &Query) -> Result<Response, Response> {
                 "max_rel": r.max_rel,
                 "albedo_err": r.albedo_err,
                 "pairs": opts.pairs,
-                "weight": if measured { "cos θi cos θo, within 80°" } else { "cos θi" },
+                "weight": if measured { "cos θi cos θo, within 80°" } else { "cos θi cos θo" },
             })
             .to_string(),
             Err(e) => json!({ "error": e.to_string() }).to_string(),
