@@ -122,9 +122,12 @@ pub struct Accuracy {
 impl Accuracy {
     /// Compares `table` with `source` on `pairs` random pairs (seed 1).
     pub fn measure(table: &dyn Brdf, source: &dyn Brdf, pairs: usize) -> Result<Accuracy> {
-        use crate::analysis::accuracy::{compare, compare_cap};
-        let all = compare(table, source, pairs, 1)?;
-        let cap = compare_cap(table, source, pairs, 1, 80f64.to_radians())?;
+        // Both cosines: f_r cos θi has no finite RMS for measured data, Ward or Cook-Torrance
+        // (the figure the struct's fields say; it read f_r cos θi until session 26).
+        use crate::analysis::accuracy::{Weight, compare_weighted};
+        let w = Weight::CosInCosOut;
+        let all = compare_weighted(table, source, pairs, 1, std::f64::consts::FRAC_PI_2, w)?;
+        let cap = compare_weighted(table, source, pairs, 1, 80f64.to_radians(), w)?;
         Ok(Accuracy {
             pairs: all.pairs,
             rel_rmse: all.rel_rmse,

@@ -62,7 +62,7 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
             )?;
             if let Some(acc) = r.accuracy {
                 outln!(
-                    "  accuracy vs native ({interp:?}, {} pairs): cosine-weighted relative RMSE {:.3e}, max relative {:.3e}",
+                    "  accuracy vs native ({interp:?}, {} pairs): relative RMSE of f_r cos θi cos θo {:.3e}, max relative {:.3e}",
                     acc.pairs,
                     acc.rel_rmse,
                     acc.max_rel
