@@ -97,6 +97,12 @@ pub(super) enum Checked {
     Missed(String),
 }
 
+/// Whether a candidate's error over random pairs `r` is within [`PRESET_CHECK_RMSE_SLACK`] of
+/// the preset's `rp` (any error up to 1 % passes).
+fn within_slack(r: f64, rp: f64) -> bool {
+    r <= (rp * (1.0 + PRESET_CHECK_RMSE_SLACK)).max(0.01)
+}
+
 /// `why` before the bake's own note, if it has one.
 pub(super) fn with_note(why: String, note: Option<String>) -> String {
     match note {
@@ -174,16 +180,13 @@ impl BakeRequest {
         } else {
             Weight::CosIn
         };
-        let rmse = |t: &dyn Brdf| {
+        let rmse_weighted = |t: &dyn Brdf, w: Weight| {
             let whole = Region::Cap(std::f64::consts::FRAC_PI_2);
-            compare_region(t, src, PRESET_CHECK_PAIRS, 1, whole, weight).map(|a| a.rel_rmse)
+            compare_region(t, src, PRESET_CHECK_PAIRS, 1, whole, w).map(|a| a.rel_rmse)
         };
+        let rmse = |t: &dyn Brdf| rmse_weighted(t, weight);
         // The error of the whole-hemisphere f_r cos θi cos θo ([`PRESET_RMSE_TOLERANCE`]).
-        let rmse_cc = |t: &dyn Brdf| {
-            let whole = Region::Cap(std::f64::consts::FRAC_PI_2);
-            compare_region(t, src, PRESET_CHECK_PAIRS, 1, whole, Weight::CosInCosOut)
-                .map(|a| a.rel_rmse)
-        };
+        let rmse_cc = |t: &dyn Brdf| rmse_weighted(t, Weight::CosInCosOut);
         let plain = TabulatedBrdf::from_table(preset.clone());
         let e = albedo(&plain)?;
         if e.worst <= PRESET_ALBEDO_TOLERANCE {
@@ -201,8 +204,7 @@ impl BakeRequest {
                 .table_of(src, &Silent)?;
             let adaptive = TabulatedBrdf::from_table(adaptive);
             let (a, ac, r) = (albedo(&adaptive)?, rmse_cc(&adaptive)?, rmse(&adaptive)?);
-            let bound = (rp * (1.0 + PRESET_CHECK_RMSE_SLACK)).max(0.01);
-            if ac < pc && a.worst <= PRESET_ALBEDO_TOLERANCE && r <= bound {
+            if ac < pc && a.worst <= PRESET_ALBEDO_TOLERANCE && within_slack(r, rp) {
                 let why = format!(
                     "the medium preset's table was {:.2} % off over random pairs: baked to an \
                      error target of {} % instead ({:.2} %)",
@@ -218,8 +220,7 @@ impl BakeRequest {
         drop(plain);
         let mut best: Option<(Fallback, AlbedoError)> = None;
         let mut consider = |f: Fallback, a: AlbedoError, r: f64| {
-            let bound = (rp * (1.0 + PRESET_CHECK_RMSE_SLACK)).max(0.01);
-            if a.worst < best.as_ref().map_or(e.worst, |b| b.1.worst) && r <= bound {
+            if a.worst < best.as_ref().map_or(e.worst, |b| b.1.worst) && within_slack(r, rp) {
                 best = Some((f, a));
             }
             best.as_ref()
