@@ -292,10 +292,16 @@ impl MerlBrdf {
     }
 
     /// The sampler of [`Brdf::sample`] and [`Brdf::pdf`], built on first use (MERL data are
-    /// isotropic: conditioned on θo alone, at [`SamplingResolution::binned`]).
+    /// isotropic: conditioned on θo alone, at [`SamplingResolution::binned`], as
+    /// [`SamplingResolution::for_source`] refines it).
     pub fn sampler(&self) -> &TableSampler {
-        self.sampler
-            .get_or_init(|| TableSampler::build(self, true, &SamplingResolution::binned()))
+        self.sampler.get_or_init(|| {
+            TableSampler::build(
+                self,
+                true,
+                &SamplingResolution::for_source(self, true, true),
+            )
+        })
     }
 
     /// Builds from raw stored values (3 × [`SAMPLES`], channel-planar, unscaled).

@@ -555,7 +555,7 @@ impl RglBrdf {
     /// The sampler of [`Brdf::sample`] and [`Brdf::pdf`] (built on first use).
     pub fn sampler(&self) -> &TableSampler {
         self.sampler.get_or_init(|| {
-            let res = SamplingResolution::for_isotropy(self.isotropic);
+            let res = SamplingResolution::for_source(self, self.isotropic, false);
             TableSampler::build(self, self.isotropic, &res)
         })
     }

@@ -46,10 +46,32 @@ pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
         "chunks": t.chunk_count(),
         "bytes": bytes,
         "ratio_to_f32": (h.values as f64 * 4.0) / (bytes.max(1) as f64),
-        "sampling_bytes": SamplingResolution::for_lookup(isotropic, cells).memory_bytes(isotropic),
+        "sampling_bytes": sampling_resolution(&t, grid.as_ref(), isotropic, cells)
+            .memory_bytes(isotropic),
         "quantity": quantity.name(),
         "calibrated": calibrated,
     }))
+}
+
+/// The resolution of the sampler the table `t` builds when opened with its default lookup
+/// ([`SamplingResolution::for_source`]: probes the table's peak at normal incidence, reading
+/// the chunks it needs); [`SamplingResolution::for_lookup`] when the grid is unreadable.
+fn sampling_resolution(
+    t: &super::StoredTable,
+    grid: Option<&crate::table::Grid>,
+    isotropic: bool,
+    cells: bool,
+) -> SamplingResolution {
+    match grid {
+        Some(g) if isotropic => {
+            let mut b = crate::table::TabulatedBrdf::lazy(g.clone(), Box::new(t.loader()), "");
+            if cells {
+                b.set_interp(crate::table::Interp::Nearest);
+            }
+            SamplingResolution::for_source(&b, isotropic, cells)
+        }
+        _ => SamplingResolution::for_lookup(isotropic, cells),
+    }
 }
 
 /// The summary of table `name` of the file at `path`.

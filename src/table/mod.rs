@@ -28,6 +28,7 @@ mod horizon;
 pub mod kernel;
 pub mod lookup;
 pub mod param;
+mod pole;
 pub mod presets;
 pub mod raw;
 pub mod sampling;
@@ -40,7 +41,9 @@ pub(crate) mod warp2d;
 pub use fill::{BakeOptions, BakeStats, bake, bake_chunks};
 pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, Quantity, StoredAxis};
 pub use lookup::Interp;
-pub use sampling::{Adjoint, AliasTables, Draw, SamplingNodes, SamplingResolution, TableSampler};
+pub use sampling::{
+    Adjoint, AliasTables, Draw, HALF_MAP_LINEAR, SamplingNodes, SamplingResolution, TableSampler,
+};
 pub use symmetry::Symmetry;
 pub use tabulated::{ChunkLoader, TabulatedBrdf};
 

@@ -13,7 +13,7 @@
 //!   h, wi = 2 (wo·h) h − wo (dωi = 4 (wo·h) dωh). Reflectance concentrates around h = n (the
 //!   specular peak) for every view, so the distributions of neighbouring views look alike and
 //!   interpolate well, and one fixed, pole-dense parameterization resolves sharp peaks: the unit
-//!   square (s, y) maps to θh = (π/2)(0.1 s + 0.9 s²) (nearly the RGL format's u(θ) = √(2θ/π),
+//!   square (s, y) maps to θh = (π/2)(0.02 s + 0.98 s²) (nearly the RGL format's u(θ) = √(2θ/π),
 //!   but with a Jacobian that vanishes at the pole as the bilinear density does, so the density
 //!   of `wi` stays finite at the mirror direction) and φh = 2π y − π (relative to φo for
 //!   isotropic sources, absolute otherwise).
@@ -120,6 +120,46 @@ impl SamplingResolution {
         }
     }
 
+    /// The resolution for `brdf` looked up as `isotropic` and `nearest` say:
+    /// [`SamplingResolution::for_lookup`], with twice the θh nodes for an isotropic source whose
+    /// specular peak at normal incidence is too sharp for them ([`SamplingResolution::sharp_peak`]).
+    /// What tables, the native readers and `info` use.
+    pub fn for_source(brdf: &dyn Brdf, isotropic: bool, nearest: bool) -> Self {
+        let res = Self::for_lookup(isotropic, nearest);
+        if isotropic && Self::sharp_peak(brdf, &res) {
+            SamplingResolution {
+                theta_h: 2 * res.theta_h,
+                ..res
+            }
+        } else {
+            res
+        }
+    }
+
+    /// Whether more than [`SHARP_POLE_SHARE`] of the normal view's f_r cos θi (in the
+    /// sampler's half-vector domain) lies within the first [`SHARP_POLE_CELLS`] θh cells of
+    /// `res`: a lobe the bilinear density over those cells cannot follow. GGX α = 0.002 puts
+    /// 0.85 of its mass there and samples with a CV of 0.18 on 64 θh nodes, 0.09 on 128;
+    /// α = 0.005 0.49 (0.10 → 0.06); α = 0.01 (0.21, CV 0.07), the reciprocal Phong at
+    /// n = 1000 (0.05) and every shipped RGL file (at most 0.04) keep 64
+    /// (`examples/sampling_cv`).
+    pub fn sharp_peak(brdf: &dyn Brdf, res: &SamplingResolution) -> bool {
+        Self::pole_share(brdf, res) > SHARP_POLE_SHARE
+    }
+
+    /// The share of the normal view's f_r cos θi (in the sampler's half-vector domain) within
+    /// the first [`SHARP_POLE_CELLS`] θh cells of `res` (0 for a source that is nowhere
+    /// positive there).
+    pub fn pole_share(brdf: &dyn Brdf, res: &SamplingResolution) -> f64 {
+        super::pole::pole_share(
+            brdf,
+            res.theta_h.max(2),
+            SHARP_POLE_CELLS,
+            theta_of_s,
+            half_jacobian,
+        )
+    }
+
     /// Bytes a [`TableSampler`] of this resolution holds (`isotropic`: one node per θo).
     pub fn memory_bytes(&self, isotropic: bool) -> usize {
         let (nx, ny) = (self.theta_h.max(2), self.phi_h.max(2));
@@ -155,6 +195,13 @@ impl SamplingResolution {
     }
 }
 
+/// θh cells of the sampler's map that [`SamplingResolution::sharp_peak`] looks at.
+pub const SHARP_POLE_CELLS: usize = 3;
+
+/// Share of the normal view's mass within [`SHARP_POLE_CELLS`] above which a source's peak is
+/// sharp ([`SamplingResolution::sharp_peak`]).
+pub const SHARP_POLE_SHARE: f64 = 0.3;
+
 /// Conditional half-vector warps of f_r·cos θi (see the module docs).
 #[derive(Debug, Clone)]
 pub struct TableSampler {
@@ -164,12 +211,17 @@ pub struct TableSampler {
     warp: AliasWarp,
 }
 
-/// Share of the θh map that is linear in s: θh = (π/2)(a s + (1 − a) s²), a = `LINEAR`.
+/// Share of the θh map that is linear in s: θh = (π/2)(a s + (1 − a) s²), a = `HALF_MAP_LINEAR`.
 /// The quadratic part puts the nodes close together at the pole (the RGL format's u(θ) = √(2θ/π)
 /// is the pure quadratic); the linear part keeps dθh/ds > 0 there, so that the Jacobian
 /// vanishes like s at the pole, as the bilinear density does — with the pure quadratic it
 /// vanishes like s³ and the density of `wi` would be infinite at the mirror direction.
-const LINEAR: f64 = 0.1;
+/// 0.02 rather than the 0.1 of sessions 9–26: the first cell narrows from 0.16° to 0.05°, so a
+/// sharp peak spreads over more of them — GGX α = 0.002's weights' CV went from 0.85 to 0.18 on
+/// 64 θh nodes and cg_sunflower's from 0.045–0.073 to 0.039–0.062 over views 3–75°, GGX
+/// α = 0.05 unchanged (0.024–0.036); the outer cells barely change (2.7° → 2.8°).
+pub const HALF_MAP_LINEAR: f64 = 0.02;
+const LINEAR: f64 = HALF_MAP_LINEAR;
 
 /// θh of the square's first coordinate s.
 #[inline]
@@ -220,7 +272,7 @@ fn square_of(h: DVec3) -> [f64; 2] {
 }
 
 /// The densities a [`TableSampler`] is built from: g(s, y) at `nx` × `ny` nodes of the unit
-/// square (s → θh = (π/2)(0.1 s + 0.9 s²), y → φh = 2π y − π relative to φo for isotropic
+/// square (s → θh = (π/2)(0.02 s + 0.98 s²), y → φh = 2π y − π relative to φo for isotropic
 /// sources) for each conditioning node, `nt` over t = sqrt(1 − cos θo) ∈ [0, 1] (uniform; one
 /// node: t = ½) times `np` over φo ∈ [0, 2π) (periodic; 1 for isotropic sources), the floor
 /// included (see the module docs), not normalized.

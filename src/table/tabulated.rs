@@ -258,12 +258,13 @@ impl TabulatedBrdf {
     }
 
     /// The importance sampler of [`Brdf::sample`]/[`Brdf::pdf`], built on first use with
-    /// [`SamplingResolution::default`] (isotropic tables), [`SamplingResolution::binned`]
-    /// (isotropic tables read with nearest lookups) or [`SamplingResolution::anisotropic`].
+    /// [`SamplingResolution::for_source`]: [`SamplingResolution::default`] (isotropic tables),
+    /// [`SamplingResolution::binned`] (isotropic tables read with nearest lookups) or
+    /// [`SamplingResolution::anisotropic`], with twice the θh nodes for a sharp peak.
     pub fn sampler(&self) -> &TableSampler {
         self.sampler.get_or_init(|| {
             let iso = self.grid.symmetry().isotropic;
-            let res = SamplingResolution::for_lookup(iso, self.interp == Interp::Nearest);
+            let res = SamplingResolution::for_source(self, iso, self.interp == Interp::Nearest);
             TableSampler::build(self, iso, &res)
         })
     }
