@@ -439,3 +439,19 @@ def test_bad_arguments():
         brdftab.fit(LAMBERT, "lambert", max_theta_deg=100)
     # one-pair evaluation does not leak state between bad and good calls
     assert b.eval([0, 0, 1], [0, 0, 1]).tolist() == pytest.approx([0.1, 0.2, 0.3])
+
+
+def test_sampling_resolution_doubles_theta_h_for_a_sharp_peak():
+    """The library's sampler resolution (what the Mitsuba plugin asks for): 64 × 64 half-vector
+    nodes over 32 views for a broad lobe, 128 θh nodes for GGX α = 0.002 (its peak lies within
+    the first θh cells of 64), 48 × 48 over 20 × 16 views for an anisotropic source; the nodes
+    carry the θh map's constant."""
+    broad = brdftab.open('{"model": "ggx", "alpha": 0.3}').sampling_resolution()
+    assert broad == {"theta_h": 64, "phi_h": 64, "theta_o": 32, "phi_o": 16}
+    sharp = brdftab.open('{"model": "ggx", "alpha": 0.002}')
+    res = sharp.sampling_resolution(adjoint=True)
+    assert res["theta_h"] == 128 and res["phi_h"] == 64
+    nodes = sharp.sampling_nodes(adjoint=True, **res)
+    assert nodes["version"] == 3 and nodes["nx"] == 128 and 0.0 < nodes["linear"] < 0.1
+    aniso = brdftab.open('{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}')
+    assert aniso.sampling_resolution() == {"theta_h": 48, "phi_h": 48, "theta_o": 20, "phi_o": 16}

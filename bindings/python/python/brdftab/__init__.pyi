@@ -66,6 +66,10 @@ class Brdf:
         A closed form where the model has one, else adaptive quadrature: 1e-6 relative for
         models, 1e-4 for tables and measured data.
         """
+    def sampling_resolution(self, adjoint: bool = False, nearest: bool = False) -> dict[str, int]:
+        """The resolution the library samples this source at: {"theta_h", "phi_h", "theta_o",
+        "phi_o"}, the keywords of `sampling_nodes` — twice the θh nodes for a peak at normal
+        incidence too sharp for 64; nearest=True for a table read by cell."""
     def table(self, **options: Any) -> Table:
         """The decoded table (other sources are baked with the keywords of `bake`); unpacks as
         `values, grid = b.table()`."""
@@ -77,8 +81,9 @@ class Brdf:
         theta_o: int = 32,
         phi_o: int = 16,
     ) -> dict[str, Any]:
-        """The node densities of the library's importance sampler: {"version": 2, "nx", "ny",
-        "nt", "np", "isotropic", "data": float32 (nt·np, ny, nx), "alias": {"other_bits",
+        """The node densities of the library's importance sampler: {"version": 3, "linear" (a of
+        the θh map (π/2)(a s + (1 − a) s²)), "nx", "ny", "nt", "np", "isotropic", "data": float32
+        (nt·np, ny, nx), "alias": {"other_bits",
         "pdf": float32 (nt·np, ny, nx) normalized, "strips": uint32 (nt·np, 2(ny − 1)),
         "cells": uint32 (nt·np, ny, nx − 1)}} — "alias" is the library's constant-time draw
         (Rust ``brdftab::table::AliasTables``); adjoint=True conditions on wi (Mitsuba's

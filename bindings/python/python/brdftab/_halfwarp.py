@@ -6,7 +6,7 @@ Why a module: the plugin used to sample wo from 2D distributions of its own (16 
 the design of ``src/table/sampling.rs`` (see its module docs) on the densities the library
 exports (:meth:`brdftab.Brdf.sampling_nodes`, adjoint: conditioned on wi, ∝ f_r cos θo):
 
-- the unit square (s, y) ↦ half vector h, θh = (π/2)(0.1 s + 0.9 s²), φh = 2π y − π relative
+- the unit square (s, y) ↦ half vector h, θh = (π/2)(a s + (1 − a) s²) (a = the nodes' ``linear``), φh = 2π y − π relative
   to φi (isotropic sources); wo = 2 (wi·h) h − wi, dωo = 4 (wi·h) sin θh dθh/ds dφh/dy ds dy;
 - the densities at the nodes drawn with the library's own alias tables (``_alias2d``: the
   normalized slices interpolated linearly between conditioning nodes over t = sqrt(1 − cos θi),
@@ -23,17 +23,16 @@ from __future__ import annotations
 
 import math
 
-_LINEAR = 0.1  # sampling.rs `LINEAR`
-
-
 class HalfVectorSampler:
     """Draws wo given wi ∝ f_r(wi, wo) cos θo from the library's node densities."""
 
     def __init__(self, nodes):
         from ._alias2d import AliasWarp2D
 
-        if nodes.get("version") != 2:
-            raise ValueError(f"sampling nodes version {nodes.get('version')!r}: expected 2")
+        if nodes.get("version") != 3:
+            raise ValueError(f"sampling nodes version {nodes.get('version')!r}: expected 3")
+        # The θh map's linear share (sampling.rs `HALF_MAP_LINEAR`).
+        self.linear = float(nodes["linear"])
         self.nt, self.np, ny, nx = (int(nodes[k]) for k in ("nt", "np", "ny", "nx"))
         self.isotropic = bool(nodes["isotropic"]) or self.np == 1
         self.warp = AliasWarp2D(nodes["alias"], nx, ny)
@@ -91,28 +90,27 @@ class HalfVectorSampler:
         return mi.Vector3f(v.x, v.y, -v.z)
 
     # -- the square and the half vector (sampling.rs: half_of, square_of, half_jacobian) ----
-    @staticmethod
-    def _half_of(p):
+    def _half_of(self, p):
         import drjit as dr
         import mitsuba as mi
 
-        th = (0.5 * math.pi) * p.x * (_LINEAR + (1.0 - _LINEAR) * p.x)
+        th = (0.5 * math.pi) * p.x * (self.linear + (1.0 - self.linear) * p.x)
         st, ct = dr.sincos(th)
         sp, cp = dr.sincos(2 * math.pi * p.y)
         return mi.Vector3f(-st * cp, -st * sp, ct), st
 
-    @staticmethod
-    def _jacobian(s, sin_th):
-        return sin_th * (0.5 * math.pi) * (_LINEAR + 2.0 * (1.0 - _LINEAR) * s) * (2 * math.pi)
+    def _jacobian(self, s, sin_th):
+        a = self.linear
+        return sin_th * (0.5 * math.pi) * (a + 2.0 * (1.0 - a) * s) * (2 * math.pi)
 
-    @staticmethod
-    def _square_of(h):
+    def _square_of(self, h):
         import drjit as dr
         import mitsuba as mi
 
         r = dr.sqrt(h.x * h.x + h.y * h.y)
         q = dr.atan2(r, h.z) * (2.0 / math.pi)
-        s = 2.0 * q / (_LINEAR + dr.sqrt(_LINEAR * _LINEAR + 4.0 * (1.0 - _LINEAR) * q))
+        a = self.linear
+        s = 2.0 * q / (a + dr.sqrt(a * a + 4.0 * (1.0 - a) * q))
         y = (dr.atan2(h.y, h.x) + math.pi) * (0.5 / math.pi)
         y = y - dr.floor(y)
         return mi.Point2f(dr.clip(s, 0.0, 1.0), y), r

@@ -13,7 +13,8 @@ adaptive grid within :data:`MODEL_TARGET_ERROR`, calibrated to the model's albed
 models the library's default bake — the ``medium`` preset, calibrated where its albedo misses
 the model's by over 1 % (Ward's anisotropic lobes at the horizon); RGL files: the library's adaptive grid, MERL files: their own cells),
 ``sampling_res`` (the
-resolution of the sampling distributions: half-vector nodes per axis, default 64, 48 for
+resolution of the sampling distributions: half-vector nodes per axis; default the library's,
+:meth:`brdftab.Brdf.sampling_resolution`: 64, 128 θh nodes for a peak too sharp for 64, 48 for
 anisotropic tables), ``cache`` (bool, default
 true: baked tables are kept in the cache of baked tables, :func:`brdftab.bake_cached`, so a
 material is baked once, not at every scene load) and ``cache_dir``.
@@ -831,14 +832,16 @@ class JitBrdftabBSDF(_Common):
         # The library's importance sampler (conditional half-vector warps of f_r cos θo given
         # wi), on the densities it exports for the table (or the source): brdftab._halfwarp.
         # (A kernel layout is of an isotropic table.)
-        iso = layout["kind"] == "kernel" or layout["grid"]["symmetry"]["isotropic"]
-        res = int(_prop(props, "sampling_res", 64 if iso else 48))
-        # The library's conditioning (SamplingResolution::for_lookup): 32 θi nodes, 48 for a
-        # table read by cell (its values step as the view moves), 20 anisotropic.
+        # The library's resolution (SamplingResolution::for_source): 64 × 64 half-vector nodes
+        # (128 θh for a peak too sharp for 64) and 32 θi nodes, 48 for a table read by cell (its
+        # values step as the view moves); 48 × 48 and 20 × 16 anisotropic. `sampling_res`
+        # overrides the half-vector nodes.
         nearest = layout["kind"] == "grid" and layout["grid"]["interp"] == "nearest"
-        views = (48 if nearest else 32) if iso else 20
-        nodes = self._sampled.sampling_nodes(adjoint=True, theta_h=res, phi_h=res,
-                                             theta_o=views)
+        res = self._sampled.sampling_resolution(adjoint=True, nearest=nearest)
+        override = _prop(props, "sampling_res")
+        if override is not None:
+            res["theta_h"] = res["phi_h"] = int(override)
+        nodes = self._sampled.sampling_nodes(adjoint=True, **res)
         self.sampler = HalfVectorSampler(nodes)
         dr.eval()
 

@@ -209,9 +209,9 @@ impl PyBrdf {
     }
 
     /// The node densities of the library's importance sampler (`brdftab.table.SamplingNodes`
-    /// in Rust): {"version": 2, "nx", "ny", "nt", "np", "isotropic", "data": float32 array
-    /// (nt·np, ny, nx), "alias": {...}} — g(s, y) of f_r cos θ over the half-vector square
-    /// (s → θh = (π/2)(0.1 s + 0.9 s²), y → φh = 2π y − π relative to the conditioning
+    /// in Rust): {"version": 3, "linear", "nx", "ny", "nt", "np", "isotropic", "data": float32
+    /// array (nt·np, ny, nx), "alias": {...}} — g(s, y) of f_r cos θ over the half-vector square
+    /// (s → θh = (π/2)(a s + (1 − a) s²), a = "linear", y → φh = 2π y − π relative to the conditioning
     /// direction's azimuth) at nt conditioning nodes uniform in t = sqrt(1 − cos θ) (times np
     /// over φ for anisotropic sources), and the library's constant-time draw of them
     /// (`brdftab.table.AliasTables`): {"other_bits", "pdf": float32 (nt·np, ny, nx)
@@ -229,6 +229,20 @@ impl PyBrdf {
         phi_o: usize,
     ) -> PyResult<Py<PyAny>> {
         guard(|| self.sampling_nodes_dict(py, adjoint, theta_h, phi_h, theta_o, phi_o))
+    }
+
+    /// The resolution the library samples this source at (`SamplingResolution::for_source`):
+    /// {"theta_h", "phi_h", "theta_o", "phi_o"} for `sampling_nodes` — twice the θh nodes for
+    /// a peak at normal incidence too sharp for 64; `nearest=True` for a table read by cell (48
+    /// θ nodes); `adjoint=True` probes f_r with its directions exchanged.
+    #[pyo3(signature = (adjoint=false, nearest=false))]
+    fn sampling_resolution(
+        &self,
+        py: Python<'_>,
+        adjoint: bool,
+        nearest: bool,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| self.sampling_resolution_dict(py, adjoint, nearest))
     }
 
     /// The decoded table as a `brdftab.Table`: `values` (float32, shaped by the stored axes

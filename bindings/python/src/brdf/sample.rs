@@ -127,6 +127,28 @@ impl PyBrdf {
     }
 
     /// `Brdf.sampling_nodes`'s body, run under `guard` (documented on the method, in `mod.rs`).
+    pub(super) fn sampling_resolution_dict(
+        &self,
+        py: Python<'_>,
+        adjoint: bool,
+        nearest: bool,
+    ) -> PyResult<Py<PyAny>> {
+        use brdftab::table::{Adjoint, SamplingResolution};
+        let iso = self.inner.flags().isotropic;
+        let brdf: &dyn Brdf = self.inner.as_ref();
+        let r = unlocked(py, || match adjoint {
+            true => SamplingResolution::for_source(&Adjoint(brdf), iso, nearest),
+            false => SamplingResolution::for_source(brdf, iso, nearest),
+        })?;
+        self.check_loaded()?;
+        let d = PyDict::new(py);
+        d.set_item("theta_h", r.theta_h)?;
+        d.set_item("phi_h", r.phi_h)?;
+        d.set_item("theta_o", r.theta_o)?;
+        d.set_item("phi_o", r.phi_o)?;
+        Ok(d.into_any().unbind())
+    }
+
     pub(super) fn sampling_nodes_dict(
         &self,
         py: Python<'_>,
@@ -177,7 +199,8 @@ impl PyBrdf {
         alias.set_item("cells", cells.into_pyarray(py))?;
         let data = array(&shape, n.data)?.into_pyarray(py);
         let d = PyDict::new(py);
-        d.set_item("version", 2)?;
+        d.set_item("version", 3)?;
+        d.set_item("linear", brdftab::table::HALF_MAP_LINEAR)?;
         d.set_item("nx", n.nx)?;
         d.set_item("ny", n.ny)?;
         d.set_item("nt", n.nt)?;
