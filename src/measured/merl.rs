@@ -63,7 +63,7 @@ use crate::brdf::{BakeSource, Brdf, Flags};
 use crate::error::{Error, Result};
 use crate::geometry::{self, HalfDiff};
 use crate::spectrum::Channels;
-use crate::table::sampling::{SamplingResolution, TableSampler};
+use crate::table::sampling::TableSampler;
 
 /// θh resolution.
 pub const RES_THETA_H: usize = 90;
@@ -292,16 +292,12 @@ impl MerlBrdf {
     }
 
     /// The sampler of [`Brdf::sample`] and [`Brdf::pdf`], built on first use (MERL data are
-    /// isotropic: conditioned on θo alone, at [`SamplingResolution::binned`], as
-    /// [`SamplingResolution::for_source`] refines it).
+    /// isotropic: conditioned on θo alone, at
+    /// [`SamplingResolution::binned`](crate::table::SamplingResolution::binned), as
+    /// [`TableSampler::for_source`] refines it).
     pub fn sampler(&self) -> &TableSampler {
-        self.sampler.get_or_init(|| {
-            TableSampler::build(
-                self,
-                true,
-                &SamplingResolution::for_source(self, true, true),
-            )
-        })
+        self.sampler
+            .get_or_init(|| TableSampler::for_source(self, true, true))
     }
 
     /// Builds from raw stored values (3 × [`SAMPLES`], channel-planar, unscaled).

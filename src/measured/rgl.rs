@@ -44,7 +44,7 @@ use crate::brdf::{BakeSource, Brdf, Flags};
 use crate::error::{Error, Result};
 use crate::geometry;
 use crate::spectrum::{Channels, MAX_CHANNELS};
-use crate::table::sampling::{SamplingResolution, TableSampler};
+use crate::table::sampling::TableSampler;
 pub(crate) use crate::table::warp2d::{Corners, Planes, Warp};
 use crate::table::warp2d::{NO_PARAMS, bilinear};
 
@@ -554,10 +554,8 @@ impl RglBrdf {
 
     /// The sampler of [`Brdf::sample`] and [`Brdf::pdf`] (built on first use).
     pub fn sampler(&self) -> &TableSampler {
-        self.sampler.get_or_init(|| {
-            let res = SamplingResolution::for_source(self, self.isotropic, false);
-            TableSampler::build(self, self.isotropic, &res)
-        })
+        self.sampler
+            .get_or_init(|| TableSampler::for_source(self, self.isotropic, false))
     }
 
     /// The reference reader's value, f_r · cos θo, per channel (for tests and comparisons).

@@ -31,10 +31,12 @@ pub mod param;
 mod pole;
 pub mod presets;
 pub mod raw;
+mod resolution;
 pub mod sampling;
 pub mod symmetry;
 pub mod tabulated;
 pub mod target;
+mod views;
 pub mod warp;
 pub(crate) mod warp2d;
 

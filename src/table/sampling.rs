@@ -55,7 +55,10 @@
 //! Defaults ([`SamplingResolution::default`]): isotropic 64 θh × 64 φh nodes, 32 θo nodes
 //! (≈ 2 × 4 bytes per node and conditioning node: a density and an alias entry → 1.06 MB);
 //! anisotropic
-//! ([`SamplingResolution::anisotropic`]) 48 × 48 nodes, 20 θo × 16 φo (6.0 MB). Building
+//! ([`SamplingResolution::anisotropic`]) 48 × 48 nodes, 20 θo × 16 φo (6.0 MB). Per source
+//! ([`TableSampler::for_source`]): twice the θh nodes for a peak at normal incidence too sharp
+//! for them (`table::pole`), half again the views and φh nodes (2.4 MB) where the weights' CV
+//! predicted from the density between the grazing views misses a bar (`table::views`). Building
 //! evaluates the source once per node (131 k evaluations isotropic, 737 k anisotropic); it runs
 //! on the calling thread (no rayon: a lazy build inside `OnceLock` must not re-enter itself
 //! through rayon's work stealing).
@@ -64,76 +67,20 @@ use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use super::alias2d::AliasWarp;
+pub use super::resolution::SamplingResolution;
 use super::warp2d::{Corners, Planes};
 use crate::brdf::{Brdf, BrdfSample};
 use crate::fastmath;
 use crate::geometry::{self, mirror_z};
 use crate::spectrum::MAX_CHANNELS;
 
-/// Resolution of a [`TableSampler`] (see the module docs).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SamplingResolution {
-    /// Nodes over s = sqrt(θh / (π/2)), at least 2.
-    pub theta_h: usize,
-    /// Nodes over φh (the first and the last are the same azimuth), at least 2.
-    pub phi_h: usize,
-    /// Conditioning nodes over t = sqrt(1 − cos θo).
-    pub theta_o: usize,
-    /// Conditioning nodes over φo (anisotropic sources only).
-    pub phi_o: usize,
-    /// Density added to every node whose mirror image of `wo` is above the horizon, as a
-    /// fraction of those nodes' mean (0 < floor); a tenth of it is added to every node.
-    pub floor: f64,
-}
-
-impl Default for SamplingResolution {
-    fn default() -> Self {
-        SamplingResolution {
-            theta_h: 64,
-            phi_h: 64,
-            theta_o: 32,
-            phi_o: 16,
-            floor: 0.005,
-        }
-    }
-}
-
+/// The resolutions a source needs, decided by probing it (see [`TableSampler::for_source`]).
 impl SamplingResolution {
-    /// The default for a source: [`SamplingResolution::default`] when `isotropic`, else
-    /// [`SamplingResolution::anisotropic`].
-    pub fn for_isotropy(isotropic: bool) -> Self {
-        if isotropic {
-            Self::default()
-        } else {
-            Self::anisotropic()
-        }
-    }
-
-    /// The default for a source looked up as `isotropic` and `nearest` say:
-    /// [`SamplingResolution::binned`] for isotropic nearest lookups, else
-    /// [`SamplingResolution::for_isotropy`].
-    pub fn for_lookup(isotropic: bool, nearest: bool) -> Self {
-        if isotropic && nearest {
-            Self::binned()
-        } else {
-            Self::for_isotropy(isotropic)
-        }
-    }
-
-    /// The resolution for `brdf` looked up as `isotropic` and `nearest` say:
-    /// [`SamplingResolution::for_lookup`], with twice the θh nodes for an isotropic source whose
-    /// specular peak at normal incidence is too sharp for them ([`SamplingResolution::sharp_peak`]).
-    /// What tables, the native readers and `info` use.
+    /// The resolution for `brdf` looked up as `isotropic` and `nearest` say: the resolution of
+    /// [`TableSampler::for_source`] (which builds a sampler to decide; build that one rather
+    /// than call this and build again). What tables, the native readers and `info` use.
     pub fn for_source(brdf: &dyn Brdf, isotropic: bool, nearest: bool) -> Self {
-        let res = Self::for_lookup(isotropic, nearest);
-        if isotropic && Self::sharp_peak(brdf, &res) {
-            SamplingResolution {
-                theta_h: 2 * res.theta_h,
-                ..res
-            }
-        } else {
-            res
-        }
+        TableSampler::for_source(brdf, isotropic, nearest).resolution()
     }
 
     /// Whether more than [`SHARP_POLE_SHARE`] of the normal view's f_r cos θi (in the
@@ -159,40 +106,6 @@ impl SamplingResolution {
             half_jacobian,
         )
     }
-
-    /// Bytes a [`TableSampler`] of this resolution holds (`isotropic`: one node per θo).
-    pub fn memory_bytes(&self, isotropic: bool) -> usize {
-        let (nx, ny) = (self.theta_h.max(2), self.phi_h.max(2));
-        let views = self.theta_o.max(1) * if isotropic { 1 } else { self.phi_o.max(1) };
-        // f32 node densities, u32 alias entries over 2(ny − 1) half-strips and each row's
-        // nx − 1 cells (`table::alias2d`).
-        4 * views * (nx * ny + 2 * (ny - 1) + ny * (nx - 1))
-    }
-
-    /// The default for isotropic sources looked up by cell — a MERL file, a table read with
-    /// nearest lookups — whose values step from cell to cell as the view moves: 48 θo nodes
-    /// instead of 32 (1.6 MB). On a MERL file of `cc_ibiza_sunset` the weights' coefficient of
-    /// variation at a 75° view goes from 0.105 to 0.098, at 85° from 0.167 to 0.124; more θh
-    /// or φh nodes change it by less than 0.01.
-    pub fn binned() -> Self {
-        SamplingResolution {
-            theta_o: 48,
-            ..Default::default()
-        }
-    }
-
-    /// The default for anisotropic sources (fewer nodes per view, 20 × 16 views: with 12 θo
-    /// nodes the view at 85° blends the 80° and 90° slices, and anisotropic Ward's weights
-    /// reached a CV of 0.23 there; 20 bring it to 0.18, for 6.0 MB).
-    pub fn anisotropic() -> Self {
-        SamplingResolution {
-            theta_h: 48,
-            phi_h: 48,
-            theta_o: 20,
-            phi_o: 16,
-            ..Default::default()
-        }
-    }
 }
 
 /// θh cells of the sampler's map that [`SamplingResolution::sharp_peak`] looks at.
@@ -208,6 +121,7 @@ pub struct TableSampler {
     nt: usize,
     np: usize,
     isotropic: bool,
+    res: SamplingResolution,
     warp: AliasWarp,
 }
 
@@ -507,7 +421,89 @@ impl TableSampler {
             nt,
             np,
             isotropic,
+            res: *res,
             warp,
+        }
+    }
+
+    /// The sampler of `brdf` looked up as `isotropic` and `nearest` say, at the resolution
+    /// that source needs: [`SamplingResolution::for_lookup`], with twice the θh nodes for an
+    /// isotropic source whose specular peak at normal incidence is too sharp for them
+    /// ([`SamplingResolution::sharp_peak`]), and then, for an isotropic source whose
+    /// predicted weights miss a bar between the conditioning views
+    /// ([`TableSampler::view_excess`] > 1), [`SamplingResolution::finer_views`] when those do
+    /// better by a tenth. Costs a build and the prediction (about 150 k evaluations and
+    /// densities), twice for a source that gets the finer views.
+    pub fn for_source(brdf: &dyn Brdf, isotropic: bool, nearest: bool) -> TableSampler {
+        let mut res = SamplingResolution::for_lookup(isotropic, nearest);
+        if !isotropic {
+            return TableSampler::build(brdf, false, &res);
+        }
+        if SamplingResolution::sharp_peak(brdf, &res) {
+            res.theta_h *= 2;
+        }
+        let base = TableSampler::build(brdf, true, &res);
+        let excess = base.view_excess(brdf);
+        if excess <= 1.0 {
+            return base;
+        }
+        let finer = TableSampler::build(brdf, true, &res.finer_views());
+        if finer.view_excess(brdf) < 0.9 * excess {
+            finer
+        } else {
+            base
+        }
+    }
+
+    /// The resolution this sampler was built at.
+    pub fn resolution(&self) -> SamplingResolution {
+        self.res
+    }
+
+    /// The coefficient of variation the weights f_r cos θi / pdf of `brdf` (channel mean of
+    /// f_r, the source this sampler was built from) have at the view `wo`, computed from the
+    /// density (∫ g²/p dωi / (∫ g dωi)² − 1 with g = f_r cos θi) on cells of half the node
+    /// spacing of the sampler's own half-vector square rather than drawn (`table::views`).
+    pub fn predicted_cv(&self, brdf: &dyn Brdf, wo: DVec3) -> f64 {
+        let Some(wo) = geometry::unit(wo).filter(|w| w.z > 0.0) else {
+            return 0.0;
+        };
+        // The rule covers every azimuth of h, so any frame serves.
+        let pdf = |wi: DVec3, wo: DVec3| self.pdf(wi, wo);
+        let cells = |n: usize| 2 * (n.max(2) - 1);
+        super::views::predicted_cv(
+            brdf,
+            &pdf,
+            &Self::half_map(),
+            wo,
+            cells(self.res.theta_h),
+            cells(self.res.phi_h),
+        )
+    }
+
+    /// The worst over the views between the grazing conditioning nodes (θo 60–85°) of the
+    /// predicted CV ([`TableSampler::predicted_cv`]) over 0.95 × its bar (0.10 up to 75°, 0.2
+    /// to 85°): above 1, a view between the nodes is expected to miss its bar. 0 for an
+    /// anisotropic sampler (not probed).
+    pub fn view_excess(&self, brdf: &dyn Brdf) -> f64 {
+        if !self.isotropic {
+            return 0.0;
+        }
+        let pdf = |wi: DVec3, wo: DVec3| self.pdf(wi, wo);
+        super::views::worst_excess(
+            brdf,
+            &pdf,
+            &Self::half_map(),
+            self.res.theta_h,
+            self.res.phi_h,
+            self.nt,
+        )
+    }
+
+    fn half_map() -> super::views::HalfMap<'static> {
+        super::views::HalfMap {
+            theta_of_s: &theta_of_s,
+            jacobian: &half_jacobian,
         }
     }
 

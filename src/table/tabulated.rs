@@ -257,15 +257,15 @@ impl TabulatedBrdf {
         self.sampler = OnceLock::new();
     }
 
-    /// The importance sampler of [`Brdf::sample`]/[`Brdf::pdf`], built on first use with
-    /// [`SamplingResolution::for_source`]: [`SamplingResolution::default`] (isotropic tables),
+    /// The importance sampler of [`Brdf::sample`]/[`Brdf::pdf`], built on first use by
+    /// [`TableSampler::for_source`]: [`SamplingResolution::default`] (isotropic tables),
     /// [`SamplingResolution::binned`] (isotropic tables read with nearest lookups) or
-    /// [`SamplingResolution::anisotropic`], with twice the θh nodes for a sharp peak.
+    /// [`SamplingResolution::anisotropic`], with twice the θh nodes for a sharp peak and
+    /// finer views for a lobe that changes shape between them.
     pub fn sampler(&self) -> &TableSampler {
         self.sampler.get_or_init(|| {
             let iso = self.grid.symmetry().isotropic;
-            let res = SamplingResolution::for_source(self, iso, self.interp == Interp::Nearest);
-            TableSampler::build(self, iso, &res)
+            TableSampler::for_source(self, iso, self.interp == Interp::Nearest)
         })
     }
 

@@ -455,3 +455,17 @@ def test_sampling_resolution_doubles_theta_h_for_a_sharp_peak():
     assert nodes["version"] == 3 and nodes["nx"] == 128 and 0.0 < nodes["linear"] < 0.1
     aniso = brdftab.open('{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}')
     assert aniso.sampling_resolution() == {"theta_h": 48, "phi_h": 48, "theta_o": 20, "phi_o": 16}
+
+
+def test_sampling_resolution_gives_finer_views_to_a_grazing_crescent():
+    """A Phong lobe (reciprocal Phong, n = 1000) seen near grazing is a thin crescent in the
+    half vector that changes shape between the default 32 views: the library samples it with
+    half again the views and the φh nodes (48 and 96), in the nodes the plugin builds too; a
+    broad Phong lobe (n = 20) keeps the default."""
+    sharp = brdftab.open('{"model": "reciprocal_phong", "ks": 0.5, "n": 1000}')
+    res = sharp.sampling_resolution(adjoint=True)
+    assert res == {"theta_h": 64, "phi_h": 96, "theta_o": 48, "phi_o": 16}
+    nodes = sharp.sampling_nodes(adjoint=True, **res)
+    assert (nodes["nx"], nodes["ny"], nodes["nt"]) == (64, 96, 48)
+    broad = brdftab.open('{"model": "reciprocal_phong", "ks": 0.5, "n": 20}')
+    assert broad.sampling_resolution()["theta_o"] == 32

@@ -69,7 +69,9 @@ class Brdf:
     def sampling_resolution(self, adjoint: bool = False, nearest: bool = False) -> dict[str, int]:
         """The resolution the library samples this source at: {"theta_h", "phi_h", "theta_o",
         "phi_o"}, the keywords of `sampling_nodes` — twice the θh nodes for a peak at normal
-        incidence too sharp for 64; nearest=True for a table read by cell."""
+        incidence too sharp for 64, half again the views and φh nodes for a lobe that changes
+        shape between the grazing views faster than they follow (the Phong family);
+        nearest=True for a table read by cell. Decides by building a sampler (tens of ms)."""
     def table(self, **options: Any) -> Table:
         """The decoded table (other sources are baked with the keywords of `bake`); unpacks as
         `values, grid = b.table()`."""

@@ -834,8 +834,9 @@ class JitBrdftabBSDF(_Common):
         # (A kernel layout is of an isotropic table.)
         # The library's resolution (SamplingResolution::for_source): 64 × 64 half-vector nodes
         # (128 θh for a peak too sharp for 64) and 32 θi nodes, 48 for a table read by cell (its
-        # values step as the view moves); 48 × 48 and 20 × 16 anisotropic. `sampling_res`
-        # overrides the half-vector nodes.
+        # values step as the view moves), half again the θi and φh nodes for a lobe that changes
+        # shape between grazing views (the Phong family); 48 × 48 and 20 × 16 anisotropic.
+        # `sampling_res` overrides the half-vector nodes.
         nearest = layout["kind"] == "grid" and layout["grid"]["interp"] == "nearest"
         res = self._sampled.sampling_resolution(adjoint=True, nearest=nearest)
         override = _prop(props, "sampling_res")

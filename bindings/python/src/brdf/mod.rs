@@ -233,8 +233,10 @@ impl PyBrdf {
 
     /// The resolution the library samples this source at (`SamplingResolution::for_source`):
     /// {"theta_h", "phi_h", "theta_o", "phi_o"} for `sampling_nodes` — twice the θh nodes for
-    /// a peak at normal incidence too sharp for 64; `nearest=True` for a table read by cell (48
-    /// θ nodes); `adjoint=True` probes f_r with its directions exchanged.
+    /// a peak at normal incidence too sharp for 64, half again the views and φh nodes for a
+    /// lobe that changes shape between the grazing views faster than they follow (the Phong
+    /// family); `nearest=True` for a table read by cell (48 θ nodes); `adjoint=True` probes
+    /// f_r with its directions exchanged. Decides by building a sampler (tens of ms).
     #[pyo3(signature = (adjoint=false, nearest=false))]
     fn sampling_resolution(
         &self,
