@@ -11,7 +11,10 @@
 //! table sampler's θh, φh and θo nodes (and floor); SOURCE may be a model spec, e.g.
 //! `'{"model": "ggx", "alpha": 0.1, "fresnel": {"conductor": "Cu"}}'`; `--grid G` bakes on grid
 //! G instead of the default, e.g. `medium`; `--quantity fr|fr_cos_cos|fr_cos_out` bakes that
-//! stored quantity instead of the default.)
+//! stored quantity instead of the default; `--midway` prints instead, per source, the sampler's
+//! resolution (`TableSampler::for_source`, or `--res`) and the worst CV predicted from its
+//! density (`TableSampler::predicted_cv`) at the views midway between its conditioning views,
+//! over 3–75° and 75–85° (and 85° itself), where a drawn figure at fixed views may miss it.)
 
 use std::time::Instant;
 
@@ -129,6 +132,44 @@ fn row(label: &str, b: &dyn Brdf, samples: usize) {
     );
 }
 
+/// The `--midway` row of `b`: its sampler's resolution and worst predicted CV between views.
+fn midway(label: &str, b: &dyn Brdf, res: Option<&SamplingResolution>) {
+    let iso = b.flags().isotropic;
+    let s = match res {
+        Some(r) => TableSampler::build(b, iso, r),
+        None => TableSampler::for_source(b, iso, false),
+    };
+    let r = s.resolution();
+    let nt = r.theta_o.max(2);
+    let mut views: Vec<f64> = (0..nt - 1)
+        .map(|k| {
+            let t = (k as f64 + 0.5) / (nt - 1) as f64;
+            (1.0 - t * t).acos().to_degrees()
+        })
+        .filter(|t| (3.0..=85.0).contains(t))
+        .collect();
+    views.push(85.0);
+    let (mut near, mut grazing) = ((0.0f64, 0.0f64), (0.0f64, 0.0f64));
+    for v in views {
+        let cv = s.predicted_cv(b, geometry::spherical(v.to_radians(), 0.3));
+        let w = if v <= 75.0 { &mut near } else { &mut grazing };
+        if cv > w.1 {
+            *w = (v, cv);
+        }
+    }
+    println!(
+        "| {label:<34} | {}×{}×{} | {:.3} ({:.1}°) | {:.3} ({:.1}°) | {:.2} MB |",
+        r.theta_h,
+        r.phi_h,
+        r.theta_o,
+        near.1,
+        near.0,
+        grazing.1,
+        grazing.0,
+        s.memory_bytes() as f64 / 1e6
+    );
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut samples = 40_000;
     let (mut native, mut table) = (true, true);
@@ -137,6 +178,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut res = SamplingResolution::default();
     let mut res_set = false;
     let mut wrap = false;
+    let mut mid = false;
     let mut sources = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -144,6 +186,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--samples" => samples = args.next().and_then(|s| s.parse().ok()).unwrap_or(samples),
             "--native-only" => table = false,
             "--wrap" => wrap = true,
+            "--midway" => mid = true,
             "--table-only" => native = false,
             "--grid" => grid = args.next().map(|g| g.parse()).transpose()?,
             "--quantity" => {
@@ -169,11 +212,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             _ => sources.push(a),
         }
     }
-    println!(
-        "| source | {} | max w/mean | refused | build s | sample / eval |",
-        VIEWS.map(|v| format!("{v}°")).join(" | ")
-    );
-    println!("|---|{}---|---|---|---|", "---|".repeat(VIEWS.len()));
+    if mid {
+        println!("| source | θh × φh × θo | worst midway 3–75° | 75–85° | bytes |");
+        println!("|---|---|---|---|---|");
+    } else {
+        println!(
+            "| source | {} | max w/mean | refused | build s | sample / eval |",
+            VIEWS.map(|v| format!("{v}°")).join(" | ")
+        );
+        println!("|---|{}---|---|---|---|", "---|".repeat(VIEWS.len()));
+    }
+    let fixed = res_set.then_some(&res);
     let dir = brdftab::testkit::TempDir::new("sampling-cv");
     for (i, s) in sources.iter().enumerate() {
         let name = std::path::Path::new(s)
@@ -183,7 +232,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .unwrap_or_else(|| format!("source {i}"));
         if native {
             let b = source::open(s)?;
-            if wrap {
+            if mid {
+                midway(&format!("{name} native"), b.as_ref(), fixed);
+            } else if wrap {
                 let iso = b.flags().isotropic;
                 let r = if res_set || iso {
                     res
@@ -208,6 +259,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             req.run(&BakeTarget::file(out.to_string_lossy()))?;
             let mut b = source::open_table(&out.to_string_lossy(), &Default::default())?;
+            if mid {
+                midway(&format!("{name} table"), &b, fixed);
+                continue;
+            }
             if res_set {
                 b.set_sampling_resolution(&res);
             }
