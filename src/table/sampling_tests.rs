@@ -1,8 +1,9 @@
 //! Specifications of table importance sampling: chi-square tests of the sampler against its pdf
 //! for every kind of sampler — isotropic tables baked from analytic models and from measured
-//! (RGL) data, an anisotropic table on a full 4D grid (Ward), and the native RGL and MERL
-//! readers (which sample with the same structure) — weight = f_r cos θi / pdf, `pdf()` = the sampler's
-//! density, and the mean weight = the table's directional albedo.
+//! (RGL) data, an anisotropic table on a full 4D grid (Ward), the native RGL and MERL readers
+//! (which sample with the same structure) and a sampler with finer views (a Phong lobe) —
+//! weight = f_r cos θi / pdf, `pdf()` = the sampler's density, and the mean weight = the
+//! table's directional albedo.
 
 use glam::DVec3;
 use std::sync::OnceLock;
@@ -21,9 +22,9 @@ use crate::table::{
     bake,
 };
 
-/// Chi-square cases in this file (6 samplers × 5 directions): the Šidák correction counts them
+/// Chi-square cases in this file (7 samplers × 5 directions): the Šidák correction counts them
 /// all.
-const CASES: usize = 30;
+const CASES: usize = 35;
 /// Samples per chi-square case.
 const SAMPLES: usize = 1_000_000;
 
@@ -129,6 +130,23 @@ fn merl_native() -> &'static crate::measured::MerlBrdf {
     })
 }
 
+/// The reciprocal Phong at n = 200 (the model) sampled by the sampler
+/// [`TableSampler::for_source`] gives it: half again the views and φh nodes (48 views × 64 × 96,
+/// see `a_lobe_that_changes_shape_between_views_gets_finer_views`).
+fn phong_finer_views() -> &'static Sampled<'static> {
+    static T: OnceLock<Sampled<'static>> = OnceLock::new();
+    T.get_or_init(|| {
+        let m = ModelSpec::parse(r#"{"model": "reciprocal_phong", "ks": 0.5, "n": 200}"#)
+            .unwrap()
+            .build(&Channels::Rgb)
+            .unwrap();
+        let m: &'static dyn Brdf = Box::leak(m);
+        let s = TableSampler::for_source(m, true, false);
+        assert_eq!(s.resolution(), SamplingResolution::default().finer_views());
+        Sampled(m, s)
+    })
+}
+
 /// The chi-square test of the crate's harness (`analysis::chi2`, bins in (cos θ, φ), expected
 /// counts by adaptive quadrature of `pdf()`) for [`test_wos`] direction `case`, Šidák-corrected
 /// over the [`CASES`] cases.
@@ -215,6 +233,11 @@ chi2_tests! {
     chi2_merl_native_60: merl_native, "merl native cook_torrance Au", 2;
     chi2_merl_native_80: merl_native, "merl native cook_torrance Au", 3;
     chi2_merl_native_88: merl_native, "merl native cook_torrance Au", 4;
+    chi2_finer_views_0: phong_finer_views, "reciprocal_phong n=200, finer views", 0;
+    chi2_finer_views_30: phong_finer_views, "reciprocal_phong n=200, finer views", 1;
+    chi2_finer_views_60: phong_finer_views, "reciprocal_phong n=200, finer views", 2;
+    chi2_finer_views_80: phong_finer_views, "reciprocal_phong n=200, finer views", 3;
+    chi2_finer_views_88: phong_finer_views, "reciprocal_phong n=200, finer views", 4;
 }
 
 #[test]
