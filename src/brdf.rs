@@ -287,6 +287,52 @@ pub trait Brdf: Send + Sync {
         })
     }
 
+    /// [`Brdf::sample`] with the weight at the wavelengths `nm` (in nm) instead of the channels:
+    /// the same draw (`wi`, `pdf`, `delta`) as `sample(wo, u, ..)`, and `weight[k]` the weight at
+    /// `nm[k]` — f_r cos θi / pdf from [`Brdf::eval_wavelength`] for a smooth draw, the delta
+    /// lobe's reflectance at `nm[k]` for a delta draw. What a spectral renderer needs: the
+    /// weight at the wavelengths its path carries, also for a mirror, whose reflectance lives
+    /// only in the sample.
+    ///
+    /// The default interpolates a delta draw's channel weights as `eval_wavelength`'s default
+    /// interpolates channels; the delta models (and sums holding them) override it with their
+    /// spectral data. `weight` must hold `nm.len()` values.
+    ///
+    /// # Example
+    /// ```
+    /// use brdftab::{Brdf, fresnel::FresnelSpec, models::mirror::Mirror, spectrum::Channels};
+    /// use glam::{DVec2, DVec3};
+    ///
+    /// let gold = Mirror::new(&FresnelSpec::Conductor("Au".into()), &Channels::Rgb).unwrap();
+    /// let mut w = [0.0f32; 2];
+    /// let s = gold.sample_wavelengths(DVec3::Z, DVec2::splat(0.5), &[450.0, 650.0], &mut w);
+    /// assert!(s.unwrap().delta);
+    /// assert!(w[0] < 0.5 && w[1] > 0.9); // gold reflects red, not blue
+    /// ```
+    fn sample_wavelengths(
+        &self,
+        wo: DVec3,
+        u: DVec2,
+        nm: &[f64],
+        weight: &mut [f32],
+    ) -> Option<BrdfSample> {
+        let mut buf = [0.0f32; MAX_CHANNELS];
+        let c = self.channels().len().min(MAX_CHANNELS);
+        let s = self.sample(wo, u, &mut buf[..c])?;
+        if s.delta {
+            for (w, &x) in weight.iter_mut().zip(nm) {
+                let (i0, i1, t) = self.channels().lerp_at(x);
+                *w = ((1.0 - t) * buf[i0] as f64 + t * buf[i1] as f64) as f32;
+            }
+        } else {
+            let k = s.wi.z.abs() / s.pdf;
+            for (w, &x) in weight.iter_mut().zip(nm) {
+                *w = (self.eval_wavelength(s.wi, wo, x) * k) as f32;
+            }
+        }
+        Some(s)
+    }
+
     /// The density with which [`Brdf::sample`] draws `wi` given `wo` (solid angle, 1/sr);
     /// 0 for delta models and for directions the sampler never produces.
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
@@ -403,6 +449,15 @@ macro_rules! forward_brdf {
             }
             fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
                 (**self).sample(wo, u, weight)
+            }
+            fn sample_wavelengths(
+                &self,
+                wo: DVec3,
+                u: DVec2,
+                nm: &[f64],
+                weight: &mut [f32],
+            ) -> Option<BrdfSample> {
+                (**self).sample_wavelengths(wo, u, nm, weight)
             }
             fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
                 (**self).pdf(wi, wo)

@@ -121,6 +121,24 @@ impl Brdf for Mirror {
     fn pdf(&self, _wi: DVec3, _wo: DVec3) -> f64 {
         0.0
     }
+
+    /// The reflection direction, weight k_r(N·V) at each wavelength from the Fresnel term's
+    /// spectral data.
+    fn sample_wavelengths(
+        &self,
+        wo: DVec3,
+        u: DVec2,
+        nm: &[f64],
+        weight: &mut [f32],
+    ) -> Option<BrdfSample> {
+        let mut buf = [0.0f32; crate::spectrum::MAX_CHANNELS];
+        let s = self.sample(wo, u, &mut buf[..self.channels.len()])?;
+        let cos = geometry::unit(wo)?.z;
+        for (w, &x) in weight.iter_mut().zip(nm) {
+            *w = self.fresnel.eval_at(cos, x) as f32;
+        }
+        Some(s)
+    }
 }
 
 /// Ideal refraction into (or out of) a dielectric of relative index η = n_inside / n_outside,
@@ -251,6 +269,24 @@ impl Brdf for Refractor {
     fn pdf(&self, _wi: DVec3, _wo: DVec3) -> f64 {
         0.0
     }
+
+    /// The refraction direction (from the mean η, as [`Brdf::sample`]), weight k_t = 1 − F at
+    /// each wavelength from η's spectral data.
+    fn sample_wavelengths(
+        &self,
+        wo: DVec3,
+        u: DVec2,
+        nm: &[f64],
+        weight: &mut [f32],
+    ) -> Option<BrdfSample> {
+        let mut buf = [0.0f32; crate::spectrum::MAX_CHANNELS];
+        let s = self.sample(wo, u, &mut buf[..self.channels.len()])?;
+        let cos = geometry::unit(wo)?.z;
+        for (w, &x) in weight.iter_mut().zip(nm) {
+            *w = (1.0 - fresnel::dielectric(cos, self.eta_spec.at(x))) as f32;
+        }
+        Some(s)
+    }
 }
 
 #[cfg(test)]
@@ -278,6 +314,51 @@ mod tests {
         m.eval(s.wi, wo, &mut f);
         assert_eq!(f, [0.0; 3]);
         assert!(m.flags().delta && m.flags().reciprocal);
+    }
+
+    /// At normal incidence k_r = ((n − 1)² + k²) / ((n + 1)² + k²) and k_t = 1 − ((η − 1)/(η + 1))²,
+    /// with n, k and η interpolated linearly between their spectral nodes.
+    #[test]
+    fn spectral_sample_weights_are_the_closed_form_at_each_wavelength() {
+        let spectral = |a: f64, b: f64| Value::Spectral {
+            wavelengths: vec![400.0, 700.0],
+            values: vec![a, b],
+        };
+        let m = Mirror::new(
+            &FresnelSpec::Complex {
+                n: spectral(0.2, 1.4),
+                k: spectral(3.0, 1.0),
+            },
+            &Channels::Rgb,
+        )
+        .unwrap();
+        let r = Refractor::new(spectral(1.8, 1.2), &Channels::Rgb).unwrap();
+        let nm = [400.0, 475.0, 550.0, 700.0];
+        let (mut wm, mut wr) = ([0.0f32; 4], [0.0f32; 4]);
+        let sm = m
+            .sample_wavelengths(DVec3::Z, DVec2::splat(0.5), &nm, &mut wm)
+            .unwrap();
+        let sr = r
+            .sample_wavelengths(DVec3::Z, DVec2::splat(0.5), &nm, &mut wr)
+            .unwrap();
+        assert!(sm.delta && sr.delta && sm.wi.z > 0.0 && sr.wi.z < 0.0);
+        for (i, &x) in nm.iter().enumerate() {
+            let t = (x - 400.0) / 300.0;
+            let (n, k) = (0.2 + 1.2 * t, 3.0 - 2.0 * t);
+            let kr = ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
+            let eta = 1.8 - 0.6 * t;
+            let kt = 1.0 - ((eta - 1.0) / (eta + 1.0)).powi(2);
+            assert!(
+                (wm[i] as f64 - kr).abs() < 1e-6,
+                "{x} nm: k_r {} vs {kr}",
+                wm[i]
+            );
+            assert!(
+                (wr[i] as f64 - kt).abs() < 1e-6,
+                "{x} nm: k_t {} vs {kt}",
+                wr[i]
+            );
+        }
     }
 
     #[test]

@@ -203,16 +203,40 @@ impl Sum {
         }
     }
 
+    /// [`Brdf::sample`], telling which term drew and from which numbers (`chosen`).
+    fn sample_chosen(
+        &self,
+        wo: DVec3,
+        u: DVec2,
+        weight: &mut [f32],
+        chosen: &mut (usize, DVec2),
+    ) -> Option<BrdfSample> {
+        if !geometry::in_unit_square(u) {
+            return None;
+        }
+        if let ([a, b], 3) = (self.terms.as_slice(), self.channels.len()) {
+            return self.sample_pair_rgb([a.as_ref(), b.as_ref()], wo, u, weight, chosen);
+        }
+        if self.channels.len() <= 4 {
+            self.sample_n::<4>(wo, u, weight, chosen)
+        } else {
+            self.sample_n::<MAX_CHANNELS>(wo, u, weight, chosen)
+        }
+    }
+
     /// [`Brdf::sample`] with scratch arrays of `N` ≥ channels entries (4 for RGB, so the
     /// per-call scratch is not a kilobyte of zeroes).
     ///
     /// Written for latency: the selection weights are computed once, the chosen term writes its
     /// weight straight into `weight`, and the mixture density is normalized by one division.
+    /// `chosen` receives the term drawn from and the numbers it was given (for
+    /// [`Brdf::sample_wavelengths`]' delta draws).
     fn sample_n<const N: usize>(
         &self,
         wo: DVec3,
         u: DVec2,
         weight: &mut [f32],
+        chosen: &mut (usize, DVec2),
     ) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
@@ -240,6 +264,7 @@ impl Sum {
             ux = 1.0;
         }
         let ux = ux.clamp(0.0, 1.0 - f64::EPSILON);
+        *chosen = (j, DVec2::new(ux, u.y));
         let c = self.channels.len();
         // Only the fields are read from the returned sample (not the whole `Option`), so no
         // load of its padding waits on the callee's narrower stores.
@@ -312,6 +337,7 @@ impl Sum {
         wo: DVec3,
         u: DVec2,
         weight: &mut [f32],
+        chosen: &mut (usize, DVec2),
     ) -> Option<BrdfSample> {
         let wo = geometry::unit(wo)?;
         if wo.z <= 0.0 {
@@ -330,6 +356,7 @@ impl Sum {
             (1, s1, s0, (u.x - s0) * inv1)
         };
         let ux = ux.clamp(0.0, 1.0 - f64::EPSILON);
+        *chosen = (j, DVec2::new(ux, u.y));
         let w = &mut weight[..3];
         let (wi, tpdf, delta) = match terms[j].sample(wo, DVec2::new(ux, u.y), w) {
             Some(s) => (s.wi, s.pdf, s.delta),
@@ -588,17 +615,37 @@ impl Brdf for Sum {
     }
 
     fn sample(&self, wo: DVec3, u: DVec2, weight: &mut [f32]) -> Option<BrdfSample> {
-        if !geometry::in_unit_square(u) {
-            return None;
-        }
-        if let ([a, b], 3) = (self.terms.as_slice(), self.channels.len()) {
-            return self.sample_pair_rgb([a.as_ref(), b.as_ref()], wo, u, weight);
-        }
-        if self.channels.len() <= 4 {
-            self.sample_n::<4>(wo, u, weight)
+        self.sample_chosen(wo, u, weight, &mut (0, DVec2::ZERO))
+    }
+
+    /// A smooth draw weighs the sum's f_r at each wavelength ([`Brdf::eval_wavelength`]) by
+    /// cos θi / pdf; a delta draw is the chosen term's, at each wavelength, scaled as
+    /// [`Brdf::sample`] scales it (term weight / probability of the choice).
+    fn sample_wavelengths(
+        &self,
+        wo: DVec3,
+        u: DVec2,
+        nm: &[f64],
+        weight: &mut [f32],
+    ) -> Option<BrdfSample> {
+        let mut buf = [0.0f32; MAX_CHANNELS];
+        let mut chosen = (0, DVec2::ZERO);
+        let s = self.sample_chosen(wo, u, &mut buf[..self.channels.len()], &mut chosen)?;
+        if s.delta {
+            let (j, uj) = chosen;
+            let t = self.terms[j].sample_wavelengths(wo, uj, nm, weight)?;
+            // s.pdf = p_j · (the term's pdf): the term's weight times w_j / p_j.
+            let scale = self.weights[j] * t.pdf / s.pdf;
+            for w in &mut weight[..nm.len()] {
+                *w = (scale * *w as f64) as f32;
+            }
         } else {
-            self.sample_n::<MAX_CHANNELS>(wo, u, weight)
+            let k = s.wi.z.abs() / s.pdf;
+            for (w, &x) in weight.iter_mut().zip(nm) {
+                *w = (self.eval_wavelength(s.wi, wo, x) * k) as f32;
+            }
         }
+        Some(s)
     }
 
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
@@ -937,6 +984,70 @@ mod tests {
         }
     }
 
+    /// The mean weight of `sample_wavelengths` over stratified numbers is the reflectance
+    /// towards wo at each wavelength — k_d π plus each mirror's Fresnel term there — for the
+    /// two-term RGB path and the general one. Each branch's weight is its reflectance over its
+    /// choice probability, so the strata leave an error of at most two strata's weights.
+    #[test]
+    fn spectral_sample_weights_of_delta_terms_are_the_terms_reflectance() {
+        let mirror = |m: &str| -> Box<dyn Brdf + Send + Sync> {
+            Box::new(
+                crate::models::mirror::Mirror::new(
+                    &FresnelSpec::Conductor(m.into()),
+                    &Channels::Rgb,
+                )
+                .unwrap(),
+            )
+        };
+        let nm = [420.0, 480.0, 530.0, 610.0, 700.0];
+        let sums = [
+            Sum::new(vec![lambert(0.1), mirror("Au")], None, &Channels::Rgb).unwrap(),
+            Sum::new(
+                vec![lambert(0.1), mirror("Au"), mirror("Cu")],
+                Some(vec![1.0, 0.5, 0.5]),
+                &Channels::Rgb,
+            )
+            .unwrap(),
+        ];
+        let fresnel = |m: &str, cos: f64, x: f64| {
+            crate::fresnel::Fresnel::new(&FresnelSpec::Conductor(m.into()), &Channels::Rgb, "f")
+                .unwrap()
+                .eval_at(cos, x)
+        };
+        for (k, s) in sums.iter().enumerate() {
+            for deg in [5.0f64, 60.0] {
+                let wo = geometry::spherical(deg.to_radians(), 0.4);
+                let n = 8192;
+                let (mut sum, mut most) = ([0.0f64; 5], 0.0f64);
+                for i in 0..n {
+                    let u = DVec2::new((i as f64 + 0.5) / n as f64, 0.37);
+                    let mut w = [0.0f32; 5];
+                    let d = s.sample_wavelengths(wo, u, &nm, &mut w).unwrap();
+                    if d.delta {
+                        assert!((d.wi - geometry::reflect_z(wo)).length() < 1e-12);
+                    }
+                    for (a, &x) in sum.iter_mut().zip(&w) {
+                        *a += x as f64;
+                        most = most.max(x as f64);
+                    }
+                }
+                for (j, &x) in nm.iter().enumerate() {
+                    let metals = match k {
+                        0 => fresnel("Au", wo.z, x),
+                        _ => 0.5 * (fresnel("Au", wo.z, x) + fresnel("Cu", wo.z, x)),
+                    };
+                    let expect = 0.1 * std::f64::consts::PI + metals;
+                    let mean = sum[j] / n as f64;
+                    let tol = 2.0 * most / n as f64;
+                    assert!(
+                        (mean - expect).abs() <= tol,
+                        "sum {k}, {deg}°, {x} nm: {mean} vs {expect} (± {tol})"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn selection_follows_albedo() {
         // A white Lambert (albedo 1) and a GGX with F = 1 weighted by 0 gets nothing.
@@ -1003,7 +1114,10 @@ mod tests {
             let wo = geometry::cosine_hemisphere(rng.next_dvec2());
             let u = rng.next_dvec2();
             let (mut a, mut b) = ([0.0f32; 3], [0.0f32; 3]);
-            match (s.sample(wo, u, &mut a), s.sample_n::<4>(wo, u, &mut b)) {
+            match (
+                s.sample(wo, u, &mut a),
+                s.sample_n::<4>(wo, u, &mut b, &mut (0, DVec2::ZERO)),
+            ) {
                 (Some(x), Some(y)) => {
                     assert!((x.wi - y.wi).length() < 1e-12, "{x:?} vs {y:?}");
                     assert!((x.pdf - y.pdf).abs() <= 1e-10 * x.pdf, "{x:?} vs {y:?}");

@@ -6,7 +6,7 @@ use glam::{DVec2, DVec3};
 use crate::brdf::Brdf;
 use crate::geometry;
 use crate::rng::Pcg32;
-use crate::spectrum::MAX_CHANNELS;
+use crate::spectrum::{Channels, MAX_CHANNELS};
 
 /// How hard [`check_contract`] looks.
 #[derive(Debug, Clone, PartialEq)]
@@ -449,10 +449,12 @@ fn sampling<B: Brdf + ?Sized>(
         let mut got = 0;
         for _ in 0..opts.samples {
             let mut w = [0.0f32; MAX_CHANNELS];
-            let Some(s) = brdf.sample(wo, rng.next_dvec2(), &mut w[..c]) else {
+            let u = rng.next_dvec2();
+            let Some(s) = brdf.sample(wo, u, &mut w[..c]) else {
                 continue;
             };
             got += 1;
+            spectral_sample(brdf, wo, u, &s, &w[..c], log);
             if !((s.wi.length() - 1.0).abs() < 1e-9 && s.wi.is_finite()) {
                 log.fail("sample", || format!("wo {wo}: wi {} not unit", s.wi));
                 continue;
@@ -511,6 +513,39 @@ fn sampling<B: Brdf + ?Sized>(
             log.fail("sample", || {
                 format!("wo {wo}: only {got} of {} samples drawn", opts.samples)
             });
+        }
+    }
+}
+
+/// `sample_wavelengths` makes `sample`'s draw, and at the channels' own wavelengths (sources of
+/// wavelength channels) `sample`'s weights.
+fn spectral_sample<B: Brdf + ?Sized>(
+    brdf: &B,
+    wo: DVec3,
+    u: DVec2,
+    s: &crate::brdf::BrdfSample,
+    w: &[f32],
+    log: &mut Log,
+) {
+    let nm = match brdf.channels() {
+        Channels::Wavelengths(nm) => nm.clone(),
+        Channels::Rgb => vec![450.0, 550.0, 650.0],
+    };
+    let mut ws = [0.0f32; MAX_CHANNELS];
+    let got = brdf.sample_wavelengths(wo, u, &nm, &mut ws[..nm.len()]);
+    if got != Some(*s) {
+        log.fail("sample_wavelengths", || {
+            format!("wo {wo}, u {u}: draw {got:?} vs sample's {s:?}")
+        });
+        return;
+    }
+    if let Channels::Wavelengths(_) = brdf.channels() {
+        for (k, (&a, &b)) in ws.iter().zip(w).enumerate() {
+            if !close_abs(a as f64, b as f64, 1e-5, 1e-7) {
+                log.fail("sample_wavelengths", || {
+                    format!("wo {wo}, u {u}: weight {a} at {} nm vs sample's {b}", nm[k])
+                });
+            }
         }
     }
 }
