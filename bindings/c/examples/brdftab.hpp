@@ -35,10 +35,13 @@ struct Vec3 {
 };
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 must be three packed doubles");
 
-/// One sample of Brdf::sample.
+/// One sample of Brdf::sample. `delta`: drawn from a delta lobe (a mirror, or a sum's mirror
+/// term): `pdf` is then the probability of choosing that lobe, and the weight its reflectance
+/// over it.
 struct Sample {
     Vec3 wi;
     double pdf;
+    bool delta;
 };
 
 /// An open BRDF (move-only). eval/pdf/sample/albedo may be called from several threads at once.
@@ -96,10 +99,17 @@ public:
                 float *weight) const {
         detail::check(brdftab_sample(h_, n, &wo->x, u, &wi->x, p, weight));
     }
+    /// The same with each draw's delta flag (delta: n bytes, 1 for a delta lobe's draw).
+    void sample(std::size_t n, const Vec3 *wo, const double *u, Vec3 *wi, double *p,
+                float *weight, unsigned char *delta) const {
+        detail::check(brdftab_sample_delta(h_, n, &wo->x, u, &wi->x, p, weight, delta));
+    }
     Sample sample(const Vec3 &wo, double u0, double u1, float *weight) const {
         double u[2] = {u0, u1};
         Sample s{};
-        sample(1, &wo, u, &s.wi, &s.pdf, weight);
+        unsigned char d = 0;
+        sample(1, &wo, u, &s.wi, &s.pdf, weight, &d);
+        s.delta = d != 0;
         return s;
     }
     /// Directional albedo at incidence theta (radians), one value per channel.

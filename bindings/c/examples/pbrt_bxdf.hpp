@@ -58,6 +58,15 @@ public:
         return out;
     }
 
+    /// The flags of a smooth draw: Flags() without Specular.
+    BxDFFlags SmoothFlags() const {
+        unsigned f = b_->flags();
+        BxDFFlags out = BxDFFlags::Reflection;
+        if (f & BRDFTAB_DIFFUSE) out = out | BxDFFlags::Diffuse;
+        if ((f & BRDFTAB_GLOSSY) || !(f & BRDFTAB_DIFFUSE)) out = out | BxDFFlags::Glossy;
+        return out;
+    }
+
     SampledSpectrum f(Vector3f wo, Vector3f wi) const {
         if (wo.z <= 0 || wi.z <= 0) return {};  // front side only, as pbrt's measured BxDF
         float v[3];
@@ -69,9 +78,17 @@ public:
         if (wo.z <= 0) return std::nullopt;
         float w[3];
         brdftab::Sample s = b_->sample(to(wo), u[0], u[1], w);
-        if (!(s.pdf > 0)) return std::nullopt;
+        if (!(s.pdf > 0) || !(s.wi.z > 0)) return std::nullopt;
         Vector3f wi{Float(s.wi.x), Float(s.wi.y), Float(s.wi.z)};
-        return BSDFSample{f(wo, wi), wi, Float(s.pdf), Flags()};
+        if (s.delta) {
+            // pbrt's specular sample: f = weight · pdf / |cos θi|, so that f |cos θi| / pdf is the
+            // library's weight (the lobe's reflectance over the probability of choosing it).
+            Float k = Float(s.pdf / s.wi.z);
+            return BSDFSample{{{w[0] * k, w[1] * k, w[2] * k}}, wi, Float(s.pdf),
+                              BxDFFlags::Reflection | BxDFFlags::Specular};
+        }
+        // A smooth draw: the smooth lobes' flags (a sum's mirror term did not draw it).
+        return BSDFSample{f(wo, wi), wi, Float(s.pdf), SmoothFlags()};
     }
 
     Float PDF(Vector3f wo, Vector3f wi) const {

@@ -82,6 +82,12 @@ int brdftab_pdf(const brdftab_brdf *b, size_t n, const double *wi, const double 
  * with no sample gets wi = 0, pdf = 0, weight = 0. */
 int brdftab_sample(const brdftab_brdf *b, size_t n, const double *wo, const double *u,
                    double *wi, double *pdf, float *weight);
+/* brdftab_sample, and delta[k] = 1 where pair k drew a delta lobe (a mirror, or a sum's mirror
+ * term: its pdf is then the probability of choosing that lobe, not a density, brdftab_pdf does
+ * not contain it, and its weight is the lobe's reflectance over that probability), else 0. A
+ * renderer gives such draws its specular path (no MIS with light sampling). delta: n bytes. */
+int brdftab_sample_delta(const brdftab_brdf *b, size_t n, const double *wo, const double *u,
+                         double *wi, double *pdf, float *weight, unsigned char *delta);
 /* Directional albedo for light at polar angle theta in [0, pi/2) (radians, light above the
  * horizon; anything else, pi/2 included, is an error, -1): one double per channel (a closed
  * form where the model has one, else adaptive quadrature: 1e-6 relative for models, 1e-4 for

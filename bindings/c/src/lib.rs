@@ -425,6 +425,48 @@ pub unsafe extern "C" fn brdftab_sample(
     })
 }
 
+/// [`brdftab_sample`] and each draw's delta flag: `delta[k]` = 1 where pair `k` drew a delta
+/// lobe (a mirror, or a sum's mirror term — its pdf is then the probability of choosing that
+/// lobe, not a density, and `brdftab_pdf` does not contain it; its weight is the lobe's
+/// reflectance over that probability), else 0 ([`brdftab::batch::sample_flagged`]). What a
+/// renderer needs to give such draws its specular path (no MIS with light sampling).
+///
+/// # Safety
+/// With n > 0: as [`brdftab_sample`], and `delta` points to n bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_sample_delta(
+    b: *const brdftab_brdf,
+    n: usize,
+    wo: *const f64,
+    u: *const f64,
+    wi: *mut f64,
+    pdf: *mut f64,
+    weight: *mut f32,
+    delta: *mut u8,
+) -> c_int {
+    guard(|| {
+        if n == 0 {
+            return Ok(());
+        }
+        // SAFETY (all seven): the header's contract on sizes; NULL and alignment are checked.
+        let b = unsafe { handle(b) }?;
+        let c = b.names.len();
+        let wo = unsafe { slice(wo as *const DVec3, n, "wo") }?;
+        let u = unsafe { slice(u as *const DVec2, n, "u") }?;
+        let wi = unsafe { slice_mut(wi as *mut DVec3, n, "wi") }?;
+        let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
+        let weight = unsafe { slice_mut(weight, times(n, c, "weight")?, "weight") }?;
+        let flags = unsafe { slice_mut(delta, n, "delta") }?;
+        // Zeroed first, the bytes are valid `bool`s (false); the library writes 0 or 1.
+        flags.fill(0);
+        // SAFETY: u8 and bool have one size and alignment, and every byte is now 0.
+        let flags = unsafe { std::slice::from_raw_parts_mut(flags.as_mut_ptr() as *mut bool, n) };
+        let out = brdftab::batch::SampleOut { wi, pdf, weight };
+        brdftab::batch::sample_flagged(&b.brdf, wo, u, out, flags);
+        healthy(b)
+    })
+}
+
 /// Directional albedo a(θ′) = ∫ f_r cos θ dω for light incident at polar angle `theta` (radians,
 /// azimuth 0), one double per channel into `albedo`. 0 on success, -1 on failure (a `theta`
 /// outside [0, π/2), light at or below the horizon: [`brdftab::analysis::albedo::incidence`]).

@@ -117,6 +117,51 @@ int main(int argc, char **argv) {
         }
     }
     CHECK(brdftab_albedo(b, 30.0 * BRDFTAB_PI / 180.0, alb) == 0, "albedo");
+    {
+        /* brdftab_sample_delta: the same draws as brdftab_sample, and a delta flag per draw — a
+         * sum's mirror term flagged (its pdf the probability of that term, below 1), its
+         * diffuse term not; this source (argv[1]) has no delta lobe. */
+        unsigned char *d = malloc(n);
+        double *swi2 = malloc(n * 3 * sizeof(double)), *spdf2 = malloc(n * sizeof(double));
+        float *w2 = malloc(n * c * sizeof(float));
+        CHECK(brdftab_sample_delta(b, n, wo, u, swi2, spdf2, w2, NULL) == -1 &&
+              strstr(brdftab_last_error(), "delta") != NULL, "NULL delta");
+        CHECK(brdftab_sample_delta(b, 0, NULL, NULL, NULL, NULL, NULL, NULL) == 0, "n = 0");
+        memset(d, 7, n);
+        CHECK(brdftab_sample_delta(b, n, wo, u, swi2, spdf2, w2, d) == 0, "sample_delta");
+        CHECK(memcmp(swi, swi2, n * 3 * sizeof(double)) == 0 &&
+              memcmp(spdf, spdf2, n * sizeof(double)) == 0 &&
+              memcmp(w, w2, n * c * sizeof(float)) == 0, "the draws of brdftab_sample");
+        int none = 1;
+        for (size_t k = 0; k < n; k++) none &= d[k] == 0;
+        CHECK(none, "no delta lobe, no delta draw");
+        brdftab_brdf *m = brdftab_open(
+            "{\"model\": \"sum\", \"terms\": [{\"model\": \"lambert\", \"kd\": 0.2},"
+            " {\"model\": \"mirror\"}]}");
+        CHECK(m != NULL && (brdftab_flags(m) & BRDFTAB_DELTA), "a sum with a mirror term");
+        double wo1[3] = {0.6, 0.0, 0.8}, wi1[3], p1;
+        float w1[3];
+        int deltas = 0, smooth = 0;
+        for (int k = 0; k < 64; k++) {
+            double u1[2] = {(k + 0.5) / 64.0, 0.3};
+            unsigned char d1 = 9;
+            CHECK(brdftab_sample_delta(m, 1, wo1, u1, wi1, &p1, w1, &d1) == 0, "sum sample");
+            CHECK(d1 == 0 || d1 == 1, "a flag is 0 or 1");
+            if (d1) {
+                deltas++;
+                CHECK(fabs(wi1[0] + 0.6) < 1e-12 && fabs(wi1[2] - 0.8) < 1e-12 && p1 < 1.0,
+                      "a mirror draw: the mirror direction, the term's probability");
+            } else {
+                smooth++;
+            }
+        }
+        CHECK(deltas > 0 && smooth > 0, "both terms drawn");
+        brdftab_close(m);
+        free(d);
+        free(swi2);
+        free(spdf2);
+        free(w2);
+    }
 
     /* Two threads on one handle give what one thread gave, bit for bit. */
     float *f1 = malloc(n * c * sizeof(float)), *f2 = malloc(n * c * sizeof(float));

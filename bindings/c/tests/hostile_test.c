@@ -45,6 +45,11 @@ static void overflowing_counts(const brdftab_brdf *b) {
                   strlen(brdftab_last_error()) > 0 && !strstr(brdftab_last_error(), "panic"),
               what);
         CHECK(!strstr(brdftab_last_error(), "panic"), "no panic behind the -1");
+        unsigned char d[1];
+        snprintf(what, sizeof what, "sample_delta n = %zu is -1, not a caught panic", huge[k]);
+        CHECK(brdftab_sample_delta(b, huge[k], wo, u, swi, pdf, w, d) == -1 &&
+                  strlen(brdftab_last_error()) > 0 && !strstr(brdftab_last_error(), "panic"),
+              what);
     }
     /* The handle still works. */
     CHECK(brdftab_eval(b, 1, wi, wo, f) == 0 && f[0] > 0, "eval after the hostile counts");
@@ -107,6 +112,10 @@ static void corrupt_table(const char *path) {
     CHECK(brdftab_sample(b, N, wo, u, swi, pdf, w) == -1 &&
               strstr(brdftab_last_error(), "checksum"),
           "sample on a failed handle");
+    static unsigned char d[N];
+    CHECK(brdftab_sample_delta(b, N, wo, u, swi, pdf, w, d) == -1 &&
+              strstr(brdftab_last_error(), "checksum"),
+          "sample_delta on a failed handle");
     brdftab_close(b);
     brdftab_open_options eager = {0, 0, NULL, 1};
     CHECK(brdftab_open_with(path, &eager) == NULL && strstr(brdftab_last_error(), "checksum"),
