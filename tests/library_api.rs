@@ -302,3 +302,56 @@ fn declared_symmetry_is_taken_unverified() {
         brdftab::table::Symmetry::from_flags(src.flags())
     );
 }
+
+/// A delta lobe — a mirror alone, or a mirror term of a sum — has no f_r values to tabulate:
+/// every bake and conversion refuses it before writing anything (a sum's table silently held
+/// its smooth terms only, and a mirror written as a MERL file was zeros).
+#[test]
+fn sources_with_a_delta_lobe_are_refused_by_every_bake_and_conversion() {
+    use brdftab::request::{self, BakeSettings, ConvertSettings};
+    let dir = TempDir::new("delta-bakes");
+    let sources = [
+        r#"{"model": "mirror", "fresnel": {"conductor": "Au"}}"#,
+        r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.2}, {"model": "mirror"}]}"#,
+        r#"{"model": "sum", "terms": [{"model": "ggx", "alpha": 0.2}, {"model": "refractor", "eta": 1.5}]}"#,
+    ];
+    for src in sources {
+        let unsupported = |what: &str, r: Result<(), Error>| {
+            assert!(
+                matches!(r, Err(Error::Unsupported(ref m)) if m.contains("delta")),
+                "{what} of {src}: {r:?}"
+            )
+        };
+        let adaptive: BakeSettings = request::from_json(r#"{"target_error": 0.01}"#).unwrap();
+        for (name, settings) in [
+            ("bake", BakeSettings::default()),
+            ("adaptive bake", adaptive),
+        ] {
+            let out = dir.join("t.btdb");
+            let r = request::bake(src, out.to_str().unwrap(), &settings, &Silent);
+            unsupported(name, r.map(|_| ()));
+            assert!(!out.exists());
+        }
+        for ext in ["btdb", "bsdf", "binary"] {
+            let out = dir.join(format!("c.{ext}"));
+            let r = request::convert(
+                src,
+                out.to_str().unwrap(),
+                &ConvertSettings::default(),
+                &Silent,
+            );
+            unsupported(ext, r.map(|_| ()));
+            assert!(!out.exists(), "{ext}");
+        }
+        let b = ModelSpec::parse(src)
+            .unwrap()
+            .build(&Channels::Rgb)
+            .unwrap();
+        unsupported(
+            "in memory",
+            BakeRequest::new(src)
+                .table_of(b.as_ref(), &Silent)
+                .map(|_| ()),
+        );
+    }
+}

@@ -23,7 +23,9 @@ impl BakeRequest {
             channels: self.channels.clone(),
             ..OpenOptions::default()
         };
-        source::open_with(&self.source, &opts)
+        let src = source::open_with(&self.source, &opts)?;
+        crate::table::fill::tabulable(src.as_ref())?;
+        Ok(src)
     }
 
     /// Bakes into memory: the table and what the bake did.
@@ -34,6 +36,7 @@ impl BakeRequest {
 
     /// Bakes an already opened source (for callers that also use it, e.g. to compare).
     pub fn table_of(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<(Table, BakeReport)> {
+        crate::table::fill::tabulable(src)?;
         let t0 = Instant::now();
         match self.preset_misses(src, progress)? {
             Checked::Instead(Fallback::Adaptive, why) => {

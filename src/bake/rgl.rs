@@ -38,6 +38,7 @@ pub fn to_rgl(
     };
     crate::files::refuse_input(std::path::Path::new(output), &[source])?;
     let brdf = source::open_with(source, &open)?;
+    crate::table::fill::tabulable(brdf.as_ref())?;
     let opts = opts.clone().reuse_source_file(source)?;
     let t = std::time::Instant::now();
     let written = rgl_write::write(&*brdf, output, &opts, progress)?;

@@ -77,6 +77,26 @@ pub struct BakeStats {
 }
 
 /// Checks the source against the grid: channel count and declared symmetry.
+/// Refuses a source with a delta lobe — a mirror or refractor, alone or as a term of a sum:
+/// a table (or an RGL or MERL file) holds f_r values, which a Dirac delta has none of, so its
+/// table would silently lack the lobe (a sum's smooth terms alone, or zeros). Every bake and
+/// conversion checks this before any work.
+pub fn tabulable(brdf: &dyn Brdf) -> Result<()> {
+    let f = brdf.flags();
+    match (f.delta, f.lobes.delta) {
+        (true, _) => Err(Error::Unsupported(
+            "a delta (mirror/refractor) BRDF cannot be tabulated".into(),
+        )),
+        (false, true) => Err(Error::Unsupported(
+            "a sum with a delta term (mirror/refractor) cannot be tabulated: a table holds \
+             f_r values, which the delta has none of; tabulate the other terms and add the \
+             delta in the renderer"
+                .into(),
+        )),
+        _ => Ok(()),
+    }
+}
+
 fn check(brdf: &dyn Brdf, grid: &Grid, opts: &BakeOptions) -> Result<Option<String>> {
     if brdf.channels().len() != grid.channels().len() {
         return Err(Error::arg(
@@ -88,11 +108,7 @@ fn check(brdf: &dyn Brdf, grid: &Grid, opts: &BakeOptions) -> Result<Option<Stri
             ),
         ));
     }
-    if brdf.flags().delta {
-        return Err(Error::Unsupported(
-            "a delta (mirror/refractor) BRDF cannot be tabulated".into(),
-        ));
-    }
+    tabulable(brdf)?;
     if !(1..=MAX_SUPERSAMPLE).contains(&opts.supersample) {
         return Err(Error::arg(
             "supersample",
