@@ -64,6 +64,46 @@ def test_pdf_and_sample_match_cli(cli):
     np.testing.assert_allclose(w[ok], f * (cos_i / pdf[ok])[:, None], rtol=1e-4)
 
 
+def test_sample_at_wavelengths_and_its_delta_flags():
+    """`sample(wo, u, nm=..., delta=True)`: the same draws as `sample(wo, u)`; smooth draws
+    weighted by `eval_spectral` at nm, a mirror term's draws by its Fresnel term there (for a
+    spectral source at its own wavelengths: `sample`'s weights), and flagged as delta draws."""
+    lam = [420.0, 530.0, 650.0]
+    spec = json.dumps({"model": "sum", "terms": [
+        {"model": "ggx", "alpha": 0.3, "fresnel": {"conductor": "Cu"}},
+        {"model": "mirror", "fresnel": {"conductor": "Au"}}]})
+    wo = upper(400, 5)
+    u = np.random.default_rng(6).random((400, 2))
+    for b in (brdftab.open(spec), brdftab.open(spec, wavelengths=lam)):
+        wi, pdf, w = b.sample(wo, u)
+        wi2, pdf2, w2, delta = b.sample(wo, u, nm=lam, delta=True)
+        assert w2.shape == (400, 3) and delta.dtype == np.bool_
+        np.testing.assert_array_equal(wi, wi2)
+        np.testing.assert_array_equal(pdf, pdf2)
+        assert 0 < delta.sum() < 400
+        # delta draws: the mirror direction, a choice probability, not in pdf()
+        mirror = wo[delta] * [-1, -1, 1] / np.linalg.norm(wo[delta], axis=1)[:, None]
+        np.testing.assert_allclose(wi[delta], mirror, atol=1e-12)
+        assert np.all(pdf[delta] < 1) and np.all(b.pdf(wi[delta], wo[delta]) < pdf[delta] * 1e3)
+        smooth = ~delta & (pdf > 0)
+        cos_i = wi[smooth, 2]
+        want = b.eval_spectral(wi[smooth], wo[smooth], lam) * (cos_i / pdf[smooth])[:, None]
+        np.testing.assert_allclose(w2[smooth], want, rtol=1e-5)
+        if b.wavelengths:
+            np.testing.assert_allclose(w2, w, rtol=1e-5, atol=1e-7)
+        else:
+            assert not np.allclose(w2[delta], w[delta], rtol=1e-3)  # RGB sits elsewhere
+        # one row, and nm per row
+        one = b.sample(wo[0], u[0], nm=lam, delta=True)
+        assert one[2].shape == (3,) and one[3].shape == ()
+        per_row = b.sample(wo, u, nm=np.tile(lam, (400, 1)))
+        np.testing.assert_array_equal(per_row[2], w2)
+    with pytest.raises(ValueError, match="nm"):
+        b.sample(wo, u, nm=[500.0, float("nan")])
+    with pytest.raises(ValueError, match="nm"):
+        b.sample(wo, u, nm=np.ones((3, 2)))
+
+
 def test_rgl_matches_published_reference(rgl):
     """rgl-epfl/brdf-loader's values (f_r cos θo) for the seven files, as tests/rgl_reference.rs."""
     rows = [l.split("\t") for l in (rgl / "reference_eval_powitacq_rgb.tsv").read_text().splitlines()[1:]]

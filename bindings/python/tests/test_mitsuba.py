@@ -1,6 +1,7 @@
 """The Mitsuba 3 plugin `brdftab` against Mitsuba's own `measured` plugin on the same RGL file,
 its Dr.Jit table lookup against the Rust lookup, and its sampler through `mitsuba.chi2`."""
 
+import json
 import math
 import os
 import pathlib
@@ -535,3 +536,106 @@ def test_scalar_flags_and_delta():
     si.wi = mi.Vector3f(0, 0, -1)
     assert np.all(np.array(ggx.eval(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1))) == 0)
     assert ggx.pdf(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1)) == 0
+
+
+# A conductor whose n and k vary linearly between 400 and 700 nm, as the library's spec and as
+# Mitsuba's `irregular` spectra (both interpolate linearly).
+SPECTRAL_N = {"wavelengths": [400, 700], "values": [0.2, 1.4]}
+SPECTRAL_K = {"wavelengths": [400, 700], "values": [3.0, 1.0]}
+
+
+def _irregular(v):
+    return {"type": "irregular", "wavelengths": ", ".join(map(str, v["wavelengths"])),
+            "values": ", ".join(map(str, v["values"]))}
+
+
+def test_scalar_spectral_mirror_weighs_each_wavelength_as_mitsubas_conductor():
+    """A mirror's reflectance lives only in its sample: in a spectral variant the weight is
+    the Fresnel term at each of the path's wavelengths (it was the mean of the RGB weights),
+    as Mitsuba's own `conductor` gives it for the same n(λ), k(λ)."""
+    use("scalar_spectral")
+    spec = json.dumps({"model": "mirror", "fresnel": {"n": SPECTRAL_N, "k": SPECTRAL_K}})
+    ours = mi.load_dict({"type": "brdftab", "source": spec})
+    ref = mi.load_dict({"type": "conductor", "eta": _irregular(SPECTRAL_N),
+                        "k": _irregular(SPECTRAL_K)})
+    ctx = mi.BSDFContext()
+    for t in (0.0, 0.6, 1.43):  # to 82°
+        wi = [math.sin(t), 0.0, math.cos(t)]
+        si = mi.SurfaceInteraction3f()
+        si.wi = mi.Vector3f(*wi)
+        si.wavelengths = mi.Spectrum([410, 480, 555, 690])
+        (bs, w), (rbs, rw) = (b.sample(ctx, si, 0.5, mi.Point2f(0.3, 0.6)) for b in (ours, ref))
+        np.testing.assert_allclose(np.array(bs.wo), np.array(rbs.wo), atol=1e-6)
+        assert bs.pdf == rbs.pdf == 1 and bs.sampled_type == int(mi.BSDFFlags.DeltaReflection)
+        # float32 arithmetic on both sides
+        np.testing.assert_allclose(np.array(w), np.array(rw), rtol=1e-5)
+        assert np.ptp(np.array(w)) > 0.1  # the four wavelengths differ: not one grey value
+
+
+def test_scalar_sum_with_a_mirror_term_keeps_the_mirror():
+    """A sum of a diffuse and a mirror term: draws of the mirror term are delta samples
+    (DeltaReflection, pdf = the probability of that term, the library's weight), so the mean
+    weight is the sum's albedo — it lost the mirror when the weight was recomputed from eval —
+    in RGB and at each wavelength of a spectral variant."""
+    spec = json.dumps({"model": "sum", "terms": [
+        {"model": "lambert", "kd": 0.1},
+        {"model": "mirror", "fresnel": {"n": SPECTRAL_N, "k": SPECTRAL_K}}]})
+    theta = 0.5
+    wi = [math.sin(theta), 0.0, math.cos(theta)]
+    n = 4096
+    u = [((k + 0.5) / n, 0.37) for k in range(n)]
+    for variant, lam in (("scalar_rgb", None), ("scalar_spectral", [410.0, 480.0, 555.0, 690.0])):
+        use(variant)
+        b = mi.load_dict({"type": "brdftab", "source": spec})
+        assert b.flags() & mi.BSDFFlags.DeltaReflection and b.flags() & mi.BSDFFlags.DiffuseReflection
+        si = mi.SurfaceInteraction3f()
+        si.wi = mi.Vector3f(*wi)
+        if lam:
+            si.wavelengths = mi.Spectrum(lam)
+        ctx = mi.BSDFContext()
+        total, most, deltas = 0.0, 0.0, 0
+        for x in u:
+            bs, w = b.sample(ctx, si, 0.5, mi.Point2f(*x))
+            w = np.array(w)
+            total, most = total + w, max(most, w.max())
+            if bs.sampled_type & int(mi.BSDFFlags.Delta):
+                deltas += 1
+                assert 0 < bs.pdf < 1 and b.pdf(ctx, si, bs.wo) < 10  # not in the smooth pdf
+        want = (brdftab.open(spec).albedo(theta) if lam is None else
+                brdftab.open(spec, wavelengths=lam).albedo(theta))
+        # each branch's weight is its reflectance / its probability; stratified u leave at most
+        # two strata's weights
+        np.testing.assert_allclose(total / n, want, atol=2 * most / n)
+        assert 0 < deltas < n
+
+
+def test_jit_spectral_reads_rgb_tables_as_the_scalar_variant(tmp_path):
+    """An RGB table in a spectral JIT variant is read at each wavelength as the library reads
+    RGB channels (`eval_spectral`, the scalar variant's reading) — not as one grey value."""
+    use("llvm_ad_rgb")  # skips without libLLVM
+    use("llvm_ad_spectral")
+    spec = '{"model": "ggx", "alpha": 0.4, "fresnel": {"conductor": "Au"}}'
+    path = str(tmp_path / "au.btdb")
+    brdftab.bake(spec, path, preset="small")
+    b = mi.load_dict({"type": "brdftab", "source": path})
+    n = 64
+    wi, wo = random_dirs(n, 3, 0.2), random_dirs(n, 4, 0.2)
+    lam = np.array([420.0, 500.0, 560.0, 680.0])
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.wi = mi.Vector3f(*wi.T)
+    si.wavelengths = mi.Spectrum(*[np.full(n, x) for x in lam])
+    v = np.array(b.eval(mi.BSDFContext(), si, mi.Vector3f(*wo.T))).T
+    want = brdftab.open(path).eval_spectral(wi, wo, lam) * wo[:, 2:3]
+    # the JIT lookup in float32 against the library's
+    np.testing.assert_allclose(v, want, rtol=1e-4, atol=1e-6)
+    assert np.all(np.ptp(want, axis=1) > 0.3 * want.max(axis=1))  # gold: not grey
+
+
+def test_jit_refuses_a_sum_with_a_mirror_term():
+    """A table cannot hold a delta lobe: a JIT variant refuses a sum with a mirror term (it
+    dropped the mirror) as it refuses a mirror, and points to the scalar variants."""
+    use("llvm_ad_rgb")  # skips without libLLVM
+    spec = ('{"model": "sum", "terms": [{"model": "lambert", "kd": 0.1},'
+            ' {"model": "mirror"}]}')
+    with pytest.raises(Exception, match="scalar variant"):
+        mi.load_dict({"type": "brdftab", "source": spec})

@@ -1,7 +1,7 @@
 """Type stubs of the brdftab package (the Rust extension `brdftab._native` and its wrappers)."""
 
 from os import PathLike
-from typing import Any, Iterator, Sequence, Union
+from typing import Any, Iterator, Literal, Sequence, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -55,10 +55,21 @@ class Brdf:
         (n, k) float32."""
     def pdf(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float64]:
         """Density of `sample` drawing wi given wo: (n,) float64."""
+    @overload
     def sample(
-        self, wo: ArrayLike, u: ArrayLike
+        self, wo: ArrayLike, u: ArrayLike, *, nm: ArrayLike | None = None,
+        delta: Literal[False] = False
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32]]:
-        """(wi (n, 3), pdf (n,), weight = f cos θi / pdf (n, c)) for u in [0, 1)² of shape (n, 2)."""
+        """(wi (n, 3), pdf (n,), weight = f cos θi / pdf (n, c)) for u in [0, 1)² of shape (n, 2);
+        with `nm` (k,) or (n, k) the weights at those wavelengths, (n, k) (a delta draw: its
+        lobe's reflectance there)."""
+    @overload
+    def sample(
+        self, wo: ArrayLike, u: ArrayLike, *, nm: ArrayLike | None = None, delta: Literal[True]
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32],
+               npt.NDArray[np.bool_]]:
+        """The same and a bool (n,): the draws of a delta lobe (their pdf is the probability
+        of choosing that lobe; `pdf()` does not contain them)."""
     def albedo(self, theta: ArrayLike) -> npt.NDArray[np.float64]:
         """Directional albedo at θ′ in radians, 0 ≤ θ′ < π/2 (light above the horizon; else
         ValueError naming theta): (k, c) float64.

@@ -24,8 +24,15 @@ the light in brdftab's words; the tensor's incident axes for RGL data), Mitsuba'
 brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only.
 
 - Scalar variants (``scalar_rgb``, ``scalar_spectral``) call the library for every query (the
-  native source: RGL files evaluate with their own adaptive parameterization).
-- JIT variants (``llvm_ad_rgb``, ``cuda_ad_rgb``) cannot call back into the host per query:
+  native source: RGL files evaluate with their own adaptive parameterization). Delta lobes — a
+  mirror, or a sum's mirror term — are delta samples (``DeltaReflection``, pdf the probability
+  of choosing the lobe, weight the library's: in a spectral variant its reflectance at each of
+  the path's wavelengths, :meth:`brdftab.Brdf.sample` with ``nm``); smooth draws carry the
+  smooth lobes' flags.
+- In a spectral variant an RGB source is read at each wavelength as the library reads RGB
+  channels (:data:`RGB_WAVELENGTHS`, linear between), in the scalar and the JIT variants.
+- JIT variants (``llvm_ad_rgb``, ``cuda_ad_rgb``; sources with a delta lobe are refused: a
+  table cannot hold one) cannot call back into the host per query:
   the plugin bakes (or loads) a table, uploads the library's *device layout* of it once
   (``Table.device_layout``, Rust ``src/table/device.rs``: the kernel's knot lines and packed
   values, or a dense grid with its folds and axis mappings) and evaluates that layout in Dr.Jit
@@ -47,6 +54,10 @@ import brdftab
 from brdftab._halfwarp import HalfVectorSampler
 
 _REGISTERED = set()
+
+#: Where the library places the B, G and R channels of an RGB source on the wavelength axis
+#: (nm; `brdftab::spectrum::RGB_WAVELENGTHS`): a spectral variant reads RGB tables there.
+RGB_WAVELENGTHS = (444.0, 526.0, 645.0)
 
 #: The error target of the JIT variants' tables of isotropic models (relative RMSE of
 #: f_r cos θi cos θo, ``brdftab.bake``'s ``target_error``). The medium preset (4.4 M values,
@@ -202,19 +213,28 @@ class ScalarBrdftabBSDF(_Common):
         u = [min(float(sample2[0]), 0.99999994), min(float(sample2[1]), 0.99999994)]
         if not (wi[2] > 0) or not active:
             return bs, mi.Spectrum(0.0)
-        d, pdf, w = self.brdf.sample(wi, u)
+        # A spectral variant asks for the weights at the path's wavelengths (a mirror's
+        # reflectance lives only in its sample); `delta` tells a delta lobe's draw (a mirror, or
+        # a sum's mirror term) from a smooth one.
+        nm = [float(x) for x in si.wavelengths] if self.spectral else None
+        d, pdf, w, delta = self.brdf.sample(wi, u, nm=nm, delta=True)
         pdf = float(pdf)
         if not (pdf > 0 and d[2] > 0):
             return bs, mi.Spectrum(0.0)
         bs.wo = mi.Vector3f(*[float(x) for x in d])
         bs.eta = 1.0
         bs.sampled_component = 0
-        if self.delta:
-            bs.pdf = 1.0
+        if delta:
+            # pdf: the probability of choosing the delta lobe (1 for a mirror alone), as
+            # Mitsuba's BSDFs with a delta component report it; the weight is the library's.
+            bs.pdf = pdf
             bs.sampled_type = mi.UInt32(+mi.BSDFFlags.DeltaReflection)
-            return bs, mi.Spectrum(w.tolist()) if not self.spectral else mi.Spectrum(float(w.mean()))
+            return bs, mi.Spectrum(w.tolist())
         bs.pdf = pdf
-        bs.sampled_type = mi.UInt32(+self.m_flags & ~int(mi.BSDFFlags.FrontSide))
+        # A smooth draw: the smooth lobes' flags (a sum's mirror term is not what drew it, and a
+        # Delta bit would tell the integrator to skip multiple importance sampling).
+        not_drawn = int(mi.BSDFFlags.FrontSide) | int(mi.BSDFFlags.Delta)
+        bs.sampled_type = mi.UInt32(+self.m_flags & ~not_drawn)
         # The weight is recomputed from eval: exact also for sources that are not reciprocal.
         value = self.eval(ctx, si, bs.wo)
         return bs, value / pdf
@@ -806,10 +826,10 @@ class JitBrdftabBSDF(_Common):
 
         self._base.__init__(self, props)
         self._init_common(props)
-        if self.delta:
+        if self.brdf.flags["lobes"]["delta"]:
             raise brdftab.Error(
-                f"{self.source}: a delta (mirror/refractor) source has no table; the JIT "
-                "variants of the plugin do not support it (use a scalar variant)"
+                f"{self.source}: a delta lobe (a mirror or refractor, alone or in a sum) has no "
+                "table; the JIT variants of the plugin do not support it (use a scalar variant)"
             )
         # The cache of baked tables: property `cache` (default true), `cache_dir` (default
         # $BRDFTAB_CACHE_DIR, $XDG_CACHE_HOME/brdftab or ~/.cache/brdftab).
@@ -905,8 +925,11 @@ class JitBrdftabBSDF(_Common):
         if not self.spectral:
             return mi.Spectrum(f[0], f[1], f[2])
         wl = self.table.wavelengths
-        if wl is None:  # an RGB table in a spectral variant: its mean
-            return mi.Spectrum(sum(f) / len(f))
+        if wl is None:
+            # An RGB table in a spectral variant: the library's reading of RGB channels at a
+            # wavelength (`Brdf.eval_spectral`, `Channels::lerp_at`: B, G, R placed at
+            # RGB_WAVELENGTHS and interpolated linearly), as the scalar variants give it.
+            wl, f = RGB_WAVELENGTHS, [f[2], f[1], f[0]]
         out = []
         for i in range(len(lam)):
             x = lam[i]

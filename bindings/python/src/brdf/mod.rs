@@ -184,13 +184,27 @@ impl PyBrdf {
     /// weight = f_r cos θi / pdf (`brdftab sample`'s conventions). Where no direction can be
     /// drawn (wo below the horizon, NaN, infinite or zero) wi, pdf and weight are 0; `u`
     /// outside [0, 1) (NaN included) is a `ValueError`.
+    ///
+    /// `nm` (wavelengths in nm, shape (k,) or (n, k)): the weights at those wavelengths,
+    /// (n, k), instead of the channels — for a smooth draw f_r from `eval_spectral`, for a
+    /// delta draw (a mirror) the lobe's reflectance at each wavelength; the draws are those
+    /// without `nm`. `delta=True`: a fourth array, bool (n,), true where the draw is a delta
+    /// lobe's (a mirror term of a sum: its pdf is then the probability of choosing that lobe,
+    /// not a density, and `pdf(wi, wo)` does not contain it) — what a renderer's multiple
+    /// importance sampling needs to tell the two apart.
+    #[pyo3(signature = (wo, u, *, nm=None, delta=false))]
     fn sample(
         &self,
         py: Python<'_>,
         wo: &Bound<'_, PyAny>,
         u: &Bound<'_, PyAny>,
+        nm: Option<&Bound<'_, PyAny>>,
+        delta: bool,
     ) -> PyResult<Py<PyTuple>> {
-        guard(|| self.sample_pairs(py, wo, u))
+        guard(|| match (nm, delta) {
+            (None, false) => self.sample_pairs(py, wo, u),
+            _ => self.sample_pairs_spectral(py, wo, u, nm, delta),
+        })
     }
 
     /// Directional albedo ∫ f_r cos θo dωo at incidence angles θ′ (radians, in [0, π/2): light

@@ -22,6 +22,18 @@ use crate::errors::{Error, batch, unlocked};
 /// One block of `sample`'s outputs, numbered: (block, ((wi, pdf), weights)).
 type SampleBlock<'a> = (usize, ((&'a mut [DVec3], &'a mut [f64]), &'a mut [f32]));
 
+/// `u` in [0, 1)², row by row: anything else (NaN included) is a `ValueError` naming the row.
+fn check_u(u: &[DVec2]) -> PyResult<()> {
+    for (k, u) in u.iter().enumerate() {
+        if let Some(x) = [u.x, u.y].into_iter().find(|x| !(0.0..1.0).contains(x)) {
+            return Err(PyValueError::new_err(format!(
+                "u: row {k}: {x} is outside [0, 1)"
+            )));
+        }
+    }
+    Ok(())
+}
+
 impl PyBrdf {
     /// `Brdf.pdf`'s body, run under `guard` (documented on the method, in `mod.rs`).
     pub(super) fn pdf_pairs(
@@ -53,14 +65,7 @@ impl PyBrdf {
         u: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyTuple>> {
         let (a, b) = (Rows::<DVec3>::new(wo, "wo")?, Rows::<DVec2>::new(u, "u")?);
-        let uu = b.as_slice();
-        for (k, u) in uu.iter().enumerate() {
-            if let Some(x) = [u.x, u.y].into_iter().find(|x| !(0.0..1.0).contains(x)) {
-                return Err(PyValueError::new_err(format!(
-                    "u: row {k}: {x} is outside [0, 1)"
-                )));
-            }
-        }
+        check_u(b.as_slice())?;
         let p = Pairs::new(&a, "wo", &b, "u")?;
         let (n, c) = (p.n, self.c());
         let (s3, s1, sc): (&[usize], &[usize], &[usize]) = match p.single {
@@ -124,6 +129,122 @@ impl PyBrdf {
         drop((wi_w, pdf_w, w_w));
         self.check_loaded()?;
         Ok(PyTuple::new(py, [wi.into_any(), pdf.into_any(), weight.into_any()])?.unbind())
+    }
+
+    /// `Brdf.sample`'s body with `nm` (weights at wavelengths) or `delta` (the draws' delta
+    /// flags) asked for: pair by pair through `Brdf::sample_wavelengths` / `Brdf::sample`
+    /// (documented on the method, in `mod.rs`).
+    pub(super) fn sample_pairs_spectral(
+        &self,
+        py: Python<'_>,
+        wo: &Bound<'_, PyAny>,
+        u: &Bound<'_, PyAny>,
+        nm: Option<&Bound<'_, PyAny>>,
+        want_delta: bool,
+    ) -> PyResult<Py<PyTuple>> {
+        use numpy::PyUntypedArrayMethods;
+        let (a, b) = (Rows::<DVec3>::new(wo, "wo")?, Rows::<DVec2>::new(u, "u")?);
+        check_u(b.as_slice())?;
+        let p = Pairs::new(&a, "wo", &b, "u")?;
+        let (n, c) = (p.n, self.c());
+        let l = nm.map(|x| arrays::f64_array(x, "nm")).transpose()?;
+        let (k, per_row) = match l.as_ref().map(|l| l.shape().to_vec()) {
+            None => (c, false),
+            Some(s) => match s.as_slice() {
+                [k] => (*k, false),
+                [m, k] if *m == n => (*k, true),
+                s => {
+                    return Err(PyValueError::new_err(format!(
+                        "nm: expected shape (k,) or ({n}, k), got {}",
+                        arrays::shape_str(s)
+                    )));
+                }
+            },
+        };
+        let lv = l.as_ref().map(|l| l.as_array());
+        if n > 0
+            && let Some(x) = lv
+                .as_ref()
+                .and_then(|v| v.iter().find(|&&x| !brdftab::spectrum::is_wavelength(x)))
+        {
+            return Err(PyValueError::new_err(format!(
+                "nm: {x} is not a wavelength (a finite number of nm > 0)"
+            )));
+        }
+        let (s3, s1, sk): (&[usize], &[usize], &[usize]) = match p.single {
+            true => (&[3], &[], &[k]),
+            false => (&[n, 3], &[n], &[n, k]),
+        };
+        let (wi, pdf, weight, delta) = (
+            arrays::zeros::<f64>(py, s3)?,
+            arrays::zeros::<f64>(py, s1)?,
+            arrays::zeros::<f32>(py, sk)?,
+            arrays::zeros::<bool>(py, s1)?,
+        );
+        let (mut wi_w, mut pdf_w, mut w_w, mut d_w) = (
+            wi.readwrite(),
+            pdf.readwrite(),
+            weight.readwrite(),
+            delta.readwrite(),
+        );
+        let slice_err = |e: numpy::NotContiguousError| Error::new_err(e.to_string());
+        let wi_s = arrays::as_rows_mut(wi_w.as_slice_mut().map_err(slice_err)?)?;
+        let pdf_s = pdf_w.as_slice_mut().map_err(slice_err)?;
+        let w_s = w_w.as_slice_mut().map_err(slice_err)?;
+        let d_s = d_w.as_slice_mut().map_err(slice_err)?;
+        let brdf = &self.inner;
+        batch(py, n, || {
+            let kw = k.max(1);
+            for (s, (((wi, pd), w), d)) in wi_s
+                .chunks_mut(BLOCK)
+                .zip(pdf_s.chunks_mut(BLOCK))
+                .zip(w_s.chunks_mut(BLOCK * kw))
+                .zip(d_s.chunks_mut(BLOCK))
+                .enumerate()
+            {
+                let (a, b) = p.block(s * BLOCK, pd.len());
+                for r in 0..pd.len() {
+                    let w = &mut w[r * k..(r + 1) * k];
+                    let drawn = match (brdftab::batch::drawable(a[r], b[r]), &lv) {
+                        (false, _) => None,
+                        (true, None) => brdf.sample(a[r], b[r], w),
+                        (true, Some(l)) => {
+                            let row = match per_row {
+                                true => l.index_axis(numpy::ndarray::Axis(0), s * BLOCK + r),
+                                false => l.view(),
+                            };
+                            let mut nm = [0.0f64; brdftab::spectrum::MAX_CHANNELS];
+                            match row.len() <= nm.len() {
+                                true => {
+                                    for (o, &x) in nm.iter_mut().zip(row.iter()) {
+                                        *o = x;
+                                    }
+                                    brdf.sample_wavelengths(a[r], b[r], &nm[..k], w)
+                                }
+                                false => {
+                                    let nm: Vec<f64> = row.iter().copied().collect();
+                                    brdf.sample_wavelengths(a[r], b[r], &nm, w)
+                                }
+                            }
+                        }
+                    };
+                    match drawn {
+                        Some(x) => (wi[r], pd[r], d[r]) = (x.wi, x.pdf, x.delta),
+                        None => {
+                            brdftab::batch::no_sample(&mut wi[r], &mut pd[r], w);
+                            d[r] = false;
+                        }
+                    }
+                }
+            }
+        })?;
+        drop((wi_w, pdf_w, w_w, d_w));
+        self.check_loaded()?;
+        let mut parts = vec![wi.into_any(), pdf.into_any(), weight.into_any()];
+        if want_delta {
+            parts.push(delta.into_any());
+        }
+        Ok(PyTuple::new(py, parts)?.unbind())
     }
 
     /// `Brdf.sampling_nodes`'s body, run under `guard` (documented on the method, in `mod.rs`).
