@@ -149,3 +149,19 @@ fn cook_torrance_recovered_through_a_baked_table() {
     // The table itself is least accurate at grazing angles, which `rmse_uniform` includes.
     assert!(r.rmse < 0.02, "{}", r.rmse);
 }
+
+/// A source with a delta lobe cannot be fitted: eval is 0 for a mirror, and a sum's mirror term
+/// is invisible to it, so a fit would silently match the other terms only.
+#[test]
+fn sources_with_a_delta_lobe_are_refused() {
+    for src in [
+        r#"{"model": "mirror"}"#,
+        r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.2}, {"model": "mirror"}]}"#,
+    ] {
+        let r = fit::fit(build(src).as_ref(), &fit::preset("ggx").unwrap(), &grey(1));
+        assert!(
+            matches!(r, Err(brdftab::Error::Unsupported(ref m)) if m.contains("delta")),
+            "{src}: {r:?}"
+        );
+    }
+}

@@ -342,6 +342,14 @@ pub fn fit_with_progress(
             "fitting a delta (mirror/refractor) source: eval is 0 everywhere".into(),
         ));
     }
+    // A sum's delta term is invisible to eval: a fit would match the other terms only.
+    if source.flags().lobes.delta {
+        return Err(Error::Unsupported(
+            "fitting a source with a delta term (mirror/refractor): eval does not see the delta, \
+             so the fit would match the other terms only; fit those"
+                .into(),
+        ));
+    }
     let channels = source.channels().clone();
     let mut base = serde_json::to_value(init).map_err(|e| Error::Json {
         context: "spec".into(),
