@@ -3,7 +3,9 @@
 //! `sample` prints one line per drawn direction: `wix wiy wiz pdf w_1 .. w_c` where `w` is the
 //! per-channel weight f_r cos θi / pdf. Numbers are printed in Rust's shortest round-trip form,
 //! so `wi` can be fed back to `pdf` or `eval` exactly. Delta samples (mirror, refractor) print
-//! pdf 1 (the library's convention) and the lobe's reflectance as weight; nothing else marks them.
+//! pdf 1 (the library's convention; a sum's mirror term: the probability of choosing it) and
+//! the lobe's reflectance (over that probability) as weight; `--delta` adds a last column, 1
+//! for such a draw and 0 for a smooth one.
 //! Draws for which the sampler returns no direction (e.g. `wo` below the horizon) print nothing, so
 //! fewer than `--count` lines may appear.
 
@@ -28,6 +30,10 @@ pub struct SampleArgs {
     /// Seed of the uniform numbers (PCG32).
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Append a column: 1 where the draw is a delta lobe's (a mirror, or a sum's mirror term,
+    /// which `pdf` does not contain), 0 elsewhere.
+    #[arg(long)]
+    delta: bool,
     #[command(flatten)]
     open: brdftab::request::OpenSettings,
 }
@@ -78,6 +84,9 @@ pub fn sample(a: SampleArgs) -> Result<()> {
         write!(out, "{} {} {} {}", s.wi.x, s.wi.y, s.wi.z, s.pdf).map_err(out_err)?;
         for x in &w {
             write!(out, " {x}").map_err(out_err)?;
+        }
+        if a.delta {
+            write!(out, " {}", u8::from(s.delta)).map_err(out_err)?;
         }
         writeln!(out).map_err(out_err)?;
     }

@@ -104,6 +104,51 @@ fn sample_pdf_matches_pdf_command_for_glossy_models() {
     }
 }
 
+/// `--delta` marks a sum's mirror-term draws (the mirror direction, pdf below 1, not the pdf
+/// command's density) with 1 and the smooth draws, which `pdf` gives back, with 0.
+#[test]
+fn sample_delta_marks_the_draws_of_a_mirror_term() {
+    let sum =
+        r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.1}, {"model": "mirror"}]}"#;
+    let r = brdftab(&[
+        "sample",
+        sum,
+        "--wo",
+        "0.6,0,0.8",
+        "--count",
+        "64",
+        "--delta",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let (mut deltas, mut smooth) = (0, 0);
+    for l in r.stdout.lines() {
+        let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+        assert_eq!(v.len(), 4 + 3 + 1, "{l}");
+        let input = format!("{} {} {} 0.6 0 0.8\n", v[0], v[1], v[2]);
+        let p: f64 = brdftab_with_stdin(&["pdf", sum], &input)
+            .stdout
+            .trim()
+            .parse()
+            .unwrap();
+        match v[7] {
+            1.0 => {
+                deltas += 1;
+                assert!(
+                    (v[0] + 0.6).abs() < 1e-12 && (v[2] - 0.8).abs() < 1e-12,
+                    "{l}"
+                );
+                assert!(v[3] < 1.0 && p != v[3], "{l}: pdf {p}");
+            }
+            0.0 => {
+                smooth += 1;
+                assert!((v[3] - p).abs() <= 1e-6 * p, "{l}: pdf {p}");
+            }
+            x => panic!("flag {x}"),
+        }
+    }
+    assert!(deltas > 0 && smooth > 0, "{}", r.stdout);
+}
+
 #[test]
 fn pdf_reads_stdin_like_eval() {
     let r = brdftab_with_stdin(
