@@ -22,6 +22,15 @@ use crate::errors::{Error, batch, unlocked};
 /// One block of `sample`'s outputs, numbered: (block, ((wi, pdf), weights)).
 type SampleBlock<'a> = (usize, ((&'a mut [DVec3], &'a mut [f64]), &'a mut [f32]));
 
+/// The same with the draws' delta flags: (block, (((wi, pdf), weights), flags)).
+type FlaggedBlock<'a> = (
+    usize,
+    (
+        ((&'a mut [DVec3], &'a mut [f64]), &'a mut [f32]),
+        &'a mut [bool],
+    ),
+);
+
 /// `u` in [0, 1)², row by row: anything else (NaN included) is a `ValueError` naming the row.
 fn check_u(u: &[DVec2]) -> PyResult<()> {
     for (k, u) in u.iter().enumerate() {
@@ -194,15 +203,18 @@ impl PyBrdf {
         let d_s = d_w.as_slice_mut().map_err(slice_err)?;
         let brdf = &self.inner;
         batch(py, n, || {
-            let kw = k.max(1);
-            for (s, (((wi, pd), w), d)) in wi_s
-                .chunks_mut(BLOCK)
-                .zip(pdf_s.chunks_mut(BLOCK))
-                .zip(w_s.chunks_mut(BLOCK * kw))
-                .zip(d_s.chunks_mut(BLOCK))
-                .enumerate()
-            {
+            // Without nm, a batch with no broadcast row is the library's (a table's batch path).
+            if let (None, Some((a, b))) = (&lv, p.whole()) {
+                let out = brdftab::batch::SampleOut {
+                    wi: wi_s,
+                    pdf: pdf_s,
+                    weight: w_s,
+                };
+                return brdftab::batch::sample_flagged(brdf, a, b, out, d_s);
+            }
+            let go = |(s, (((wi, pd), w), d)): FlaggedBlock<'_>| {
                 let (a, b) = p.block(s * BLOCK, pd.len());
+                let mut nm = [0.0f64; brdftab::spectrum::MAX_CHANNELS];
                 for r in 0..pd.len() {
                     let w = &mut w[r * k..(r + 1) * k];
                     let drawn = match (brdftab::batch::drawable(a[r], b[r]), &lv) {
@@ -213,7 +225,7 @@ impl PyBrdf {
                                 true => l.index_axis(numpy::ndarray::Axis(0), s * BLOCK + r),
                                 false => l.view(),
                             };
-                            let mut nm = [0.0f64; brdftab::spectrum::MAX_CHANNELS];
+                            // nm.len() = k ≤ the weights' row; beyond MAX_CHANNELS a copy.
                             match row.len() <= nm.len() {
                                 true => {
                                     for (o, &x) in nm.iter_mut().zip(row.iter()) {
@@ -236,6 +248,24 @@ impl PyBrdf {
                         }
                     }
                 }
+            };
+            let kw = k.max(1);
+            if n >= brdftab::batch::PARALLEL {
+                brdftab::par::install(|| {
+                    wi_s.par_chunks_mut(BLOCK)
+                        .zip(pdf_s.par_chunks_mut(BLOCK))
+                        .zip(w_s.par_chunks_mut(BLOCK * kw))
+                        .zip(d_s.par_chunks_mut(BLOCK))
+                        .enumerate()
+                        .for_each(go)
+                })
+            } else {
+                wi_s.chunks_mut(BLOCK)
+                    .zip(pdf_s.chunks_mut(BLOCK))
+                    .zip(w_s.chunks_mut(BLOCK * kw))
+                    .zip(d_s.chunks_mut(BLOCK))
+                    .enumerate()
+                    .for_each(go)
             }
         })?;
         drop((wi_w, pdf_w, w_w, d_w));
