@@ -320,10 +320,7 @@ pub trait Brdf: Send + Sync {
         let c = self.channels().len().min(MAX_CHANNELS);
         let s = self.sample(wo, u, &mut buf[..c])?;
         if s.delta {
-            for (w, &x) in weight.iter_mut().zip(nm) {
-                let (i0, i1, t) = self.channels().lerp_at(x);
-                *w = ((1.0 - t) * buf[i0] as f64 + t * buf[i1] as f64) as f32;
-            }
+            lerp_channels(self.channels(), &buf[..c], nm, weight);
         } else {
             let k = s.wi.z.abs() / s.pdf;
             for (w, &x) in weight.iter_mut().zip(nm) {
@@ -410,6 +407,16 @@ pub fn check_batch(wi: &[DVec3], wo: &[DVec3], out: &[f32], c: usize) -> usize {
         out.len()
     );
     wi.len()
+}
+
+/// Per-channel values `v` read at the wavelengths `nm` into `out` as
+/// [`Brdf::eval_wavelength`]'s default reads channels ([`Channels::lerp_at`]): what a source whose
+/// spectral values are its channels' interpolation gives at a wavelength.
+pub fn lerp_channels(channels: &Channels, v: &[f32], nm: &[f64], out: &mut [f32]) {
+    for (o, &x) in out.iter_mut().zip(nm) {
+        let (i0, i1, t) = channels.lerp_at(x);
+        *o = ((1.0 - t) * v[i0] as f64 + t * v[i1] as f64) as f32;
+    }
 }
 
 /// Smart pointers to a `Brdf` are `Brdf`s: every method forwards to the pointee (so overrides such

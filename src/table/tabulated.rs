@@ -578,6 +578,22 @@ impl Brdf for TabulatedBrdf {
         self.sampler().pdf(wi, wo)
     }
 
+    /// A table's f_r at a wavelength interpolates its channels, so the weights do too: one
+    /// draw and one lookup, whatever the number of wavelengths.
+    fn sample_wavelengths(
+        &self,
+        wo: DVec3,
+        u: DVec2,
+        nm: &[f64],
+        weight: &mut [f32],
+    ) -> Option<BrdfSample> {
+        let mut buf = [0.0f32; crate::spectrum::MAX_CHANNELS];
+        let c = self.lookup.channels().min(buf.len());
+        let s = self.sample(wo, u, &mut buf[..c])?;
+        crate::brdf::lerp_channels(self.channels(), &buf[..c], nm, weight);
+        Some(s)
+    }
+
     /// Draws a run of pairs, then evaluates their weights together ([`Brdf::eval_batch`]'s
     /// path: eight lookups per AVX2 group on kernel tables), then weighs them: the same values
     /// as [`TabulatedBrdf::sample`] pair by pair, at a batch lookup's cost for the weights.

@@ -517,8 +517,8 @@ fn sampling<B: Brdf + ?Sized>(
     }
 }
 
-/// `sample_wavelengths` makes `sample`'s draw, and at the channels' own wavelengths (sources of
-/// wavelength channels) `sample`'s weights.
+/// `sample_wavelengths` makes `sample`'s draw, weighs a smooth draw by `eval_wavelength`, and at
+/// the channels' own wavelengths (sources of wavelength channels) gives `sample`'s weights.
 fn spectral_sample<B: Brdf + ?Sized>(
     brdf: &B,
     wo: DVec3,
@@ -538,6 +538,20 @@ fn spectral_sample<B: Brdf + ?Sized>(
             format!("wo {wo}, u {u}: draw {got:?} vs sample's {s:?}")
         });
         return;
+    }
+    if !s.delta {
+        // A smooth draw: f_r at each wavelength, cos θi / pdf.
+        for (k, &x) in nm.iter().enumerate() {
+            let want = brdf.eval_wavelength(s.wi, wo, x) * s.wi.z.abs() / s.pdf;
+            if !close_abs(ws[k] as f64, want, 1e-5, 1e-7) {
+                log.fail("sample_wavelengths", || {
+                    format!(
+                        "wo {wo}, u {u}: weight {} at {x} nm vs f cos θi / pdf {want}",
+                        ws[k]
+                    )
+                });
+            }
+        }
     }
     if let Channels::Wavelengths(_) = brdf.channels() {
         for (k, (&a, &b)) in ws.iter().zip(w).enumerate() {
