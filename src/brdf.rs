@@ -419,6 +419,91 @@ pub fn lerp_channels(channels: &Channels, v: &[f32], nm: &[f64], out: &mut [f32]
     }
 }
 
+/// One block of [`sample_flagged`]'s outputs, numbered: (block, (((wi, pdf), weights), flags)).
+type FlaggedBlock<'a> = (
+    usize,
+    (
+        ((&'a mut [DVec3], &'a mut [f64]), &'a mut [f32]),
+        &'a mut [bool],
+    ),
+);
+
+/// [`Brdf::sample_batch`] and each draw's delta flag:
+/// `delta[k]` is true where pair `k` drew a delta lobe (a mirror, or a sum's mirror term: its
+/// pdf is then the probability of choosing that lobe, not a density, and
+/// [`Brdf::pdf`] does not contain it). What a host's renderer needs to
+/// tell such draws from smooth ones (pbrt's `BSDFSample::flags`, Mitsuba's `sampled_type`).
+/// Sources without a delta lobe take `sample_batch` (a table's batch path) and flag nothing.
+///
+/// # Panics
+///
+/// If the lengths do not match `wo.len()` pairs.
+pub fn sample_flagged<B: Brdf + ?Sized>(
+    brdf: &B,
+    wo: &[DVec3],
+    u: &[DVec2],
+    out: crate::batch::SampleOut<'_>,
+    delta: &mut [bool],
+) {
+    use crate::batch::{BLOCK, PARALLEL, SampleOut, drawable, no_sample};
+    use rayon::prelude::*;
+    let n = wo.len();
+    assert_eq!(
+        delta.len(),
+        n,
+        "sample_flagged: {n} wo and {} flags",
+        delta.len()
+    );
+    if !brdf.flags().lobes.delta {
+        delta.fill(false);
+        return brdf.sample_batch(wo, u, out);
+    }
+    let c = brdf.channels().len().max(1);
+    let SampleOut { wi, pdf, weight } = out;
+    assert!(
+        u.len() == n && wi.len() == n && pdf.len() == n && weight.len() == n * c,
+        "sample_flagged: {n} wo, {} u, {} wi, {} pdf and {} weights do not match ({c} channels)",
+        u.len(),
+        wi.len(),
+        pdf.len(),
+        weight.len()
+    );
+    let go = |(b, (((wi, p), w), d)): FlaggedBlock<'_>| {
+        for k in 0..wi.len() {
+            let (wo, u) = (wo[b * BLOCK + k], u[b * BLOCK + k]);
+            let w = &mut w[k * c..(k + 1) * c];
+            let drawn = match drawable(wo, u) {
+                true => brdf.sample(wo, u, w),
+                false => None,
+            };
+            match drawn {
+                Some(s) => (wi[k], p[k], d[k]) = (s.wi, s.pdf, s.delta),
+                None => {
+                    no_sample(&mut wi[k], &mut p[k], w);
+                    d[k] = false;
+                }
+            }
+        }
+    };
+    if n >= PARALLEL {
+        crate::par::install(|| {
+            wi.par_chunks_mut(BLOCK)
+                .zip(pdf.par_chunks_mut(BLOCK))
+                .zip(weight.par_chunks_mut(BLOCK * c))
+                .zip(delta.par_chunks_mut(BLOCK))
+                .enumerate()
+                .for_each(go)
+        });
+    } else {
+        wi.chunks_mut(BLOCK)
+            .zip(pdf.chunks_mut(BLOCK))
+            .zip(weight.chunks_mut(BLOCK * c))
+            .zip(delta.chunks_mut(BLOCK))
+            .enumerate()
+            .for_each(go);
+    }
+}
+
 /// Smart pointers to a `Brdf` are `Brdf`s: every method forwards to the pointee (so overrides such
 /// as a table's `eval_batch` or a model's closed-form `albedo` are kept).
 macro_rules! forward_brdf {
@@ -500,4 +585,63 @@ pub fn albedo_with<B: Brdf + ?Sized>(
     });
     let c = est.value.len().min(out.len());
     out[..c].copy_from_slice(&est.value[..c]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::batch::{BLOCK, PARALLEL, SampleOut};
+    use crate::models::lambert::Lambert;
+    use crate::spectrum::Value;
+
+    fn dirs(n: usize) -> Vec<DVec3> {
+        (0..n)
+            .map(|k| {
+                let t = k as f64 * 0.618;
+                DVec3::new(t.sin() * 0.7, t.cos() * 0.5, 0.2 + (k % 7) as f64 * 0.1)
+            })
+            .collect()
+    }
+
+    /// `sample_flagged` gives the one-pair draws and their delta flags (a sum with a mirror
+    /// term, across the parallel path's blocks); a source without a delta lobe flags nothing.
+    #[test]
+    fn flagged_batches_carry_the_draws_delta_flags() {
+        let spec = crate::spec::ModelSpec::parse(
+            r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.2},
+                {"model": "mirror", "fresnel": {"conductor": "Au"}}]}"#,
+        )
+        .unwrap();
+        let lambert: Box<dyn Brdf + Send + Sync> =
+            Box::new(Lambert::new(Value::Grey(0.5), &Channels::Rgb).unwrap());
+        let sum = spec.build(&Channels::Rgb).unwrap();
+        let n = PARALLEL + BLOCK / 2 + 3;
+        let wo = dirs(n);
+        let u: Vec<DVec2> = (0..n)
+            .map(|k| DVec2::new((k % 97) as f64 / 97.0, (k % 89) as f64 / 89.0))
+            .collect();
+        for (b, has_delta) in [(&sum, true), (&lambert, false)] {
+            let (mut si, mut sp, mut sw) = (vec![DVec3::NAN; n], vec![-1.0; n], vec![-1.0; 3 * n]);
+            let mut d = vec![true; n];
+            let out = SampleOut {
+                wi: &mut si,
+                pdf: &mut sp,
+                weight: &mut sw,
+            };
+            sample_flagged(b.as_ref(), &wo, &u, out, &mut d);
+            let mut deltas = 0;
+            for k in 0..n {
+                let mut w = [0.0f32; 3];
+                match b.sample(wo[k], u[k], &mut w) {
+                    Some(s) => {
+                        assert_eq!((si[k], sp[k], d[k]), (s.wi, s.pdf, s.delta), "pair {k}");
+                        assert_eq!(&sw[3 * k..3 * k + 3], &w);
+                        deltas += s.delta as usize;
+                    }
+                    None => assert_eq!((si[k], sp[k], d[k]), (DVec3::ZERO, 0.0, false)),
+                }
+            }
+            assert_eq!(deltas > 0, has_delta, "{deltas} delta draws");
+        }
+    }
 }

@@ -428,7 +428,7 @@ pub unsafe extern "C" fn brdftab_sample(
 /// [`brdftab_sample`] and each draw's delta flag: `delta[k]` = 1 where pair `k` drew a delta
 /// lobe (a mirror, or a sum's mirror term — its pdf is then the probability of choosing that
 /// lobe, not a density, and `brdftab_pdf` does not contain it; its weight is the lobe's
-/// reflectance over that probability), else 0 ([`brdftab::batch::sample_flagged`]). What a
+/// reflectance over that probability), else 0 ([`brdftab::brdf::sample_flagged`]). What a
 /// renderer needs to give such draws its specular path (no MIS with light sampling).
 ///
 /// # Safety
@@ -462,7 +462,7 @@ pub unsafe extern "C" fn brdftab_sample_delta(
         // SAFETY: u8 and bool have one size and alignment, and every byte is now 0.
         let flags = unsafe { std::slice::from_raw_parts_mut(flags.as_mut_ptr() as *mut bool, n) };
         let out = brdftab::batch::SampleOut { wi, pdf, weight };
-        brdftab::batch::sample_flagged(&b.brdf, wo, u, out, flags);
+        brdftab::brdf::sample_flagged(&b.brdf, wo, u, out, flags);
         healthy(b)
     })
 }

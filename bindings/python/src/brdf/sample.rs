@@ -210,7 +210,7 @@ impl PyBrdf {
                     pdf: pdf_s,
                     weight: w_s,
                 };
-                return brdftab::batch::sample_flagged(brdf, a, b, out, d_s);
+                return brdftab::brdf::sample_flagged(brdf, a, b, out, d_s);
             }
             let go = |(s, (((wi, pd), w), d)): FlaggedBlock<'_>| {
                 let (a, b) = p.block(s * BLOCK, pd.len());
