@@ -45,6 +45,9 @@ class BrdftabBxDF {
 public:
     explicit BrdftabBxDF(const brdftab::Brdf &b) : b_(&b) {
         if (b.channels() != 3) throw brdftab::Error("BrdftabBxDF expects an RGB source");
+        // pbrt's BxDF for these is a dielectric; this adapter reflects only (front side).
+        if (b.flags() & BRDFTAB_TRANSMISSION)
+            throw brdftab::Error("BrdftabBxDF reflects only: the source transmits (a refractor)");
     }
 
     /// pbrt's flags from the lobes the library declares (glossy when it declares none).

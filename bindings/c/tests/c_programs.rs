@@ -340,6 +340,13 @@ fn the_examples_build_and_print_what_the_library_computes() {
     let out = Command::new(&bxdf).arg("/no/such.btdb").output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such.btdb"));
+    // A refractor: the adapter reflects only, so it refuses the source (it rendered black).
+    let out = Command::new(&bxdf)
+        .arg(r#"{"model":"refractor","eta":1.5}"#)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("transmits"));
 }
 
 #[test]

@@ -631,6 +631,18 @@ def test_jit_spectral_reads_rgb_tables_as_the_scalar_variant(tmp_path):
     assert np.all(np.ptp(want, axis=1) > 0.3 * want.max(axis=1))  # gold: not grey
 
 
+def test_a_refractor_is_refused_not_rendered_black():
+    """The plugin is a BRDF (front side only): a refractor's draws all lie below the surface,
+    so it rendered black; it is refused with a pointer to Mitsuba's dielectric."""
+    for variant in ("scalar_rgb", "scalar_spectral"):
+        use(variant)
+        for spec in ('{"model": "refractor", "eta": 1.5}',
+                     '{"model": "sum", "terms": [{"model": "ggx", "alpha": 0.2},'
+                     ' {"model": "refractor", "eta": 1.5}]}'):
+            with pytest.raises(Exception, match="dielectric"):
+                mi.load_dict({"type": "brdftab", "source": spec})
+
+
 def test_jit_refuses_a_sum_with_a_mirror_term():
     """A table cannot hold a delta lobe: a JIT variant refuses a sum with a mirror term (it
     dropped the mirror) as it refuses a mirror, and points to the scalar variants."""

@@ -118,7 +118,7 @@ def _flags(brdf, source):
     lobes = brdf.flags["lobes"]
     flags = F.FrontSide
     if lobes["delta"]:
-        flags |= F.DeltaTransmission if brdf.flags["transmission"] else F.DeltaReflection
+        flags |= F.DeltaReflection  # transmitting sources are refused
     if lobes["diffuse"]:
         flags |= F.DiffuseReflection
     if lobes["glossy"] or not (lobes["delta"] or lobes["diffuse"]):
@@ -152,6 +152,13 @@ class _Common:
         self.interp = str(_prop(props, "interp", "auto"))
         self.spectral = mi.is_spectral
         self.brdf = brdftab.open(src, interp=self.interp)
+        if self.brdf.flags["transmission"]:
+            # Every draw of a refractor lies below the surface, where this front-side BRDF
+            # plugin gives nothing: it rendered black.
+            raise brdftab.Error(
+                f"{src}: the source transmits light (a refractor); the plugin is a BRDF (front "
+                "side only): use Mitsuba's dielectric for the interface"
+            )
         if not self.spectral and len(self.brdf.channels) != 3:
             raise brdftab.Error(
                 f"{src}: channels {' '.join(self.brdf.channels)}; an RGB variant needs R, G, B "
