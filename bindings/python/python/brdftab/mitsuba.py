@@ -21,7 +21,8 @@ material is baked once, not at every scene load) and ``cache_dir``.
 
 Conventions are those of Mitsuba's ``measured`` plugin: ``si.wi`` is brdftab's ``wi`` (towards
 the light in brdftab's words; the tensor's incident axes for RGL data), Mitsuba's ``wo`` is
-brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only.
+brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only (so a source that transmits
+— a refractor — is refused: use Mitsuba's ``dielectric``).
 
 - Scalar variants (``scalar_rgb``, ``scalar_spectral``) call the library for every query (the
   native source: RGL files evaluate with their own adaptive parameterization). Delta lobes — a
