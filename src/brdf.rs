@@ -445,8 +445,6 @@ pub fn sample_flagged<B: Brdf + ?Sized>(
     out: crate::batch::SampleOut<'_>,
     delta: &mut [bool],
 ) {
-    use crate::batch::{BLOCK, PARALLEL, SampleOut, drawable, no_sample};
-    use rayon::prelude::*;
     let n = wo.len();
     assert_eq!(
         delta.len(),
@@ -459,37 +457,84 @@ pub fn sample_flagged<B: Brdf + ?Sized>(
         return brdf.sample_batch(wo, u, out);
     }
     let c = brdf.channels().len().max(1);
+    flagged_blocks(c, wo, u, out, delta, |wo, u, w| brdf.sample(wo, u, w));
+}
+
+/// [`sample_flagged`] with the weights at the wavelengths `nm` ([`Brdf::sample_wavelengths`]):
+/// `out.weight` holds `nm.len()` values per pair. The same draws and flags as
+/// [`sample_flagged`]; what a spectral renderer with wavelengths of its own per path (pbrt-v4's
+/// sampled wavelengths) calls.
+///
+/// # Panics
+///
+/// If the lengths do not match `wo.len()` pairs of `nm.len()` weights.
+pub fn sample_flagged_at<B: Brdf + ?Sized>(
+    brdf: &B,
+    wo: &[DVec3],
+    u: &[DVec2],
+    nm: &[f64],
+    out: crate::batch::SampleOut<'_>,
+    delta: &mut [bool],
+) {
+    flagged_blocks(nm.len(), wo, u, out, delta, |wo, u, w| {
+        brdf.sample_wavelengths(wo, u, nm, w)
+    });
+}
+
+/// Draws pair by pair with `draw(wo, u, weights)` (`width` weights a pair) into `out` and each
+/// draw's delta flag into `delta`, in blocks, on the library's pool from
+/// [`crate::batch::PARALLEL`] pairs on: [`sample_flagged`]'s and [`sample_flagged_at`]'s loop.
+fn flagged_blocks(
+    width: usize,
+    wo: &[DVec3],
+    u: &[DVec2],
+    out: crate::batch::SampleOut<'_>,
+    delta: &mut [bool],
+    draw: impl Fn(DVec3, DVec2, &mut [f32]) -> Option<BrdfSample> + Sync,
+) {
+    use crate::batch::{BLOCK, PARALLEL, SampleOut, drawable, no_sample};
+    use rayon::prelude::*;
+    let n = wo.len();
     let SampleOut { wi, pdf, weight } = out;
     assert!(
-        u.len() == n && wi.len() == n && pdf.len() == n && weight.len() == n * c,
-        "sample_flagged: {n} wo, {} u, {} wi, {} pdf and {} weights do not match ({c} channels)",
+        u.len() == n
+            && wi.len() == n
+            && pdf.len() == n
+            && weight.len() == n * width
+            && delta.len() == n,
+        "sample_flagged: {n} wo, {} u, {} wi, {} pdf, {} weights ({width} a pair) and {} flags \
+         do not match",
         u.len(),
         wi.len(),
         pdf.len(),
-        weight.len()
+        weight.len(),
+        delta.len()
     );
     let go = |(b, (((wi, p), w), d)): FlaggedBlock<'_>| {
-        for k in 0..wi.len() {
-            let (wo, u) = (wo[b * BLOCK + k], u[b * BLOCK + k]);
-            let w = &mut w[k * c..(k + 1) * c];
+        for j in 0..wi.len() {
+            let (wo, u) = (wo[b * BLOCK + j], u[b * BLOCK + j]);
+            let w = &mut w[j * width..(j + 1) * width];
             let drawn = match drawable(wo, u) {
-                true => brdf.sample(wo, u, w),
+                true => draw(wo, u, w),
                 false => None,
             };
             match drawn {
-                Some(s) => (wi[k], p[k], d[k]) = (s.wi, s.pdf, s.delta),
+                Some(s) => (wi[j], p[j], d[j]) = (s.wi, s.pdf, s.delta),
                 None => {
-                    no_sample(&mut wi[k], &mut p[k], w);
-                    d[k] = false;
+                    no_sample(&mut wi[j], &mut p[j], w);
+                    d[j] = false;
                 }
             }
         }
     };
+    // At least one weight a pair in the block sizes, so that zero wavelengths still split by
+    // pairs (their weight blocks are then empty).
+    let ww = width.max(1);
     if n >= PARALLEL {
         crate::par::install(|| {
             wi.par_chunks_mut(BLOCK)
                 .zip(pdf.par_chunks_mut(BLOCK))
-                .zip(weight.par_chunks_mut(BLOCK * c))
+                .zip(weight.par_chunks_mut(BLOCK * ww))
                 .zip(delta.par_chunks_mut(BLOCK))
                 .enumerate()
                 .for_each(go)
@@ -497,11 +542,40 @@ pub fn sample_flagged<B: Brdf + ?Sized>(
     } else {
         wi.chunks_mut(BLOCK)
             .zip(pdf.chunks_mut(BLOCK))
-            .zip(weight.chunks_mut(BLOCK * c))
+            .zip(weight.chunks_mut(BLOCK * ww))
             .zip(delta.chunks_mut(BLOCK))
             .enumerate()
             .for_each(go);
     }
+}
+
+/// f_r at the wavelengths `nm` for every pair: `out[p * k .. (p + 1) * k]` receives
+/// [`Brdf::eval_wavelength`] of pair `p` at each of the `k = nm.len()` wavelengths, on the
+/// library's pool from [`crate::batch::PARALLEL`] pairs on.
+///
+/// # Panics
+///
+/// If the lengths do not match `wi.len()` pairs of `nm.len()` values ([`check_batch`]).
+#[track_caller]
+pub fn eval_wavelengths<B: Brdf + ?Sized>(
+    brdf: &B,
+    wi: &[DVec3],
+    wo: &[DVec3],
+    nm: &[f64],
+    out: &mut [f32],
+) {
+    let k = nm.len();
+    check_batch(wi, wo, out, k);
+    if k == 0 {
+        return;
+    }
+    crate::batch::blocks(out, k, |s, o| {
+        for (r, o) in o.chunks_exact_mut(k).enumerate() {
+            for (o, &x) in o.iter_mut().zip(nm) {
+                *o = brdf.eval_wavelength(wi[s + r], wo[s + r], x) as f32;
+            }
+        }
+    });
 }
 
 /// Smart pointers to a `Brdf` are `Brdf`s: every method forwards to the pointee (so overrides such
@@ -643,5 +717,51 @@ mod tests {
             }
             assert_eq!(deltas > 0, has_delta, "{deltas} delta draws");
         }
+    }
+
+    /// The wavelength batches give the one-pair calls: `sample_flagged_at` the draws, flags and
+    /// weights of `sample_wavelengths`, `eval_wavelengths` those of `eval_wavelength` (across
+    /// the parallel path's blocks).
+    #[test]
+    fn wavelength_batches_equal_one_pair_calls() {
+        let sum = crate::spec::ModelSpec::parse(
+            r#"{"model": "sum", "terms": [{"model": "ggx", "alpha": 0.3, "fresnel":
+                {"conductor": "Cu"}}, {"model": "mirror", "fresnel": {"conductor": "Au"}}]}"#,
+        )
+        .unwrap()
+        .build(&Channels::Rgb)
+        .unwrap();
+        let n = PARALLEL + BLOCK / 2 + 3;
+        let (wo, wi) = (dirs(n), dirs(n + 5)[5..].to_vec());
+        let u: Vec<DVec2> = (0..n)
+            .map(|k| DVec2::new((k % 97) as f64 / 97.0, (k % 89) as f64 / 89.0))
+            .collect();
+        let nm = [430.0, 520.0, 610.0, 700.0];
+        let (mut si, mut sp, mut sw) = (vec![DVec3::NAN; n], vec![-1.0; n], vec![-1.0; 4 * n]);
+        let mut d = vec![true; n];
+        let out = SampleOut {
+            wi: &mut si,
+            pdf: &mut sp,
+            weight: &mut sw,
+        };
+        sample_flagged_at(sum.as_ref(), &wo, &u, &nm, out, &mut d);
+        let mut f = vec![-1.0f32; 4 * n];
+        eval_wavelengths(sum.as_ref(), &wi, &wo, &nm, &mut f);
+        let mut deltas = 0;
+        for k in 0..n {
+            let mut w = [0.0f32; 4];
+            match sum.sample_wavelengths(wo[k], u[k], &nm, &mut w) {
+                Some(s) => {
+                    assert_eq!((si[k], sp[k], d[k]), (s.wi, s.pdf, s.delta), "pair {k}");
+                    assert_eq!(&sw[4 * k..4 * k + 4], &w);
+                    deltas += s.delta as usize;
+                }
+                None => assert_eq!((si[k], sp[k], d[k]), (DVec3::ZERO, 0.0, false)),
+            }
+            for (j, &x) in nm.iter().enumerate() {
+                assert_eq!(f[4 * k + j], sum.eval_wavelength(wi[k], wo[k], x) as f32);
+            }
+        }
+        assert!(deltas > 0);
     }
 }

@@ -1,7 +1,8 @@
 // pbrt_bxdf.hpp — a pbrt-v4-style BxDF over brdftab (f, Sample_f, PDF, Flags), on the C++
 // wrapper. It mirrors pbrt-v4's BxDF interface (src/pbrt/bxdfs.h) with small stand-in types
 // so it compiles with g++ alone; in pbrt, replace the stand-ins by pbrt's own Vector3f,
-// SampledSpectrum (evaluate a spectral source at the sampled wavelengths, or an RGB one through
+// SampledSpectrum (evaluate at the path's sampled wavelengths with brdftab_eval_spectral and
+// brdftab_sample_spectral — a mirror's reflectance at each of them —, or an RGB result through
 // an RGBAlbedoSpectrum), BSDFSample and BxDFFlags.
 //
 // Conventions agree: pbrt's wo (to the viewer) and wi (to the light) are brdftab's wo and wi, in

@@ -88,6 +88,17 @@ int brdftab_sample(const brdftab_brdf *b, size_t n, const double *wo, const doub
  * renderer gives such draws its specular path (no MIS with light sampling). delta: n bytes. */
 int brdftab_sample_delta(const brdftab_brdf *b, size_t n, const double *wo, const double *u,
                          double *wi, double *pdf, float *weight, unsigned char *delta);
+/* f_r of n pairs at the k wavelengths nm (the same for every pair, each a finite number of nm
+ * > 0) into f (n x k): the source's own spectral data where it has them (models, spectral RGL
+ * files), its channels interpolated otherwise (RGB at 645, 526 and 444 nm). For renderers that
+ * draw their wavelengths per path (pbrt-v4). */
+int brdftab_eval_spectral(const brdftab_brdf *b, size_t n, const double *wi, const double *wo,
+                          size_t k, const double *nm, float *f);
+/* brdftab_sample_delta with the weights at the k wavelengths nm (weight: n x k), a mirror's
+ * reflectance at each of them for its draws. */
+int brdftab_sample_spectral(const brdftab_brdf *b, size_t n, const double *wo, const double *u,
+                            size_t k, const double *nm, double *wi, double *pdf, float *weight,
+                            unsigned char *delta);
 /* Directional albedo for light at polar angle theta in [0, pi/2) (radians, light above the
  * horizon; anything else, pi/2 included, is an error, -1): one double per channel (a closed
  * form where the model has one, else adaptive quadrature: 1e-6 relative for models, 1e-4 for

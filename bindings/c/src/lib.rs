@@ -425,6 +425,54 @@ pub unsafe extern "C" fn brdftab_sample(
     })
 }
 
+/// The arguments of a sampling call with delta flags, checked: the handle, `wo` and `u`, the
+/// outputs (`width` weights a pair; `None`: the handle's channels) and the flags as `bool`s.
+struct Flagged<'a> {
+    b: &'a brdftab_brdf,
+    wo: &'a [DVec3],
+    u: &'a [DVec2],
+    out: brdftab::batch::SampleOut<'a>,
+    flags: &'a mut [bool],
+}
+
+/// # Safety
+/// `b` is NULL or a live handle; with n > 0, `wo` and `wi` point to 3n doubles, `u` to 2n,
+/// `pdf` to n, `weight` to n·width floats and `delta` to n bytes (NULL and alignment checked).
+#[allow(clippy::too_many_arguments)]
+unsafe fn flagged_args<'a>(
+    b: *const brdftab_brdf,
+    n: usize,
+    wo: *const f64,
+    u: *const f64,
+    wi: *mut f64,
+    pdf: *mut f64,
+    weight: *mut f32,
+    width: Option<usize>,
+    delta: *mut u8,
+) -> Result<Flagged<'a>, String> {
+    // SAFETY (all seven): the caller's contract on sizes; NULL and alignment are checked.
+    let b = unsafe { handle(b) }?;
+    let width = width.unwrap_or(b.names.len());
+    let wo = unsafe { slice(wo as *const DVec3, n, "wo") }?;
+    let u = unsafe { slice(u as *const DVec2, n, "u") }?;
+    let wi = unsafe { slice_mut(wi as *mut DVec3, n, "wi") }?;
+    let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
+    let weight = unsafe { slice_mut(weight, times(n, width, "weight")?, "weight") }?;
+    let flags = unsafe { slice_mut(delta, n, "delta") }?;
+    // Zeroed first, the bytes are valid `bool`s (false); the library writes 0 or 1.
+    flags.fill(0);
+    // SAFETY: u8 and bool have one size and alignment, and every byte is now 0.
+    let flags = unsafe { std::slice::from_raw_parts_mut(flags.as_mut_ptr() as *mut bool, n) };
+    let out = brdftab::batch::SampleOut { wi, pdf, weight };
+    Ok(Flagged {
+        b,
+        wo,
+        u,
+        out,
+        flags,
+    })
+}
+
 /// [`brdftab_sample`] and each draw's delta flag: `delta[k]` = 1 where pair `k` drew a delta
 /// lobe (a mirror, or a sum's mirror term — its pdf is then the probability of choosing that
 /// lobe, not a density, and `brdftab_pdf` does not contain it; its weight is the lobe's
@@ -448,21 +496,91 @@ pub unsafe extern "C" fn brdftab_sample_delta(
         if n == 0 {
             return Ok(());
         }
-        // SAFETY (all seven): the header's contract on sizes; NULL and alignment are checked.
-        let b = unsafe { handle(b) }?;
-        let c = b.names.len();
-        let wo = unsafe { slice(wo as *const DVec3, n, "wo") }?;
-        let u = unsafe { slice(u as *const DVec2, n, "u") }?;
-        let wi = unsafe { slice_mut(wi as *mut DVec3, n, "wi") }?;
-        let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
-        let weight = unsafe { slice_mut(weight, times(n, c, "weight")?, "weight") }?;
-        let flags = unsafe { slice_mut(delta, n, "delta") }?;
-        // Zeroed first, the bytes are valid `bool`s (false); the library writes 0 or 1.
-        flags.fill(0);
-        // SAFETY: u8 and bool have one size and alignment, and every byte is now 0.
-        let flags = unsafe { std::slice::from_raw_parts_mut(flags.as_mut_ptr() as *mut bool, n) };
-        let out = brdftab::batch::SampleOut { wi, pdf, weight };
-        brdftab::brdf::sample_flagged(&b.brdf, wo, u, out, flags);
+        // SAFETY: the header's contract on sizes; NULL and alignment are checked.
+        let a = unsafe { flagged_args(b, n, wo, u, wi, pdf, weight, None, delta) }?;
+        brdftab::brdf::sample_flagged(&a.b.brdf, a.wo, a.u, a.out, a.flags);
+        let b = a.b;
+        healthy(b)
+    })
+}
+
+/// The `k` wavelengths of a spectral call: NULL is an error unless `k` = 0, and every entry must
+/// be a wavelength (finite, > 0 nm).
+///
+/// # Safety
+/// With k > 0, `nm` points to k doubles.
+unsafe fn wavelengths<'a>(k: usize, nm: *const f64) -> Result<&'a [f64], String> {
+    if k == 0 {
+        return Ok(&[]);
+    }
+    // SAFETY: the caller's contract; NULL and alignment are checked.
+    let nm = unsafe { slice(nm, k, "nm") }?;
+    match nm.iter().find(|&&x| !brdftab::spectrum::is_wavelength(x)) {
+        Some(x) => Err(format!(
+            "`nm`: {x} is not a wavelength (a finite number of nm > 0)"
+        )),
+        None => Ok(nm),
+    }
+}
+
+/// f_r of `n` pairs at the `k` wavelengths `nm` into `f` (n × k): a source's own spectral data
+/// where it has them (models, spectral RGL files), its channels interpolated otherwise (RGB at
+/// 645, 526 and 444 nm) — [`brdftab::brdf::eval_wavelengths`]. For renderers that draw their
+/// wavelengths per path (pbrt-v4), where a handle opened at fixed wavelengths does not serve.
+///
+/// # Safety
+/// With n > 0: `wi`, `wo` point to 3n doubles, `f` to n·k floats; with k > 0, `nm` to k doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_eval_spectral(
+    b: *const brdftab_brdf,
+    n: usize,
+    wi: *const f64,
+    wo: *const f64,
+    k: usize,
+    nm: *const f64,
+    f: *mut f32,
+) -> c_int {
+    guard(|| {
+        if n == 0 {
+            return Ok(());
+        }
+        // SAFETY (all four): the header's contract on sizes; NULL and alignment are checked.
+        let (b, wi, wo) = unsafe { pair_args(b, n, wi, wo) }?;
+        let nm = unsafe { wavelengths(k, nm) }?;
+        let f = unsafe { slice_mut(f, times(n, k, "f")?, "f") }?;
+        brdftab::brdf::eval_wavelengths(&b.brdf, wi, wo, nm, f);
+        healthy(b)
+    })
+}
+
+/// [`brdftab_sample_delta`] with the weights at the `k` wavelengths `nm` (`weight`: n × k) —
+/// a mirror's reflectance at each of them for its draws ([`brdftab::brdf::sample_flagged_at`]).
+///
+/// # Safety
+/// With n > 0: as [`brdftab_sample_delta`], with `weight` of n·k floats; with k > 0, `nm`
+/// points to k doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_sample_spectral(
+    b: *const brdftab_brdf,
+    n: usize,
+    wo: *const f64,
+    u: *const f64,
+    k: usize,
+    nm: *const f64,
+    wi: *mut f64,
+    pdf: *mut f64,
+    weight: *mut f32,
+    delta: *mut u8,
+) -> c_int {
+    guard(|| {
+        if n == 0 {
+            return Ok(());
+        }
+        // SAFETY: the header's contract on sizes; NULL and alignment are checked.
+        let nm = unsafe { wavelengths(k, nm) }?;
+        let a = unsafe { flagged_args(b, n, wo, u, wi, pdf, weight, Some(k), delta) }?;
+        brdftab::brdf::sample_flagged_at(&a.b.brdf, a.wo, a.u, nm, a.out, a.flags);
+        let b = a.b;
         healthy(b)
     })
 }

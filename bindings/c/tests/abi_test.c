@@ -157,6 +157,40 @@ int main(int argc, char **argv) {
         }
         CHECK(deltas > 0 && smooth > 0, "both terms drawn");
         brdftab_close(m);
+        /* brdftab_eval_spectral / brdftab_sample_spectral at wavelengths of the call: what a
+         * handle opened at those wavelengths gives at its channels. */
+        double nm[3] = {450.0, 531.5, 690.0}, nan_nm[2] = {500.0, NAN};
+        brdftab_open_options at = {0, 3, nm, 0};
+        const char *ggx = "{\"model\": \"ggx\", \"alpha\": 0.3, \"fresnel\": {\"conductor\": \"Au\"}}";
+        const char *gold = "{\"model\": \"mirror\", \"fresnel\": {\"conductor\": \"Au\"}}";
+        brdftab_brdf *g = brdftab_open(ggx), *g3 = brdftab_open_with(ggx, &at);
+        brdftab_brdf *au = brdftab_open(gold), *au3 = brdftab_open_with(gold, &at);
+        CHECK(g && g3 && au && au3, "spectral handles");
+        float fs[3 * 64], f3[3 * 64];
+        CHECK(brdftab_eval_spectral(g, 64, wi, wo, 3, nm, fs) == 0, "eval_spectral");
+        CHECK(brdftab_eval(g3, 64, wi, wo, f3) == 0, "eval at channels");
+        int same = 1;
+        for (int i = 0; i < 3 * 64; i++) same &= fabsf(fs[i] - f3[i]) <= 1e-5f * fabsf(f3[i]) + 1e-12f;
+        CHECK(same, "eval_spectral = eval of a handle opened at those wavelengths");
+        double u1[2] = {0.5, 0.5}, swi3[3], sp3;
+        float ws[3], w3[3];
+        unsigned char d1 = 0;
+        CHECK(brdftab_sample_spectral(au, 1, wo1, u1, 3, nm, wi1, &p1, ws, &d1) == 0 && d1 == 1,
+              "sample_spectral of a mirror: a delta draw");
+        CHECK(brdftab_sample(au3, 1, wo1, u1, swi3, &sp3, w3) == 0, "sample at channels");
+        CHECK(ws[0] == w3[0] && ws[1] == w3[1] && ws[2] == w3[2] && ws[0] < 0.5f && ws[2] > 0.9f,
+              "the mirror's Fresnel term at each wavelength");
+        CHECK(brdftab_eval_spectral(g, 1, wi, wo, 2, NULL, fs) == -1 &&
+              strstr(brdftab_last_error(), "nm") != NULL, "NULL nm");
+        CHECK(brdftab_eval_spectral(g, 1, wi, wo, 2, nan_nm, fs) == -1 &&
+              strstr(brdftab_last_error(), "wavelength") != NULL, "NaN in nm");
+        CHECK(brdftab_sample_spectral(au, 1, wo1, u1, 2, nan_nm, wi1, &p1, ws, &d1) == -1,
+              "NaN in nm (sample)");
+        CHECK(brdftab_eval_spectral(g, 1, wi, wo, 0, NULL, fs) == 0, "k = 0");
+        brdftab_close(g);
+        brdftab_close(g3);
+        brdftab_close(au);
+        brdftab_close(au3);
         free(d);
         free(swi2);
         free(spdf2);

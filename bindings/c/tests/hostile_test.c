@@ -50,6 +50,15 @@ static void overflowing_counts(const brdftab_brdf *b) {
         CHECK(brdftab_sample_delta(b, huge[k], wo, u, swi, pdf, w, d) == -1 &&
                   strlen(brdftab_last_error()) > 0 && !strstr(brdftab_last_error(), "panic"),
               what);
+        double nm[2] = {500.0, 600.0};
+        snprintf(what, sizeof what, "eval_spectral n = %zu is -1, not a caught panic", huge[k]);
+        CHECK(brdftab_eval_spectral(b, huge[k], wi, wo, 2, nm, f) == -1 &&
+                  strlen(brdftab_last_error()) > 0 && !strstr(brdftab_last_error(), "panic"),
+              what);
+        snprintf(what, sizeof what, "sample_spectral n = %zu is -1, not a caught panic", huge[k]);
+        CHECK(brdftab_sample_spectral(b, huge[k], wo, u, 2, nm, swi, pdf, w, d) == -1 &&
+                  strlen(brdftab_last_error()) > 0 && !strstr(brdftab_last_error(), "panic"),
+              what);
     }
     /* The handle still works. */
     CHECK(brdftab_eval(b, 1, wi, wo, f) == 0 && f[0] > 0, "eval after the hostile counts");
