@@ -203,14 +203,24 @@ impl PyBrdf {
         let d_s = d_w.as_slice_mut().map_err(slice_err)?;
         let brdf = &self.inner;
         batch(py, n, || {
-            // Without nm, a batch with no broadcast row is the library's (a table's batch path).
-            if let (None, Some((a, b))) = (&lv, p.whole()) {
+            // A batch with no broadcast row and one set of wavelengths (or none) is the
+            // library's (without nm, a table's batch path).
+            if let (Some((a, b)), false) = (p.whole(), per_row) {
                 let out = brdftab::batch::SampleOut {
                     wi: wi_s,
                     pdf: pdf_s,
                     weight: w_s,
                 };
-                return brdftab::brdf::sample_flagged(brdf, a, b, out, d_s);
+                return match lv.as_ref().map(|l| l.as_slice()) {
+                    None => brdftab::brdf::sample_flagged(brdf, a, b, out, d_s),
+                    Some(Some(nm)) => brdftab::brdf::sample_flagged_at(brdf, a, b, nm, out, d_s),
+                    Some(None) => {
+                        let nm: Vec<f64> = lv
+                            .as_ref()
+                            .map_or(Vec::new(), |l| l.iter().copied().collect());
+                        brdftab::brdf::sample_flagged_at(brdf, a, b, &nm, out, d_s)
+                    }
+                };
             }
             let go = |(s, (((wi, pd), w), d)): FlaggedBlock<'_>| {
                 let (a, b) = p.block(s * BLOCK, pd.len());
