@@ -811,7 +811,10 @@ impl Grid {
             None => Ok(self),
         }
     }
-    /// The same grid without a calibration.
+    /// The same grid without a calibration: lookups return the interpolated values (divided by
+    /// the stored quantity's cosines) without the albedo factors. For a caller that puts
+    /// another material's values on this grid ([`Table::with_values`](super::Table::with_values)):
+    /// the factors pinned the albedo of the source the grid was baked from, not theirs.
     pub fn without_calibration(mut self) -> Grid {
         self.calibration = None;
         self

@@ -4,7 +4,9 @@
 //!   the stored layout and its chunks ([`Layout`]);
 //! - [`symmetry`]: [`Symmetry`], the canonical maps, [`symmetry::verify`] and
 //!   [`symmetry::detect`];
-//! - [`Table`]: a grid plus its stored values, in memory;
+//! - [`Table`]: a grid plus its stored values, in memory; `edit`: the same grid holding values
+//!   made elsewhere ([`Table::with_values`], [`Table::with_array`]), the road back in from
+//!   numpy or an optimizer;
 //! - [`fill`]: any `Brdf` → values, chunk by chunk ([`bake_chunks`], for streaming
 //!   writers) or into a [`Table`];
 //! - [`lookup`]: nearest and multilinear interpolation ([`Interp`]);
@@ -22,6 +24,7 @@ pub mod adaptive;
 mod alias2d;
 pub mod calibration;
 pub mod device;
+mod edit;
 pub mod fill;
 pub mod grid;
 mod horizon;
@@ -40,6 +43,7 @@ mod views;
 pub mod warp;
 pub(crate) mod warp2d;
 
+pub(crate) use edit::first_nonfinite_at;
 pub use fill::{BakeOptions, BakeStats, bake, bake_chunks};
 pub use grid::{Axis, Grid, Layout, Mapping, Nodes, Param, Quantity, StoredAxis};
 pub use lookup::Interp;
