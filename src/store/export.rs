@@ -7,28 +7,9 @@ use std::io::Write;
 use std::path::Path;
 
 use super::StoredTable;
+pub use super::npy::npy_header;
 use crate::error::{Error, Result};
 use crate::spectrum::Channels;
-
-/// The `.npy` v1.0 header for a little-endian f32 C-order array of `shape`.
-pub fn npy_header(shape: &[u64]) -> Vec<u8> {
-    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
-    let shape = if dims.len() == 1 {
-        format!("({},)", dims[0])
-    } else {
-        format!("({})", dims.join(", "))
-    };
-    let mut dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {shape}, }}");
-    // magic(6) + version(2) + len(2) + dict + '\n' must be a multiple of 64.
-    let unpadded = 10 + dict.len() + 1;
-    dict.push_str(&" ".repeat(unpadded.next_multiple_of(64) - unpadded));
-    dict.push('\n');
-    let mut out = Vec::with_capacity(10 + dict.len());
-    out.extend_from_slice(b"\x93NUMPY\x01\x00");
-    out.extend_from_slice(&(dict.len() as u16).to_le_bytes());
-    out.extend_from_slice(dict.as_bytes());
-    out
-}
 
 /// Maps the index of a node (one per angular axis of the stored shape) to the flat offset of its
 /// channel 0, or `None` when the node is not stored (packed layouts). `None` as a whole means the

@@ -18,7 +18,8 @@
 //!   `ChunkLoader` is the [`StoredTable`] (chunks decoded, checksum checked, on first touch; the
 //!   `TabulatedBrdf` keeps what it loaded, so the memory bound of [`StoreOptions::cache_bytes`]
 //!   applies to [`StoredTable::chunk`] users such as the exports, not to a `TabulatedBrdf`).
-//! - [`export`]: `.npy` of the dense table, EXR of 2D slices.
+//! - [`export`]: `.npy` of the dense table, EXR of 2D slices; [`npy`]: the `.npy` header the
+//!   export writes and the reader that takes arrays back in (`brdftab import`).
 //!
 //! ```
 //! use brdftab::codec::{Codec, Quant};
@@ -51,6 +52,7 @@ pub mod export;
 pub mod format;
 pub mod info;
 pub mod name;
+pub mod npy;
 pub mod tables;
 mod writer;
 
