@@ -2,8 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::save::{SaveSettings, target};
 use super::values::{ErrorTarget, Wavelengths};
-use crate::bake::{self, BakeReport, BakeRequest, BakeTarget, GridChoice, SymmetryChoice};
+use crate::bake::{BakeReport, BakeRequest, GridChoice, SymmetryChoice};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
 use crate::table::{Param, fill};
@@ -85,6 +86,20 @@ pub struct BakeSettings {
 }
 
 impl BakeSettings {
+    /// The settings of this bake that say how its table is stored (codec, name, replace):
+    /// one validation of those fields for a bake and a save.
+    pub fn save(&self) -> SaveSettings {
+        SaveSettings {
+            codec: self.codec.clone(),
+            codec_tolerance: self.codec_tolerance,
+            floor: self.floor,
+            level: self.level,
+            exhaustive: self.exhaustive,
+            name: self.name.clone(),
+            replace: self.replace,
+        }
+    }
+
     /// The request these settings describe for `source`; every check of a bake's settings is
     /// here or in what it calls.
     ///
@@ -113,16 +128,7 @@ impl BakeSettings {
             r.symmetry_tolerance = t;
         }
         r.force = self.force;
-        r.codec = bake::codec(
-            self.codec.as_deref().unwrap_or("log16"),
-            self.codec_tolerance,
-            self.floor,
-            self.level,
-            self.exhaustive,
-        )?;
-        if let Some(n) = &self.name {
-            crate::store::name::check("name", n)?;
-        }
+        r.codec = self.save().codec()?;
         r.name = self.name.clone();
         if let Some(k) = self.supersample {
             if !(1..=fill::MAX_SUPERSAMPLE).contains(&k) {
@@ -164,19 +170,6 @@ pub fn bake(
     req.run_with(&target(output, settings.replace)?, progress)
 }
 
-/// Where [`bake()`] writes `output`; a `DB#NAME` with an empty or invalid name is an argument
-/// error naming `output` ([`crate::store::name`]).
-pub fn target(output: &str, replace: bool) -> Result<BakeTarget> {
-    Ok(match crate::store::name::parse_source("output", output)? {
-        (path, Some(name)) => BakeTarget::Db {
-            path: path.into(),
-            name: name.into(),
-            replace,
-        },
-        (path, None) => BakeTarget::File(path.into()),
-    })
-}
-
 /// The same error naming `field` (a parser names what it parses, e.g. `preset` for a grid).
 fn rename(e: Error, field: &str) -> Error {
     match e {
@@ -188,6 +181,7 @@ fn rename(e: Error, field: &str) -> Error {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bake::BakeTarget;
 
     #[test]
     fn an_output_with_an_empty_or_control_character_name_is_an_output_error() {

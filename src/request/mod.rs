@@ -1,5 +1,6 @@
-//! One request layer for every host: the settings of a bake, a conversion, a fit and an open,
-//! as plain data that deserialize from the same field names wherever they come from.
+//! One request layer for every host: the settings of a bake, a conversion, a fit, an open and
+//! a save (a table whose values a host made: [`save_table`], [`import_npy`]), as plain data
+//! that deserialize from the same field names wherever they come from.
 //!
 //! The CLI's flags are these fields (`--target-error` is [`BakeSettings::target_error`]; with the
 //! non-default feature `clap` the structs derive `clap::Args`, so the CLI parses into them
@@ -26,12 +27,14 @@ mod bake;
 mod convert;
 mod fit;
 mod open;
+mod save;
 mod values;
 
 pub use bake::{BakeSettings, bake};
 pub use convert::{ConvertOutput, ConvertSettings, convert};
 pub use fit::{FitSettings, fit};
 pub use open::{OpenSettings, open};
+pub use save::{SaveSettings, import_npy, save_table};
 pub use values::{ErrorTarget, Names, Wavelengths};
 
 use serde::Serialize;
@@ -99,6 +102,14 @@ mod tests {
         assert!(field_names::<ConvertSettings>().contains(&"codec".to_string()));
         assert!(field_names::<FitSettings>().contains(&"max_theta_deg".to_string()));
         assert!(field_names::<OpenSettings>().contains(&"interp".to_string()));
+        // A save's fields are the bake's fields of the same name.
+        let bake = field_names::<BakeSettings>();
+        assert!(
+            field_names::<SaveSettings>()
+                .iter()
+                .all(|f| bake.contains(f))
+        );
+        assert_eq!(field_names::<SaveSettings>().len(), 7);
         let e = from_json::<FitSettings>(r#"{"strats": 3}"#).unwrap_err();
         assert!(matches!(e, Error::InvalidArgument { ref name, .. } if name == "strats"));
         let e = from_json::<BakeSettings>(r#"{"supersample": "two"}"#).unwrap_err();

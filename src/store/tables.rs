@@ -89,6 +89,24 @@ pub fn save(
     db::put(path, header, replace, |w| write_table_chunks(w, table))
 }
 
+/// Writes `table` as `name`, the one table of a new brdftab file that replaces whatever is at
+/// `path` atomically (a failed write leaves the old file as it was), encoding its chunks in
+/// parallel.
+pub fn save_file(
+    path: impl AsRef<Path>,
+    name: &str,
+    source: Source,
+    table: &Table,
+    codec: Codec,
+) -> Result<()> {
+    super::name::check("name", name)?;
+    let mut w = Writer::create(path)?;
+    w.begin_table(TableHeader::for_grid(name, source, table.grid(), codec))?;
+    write_table_chunks(&mut w, table)?;
+    w.end_table()?;
+    w.finish()
+}
+
 /// Appends all chunks of `table` to a writer whose table is begun (encoded in parallel).
 pub fn write_table_chunks(w: &mut Writer, table: &Table) -> Result<()> {
     let grid = table.grid();
