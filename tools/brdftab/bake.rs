@@ -10,7 +10,7 @@ use clap::Args;
 use crate::progress::Bar;
 
 /// Names the CLI flag in an argument error of the library, which names the settings field
-/// (`target_error` → `--target-error`); errors naming anything else pass unchanged.
+/// (`target_error` → `--target-error`) or `like`; errors naming anything else pass unchanged.
 pub fn flag(e: Error) -> Error {
     let fields: Vec<String> = [
         request::field_names::<request::ConvertSettings>(),
@@ -19,7 +19,7 @@ pub fn flag(e: Error) -> Error {
     ]
     .concat();
     match e {
-        Error::InvalidArgument { name, msg } if fields.contains(&name) => {
+        Error::InvalidArgument { name, msg } if fields.contains(&name) || name == "like" => {
             Error::arg(format!("--{}", name.replace('_', "-")), msg)
         }
         e => e,

@@ -1,8 +1,12 @@
-//! `brdftab export`: a stored table as NumPy `.npy` or a 2D slice as OpenEXR.
+//! `brdftab export`: a stored table as NumPy `.npy` or a 2D slice as OpenEXR; `brdftab import`:
+//! an edited `.npy` back as a table on the grid of a stored one ([`request::import_npy`]).
 
+use brdftab::request::{self, SaveSettings};
 use brdftab::store::{Store, db, export, tables};
 use brdftab::{Error, Result};
 use clap::Args;
+
+use crate::bake::flag;
 
 /// Arguments of `brdftab export`.
 #[derive(Args)]
@@ -39,11 +43,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
         None => s.single()?,
     };
     // Tables with a grid use its layout (packed reciprocal tables expand, unstored nodes NaN).
-    let grid = if t.header().grid.is_null() {
-        None
-    } else {
-        Some(t.grid()?)
-    };
+    let grid = (!t.header().grid.is_null()).then(|| t.grid()).transpose()?;
     let off = grid.as_ref().map(tables::node_offset);
     let off_ref: export::NodeOffset<'_> = off
         .as_ref()
@@ -51,14 +51,13 @@ pub fn run(a: ExportArgs) -> Result<()> {
     // What the raw values are (as `info` says): not f_r for tables of f_r cos θo or
     // f_r cos θi cos θo, and without a calibration's factors.
     let stored = match &grid {
-        Some(g) => {
-            let calibrated = if g.calibration().is_some() {
-                ", before the albedo calibration's factors"
-            } else {
-                ""
-            };
-            format!("{}{calibrated}", g.quantity().name())
+        Some(g) if g.calibration().is_some() => {
+            format!(
+                "{}, before the albedo calibration's factors",
+                g.quantity().name()
+            )
         }
+        Some(g) => g.quantity().name().to_owned(),
         None => "fr".to_owned(),
     };
     if let Some(out) = &a.npy {
@@ -74,5 +73,31 @@ pub fn run(a: ExportArgs) -> Result<()> {
         export::exr(&t, &sl, off_ref, out, a.half)?;
         eprintln!("wrote {out} (stored values: {stored})");
     }
+    Ok(())
+}
+
+/// Arguments of `brdftab import`.
+#[derive(Args)]
+pub struct ImportArgs {
+    /// A .npy file shaped as `export --npy` writes the --like table (float32 or float64, C
+    /// order; NaN only where a packed table stores nothing): values before any calibration.
+    array: std::path::PathBuf,
+    /// The table (file or DB#NAME) whose grid — layout, symmetry, stored quantity, albedo
+    /// calibration — the values are on.
+    #[arg(long)]
+    like: String,
+    /// Output: a table file (`.btdb`, replaced atomically) or DB#NAME.
+    #[arg(short, long)]
+    output: String,
+    #[command(flatten)]
+    settings: SaveSettings,
+}
+
+/// `brdftab import`.
+pub fn import(a: ImportArgs) -> Result<()> {
+    let info = request::import_npy(&a.array, &a.like, &a.output, &a.settings).map_err(flag)?;
+    let t = &info["tables"][0];
+    let codec = t["codec"]["quant"].as_str().unwrap_or("?");
+    eprintln!("wrote {} ({} values, codec {codec})", a.output, t["values"]);
     Ok(())
 }

@@ -46,6 +46,8 @@ enum Command {
     Db(db::DbArgs),
     /// Export a stored table as .npy, or a 2D slice of it as EXR.
     Export(export::ExportArgs),
+    /// Write a .npy array of values (an export edited in numpy) as a table on another's grid.
+    Import(export::ImportArgs),
     /// Describe a table file (grid, symmetry, channels, sizes) or a measured file (MERL, RGL).
     Info(table::InfoArgs),
     /// Time lookups of SOURCE on random pairs (single thread and batch on all cores).
@@ -87,6 +89,7 @@ fn main() -> ExitCode {
         Command::Info(a) => table::info(a),
         Command::Db(a) => db::run(a),
         Command::Export(a) => export::run(a),
+        Command::Import(a) => export::import(a),
         Command::Bench(a) => bench::bench(a),
         Command::Render(a) => render::run(a),
         Command::Slice(a) => slice::slice(a),
