@@ -903,6 +903,62 @@ mod tests {
         assert_eq!(field.as_deref(), Some("header"), "{msg}");
     }
 
+    /// Random mutants of valid files — bytes flipped, overwritten, cut and inserted, in the
+    /// header and the data — are read or refused with a format error, never a panic; what is
+    /// read holds exactly the elements its shape says.
+    #[test]
+    fn mutants_are_read_or_refused_never_a_panic() {
+        let dicts = [
+            (
+                1,
+                "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }",
+            ),
+            (
+                2,
+                "{'shape': (3, 2), 'fortran_order': False, 'descr': '<f8'}",
+            ),
+            (3, "{'descr': '<f4', 'fortran_order': False, 'shape': (6,)}"),
+        ];
+        let mut rng = crate::rng::Pcg32::new(7);
+        let (mut read_ok, mut refused) = (0, 0);
+        for k in 0..30_000 {
+            let (version, dict) = dicts[k % dicts.len()];
+            let data = if dict.contains("<f8") {
+                VALUES
+                    .iter()
+                    .flat_map(|&x| (x as f64).to_le_bytes())
+                    .collect()
+            } else {
+                f32_bytes(&VALUES)
+            };
+            let mut b = npy(version, dict, &data);
+            for _ in 0..1 + rng.below(3) {
+                let at = rng.below(b.len() as u32) as usize;
+                match rng.below(4) {
+                    0 => b[at] ^= 1 << rng.below(8),
+                    1 => b[at] = b"0123456789(),' -:{}TF"[rng.below(21) as usize],
+                    2 => b.truncate(at),
+                    _ => b.insert(at, rng.below(256) as u8),
+                }
+                if b.is_empty() {
+                    break;
+                }
+            }
+            match read(&b) {
+                Ok((h, v)) => {
+                    assert_eq!(v.len(), h.elements());
+                    read_ok += 1;
+                }
+                Err(Error::Format { .. }) => refused += 1,
+                Err(e) => panic!("mutant {k}: {e}"),
+            }
+        }
+        assert!(
+            read_ok > 1000 && refused > 10_000,
+            "{read_ok} read, {refused} refused"
+        );
+    }
+
     #[test]
     fn a_file_reads_by_its_path() {
         let d = crate::testkit::TempDir::new("npy-read");
