@@ -1,4 +1,5 @@
-//! numpy arrays in and out of batch calls without copies.
+//! numpy arrays in and out of batch calls without copies (and in as a table's values,
+//! `Table.with_values`).
 //!
 //! Why a module: a batch call's cost should be the library's. Directions arrive as `(n, 3)`
 //! arrays; a C-contiguous, aligned float64 array is read in place as `[DVec3]` (glam's `DVec3`
@@ -23,8 +24,26 @@ pub(crate) fn f64_array<'py>(
     obj: &Bound<'py, PyAny>,
     name: &str,
 ) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+    real_array(obj, name, "float64")
+}
+
+/// [`f64_array`] in float32 (`dtype`): a table's values. A float32 array is borrowed as it is
+/// (any strides: read it in C order with `as_array().iter()`).
+pub(crate) fn f32_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+) -> PyResult<PyReadonlyArrayDyn<'py, f32>> {
+    real_array(obj, name, "float32")
+}
+
+/// An array-like of real numbers as an array of `T`, whose numpy name is `dtype`.
+fn real_array<'py, T: Element>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+    dtype: &str,
+) -> PyResult<PyReadonlyArrayDyn<'py, T>> {
     refuse_masked(obj, name)?;
-    if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'py, f64>>() {
+    if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'py, T>>() {
         return Ok(a);
     }
     let py = obj.py();
@@ -51,9 +70,9 @@ pub(crate) fn f64_array<'py>(
     }
     let np = py.import("numpy")?;
     let arr = np
-        .call_method1("asarray", (obj, "float64"))
+        .call_method1("asarray", (obj, dtype))
         .map_err(|e| PyTypeError::new_err(format!("{name}: not an array of real numbers ({e})")))?;
-    arr.extract::<PyReadonlyArrayDyn<'py, f64>>()
+    arr.extract::<PyReadonlyArrayDyn<'py, T>>()
         .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))
 }
 

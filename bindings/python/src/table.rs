@@ -1,20 +1,26 @@
 //! The `brdftab.Table` class (a decoded table: its values shared with numpy, its grid as a
-//! dict) and the dict of a device layout, which both `Table.device_layout` and
-//! `Brdf.device_layout` return.
+//! dict; edited values back in with `with_values`, written with `save`, looked up with `open`)
+//! and the dict of a device layout, which both `Table.device_layout` and `Brdf.device_layout`
+//! return.
 //!
-//! Why a module: these are what a host takes away to evaluate a table elsewhere (a GPU, a JIT):
-//! values, grid and layout, held apart from the `Brdf` that made them.
+//! Why a module: these are what a host takes away to evaluate a table elsewhere (a GPU, a JIT)
+//! or to edit it (numpy, an optimizer): values, grid and layout, held apart from the `Brdf`
+//! that made them.
 
 use brdftab::Channels;
+use brdftab::request::{self, SaveSettings};
+use brdftab::store::Source;
 use brdftab::table::device::DeviceLayout;
 use brdftab::table::{Interp, Table};
 use numpy::ndarray::IxDyn;
-use numpy::{IntoPyArray, PyArrayDyn};
+use numpy::{IntoPyArray, PyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
+use crate::arrays::f32_array;
+use crate::brdf::PyBrdf;
 use crate::errors::{Error, guard, lib_err, unlocked};
-use crate::values::to_py;
+use crate::values::{settings_of, text_arg, to_py};
 
 /// A decoded table (`Brdf.table()`): its values as a numpy array sharing the table's memory,
 /// and its grid.
@@ -91,6 +97,83 @@ impl PyTable {
             let d = unlocked(py, || DeviceLayout::new(t, interp))?.map_err(lib_err)?;
             layout_dict(py, d, t.grid().channels())
         })
+    }
+
+    /// The same table — grid (stored layout, symmetry, quantity, albedo calibration) — holding
+    /// `values`: any array-like of real numbers shaped as `values` is (the stored axes and
+    /// channels; for a packed table the flat values, or the rectangle `brdftab export --npy`
+    /// writes, whose unstored nodes are ignored) or flat, converted to float32 in C order.
+    /// The values are the stored quantity before the albedo calibration, as `values` gives
+    /// them; negative values mark unmeasured nodes in a table of f_r (lookups read 0 there).
+    /// `calibration=False` drops the grid's albedo calibration (for another material's values
+    /// on this grid: its factors pinned the first material's albedo). A wrong size or shape, or
+    /// a NaN or infinite stored value, is a `ValueError` naming `values` and the index.
+    #[pyo3(signature = (values, *, calibration = true))]
+    fn with_values(
+        &self,
+        py: Python<'_>,
+        values: &Bound<'_, PyAny>,
+        calibration: bool,
+    ) -> PyResult<PyTable> {
+        guard(|| {
+            let a = f32_array(values, "values")?;
+            let shape = a.shape().to_vec();
+            // In C order: a Fortran-order or strided array by its indices, not its memory.
+            let data: Vec<f32> = match a.as_slice() {
+                Ok(s) if a.is_c_contiguous() => s.to_vec(),
+                _ => a.as_array().iter().copied().collect(),
+            };
+            drop(a);
+            let old = &self.table;
+            let description = format!("values from Python on the grid of {}", old.description());
+            let t = unlocked(py, || old.with_array(&shape, data))?
+                .map_err(lib_err)?
+                .with_description(description);
+            let t = match calibration {
+                true => t,
+                false => {
+                    let (grid, values, description) = t.into_parts();
+                    Table::new(grid.without_calibration(), values, description).map_err(lib_err)?
+                }
+            };
+            PyTable::new(py, t)
+        })
+    }
+
+    /// Writes the table to `output`: a `.btdb` file (replaced atomically) or "DB#NAME" (a
+    /// table of a database, created if absent; an existing name needs `replace=True`). The
+    /// keywords are those of `brdftab.bake` that say how a table is stored: `codec` ("f32"
+    /// keeps the values bit for bit; default "log16", 1e-3 relative), `codec_tolerance`,
+    /// `floor`, `level`, `exhaustive`, `name` (default: the file's stem) and `replace`. The
+    /// provenance is the table's description. Returns what `brdftab info --json OUTPUT`
+    /// reports.
+    #[pyo3(signature = (output, **options))]
+    fn save(
+        &self,
+        py: Python<'_>,
+        output: &Bound<'_, PyAny>,
+        options: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Py<PyAny>> {
+        guard(|| {
+            let output = text_arg(output, "output")?;
+            let settings: SaveSettings = settings_of(options)?;
+            let source = Source::Other {
+                description: self.table.description().to_owned(),
+            };
+            let t = &self.table;
+            let info = unlocked(py, || request::save_table(t, &output, source, &settings))?
+                .map_err(lib_err)?;
+            to_py(py, &info)
+        })
+    }
+
+    /// The table as a `brdftab.Brdf` (in memory: a copy of its values), looked up with
+    /// `interp` ("auto": nearest on a grid of MERL cells, linear otherwise; "nearest";
+    /// "linear"), as `brdftab.open` of the saved table would. It has no SOURCE to reopen:
+    /// it does not pickle, and `table(**options)` does not bake it again.
+    #[pyo3(signature = (interp = "auto"))]
+    fn open(&self, interp: &str) -> PyResult<PyBrdf> {
+        guard(|| PyBrdf::from_table(self.table.clone(), interp))
     }
 
     /// `values, grid = table`.

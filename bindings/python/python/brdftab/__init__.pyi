@@ -107,7 +107,8 @@ class Table:
     """A decoded table: `values` shares its memory (read-only float32, stored axes + channels,
     λ innermost; flat when packed), `grid` describes it. The values are the stored quantity
     (`info(...)["tables"][k]["quantity"]`: "fr", "fr_cos_out" or "fr_cos_cos", i.e. f_r, f_r cos θo
-    or f_r cos θi cos θo), before any albedo calibration (`"calibrated"`) a lookup applies."""
+    or f_r cos θi cos θo), before any albedo calibration (`"calibrated"`) a lookup applies.
+    Edited values go back in with `with_values`; `save` writes the table, `open` looks it up."""
     @property
     def values(self) -> npt.NDArray[np.float32]:
         """float32 values shaped by the stored axes and the channels (grid["stored_shape"] +
@@ -123,6 +124,35 @@ class Table:
         device layout, a dict with "version", "kind" ("kernel" or "grid"), "channels",
         "channel_names", "quantity", "calibration", "kernel" and "grid" (None or the layout's
         fields, each with its float32 "values")."""
+    def with_values(self, values: ArrayLike, *, calibration: bool = True) -> Table:
+        """The same table (grid: stored layout, symmetry, quantity, albedo calibration) holding
+        `values`: any array-like of real numbers the size of `values` — shaped as it is (stored
+        axes + channels), flat, or for a packed table the rectangle `brdftab export --npy`
+        writes (unstored nodes ignored) — converted to float32 in C order. Values are the stored
+        quantity before the calibration, as `values` gives them; negative values mark unmeasured
+        nodes of an f_r table (lookups read 0). `calibration=False` drops the grid's albedo
+        calibration (for another material's values on this grid). A wrong size or shape, or a
+        NaN or infinite stored value, is a ValueError naming `values` and the index."""
+    def save(
+        self,
+        output: str | PathLike[str],
+        *,
+        codec: str | None = ...,
+        codec_tolerance: float | None = ...,
+        floor: float | None = ...,
+        level: int | None = ...,
+        exhaustive: bool = ...,
+        name: str | None = ...,
+        replace: bool = ...,
+    ) -> dict[str, Any]:
+        """Writes the table to OUTPUT, a .btdb file (replaced atomically) or DB#NAME (an
+        existing name needs replace=True), with the storage keywords of `bake` (codec "f32"
+        keeps the values bit for bit; default "log16", 1e-3 relative). Returns
+        `brdftab info --json OUTPUT`."""
+    def open(self, interp: str = "auto") -> Brdf:
+        """The table as a Brdf, in memory ("auto": nearest on a grid of MERL cells, linear
+        otherwise). It has no SOURCE: it does not pickle, and `table(**options)` refuses to
+        bake it again."""
     def __iter__(self) -> Iterator[Any]:
         """Yields values, then grid: `values, grid = b.table()`."""
     def __len__(self) -> int:

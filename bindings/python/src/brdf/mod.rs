@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use brdftab::request::OpenSettings;
 use brdftab::source::{self, OpenOptions, SourceKind};
-use brdftab::table::TabulatedBrdf;
+use brdftab::table::{Table, TabulatedBrdf};
 use brdftab::{Brdf, Channels};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -37,6 +37,9 @@ pub(crate) struct PyBrdf {
     interp: String,
     wavelengths: Option<Vec<f64>>,
     eager: bool,
+    /// An in-memory table (`Table.open`): `source` describes it, it names nothing to reopen
+    /// (no pickling) or bake from.
+    in_memory: bool,
 }
 
 impl PyBrdf {
@@ -72,6 +75,29 @@ impl PyBrdf {
             interp: interp.trim().to_ascii_lowercase(),
             wavelengths: wavelengths_of(&channels),
             eager,
+            in_memory: false,
+        })
+    }
+
+    /// `Table.open`: an in-memory table looked up with `interp` (auto, nearest or linear).
+    pub(crate) fn from_table(table: Table, interp: &str) -> PyResult<PyBrdf> {
+        let settings = OpenSettings {
+            interp: Some(interp.to_owned()),
+            ..OpenSettings::default()
+        };
+        let opts = settings.options().map_err(lib_err)?;
+        let source = format!("<in-memory table: {}>", table.description());
+        let t = TabulatedBrdf::from_table(table);
+        let i = opts.interp.unwrap_or_else(|| t.default_interp());
+        let t = Arc::new(t.with_interp(i));
+        Ok(PyBrdf {
+            inner: t.clone(),
+            table: Some(t),
+            source,
+            interp: interp.trim().to_ascii_lowercase(),
+            wavelengths: None,
+            eager: true,
+            in_memory: true,
         })
     }
 
@@ -112,7 +138,8 @@ impl PyBrdf {
         ser(py, &self.inner.flags())
     }
 
-    /// The SOURCE string this BRDF was opened from.
+    /// The SOURCE string this BRDF was opened from (`"<in-memory table: ...>"` for
+    /// `Table.open`).
     #[getter]
     fn source(&self) -> String {
         self.source.clone()
@@ -272,6 +299,13 @@ impl PyBrdf {
     }
 
     fn __reduce__(&self, py: Python<'_>) -> PyResult<Py<PyTuple>> {
+        if self.in_memory {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "cannot pickle {}: it has no SOURCE to reopen (Table.save it and \
+                 brdftab.open the file)",
+                self.source
+            )));
+        }
         let module = py.import("brdftab._native")?;
         let f = module.getattr("_reopen")?;
         let args = (

@@ -27,6 +27,13 @@ impl PyBrdf {
                 let t = t.clone();
                 unlocked(py, move || t.to_table())?.map_err(lib_err)?
             }
+            _ if self.in_memory => {
+                return Err(Error::new_err(format!(
+                    "{}: an in-memory table has no SOURCE to bake with options (Table.save it \
+                     and brdftab.open the file)",
+                    self.source
+                )));
+            }
             _ => {
                 let settings: BakeSettings = settings_of(options)?;
                 let mut req = settings.request(&self.source).map_err(lib_err)?;
