@@ -43,6 +43,13 @@ brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only (so a sour
   node densities the library exports (``Brdf.sampling_nodes``), conditioned on θi (and φi for
   anisotropic tables), drawn with the library's own alias tables (``brdftab._alias2d``), with
   the exactly consistent pdf (``brdftab._halfwarp``).
+- In JIT variants the table's values are a differentiable scene parameter, ``values``
+  (``mi.traverse``; the table's stored values before its albedo calibration, as the layout
+  holds them): eval, eval_pdf and sample's weight are linear in them, so an inverse-rendering
+  loop optimizes a table like a texture (``bindings/python/examples/optimize_values.py``).
+  Edited values are read as float32 (the packed f16 codes of an adaptive table give way, at
+  some cost per lookup); the sampling distributions stay those of the loaded table.
+  ``export_table()`` gives the edited table as a :class:`brdftab.Table` to save.
 """
 
 from __future__ import annotations
@@ -363,6 +370,12 @@ class JitTable:
       axis its mapping and node placement, the nearest node or 16 corners.
 
     Weights and values are float32, blended in the reference's order.
+
+    :attr:`params` holds the layout's values (float32, the stored layout of the table: the
+    kernel's, or the grid's) as one Dr.Jit array, what the plugin exposes to ``mi.traverse``
+    as its differentiable parameter ``values``. Lookups read packed f16 codes (the kernel's fast
+    path) until the values are edited (:meth:`edit`) or need gradients, and :attr:`params`
+    from then on.
     """
 
     def __init__(self, layout):
@@ -405,6 +418,7 @@ class JitTable:
                 for a in k["axes"]]
             values = np.ascontiguousarray(k["values"], np.float32)
             self.kernel["values"] = mi.Float(values)
+            self.params = self.kernel["values"]
             # The f16 codes of an adaptive table, four to a 64-bit word (module docs of
             # _packed_codes): one gather per corner node instead of one per channel.
             self.kernel["packed"] = _packed_codes(values, self.c)
@@ -423,6 +437,8 @@ class JitTable:
             self.shape = [int(n) for n in g["shape"]]
             self.values = mi.Float(np.ascontiguousarray(g["values"], np.float32))
             dr.eval(self.values)
+            if k is None:
+                self.params = self.values
             for ax in self.axes:
                 # Warped axes (adaptive grids): the knots as a Dr.Jit array, for gathers.
                 if isinstance(ax["mapping"], dict) and "warp" in ax["mapping"]:
@@ -431,6 +447,35 @@ class JitTable:
         if (self.kind == "kernel") != (self.kernel is not None) or (
                 self.kernel is None and self.grid is None):
             raise brdftab.Error(f"device layout of kind {self.kind!r} without its arrays")
+        #: Number of values in :attr:`params` (what an edit must keep).
+        self.n_values = dr.width(self.params)
+        if self.kernel is not None and self.grid is not None and dr.width(self.values) != self.n_values:
+            raise brdftab.Error("device layout: a kernel's fallback grid holds other values than "
+                                "the kernel")
+        #: Whether :attr:`params` were edited (:meth:`edit`): lookups read them, not the codes.
+        self.edited = False
+
+    def edit(self):
+        """Lookups read :attr:`params` from now on (after a change of them in place, as
+        ``mi.SceneParameters.update`` makes): the kernel's float32 values instead of its packed
+        codes, and a kernel's fallback grid (pairs beyond a resampled axis's cut) the same values,
+        which it holds in the same order. Raises :class:`brdftab.Error` when the number of values
+        changed."""
+        import drjit as dr
+
+        n = dr.width(self.params)
+        if n != self.n_values:
+            raise brdftab.Error(
+                f"values: {n} given, the table holds {self.n_values} (an edit keeps the table's "
+                "layout; bake another table for another grid)")
+        self.edited = True
+
+    def _reads_params(self):
+        """Whether lookups read :attr:`params` (edited, or tracking gradients) rather than the
+        layout's own arrays."""
+        import drjit as dr
+
+        return self.edited or dr.grad_enabled(self.params)
 
     # -- GridLayout: canonical coordinates (symmetry.rs) -------------------------------------
     def coords(self, wi, wo):
@@ -665,11 +710,12 @@ class JitTable:
         valid &= active
         n0, s1, n2, s3 = self.shape
         c = self.c
-        Fl = type(self.values)
+        values = self.params if self._reads_params() else self.values
+        Fl = type(values)
         if self.interp == "nearest":
             idx = [self._nearest(self.axes[k], x[k]) for k in range(4)]
             base = (((idx[0] * s1 + idx[1]) * n2 + idx[2]) * s3 + idx[3]) * c
-            out = [dr.gather(Fl, self.values, base + k, valid) for k in range(c)]
+            out = [dr.gather(Fl, values, base + k, valid) for k in range(c)]
         else:
             lin = [self._linear(self.axes[k], x[k]) for k in range(4)]
             out = [Fl(0.0) for _ in range(c)]
@@ -685,7 +731,7 @@ class JitTable:
                             wt = w2 * wq
                             base = (row + q) * c
                             for k in range(c):
-                                out[k] = out[k] + wt * dr.gather(Fl, self.values, base + k, valid)
+                                out[k] = out[k] + wt * dr.gather(Fl, values, base + k, valid)
         if self.quantity != "fr" or self.calibration is not None:
             out = self._project(wi, wo, out)
         return [dr.select(valid, o, 0.0) for o in out]
@@ -743,7 +789,8 @@ class JitTable:
         import mitsuba as mi
 
         F64, U = self.Float64, self.UInt
-        kv = self.kernel["values"]
+        reads_params = self._reads_params()
+        kv = self.params if reads_params else self.kernel["values"]
         Fl = mi.Float
         (ix, iy, iz), ok_i = _unit([F64(wi.x), F64(wi.y), F64(wi.z)], True)
         (ox, oy, oz), ok_o = _unit([F64(wo.x), F64(wo.y), F64(wo.z)], True)
@@ -788,7 +835,7 @@ class JitTable:
                 (node + nodes_chunk + nodes_row, th * td)]
         out = [Fl(0.0) for _ in range(c)]
         ok = valid & inside
-        packed = self.kernel["packed"]
+        packed = None if reads_params else self.kernel["packed"]
         if packed is not None:
             words, scale = packed
             W = type(words)
@@ -889,6 +936,9 @@ class JitBrdftabBSDF(_Common):
         # What the sampling distributions are built from: the table when it is at hand as a
         # Brdf, else the source.
         self._sampled = self.brdf
+        # The table the layout is of (a Brdf over a stored table, or a brdftab.Table baked in
+        # memory), for export_table.
+        self._table_src = self.brdf
         if brdftab_kind(self.source) == "table" and not options:
             return self._layout(self.brdf)
         # MERL files keep their own cells, RGL files get the library's adaptive grid. Other
@@ -913,7 +963,7 @@ class JitBrdftabBSDF(_Common):
                 hit = brdftab.bake_cached(self.source, self.cache_dir, refresh, **options)
                 try:
                     t = brdftab.open(hit["path"], interp=self.interp)
-                    self._sampled = t
+                    self._sampled = self._table_src = t
                     return self._layout(t)
                 except brdftab.Error:
                     if refresh:  # a fresh bake that does not open is the library's error
@@ -921,7 +971,8 @@ class JitBrdftabBSDF(_Common):
         b = self.brdf
         if "wavelengths" in options:
             b = brdftab.open(self.source, interp=self.interp, wavelengths=options.pop("wavelengths"))
-        return self._layout(b.table(param="halfdiff", **options))
+        self._table_src = b.table(param="halfdiff", **options)
+        return self._layout(self._table_src)
 
     def _f(self, wi, wo, lam, active):
         """f_r of the table at (wi, wo) as the variant's spectrum; ``lam``: the wavelengths of
@@ -1029,7 +1080,35 @@ class JitBrdftabBSDF(_Common):
         return bs, weight
 
     def traverse(self, callback):
-        pass
+        """Exposes ``values``: the table's values as lookups read them (float32, the table's
+        stored layout and quantity, before its albedo calibration — lookups keep applying it),
+        differentiable: ``eval``, ``eval_pdf`` and ``sample``'s weight are linear in them."""
+        import mitsuba as mi
+
+        callback.put("values", self.table.params, mi.ParamFlags.Differentiable)
 
     def parameters_changed(self, keys):
-        pass
+        """After ``values`` changed: lookups read them (:meth:`JitTable.edit`). The sampling
+        distributions stay those of the table as loaded: draws and their pdf stay consistent
+        and weights follow the new values (``eval / pdf``), so renders stay unbiased; a table
+        edited far from its start samples as well as before once saved and loaded again
+        (:meth:`export_table`)."""
+        if not keys or "values" in keys:
+            self.table.edit()
+
+    def export_table(self):
+        """The table this plugin evaluates with its current ``values`` (after an optimization,
+        the optimized ones) as a :class:`brdftab.Table` on the same grid, albedo calibration
+        included; save it with :meth:`brdftab.Table.save`. Values as lookups read them: an
+        adaptive table's f16-rounded values, an f_r table's unmeasured (negative) ones as 0."""
+        import drjit as dr
+
+        src = self._table_src
+        table = src if isinstance(src, brdftab.Table) else src.table()
+        values = np.asarray(dr.detach(self.table.params), np.float32)
+        if values.size != table.values.size:
+            raise brdftab.Error(
+                f"{self.source}: the device layout holds {values.size} values, the table stores "
+                f"{table.values.size} (a packed inout table's layout expands them); export is "
+                "for layouts that hold the stored values")
+        return table.with_values(values)

@@ -20,8 +20,34 @@ class JitTable:
     """A brdftab table evaluated in Dr.Jit operations: an implementation of the library's
     device layout (`Table.device_layout(interp)`), tested against the library's lookup."""
 
+    params: Any
+    """The layout's values (float32 Dr.Jit array, the table's stored layout): the plugin's
+    differentiable scene parameter `values`."""
+    n_values: int
+    """Number of values in `params`."""
+    edited: bool
+    """Whether `params` were edited (lookups then read them instead of packed codes)."""
+
     def __init__(self, layout: dict[str, Any]) -> None: ...
     def coords(self, wi: Any, wo: Any) -> tuple[list[Any], Any]:
         """Canonical [x0, x1, x2, x3] (float64) of the grid layout, and the validity mask."""
     def lookup(self, wi: Any, wo: Any, active: Any = True) -> list[Any]:
         """f_r per channel: a list of c float32 arrays (0 where invalid)."""
+    def edit(self) -> None:
+        """Lookups read `params` from now on (after an in-place change, as
+        `mi.SceneParameters.update` makes); raises brdftab.Error if their number changed."""
+
+class BrdftabBSDF:
+    """The plugin object of a JIT variant (what `mi.load_dict({"type": "brdftab", ...})`
+    returns; a subclass of the variant's `mi.BSDF`)."""
+
+    table: JitTable
+    def traverse(self, callback: Any) -> None:
+        """Exposes `values` (differentiable): the table's values before its albedo calibration;
+        eval, eval_pdf and sample's weight are linear in them."""
+    def parameters_changed(self, keys: list[str]) -> None:
+        """After `values` changed: lookups read them; the sampling distributions stay those of
+        the loaded table (unbiased; save and reload an edited table to sample it as well)."""
+    def export_table(self) -> Any:
+        """The table with its current values, a `brdftab.Table` on the same grid (albedo
+        calibration included); save it with `Table.save`."""
