@@ -99,14 +99,14 @@ impl BakeRequest {
                 || self.calibrates_model_table() =>
             {
                 let (table, r) = built(checked)?;
-                let (path, replace) = match target {
-                    BakeTarget::Db { path, replace, .. } => (path.as_str(), *replace),
-                    t => (t.path(), true),
-                };
-                if matches!(target, BakeTarget::File(_)) {
-                    let _ = std::fs::remove_file(path);
+                match target {
+                    BakeTarget::Db { path, replace, .. } => {
+                        tables::save(path, &name, provenance, &table, self.codec, *replace)?
+                    }
+                    // Replaced atomically, as a streamed bake replaces it: a write that fails
+                    // (a value the codec cannot hold, a full disk) leaves the old file as it was.
+                    t => tables::save_file(t.path(), &name, provenance, &table, self.codec)?,
                 }
-                tables::save(path, &name, provenance, &table, self.codec, replace)?;
                 (r, Some(table))
             }
             _ => (
@@ -262,6 +262,30 @@ mod tests {
             replace: true,
         };
         req.run(&replace).unwrap();
+    }
+
+    #[test]
+    fn a_bake_that_fails_to_write_leaves_the_old_file() {
+        let d = tmp("failed_write");
+        let out = d.join("keep.btdb").to_str().unwrap().to_owned();
+        BakeRequest::new(r#"{"model":"lambert","kd":0.5}"#)
+            .preset(Preset::Small)
+            .run(&BakeTarget::file(&out))
+            .unwrap();
+        let before = std::fs::read(&out).unwrap();
+        // f_r = 1e5 is beyond f16 (±65504): the encoding fails once the table is baked. The
+        // default grid builds the table whole (the preset check's table), the small preset
+        // streams it; neither may remove the old file first.
+        let bright = r#"{"model":"lambert","kd":1e5}"#;
+        let f16 = codec("f16", None, None, None, false).unwrap();
+        for req in [
+            BakeRequest::new(bright).codec(f16),
+            BakeRequest::new(bright).preset(Preset::Small).codec(f16),
+        ] {
+            let e = req.run(&BakeTarget::file(&out)).unwrap_err();
+            assert!(e.to_string().contains("f16"), "{e}");
+            assert_eq!(std::fs::read(&out).unwrap(), before);
+        }
     }
 
     #[test]
