@@ -872,6 +872,15 @@ impl Grid {
         ]
     }
 
+    /// The angles of every stored node ([`Grid::node_angles`]) in the stored order
+    /// ([`Layout::stored_nodes`]): node k's values are `k·c..(k + 1)·c` of the table's values.
+    pub fn stored_node_angles(&self) -> Vec<[f64; 4]> {
+        self.layout
+            .stored_nodes()
+            .map(|idx| self.node_angles(idx))
+            .collect()
+    }
+
     /// A one-line human description, e.g. `halfdiff 90x1x90x180 (sqrt θh) rgb isotropic+reciprocal`.
     pub fn summary(&self) -> String {
         let s = self.stored_shape();
@@ -1013,6 +1022,17 @@ impl Layout {
     pub fn rows_in_chunk(&self, a: usize) -> usize {
         self.shape[1] * self.rows2(a).1
     }
+
+    /// Every stored node `[a, p, b, q]` in the stored order: chunk by chunk, row by row, axis 3
+    /// innermost, so node k's values are `k·c..(k + 1)·c` of the whole array.
+    pub fn stored_nodes(&self) -> impl Iterator<Item = [usize; 4]> + '_ {
+        (0..self.chunk_count()).flat_map(move |a| {
+            (0..self.rows_in_chunk(a)).flat_map(move |r| {
+                let (p, b) = self.row_node(a, r);
+                (0..self.shape[3]).map(move |q| [a, p, b, q])
+            })
+        })
+    }
 }
 
 #[cfg(test)]
@@ -1052,6 +1072,38 @@ mod tests {
         assert_eq!(bil, 4095 * 181); // 0.74e6
         let ratio = full.stored_values() as f64 / bil as f64;
         assert!((1400.0..1450.0).contains(&ratio), "{ratio}");
+    }
+
+    #[test]
+    fn stored_nodes_walk_the_values_in_order() {
+        // Plain and packed (inout reciprocal: a triangle of the θ axes) layouts: node k of the
+        // walk has its values at k·c, and every stored value belongs to one node.
+        for (param, s) in [
+            (Param::HalfDiff, sym(true, true, true)),
+            (Param::InOut, sym(true, true, false)),
+            (Param::InOut, sym(false, false, false)),
+        ] {
+            let g = Grid::with_sizes(
+                param,
+                [6, 8, 6, 12],
+                [Mapping::Cos, Mapping::Cos],
+                Channels::Rgb,
+                s,
+            )
+            .unwrap();
+            let l = g.layout();
+            let nodes: Vec<_> = l.stored_nodes().collect();
+            assert_eq!(nodes.len() * l.channels, l.len(), "{param:?} {s:?}");
+            for (k, idx) in nodes.iter().enumerate() {
+                assert_eq!(l.offset(*idx), Some(k * l.channels), "{idx:?}");
+            }
+            let angles = g.stored_node_angles();
+            assert_eq!(angles.len(), nodes.len());
+            assert_eq!(
+                angles[nodes.len() - 1],
+                g.node_angles(nodes[nodes.len() - 1])
+            );
+        }
     }
 
     #[test]

@@ -95,16 +95,8 @@ impl Table {
         let l = grid.layout().clone();
         let c = l.channels;
         let mut values = vec![0.0f32; l.len()];
-        for a in 0..l.chunk_count() {
-            let base = l.chunk_range(a).start;
-            for r in 0..l.rows_in_chunk(a) {
-                let (p, b) = l.row_node(a, r);
-                for q in 0..l.shape[3] {
-                    let idx = [a, p, b, q];
-                    let off = base + (r * l.shape[3] + q) * c;
-                    f(idx, grid.node_angles(idx), &mut values[off..off + c]);
-                }
-            }
+        for (idx, out) in l.stored_nodes().zip(values.chunks_exact_mut(c)) {
+            f(idx, grid.node_angles(idx), out);
         }
         Table {
             grid,
@@ -199,13 +191,12 @@ impl Table {
     }
 }
 
-/// The representative direction pair of stored coordinates `c` (in the stored domains):
-/// `inout` → spherical(θ1, φ1), spherical(θ2, φ2); `halfdiff` → the inverse Rusinkiewicz
-/// transform. Directions at or below the horizon are lifted to z = [`HORIZON_Z`] so that nodes
-/// outside the physical domain carry the nearby boundary value (this keeps interpolation next to
-/// the horizon accurate, and constant sources exact).
-pub fn pair_of(param: Param, c: [f64; 4]) -> (DVec3, DVec3) {
-    let (wi, wo) = match param {
+/// The direction pair (wi, wo) of stored coordinates `c` (in the stored domains): `inout` →
+/// spherical(θ1, φ1), spherical(θ2, φ2); `halfdiff` → the inverse Rusinkiewicz transform. Unit
+/// vectors, at or below the horizon for nodes outside the physical domain (which a table holds
+/// for interpolation next to it).
+pub fn node_pair(param: Param, c: [f64; 4]) -> (DVec3, DVec3) {
+    match param {
         Param::InOut => (
             crate::geometry::spherical(c[0], c[1]),
             crate::geometry::spherical(c[2], c[3]),
@@ -216,7 +207,15 @@ pub fn pair_of(param: Param, c: [f64; 4]) -> (DVec3, DVec3) {
             theta_d: c[2],
             phi_d: c[3],
         }),
-    };
+    }
+}
+
+/// The representative direction pair a bake evaluates for stored coordinates `c`:
+/// [`node_pair`], with directions at or below the horizon lifted to z = [`HORIZON_Z`] so that
+/// nodes outside the physical domain carry the nearby boundary value (this keeps interpolation
+/// next to the horizon accurate, and constant sources exact).
+pub fn pair_of(param: Param, c: [f64; 4]) -> (DVec3, DVec3) {
+    let (wi, wo) = node_pair(param, c);
     (lift(wi), lift(wo))
 }
 
