@@ -176,6 +176,37 @@ impl PyTable {
         guard(|| PyBrdf::from_table(self.table.clone(), interp))
     }
 
+    /// The coordinates of every stored node, in radians: float64 shaped like `values` with
+    /// the channels replaced by the parameterization's four angles (`grid["param"]`:
+    /// "halfdiff" θh, φh, θd, φd; "inout" θi, φi, θo, φo — an isotropic table's φi is 0 and its
+    /// φo the azimuth difference), flat (nodes × 4) for a packed table.
+    fn node_angles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            let angles = self.table.grid().stored_node_angles();
+            node_array(py, &self.table, angles.into_iter().flatten().collect(), 4)
+        })
+    }
+
+    /// The direction pair of every stored node: `(wi, wo)`, unit float64 vectors shaped like
+    /// `node_angles` with 3 components, as `Brdf.eval(wi, wo)` takes them — so a source can be
+    /// evaluated at a table's nodes in numpy. Nodes outside the physical domain (kept for
+    /// interpolation next to the horizon) have a direction at or below it (z ≤ 0), where
+    /// `eval` gives 0.
+    fn node_directions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        guard(|| {
+            let grid = self.table.grid();
+            let (mut wi, mut wo) = (Vec::new(), Vec::new());
+            for c in grid.stored_node_angles() {
+                let (i, o) = brdftab::table::node_pair(grid.param(), c);
+                wi.extend(i.to_array());
+                wo.extend(o.to_array());
+            }
+            let wi = node_array(py, &self.table, wi, 3)?;
+            let wo = node_array(py, &self.table, wo, 3)?;
+            PyTuple::new(py, [wi, wo])
+        })
+    }
+
     /// `values, grid = table`.
     fn __iter__<'py>(slf: Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
         let py = slf.py();
@@ -195,6 +226,24 @@ impl PyTable {
             self.table.description()
         )
     }
+}
+
+/// `data` (`k` numbers per stored node, in the stored order) as a numpy array shaped like the
+/// table's values with the channels replaced by `k`, flat (nodes × k) for a packed layout.
+fn node_array<'py>(
+    py: Python<'py>,
+    table: &Table,
+    data: Vec<f64>,
+    k: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut shape: Vec<usize> = match table.shape() {
+        Some(s) => s[..4].to_vec(),
+        None => vec![data.len() / k],
+    };
+    shape.push(k);
+    let arr = numpy::ndarray::ArrayD::from_shape_vec(IxDyn(&shape), data)
+        .map_err(|e| Error::new_err(e.to_string()))?;
+    Ok(arr.into_pyarray(py).into_any())
 }
 
 /// A device layout as the dict `Table.device_layout` and `Brdf.device_layout` return: its

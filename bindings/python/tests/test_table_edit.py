@@ -161,3 +161,35 @@ def test_an_in_memory_brdf_has_no_source_to_reopen(tmp_path):
         m.table(preset="small")
     with pytest.raises(ValueError, match="interp"):
         t.open(interp="cubic")
+
+
+@pytest.mark.parametrize("options", [dict(preset="small"),
+                                     dict(grid="6x1x6x12", param="inout", symmetry="all")])
+def test_node_directions_are_where_the_bake_sampled(options):
+    """`node_angles` and `node_directions` name every stored node in the layout of `values`
+    (a packed inout table: flat): a table baked in memory (no codec) holds the source's own
+    f_r at each node whose directions are both above the horizon, bit for bit; the angles
+    are the parameterization's of those directions."""
+    src = brdftab.open(GGX)
+    t = src.table(**options)
+    a = t.node_angles()
+    wi, wo = t.node_directions()
+    v = t.values.reshape(-1, 3)
+    assert a.shape[-1] == 4 and wi.shape == wo.shape == a.shape[:-1] + (3,)
+    assert a.shape[:-1] == (t.values.shape[:-1] if t.values.ndim > 1 else (v.shape[0],))
+    wi, wo, a = wi.reshape(-1, 3), wo.reshape(-1, 3), a.reshape(-1, 4)
+    np.testing.assert_allclose(np.linalg.norm(wi, axis=1), 1, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(wo, axis=1), 1, atol=1e-12)
+    inside = (wi[:, 2] > 1e-3) & (wo[:, 2] > 1e-3)
+    assert inside.sum() > len(inside) // 3
+    np.testing.assert_array_equal(src.eval(wi[inside], wo[inside]), v[inside])
+    if t.grid["param"] == "halfdiff":
+        # θh is the angle of wi + wo from the normal, θd the angle of wi from it.
+        h = wi + wo
+        h /= np.linalg.norm(h, axis=1, keepdims=True)
+        np.testing.assert_allclose(np.arccos(np.clip(h[:, 2], -1, 1)), a[:, 0], atol=1e-9)
+        np.testing.assert_allclose(np.arccos(np.clip((wi * h).sum(1), -1, 1)), a[:, 2],
+                                   atol=1e-9)
+    else:
+        np.testing.assert_allclose(np.arccos(wi[:, 2]), a[:, 0], atol=1e-9)
+        np.testing.assert_allclose(np.arccos(wo[:, 2]), a[:, 2], atol=1e-9)

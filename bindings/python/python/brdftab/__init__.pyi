@@ -153,6 +153,17 @@ class Table:
         """The table as a Brdf, in memory ("auto": nearest on a grid of MERL cells, linear
         otherwise). It has no SOURCE: it does not pickle, and `table(**options)` refuses to
         bake it again."""
+    def node_angles(self) -> npt.NDArray[np.float64]:
+        """The coordinates of every stored node in radians, shaped like `values` with the
+        channels replaced by the parameterization's four angles ("halfdiff": θh, φh, θd, φd;
+        "inout": θi, φi, θo, φo, an isotropic table's φi 0 and φo the azimuth difference);
+        flat (nodes × 4) for a packed table."""
+    def node_directions(
+        self,
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """(wi, wo) of every stored node: unit vectors shaped like `node_angles` with 3
+        components, as `Brdf.eval` takes them (nodes outside the physical domain have a
+        direction at or below the horizon, where eval gives 0)."""
     def __iter__(self) -> Iterator[Any]:
         """Yields values, then grid: `values, grid = b.table()`."""
     def __len__(self) -> int:
