@@ -38,6 +38,13 @@ impl PyTable {
         g["stored_axes"] =
             serde_json::to_value(grid.stored_axes()).map_err(|e| Error::new_err(e.to_string()))?;
         g["stored_shape"] = serde_json::json!(grid.stored_shape());
+        // The grid's serialization leaves out defaults (an f_r table, no calibration); the
+        // dict names them, as its docs list them.
+        g["quantity"] =
+            serde_json::to_value(grid.quantity()).map_err(|e| Error::new_err(e.to_string()))?;
+        if g.get("calibration").is_none() {
+            g["calibration"] = serde_json::Value::Null;
+        }
         g["packed"] = serde_json::json!(grid.layout().packed);
         g["channel_names"] = serde_json::json!(grid.channels().names());
         g["description"] = serde_json::json!(table.description());

@@ -366,6 +366,8 @@ def test_table_values_and_grid(tmp_path):
     assert values.dtype == np.float32
     assert list(values.shape) == grid["stored_shape"] + [3]
     assert grid["param"] == "halfdiff" and len(grid["stored_axes"]) == 4
+    # The keys the docs list are there for defaults too: an f_r table without calibration.
+    assert grid["quantity"] == "fr" and grid["calibration"] is None
     v2, g2 = brdftab.open(GGX).table(preset="small")
     np.testing.assert_allclose(v2, values, rtol=2e-3, atol=1e-6)
     # Table.values is a view of the table's memory: no copy per access, read-only, kept alive
