@@ -48,8 +48,9 @@ brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only (so a sour
   holds them): eval, eval_pdf and sample's weight are linear in them, so an inverse-rendering
   loop optimizes a table like a texture (``bindings/python/examples/optimize_values.py``).
   Edited values are read as float32 (the packed f16 codes of an adaptive table give way, at
-  some cost per lookup); the sampling distributions stay those of the loaded table.
-  ``export_table()`` gives the edited table as a :class:`brdftab.Table` to save.
+  some cost per lookup); the sampling distributions stay those of the loaded table until
+  ``resample()`` rebuilds them from the current values. ``export_table()`` gives the edited
+  table as a :class:`brdftab.Table` to save.
 """
 
 from __future__ import annotations
@@ -912,14 +913,18 @@ class JitBrdftabBSDF(_Common):
         # values step as the view moves), half again the θi and φh nodes for a lobe that changes
         # shape between grazing views (the Phong family); 48 × 48 and 20 × 16 anisotropic.
         # `sampling_res` overrides the half-vector nodes.
-        nearest = layout["kind"] == "grid" and layout["grid"]["interp"] == "nearest"
-        res = self._sampled.sampling_resolution(adjoint=True, nearest=nearest)
-        override = _prop(props, "sampling_res")
-        if override is not None:
-            res["theta_h"] = res["phi_h"] = int(override)
-        nodes = self._sampled.sampling_nodes(adjoint=True, **res)
-        self.sampler = HalfVectorSampler(nodes)
+        self._nearest = layout["kind"] == "grid" and layout["grid"]["interp"] == "nearest"
+        self._sampling_res = _prop(props, "sampling_res")
+        self.sampler = self._sampler_of(self._sampled)
         dr.eval()
+
+    def _sampler_of(self, brdf):
+        """The library's sampler of ``brdf`` (a Brdf over the table or its source) at the
+        library's resolution, or at the ``sampling_res`` property's half-vector nodes."""
+        res = brdf.sampling_resolution(adjoint=True, nearest=self._nearest)
+        if self._sampling_res is not None:
+            res["theta_h"] = res["phi_h"] = int(self._sampling_res)
+        return HalfVectorSampler(brdf.sampling_nodes(adjoint=True, **res))
 
     def _layout(self, table):
         """The device layout of ``table``: a Brdf over a table (its values move into the
@@ -1090,11 +1095,21 @@ class JitBrdftabBSDF(_Common):
     def parameters_changed(self, keys):
         """After ``values`` changed: lookups read them (:meth:`JitTable.edit`). The sampling
         distributions stay those of the table as loaded: draws and their pdf stay consistent
-        and weights follow the new values (``eval / pdf``), so renders stay unbiased; a table
-        edited far from its start samples as well as before once saved and loaded again
-        (:meth:`export_table`)."""
+        and weights follow the new values (``eval / pdf``), so renders stay unbiased;
+        :meth:`resample` rebuilds them for a table edited far from its start."""
         if not keys or "values" in keys:
             self.table.edit()
+
+    def resample(self):
+        """Rebuilds the sampling distributions from the table's current ``values`` (between
+        renders, after edits that moved the lobe: the loaded table's distributions stay
+        consistent but no longer follow it). Costs what building them at a scene load costs
+        (tens of ms for an RGL file's default table); the pdf is then the one a plugin loading
+        the exported table would have."""
+        import drjit as dr
+
+        self.sampler = self._sampler_of(self.export_table().open(self.interp))
+        dr.eval()
 
     def export_table(self):
         """The table this plugin evaluates with its current ``values`` (after an optimization,

@@ -47,7 +47,9 @@ class BrdftabBSDF:
         eval, eval_pdf and sample's weight are linear in them."""
     def parameters_changed(self, keys: list[str]) -> None:
         """After `values` changed: lookups read them; the sampling distributions stay those of
-        the loaded table (unbiased; save and reload an edited table to sample it as well)."""
+        the loaded table (unbiased) until `resample`."""
+    def resample(self) -> None:
+        """Rebuilds the sampling distributions from the current `values` (between renders)."""
     def export_table(self) -> Any:
         """The table with its current values, a `brdftab.Table` on the same grid (albedo
         calibration included); save it with `Table.save`."""
