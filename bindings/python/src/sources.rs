@@ -85,3 +85,11 @@ pub(crate) fn info(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<Py<PyA
         )
     })
 }
+
+/// The kind of SOURCE as the library classifies it (`spec`, `merl`, `rgl` or `table`): a
+/// `DB#NAME` is a table whatever its name ends with. For the Mitsuba plugin, which chooses a
+/// lookup by kind before it opens anything.
+#[pyfunction]
+pub(crate) fn _source_kind(source: &str) -> &'static str {
+    brdftab::source::classify(source).name()
+}

@@ -265,6 +265,8 @@ class _BytesPath:
 
 def test_database(tmp_path):
     db = brdftab.Database(tmp_path / "m.btdb")
+    assert "matte" not in db  # a database not created yet holds no table
+    assert not (tmp_path / "m.btdb").exists()
     db.add(LAMBERT, "matte", preset="small")
     db.add(GGX, "shiny", preset="small")
     assert db.names() == ["matte", "shiny"] and "matte" in db
@@ -283,6 +285,8 @@ def test_database(tmp_path):
         db.open("matte")
     with pytest.raises(ValueError):
         db.add(LAMBERT, "a#b")
+    with pytest.raises(ValueError, match="name"):  # the name's rule, as add and open apply it
+        db.remove("a#b")
     assert pickle.loads(pickle.dumps(db)).names() == ["shiny"]
 
 

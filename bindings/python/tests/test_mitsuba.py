@@ -651,3 +651,59 @@ def test_jit_refuses_a_sum_with_a_mirror_term():
             ' {"model": "mirror"}]}')
     with pytest.raises(Exception, match="scalar variant"):
         mi.load_dict({"type": "brdftab", "source": spec})
+
+
+GGX_SPEC = '{"model": "ggx", "alpha": 0.3, "fresnel": {"conductor": "Cu"}}'
+
+
+def test_a_database_table_named_like_a_file_is_the_stored_table(tmp_path):
+    """`db.btdb#paper.bsdf` names the stored table `paper.bsdf`: the plugin classified the
+    SOURCE by its ending and re-baked the table as an RGL file (17.5 M values for a 197 k-value
+    table, and `export_table` gave that bake back, not the user's table)."""
+    import brdftab.mitsuba as bm
+
+    db = brdftab.Database(tmp_path / "kind.btdb")
+    db.add(GGX_SPEC, "ggx.json", preset="small")
+    db.add(GGX_SPEC, "paper.bsdf", preset="small")
+    db.add(GGX_SPEC, "scan.binary", preset="small")
+    for name in db.names():
+        assert bm.brdftab_kind(db.source(name)) == "table"
+    assert bm.brdftab_kind('{"model": "lambert"}') == "spec"
+    assert bm.brdftab_kind("x/paper.bsdf") == "rgl"
+    use("llvm_ad_rgb")  # skips without libLLVM
+    stored = brdftab.open(db.source("paper.bsdf")).table().values.size
+    b = mi.load_dict({"type": "brdftab", "source": db.source("paper.bsdf"),
+                      "cache_dir": str(tmp_path / "cache")})
+    assert b.table.n_values == stored
+    assert not (tmp_path / "cache").exists()  # nothing was baked
+
+
+@pytest.mark.parametrize("variant", ["scalar_rgb", "llvm_ad_rgb"])
+def test_an_rgb_variant_refuses_three_wavelengths(tmp_path, variant):
+    """A table at 450, 550 and 650 nm has three channels but they are not R, G, B: an RGB
+    variant read its 450 nm channel as red (a blue Lambert rendered red)."""
+    use(variant)
+    table = tmp_path / "blue.btdb"
+    brdftab.bake('{"model": "lambert", "kd": [0.02, 0.05, 0.25]}', table, preset="small",
+                 wavelengths=[450, 550, 650])
+    with pytest.raises(Exception, match="R, G, B"):
+        mi.load_dict({"type": "brdftab", "source": str(table)})
+
+
+def test_a_scalar_variant_loads_a_scene_written_for_the_jit_variants(tmp_path):
+    """The JIT table's properties (preset, grid, cache, cache_dir, sampling_res) made Mitsuba's
+    scalar variants refuse the scene ("unreferenced property"); they are accepted and ignored
+    there: a scalar variant evaluates the source itself."""
+    import brdftab.mitsuba as bm
+
+    use("scalar_rgb")
+    props = {"preset": "small", "cache": False, "cache_dir": str(tmp_path), "sampling_res": 32}
+    assert set(props) | {"grid"} == set(bm.JIT_TABLE_PROPERTIES)
+    b = mi.load_dict({"type": "brdftab", "source": GGX_SPEC, **props})
+    si = mi.SurfaceInteraction3f()
+    si.wi = mi.Vector3f(0.3, 0.1, 0.948683)
+    wo = mi.Vector3f(-0.3, 0.0, 0.953939)
+    want = brdftab.open(GGX_SPEC).eval([-0.3, 0.0, 0.953939], [0.3, 0.1, 0.948683])
+    got = np.array(b.eval(mi.BSDFContext(), si, wo)) / 0.953939
+    np.testing.assert_allclose(got, want, rtol=1e-5)
+    assert not list(tmp_path.iterdir())  # nothing baked or cached

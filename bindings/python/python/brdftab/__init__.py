@@ -19,6 +19,8 @@ the library's message; wrong arguments raise ``ValueError`` or ``TypeError``.
 
 from __future__ import annotations
 
+import os as _os
+
 from ._native import (  # noqa: F401
     Brdf,
     Error,
@@ -71,6 +73,9 @@ class Database:
         return _native.db_names(self.path)
 
     def __contains__(self, name):
+        # A database that does not exist yet holds no table (``add`` creates it).
+        if not _os.path.exists(self.path):
+            return False
         return name in self.names()
 
     def add(self, source, name, *, replace=False, **options):
@@ -96,6 +101,7 @@ class Database:
 
     def remove(self, name):
         """Removes table NAME."""
+        _check_name(name)
         _native.db_remove(self.path, name)
 
     def open(self, name, **options):

@@ -135,17 +135,19 @@ def _flags(brdf, source):
     return flags
 
 
+JIT_TABLE_PROPERTIES = ("preset", "grid", "cache", "cache_dir", "sampling_res")
+"""Properties of the JIT variants' table (how a non-table source is baked, where the bake is
+cached, the sampler's resolution). The scalar variants accept them and ignore them: they
+evaluate the source itself."""
+
+
 def brdftab_kind(source):
-    """The kind of SOURCE by its name, as the plugin needs it: "spec", "merl", "rgl" or "table"."""
-    s = source.strip()
-    low = s.lower()
-    if s.startswith("{") or low.endswith(".json"):
-        return "spec"
-    if low.endswith(".binary"):
-        return "merl"
-    if low.endswith(".bsdf"):
-        return "rgl"
-    return "table"
+    """The kind of SOURCE as the library classifies it: "spec", "merl", "rgl" or "table".
+
+    A ``DB.btdb#NAME`` is a table whatever its name ends with (``db.btdb#paper.bsdf`` is the
+    stored table named ``paper.bsdf``, not an RGL file to bake again).
+    """
+    return brdftab._native._source_kind(source.strip())
 
 
 class _Common:
@@ -168,7 +170,8 @@ class _Common:
                 f"{src}: the source transmits light (a refractor); the plugin is a BRDF (front "
                 "side only): use Mitsuba's dielectric for the interface"
             )
-        if not self.spectral and len(self.brdf.channels) != 3:
+        if not self.spectral and list(self.brdf.channels) != ["R", "G", "B"]:
+            # Three wavelengths are not R, G, B: read in order they would be B, G, R at best.
             raise brdftab.Error(
                 f"{src}: channels {' '.join(self.brdf.channels)}; an RGB variant needs R, G, B "
                 "(use a spectral variant)"
@@ -188,6 +191,11 @@ class ScalarBrdftabBSDF(_Common):
     def __init__(self, props):
         self._base.__init__(self, props)
         self._init_common(props)
+        # The JIT variants' table properties are read (so that a scene written for them loads
+        # here, where Mitsuba refuses a property nobody reads) and have no effect: a scalar
+        # variant evaluates and samples the source itself, not a table baked from it.
+        for key in JIT_TABLE_PROPERTIES:
+            _prop(props, key)
 
     def _f(self, wi, wo, si):
         import mitsuba as mi
@@ -480,8 +488,16 @@ class JitTable:
 
     # -- GridLayout: canonical coordinates (symmetry.rs) -------------------------------------
     def coords(self, wi, wo):
-        """Canonical [x0, x1, x2, x3] (float64) and the validity mask."""
+        """Canonical [x0, x1, x2, x3] (float64) and the validity mask, of a grid layout."""
         import drjit as dr
+
+        if self.kind != "grid":
+            # A kernel layout's lookup works in its own warped variables (`lookup`); it has no
+            # canonical grid coordinates.
+            raise brdftab.Error(
+                f"coords: a {self.kind} layout has no canonical grid coordinates (grid layouts "
+                "only; `lookup` evaluates every layout)"
+            )
 
         F = self.Float64
         # Linear lookups use the polynomial acos/atan2 (canonical_coords_fast) on `unit`

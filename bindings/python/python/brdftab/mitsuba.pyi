@@ -7,8 +7,12 @@ def plugin_class() -> type:
     """The plugin's class for the current variant (a subclass of that variant's `mi.BSDF`)."""
 
 def brdftab_kind(source: str) -> str:
-    """The kind of SOURCE by its name, as the plugin needs it: "spec", "merl", "rgl" or "table"."""
+    """The kind of SOURCE as the library classifies it: "spec", "merl", "rgl" or "table" (a
+    ``DB.btdb#NAME`` is a table whatever its name ends with)."""
 
+JIT_TABLE_PROPERTIES: tuple[str, ...]
+"""Properties of the JIT variants' table (preset, grid, cache, cache_dir, sampling_res); the scalar
+variants accept them and ignore them (they evaluate the source itself)."""
 LAYOUT_VERSION: int
 """The device-layout version JitTable implements (Rust `brdftab::table::device::VERSION`)."""
 RGB_WAVELENGTHS: tuple[float, float, float]
@@ -30,7 +34,8 @@ class JitTable:
 
     def __init__(self, layout: dict[str, Any]) -> None: ...
     def coords(self, wi: Any, wo: Any) -> tuple[list[Any], Any]:
-        """Canonical [x0, x1, x2, x3] (float64) of the grid layout, and the validity mask."""
+        """Canonical [x0, x1, x2, x3] (float64) of a grid layout, and the validity mask; raises
+        `brdftab.Error` on a kernel layout (its lookup works in its own warped variables)."""
     def lookup(self, wi: Any, wo: Any, active: Any = True) -> list[Any]:
         """f_r per channel: a list of c float32 arrays (0 where invalid)."""
     def edit(self) -> None:

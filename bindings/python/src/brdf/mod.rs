@@ -106,11 +106,12 @@ impl PyBrdf {
     }
 
     /// A lazily decoded chunk that failed (corrupt data) is an error, not silent zeros
-    /// ([`Brdf::health`], sticky: the object stays failed).
+    /// ([`Brdf::health`], sticky: the object stays failed). The library's error names the file
+    /// and the chunk already.
     fn check_loaded(&self) -> PyResult<()> {
         self.inner
             .health()
-            .map_err(|e| Error::new_err(format!("{}: {e}", self.source)))
+            .map_err(|e| Error::new_err(e.to_string()))
     }
 }
 
