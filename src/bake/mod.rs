@@ -50,7 +50,7 @@ pub use preset_check::{
 };
 pub use report::{Accuracy, BakeReport};
 pub use rgl::{Converted, to_rgl};
-pub use run::stem;
+pub use run::{source_stem, stem};
 
 use crate::codec::Codec;
 use crate::spectrum::Channels;

@@ -40,6 +40,15 @@ impl BakeRequest {
         if matches!(target, BakeTarget::File(_) | BakeTarget::Db { .. }) {
             crate::store::name::check("name", &name)?;
         }
+        // An existing name without `replace` is refused before the bake, not after it.
+        if let BakeTarget::Db {
+            path,
+            replace: false,
+            ..
+        } = target
+        {
+            db::refuse_duplicate(path, &name)?;
+        }
         let src = self.open_source()?;
         let t0 = Instant::now();
         // A model the medium preset misses is baked as the request with an error target would
@@ -215,6 +224,20 @@ pub fn stem(path: &str) -> String {
         .unwrap_or_else(|| "table".into())
 }
 
+/// The default name of a table converted from SOURCE: the table's own name for `DB#NAME`, the
+/// model's name for an inline spec (`lambert`; not a stem of the JSON text, cut at its last
+/// `.`), else its file's [`stem`].
+pub fn source_stem(source: &str) -> String {
+    if source.trim_start().starts_with('{') {
+        return crate::spec::ModelSpec::parse(source)
+            .map_or_else(|_| "table".into(), |s| s.name().to_owned());
+    }
+    match crate::store::name::parse_input("source", source) {
+        Ok((_, Some(name))) => name.to_owned(),
+        _ => stem(crate::store::name::path_of(source)),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -286,6 +309,54 @@ mod tests {
             assert!(e.to_string().contains("f16"), "{e}");
             assert_eq!(std::fs::read(&out).unwrap(), before);
         }
+    }
+
+    #[test]
+    fn a_converted_specs_default_name_is_its_model() {
+        assert_eq!(source_stem(r#" {"model":"lambert","kd":0.3}"#), "lambert");
+        assert_eq!(source_stem(r#"{"model":"ggx","alpha":0.1}"#), "ggx");
+        assert_eq!(source_stem("{not json"), "table");
+        assert_eq!(
+            source_stem("data/rgl/paper_white_rgb.bsdf"),
+            "paper_white_rgb"
+        );
+        assert_eq!(source_stem("lib.btdb#gold"), "gold");
+    }
+
+    #[test]
+    fn an_existing_name_is_refused_before_the_bake() {
+        /// Counts the stages a bake begins.
+        #[derive(Default)]
+        struct Stages(std::sync::atomic::AtomicUsize);
+        impl Progress for Stages {
+            fn begin(&self, _: &str, _: u64) {
+                self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
+        let d = tmp("duplicate_first");
+        let db = d.join("lib.btdb").to_str().unwrap().to_owned();
+        let req = BakeRequest::new(r#"{"model":"lambert","kd":0.5}"#).preset(Preset::Small);
+        let target = |replace| BakeTarget::Db {
+            path: db.clone(),
+            name: "matte".into(),
+            replace,
+        };
+        let stages = Stages::default();
+        req.run_with(&target(false), &stages).unwrap();
+        assert!(
+            stages.0.into_inner() > 0,
+            "the first bake reports its stages"
+        );
+        let before = std::fs::read(&db).unwrap();
+        let stages = Stages::default();
+        let e = req.run_with(&target(false), &stages).unwrap_err();
+        assert!(
+            matches!(e, Error::Duplicate { ref name, .. } if name == "matte"),
+            "{e}"
+        );
+        assert_eq!(stages.0.into_inner(), 0, "refused before any stage began");
+        assert_eq!(std::fs::read(&db).unwrap(), before);
+        req.run(&target(true)).unwrap(); // replace still works
     }
 
     #[test]

@@ -86,7 +86,9 @@ pub fn convert(
             format!("{pairs}: at most {MAX_SAMPLES} pairs (fewer with many channels)"),
         ));
     }
-    match classify_output(output) {
+    let kind = classify_output(output);
+    refuse_unused(settings, kind, output)?;
+    match kind {
         SourceKind::Merl => Ok(ConvertOutput::Merl(
             req.run_with(&BakeTarget::Merl(output.to_owned()), progress)?,
         )),
@@ -119,7 +121,7 @@ pub fn convert(
                     name: req
                         .name
                         .clone()
-                        .unwrap_or_else(|| bake::stem(crate::store::name::path_of(source))),
+                        .unwrap_or_else(|| bake::source_stem(source)),
                     replace,
                 },
                 t => t,
@@ -129,6 +131,98 @@ pub fn convert(
                 report,
                 interp: req.accuracy_interp,
             })
+        }
+    }
+}
+
+/// Refuses a setting the output's kind does not use: it was dropped without a word (a MERL
+/// `.binary` asked for `wavelengths` came out RGB; a `.bsdf` asked for a codec or a preset
+/// ignored it).
+fn refuse_unused(settings: &ConvertSettings, kind: SourceKind, output: &str) -> Result<()> {
+    let b = &settings.bake;
+    let table = [
+        ("preset", b.preset.is_some()),
+        ("grid", b.grid.is_some()),
+        ("param", b.param.is_some()),
+        ("symmetry", b.symmetry.is_some()),
+        ("symmetry_tolerance", b.symmetry_tolerance.is_some()),
+        ("force", b.force),
+        ("codec", b.codec.is_some()),
+        ("codec_tolerance", b.codec_tolerance.is_some()),
+        ("floor", b.floor.is_some()),
+        ("level", b.level.is_some()),
+        ("exhaustive", b.exhaustive),
+        ("name", b.name.is_some()),
+        ("supersample", b.supersample.is_some()),
+        ("target_error", b.target_error.is_some()),
+        ("calibrate", b.calibrate.is_some()),
+        ("interp", settings.interp.is_some()),
+    ];
+    let rgl = [
+        ("resolution", settings.resolution.is_some()),
+        ("theta_i", settings.theta_i.is_some()),
+        ("phi_i", settings.phi_i.is_some()),
+        ("ndf_resolution", settings.ndf_resolution.is_some()),
+    ];
+    let (what, unused): (&str, Vec<_>) = match kind {
+        SourceKind::Merl => (
+            "a MERL .binary file (RGB cell means on the MERL grid)",
+            [("wavelengths", b.wavelengths.is_some())]
+                .into_iter()
+                .chain(table)
+                .chain(rgl)
+                .collect(),
+        ),
+        SourceKind::Rgl => ("an RGL .bsdf file", table.into_iter().collect()),
+        SourceKind::Spec | SourceKind::Table => ("a table", rgl.into_iter().collect()),
+    };
+    match unused.into_iter().find(|(_, given)| *given) {
+        Some((field, _)) => Err(crate::Error::arg(
+            field,
+            format!("does not apply to {output}, {what}"),
+        )),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::Silent;
+
+    #[test]
+    fn a_setting_the_output_does_not_use_is_refused_before_any_work() {
+        let d = crate::testkit::TempDir::new("convert-unused");
+        let lambert = r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#;
+        let bake = |b: BakeSettings| ConvertSettings {
+            bake: b,
+            ..Default::default()
+        };
+        let wl = bake(BakeSettings {
+            wavelengths: Some("450,550".parse().unwrap()),
+            ..Default::default()
+        });
+        let codec = bake(BakeSettings {
+            codec: Some("f16".into()),
+            ..Default::default()
+        });
+        let res = ConvertSettings {
+            resolution: Some(16),
+            ..Default::default()
+        };
+        for (out, settings, field) in [
+            ("a.binary", &wl, "wavelengths"),
+            ("a.binary", &codec, "codec"),
+            ("a.bsdf", &codec, "codec"),
+            ("a.btdb", &res, "resolution"),
+            ("a.binary", &res, "resolution"),
+        ] {
+            let path = d.join(out).to_str().unwrap().to_owned();
+            match convert(lambert, &path, settings, &Silent) {
+                Err(crate::Error::InvalidArgument { name, .. }) => assert_eq!(name, field, "{out}"),
+                r => panic!("{out}: {:?}", r.map(|_| ())),
+            }
+            assert!(!d.join(out).exists(), "{out} was written");
         }
     }
 }

@@ -49,6 +49,20 @@ fn existing(path: &Path) -> Result<Option<Store>> {
     }
 }
 
+/// Refuses `name` when the database at `path` holds a table of that name already — what
+/// [`put`] refuses without `replace`, checked before the work that makes the table (a bake of
+/// seconds to minutes) rather than at its end. A database not created yet holds no name.
+pub fn refuse_duplicate(path: impl AsRef<Path>, name: &str) -> Result<()> {
+    let path = path.as_ref();
+    match existing(path)? {
+        Some(s) if s.tables().iter().any(|t| t.name == name) => Err(Error::Duplicate {
+            container: path.display().to_string(),
+            name: name.to_owned(),
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// Copies table `e` of `from` into `w` without decoding (checksums are checked on the way).
 fn copy_table(from: &Store, e: &TocEntry, w: &mut Writer) -> Result<()> {
     let t = from.table(&e.name)?;
