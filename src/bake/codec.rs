@@ -37,6 +37,35 @@ pub fn codec(
         ),
         None => (name, None),
     };
+    // Each setting once, and only where it means something: a silently dropped or overridden
+    // tolerance stores a table at another precision than the one asked for.
+    if let (Some(t), Some(u)) = (tol, tolerance) {
+        return Err(Error::arg(
+            "codec_tolerance",
+            format!("the codec `{name}:{t}` gives a tolerance already; {u} is a second one"),
+        ));
+    }
+    let plain = matches!(name.trim(), "f32" | "f16");
+    for (field, given) in [
+        ("codec", tol.is_some()),
+        ("codec_tolerance", tolerance.is_some()),
+        ("floor", floor.is_some()),
+    ] {
+        if given && plain {
+            let what = if field == "floor" {
+                "a floor"
+            } else {
+                "a tolerance"
+            };
+            return Err(Error::arg(
+                field,
+                format!(
+                    "{what} applies to the log16 codec only; `{}` stores values as they are",
+                    name.trim()
+                ),
+            ));
+        }
+    }
     let quant = Quant::parse(name.trim(), tolerance.or(tol), floor)?;
     let level = level.unwrap_or(quant.default_level());
     if !(1..=22).contains(&level) {
@@ -51,4 +80,49 @@ pub fn codec(
         exhaustive,
         ..Codec::default()
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn field(r: Result<Codec>) -> String {
+        match r {
+            Err(Error::InvalidArgument { name, .. }) => name,
+            r => panic!("not an argument error: {r:?}"),
+        }
+    }
+
+    #[test]
+    fn a_setting_given_twice_or_where_it_means_nothing_is_refused() {
+        // `log16:1e-2` and a separate tolerance of 1e-4: 1e-4 won without a word.
+        assert_eq!(
+            field(codec("log16:1e-2", Some(1e-4), None, None, false)),
+            "codec_tolerance"
+        );
+        assert_eq!(field(codec("f16:1e-2", None, None, None, false)), "codec");
+        assert_eq!(
+            field(codec("f32", Some(1e-2), None, None, false)),
+            "codec_tolerance"
+        );
+        assert_eq!(field(codec("f32", None, Some(1e-3), None, false)), "floor");
+        assert_eq!(field(codec("f16", None, Some(1e-3), None, false)), "floor");
+        assert_eq!(field(codec("zip:1e-2", None, None, None, false)), "codec");
+        let q = |r: Result<Codec>| r.unwrap().quant;
+        assert_eq!(
+            q(codec("log16:1e-2", None, Some(1e-6), None, false)),
+            Quant::Log16 {
+                tolerance: 1e-2,
+                floor: Some(1e-6)
+            }
+        );
+        assert_eq!(
+            q(codec("log16", Some(1e-4), None, None, false)),
+            Quant::Log16 {
+                tolerance: 1e-4,
+                floor: None
+            }
+        );
+        assert_eq!(q(codec("f16", None, None, Some(9), false)), Quant::F16);
+    }
 }
