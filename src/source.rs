@@ -263,6 +263,14 @@ pub fn open_table(source: &str, opts: &OpenOptions) -> Result<TabulatedBrdf> {
         TabulatedBrdf::from_table(Table::open_raw(source)?)
     } else if !Path::new(path).exists() {
         return Err(Error::NotFound(format!("{}: no such file", excerpt(path))));
+    } else if crate::measured::tensor::has_magic(path) {
+        // Sources are told apart by name (`classify`); an RGL file under another name would
+        // otherwise be "no RGL signature", which it has.
+        return Err(Error::Unsupported(format!(
+            "{}: an RGL tensor file (its signature) without the .bsdf name that RGL files are \
+             opened by: give it a .bsdf name",
+            excerpt(path)
+        )));
     } else {
         return Err(Error::Unsupported(format!(
             "{}: not a file brdftab can read (no brdftab, MERL or RGL signature, and not a \
@@ -312,6 +320,36 @@ pub fn provenance(source: &str, brdf: &dyn Brdf) -> Result<crate::store::Source>
 mod tests {
     use super::*;
     use glam::DVec3;
+
+    #[test]
+    fn a_file_under_the_wrong_name_is_named_by_its_signature() {
+        let d = crate::testkit::TempDir::new("source-misnamed");
+        let rgl = crate::measured::data::rgl_file("paper_white_rgb.bsdf").unwrap();
+        let as_dat = d.join("paper.dat");
+        std::fs::copy(&rgl, &as_dat).unwrap();
+        let e = open(as_dat.to_str().unwrap()).err().unwrap().to_string();
+        assert!(
+            e.contains("an RGL tensor file") && e.contains(".bsdf name"),
+            "{e}"
+        );
+        let table = d.join("t.btdb");
+        crate::bake::BakeRequest::new(r#"{"model":"lambert","kd":0.5}"#)
+            .preset(crate::table::presets::Preset::Small)
+            .run(&crate::bake::BakeTarget::file(table.to_str().unwrap()))
+            .unwrap();
+        let as_bsdf = d.join("t.bsdf");
+        std::fs::copy(&table, &as_bsdf).unwrap();
+        let e = open(as_bsdf.to_str().unwrap()).err().unwrap().to_string();
+        assert!(
+            e.contains("brdftab table") && e.contains(".btdb name"),
+            "{e}"
+        );
+        // Neither signature: the message says so.
+        let junk = d.join("junk.dat");
+        std::fs::write(&junk, b"0123456789abcdef").unwrap();
+        let e = open(junk.to_str().unwrap()).err().unwrap().to_string();
+        assert!(e.contains("no brdftab, MERL or RGL signature"), "{e}");
+    }
 
     #[test]
     fn classify_is_by_string_only() {

@@ -27,6 +27,18 @@ use crate::error::{Error, Result};
 /// The 12-byte magic at the start of every tensor file.
 pub const MAGIC: &[u8; 12] = b"tensor_file\0";
 
+/// Whether the regular file at `path` starts with the tensor files' [`MAGIC`] (false for
+/// anything unreadable).
+pub fn has_magic(path: impl AsRef<std::path::Path>) -> bool {
+    use std::io::Read;
+    let mut m = [0u8; 12];
+    crate::files::is_regular(path.as_ref())
+        && std::fs::File::open(path)
+            .and_then(|mut f| f.read_exact(&mut m))
+            .is_ok()
+        && &m == MAGIC
+}
+
 /// Element type of a tensor field.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Dtype {
@@ -216,11 +228,17 @@ impl TensorFile {
         };
         let magic = c.take(12, "the magic", None)?;
         if magic != MAGIC {
+            // A brdftab table given a `.bsdf` name is the likely mistake: say so.
+            let table = bytes.get(..8) == Some(&crate::store::format::MAGIC[..]);
             return Err(Error::format(
                 &file,
                 None,
                 Some(0),
-                "not a tensor file (magic `tensor_file\\0` missing)",
+                if table {
+                    "not a tensor file but a brdftab table (its signature): give it a .btdb name"
+                } else {
+                    "not a tensor file (magic `tensor_file\\0` missing)"
+                },
             ));
         }
         let v0 = c.u8("the version", None)?;
