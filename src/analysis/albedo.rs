@@ -53,8 +53,8 @@ pub fn quadrature<B: Brdf + ?Sized>(brdf: &B, wi: DVec3, out: &mut [f64]) {
 /// [`Error::InvalidArgument`](crate::Error::InvalidArgument) naming `theta`.
 ///
 /// Why π/2 itself is refused: light at the horizon reaches the surface with cos θ′ = 0, where the
-/// albedo is at best a limit, and not always a finite one (Ward's and the original Phong's f_r
-/// grow like 1/cos θ′, and so does their albedo). The direction computed for θ′ = π/2 is not at
+/// albedo is at best a limit, and not always a finite one (the original Phong's f_r grows like
+/// 1/cos θ′ and so does its albedo; Ward's like 1/√(cos θi cos θo), its albedo like 1/√cos θ′). The direction computed for θ′ = π/2 is not at
 /// the horizon either: cos(π/2) in f64 is 6e-17 > 0, so it was evaluated as a light just above it,
 /// and Ward's albedo came out as 3.5e5. A negative angle would silently mean its mirror image.
 pub fn incidence(theta: f64) -> crate::Result<DVec3> {
@@ -62,8 +62,14 @@ pub fn incidence(theta: f64) -> crate::Result<DVec3> {
         return Err(crate::Error::arg(
             "theta",
             format!(
-                "{theta} is outside [0, π/2) (radians): the albedo is defined for light above \
-                 the horizon"
+                "{} is outside [0, π/2) (radians): the albedo is defined for light above the \
+                 horizon",
+                // `{:e}` for tiny and huge angles: `{}` of -1e-300 prints 300 zeros.
+                if theta == 0.0 || (1e-4..1e6).contains(&theta.abs()) || !theta.is_finite() {
+                    format!("{theta}")
+                } else {
+                    format!("{theta:e}")
+                }
             ),
         ));
     }
@@ -207,6 +213,22 @@ mod tests {
                 est.evals
             );
             assert!(est.evals < 300_000, "n = {n}: {} evals", est.evals);
+        }
+    }
+
+    #[test]
+    fn a_refused_angle_is_named_in_a_short_message() {
+        for (theta, shown) in [
+            (-1e-300, "-1e-300"),
+            (1.6, "1.6"),
+            (f64::NAN, "NaN"),
+            (1e300, "1e300"),
+        ] {
+            let e = incidence(theta).unwrap_err().to_string();
+            assert!(
+                e.contains(&format!("{shown} is outside")) && e.len() < 160,
+                "{e}"
+            );
         }
     }
 
