@@ -52,9 +52,10 @@ class Brdf:
         NaN, infinite or zero directions give 0 (not an error), as in every host."""
     def eval_spectral(self, wi: ArrayLike, wo: ArrayLike, nm: ArrayLike) -> npt.NDArray[np.float32]:
         """f_r at wavelengths nm ((k,) or (n, k); each finite and > 0, else ValueError):
-        (n, k) float32."""
+        (n, k) float32, or (k,) for one pair of shape (3,)."""
     def pdf(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float64]:
-        """Density of `sample` drawing wi given wo: (n,) float64."""
+        """Density of `sample` drawing wi given wo: (n,) float64, or 0-d for one pair of shape
+        (3,)."""
     @overload
     def sample(
         self, wo: ArrayLike, u: ArrayLike, *, nm: ArrayLike | None = None,
@@ -62,7 +63,10 @@ class Brdf:
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32]]:
         """(wi (n, 3), pdf (n,), weight = f cos θi / pdf (n, c)) for u in [0, 1)² of shape (n, 2);
         with `nm` (k,) or (n, k) the weights at those wavelengths, (n, k) (a delta draw: its
-        lobe's reflectance there)."""
+        lobe's reflectance there over its pdf, the probability of choosing that lobe).
+
+        One wo of shape (3,) with u of shape (2,): wi (3,), pdf 0-d, weight (c,) — one pair's
+        shapes, as in `eval`."""
     @overload
     def sample(
         self, wo: ArrayLike, u: ArrayLike, *, nm: ArrayLike | None = None, delta: Literal[True]

@@ -215,9 +215,10 @@ impl PyBrdf {
     ///
     /// `nm` (wavelengths in nm, shape (k,) or (n, k)): the weights at those wavelengths,
     /// (n, k), instead of the channels — for a smooth draw f_r from `eval_spectral`, for a
-    /// delta draw (a mirror) the lobe's reflectance at each wavelength; the draws are those
-    /// without `nm`. `delta=True`: a fourth array, bool (n,), true where the draw is a delta
-    /// lobe's (a mirror term of a sum: its pdf is then the probability of choosing that lobe,
+    /// delta draw (a mirror) the lobe's reflectance at each wavelength over its `pdf` (the
+    /// probability of choosing that lobe, 1 for a mirror alone); the draws are those without
+    /// `nm`. `delta=True`: a fourth array, bool (n,), true where the draw is a delta lobe's (a
+    /// mirror term of a sum: its pdf is then the probability of choosing that lobe,
     /// not a density, and `pdf(wi, wo)` does not contain it) — what a renderer's multiple
     /// importance sampling needs to tell the two apart.
     #[pyo3(signature = (wo, u, *, nm=None, delta=false))]
