@@ -5,6 +5,7 @@ import json
 import math
 import os
 import pathlib
+import shutil
 
 import numpy as np
 import pytest
@@ -707,3 +708,37 @@ def test_a_scalar_variant_loads_a_scene_written_for_the_jit_variants(tmp_path):
     got = np.array(b.eval(mi.BSDFContext(), si, wo)) / 0.953939
     np.testing.assert_allclose(got, want, rtol=1e-5)
     assert not list(tmp_path.iterdir())  # nothing baked or cached
+
+
+
+@pytest.mark.parametrize("variant", ["scalar_rgb", "llvm_ad_rgb"])
+def test_a_scene_file_names_its_material_as_it_would_for_measured(rgl, tmp_path, variant,
+                                                                  monkeypatch):
+    """A scene written for Mitsuba's `measured` says `filename`, relative to the scene file;
+    the plugin took only `source`, relative to the working directory."""
+    use(variant)
+    scene_dir = tmp_path / "scene"
+    scene_dir.mkdir()
+    shutil.copy(rgl / RGL_FILE, scene_dir / "material.bsdf")
+    db = brdftab.Database(scene_dir / "lib.btdb")
+    db.add(GGX_SPEC, "ggx", preset="small")
+    cache = {} if variant.startswith("scalar") else {"cache_dir": str(tmp_path / "cache")}
+    extra = "".join(f'<string name="{k}" value="{v}"/>' for k, v in cache.items())
+    monkeypatch.chdir(tmp_path)  # not the scene's directory: the resolver finds the files
+    wi, wo = random_dirs(8, 1, 0.2), random_dirs(8, 2, 0.2)
+    for prop, value, want in [
+        ("filename", "material.bsdf", str(rgl / RGL_FILE)),
+        ("source", "lib.btdb#ggx", db.source("ggx")),
+    ]:
+        xml = scene_dir / f"{prop}.xml"
+        xml.write_text(
+            f'<bsdf version="3.0.0" type="brdftab"><string name="{prop}" value="{value}"/>'
+            f"{extra}</bsdf>"
+        )
+        got = mi.load_file(str(xml))
+        ref = mi.load_dict({"type": "brdftab", "source": want, **cache})
+        a, b = eval_both(variant, got, ref, wi, wo)
+        np.testing.assert_array_equal(a, b)
+        assert np.all(a > 0)
+    with pytest.raises(Exception, match="not both"):
+        mi.load_dict({"type": "brdftab", "source": "a.bsdf", "filename": "a.bsdf"})

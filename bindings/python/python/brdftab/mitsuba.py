@@ -5,7 +5,8 @@
 >>> brdftab.mitsuba.register()
 >>> bsdf = mi.load_dict({"type": "brdftab", "source": "paper_white_rgb.bsdf"})  # doctest: +SKIP
 
-Properties: ``source`` (string, any SOURCE: spec, table, ``DB#NAME``, MERL, RGL), optional
+Properties: ``source`` (string, any SOURCE: spec, table, ``DB#NAME``, MERL, RGL; or
+``filename``, the name Mitsuba's own file-reading plugins such as ``measured`` use), optional
 ``interp`` (``"auto"``, the default: nearest on tables of MERL cells as every host of the
 library reads them, linear otherwise; or ``"linear"`` or ``"nearest"``), and for JIT variants optional ``preset`` / ``grid``
 (the table a non-table source is baked on; default: for an isotropic model the smallest
@@ -56,6 +57,7 @@ brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only (so a sour
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 
@@ -150,15 +152,49 @@ def brdftab_kind(source):
     return brdftab._native._source_kind(source.strip())
 
 
+def _resolve(source):
+    """SOURCE with its file found as Mitsuba finds files: through the file resolver, which holds
+    the scene file's directory while a scene loads (so ``filename="paper.bsdf"`` beside the
+    scene works as it does for ``measured``). A path part of ``DB#NAME`` is resolved alike;
+    inline specs and names the resolver does not find are left as they are."""
+    import mitsuba as mi
+
+    if source.lstrip().startswith("{"):
+        return source
+    resolver = mi.file_resolver() if hasattr(mi, "file_resolver") else (
+        mi.Thread.thread().file_resolver())
+
+    def found(path):
+        r = str(resolver.resolve(path))
+        return r if os.path.exists(r) else None
+
+    whole = found(source)
+    if whole is not None:
+        return whole
+    head, sep, name = source.rpartition("#")
+    if sep and "/" not in name:
+        db = found(head)
+        if db is not None:
+            return f"{db}#{name}"
+    return source
+
+
 class _Common:
     """What both plugin flavours share: properties, flags, description."""
 
     def _init_common(self, props):
         import mitsuba as mi
 
-        src = _prop(props, "source")
+        src, filename = _prop(props, "source"), _prop(props, "filename")
+        if src is not None and filename is not None:
+            raise ValueError("brdftab plugin: give `source` or `filename`, not both")
+        # `filename`: what a scene written for Mitsuba's `measured` says (one word changed).
+        src = str(filename) if filename is not None else src
         if not isinstance(src, str) or not src:
-            raise ValueError("brdftab plugin: the string property `source` is required")
+            raise ValueError(
+                "brdftab plugin: the string property `source` (or `filename`) is required"
+            )
+        src = _resolve(src)
         self.source = src
         self.interp = str(_prop(props, "interp", "auto"))
         self.spectral = mi.is_spectral
