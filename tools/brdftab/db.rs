@@ -69,7 +69,7 @@ pub fn run(a: DbArgs) -> Result<()> {
                 .name
                 .clone()
                 .ok_or_else(|| Error::arg("--name", "db add needs --name NAME"))?;
-            let req = a.bake.request(&a.source).map_err(crate::bake::flag)?;
+            let req = a.bake.request(&a.source)?;
             let target = BakeTarget::Db {
                 path: a.db.clone(),
                 name,

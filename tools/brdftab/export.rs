@@ -6,8 +6,6 @@ use brdftab::store::{Store, db, export, tables};
 use brdftab::{Error, Result};
 use clap::Args;
 
-use crate::bake::flag;
-
 /// Arguments of `brdftab export`.
 #[derive(Args)]
 pub struct ExportArgs {
@@ -95,7 +93,7 @@ pub struct ImportArgs {
 
 /// `brdftab import`.
 pub fn import(a: ImportArgs) -> Result<()> {
-    let info = request::import_npy(&a.array, &a.like, &a.output, &a.settings).map_err(flag)?;
+    let info = request::import_npy(&a.array, &a.like, &a.output, &a.settings)?;
     let t = &info["tables"][0];
     let codec = t["codec"]["quant"].as_str().unwrap_or("?");
     eprintln!("wrote {} ({} values, codec {codec})", a.output, t["values"]);

@@ -77,12 +77,11 @@ fn parse_size(s: &str) -> Result<(usize, usize)> {
 
 fn options(a: &RenderArgs) -> Result<RenderOptions> {
     let (width, height) = parse_size(&a.size)?;
-    let mode = Mode::parse(&a.mode).map_err(|e| flag_named(e, "--mode"))?;
+    let mode = Mode::parse(&a.mode)?;
     let env = EnvChoice::parse(&a.env).map_err(|e| flag_named(e, "--env"))?;
-    let light = LightChoice::parse(&a.light).map_err(|e| flag_named(e, "--light"))?;
+    let light = LightChoice::parse(&a.light)?;
     let default_sampling = if a.compare.is_some() { "fixed" } else { "mis" };
-    let sampling = Sampling::parse(a.sampling.as_deref().unwrap_or(default_sampling))
-        .map_err(|e| flag_named(e, "--sampling"))?;
+    let sampling = Sampling::parse(a.sampling.as_deref().unwrap_or(default_sampling))?;
     Ok(RenderOptions {
         width,
         height,

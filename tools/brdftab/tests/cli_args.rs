@@ -1,0 +1,71 @@
+//! Arguments as the user typed them: errors name flags (`--max-depth`, not `max_depth`), usage
+//! says what is required, negative numbers reach the range checks, and a flag that would do
+//! nothing in the chosen mode is refused rather than ignored.
+
+mod common;
+
+use brdftab::testkit::TempDir;
+use common::{Run, brdftab};
+
+const LAMBERT: &str = r#"{"model": "lambert", "kd": 0.5}"#;
+
+/// Exit 1, `error:` first, no panic, nothing on stdout, and every needle in stderr.
+fn refused(o: &Run, needles: &[&str]) {
+    assert_eq!(o.code, 1, "stderr: {}", o.stderr);
+    assert!(o.stderr.starts_with("error:"), "stderr: {}", o.stderr);
+    assert!(!o.stderr.contains("panicked"), "stderr: {}", o.stderr);
+    assert!(o.stdout.is_empty(), "stdout: {}", o.stdout);
+    for n in needles {
+        assert!(o.stderr.contains(n), "`{n}` not in: {}", o.stderr);
+    }
+}
+
+#[test]
+fn library_argument_errors_name_the_flag_or_value_the_user_typed() {
+    let d = TempDir::new("args-names");
+    let png = d.file("r.png");
+    let render = |extra: &[&str]| {
+        let args = ["render", LAMBERT, "-o", &png, "--size", "8x8"];
+        brdftab(&[&args[..], extra].concat())
+    };
+    // Fields of the preview's options, named by the library as `max_depth`, `spp`, `threads`.
+    refused(&render(&["--max-depth", "0"]), &["`--max-depth`"]);
+    refused(&render(&["--spp", "0"]), &["`--spp`"]);
+    refused(&render(&["--threads", "0"]), &["`--threads`"]);
+    refused(&render(&["--mode", "bogus"]), &["`--mode`"]);
+    // A settings field of a nested subcommand (`db add`).
+    let db = d.file("lib.btdb");
+    let o = brdftab(&[
+        "db",
+        "add",
+        &db,
+        LAMBERT,
+        "--name",
+        "a",
+        "--preset",
+        "small",
+        "--target-error",
+        "1%",
+    ]);
+    refused(&o, &["`--target-error`"]);
+    // A positional value: `convert`'s OUTPUT onto its input.
+    let t = d.file("t.btdb");
+    assert!(brdftab(&["bake", LAMBERT, "-o", &t, "--preset", "small"]).ok);
+    refused(
+        &brdftab(&["convert", &t, &t, "--pairs", "0"]),
+        &["`OUTPUT`", "is the input"],
+    );
+    // `fit`'s model, and an open setting.
+    refused(
+        &brdftab(&["fit", LAMBERT, "--model", "bogus"]),
+        &["`--model`"],
+    );
+    refused(
+        &brdftab(&["eval", LAMBERT, "--interp", "bogus"]),
+        &["`--interp`"],
+    );
+    // `bench --pairs 0` spoke of "repeats", which is no flag.
+    let o = brdftab(&["bench", LAMBERT, "--pairs", "0"]);
+    refused(&o, &["`--pairs`"]);
+    assert!(!o.stderr.contains("repeats"), "{}", o.stderr);
+}
