@@ -15,21 +15,17 @@ use crate::progress::Bar;
 pub struct BakeArgs {
     /// The source: a model spec (inline JSON or .json), a table, a MERL or RGL file.
     pub source: String,
-    /// Output table file (`.btdb`).
+    /// Output table file (`.btdb`), or `DB#NAME`.
     #[arg(short, long)]
-    pub output: Option<String>,
+    pub output: String,
     #[command(flatten)]
     pub settings: BakeSettings,
 }
 
 /// `brdftab bake`.
 pub fn bake(a: BakeArgs) -> Result<()> {
-    let out = a
-        .output
-        .clone()
-        .ok_or_else(|| Error::arg("--output", "an output file is required"))?;
     let codec = a.settings.request(&a.source)?.codec;
-    let r = request::bake(&a.source, &out, &a.settings, &Bar::values())?;
+    let r = request::bake(&a.source, &a.output, &a.settings, &Bar::values())?;
     eprint!("{}", r.summary(&codec));
     Ok(())
 }

@@ -12,7 +12,7 @@ use brdftab_tools::text::print_out;
 #[derive(Args)]
 pub struct BenchArgs {
     /// The source: a table file or a model spec (not with --measured).
-    #[arg(required_unless_present = "measured")]
+    #[arg(required_unless_present = "measured", conflicts_with = "measured")]
     source: Option<String>,
     /// Instead of one source: bake every RGL `.bsdf` file of DIR (default: the shipped
     /// data/rgl) with the defaults and compare each table with the file's own evaluation in

@@ -69,3 +69,34 @@ fn library_argument_errors_name_the_flag_or_value_the_user_typed() {
     refused(&o, &["`--pairs`"]);
     assert!(!o.stderr.contains("repeats"), "{}", o.stderr);
 }
+
+#[test]
+fn usage_says_what_is_required() {
+    let o = brdftab(&["bake", "--help"]);
+    assert!(o.ok, "{}", o.stderr);
+    assert!(
+        o.stdout
+            .contains("Usage: brdftab bake [OPTIONS] --output <OUTPUT> <SOURCE>"),
+        "{}",
+        o.stdout
+    );
+    refused(&brdftab(&["bake", LAMBERT]), &["--output"]);
+    // A database's tables are found by name: `db add` requires one, and its help says so
+    // (it documented a default, a file's stem, that `db add` never used).
+    let o = brdftab(&["db", "add", "--help"]);
+    assert!(o.ok, "{}", o.stderr);
+    assert!(
+        o.stdout
+            .contains("Usage: brdftab db add [OPTIONS] --name <NAME> <DB> <SOURCE>"),
+        "{}",
+        o.stdout
+    );
+    assert!(!o.stdout.contains("stem"), "{}", o.stdout);
+    let d = TempDir::new("args-db-name");
+    let o = brdftab(&["db", "add", &d.file("lib.btdb"), LAMBERT]);
+    refused(&o, &["--name <NAME>"]);
+    // `bench` times SOURCE or, with --measured, the RGL files: not both.
+    let o = brdftab(&["bench", LAMBERT, "--measured", "/no/such/dir"]);
+    refused(&o, &["--measured"]);
+    assert!(o.stderr.contains("cannot be used with"), "{}", o.stderr);
+}
