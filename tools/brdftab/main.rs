@@ -77,9 +77,18 @@ enum Command {
     View(view::ViewArgs),
 }
 
-/// The command line's grammar.
+/// The command line's grammar: the derived one, with every value free to be a negative number
+/// (`--theta-in -10` is a value for the library's range check to answer, not an unknown
+/// flag `-1`), including the flags the library's settings structs derive.
 fn command() -> clap::Command {
-    Cli::command()
+    fn negatives(c: clap::Command) -> clap::Command {
+        let c = c.mut_args(|a| match a.get_action().takes_values() {
+            true => a.allow_negative_numbers(true),
+            false => a,
+        });
+        c.mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
 }
 
 /// The names of the subcommand that ran, outermost first (`["db", "add"]`).

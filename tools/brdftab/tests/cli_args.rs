@@ -100,3 +100,99 @@ fn usage_says_what_is_required() {
     refused(&o, &["--measured"]);
     assert!(o.stderr.contains("cannot be used with"), "{}", o.stderr);
 }
+
+#[test]
+fn negative_numbers_reach_the_range_checks() {
+    let d = TempDir::new("args-negative");
+    let png = d.file("s.png");
+    // clap read `-10` as a flag `-1`: "unexpected argument".
+    let o = brdftab(&[
+        "slice",
+        LAMBERT,
+        "--kind",
+        "polar",
+        "--theta-in",
+        "-10",
+        "-o",
+        &png,
+        "--size",
+        "8",
+    ]);
+    refused(&o, &["`--theta-in`", "above the horizon"]);
+    let o = brdftab(&[
+        "slice", LAMBERT, "--kind", "polar", "--phi-in", "-30", "-o", &png, "--size", "8",
+    ]);
+    assert!(o.ok, "{}", o.stderr);
+    // Flags the library's settings structs derive take them too.
+    let t = d.file("t.btdb");
+    let bake = |extra: &[&str]| {
+        let args = ["bake", LAMBERT, "-o", &t, "--preset", "small"];
+        brdftab(&[&args[..], extra].concat())
+    };
+    refused(&bake(&["--level", "-1"]), &["`--level`", "1..=22"]);
+    refused(
+        &bake(&["--symmetry-tolerance", "-1"]),
+        &["`--symmetry-tolerance`"],
+    );
+}
+
+#[test]
+fn flags_of_another_mode_are_refused_not_ignored() {
+    let d = TempDir::new("args-modes");
+    let png = d.file("x.png");
+    let render = |extra: &[&str]| {
+        let args = ["render", LAMBERT, "-o", &png, "--size", "8x8", "--spp", "1"];
+        brdftab(&[&args[..], extra].concat())
+    };
+    refused(&render(&["--compare-seed", "3"]), &["--compare"]);
+    refused(
+        &render(&["--mode", "lit", "--max-depth", "3"]),
+        &["`--max-depth`", "path"],
+    );
+    // The lit sphere's one bounce does sample (light, BRDF or both): --sampling is used.
+    let o = render(&["--mode", "lit", "--sampling", "brdf"]);
+    assert!(o.ok, "{}", o.stderr);
+    let slice = |extra: &[&str]| {
+        let args = ["slice", LAMBERT, "-o", &png, "--size", "8"];
+        brdftab(&[&args[..], extra].concat())
+    };
+    refused(
+        &slice(&["--kind", "polar", "--phi-d", "30"]),
+        &["`--phi-d`", "halfdiff"],
+    );
+    refused(&slice(&["--theta-in", "30"]), &["`--theta-in`", "polar"]);
+    refused(
+        &slice(&["--kind", "halfdiff", "--phi-in", "30"]),
+        &["`--phi-in`", "polar"],
+    );
+    assert!(slice(&["--kind", "halfdiff", "--phi-d", "30"]).ok);
+    assert!(slice(&["--kind", "polar", "--theta-in", "30", "--phi-in", "10"]).ok);
+}
+
+#[test]
+fn an_exposure_that_is_no_number_is_refused() {
+    // NaN or infinite stops wrote an all-black PNG and succeeded.
+    let d = TempDir::new("args-exposure");
+    let png = d.file("x.png");
+    for x in ["nan", "inf", "-inf"] {
+        let e = format!("--exposure={x}");
+        let o = brdftab(&[
+            "render", LAMBERT, "-o", &png, "--size", "8x8", "--spp", "1", &e,
+        ]);
+        refused(&o, &["`--exposure`"]);
+        assert!(!std::path::Path::new(&png).exists(), "{x}: written");
+    }
+    let o = brdftab(&[
+        "render",
+        LAMBERT,
+        "-o",
+        &png,
+        "--size",
+        "8x8",
+        "--spp",
+        "1",
+        "--exposure",
+        "-2",
+    ]);
+    assert!(o.ok, "{}", o.stderr);
+}
