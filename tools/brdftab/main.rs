@@ -12,6 +12,7 @@ mod demo_extra;
 mod export;
 mod fit;
 mod models;
+mod output;
 mod progress;
 mod render;
 mod sample;

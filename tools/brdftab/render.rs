@@ -139,6 +139,8 @@ fn diff_path(out: &Path) -> PathBuf {
 
 /// Runs `brdftab render`.
 pub fn run(a: RenderArgs) -> Result<()> {
+    // An output the render could not be written to is refused before the render.
+    crate::output::check(&a.output, "--output", &["png", "exr"])?;
     let opts = options(&a)?;
     let brdf = brdftab::request::open(&a.source, &a.open)?;
     let img = render_one(brdf.as_ref(), &opts, &a.source)?;

@@ -1,0 +1,102 @@
+//! What the CLI writes: output paths checked before any work, and `export`'s flags.
+
+mod common;
+
+use brdftab::testkit::TempDir;
+use common::{Run, brdftab};
+
+const LAMBERT: &str = r#"{"model": "lambert", "kd": 0.5}"#;
+
+/// Exit 1, `error:` first, no panic, nothing on stdout, and every needle in stderr.
+fn refused(o: &Run, needles: &[&str]) {
+    assert_eq!(o.code, 1, "stderr: {}", o.stderr);
+    assert!(o.stderr.starts_with("error:"), "stderr: {}", o.stderr);
+    assert!(!o.stderr.contains("panicked"), "stderr: {}", o.stderr);
+    assert!(o.stdout.is_empty(), "stdout: {}", o.stdout);
+    for n in needles {
+        assert!(o.stderr.contains(n), "`{n}` not in: {}", o.stderr);
+    }
+}
+
+#[test]
+fn outputs_are_checked_before_the_work() {
+    let d = TempDir::new("io-outputs");
+    let gone = d.join("no-such-dir");
+    let gone = gone.to_str().unwrap();
+    // `render` printed its timing (it had rendered) and only then refused the extension.
+    let jpg = d.file("a.jpg");
+    let o = brdftab(&["render", LAMBERT, "-o", &jpg, "--size", "8x8", "--spp", "1"]);
+    refused(&o, &["`--output`", ".png or .exr"]);
+    assert!(!o.stderr.contains(" spp in "), "rendered: {}", o.stderr);
+    let png = format!("{gone}/a.png");
+    let o = brdftab(&["render", LAMBERT, "-o", &png, "--size", "8x8", "--spp", "1"]);
+    refused(&o, &["`--output`", gone, "does not exist"]);
+    assert!(!o.stderr.contains(" spp in "), "rendered: {}", o.stderr);
+    // `slice` named the library's `output`.
+    let o = brdftab(&["slice", LAMBERT, "-o", &jpg, "--size", "8"]);
+    refused(&o, &["`--output`", ".exr or .png"]);
+    refused(
+        &brdftab(&["slice", LAMBERT, "-o", &png, "--size", "8"]),
+        &["`--output`", "does not exist"],
+    );
+    // `export` wrote the .npy and then failed on the --exr's directory.
+    let t = d.file("t.btdb");
+    assert!(brdftab(&["bake", LAMBERT, "-o", &t, "--preset", "small"]).ok);
+    let npy = d.file("t.npy");
+    let exr = format!("{gone}/t.exr");
+    let o = brdftab(&["export", &t, "--npy", &npy, "--exr", &exr, "--slice", "0,2"]);
+    refused(&o, &["`--exr`", "does not exist"]);
+    assert!(!std::path::Path::new(&npy).exists(), "the .npy was written");
+}
+
+#[test]
+fn export_flags_agree_with_what_export_does() {
+    let d = TempDir::new("io-export");
+    let t = d.file("t.btdb");
+    assert!(brdftab(&["bake", LAMBERT, "-o", &t, "--preset", "small"]).ok);
+    // EXR bytes went into a .png.
+    let png = d.file("a.png");
+    refused(
+        &brdftab(&["export", &t, "--exr", &png, "--slice", "0,2"]),
+        &["`--exr`", ".exr"],
+    );
+    assert!(!std::path::Path::new(&png).exists());
+    // --slice (and --half) are the EXR's: with --npy alone they did nothing.
+    let npy = d.file("a.npy");
+    refused(
+        &brdftab(&["export", &t, "--npy", &npy, "--slice", "0,2"]),
+        &["--exr"],
+    );
+    refused(
+        &brdftab(&["export", &t, "--npy", &npy, "--half"]),
+        &["--exr"],
+    );
+    assert!(!std::path::Path::new(&npy).exists());
+    // The fixed indices are one per stored axis (four here); fewer were padded with zeros.
+    let exr = d.file("a.exr");
+    for bad in ["0,2:1", "0,2:0,0,0", "0,2:0,0,0,0,0"] {
+        refused(
+            &brdftab(&["export", &t, "--exr", &exr, "--slice", bad]),
+            &["`--slice`", "of the 4 indices"],
+        );
+    }
+    for good in ["0,2", "0,2:0,0,0,0", "2,0:9,0,9,0"] {
+        let o = brdftab(&["export", &t, "--exr", &exr, "--slice", good]);
+        assert!(o.ok, "{good}: {}", o.stderr);
+    }
+    let o = brdftab(&["export", "--help"]);
+    assert!(
+        o.stdout.contains("an index for every stored axis"),
+        "{}",
+        o.stdout
+    );
+    // A table that is itself the --npy output: the refusal names the flag, not `output`.
+    let same = d.file("same.npy");
+    std::fs::copy(&t, &same).unwrap();
+    refused(
+        &brdftab(&["export", &same, "--npy", &same]),
+        &["`--npy`", "is the input"],
+    );
+    // The .npy of a table needs a .npy name too.
+    refused(&brdftab(&["export", &t, "--npy", &t]), &["`--npy`", ".npy"]);
+}
