@@ -63,7 +63,7 @@ fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
         let _ = writeln!(o, "{}", measured::markdown(&rows));
         let _ = writeln!(
             o,
-            "error: relative RMSE of f_r cos θi cos θo, both directions within 80°, {} pairs; \
+            "columns: error is the relative RMSE of f_r cos θi cos θo, both directions within 80°, {} pairs; \
              ns: wall time per lookup on one thread, median of {} rounds each timing the native \
              evaluation then the table on the same pairs (speedup: median of the per-round \
              ratios); batch: eval_batch lookups per second of CPU time",

@@ -196,3 +196,28 @@ fn an_exposure_that_is_no_number_is_refused() {
     ]);
     assert!(o.ok, "{}", o.stderr);
 }
+
+#[test]
+fn bench_measured_prints_no_line_that_looks_like_an_error() {
+    // Its column legend began `error: relative RMSE ...`, the CLI's error format.
+    let rgl = brdftab::measured::data::rgl_dir().expect("data/rgl ships");
+    let d = TempDir::new("args-bench");
+    std::fs::copy(
+        rgl.join("paper_white_rgb.bsdf"),
+        d.join("paper_white_rgb.bsdf"),
+    )
+    .unwrap();
+    let dir = d.path().to_str().unwrap();
+    let o = brdftab(&["bench", "--measured", dir, "--pairs", "1000"]);
+    assert!(o.ok, "{}", o.stderr);
+    assert!(o.stdout.contains("paper_white_rgb"), "{}", o.stdout);
+    assert!(
+        !o.stdout.lines().any(|l| l.starts_with("error")),
+        "{}",
+        o.stdout
+    );
+    refused(
+        &brdftab(&["bench", "--measured", dir, "--pairs", "3"]),
+        &["`--pairs`"],
+    );
+}
