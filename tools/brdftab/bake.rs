@@ -1,6 +1,7 @@
 //! `bake`, and the bake settings `convert` and `db add` share: the library's
 //! [`brdftab::request::BakeSettings`] as flags, so a flag is the field of the same
-//! name in Python and in the C ABI's JSON, and the library makes every decision.
+//! name in Python and in the C ABI's JSON, and the library makes every decision. The library's
+//! argument errors name the field (`target_error`); `main` names the flag (`--target-error`).
 
 use brdftab::bake::{BakeReport, BakeRequest, BakeTarget};
 use brdftab::request::{self, BakeSettings};
@@ -9,50 +10,29 @@ use clap::Args;
 
 use crate::progress::Bar;
 
-/// Names the CLI flag in an argument error of the library, which names the settings field
-/// (`target_error` → `--target-error`) or `like`; errors naming anything else pass unchanged.
-pub fn flag(e: Error) -> Error {
-    let fields: Vec<String> = [
-        request::field_names::<request::ConvertSettings>(),
-        request::field_names::<request::FitSettings>(),
-        request::field_names::<request::OpenSettings>(),
-    ]
-    .concat();
-    match e {
-        Error::InvalidArgument { name, msg } if fields.contains(&name) || name == "like" => {
-            Error::arg(format!("--{}", name.replace('_', "-")), msg)
-        }
-        e => e,
-    }
-}
-
 /// Arguments of `brdftab bake`.
 #[derive(Args)]
 pub struct BakeArgs {
     /// The source: a model spec (inline JSON or .json), a table, a MERL or RGL file.
     pub source: String,
-    /// Output table file (`.btdb`).
+    /// Output table file (`.btdb`), or `DB#NAME`.
     #[arg(short, long)]
-    pub output: Option<String>,
+    pub output: String,
     #[command(flatten)]
     pub settings: BakeSettings,
 }
 
 /// `brdftab bake`.
 pub fn bake(a: BakeArgs) -> Result<()> {
-    let out = a
-        .output
-        .clone()
-        .ok_or_else(|| Error::arg("--output", "an output file is required"))?;
-    let codec = a.settings.request(&a.source).map_err(flag)?.codec;
-    let r = request::bake(&a.source, &out, &a.settings, &Bar::values()).map_err(flag)?;
+    let codec = a.settings.request(&a.source)?.codec;
+    let r = request::bake(&a.source, &a.output, &a.settings, &Bar::values())?;
     eprint!("{}", r.summary(&codec));
     Ok(())
 }
 
 /// Runs a request with a progress bar and prints what it did on stderr.
 pub fn run(req: &BakeRequest, target: &BakeTarget) -> Result<BakeReport> {
-    let r = req.run_with(target, &Bar::values()).map_err(flag)?;
+    let r = req.run_with(target, &Bar::values())?;
     eprint!("{}", r.summary(&req.codec));
     Ok(r)
 }

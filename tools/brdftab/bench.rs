@@ -2,18 +2,17 @@
 
 use std::fmt::Write as _;
 
-use brdftab::Result;
 use brdftab::analysis::timing;
+use brdftab::{Error, Result};
 use clap::Args;
 
-use crate::bake::flag_named;
 use brdftab_tools::text::print_out;
 
 /// Arguments of `brdftab bench`.
 #[derive(Args)]
 pub struct BenchArgs {
     /// The source: a table file or a model spec (not with --measured).
-    #[arg(required_unless_present = "measured")]
+    #[arg(required_unless_present = "measured", conflicts_with = "measured")]
     source: Option<String>,
     /// Instead of one source: bake every RGL `.bsdf` file of DIR (default: the shipped
     /// data/rgl) with the defaults and compare each table with the file's own evaluation in
@@ -35,13 +34,17 @@ fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
     use brdftab_tools::report::measured;
     let dir = match dir {
         "" => brdftab::measured::data::rgl_dir().ok_or_else(|| {
-            brdftab::Error::NotFound(format!(
+            Error::NotFound(format!(
                 "no RGL directory (searched {:?})",
                 brdftab::measured::data::rgl_dirs()
             ))
         })?,
         d => std::path::PathBuf::from(d),
     };
+    // The native file is timed on a quarter of the pairs.
+    if a.pairs < 4 {
+        return Err(Error::arg("--pairs", "must be at least 4 with --measured"));
+    }
     let files = measured::rgl_files(&dir)?;
     let opts = measured::MeasuredOptions {
         timing_pairs: a.pairs,
@@ -60,7 +63,7 @@ fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
         let _ = writeln!(o, "{}", measured::markdown(&rows));
         let _ = writeln!(
             o,
-            "error: relative RMSE of f_r cos θi cos θo, both directions within 80°, {} pairs; \
+            "columns: error is the relative RMSE of f_r cos θi cos θo, both directions within 80°, {} pairs; \
              ns: wall time per lookup on one thread, median of {} rounds each timing the native \
              evaluation then the table on the same pairs (speedup: median of the per-round \
              ratios); batch: eval_batch lookups per second of CPU time",
@@ -82,12 +85,16 @@ fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
 
 /// `brdftab bench`.
 pub fn bench(a: BenchArgs) -> Result<()> {
+    // The library's check says "pairs and repeats": repeats is no flag here.
+    if a.pairs == 0 {
+        return Err(Error::arg("--pairs", "must be at least 1"));
+    }
     if let Some(d) = &a.measured {
         return measured(d, &a);
     }
     let interp = a.open.interp.as_deref().unwrap_or("auto");
     let src = brdftab::request::open(a.source.as_deref().unwrap_or_default(), &a.open)?;
-    let t = timing::lookups(src.as_ref(), a.pairs, 5).map_err(|e| flag_named(e, "--pairs"))?;
+    let t = timing::lookups(src.as_ref(), a.pairs, 5)?;
     let mut o = String::new();
     if a.json {
         let mut v = serde_json::to_value(&t).unwrap_or_default();

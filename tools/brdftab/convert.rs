@@ -5,7 +5,6 @@ use brdftab::Result;
 use brdftab::request::{self, ConvertOutput, ConvertSettings};
 use clap::Args;
 
-use crate::bake::flag;
 use crate::progress::Bar;
 use brdftab_tools::outln;
 
@@ -24,7 +23,7 @@ pub struct ConvertArgs {
 
 /// Converts between formats and prints what was written.
 pub fn convert(a: ConvertArgs) -> Result<()> {
-    match request::convert(&a.input, &a.output, &a.settings, &Bar::values()).map_err(flag)? {
+    match request::convert(&a.input, &a.output, &a.settings, &Bar::values())? {
         ConvertOutput::Merl(r) => outln!(
             "{}: {} resampled on the MERL grid (means over 90 × 90 × 180 cells) in {:.2} s",
             r.output,

@@ -27,7 +27,13 @@ enum DbCommand {
     Verify(VerifyArgs),
 }
 
+/// A table of a database is found by its name, so `db add` takes one: the bake settings'
+/// `--name` (whose default, a file's stem, would name every table of DB alike) is required.
 #[derive(Args)]
+#[command(mut_arg("name", |a| a
+    .required(true)
+    .help("Table name inside the database (required)")
+    .long_help(None::<&str>)))]
 struct AddArgs {
     /// The database file.
     db: String,
@@ -69,7 +75,7 @@ pub fn run(a: DbArgs) -> Result<()> {
                 .name
                 .clone()
                 .ok_or_else(|| Error::arg("--name", "db add needs --name NAME"))?;
-            let req = a.bake.request(&a.source).map_err(crate::bake::flag)?;
+            let req = a.bake.request(&a.source)?;
             let target = BakeTarget::Db {
                 path: a.db.clone(),
                 name,

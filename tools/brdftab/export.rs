@@ -6,8 +6,6 @@ use brdftab::store::{Store, db, export, tables};
 use brdftab::{Error, Result};
 use clap::Args;
 
-use crate::bake::flag;
-
 /// Arguments of `brdftab export`.
 #[derive(Args)]
 pub struct ExportArgs {
@@ -17,14 +15,16 @@ pub struct ExportArgs {
     /// quantity as `info` names it (f_r, f_r cos θo or f_r cos θi cos θo; before a calibration).
     #[arg(long)]
     npy: Option<String>,
-    /// Write a 2D slice as OpenEXR (channels as EXR channels).
+    /// Write a 2D slice as OpenEXR (channels as EXR channels): a `.exr` file.
     #[arg(long, requires = "slice")]
     exr: Option<String>,
-    /// The slice: `X,Y[:i0,i1,i2,i3]` — stored axes along x and y, fixed indices of the others.
-    #[arg(long)]
+    /// The --exr slice: `X,Y[:I0,I1,I2,I3]` — the stored axes along x and y, then an index for
+    /// every stored axis (as many as `info` lists before the channels; those at X and Y are
+    /// ignored); without them, the others at index 0.
+    #[arg(long, requires = "exr")]
     slice: Option<String>,
     /// Write EXR channels as half floats instead of f32.
-    #[arg(long)]
+    #[arg(long, requires = "exr")]
     half: bool,
 }
 
@@ -35,6 +35,13 @@ pub fn run(a: ExportArgs) -> Result<()> {
             "--npy/--exr",
             "give --npy OUT and/or --exr OUT --slice ...",
         ));
+    }
+    // Every output is checked before anything is written.
+    if let Some(out) = &a.npy {
+        crate::output::check(out, "--npy", &["npy"])?;
+    }
+    if let Some(out) = &a.exr {
+        crate::output::check(out, "--exr", &["exr"])?;
     }
     let (path, name) = db::split_source(&a.file)?;
     let s = Store::open(path)?;
@@ -60,20 +67,49 @@ pub fn run(a: ExportArgs) -> Result<()> {
         Some(g) => g.quantity().name().to_owned(),
         None => "fr".to_owned(),
     };
+    let axes = t.header().shape.len().saturating_sub(1);
+    let sl = match &a.slice {
+        Some(s) => Some(slice(s, axes)?),
+        None => None,
+    };
     if let Some(out) = &a.npy {
-        export::npy(&t, out, off_ref)?;
+        export::npy(&t, out, off_ref).map_err(|e| named(e, "--npy"))?;
         eprintln!(
             "wrote {out} (shape {:?}, float32; stored values: {stored})",
             t.header().shape
         );
     }
-    if let Some(out) = &a.exr {
-        let axes = t.header().shape.len().saturating_sub(1);
-        let sl = export::Slice::parse(a.slice.as_deref().unwrap_or(""), axes)?;
-        export::exr(&t, &sl, off_ref, out, a.half)?;
+    if let (Some(out), Some(sl)) = (&a.exr, &sl) {
+        export::exr(&t, sl, off_ref, out, a.half).map_err(|e| named(e, "--exr"))?;
         eprintln!("wrote {out} (stored values: {stored})");
     }
     Ok(())
+}
+
+/// The library names the file it writes `output`: here that is the flag that gave it.
+fn named(e: Error, flag: &str) -> Error {
+    match e {
+        Error::InvalidArgument { name, msg } if name == "output" => Error::arg(flag, msg),
+        e => e,
+    }
+}
+
+/// `--slice X,Y[:I0,..]` for a table of `axes` stored axes: the fixed indices, when given, are
+/// one per axis (the library pads a shorter list with zeros, which hid a miscount).
+fn slice(s: &str, axes: usize) -> Result<export::Slice> {
+    if let Some((_, fixed)) = s.split_once(':') {
+        let n = fixed.split(',').count();
+        if n != axes {
+            return Err(Error::arg(
+                "--slice",
+                format!(
+                    "`{s}` gives {n} of the {axes} indices after `:`: one for every stored axis \
+                     (those at X and Y are ignored), or none for index 0 on the others"
+                ),
+            ));
+        }
+    }
+    export::Slice::parse(s, axes)
 }
 
 /// Arguments of `brdftab import`.
@@ -95,7 +131,7 @@ pub struct ImportArgs {
 
 /// `brdftab import`.
 pub fn import(a: ImportArgs) -> Result<()> {
-    let info = request::import_npy(&a.array, &a.like, &a.output, &a.settings).map_err(flag)?;
+    let info = request::import_npy(&a.array, &a.like, &a.output, &a.settings)?;
     let t = &info["tables"][0];
     let codec = t["codec"]["quant"].as_str().unwrap_or("?");
     eprintln!("wrote {} ({} values, codec {codec})", a.output, t["values"]);

@@ -12,6 +12,7 @@ mod demo_extra;
 mod export;
 mod fit;
 mod models;
+mod output;
 mod progress;
 mod render;
 mod sample;
@@ -23,7 +24,7 @@ mod table;
 #[path = "view.rs"]
 mod view;
 
-use clap::{Parser, Subcommand};
+use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 /// Tabulated BRDFs: analytic models, dense compressed tables, measured data.
@@ -77,10 +78,67 @@ enum Command {
     View(view::ViewArgs),
 }
 
+/// The command line's grammar: the derived one, with every value free to be a negative number
+/// (`--theta-in -10` is a value for the library's range check to answer, not an unknown
+/// flag `-1`), including the flags the library's settings structs derive.
+fn command() -> clap::Command {
+    fn negatives(c: clap::Command) -> clap::Command {
+        let c = c.mut_args(|a| match a.get_action().takes_values() {
+            true => a.allow_negative_numbers(true),
+            false => a,
+        });
+        c.mut_subcommands(negatives)
+    }
+    negatives(Cli::command())
+}
+
+/// The names of the subcommand that ran, outermost first (`["db", "add"]`).
+fn subcommand_path(m: &ArgMatches) -> Vec<String> {
+    let mut path = Vec::new();
+    let mut m = m;
+    while let Some((name, sub)) = m.subcommand() {
+        path.push(name.to_owned());
+        m = sub;
+    }
+    path
+}
+
+/// An argument error of the library names a request field (`max_depth`) or a value
+/// (`source`); when that is the id of an argument of the subcommand that ran, it is named as
+/// the user typed it: its flag (`--max-depth`) or its value name (`SOURCE`). Other names pass
+/// unchanged.
+fn as_typed(e: brdftab::Error, path: &[String]) -> brdftab::Error {
+    let brdftab::Error::InvalidArgument { name, msg } = e else {
+        return e;
+    };
+    let cmd = command();
+    let mut sub = &cmd;
+    for p in path {
+        match sub.find_subcommand(p) {
+            Some(s) => sub = s,
+            None => return brdftab::Error::InvalidArgument { name, msg },
+        }
+    }
+    let name = match sub.get_arguments().find(|a| a.get_id() == name.as_str()) {
+        Some(a) => match (a.get_long(), a.get_value_names()) {
+            (Some(long), _) => format!("--{long}"),
+            (None, Some([v, ..])) => v.to_string(),
+            (None, _) => a.get_id().as_str().to_uppercase(),
+        },
+        None => name,
+    };
+    brdftab::Error::InvalidArgument { name, msg }
+}
+
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
-        Ok(cli) => cli,
+    let mut matches = match command().try_get_matches() {
+        Ok(m) => m,
         Err(e) => return clap_exit(e),
+    };
+    let path = subcommand_path(&matches);
+    let cli = match Cli::from_arg_matches_mut(&mut matches) {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(e.format(&mut command())),
     };
     let result = match cli.command {
         Command::Eval(a) => models::eval(a),
@@ -112,6 +170,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
+            let e = as_typed(e, &path);
             eprintln!("error: {e}{}", hint(&e));
             ExitCode::from(1)
         }

@@ -30,9 +30,9 @@ pub struct RenderArgs {
     /// `path` (full path tracing) or `lit` (direct lighting only, fast).
     #[arg(long, default_value = "path")]
     mode: String,
-    /// Maximum path length in bounces (path mode).
-    #[arg(long, default_value_t = 8)]
-    max_depth: usize,
+    /// Maximum path length in bounces (path mode; default 8).
+    #[arg(long)]
+    max_depth: Option<usize>,
     /// Environment: `sky` (smooth procedural), `white` (constant 1, the furnace), `none`, or a
     /// lat-long FILE.exr (z up: row 0 = zenith).
     #[arg(long, default_value = "sky")]
@@ -58,7 +58,7 @@ pub struct RenderArgs {
     compare: Option<String>,
     /// Seed for the --compare render (default: the same seed). Comparing a SOURCE with itself
     /// under another seed measures the noise floor.
-    #[arg(long)]
+    #[arg(long, requires = "compare")]
     compare_seed: Option<u64>,
     #[command(flatten)]
     open: brdftab::request::OpenSettings,
@@ -77,18 +77,31 @@ fn parse_size(s: &str) -> Result<(usize, usize)> {
 
 fn options(a: &RenderArgs) -> Result<RenderOptions> {
     let (width, height) = parse_size(&a.size)?;
-    let mode = Mode::parse(&a.mode).map_err(|e| flag_named(e, "--mode"))?;
+    let mode = Mode::parse(&a.mode)?;
+    // The lit sphere is one bounce whatever the flag says.
+    if mode == Mode::Lit && a.max_depth.is_some() {
+        return Err(Error::arg(
+            "--max-depth",
+            "is for --mode path (lit is one bounce)",
+        ));
+    }
+    // A NaN or infinite exposure wrote an all-black PNG.
+    if !a.exposure.is_finite() {
+        return Err(Error::arg(
+            "--exposure",
+            format!("{} is not a number of stops", a.exposure),
+        ));
+    }
     let env = EnvChoice::parse(&a.env).map_err(|e| flag_named(e, "--env"))?;
-    let light = LightChoice::parse(&a.light).map_err(|e| flag_named(e, "--light"))?;
+    let light = LightChoice::parse(&a.light)?;
     let default_sampling = if a.compare.is_some() { "fixed" } else { "mis" };
-    let sampling = Sampling::parse(a.sampling.as_deref().unwrap_or(default_sampling))
-        .map_err(|e| flag_named(e, "--sampling"))?;
+    let sampling = Sampling::parse(a.sampling.as_deref().unwrap_or(default_sampling))?;
     Ok(RenderOptions {
         width,
         height,
         spp: a.spp,
         seed: a.seed,
-        max_depth: a.max_depth,
+        max_depth: a.max_depth.unwrap_or(8),
         mode,
         sampling,
         env,
@@ -126,6 +139,8 @@ fn diff_path(out: &Path) -> PathBuf {
 
 /// Runs `brdftab render`.
 pub fn run(a: RenderArgs) -> Result<()> {
+    // An output the render could not be written to is refused before the render.
+    crate::output::check(&a.output, "--output", &["png", "exr"])?;
     let opts = options(&a)?;
     let brdf = brdftab::request::open(&a.source, &a.open)?;
     let img = render_one(brdf.as_ref(), &opts, &a.source)?;

@@ -25,15 +25,15 @@ pub struct SliceArgs {
     /// Which slice.
     #[arg(long, value_enum, default_value = "halfdiff")]
     kind: SliceKind,
-    /// Incident polar angle in degrees (polar slice).
-    #[arg(long, default_value_t = 45.0)]
-    theta_in: f64,
-    /// Incident azimuth in degrees (polar slice).
-    #[arg(long, default_value_t = 0.0)]
-    phi_in: f64,
-    /// Difference azimuth φd in degrees (halfdiff slice).
-    #[arg(long, default_value_t = 90.0)]
-    phi_d: f64,
+    /// Incident polar angle in degrees (polar slice; default 45).
+    #[arg(long)]
+    theta_in: Option<f64>,
+    /// Incident azimuth in degrees (polar slice; default 0).
+    #[arg(long)]
+    phi_in: Option<f64>,
+    /// Difference azimuth φd in degrees (halfdiff slice; default 90).
+    #[arg(long)]
+    phi_d: Option<f64>,
     /// Channel to show in PNGs (and grey EXRs): a name (R, G, B, 550nm) or index; default
     /// luminance for RGB, the channel mean otherwise.
     #[arg(long)]
@@ -45,10 +45,38 @@ pub struct SliceArgs {
     open: brdftab::request::OpenSettings,
 }
 
+/// Refuses the angles of the other kind of slice, which this one would ignore.
+fn refuse_other_kind(a: &SliceArgs) -> Result<()> {
+    let (other, kind): (&[(&str, Option<f64>)], &str) = match a.kind {
+        SliceKind::Halfdiff => (
+            &[("--theta-in", a.theta_in), ("--phi-in", a.phi_in)],
+            "polar",
+        ),
+        SliceKind::Polar => (&[("--phi-d", a.phi_d)], "halfdiff"),
+    };
+    match other.iter().find(|(_, x)| x.is_some()) {
+        Some((flag, _)) => Err(Error::arg(
+            *flag,
+            format!("is for --kind {kind} slices only"),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Renders a slice image.
 pub fn slice(a: SliceArgs) -> Result<()> {
     if a.size == 0 || a.size > 8192 {
         return Err(Error::arg("--size", "must be 1..=8192"));
+    }
+    crate::output::check(&a.output, "--output", &["exr", "png"])?;
+    refuse_other_kind(&a)?;
+    let (theta_in, phi_in) = (a.theta_in.unwrap_or(45.0), a.phi_in.unwrap_or(0.0));
+    let phi_d = a.phi_d.unwrap_or(90.0);
+    // An angle that is not a number drew an all-black image.
+    for (flag, x) in [("--phi-in", phi_in), ("--phi-d", phi_d)] {
+        if !x.is_finite() {
+            return Err(Error::arg(flag, format!("{x} is not an angle")));
+        }
     }
     let brdf = brdftab::request::open(&a.source, &a.open)?;
     let names = brdf.channels().names();
@@ -64,25 +92,18 @@ pub fn slice(a: SliceArgs) -> Result<()> {
                 })?,
         ),
     };
-    // An angle that is not a number drew an all-black image.
-    for (flag, x) in [("--phi-in", a.phi_in), ("--phi-d", a.phi_d)] {
-        if !x.is_finite() {
-            return Err(Error::arg(flag, format!("{x} is not an angle")));
-        }
-    }
     let img = match a.kind {
-        SliceKind::Halfdiff => slice::halfdiff(&*brdf, a.size, a.phi_d.to_radians()),
+        SliceKind::Halfdiff => slice::halfdiff(&*brdf, a.size, phi_d.to_radians()),
         SliceKind::Polar => {
-            let wi =
-                slice::incident(a.theta_in.to_radians(), a.phi_in.to_radians()).map_err(|_| {
-                    Error::arg(
-                        "--theta-in",
-                        format!(
-                            "{}° is outside [0°, 90°): the light must be above the horizon",
-                            a.theta_in
-                        ),
-                    )
-                })?;
+            let wi = slice::incident(theta_in.to_radians(), phi_in.to_radians()).map_err(|_| {
+                Error::arg(
+                    "--theta-in",
+                    format!(
+                        "{}° is outside [0°, 90°): the light must be above the horizon",
+                        theta_in
+                    ),
+                )
+            })?;
             slice::polar(&*brdf, a.size, wi)
         }
     };
@@ -92,16 +113,16 @@ pub fn slice(a: SliceArgs) -> Result<()> {
         // An isotropic BRDF is the same at every φh; an anisotropic one shows its φh = 0 slice.
         SliceKind::Halfdiff if brdf.flags().isotropic => format!(
             "f_r, x = θh 0..90°, y = θd 0..90° (top to bottom), φd = {}°",
-            a.phi_d
+            phi_d
         ),
         SliceKind::Halfdiff => format!(
             "f_r, x = θh 0..90°, y = θd 0..90° (top to bottom), φd = {}°, φh = 0° (anisotropic: \
              the half vector in the x–z plane)",
-            a.phi_d
+            phi_d
         ),
         SliceKind::Polar => format!(
             "f_r·cos θo over the outgoing hemisphere (radius ∝ θo, +x right, +y up), θi = {}°, φi = {}°",
-            a.theta_in, a.phi_in
+            theta_in, phi_in
         ),
     };
     let legend = slice::write(&img, channel, &a.output)?;

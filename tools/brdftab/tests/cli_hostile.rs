@@ -161,8 +161,9 @@ fn an_output_that_is_the_input_is_refused_and_the_input_kept() {
     let before = std::fs::read(&good).unwrap();
     let r = brdftab(&["bake", s(&good), "-o", s(&good)]);
     assert!(!r.ok && r.stderr.contains("is the input"), "{}", r.stderr);
+    // (a .btdb is no .npy name; a table named `.npy` onto itself: cli_inputs_outputs.rs)
     let r = brdftab(&["export", s(&good), "--npy", s(&good)]);
-    assert!(!r.ok && r.stderr.contains("is the input"), "{}", r.stderr);
+    assert!(!r.ok && r.stderr.contains("`--npy`"), "{}", r.stderr);
     assert_eq!(std::fs::read(&good).unwrap(), before);
     // Another entry of the database the source reads is fine.
     let db = d.join("lib.btdb");
@@ -280,25 +281,6 @@ fn errors_quote_huge_inputs_in_part() {
         "a {} byte error",
         r.stderr.len()
     );
-}
-
-#[test]
-fn nan_directions_give_zero() {
-    let d = TempDir::new("hostile-nan");
-    let (good, _) = good_and_bad(d.path());
-    let rgl = brdftab::measured::data::rgl_dir().expect("data/rgl ships");
-    let paper = rgl.join("paper_white_rgb.bsdf");
-    for src in [CT, s(&good), s(&paper)] {
-        let r = brdftab_with_stdin(
-            &["eval", src],
-            "nan 0 1 0 0 1\n0 0 1 0 inf 1\n0 0 0 0 0 1\n",
-        );
-        assert!(r.ok, "{src}: {}", r.stderr);
-        assert_eq!(r.stdout, "0e0 0e0 0e0\n".repeat(3), "{src}");
-        let r = brdftab_with_stdin(&["pdf", src], "nan 0 1 0 0 1\n0 0 1 0 0 NaN\n");
-        assert!(r.ok, "{src}: {}", r.stderr);
-        assert_eq!(r.stdout, "0\n0\n", "{src}");
-    }
 }
 
 /// A reader that went away (`brdftab models | head -1`) ends the command quietly with status 0:

@@ -1,0 +1,48 @@
+//! Output paths checked before any work: a render, a slice or an export that could not be
+//! written (a wrong extension, a missing directory) is refused at once, not after the work.
+
+use std::path::Path;
+
+use brdftab::{Error, Result};
+
+/// Refuses `path` (given as `flag`) unless it ends in one of `exts` (lowercase, no dot; any
+/// case matches) and its directory exists.
+pub fn check(path: impl AsRef<Path>, flag: &str, exts: &[&str]) -> Result<()> {
+    let path = path.as_ref();
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if !exts.iter().any(|e| ext.as_deref() == Some(*e)) {
+        let list: Vec<String> = exts.iter().map(|e| format!(".{e}")).collect();
+        return Err(Error::arg(
+            flag,
+            format!("{} must end in {}", path.display(), list.join(" or ")),
+        ));
+    }
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => Err(Error::arg(
+            flag,
+            format!(
+                "{}: directory {} does not exist",
+                path.display(),
+                dir.display()
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extension_and_directory() {
+        assert!(check("a.PNG", "-o", &["png", "exr"]).is_ok());
+        assert!(check("a.jpg", "-o", &["png", "exr"]).is_err());
+        assert!(check("a", "-o", &["exr"]).is_err());
+        assert!(check("/no/such/dir/a.exr", "-o", &["exr"]).is_err());
+        let e = check("a.png", "--exr", &["exr"]).unwrap_err().to_string();
+        assert!(e.contains("--exr") && e.contains(".exr"), "{e}");
+    }
+}
