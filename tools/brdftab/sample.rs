@@ -7,8 +7,7 @@
 //! the lobe's reflectance (over that probability) as weight; `--delta` adds a last column, 1
 //! for such a draw and 0 for a smooth one.
 //! Draws for which the sampler returns no direction (e.g. `wo` below the horizon) print nothing, so
-//! fewer than `--count` lines may appear. A `--wo` that is no direction (NaN, infinite, zero)
-//! is an error, as such lines of `eval` and `pdf` are ([`brdftab_tools::text`]).
+//! fewer than `--count` lines may appear.
 
 use std::io::Write;
 
@@ -54,22 +53,12 @@ fn parse_wo(s: &str) -> Result<DVec3> {
         .map(|x| x.trim().parse::<f64>())
         .collect::<std::result::Result<_, _>>()
         .map_err(|_| Error::arg("--wo", format!("`{s}`: expected X,Y,Z")))?;
-    let wo = match v[..] {
-        [x, y, z] => DVec3::new(x, y, z),
-        _ => {
-            return Err(Error::arg(
-                "--wo",
-                format!("`{s}`: expected 3 numbers X,Y,Z"),
-            ));
-        }
-    };
-    // The sampler draws nothing for NaN or zero: `sample` printed no line and succeeded.
-    if !wo.is_finite() {
-        return Err(Error::arg("--wo", format!("`{s}`: not finite numbers")));
-    }
-    match brdftab_tools::text::not_a_direction(wo) {
-        Some(why) => Err(Error::arg("--wo", format!("`{s}` {why}"))),
-        None => Ok(wo),
+    match v[..] {
+        [x, y, z] => Ok(DVec3::new(x, y, z)),
+        _ => Err(Error::arg(
+            "--wo",
+            format!("`{s}`: expected 3 numbers X,Y,Z"),
+        )),
     }
 }
 
@@ -79,8 +68,8 @@ fn out_err(e: std::io::Error) -> Error {
 
 /// Draws `count` directions for `wo` and prints `wix wiy wiz pdf w_1 .. w_c`.
 pub fn sample(a: SampleArgs) -> Result<()> {
-    let wo = parse_wo(&a.wo)?;
     let brdf = brdftab::request::open(&a.source, &a.open)?;
+    let wo = parse_wo(&a.wo)?;
     let c = brdf.channels().len();
     let mut w = vec![0.0f32; c];
     let mut rng = Rng::new(a.seed);

@@ -283,6 +283,25 @@ fn errors_quote_huge_inputs_in_part() {
     );
 }
 
+#[test]
+fn nan_directions_give_zero() {
+    let d = TempDir::new("hostile-nan");
+    let (good, _) = good_and_bad(d.path());
+    let rgl = brdftab::measured::data::rgl_dir().expect("data/rgl ships");
+    let paper = rgl.join("paper_white_rgb.bsdf");
+    for src in [CT, s(&good), s(&paper)] {
+        let r = brdftab_with_stdin(
+            &["eval", src],
+            "nan 0 1 0 0 1\n0 0 1 0 inf 1\n0 0 0 0 0 1\n",
+        );
+        assert!(r.ok, "{src}: {}", r.stderr);
+        assert_eq!(r.stdout, "0e0 0e0 0e0\n".repeat(3), "{src}");
+        let r = brdftab_with_stdin(&["pdf", src], "nan 0 1 0 0 1\n0 0 1 0 0 NaN\n");
+        assert!(r.ok, "{src}: {}", r.stderr);
+        assert_eq!(r.stdout, "0\n0\n", "{src}");
+    }
+}
+
 /// A reader that went away (`brdftab models | head -1`) ends the command quietly with status 0:
 /// never a panic (`println!` panics on a closed pipe). The pipe's read end is closed before
 /// the command writes, so every write fails.

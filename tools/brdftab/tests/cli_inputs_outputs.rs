@@ -1,10 +1,9 @@
-//! What the CLI reads and writes: output paths checked before any work, `export`'s flags, and
-//! text lines whose numbers are no direction (NaN, infinite, zero length).
+//! What the CLI writes: output paths checked before any work, and `export`'s flags.
 
 mod common;
 
 use brdftab::testkit::TempDir;
-use common::{Run, brdftab, brdftab_with_stdin};
+use common::{Run, brdftab};
 
 const LAMBERT: &str = r#"{"model": "lambert", "kd": 0.5}"#;
 
@@ -100,50 +99,4 @@ fn export_flags_agree_with_what_export_does() {
     );
     // The .npy of a table needs a .npy name too.
     refused(&brdftab(&["export", &t, "--npy", &t]), &["`--npy`", ".npy"]);
-}
-
-#[test]
-fn lines_that_are_no_direction_are_errors_naming_the_line() {
-    // They printed 0 and succeeded: a reader could not tell them from a true 0. The library
-    // answers 0 for them (README, Conventions); the CLI's text reader refuses them, whatever
-    // the source: a spec, a table, an RGL file.
-    let d = TempDir::new("io-nan");
-    let t = d.file("t.btdb");
-    assert!(brdftab(&["bake", LAMBERT, "-o", &t, "--preset", "small"]).ok);
-    let rgl = brdftab::measured::data::rgl_dir().expect("data/rgl ships");
-    let paper = rgl.join("paper_white_rgb.bsdf");
-    let ok = "0 0 1 0 0 1\n";
-    for (bad, needle) in [
-        ("nan 0 1 0 0 1", "`nan` is not a finite number"),
-        ("0 0 1 inf 0 1", "`inf` is not a finite number"),
-        ("0 0 1 0 0 NaN", "`NaN` is not a finite number"),
-        ("0 0 1 0 0 1e400", "`1e400` is not a finite number"),
-        ("0 0 0 0 0 1", "wi (0 0 0) is the zero vector"),
-        ("0 0 1 0 0 0", "wo (0 0 0) is the zero vector"),
-    ] {
-        let input = format!("{ok}# c\n{bad}\n{ok}");
-        for (cmd, src) in [
-            ("eval", LAMBERT),
-            ("pdf", LAMBERT),
-            ("eval", &t),
-            ("pdf", paper.to_str().unwrap()),
-        ] {
-            let o = brdftab_with_stdin(&[cmd, src], &input);
-            assert_eq!(o.code, 1, "{cmd} {src} {bad}: {}", o.stderr);
-            let want = format!("error: stdin: line 3: {needle}");
-            assert!(o.stderr.starts_with(&want), "{cmd} {bad}: {}", o.stderr);
-            // The line before it was answered.
-            assert_eq!(o.stdout.lines().count(), 1, "{cmd} {bad}: {}", o.stdout);
-        }
-    }
-    // Below the horizon is a direction: 0, as README says.
-    let o = brdftab_with_stdin(&["eval", LAMBERT], "0 0 -1 0 0 1\n");
-    assert!(o.ok, "{}", o.stderr);
-    assert_eq!(o.stdout, "0e0 0e0 0e0\n");
-    // `sample --wo` that is no direction printed nothing and succeeded.
-    for wo in ["0,0,0", "nan,0,1", "0,inf,1"] {
-        refused(&brdftab(&["sample", LAMBERT, "--wo", wo]), &["`--wo`", wo]);
-    }
-    let o = brdftab(&["sample", LAMBERT, "--wo", "0,0,-1"]);
-    assert!(o.ok && o.stdout.is_empty(), "{}", o.stderr);
 }
