@@ -98,8 +98,8 @@ pub fn refuse_input(output: &Path, inputs: &[&str]) -> Result<()> {
             return Err(Error::arg(
                 "output",
                 format!(
-                    "{} is the input {}: writing it would replace the source with its own \
-                     resample (write to another file)",
+                    "{} is the input {}: writing it would replace the input while it is read \
+                     (write to another file)",
                     output.display(),
                     excerpt(input)
                 ),

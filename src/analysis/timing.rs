@@ -51,7 +51,12 @@ pub struct LookupTiming {
 /// Times `src` on `pairs` random pairs (uniform on the hemisphere, fixed seed), `repeats` times.
 pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTiming> {
     if pairs == 0 || repeats == 0 {
-        return Err(Error::arg("pairs", "pairs and repeats must be positive"));
+        let (name, n) = if pairs == 0 {
+            ("pairs", pairs)
+        } else {
+            ("repeats", repeats)
+        };
+        return Err(Error::arg(name, format!("{n}: at least 1 is needed")));
     }
     let c = src.channels().len();
     let mut rng = Pcg32::new(2024);

@@ -91,7 +91,7 @@ pub fn accuracy(a: AccuracyArgs) -> Result<()> {
             "nothing to run (no sources, presets or params)",
         ));
     }
-    let bar = crate::progress::Bar::new("[{bar:30}] {pos}/{len} rows {elapsed} {msg}");
+    let bar = brdftab_tools::progress::Bar::new("[{bar:30}] {pos}/{len} rows {elapsed} {msg}");
     let report = suite::run(&cfg, &bar)?;
     let files = report.write_all(&a.out)?;
     eprintln!(

@@ -8,7 +8,7 @@ use brdftab::request::{self, BakeSettings};
 use brdftab::{Error, Result};
 use clap::Args;
 
-use crate::progress::Bar;
+use brdftab_tools::progress::Bar;
 
 /// Arguments of `brdftab bake`.
 #[derive(Args)]

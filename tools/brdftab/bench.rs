@@ -50,7 +50,7 @@ fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
         timing_pairs: a.pairs,
         ..Default::default()
     };
-    let bar = crate::progress::Bar::values();
+    let bar = brdftab_tools::progress::Bar::values();
     let rows = measured::run(&files, &opts, &bar)?;
     let mut o = String::new();
     if a.json {
@@ -85,7 +85,7 @@ fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
 
 /// `brdftab bench`.
 pub fn bench(a: BenchArgs) -> Result<()> {
-    // The library's check says "pairs and repeats": repeats is no flag here.
+    // Before either road (the measured one times the native files on a quarter of the pairs).
     if a.pairs == 0 {
         return Err(Error::arg("--pairs", "must be at least 1"));
     }

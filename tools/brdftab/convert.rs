@@ -5,8 +5,8 @@ use brdftab::Result;
 use brdftab::request::{self, ConvertOutput, ConvertSettings};
 use clap::Args;
 
-use crate::progress::Bar;
 use brdftab_tools::outln;
+use brdftab_tools::progress::Bar;
 
 /// Arguments of `brdftab convert`.
 #[derive(Args)]
@@ -25,7 +25,8 @@ pub struct ConvertArgs {
 pub fn convert(a: ConvertArgs) -> Result<()> {
     match request::convert(&a.input, &a.output, &a.settings, &Bar::values())? {
         ConvertOutput::Merl(r) => outln!(
-            "{}: {} resampled on the MERL grid (means over 90 × 90 × 180 cells) in {:.2} s",
+            "{}: {} on the MERL grid (90 × 90 × 180 cells: the mean of the source over each, or \
+             its own cells when it is on that grid) in {:.2} s",
             r.output,
             r.source,
             r.seconds

@@ -91,7 +91,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         ),
         db.display()
     ))?;
-    let bar = crate::progress::Bar::values();
+    let bar = brdftab_tools::progress::Bar::values();
     let target = |name: &str| BakeTarget::db(db.display().to_string(), name);
     let mut seconds = Vec::new();
     for s in &sources {

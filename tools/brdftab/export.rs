@@ -38,10 +38,10 @@ pub fn run(a: ExportArgs) -> Result<()> {
     }
     // Every output is checked before anything is written.
     if let Some(out) = &a.npy {
-        crate::output::check(out, "--npy", &["npy"])?;
+        brdftab_tools::output::check(out, "--npy", &["npy"])?;
     }
     if let Some(out) = &a.exr {
-        crate::output::check(out, "--exr", &["exr"])?;
+        brdftab_tools::output::check(out, "--exr", &["exr"])?;
     }
     let (path, name) = db::split_source(&a.file)?;
     let s = Store::open(path)?;

@@ -26,7 +26,7 @@ pub struct FitArgs {
 
 /// Runs the fit and prints the fitted spec (or the whole result with `--json`).
 pub fn fit(a: FitArgs) -> Result<()> {
-    let bar = crate::progress::Bar::new("fit {bar:30} {pos}/{len} starts {elapsed}");
+    let bar = brdftab_tools::progress::Bar::new("fit {bar:30} {pos}/{len} starts {elapsed}");
     let result = request::fit(&a.source, &a.model, &a.settings, &bar)?;
     let text = if a.json {
         serde_json::to_string(&result).map_err(|e| Error::Json {

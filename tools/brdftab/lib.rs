@@ -2,8 +2,11 @@
 //! `brdftab`, kept out of it so that a renderer linking brdftab (the C ABI, the Python
 //! extension) compiles none of it.
 //!
+//! - [`args`]: the subcommand that ran and library errors named by the flag the user typed;
+//! - [`output`]: output paths checked before any work;
 //! - [`preview`]: the preview renderer (path tracer and lit sphere), images (EXR, PNG), false
 //!   colour, and slice images of any `Brdf`;
+//! - [`progress`]: the library's progress reports as an indicatif bar on a terminal;
 //! - [`report`]: the accuracy suite, the measured-table benchmark and their plots;
 //! - [`rng`]: the tools' random numbers;
 //! - [`text`]: the CLI's text input and output — lines of numbers from stdin (`eval`, `pdf`,
@@ -13,7 +16,10 @@
 // `!(x > 0.0)` rejects NaN together with non-positive values, as in the core library.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod args;
+pub mod output;
 pub mod preview;
+pub mod progress;
 pub mod report;
 pub mod rng;
 pub mod text;

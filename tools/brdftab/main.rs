@@ -12,8 +12,6 @@ mod demo_extra;
 mod export;
 mod fit;
 mod models;
-mod output;
-mod progress;
 mod render;
 mod sample;
 mod slice;
@@ -24,7 +22,8 @@ mod table;
 #[path = "view.rs"]
 mod view;
 
-use clap::{ArgMatches, CommandFactory, FromArgMatches, Parser, Subcommand};
+use brdftab_tools::args::{as_typed, subcommand_path};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 /// Tabulated BRDFs: analytic models, dense compressed tables, measured data.
@@ -92,44 +91,6 @@ fn command() -> clap::Command {
     negatives(Cli::command())
 }
 
-/// The names of the subcommand that ran, outermost first (`["db", "add"]`).
-fn subcommand_path(m: &ArgMatches) -> Vec<String> {
-    let mut path = Vec::new();
-    let mut m = m;
-    while let Some((name, sub)) = m.subcommand() {
-        path.push(name.to_owned());
-        m = sub;
-    }
-    path
-}
-
-/// An argument error of the library names a request field (`max_depth`) or a value
-/// (`source`); when that is the id of an argument of the subcommand that ran, it is named as
-/// the user typed it: its flag (`--max-depth`) or its value name (`SOURCE`). Other names pass
-/// unchanged.
-fn as_typed(e: brdftab::Error, path: &[String]) -> brdftab::Error {
-    let brdftab::Error::InvalidArgument { name, msg } = e else {
-        return e;
-    };
-    let cmd = command();
-    let mut sub = &cmd;
-    for p in path {
-        match sub.find_subcommand(p) {
-            Some(s) => sub = s,
-            None => return brdftab::Error::InvalidArgument { name, msg },
-        }
-    }
-    let name = match sub.get_arguments().find(|a| a.get_id() == name.as_str()) {
-        Some(a) => match (a.get_long(), a.get_value_names()) {
-            (Some(long), _) => format!("--{long}"),
-            (None, Some([v, ..])) => v.to_string(),
-            (None, _) => a.get_id().as_str().to_uppercase(),
-        },
-        None => name,
-    };
-    brdftab::Error::InvalidArgument { name, msg }
-}
-
 fn main() -> ExitCode {
     let mut matches = match command().try_get_matches() {
         Ok(m) => m,
@@ -170,7 +131,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            let e = as_typed(e, &path);
+            let e = as_typed(e, &command(), &path);
             eprintln!("error: {e}{}", hint(&e));
             ExitCode::from(1)
         }

@@ -115,7 +115,7 @@ fn options(a: &RenderArgs) -> Result<RenderOptions> {
 /// Renders with a progress bar on a terminal, silently otherwise; reports the time on stderr.
 fn render_one(brdf: &dyn brdftab::Brdf, opts: &RenderOptions, label: &str) -> Result<Image> {
     let start = Instant::now();
-    let bar = crate::progress::Bar::new("{msg} [{bar:40}] {percent}% eta {eta}");
+    let bar = brdftab_tools::progress::Bar::new("{msg} [{bar:40}] {percent}% eta {eta}");
     bar.prefix(label);
     let img = preview::render(brdf, opts, &bar)?;
     eprintln!(
@@ -140,7 +140,7 @@ fn diff_path(out: &Path) -> PathBuf {
 /// Runs `brdftab render`.
 pub fn run(a: RenderArgs) -> Result<()> {
     // An output the render could not be written to is refused before the render.
-    crate::output::check(&a.output, "--output", &["png", "exr"])?;
+    brdftab_tools::output::check(&a.output, "--output", &["png", "exr"])?;
     let opts = options(&a)?;
     let brdf = brdftab::request::open(&a.source, &a.open)?;
     let img = render_one(brdf.as_ref(), &opts, &a.source)?;

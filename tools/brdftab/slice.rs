@@ -68,7 +68,7 @@ pub fn slice(a: SliceArgs) -> Result<()> {
     if a.size == 0 || a.size > 8192 {
         return Err(Error::arg("--size", "must be 1..=8192"));
     }
-    crate::output::check(&a.output, "--output", &["exr", "png"])?;
+    brdftab_tools::output::check(&a.output, "--output", &["exr", "png"])?;
     refuse_other_kind(&a)?;
     let (theta_in, phi_in) = (a.theta_in.unwrap_or(45.0), a.phi_in.unwrap_or(0.0));
     let phi_d = a.phi_d.unwrap_or(90.0);
