@@ -116,7 +116,10 @@ pub fn save_table(
 /// a packed layout (an `inout` reciprocal table) the whole rectangle, whose unstored nodes
 /// (NaN in the export) are ignored. The values are the stored quantity, before the
 /// calibration's factors, as the export gives them; negative values keep their meaning
-/// ([`Table::with_values`]). The provenance reads "values from FILE on the grid of LIKE".
+/// ([`Table::with_values`]). With `calibration` false the values are another material's and
+/// the like table's albedo calibration is dropped ([`Grid::without_calibration`]): its factors
+/// were measured for the like table's values. The provenance reads "values from FILE on the
+/// grid of LIKE".
 ///
 /// # Errors
 /// [`Error::InvalidArgument`] naming `like` for a SOURCE that is not a stored table, `output`
@@ -129,6 +132,7 @@ pub fn import_npy(
     like: &str,
     output: &str,
     settings: &SaveSettings,
+    calibration: bool,
 ) -> Result<serde_json::Value> {
     // Settings and output before any file is read.
     settings.codec()?;
@@ -142,7 +146,10 @@ pub fn import_npy(
             ),
         ));
     }
-    let grid = like_grid(like)?;
+    let grid = match like_grid(like)? {
+        g if calibration => g,
+        g => g.without_calibration(),
+    };
     let file = array.display().to_string();
     let reader = NpyReader::open(array)?;
     let h = reader.header().clone();
@@ -393,7 +400,7 @@ mod tests {
             let (_, exported) = store::npy::read_f32(&npy).unwrap();
             assert_eq!(exported.iter().any(|x| x.is_nan()), g.layout().packed);
             let out = d.file(&format!("back{k}.btdb"));
-            let info = import_npy(&npy, &like, &out, &lossless()).unwrap();
+            let info = import_npy(&npy, &like, &out, &lossless(), true).unwrap();
             let e = &info["tables"][0];
             assert_eq!(
                 e["source"]["description"],
@@ -422,7 +429,7 @@ mod tests {
         let npy = d.join("g.npy");
         export::npy(&st, &npy, None).unwrap();
         let out = d.file("back.btdb");
-        let info = import_npy(&npy, &like, &out, &lossless()).unwrap();
+        let info = import_npy(&npy, &like, &out, &lossless(), true).unwrap();
         assert_eq!(info["tables"][0]["calibrated"], true);
         let back = Store::open(&out)
             .unwrap()
@@ -431,6 +438,19 @@ mod tests {
             .to_table()
             .unwrap();
         assert_eq!(back.grid(), t.grid());
+        assert_eq!(bits(back.values()), bits(t.values()));
+        // Another material's values: without the like table's calibration, the grid is the
+        // uncalibrated one and the values are stored as given.
+        let other_out = d.file("other.btdb");
+        let info = import_npy(&npy, &like, &other_out, &lossless(), false).unwrap();
+        assert_eq!(info["tables"][0]["calibrated"], false);
+        let back = Store::open(&other_out)
+            .unwrap()
+            .single()
+            .unwrap()
+            .to_table()
+            .unwrap();
+        assert_eq!(back.grid(), &t.grid().clone().without_calibration());
         assert_eq!(bits(back.values()), bits(t.values()));
     }
 
@@ -471,21 +491,22 @@ mod tests {
             none.as_str(),
             nope.as_str(),
         ] {
-            let (name, msg) = arg(import_npy(&npy, src, &out, &lossless()).unwrap_err());
+            let (name, msg) = arg(import_npy(&npy, src, &out, &lossless(), true).unwrap_err());
             assert_eq!(name, "like", "{src}: {msg}");
         }
         // Not a brdftab file.
         let (name, _) =
-            arg(import_npy(&npy, npy.to_str().unwrap(), &out, &lossless()).unwrap_err());
+            arg(import_npy(&npy, npy.to_str().unwrap(), &out, &lossless(), true).unwrap_err());
         assert_eq!(name, "like");
         let (name, _) =
-            arg(import_npy(&npy, &like, npy.to_str().unwrap(), &lossless()).unwrap_err());
+            arg(import_npy(&npy, &like, npy.to_str().unwrap(), &lossless(), true).unwrap_err());
         assert_eq!(name, "output");
 
         let mut wrong = shape.clone();
         wrong.swap(0, 3);
         f32_npy(&npy, &wrong, t.values());
-        let (file, field, _, msg) = fmt(import_npy(&npy, &like, &out, &lossless()).unwrap_err());
+        let (file, field, _, msg) =
+            fmt(import_npy(&npy, &like, &out, &lossless(), true).unwrap_err());
         assert_eq!(
             (file.as_str(), field.as_deref()),
             (npy.to_str().unwrap(), Some("shape"))
@@ -495,7 +516,8 @@ mod tests {
         let mut v = t.values().to_vec();
         v[100] = f32::NAN;
         f32_npy(&npy, &shape, &v);
-        let (_, field, offset, msg) = fmt(import_npy(&npy, &like, &out, &lossless()).unwrap_err());
+        let (_, field, offset, msg) =
+            fmt(import_npy(&npy, &like, &out, &lossless(), true).unwrap_err());
         let h = NpyReader::open(&npy).unwrap().header().clone();
         assert_eq!(
             (field.as_deref(), offset),
@@ -506,7 +528,7 @@ mod tests {
         f32_npy(&npy, &shape, t.values());
         let b = std::fs::read(&npy).unwrap();
         std::fs::write(&npy, &b[..b.len() - 3]).unwrap();
-        let (_, field, _, msg) = fmt(import_npy(&npy, &like, &out, &lossless()).unwrap_err());
+        let (_, field, _, msg) = fmt(import_npy(&npy, &like, &out, &lossless(), true).unwrap_err());
         assert!(
             field.as_deref() == Some("data") && msg.contains("truncated"),
             "{msg}"

@@ -125,13 +125,17 @@ pub struct ImportArgs {
     /// Output: a table file (`.btdb`, replaced atomically) or DB#NAME.
     #[arg(short, long)]
     output: String,
+    /// The values are another material's: drop the --like table's albedo calibration (its
+    /// factors were measured for the like table's own values).
+    #[arg(long)]
+    no_calibration: bool,
     #[command(flatten)]
     settings: SaveSettings,
 }
 
 /// `brdftab import`.
 pub fn import(a: ImportArgs) -> Result<()> {
-    let info = request::import_npy(&a.array, &a.like, &a.output, &a.settings)?;
+    let info = request::import_npy(&a.array, &a.like, &a.output, &a.settings, !a.no_calibration)?;
     let t = &info["tables"][0];
     let codec = t["codec"]["quant"].as_str().unwrap_or("?");
     eprintln!("wrote {} ({} values, codec {codec})", a.output, t["values"]);

@@ -110,6 +110,40 @@ fn an_edited_export_imports_and_evaluates_scaled() {
     assert_eq!(eval(&entry), b);
 }
 
+/// `--no-calibration`: another material's values on a calibrated table's grid are stored
+/// without that table's albedo factors (measured for its own values); without the flag the
+/// import keeps them.
+#[test]
+fn no_calibration_drops_the_like_tables_factors() {
+    let d = TempDir::new("cli-import-cal");
+    let p = |f: &str| d.file(f);
+    let ggx = r#"{"model": "ggx", "alpha": 0.3}"#;
+    let like = p("g.btdb");
+    ok(brdftab(&[
+        "bake",
+        ggx,
+        "-o",
+        &like,
+        "--grid",
+        "adaptive:24x12x7",
+    ]));
+    ok(brdftab(&["export", &like, "--npy", &p("g.npy")]));
+    let calibrated = |f: &str| {
+        let r = ok(brdftab(&["info", f, "--json"]));
+        let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+        v["tables"][0]["calibrated"].as_bool().unwrap()
+    };
+    assert!(calibrated(&like));
+    let npy = p("g.npy");
+    for (extra, want) in [(None, true), (Some("--no-calibration"), false)] {
+        let out = p(&format!("out-{want}.btdb"));
+        let mut args = vec!["import", &npy, "--like", &like, "-o", &out];
+        args.extend(extra);
+        ok(brdftab(&args));
+        assert_eq!(calibrated(&out), want, "{extra:?}");
+    }
+}
+
 /// A packed table (`inout` reciprocal: θi ≤ θo stored) exports its whole rectangle with NaN at
 /// the nodes it does not store; imported as it is, they are ignored and the table is the same.
 #[test]
