@@ -312,6 +312,31 @@ mod tests {
     }
 
     #[test]
+    fn an_adaptive_grid_too_large_for_memory_is_an_error_not_an_abort() {
+        use crate::bake::GridChoice;
+        for nodes in [
+            [10_000_000, 8, 8],
+            [usize::MAX, 4, 4],
+            [8, 8, usize::MAX / 2],
+        ] {
+            let t0 = Instant::now();
+            let e = BakeRequest::new(r#"{"model":"lambert","kd":0.5}"#)
+                .grid(GridChoice::Adaptive(Some(nodes)))
+                .table(&Silent)
+                .map(|_| ())
+                .unwrap_err();
+            assert!(
+                matches!(e, Error::InvalidArgument { ref name, .. } if name == "grid"),
+                "{nodes:?}: {e}"
+            );
+            assert!(
+                t0.elapsed().as_secs_f64() < 5.0,
+                "{nodes:?}: refused only after work"
+            );
+        }
+    }
+
+    #[test]
     fn a_converted_specs_default_name_is_its_model() {
         assert_eq!(source_stem(r#" {"model":"lambert","kd":0.3}"#), "lambert");
         assert_eq!(source_stem(r#"{"model":"ggx","alpha":0.1}"#), "ggx");

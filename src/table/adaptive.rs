@@ -85,9 +85,23 @@ pub fn adaptive_grid(src: &dyn Brdf, symmetry: Symmetry, opts: &AdaptiveOptions)
             "an adaptive grid needs at least 2 nodes and 4 fine samples per axis",
         ));
     }
+    within_memory(opts.nodes, src.channels().len())?;
     let warps = fit_warps(src, phi_hi(symmetry), opts)?;
     grid_with_warps(src.channels().clone(), symmetry, opts.nodes, warps)?
         .with_quantity(opts.quantity)
+}
+
+/// Refuses node counts whose table could not be built in memory, as every adaptive table is
+/// ([`MAX_IN_MEMORY_VALUES`](crate::table::fill::MAX_IN_MEMORY_VALUES)), before the warps are
+/// fitted: `adaptive:10000000x8x8` (1.9 G values) aborted the process when its allocation
+/// failed, and a count near `usize::MAX` grew until the system killed it.
+fn within_memory(nodes: [usize; 3], channels: usize) -> Result<()> {
+    let values = nodes.iter().try_fold(channels, |n, &k| n.checked_mul(k));
+    match values {
+        Some(v) if v <= crate::table::fill::MAX_IN_MEMORY_VALUES => Ok(()),
+        Some(v) => Err(crate::table::fill::too_large(v)),
+        None => Err(crate::table::fill::too_large(usize::MAX)),
+    }
 }
 
 /// The end of the stored φd axis: π, or π/2 with reciprocity.
@@ -117,6 +131,7 @@ pub fn grid_with_warps(
             "an adaptive grid needs at least 2 nodes per axis",
         ));
     }
+    within_memory(nodes, channels.len())?;
     let [wh, wd, wp] = warps;
     // Full φd size: the stored np nodes over [0, hi] mirrored over [0, 2π).
     let full_phi = if symmetry.reciprocal {

@@ -227,9 +227,33 @@ pub fn bake_chunks(
     })
 }
 
+/// The most values a table built whole in memory ([`bake`]: adaptive and calibrated tables,
+/// raw files) may have: 2^30, 4 GiB of f32 — 240× the largest default table. Streamed bakes
+/// ([`bake_chunks`]) are bounded by the store file's limit instead. A larger grid (an adaptive
+/// `10000000×8×8`: 1.9 G values) aborted the process when its allocation failed, or was killed
+/// by the system, rather than failing.
+pub const MAX_IN_MEMORY_VALUES: usize = 1 << 30;
+
+/// The error of a table too large to build in memory.
+pub(crate) fn too_large(n: usize) -> Error {
+    Error::arg(
+        "grid",
+        format!(
+            "{n} values ({:.1} GB of f32): more than the {MAX_IN_MEMORY_VALUES} a table built in \
+             memory may hold",
+            n as f64 * 4e-9
+        ),
+    )
+}
+
 /// Bakes `brdf` on `grid` into an in-memory [`Table`].
 pub fn bake(brdf: &dyn Brdf, grid: &Grid, opts: &BakeOptions) -> Result<(Table, BakeStats)> {
-    let mut values = Vec::with_capacity(grid.stored_values());
+    // The whole table in memory: a grid too large for it is an error, not an abort.
+    let n = grid.stored_values();
+    let mut values = Vec::new();
+    if n > MAX_IN_MEMORY_VALUES || values.try_reserve_exact(n).is_err() {
+        return Err(too_large(n));
+    }
     let report = bake_chunks(brdf, grid, opts, |_, v| {
         values.extend_from_slice(v);
         Ok(())
