@@ -109,6 +109,22 @@ pub struct BrdfSample {
     pub delta: bool,
 }
 
+/// `{:?}` of a boxed or borrowed `Brdf` (what [`crate::open`] returns) is its
+/// [`describe`](Brdf::describe), so `Result`s holding one can be unwrapped and structs holding
+/// one can derive `Debug`.
+impl std::fmt::Debug for dyn Brdf + Send + Sync {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Brdf({})", self.describe())
+    }
+}
+
+/// As for `dyn Brdf + Send + Sync`.
+impl std::fmt::Debug for dyn Brdf {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Brdf({})", self.describe())
+    }
+}
+
 /// A bidirectional reflectance distribution function.
 ///
 /// Object safe and `Send + Sync`, so `Box<dyn Brdf + Send + Sync>` and `&dyn Brdf` work everywhere.

@@ -56,13 +56,15 @@ pub mod table;
 #[cfg(any(test, feature = "testkit"))]
 pub mod testkit;
 
-pub use bake::{BakeReport, BakeRequest, BakeTarget};
+pub use bake::{BakeReport, BakeRequest, BakeTarget, GridChoice};
 pub use brdf::{BakeSource, Brdf, BrdfSample, Flags, Lobes};
 pub use error::{Error, Result};
-pub use progress::Progress;
+pub use progress::{Progress, Silent};
 pub use source::{OpenOptions, SourceKind, classify, open, open_with};
 pub use spec::ModelSpec;
 pub use spectrum::{Channels, Value};
+pub use table::presets::Preset;
+pub use table::{Interp, TabulatedBrdf};
 
 /// The README's code examples, compiled and run as doctests.
 #[cfg(doctest)]

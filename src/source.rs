@@ -213,7 +213,7 @@ impl OpenOptions {
 /// ```
 /// A missing file is an error that names it:
 /// ```
-/// let e = brdftab::open("no-such-material.binary").err().expect("a missing file fails");
+/// let e = brdftab::open("no-such-material.binary").unwrap_err();
 /// assert!(e.to_string().contains("no-such-material.binary"));
 /// ```
 pub fn open(source: &str) -> Result<Box<dyn Brdf + Send + Sync>> {
@@ -222,6 +222,14 @@ pub fn open(source: &str) -> Result<Box<dyn Brdf + Send + Sync>> {
 
 /// Opens SOURCE as `opts` say (see [`open`] for the kinds).
 pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send + Sync>> {
+    // An empty SOURCE (or an empty path before `#NAME`) names nothing: it was "not found: : no
+    // such file".
+    if source.trim().is_empty() || (source.starts_with('#') && !Path::new(source).exists()) {
+        return Err(Error::arg(
+            "source",
+            format!("{source:?}: an empty SOURCE or path (expected a spec, a file or DB#NAME)"),
+        ));
+    }
     // Stat before any open: a FIFO, socket, device or directory is refused at once.
     // `x.btdb#` or a control character in NAME is an argument error, not a path to stat.
     if crate::files::source_file(source).is_some() {
@@ -293,15 +301,14 @@ pub fn spec(source: &str) -> Result<ModelSpec> {
 
 /// Parses a comma-separated list of wavelengths in nm (`"450, 550, 650"`).
 pub fn parse_wavelengths(list: &str) -> Result<Channels> {
-    let nm = list
-        .split(',')
-        .map(|x| {
-            x.trim()
-                .parse::<f64>()
-                .map_err(|_| Error::arg("wavelengths", format!("`{}` is not a number", x.trim())))
-        })
-        .collect::<Result<Vec<_>>>()?;
-    Channels::wavelengths(nm)
+    if list.trim().eq_ignore_ascii_case("rgb") {
+        // `Channels`'s parse takes "rgb" too; a list of wavelengths does not.
+        return Err(Error::arg(
+            "wavelengths",
+            "`rgb` is not a list of wavelengths",
+        ));
+    }
+    list.parse()
 }
 
 /// The provenance a table baked from SOURCE records: the spec for models, the file's name and
@@ -327,7 +334,7 @@ mod tests {
         let rgl = crate::measured::data::rgl_file("paper_white_rgb.bsdf").unwrap();
         let as_dat = d.join("paper.dat");
         std::fs::copy(&rgl, &as_dat).unwrap();
-        let e = open(as_dat.to_str().unwrap()).err().unwrap().to_string();
+        let e = open(as_dat.to_str().unwrap()).unwrap_err().to_string();
         assert!(
             e.contains("an RGL tensor file") && e.contains(".bsdf name"),
             "{e}"
@@ -339,7 +346,7 @@ mod tests {
             .unwrap();
         let as_bsdf = d.join("t.bsdf");
         std::fs::copy(&table, &as_bsdf).unwrap();
-        let e = open(as_bsdf.to_str().unwrap()).err().unwrap().to_string();
+        let e = open(as_bsdf.to_str().unwrap()).unwrap_err().to_string();
         assert!(
             e.contains("brdftab table") && e.contains(".btdb name"),
             "{e}"
@@ -347,8 +354,43 @@ mod tests {
         // Neither signature: the message says so.
         let junk = d.join("junk.dat");
         std::fs::write(&junk, b"0123456789abcdef").unwrap();
-        let e = open(junk.to_str().unwrap()).err().unwrap().to_string();
+        let e = open(junk.to_str().unwrap()).unwrap_err().to_string();
         assert!(e.contains("no brdftab, MERL or RGL signature"), "{e}");
+    }
+
+    #[test]
+    fn channels_and_quantities_parse_from_strings() {
+        use crate::table::Quantity;
+        assert_eq!("RGB".parse::<Channels>().unwrap(), Channels::Rgb);
+        assert_eq!(
+            " 450, 550 ".parse::<Channels>().unwrap(),
+            Channels::wavelengths(vec![450.0, 550.0]).unwrap()
+        );
+        for bad in ["", "450,x", "550,450", "-1"] {
+            assert!(bad.parse::<Channels>().is_err(), "{bad}");
+        }
+        assert!(parse_wavelengths("rgb").is_err());
+        assert_eq!(parse_wavelengths("450").unwrap().len(), 1);
+        assert_eq!(
+            "fr_cos_out".parse::<Quantity>().unwrap(),
+            Quantity::FrCosOut
+        );
+        match "cos".parse::<Quantity>() {
+            Err(Error::InvalidArgument { name, .. }) => assert_eq!(name, "quantity"),
+            r => panic!("{r:?}"),
+        }
+    }
+
+    #[test]
+    fn empty_source_is_an_argument_error() {
+        for s in ["", "  ", "#name"] {
+            match open(s) {
+                Err(Error::InvalidArgument { name, msg }) => {
+                    assert_eq!(name, "source", "{s:?}: {msg}")
+                }
+                r => panic!("{s:?}: {:?}", r.map(|b| b.describe())),
+            }
+        }
     }
 
     #[test]

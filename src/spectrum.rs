@@ -344,6 +344,27 @@ pub(crate) fn check_range(x: f64, field: &str) -> Result<()> {
     ))
 }
 
+/// `"rgb".parse::<Channels>()` or `"450, 550, 650".parse::<Channels>()` (wavelengths in nm, as
+/// [`Channels::wavelengths`] checks them; errors name `wavelengths`).
+impl std::str::FromStr for Channels {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Channels> {
+        if s.trim().eq_ignore_ascii_case("rgb") {
+            return Ok(Channels::Rgb);
+        }
+        let nm = s
+            .split(',')
+            .map(|x| {
+                x.trim().parse::<f64>().map_err(|_| {
+                    Error::arg("wavelengths", format!("`{}` is not a number", x.trim()))
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Channels::wavelengths(nm)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -34,8 +34,13 @@ impl BakeRequest {
         self.table_of(src.as_ref(), progress)
     }
 
-    /// Bakes an already opened source (for callers that also use it, e.g. to compare).
+    /// Bakes an already opened source (for callers that also use it, e.g. to compare). `src` is
+    /// what is sampled; the request's SOURCE string still says what kind of source it is (a
+    /// model spec, a measured file, a table), which chooses the default grid, the stored
+    /// quantity and the calibration — so for a `Brdf` of your own, name it as what it is
+    /// (e.g. `BakeRequest::new("{}")` for a model) or set the grid.
     pub fn table_of(&self, src: &dyn Brdf, progress: &dyn Progress) -> Result<(Table, BakeReport)> {
+        self.validate()?;
         crate::table::fill::tabulable(src)?;
         let t0 = Instant::now();
         match self.preset_misses(src, progress)? {
@@ -72,9 +77,14 @@ impl BakeRequest {
     ) -> Result<(Table, BakeReport)> {
         let t0 = Instant::now();
         if self.keeps_merl_cells() {
-            let table = crate::measured::MerlBrdf::open(&self.source)?.to_table();
-            let report = self.report_for(src, table.grid(), None, t0, true);
-            return Ok((table, report));
+            let merl = crate::measured::MerlBrdf::open(&self.source)?;
+            // The file's own cells only when `src` is that file (`table_of` may be handed
+            // another source under a `.binary` name: it baked the file instead).
+            if merl.describe() == src.describe() {
+                let table = merl.to_table();
+                let report = self.report_for(src, table.grid(), None, t0, true);
+                return Ok((table, report));
+            }
         }
         // What the bake samples ([`BakeSource::bake_view`](crate::brdf::BakeSource::bake_view)); the report describes the source.
         let view = src.bake_source().and_then(|b| b.bake_view());

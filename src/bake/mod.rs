@@ -105,6 +105,26 @@ pub struct BakeRequest {
 }
 
 impl BakeRequest {
+    /// Checks the fields a caller may have set directly (the request layer checks its settings
+    /// too, but a `BakeRequest` is public): a NaN or negative symmetry tolerance detected no
+    /// symmetry and silently baked an unreduced table.
+    pub(crate) fn validate(&self) -> crate::Result<()> {
+        let t = self.symmetry_tolerance;
+        if !(t >= 0.0 && t.is_finite()) {
+            return Err(crate::Error::arg(
+                "symmetry_tolerance",
+                format!("{t}: expected a finite tolerance ≥ 0"),
+            ));
+        }
+        if self.supersample == 0 {
+            return Err(crate::Error::arg(
+                "supersample",
+                "0: at least 1 sample per cell",
+            ));
+        }
+        Ok(())
+    }
+
     /// A request with the defaults for `source`.
     pub fn new(source: impl Into<String>) -> BakeRequest {
         BakeRequest {
@@ -186,7 +206,9 @@ impl BakeRequest {
         self
     }
 
-    /// Reports the accuracy of the written table on `pairs` random pairs.
+    /// Reports the accuracy of the written table on `pairs` random pairs: a bake that writes
+    /// ([`run`](Self::run)) measures it; an in-memory one ([`table`](Self::table),
+    /// [`table_of`](Self::table_of)) does not — call [`Accuracy::measure`] on its table.
     pub fn accuracy(mut self, pairs: usize) -> BakeRequest {
         self.accuracy_pairs = pairs;
         self

@@ -120,8 +120,12 @@ pub struct Accuracy {
 }
 
 impl Accuracy {
-    /// Compares `table` with `source` on `pairs` random pairs (seed 1).
+    /// Compares `table` with `source` on `pairs` random pairs (seed 1); zero pairs is an
+    /// argument error (its zero error read as a perfect match).
     pub fn measure(table: &dyn Brdf, source: &dyn Brdf, pairs: usize) -> Result<Accuracy> {
+        if pairs == 0 {
+            return Err(crate::Error::arg("pairs", "0: no pairs to measure on"));
+        }
         // Both cosines: f_r cos θi has no finite RMS for measured data, Ward or Cook-Torrance
         // (the figure the struct's fields say; it read f_r cos θi until session 26).
         use crate::analysis::accuracy::{Weight, compare_weighted};

@@ -29,6 +29,7 @@ impl BakeRequest {
 
     /// [`run`](Self::run), reporting progress.
     pub fn run_with(&self, target: &BakeTarget, progress: &dyn Progress) -> Result<BakeReport> {
+        self.validate()?;
         self.refuse_overwrite(target)?;
         let name = match (target, &self.name) {
             (BakeTarget::Db { name, .. }, _) => name.clone(),
@@ -332,6 +333,53 @@ mod tests {
             assert!(
                 t0.elapsed().as_secs_f64() < 5.0,
                 "{nodes:?}: refused only after work"
+            );
+        }
+    }
+
+    #[test]
+    fn table_of_bakes_the_source_it_is_given_not_a_file_of_the_requests_name() {
+        let d = tmp("table_of_merl_name");
+        let merl = d.join("white.binary");
+        let white = crate::open(r#"{"model":"lambert","kd":0.5}"#).unwrap();
+        crate::measured::MerlBrdf::from_brdf(white.as_ref())
+            .write(&merl)
+            .unwrap();
+        let dark = crate::open(r#"{"model":"lambert","kd":0.1}"#).unwrap();
+        let (t, _) = BakeRequest::new(merl.to_str().unwrap())
+            .table_of(dark.as_ref(), &Silent)
+            .unwrap();
+        let mut f = [0.0f32; 3];
+        TabulatedBrdf::from_table(t).eval(glam::DVec3::Z, glam::DVec3::new(0.6, 0.0, 0.8), &mut f);
+        assert!(f.iter().all(|&x| (x - 0.1).abs() < 1e-3), "{f:?}");
+        // The file itself, handed over opened, still keeps its own cells.
+        let file = crate::open(merl.to_str().unwrap()).unwrap();
+        let (t, _) = BakeRequest::new(merl.to_str().unwrap())
+            .table_of(file.as_ref(), &Silent)
+            .unwrap();
+        assert_eq!(
+            t.grid(),
+            crate::measured::MerlBrdf::open(&merl)
+                .unwrap()
+                .to_table()
+                .grid()
+        );
+    }
+
+    #[test]
+    fn fields_set_directly_are_checked_as_the_settings_are() {
+        for (t, ss, field) in [
+            (f64::NAN, 1, "symmetry_tolerance"),
+            (-1.0, 1, "symmetry_tolerance"),
+            (1e-3, 0, "supersample"),
+        ] {
+            let mut r = BakeRequest::new(r#"{"model":"lambert","kd":0.5}"#).preset(Preset::Small);
+            r.symmetry_tolerance = t;
+            r.supersample = ss;
+            let e = r.table(&Silent).map(|_| ()).unwrap_err();
+            assert!(
+                matches!(e, Error::InvalidArgument { ref name, .. } if name == field),
+                "{e}"
             );
         }
     }

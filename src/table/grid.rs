@@ -1035,6 +1035,21 @@ impl Layout {
     }
 }
 
+/// `"fr_cos_cos".parse::<Quantity>()`: [`Quantity::from_name`], an unknown name an argument
+/// error naming `quantity`.
+impl std::str::FromStr for Quantity {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Quantity> {
+        Quantity::from_name(s.trim()).ok_or_else(|| {
+            Error::arg(
+                "quantity",
+                format!("unknown quantity `{s}` (expected fr, fr_cos_cos or fr_cos_out)"),
+            )
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

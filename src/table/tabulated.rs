@@ -8,7 +8,9 @@
 //!
 //! **Load failures.** `eval` cannot return an error. When a chunk fails to load (I/O error,
 //! checksum, wrong length) the chunk is marked empty, its corners contribute 0 to every lookup
-//! (so a lookup whose corners all lie in a failed chunk writes 0), and the table enters a sticky
+//! (so a lookup whose corners all lie in a failed chunk writes 0; a table with a kernel, whose
+//! lookups read one packed array of every chunk, writes 0 for every lookup), and the table
+//! enters a sticky
 //! *failed* state that keeps the first error: [`Brdf::health`] (one atomic load while the table
 //! is healthy) returns it from then on, for the life of the table. A renderer that calls `eval`
 //! pair by pair checks `health()` after each batch (or frame); every host does so after each

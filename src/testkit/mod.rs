@@ -1,4 +1,4 @@
-//! The test kit (feature `testkit`): what a test of a [`Brdf`] needs and nothing a renderer does.
+//! The test kit (feature `testkit`): what a test of a [`Brdf`](crate::Brdf) needs and nothing a renderer does.
 //!
 //! Every `Brdf` in this crate — each model, a table of any grid, a MERL file, an RGL file — owes
 //! its callers the same contract, and [`check_contract`] checks all of it on one value:
