@@ -5,7 +5,7 @@
 //! mean of a spectrum) is what one curve or one surface shows; the per-channel values ride along
 //! where the page can use them.
 //!
-//! Every sweep samples the centres of equal cells ([`centre`]), as the library's tables and
+//! Every sweep samples the centres of equal cells (`centre`), as the library's tables and
 //! `brdftab slice` do, so no direction lies at the horizon: there cos θ is 6e-17 and a measured
 //! file's f_r (its stored f_r cos θ over cos θ) reaches 1e14, which is the data's limit, not a
 //! value a plot can show.
