@@ -7,6 +7,11 @@ use brdftab::{Error, Result};
 use brdftab_tools::view::Server;
 use clap::Args;
 
+/// Connections served at once. A worker waits on its client for up to `http::READ_TIMEOUT`, and
+/// a browser keeps idle preconnected sockets open, so there are more workers than cores (a
+/// view's evaluation is parallel within its request anyway).
+const WORKERS: usize = 16;
+
 /// Arguments of `brdftab view`.
 #[derive(Args)]
 pub struct ViewArgs {
@@ -43,13 +48,15 @@ pub fn run(a: ViewArgs) -> Result<()> {
     let server = Server::bind(&a.sources, SocketAddr::new(a.bind, a.port))?;
     let n = server.registry().materials.len();
     let mut out = std::io::stdout().lock();
-    writeln!(out, "brdftab view: {n} materials at {}", server.url())
-        .and_then(|()| out.flush())
-        .map_err(|e| Error::io("stdout", e))?;
+    let plural = if n == 1 { "" } else { "s" };
+    writeln!(
+        out,
+        "brdftab view: {n} material{plural} at {}",
+        server.url()
+    )
+    .and_then(|()| out.flush())
+    .map_err(|e| Error::io("stdout", e))?;
     drop(out);
     eprintln!("(Ctrl-C stops the server)");
-    let workers = std::thread::available_parallelism()
-        .map_or(2, |n| n.get())
-        .max(4);
-    server.run(workers)
+    server.run(WORKERS)
 }

@@ -5,108 +5,13 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::net::TcpStream;
-use std::process::{Child, Stdio};
 use std::time::{Duration, Instant};
 
 use brdftab::testkit::TempDir;
-use common::{brdftab, command};
-
-/// A running `brdftab view`, killed on drop.
-struct Viewer {
-    child: Child,
-    port: u16,
-}
-
-impl Drop for Viewer {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-/// Starts `brdftab view ARGS --port 0` and reads its port from the URL it prints.
-fn start(args: &[&str]) -> Viewer {
-    let mut all = vec!["view"];
-    all.extend_from_slice(args);
-    all.extend_from_slice(&["--port", "0"]);
-    let mut child = command(&all)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let port = line
-        .split("http://127.0.0.1:")
-        .nth(1)
-        .and_then(|r| r.trim().trim_end_matches('/').parse().ok())
-        .unwrap_or_else(|| panic!("no URL in {line:?}"));
-    Viewer { child, port }
-}
-
-/// Sends `raw` as is and returns (status, body).
-fn send(port: u16, raw: &[u8]) -> (u16, String) {
-    let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
-    s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
-    // The server may answer (and close) before it has read an oversized request whole.
-    let _ = s.write_all(raw);
-    let mut out = Vec::new();
-    let _ = s.read_to_end(&mut out);
-    let text = String::from_utf8_lossy(&out).into_owned();
-    let status = text
-        .split(' ')
-        .nth(1)
-        .and_then(|c| c.parse().ok())
-        .unwrap_or_else(|| panic!("no status in {text:?}"));
-    let body = text.split_once("\r\n\r\n").map_or("", |x| x.1).to_owned();
-    (status, body)
-}
-
-/// `GET target` with the right Host header.
-fn get(v: &Viewer, target: &str) -> (u16, String) {
-    let req = format!(
-        "GET {target} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\n\r\n",
-        v.port
-    );
-    send(v.port, req.as_bytes())
-}
-
-/// `GET target`, status 200, the body as JSON.
-fn get_json(v: &Viewer, target: &str) -> serde_json::Value {
-    let (status, body) = get(v, target);
-    assert_eq!(status, 200, "{target}: {body}");
-    serde_json::from_str(&body).unwrap()
-}
-
-/// A database of two tables (gold Cook-Torrance, matte Lambert) in `d`.
-fn database(d: &TempDir) -> String {
-    let db = d.file("lib.btdb");
-    for (name, spec) in [
-        (
-            "gold",
-            r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#,
-        ),
-        ("matte", r#"{"model": "lambert", "kd": 0.2}"#),
-    ] {
-        let r = brdftab(&["db", "add", &db, spec, "--name", name, "--preset", "small"]);
-        assert!(r.ok, "{}", r.stderr);
-    }
-    db
-}
-
-/// Percent-encodes a query value.
-fn enc(s: &str) -> String {
-    s.bytes()
-        .map(|b| match b {
-            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'_' | b'.' => (b as char).to_string(),
-            _ => format!("%{b:02X}"),
-        })
-        .collect()
-}
+use common::brdftab;
+use common::viewer::{database, enc, get, get_json, send, start};
 
 #[test]
 fn materials_and_views_of_a_database() {
@@ -358,39 +263,6 @@ fn it_binds_loopback_by_default_and_refuses_an_unnameable_bind_address() {
         "{}",
         r.stderr
     );
-}
-
-#[test]
-fn a_measured_table_is_paired_with_its_file_beside_the_database() {
-    let d = TempDir::new("view-measured");
-    let dir = brdftab::measured::data::rgl_dir().expect("data/rgl ships with brdftab");
-    let bsdf = d.file("paper_white_rgb.bsdf");
-    std::fs::copy(dir.join("paper_white_rgb.bsdf"), &bsdf).unwrap();
-    let db = d.file("m.btdb");
-    let r = brdftab(&[
-        "db", "add", &db, &bsdf, "--name", "paper", "--preset", "small",
-    ]);
-    assert!(r.ok, "{}", r.stderr);
-    {
-        let v = start(&[&db, &bsdf]);
-        let list = get_json(&v, "/api/materials");
-        assert_eq!(
-            (list[0]["kind"].as_str(), list[1]["kind"].as_str()),
-            (Some("table"), Some("rgl"))
-        );
-        assert_eq!(list[0]["provenance"]["kind"], "measured");
-        assert_eq!(list[0]["has_source"], true);
-        let c = get_json(&v, "/api/compare?m=0");
-        assert!(c["weight"].as_str().unwrap().contains("80°"), "{c}");
-        assert!(c["rel_rmse"].as_f64().unwrap() < 0.2, "{c}");
-        get_json(&v, "/api/polar?m=0&of=source&n=5");
-    }
-    // Without the file beside it, the table is shown alone.
-    std::fs::remove_file(&bsdf).unwrap();
-    let v = start(&[&db]);
-    assert_eq!(get_json(&v, "/api/materials")[0]["has_source"], false);
-    assert_eq!(get(&v, "/api/compare?m=0").0, 404);
-    assert_eq!(get(&v, "/api/polar?m=0&of=source").0, 404);
 }
 
 #[test]

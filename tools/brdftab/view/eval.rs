@@ -4,11 +4,18 @@
 //! result is plain arrays the page draws. A view's luminance `y` (Rec. 709 weights for RGB, the
 //! mean of a spectrum) is what one curve or one surface shows; the per-channel values ride along
 //! where the page can use them.
+//!
+//! Every sweep samples the centres of equal cells (`centre`), as the library's tables and
+//! `brdftab slice` do, so no direction lies at the horizon: there cos θ is 6e-17 and a measured
+//! file's f_r (its stored f_r cos θ over cos θ) reaches 1e14, which is the data's limit, not a
+//! value a plot can show.
 
 use brdftab::Brdf;
+use brdftab::analysis::albedo::albedo_curve;
 use brdftab::geometry::{self, HalfDiff};
 use brdftab::spectrum::Channels;
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::preview::image::to_srgb8;
 use serde_json::{Value, json};
@@ -39,13 +46,16 @@ fn luminances(brdf: &dyn Brdf, f: &[f32]) -> Vec<f32> {
     f.chunks(c).map(|p| luminance(brdf.channels(), p)).collect()
 }
 
-/// The in-plane polar curve: light at θi on the −x side, the viewer swept over θo ∈ [−90°, 90°]
-/// in the plane of incidence (positive θo towards the mirror direction), `n` points.
+/// The centre of cell `k` of `n` equal cells over [`lo`, `hi`].
+fn centre(k: usize, n: usize, lo: f64, hi: f64) -> f64 {
+    lo + (hi - lo) * (k as f64 + 0.5) / n as f64
+}
+
+/// The in-plane polar curve: light at θi on the −x side, the viewer at the centres of `n` cells
+/// of θo ∈ [−90°, 90°] in the plane of incidence (positive θo towards the mirror direction).
 pub fn polar(brdf: &dyn Brdf, theta_i_deg: f64, n: usize) -> Value {
     let wi = geometry::spherical(theta_i_deg.to_radians(), std::f64::consts::PI);
-    let thetas: Vec<f64> = (0..n)
-        .map(|k| -90.0 + 180.0 * k as f64 / (n - 1).max(1) as f64)
-        .collect();
+    let thetas: Vec<f64> = (0..n).map(|k| centre(k, n, -90.0, 90.0)).collect();
     let wo: Vec<DVec3> = thetas
         .iter()
         .map(|t| {
@@ -62,14 +72,13 @@ pub fn polar(brdf: &dyn Brdf, theta_i_deg: f64, n: usize) -> Value {
 }
 
 /// The lobe for light at (θi, φ = 180°): the luminance of f_r over the outgoing hemisphere on an
-/// `nt` × `np` grid of (θo ∈ [0°, 90°], φo ∈ [0°, 360°]), row by row.
+/// `nt` × `np` grid of (θo at the centres of `nt` cells of [0°, 90°], φo ∈ [0°, 360°)), row by
+/// row; `theta_o` lists the rows' angles.
 pub fn lobe(brdf: &dyn Brdf, theta_i_deg: f64, nt: usize, np: usize) -> Value {
     let wi = geometry::spherical(theta_i_deg.to_radians(), std::f64::consts::PI);
+    let rows: Vec<f64> = (0..nt).map(|i| centre(i, nt, 0.0, 90.0)).collect();
     let mut wo = Vec::with_capacity(nt * np);
-    for i in 0..nt {
-        let t = (90.0 * i as f64 / (nt - 1).max(1) as f64)
-            .min(89.5)
-            .to_radians();
+    for t in rows.iter().map(|t| t.to_radians()) {
         for j in 0..np {
             wo.push(geometry::spherical(
                 t,
@@ -78,21 +87,21 @@ pub fn lobe(brdf: &dyn Brdf, theta_i_deg: f64, nt: usize, np: usize) -> Value {
         }
     }
     let f = eval_pairs(brdf, &vec![wi; wo.len()], &wo);
-    json!({ "nt": nt, "np": np, "y": luminances(brdf, &f) })
+    json!({ "nt": nt, "np": np, "theta_o": rows, "y": luminances(brdf, &f) })
 }
 
 /// The MERL-style θh × θd slice at φd = 90°: `n` × `n` luminances, θh along rows' columns
-/// (`y[d * n + h]`), both angles over [0°, 90°].
+/// (`y[d * n + h]`), both angles at the centres of `n` cells of [0°, 90°] (`theta`).
 pub fn slice(brdf: &dyn Brdf, n: usize) -> Value {
-    let step = std::f64::consts::FRAC_PI_2 / (n - 1).max(1) as f64;
+    let angles: Vec<f64> = (0..n).map(|k| centre(k, n, 0.0, 90.0)).collect();
     let mut wi = Vec::with_capacity(n * n);
     let mut wo = Vec::with_capacity(n * n);
     for d in 0..n {
         for h in 0..n {
             let (i, o) = geometry::from_half_diff(HalfDiff {
-                theta_h: h as f64 * step,
+                theta_h: angles[h].to_radians(),
                 phi_h: 0.0,
-                theta_d: d as f64 * step,
+                theta_d: angles[d].to_radians(),
                 phi_d: std::f64::consts::FRAC_PI_2,
             });
             wi.push(i);
@@ -100,7 +109,7 @@ pub fn slice(brdf: &dyn Brdf, n: usize) -> Value {
         }
     }
     let f = eval_pairs(brdf, &wi, &wo);
-    json!({ "n": n, "y": luminances(brdf, &f) })
+    json!({ "n": n, "theta": angles, "y": luminances(brdf, &f) })
 }
 
 /// A sphere seen from +z (orthographic) under a distant light from (θ, φ) measured from the view
@@ -153,12 +162,19 @@ pub fn sphere(
 }
 
 /// The directional albedo at θ′ = 0°, 5°, ..., 85°, 89° (azimuth 0) per channel and its
-/// luminance, with the quadrature of the accuracy suite.
-pub fn albedo(brdf: &dyn Brdf) -> Value {
+/// luminance: the library's [`Brdf::albedo`], as `brdftab albedo` gives it (closed forms where a
+/// model has one, delta lobes' reflectance, the bounded quadrature of data).
+pub fn albedo(brdf: &(dyn Brdf + Sync)) -> Value {
     let mut deg: Vec<f64> = (0..18).map(|k| 5.0 * k as f64).collect();
     deg.push(89.0);
-    let rad: Vec<f64> = deg.iter().map(|d| d.to_radians()).collect();
-    let a = crate::report::suite::albedos(brdf, &rad);
+    let a: Vec<Vec<f64>> = brdftab::par::install(|| {
+        deg.par_iter()
+            .map(|d| {
+                let rad = d.to_radians();
+                albedo_curve(brdf, &[rad]).map_or_else(|_| vec![], |mut c| c.remove(0))
+            })
+            .collect()
+    });
     let y: Vec<f64> = a
         .iter()
         .map(|row| {

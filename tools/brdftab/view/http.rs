@@ -3,17 +3,19 @@
 //! The parsing is `httparse` (hyper's parser); what is ours is the bounds around it. A request
 //! head over [`MAX_HEAD`] bytes is refused (431) before it is parsed, a body over [`MAX_BODY`] is
 //! refused (413) before it is read, chunked bodies are refused (the page never sends one), and
-//! the socket's read timeout ([`READ_TIMEOUT`], set by the caller) ends a client that stalls.
+//! [`Deadline`] gives the whole request — head and body — [`READ_TIMEOUT`] in all, so a client
+//! that trickles a byte at a time is cut off as surely as one that stalls.
 //! Every response closes its connection, so no state outlives a request.
 
 use std::io::{Read, Write};
-use std::time::Duration;
+use std::net::TcpStream;
+use std::time::{Duration, Instant};
 
 /// The largest request head (request line + headers) read: URLs with an inline spec fit easily.
 pub const MAX_HEAD: usize = 16 * 1024;
 /// The largest request body read.
 pub const MAX_BODY: usize = 64 * 1024;
-/// How long a client may stall while sending its request.
+/// How long a client may take to send its whole request (head and body).
 pub const READ_TIMEOUT: Duration = Duration::from_secs(5);
 /// How long writing a response may stall.
 pub const WRITE_TIMEOUT: Duration = Duration::from_secs(10);
@@ -61,6 +63,35 @@ impl Response {
             status,
             ..Response::json(body)
         }
+    }
+}
+
+/// A connection read against one deadline for the whole request: each read may wait only for
+/// what is left of it, so the per-read socket timeout cannot be renewed a byte at a time.
+pub struct Deadline<'a> {
+    stream: &'a TcpStream,
+    until: Instant,
+}
+
+impl<'a> Deadline<'a> {
+    /// Reads from `stream` for at most `total` from now.
+    pub fn new(stream: &'a TcpStream, total: Duration) -> Deadline<'a> {
+        Deadline {
+            stream,
+            until: Instant::now() + total,
+        }
+    }
+}
+
+impl Read for Deadline<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let left = self.until.saturating_duration_since(Instant::now());
+        if left.is_zero() {
+            return Err(std::io::ErrorKind::TimedOut.into());
+        }
+        self.stream.set_read_timeout(Some(left))?;
+        let mut s = self.stream;
+        s.read(buf)
     }
 }
 

@@ -91,9 +91,9 @@ impl Server {
 /// Answers one connection: one request, one response, closed. A handler that panics answers
 /// 500 and the worker lives on.
 fn serve(reg: &Registry, hosts: &[String], mut stream: TcpStream) {
-    let _ = stream.set_read_timeout(Some(http::READ_TIMEOUT));
     let _ = stream.set_write_timeout(Some(http::WRITE_TIMEOUT));
-    let (response, head_only) = match http::read_request(&mut stream) {
+    let read = http::read_request(&mut http::Deadline::new(&stream, http::READ_TIMEOUT));
+    let (response, head_only) = match read {
         Ok(req) => {
             let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 routes::handle(reg, hosts, &req)

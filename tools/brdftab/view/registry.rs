@@ -4,13 +4,15 @@
 //! per table. Every material is opened here, once (tables decoded eagerly, so a slider never
 //! waits on a chunk and a corrupt table fails the start), and gets an index: the page names
 //! materials by that index only, never by path. A table whose provenance names a source that
-//! opens — a model spec, or a measured file of that name beside the database — is paired with
-//! it, so the page can show the difference and the error figures.
+//! opens — a model spec, or a measured file of that name and SHA-256 beside the database — is
+//! paired with it, so the page can show the difference and the error figures. A file of that
+//! name whose hash differs is another measurement: it is not paired, and the list says why.
 
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
+use brdftab::measured::merl::sha256_file;
 use brdftab::source::{OpenOptions, SourceKind, classify};
 use brdftab::store::{db, info, tables};
 use brdftab::{Brdf, Error, Result};
@@ -155,7 +157,11 @@ fn material(
         info["codec"] = s["codec"].clone();
         info["provenance"] = s["source"].clone();
         let dir = Path::new(brdftab::store::name::path_of(source)).parent();
-        (paired, measured_source) = provenance_source(&s["source"], dir);
+        let note;
+        (paired, measured_source, note) = provenance_source(&s["source"], dir);
+        if let Some(n) = note {
+            info["source_note"] = json!(n);
+        }
     }
     info["has_source"] = json!(paired.is_some());
     Ok(Material {
@@ -167,27 +173,42 @@ fn material(
 }
 
 /// The source a table's provenance names, if it opens: a model spec, or a measured file of the
-/// recorded name in the table's directory (the provenance keeps the file name only). Whether it
-/// is measured rides along.
-fn provenance_source(p: &Value, dir: Option<&Path>) -> (Option<Shared>, bool) {
+/// recorded name in the table's directory (the provenance keeps the file name only) whose
+/// SHA-256 is the recorded one. Whether it is measured rides along, and why a file of that name
+/// was not paired.
+fn provenance_source(p: &Value, dir: Option<&Path>) -> (Option<Shared>, bool, Option<String>) {
     match p["kind"].as_str() {
         Some("model") => {
             let spec = p["spec"].to_string();
             let opened = brdftab::open(&spec).ok().map(Arc::from);
-            (opened, false)
+            (opened, false, None)
         }
         Some("measured") => {
             let Some(file) = p["file"].as_str().filter(|f| !f.contains(['/', '\\'])) else {
-                return (None, false);
+                return (None, false, None);
             };
             let path = dir.unwrap_or(Path::new(".")).join(file);
-            let opened = path
+            let Some(path) = path
                 .to_str()
                 .filter(|p| classify(p).is_measured() && Path::new(p).is_file())
-                .and_then(|p| brdftab::open(p).ok())
-                .map(Arc::from);
-            (opened, true)
+            else {
+                return (None, true, None);
+            };
+            let recorded = p["sha256"].as_str().unwrap_or_default();
+            match sha256_file(path) {
+                Ok(sha) if sha.eq_ignore_ascii_case(recorded) => {
+                    (brdftab::open(path).ok().map(Arc::from), true, None)
+                }
+                Ok(_) => (
+                    None,
+                    true,
+                    Some(format!(
+                        "{file} beside it is not the file it was baked from (its sha256 differs)"
+                    )),
+                ),
+                Err(_) => (None, true, None),
+            }
         }
-        _ => (None, false),
+        _ => (None, false, None),
     }
 }

@@ -20,6 +20,7 @@ const ASSETS: &[(&str, &str, &str)] = &[
     ("/list.js", JS, include_str!("assets/list.js")),
     ("/spec.js", JS, include_str!("assets/spec.js")),
     ("/plots.js", JS, include_str!("assets/plots.js")),
+    ("/report.js", JS, include_str!("assets/report.js")),
     (
         "/style.css",
         "text/css; charset=utf-8",

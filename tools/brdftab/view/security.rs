@@ -93,10 +93,16 @@ fn decode(s: &str) -> Result<String, &'static str> {
 
 /// Parses a page-supplied SOURCE that must be an inline analytic spec; anything else — a path to
 /// a `.json` file, a table, `DB#NAME`, a measured file — is refused without opening it.
+///
+/// The `{` comes first: [`classify`] looks for a file named like a `FILE#NAME` string, so a
+/// string that is not inline JSON must be refused before anything classifies it.
 pub fn inline_spec(source: &str) -> Result<ModelSpec, String> {
-    let inline = source.trim_start().starts_with('{');
-    if classify(source) != SourceKind::Spec || !inline {
-        return Err("only inline model specs ({\"model\": ...}) are evaluated here".into());
+    let refused = || "only inline model specs ({\"model\": ...}) are evaluated here".to_owned();
+    if !source.trim_start().starts_with('{') {
+        return Err(refused());
+    }
+    if classify(source) != SourceKind::Spec {
+        return Err(refused());
     }
     ModelSpec::parse(source).map_err(|e| e.to_string())
 }

@@ -25,7 +25,7 @@ from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
-from selenium.webdriver.support.ui import WebDriverWait
+from selenium.webdriver.support.ui import Select, WebDriverWait
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "..", ".."))
 BUDGET_MS = 100.0
@@ -116,6 +116,9 @@ def check(driver, url, screenshot):
     driver.save_screenshot(screenshot)
     check_downloads(driver, wait)
     check_spec_and_shared_url(driver, wait)
+    check_scales(driver)
+    check_hash_and_errors(driver, wait, url)
+    check_ggx_sliders(driver, wait)
     errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
     assert not errors, f"console errors: {errors}"
     median = statistics.median(times)
@@ -160,6 +163,72 @@ def check_spec_and_shared_url(driver, wait):
     assert driver.find_element(By.ID, "spec-on").is_selected()
     assert driver.find_element(By.ID, "vs-source").is_selected()
     wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#polar polyline")) == lines + 1)
+
+
+def check_scales(driver):
+    """A few grazing samples (measured data near the horizon) do not set a plot's scale: they
+    are clipped, and the plot says so."""
+    legend = driver.execute_script("""
+        const xs = Array.from({length: 180}, (_, k) => -89.5 + k);
+        const ys = xs.map((t) => (Math.abs(t) > 89 ? 1e14 : 0.3));
+        polarPlot($("polar"), [{x: xs, y: ys, color: "#000"}], {log: false, thetaI: 30, label: ""});
+        const polar = [...$("polar").querySelectorAll("text")].map((t) => t.textContent).find((t) => t.startsWith("scale"));
+        const n = 10, theta = Array.from({length: n}, (_, k) => 4.5 + 9 * k);
+        const y = Array.from({length: n * n}, (_, k) => (k % n === n - 1 || k >= n * (n - 1) ? 1 : 0.01));
+        heatmap($("slice"), n, y, {signed: true, theta, label: ""});
+        return [polar, [...$("slice").querySelectorAll("text")].map((t) => t.textContent).join(" | ")];""")
+    assert legend[0].startswith("scale 0.300; 2 grazing samples clipped"), legend
+    assert "scale ±0.0100" in legend[1] and "19 cells clipped" in legend[1], legend
+
+
+def check_hash_and_errors(driver, wait, url):
+    """URL values are clamped to the controls; bad material indices are dropped; a view's error
+    stays on its panel when other views succeed."""
+    base = url.split("#")[0]
+    driver.get("about:blank")
+    driver.get(base + "#m=0&ti=90&lt=200&ev=-20")
+    wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#polar polyline"))
+    assert driver.find_element(By.ID, "theta-i").get_attribute("value") == "89"
+    assert driver.find_element(By.ID, "theta-i-val").text == "89°"
+    assert "ti=89" in driver.current_url and "lt=90" in driver.current_url, driver.current_url
+    assert "ev=-4" in driver.current_url, driver.current_url
+    for h, want in [("#m=0.5", 0), ("#m=1,1,1,1", 1), ("#m=-1,1", 1)]:
+        driver.get("about:blank")
+        driver.get(base + h)
+        wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#materials li"))
+        time.sleep(0.5)
+        assert len(driver.find_elements(By.CSS_SELECTOR, "#materials li.selected")) == want, h
+    errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+    assert not errors, f"console errors: {errors}"
+    err = driver.execute_async_script("""
+        const done = arguments[arguments.length - 1];
+        (async () => {
+          await view("polar", "theta_i=95&n=180", () => {});
+          await sphereView(48);
+          return document.querySelector('.panel[data-plot="polar"] .error').textContent;
+        })().then(done);""")
+    assert "theta_i" in err, err
+    driver.get_log("browser")  # that 400 was asked for
+
+
+def check_ggx_sliders(driver, wait):
+    """GGX offers alpha or alpha_x and alpha_y, never the three: every slider gives a valid
+    spec."""
+    labels = lambda d: [l.text.split("\n")[0].split(" ")[0] for l in d.find_elements(By.CSS_SELECTOR, "#params label")]
+    Select(driver.find_element(By.ID, "model")).select_by_value("ggx")
+    wait.until(lambda d: "alpha" in labels(d))
+    assert "alpha_x" not in labels(driver), labels(driver)
+    Select(driver.find_element(By.CSS_SELECTOR, "#params select")).select_by_index(1)
+    wait.until(lambda d: "alpha_x" in labels(d) and "alpha_y" in labels(d) and "alpha" not in labels(d))
+    if not driver.find_element(By.ID, "spec-on").is_selected():
+        driver.find_element(By.ID, "spec-on").click()
+    slider = driver.find_element(By.CSS_SELECTOR, "#params input[type=range]")
+    for _ in range(10):
+        slider.send_keys(Keys.ARROW_RIGHT)
+    time.sleep(1.5)
+    assert '"alpha_x"' in driver.find_element(By.ID, "spec-json").get_attribute("value")
+    errs = [e.text for e in driver.find_elements(By.CSS_SELECTOR, ".panel .error") if e.text]
+    assert not errs, errs
 
 
 if __name__ == "__main__":

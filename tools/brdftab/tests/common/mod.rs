@@ -7,6 +7,8 @@
 // Each test binary compiles this module and uses part of it.
 #![allow(dead_code)]
 
+pub mod viewer;
+
 use std::io::{Read, Write};
 use std::process::{Command, Stdio};
 use std::thread::JoinHandle;

@@ -3,7 +3,11 @@
 "use strict";
 
 const $ = (id) => document.getElementById(id);
-const state = { sel: [], ti: 30, scale: "linear", cos: false, src: false, lt: 40, lp: 135, ev: 0, spec: "", on: false, yaw: -0.7, pitch: 1.05 };
+// What a hash that does not name a setting means.
+const DEFAULTS = { ti: 30, scale: "linear", cos: false, src: false, lt: 40, lp: 135, ev: 0, yaw: -0.7, pitch: 1.05 };
+const state = Object.assign({ sel: [], spec: "", on: false }, DEFAULTS);
+// The settings with a slider: a hash value is clamped to its range and step.
+const SLIDERS = { ti: "theta-i", lt: "light-theta", lp: "light-phi", ev: "exposure" };
 let materials = [], models = [];
 const gen = {}; // newest request per view: older answers are dropped
 const data = { polar: [], lobe: [] };
@@ -16,10 +20,23 @@ async function getJSON(path) {
 }
 
 // ---- the URL hash ----
+function clampTo(id, x) {
+  const e = $(id), lo = +e.min, hi = +e.max, step = +e.step || 1;
+  return Math.min(hi, Math.max(lo, lo + Math.round((x - lo) / step) * step));
+}
+
 function readHash() {
   const h = new URLSearchParams(location.hash.slice(1));
-  if (h.get("m")) state.sel = h.get("m").split(",").map(Number).filter((i) => i >= 0 && i < materials.length).slice(0, 4);
-  for (const k of ["ti", "lt", "lp", "ev", "yaw", "pitch"]) if (h.has(k) && Number.isFinite(+h.get(k))) state[k] = +h.get(k);
+  Object.assign(state, DEFAULTS);
+  const num = (k) => (h.has(k) && h.get(k).trim() !== "" && Number.isFinite(+h.get(k)) ? +h.get(k) : null);
+  if (h.has("m")) {
+    // Material indices only (no 0.5, no -1), each once.
+    const ids = h.get("m").split(",").filter((x) => /^\d+$/.test(x)).map(Number).filter((i) => i < materials.length);
+    state.sel = [...new Set(ids)].slice(0, 4);
+  }
+  for (const [k, id] of Object.entries(SLIDERS)) if (num(k) !== null) state[k] = clampTo(id, num(k));
+  if (num("yaw") !== null) state.yaw = num("yaw");
+  if (num("pitch") !== null) state.pitch = Math.min(Math.PI, Math.max(0, num("pitch")));
   if (h.has("scale")) state.scale = h.get("scale") === "log" ? "log" : "linear";
   state.cos = h.get("cos") === "1";
   state.src = h.get("src") === "1";
@@ -51,19 +68,24 @@ function entries() {
   return out;
 }
 
+// Fetches one view of every entry and draws those that answered; the panel keeps the others'
+// errors until its next answer (another view's success does not clear them).
 async function view(name, params, draw) {
   const g = (gen[name] = (gen[name] || 0) + 1);
   const list = entries();
-  try {
-    const got = await Promise.all(list.map((e) => getJSON(`/api/${name}?${e.q}&${params}`)));
-    if (g !== gen[name]) return false;
-    draw(list, got);
-    $("spec-error").textContent = "";
-    return true;
-  } catch (err) {
-    if (g === gen[name]) $("spec-error").textContent = String(err.message || err);
-    return false;
-  }
+  const got = await Promise.all(list.map((e) => getJSON(`/api/${name}?${e.q}&${params}`)
+    .then((v) => ({ e, v }), (err) => ({ e, err: `${e.label}: ${err.message || err}` }))));
+  if (g !== gen[name]) return false;
+  const ok = got.filter((x) => !x.err), errors = got.filter((x) => x.err).map((x) => x.err);
+  document.querySelector(`.panel[data-plot="${name}"] .error`).textContent = errors.join("; ");
+  draw(ok.map((x) => x.e), ok.map((x) => x.v));
+  return errors.length === 0;
+}
+
+// Each shown table with its shown source, as [table, source] of a view's {e, v} items.
+function withSource(items) {
+  return items.filter((a) => a.e.id !== undefined && a.e.sourceOf === undefined)
+    .map((a) => [a, items.find((o) => o.e.sourceOf === a.e.id)]).filter(([, b]) => b);
 }
 
 // ---- the views ----
@@ -74,10 +96,7 @@ function polarSeries() {
     series.push({ x: v.theta_o, y, color: e.color, dash: e.dash });
   });
   // The difference of each table and its source, thin.
-  for (const a of data.polar) {
-    if (a.e.id === undefined || a.e.sourceOf !== undefined) continue;
-    const b = data.polar.find((o) => o.e.sourceOf === a.e.id);
-    if (!b) continue;
+  for (const [a, b] of withSource(data.polar)) {
     const y = a.v.y.map((f, k) => Math.abs(f - b.v.y[k]) * (state.cos ? Math.cos((a.v.theta_o[k] * Math.PI) / 180) : 1));
     series.push({ x: a.v.theta_o, y, color: a.e.color, dash: "1 2", width: 1 });
   }
@@ -89,18 +108,19 @@ function drawPolar() {
 }
 
 function drawLobe() {
-  lobePlot($("lobe"), data.lobe.map(({ e, v }) => ({
-    nt: v.nt, np: v.np, color: e.color, dash: e.dash,
-    r: v.y.map((f, k) => {
-      const t = (Math.PI / 2) * Math.floor(k / v.np) / (v.nt - 1);
-      return state.cos ? f * Math.cos(t) : f;
-    }),
-  })), { yaw: state.yaw, pitch: state.pitch, log: state.scale === "log" });
+  const weigh = (v, y) => y.map((f, k) => (state.cos ? f * Math.cos((v.theta_o[Math.floor(k / v.np)] * Math.PI) / 180) : f));
+  const lobes = data.lobe.map(({ e, v }) => ({ nt: v.nt, np: v.np, theta: v.theta_o, color: e.color, dash: e.dash, r: weigh(v, v.y) }));
+  // The difference of each table and its source, thin.
+  for (const [a, b] of withSource(data.lobe)) {
+    const d = a.v.y.map((f, k) => Math.abs(f - b.v.y[k]));
+    lobes.push({ nt: a.v.nt, np: a.v.np, theta: a.v.theta_o, color: a.e.color, dash: "1 2", width: 0.4, r: weigh(a.v, d) });
+  }
+  lobePlot($("lobe"), lobes, { yaw: state.yaw, pitch: state.pitch, log: state.scale === "log", thetaI: state.ti });
 }
 
 async function fastViews() {
   const t0 = performance.now();
-  const p = view("polar", `theta_i=${state.ti}&n=181`, (list, got) => {
+  const p = view("polar", `theta_i=${state.ti}&n=180`, (list, got) => {
     data.polar = list.map((e, k) => ({ e, v: got[k] }));
     drawPolar();
   });
@@ -134,61 +154,34 @@ function sphereView(size) {
   });
 }
 
+// The slice of the first selected material (a map cannot overlay); with "table vs its source",
+// its relative difference to its source.
 function sliceView() {
   return view("slice", "n=64", (list, got) => {
     const log = state.scale === "log";
-    if (!got.length) return clear($("slice"));
+    if (!got.length || list[0].sourceOf !== undefined) return clear($("slice"));
     const a = list[0], s = a.id === undefined ? -1 : list.findIndex((o) => o.sourceOf === a.id);
+    const v = got[0];
     if (s > 0) {
       // Relative to the source (floored at 1e-5 /sr): absolute differences would show only the
       // grazing row, where analytic lobes reach 1e5.
       const src = got[s].y;
-      const d = got[0].y.map((v, k) => (v - src[k]) / Math.max(Math.abs(src[k]), 1e-5));
-      heatmap($("slice"), got[0].n, d, { signed: true, label: `${a.label}: (table − source) / source` });
-    } else heatmap($("slice"), got[0].n, got[0].y, { log, label: a.label });
+      const d = v.y.map((f, k) => (f - src[k]) / Math.max(Math.abs(src[k]), 1e-5));
+      heatmap($("slice"), v.n, d, { signed: true, theta: v.theta, label: `${a.label}: (table − source) / source` });
+    } else heatmap($("slice"), v.n, v.y, { log, theta: v.theta, label: a.label });
   });
 }
 
 function albedoView() {
   return view("albedo", "", (list, got) => {
-    const series = got.map((v, k) => ({ x: v.theta, y: v.y, color: list[k].color, dash: list[k].dash }));
+    const items = list.map((e, k) => ({ e, v: got[k] }));
+    const series = items.map(({ e, v }) => ({ x: v.theta, y: v.y, color: e.color, dash: e.dash }));
+    // The difference of each table and its source, thin.
+    for (const [a, b] of withSource(items)) {
+      series.push({ x: a.v.theta, y: a.v.y.map((f, k) => Math.abs(f - b.v.y[k])), color: a.e.color, dash: "1 2", width: 1 });
+    }
     linePlot($("albedo"), series, { x0: 0, x1: 90, dx: 15, xlabel: "θ′ (luminance)" });
   });
-}
-
-async function report() {
-  const list = entries().filter((e) => e.sourceOf === undefined);
-  const rows = await Promise.all(list.map(async (e) => {
-    const p = await getJSON(`/api/plausibility?${e.q}`).catch(() => null);
-    const m = e.id !== undefined && materials[e.id].has_source ? await getJSON(`/api/compare?m=${e.id}`).catch(() => null) : null;
-    return { e, p, m };
-  }));
-  // Built as DOM nodes, not HTML text: the page's CSP allows no inline style attributes.
-  const table = document.createElement("table");
-  const row = (cells, head) => {
-    const tr = table.insertRow();
-    for (const c of cells) {
-      const td = document.createElement(head ? "th" : "td");
-      if (typeof c === "string") td.textContent = c;
-      else { td.textContent = c.text; if (c.cls) td.className = c.cls; if (c.color) td.style.color = c.color; }
-      tr.appendChild(td);
-    }
-  };
-  const yn = (b, x) => ({ text: (b ? "yes" : "no") + (x ? ` (${x})` : ""), cls: b ? "ok" : "bad" });
-  row(["", "positive", "reciprocal", "energy (max a)", "cos-weighted err", "albedo err"], true);
-  for (const { e, p, m } of rows) {
-    const cells = [{ text: e.label, color: e.color }];
-    if (p) cells.push(yn(p.positive), yn(p.reciprocal, p.max_reciprocity_error.toExponential(1)), yn(p.energy_conserving, p.max_albedo.toFixed(3)));
-    else cells.push("…", "…", "…");
-    if (m && !m.error) cells.push(`${(100 * m.rel_rmse).toFixed(3)} %`, `${(100 * m.albedo_err).toFixed(3)} %`);
-    else cells.push("–", "–");
-    row(cells);
-  }
-  $("report").replaceChildren(table);
-}
-
-function escapeHtml(s) {
-  return s.replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(0)};`);
 }
 
 let slowTimer = null;
@@ -206,9 +199,19 @@ function redrawAll() {
 }
 
 // ---- controls ----
+// The controls showing `state` (at start and when the hash changes).
+function syncControls() {
+  for (const [k, id] of Object.entries(SLIDERS)) $(id).value = state[k];
+  $("theta-i-val").textContent = `${state.ti}°`;
+  $("scale").value = state.scale;
+  $("cosine").checked = state.cos;
+  $("vs-source").checked = state.src;
+  $("spec-on").checked = state.on;
+}
+
 function bind() {
+  syncControls();
   const range = (id, key, fast) => {
-    $(id).value = state[key];
     $(id).addEventListener("input", () => { state[key] = +$(id).value; writeHash(); fast(true); });
     $(id).addEventListener("change", () => fast(false));
   };
@@ -216,14 +219,9 @@ function bind() {
   range("light-theta", "lt", (drag) => sphereView(drag ? 48 : 128));
   range("light-phi", "lp", (drag) => sphereView(drag ? 48 : 128));
   range("exposure", "ev", (drag) => sphereView(drag ? 48 : 128));
-  $("theta-i-val").textContent = `${state.ti}°`;
-  $("scale").value = state.scale;
   $("scale").addEventListener("change", () => { state.scale = $("scale").value; writeHash(); drawPolar(); drawLobe(); sliceView(); });
-  $("cosine").checked = state.cos;
   $("cosine").addEventListener("change", () => { state.cos = $("cosine").checked; writeHash(); drawPolar(); drawLobe(); });
-  $("vs-source").checked = state.src;
   $("vs-source").addEventListener("change", () => { state.src = $("vs-source").checked; redrawAll(); });
-  $("spec-on").checked = state.on;
   $("spec-on").addEventListener("change", () => {
     state.on = $("spec-on").checked && state.spec !== "";
     if (state.on) state.sel = state.sel.slice(0, 3); // four curves at most
@@ -232,10 +230,11 @@ function bind() {
   $("model").addEventListener("change", () => {
     const m = models.find((x) => x.name === $("model").value);
     loadSpec(m.example);
+    $("spec-error").textContent = "";
     specChanged(JSON.parse(state.spec));
   });
   $("spec-json").addEventListener("input", () => {
-    try { const s = JSON.parse($("spec-json").value); state.spec = JSON.stringify(s); buildParams(s); specChanged(s); }
+    try { const s = JSON.parse($("spec-json").value); $("spec-error").textContent = ""; state.spec = JSON.stringify(s); buildParams(s); specChanged(s); }
     catch { $("spec-error").textContent = "not JSON yet"; }
   });
   // Drag on the lobe rotates it; drag on the sphere moves the light.
@@ -248,6 +247,7 @@ function bind() {
   }, () => { writeHash(); sphereView(128); });
   for (const panel of document.querySelectorAll(".panel[data-plot]")) {
     addDownloads(panel, panel.querySelector("svg"), "brdftab-" + panel.dataset.plot);
+    panel.appendChild(Object.assign(document.createElement("p"), { className: "error" }));
   }
 }
 
@@ -270,7 +270,12 @@ async function main() {
   loadSpec(state.spec || models.find((m) => m.name === "cook_torrance").example);
   bind();
   redrawAll();
-  window.addEventListener("hashchange", () => { readHash(); redrawAll(); });
+  window.addEventListener("hashchange", () => {
+    readHash();
+    syncControls();
+    if (state.spec && state.spec !== $("spec-json").value) loadSpec(state.spec);
+    redrawAll();
+  });
 }
 
 main();

@@ -23,10 +23,36 @@ function clear(svg) {
   el("rect", { x: 0, y: 0, width: "100%", height: "100%", fill: "#fff" }, svg);
 }
 
-// A value mapped to [0, 1] on the plot's scale: linear against max, or log over 4 decades.
+// A value mapped to [0, 1] on the plot's scale: linear against max, or log over 4 decades;
+// values above the scale are clipped at 1.
 function scaler(max, log) {
-  if (log) return (v) => (v > 0 ? Math.max(0, 1 + Math.log10(v / max) / 4) : 0);
-  return (v) => Math.max(0, v / max);
+  if (log) return (v) => (v > 0 ? Math.min(1, Math.max(0, 1 + Math.log10(v / max) / 4)) : 0);
+  return (v) => Math.min(1, Math.max(0, v / max));
+}
+
+// Plots are scaled by their samples within SCALE_DEG of the normal (or up to θi when the light
+// is lower): measured data rise like 1/cos θ towards the horizon, where they are extrapolated
+// (the error figures leave that band out too), and a few grazing samples would make the rest of
+// the plot invisible. Samples beyond the scale are clipped, and the plot says how many.
+const SCALE_DEG = 80;
+
+// The scale of `series` ({x: angle, y: value}) counting the samples `keep(x)` accepts: {max,
+// top: the largest of all, clipped: how many exceed max}.
+function robustScale(series, keep) {
+  let max = 0, top = 0, clipped = 0;
+  for (const s of series) s.y.forEach((v, k) => {
+    if (!Number.isFinite(v)) return;
+    top = Math.max(top, Math.abs(v));
+    if (keep(s.x[k])) max = Math.max(max, Math.abs(v));
+  });
+  if (!(max > 0)) max = top > 0 ? top : 1;
+  for (const s of series) for (const v of s.y) if (Math.abs(v) > max) clipped++;
+  return { max, top, clipped };
+}
+
+function scaleNote(sc, what, sign) {
+  const note = `scale ${sign || ""}${sc.max.toPrecision(3)}`;
+  return sc.clipped ? `${note}; ${sc.clipped} ${what} clipped, up to ${sc.top.toPrecision(3)}` : note;
 }
 
 function seriesMax(series) {
@@ -39,7 +65,8 @@ function seriesMax(series) {
 function polarPlot(svg, series, opts) {
   clear(svg);
   const cx = 210, cy = 220, R = 195;
-  const max = seriesMax(series), s = scaler(max, opts.log);
+  const keep = (t) => Math.abs(t) <= Math.max(SCALE_DEG, opts.thetaI);
+  const sc = robustScale(series, keep), s = scaler(sc.max, opts.log);
   for (const f of [0.25, 0.5, 0.75, 1]) {
     el("path", { d: `M${cx - R * f},${cy} A${R * f},${R * f} 0 0 1 ${cx + R * f},${cy}`, fill: "none", stroke: "#ddd" }, svg);
   }
@@ -50,7 +77,7 @@ function polarPlot(svg, series, opts) {
   }
   const ti = (opts.thetaI * Math.PI) / 180;
   el("line", { x1: cx, y1: cy, x2: cx - R * Math.sin(ti), y2: cy - R * Math.cos(ti), stroke: "#999", "stroke-dasharray": "4 3" }, svg);
-  text(svg, 4, 12, opts.log ? `log scale, max ${max.toPrecision(3)}` : `max ${max.toPrecision(3)}`);
+  text(svg, 4, 12, (opts.log ? "log, " : "") + scaleNote(sc, "grazing samples"));
   text(svg, 4, 24, opts.label);
   for (const ser of series) {
     const pts = ser.x.map((t, k) => {
@@ -58,6 +85,12 @@ function polarPlot(svg, series, opts) {
       return `${(cx + v * Math.sin(r)).toFixed(1)},${(cy - v * Math.cos(r)).toFixed(1)}`;
     });
     el("polyline", { points: pts.join(" "), fill: "none", stroke: ser.color, "stroke-width": ser.width || 1.5, "stroke-dasharray": ser.dash || "" }, svg);
+    // Clipped samples: a ring on the rim.
+    ser.x.forEach((t, k) => {
+      if (!(Math.abs(ser.y[k]) > sc.max)) return;
+      const r = (t * Math.PI) / 180;
+      el("circle", { cx: cx + R * Math.sin(r), cy: cy - R * Math.cos(r), r: 2.5, fill: "none", stroke: ser.color }, svg);
+    });
   }
 }
 
@@ -78,7 +111,7 @@ function linePlot(svg, series, opts) {
   text(svg, L + W - 60, T + H + 26, opts.xlabel);
   for (const ser of series) {
     const pts = ser.x.map((x, k) => `${X(x).toFixed(1)},${Y(ser.y[k]).toFixed(1)}`);
-    el("polyline", { points: pts.join(" "), fill: "none", stroke: ser.color, "stroke-width": 1.5, "stroke-dasharray": ser.dash || "" }, svg);
+    el("polyline", { points: pts.join(" "), fill: "none", stroke: ser.color, "stroke-width": ser.width || 1.5, "stroke-dasharray": ser.dash || "" }, svg);
   }
 }
 
@@ -95,11 +128,17 @@ function ramp(t) {
 function heatmap(svg, n, y, opts) {
   clear(svg);
   const S = 200, L = 34, T = 6, cell = S / n;
-  // Signed maps (differences) scale by the 99th percentile, so one grazing outlier does not
-  // wash the rest out; others by their maximum.
-  const mags = y.filter((v) => Number.isFinite(v) && v !== 0).map(Math.abs).sort((a, b) => a - b);
+  // The cells that set the scale: both directions within SCALE_DEG of the normal (at φd = 90°
+  // both make cos θ = cos θh cos θd with it). Signed maps (differences) scale by the 99th
+  // percentile of those, so a few cells where the source is tiny do not wash the rest out;
+  // others by their maximum.
+  const c = (t) => Math.cos((t * Math.PI) / 180), cut = c(SCALE_DEG);
+  const mags = y.filter((v, k) => Number.isFinite(v) && v !== 0 && c(opts.theta[k % n]) * c(opts.theta[Math.floor(k / n)]) >= cut)
+    .map(Math.abs).sort((a, b) => a - b);
   const max = (opts.signed ? mags[Math.floor(0.99 * (mags.length - 1))] : mags[mags.length - 1]) || 1;
   const s = scaler(max, opts.log);
+  const all = y.filter(Number.isFinite).map(Math.abs);
+  const sc = { max, top: all.reduce((a, b) => Math.max(a, b), 0), clipped: all.filter((v) => v > max).length };
   const g = el("g", { "shape-rendering": "crispEdges" }, svg);
   for (let d = 0; d < n; d++) {
     for (let h = 0; h < n; h++) {
@@ -115,17 +154,18 @@ function heatmap(svg, n, y, opts) {
   text(svg, L + S / 2 - 10, T + S + 12, "θh →");
   text(svg, 2, T + S / 2, "θd ↑");
   text(svg, L, T + S + 26, opts.label);
-  const scale = opts.signed ? `±${max.toPrecision(3)} (red +, blue −)` : `max ${max.toPrecision(3)}`;
-  text(svg, L, T + S + 39, scale + (opts.log ? ", log over 4 decades" : ""));
+  const [scale, clip] = scaleNote(sc, "cells", opts.signed ? "±" : "").split("; ");
+  text(svg, L, T + S + 39, (opts.log ? "log, " : "") + (opts.signed ? "red +, blue −, " : "") + scale);
+  if (clip) text(svg, L, T + S + 52, clip);
 }
 
 // The 3D lobe: r(θo, φo) along each outgoing direction, rotated by yaw/pitch, projected.
 function lobePlot(svg, lobes, view) {
   clear(svg);
   const cx = 160, cy = 150, R = 120;
-  let max = 0;
-  for (const l of lobes) for (const v of l.r) max = Math.max(max, v);
-  const s = scaler(max || 1, view.log);
+  const keep = (t) => t <= Math.max(SCALE_DEG, view.thetaI);
+  const sc = robustScale(lobes.map((l) => ({ x: l.r.map((_, k) => l.theta[Math.floor(k / l.np)]), y: l.r })), keep);
+  const s = scaler(sc.max, view.log);
   const cy_ = Math.cos(view.yaw), sy = Math.sin(view.yaw), cp = Math.cos(view.pitch), sp = Math.sin(view.pitch);
   const project = (x, y, z) => {
     const x1 = cy_ * x - sy * y, y1 = sy * x + cy_ * y;
@@ -138,9 +178,10 @@ function lobePlot(svg, lobes, view) {
     text(svg, c, d, name);
   };
   axis(1, 0, 0, "x"); axis(0, 1, 0, "y"); axis(0, 0, 1, "n");
+  text(svg, 4, 12, (view.log ? "log, " : "") + scaleNote(sc, "grazing samples"));
   for (const l of lobes) {
     const pt = (i, j) => {
-      const t = (Math.PI / 2) * i / (l.nt - 1), p = (2 * Math.PI * j) / l.np, r = s(l.r[i * l.np + j]);
+      const t = (l.theta[i] * Math.PI) / 180, p = (2 * Math.PI * j) / l.np, r = s(l.r[i * l.np + j]);
       return project(r * Math.sin(t) * Math.cos(p), r * Math.sin(t) * Math.sin(p), r * Math.cos(t));
     };
     const lines = [];
@@ -155,7 +196,7 @@ function lobePlot(svg, lobes, view) {
       lines.push(col);
     }
     const d = lines.map((ps) => "M" + ps.map((p) => `${p[0].toFixed(1)},${p[1].toFixed(1)}`).join("L")).join("");
-    el("path", { d, fill: "none", stroke: l.color, "stroke-width": 0.7, "stroke-opacity": 0.85, "stroke-dasharray": l.dash || "" }, svg);
+    el("path", { d, fill: "none", stroke: l.color, "stroke-width": l.width || 0.7, "stroke-opacity": 0.85, "stroke-dasharray": l.dash || "" }, svg);
   }
 }
 

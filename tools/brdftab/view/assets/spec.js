@@ -5,6 +5,10 @@
 
 const FRESNEL = ['"none"', '{"conductor":"Au"}', '{"conductor":"Ag"}', '{"conductor":"Cu"}', '{"conductor":"Al"}', '{"eta":1.5}', '{"schlick":0.04}'];
 
+// Parameters a model takes one way or the other (its catalogue `rule`): the spec's way gets
+// sliders, and a choice switches ways, so no slider makes a spec the model refuses.
+const WAYS = { ggx: [{ label: "isotropic", params: ["alpha"] }, { label: "anisotropic", params: ["alpha_x", "alpha_y"] }] };
+
 function sliderRange(name, kind) {
   if (kind === "radians") return { min: 0, max: 1.5, log: false };
   if (name === "n") return { min: 0, max: 4, log: true };
@@ -27,7 +31,12 @@ function buildParams(spec) {
   box.innerHTML = "";
   const info = models.find((m) => m.name === spec.model);
   if (!info) return;
+  const ways = WAYS[spec.model] || [];
+  const way = Math.max(0, ways.findIndex((w) => w.params.some((n) => spec[n] !== undefined)));
+  const hidden = ways.filter((_, k) => k !== way).flatMap((w) => w.params);
+  if (ways.length) box.appendChild(wayChoice(spec, ways, way));
   for (const p of info.params) {
+    if (hidden.includes(p.name)) continue;
     const label = document.createElement("label");
     label.textContent = p.name;
     if (["number", "radians", "value"].includes(p.kind)) {
@@ -55,6 +64,25 @@ function buildParams(spec) {
     } else continue;
     box.appendChild(label);
   }
+}
+
+// The choice between a model's ways: switching carries the first value over to every
+// parameter of the other way (alpha 0.2 becomes alpha_x = alpha_y = 0.2).
+function wayChoice(spec, ways, way) {
+  const label = document.createElement("label");
+  label.textContent = "lobe";
+  const sel = document.createElement("select");
+  ways.forEach((w, k) => sel.add(new Option(`${w.label} (${w.params.join(", ")})`, k, false, k === way)));
+  sel.addEventListener("change", () => {
+    const next = JSON.parse(state.spec);
+    const v = ways[way].params.map((n) => next[n]).find((x) => typeof x === "number") ?? 0.1;
+    for (const w of ways) for (const n of w.params) delete next[n];
+    for (const n of ways[+sel.value].params) next[n] = v;
+    buildParams(next);
+    specChanged(next);
+  });
+  label.append(sel);
+  return label;
 }
 
 function specChanged(spec) {

@@ -1,0 +1,126 @@
+//! `brdftab view`'s server under clients that trickle or idle, and what it touches: a slow
+//! client is cut off by one deadline for its whole request, a refused `spec=` path is never
+//! looked up, and the start line counts its materials.
+
+mod common;
+
+use std::io::{BufRead, Read, Write};
+use std::net::TcpStream;
+use std::process::Stdio;
+use std::time::{Duration, Instant};
+
+use brdftab::testkit::TempDir;
+use common::viewer::{enc, get, get_json, start};
+
+const LAMBERT: &str = r#"{"model":"lambert","kd":0.5}"#;
+
+#[test]
+fn clients_that_trickle_their_request_are_cut_off_and_block_no_one() {
+    let v = start(&[LAMBERT]);
+    let port = v.port;
+    // Four clients sending a byte of a request head every second: each read is well within any
+    // per-read timeout, so only a deadline for the whole request ends them.
+    let tricklers: Vec<_> = (0..4)
+        .map(|_| {
+            std::thread::spawn(move || {
+                let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
+                s.set_read_timeout(Some(Duration::from_millis(1000)))
+                    .unwrap();
+                let t0 = Instant::now();
+                let mut out = Vec::new();
+                let head = b"GET /api/materials?x=aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa";
+                for &b in head.iter().cycle() {
+                    if t0.elapsed() > Duration::from_secs(15) || s.write_all(&[b]).is_err() {
+                        break;
+                    }
+                    // The answer arrives while we wait for the next byte's turn.
+                    let mut buf = [0u8; 512];
+                    match s.read(&mut buf) {
+                        Ok(0) => break,
+                        Ok(n) => out.extend_from_slice(&buf[..n]),
+                        Err(_) => {}
+                    }
+                }
+                (t0.elapsed(), String::from_utf8_lossy(&out).into_owned())
+            })
+        })
+        .collect();
+    // Meanwhile a plain request is answered at once.
+    std::thread::sleep(Duration::from_millis(1500));
+    let t0 = Instant::now();
+    assert_eq!(get(&v, "/api/materials").0, 200);
+    assert!(t0.elapsed() < Duration::from_secs(2), "{:?}", t0.elapsed());
+    for t in tricklers {
+        let (took, out) = t.join().unwrap();
+        assert!(
+            took < Duration::from_secs(9) && out.starts_with("HTTP/1.1 408"),
+            "cut off after {took:?}: {out:?}"
+        );
+    }
+}
+
+#[test]
+fn a_refused_spec_path_is_never_looked_up() {
+    // `classify` looks for a file named like a `FILE#NAME` string; the viewer must refuse
+    // a page's non-inline SOURCE before that. Seen with strace where it can trace.
+    let traced = std::process::Command::new("strace")
+        .args(["-f", "-e", "trace=%file", "-o", "/dev/null", "true"])
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !traced {
+        eprintln!("skipped: strace cannot trace here");
+        return;
+    }
+    let d = TempDir::new("view-stat");
+    let log = d.file("trace.txt");
+    let probe = d.file("probe.btdb#x");
+    let bin = env!("CARGO_BIN_EXE_brdftab");
+    let mut child = std::process::Command::new("strace")
+        .args(["-f", "-e", "trace=%file", "-o", &log, bin, "view", LAMBERT])
+        .args(["--port", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    std::io::BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let port: u16 = line
+        .split("http://127.0.0.1:")
+        .nth(1)
+        .and_then(|r| r.trim().trim_end_matches('/').parse().ok())
+        .unwrap_or_else(|| panic!("no URL in {line:?}"));
+    let req = format!(
+        "GET /api/polar?spec={} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n",
+        enc(&probe)
+    );
+    let (status, body) = common::viewer::send(port, req.as_bytes());
+    let _ = child.kill();
+    let _ = child.wait();
+    assert!(
+        status == 400 && body.contains("only inline"),
+        "{status} {body}"
+    );
+    let trace = std::fs::read_to_string(&log).unwrap();
+    assert!(!trace.contains("probe.btdb"), "looked up:\n{trace}");
+}
+
+#[test]
+fn the_start_line_counts_its_materials() {
+    let v = start(&[LAMBERT]);
+    assert!(
+        v.line.starts_with("brdftab view: 1 material at"),
+        "{}",
+        v.line
+    );
+    drop(v);
+    let v = start(&[LAMBERT, LAMBERT]);
+    assert!(
+        v.line.starts_with("brdftab view: 2 materials at"),
+        "{}",
+        v.line
+    );
+    assert_eq!(get_json(&v, "/api/materials").as_array().unwrap().len(), 2);
+}
