@@ -40,6 +40,13 @@ use crate::geometry;
 use crate::rng::Pcg32;
 use crate::spectrum::MAX_CHANNELS;
 
+/// The angles past 89° the default check looks at. The lecture's albedo argument for the
+/// original Phong (θ′ ≈ θ in the lobe) gives ≈ 2π k_s/(n+1), but its exact albedo grows like
+/// 1/cos θ′ and Ward's like 1/√cos θ′: both stay below 1 up to 89° for k_s = 0.5 (0.79 and
+/// 0.50) and pass 1 only beyond (Phong n = 20: 7.3 at 89.9°; Ward α = 0.5: 1.48 at 89.9°, 4.66
+/// at 89.99°). Checked on every degree alone, both were called energy conserving.
+pub const NEAR_HORIZON_DEG: [f64; 2] = [89.9, 89.99];
+
 /// Settings of [`check`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Options {
@@ -49,7 +56,8 @@ pub struct Options {
     pub seed: u64,
     /// Incidence angles in degrees at which the albedo is computed, each in [0°, 90°): light at
     /// the horizon has an albedo only as a limit, and not always a finite one (Ward's grows
-    /// like 1/cos θ′), so [`check`] refuses 90° as the `albedo` command does.
+    /// like 1/√cos θ′, the original Phong's like 1/cos θ′), so [`check`] refuses 90° as the
+    /// `albedo` command does. The default is every degree 0..89 and then [`NEAR_HORIZON_DEG`].
     pub thetas_deg: Vec<f64>,
     /// Largest relative reciprocity error still called reciprocal.
     pub reciprocity_tolerance: f64,
@@ -70,7 +78,7 @@ impl Default for Options {
         Options {
             pairs: 20_000,
             seed: 0x5eed_b7df,
-            thetas_deg: (0..90).map(f64::from).collect(),
+            thetas_deg: (0..90).map(f64::from).chain(NEAR_HORIZON_DEG).collect(),
             reciprocity_tolerance: 1e-3,
             reciprocity_floor: 1e-6,
             albedo_tolerance: 1e-3,
@@ -438,7 +446,7 @@ pub const LECTURE_MODELS: &[(&str, &str)] = &[
 /// albedo and where), and a list of the models this build cannot make.
 pub fn lecture_table() -> String {
     let mut text = format!(
-        "Physical plausibility of the lecture's BRDF models (RGB; albedo at θ′ = 0..89°)\n\n{:<26} {:<9} {:<22} energy conserving (max albedo @ θ′)\n",
+        "Physical plausibility of the lecture's BRDF models (RGB; albedo at θ′ = 0..89°, 89.9°, 89.99°)\n\n{:<26} {:<9} {:<22} energy conserving (max albedo @ θ′)\n",
         "model", "positive", "reciprocal (max err)"
     );
     let mut skipped = Vec::new();
@@ -639,6 +647,40 @@ mod tests {
         assert!(a.windows(2).all(|w| w[1] > w[0]), "{a:?}");
         assert!(a[4] > 1.2 * a[0], "{r}");
         assert_eq!(r.max_albedo_theta_deg, 89.0);
+    }
+
+    #[test]
+    fn albedos_that_pass_1_only_past_89_degrees_fail_energy_conservation() {
+        // The exact albedos (`brdftab albedo`): original Phong k_s = 0.5, n = 20: 0.794 at 89°,
+        // 7.28 at 89.9°; Ward k_s = 1, α = 0.5: 0.498 at 89°, 1.48 at 89.9°, 4.66 at 89.99°.
+        let o = Options {
+            pairs: 200,
+            ..Options::default()
+        };
+        for (spec, at_89) in [
+            (r#"{"model": "phong", "ks": 0.5, "n": 20}"#, 0.794),
+            (
+                r#"{"model": "ward", "ks": 1, "alpha_x": 0.5, "alpha_y": 0.5}"#,
+                0.498,
+            ),
+        ] {
+            let r = check(&*model(spec), &o);
+            let a89 = r
+                .albedo_curve
+                .iter()
+                .find(|p| p.theta_deg == 89.0)
+                .unwrap()
+                .albedo[0];
+            assert!((a89 - at_89).abs() < 2e-3, "{spec}: {a89}");
+            assert!(!r.energy_conserving && r.max_albedo > 4.0, "{spec}: {r}");
+            assert_eq!(r.max_albedo_theta_deg, 89.99, "{spec}");
+        }
+        // Bounded albedos keep their verdicts: reciprocal Phong peaks at normal incidence.
+        let r = check(
+            &*model(r#"{"model": "reciprocal_phong", "ks": 1, "n": 20}"#),
+            &o,
+        );
+        assert!(r.energy_conserving && r.max_albedo_theta_deg == 0.0, "{r}");
     }
 
     fn model(spec: &str) -> Box<dyn Brdf + Send + Sync> {

@@ -256,7 +256,9 @@ fn check_json_has_the_documented_fields() {
     let a = v["max_albedo"].as_f64().unwrap();
     assert!((a - 0.5 * std::f64::consts::PI).abs() < 1e-6);
     assert!(v["max_albedo_theta_deg"].is_number());
-    assert_eq!(v["albedo_curve"].as_array().unwrap().len(), 90);
+    // Every degree 0..89, then 89.9° and 89.99° (albedos that grow without bound at the
+    // horizon pass 1 only there).
+    assert_eq!(v["albedo_curve"].as_array().unwrap().len(), 92);
 }
 
 #[test]
