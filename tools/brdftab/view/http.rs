@@ -4,7 +4,9 @@
 //! head over [`MAX_HEAD`] bytes is refused (431) before it is parsed, a body over [`MAX_BODY`] is
 //! refused (413) before it is read, chunked bodies are refused (the page never sends one), and
 //! [`Deadline`] gives the whole request — head and body — [`READ_TIMEOUT`] in all, so a client
-//! that trickles a byte at a time is cut off as surely as one that stalls.
+//! that trickles a byte at a time is cut off as surely as one that stalls; the response gets
+//! [`WRITE_TIMEOUT`] in all the same way, so a client that reads a byte at a time cannot hold a
+//! worker either.
 //! Every response closes its connection, so no state outlives a request.
 
 use std::io::{Read, Write};
@@ -17,7 +19,7 @@ pub const MAX_HEAD: usize = 16 * 1024;
 pub const MAX_BODY: usize = 64 * 1024;
 /// How long a client may take to send its whole request (head and body).
 pub const READ_TIMEOUT: Duration = Duration::from_secs(5);
-/// How long writing a response may stall.
+/// How long writing a whole response may take.
 pub const WRITE_TIMEOUT: Duration = Duration::from_secs(10);
 /// The most headers a request may carry.
 const MAX_HEADERS: usize = 48;
@@ -66,15 +68,16 @@ impl Response {
     }
 }
 
-/// A connection read against one deadline for the whole request: each read may wait only for
-/// what is left of it, so the per-read socket timeout cannot be renewed a byte at a time.
+/// A connection read or written against one deadline for the whole request (or response): each
+/// read or write may wait only for what is left of it, so the per-call socket timeout cannot be
+/// renewed a byte at a time.
 pub struct Deadline<'a> {
     stream: &'a TcpStream,
     until: Instant,
 }
 
 impl<'a> Deadline<'a> {
-    /// Reads from `stream` for at most `total` from now.
+    /// Reads from or writes to `stream` for at most `total` from now.
     pub fn new(stream: &'a TcpStream, total: Duration) -> Deadline<'a> {
         Deadline {
             stream,
@@ -92,6 +95,23 @@ impl Read for Deadline<'_> {
         self.stream.set_read_timeout(Some(left))?;
         let mut s = self.stream;
         s.read(buf)
+    }
+}
+
+impl Write for Deadline<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let left = self.until.saturating_duration_since(Instant::now());
+        if left.is_zero() {
+            return Err(std::io::ErrorKind::TimedOut.into());
+        }
+        self.stream.set_write_timeout(Some(left))?;
+        let mut s = self.stream;
+        s.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        let mut s = self.stream;
+        s.flush()
     }
 }
 
@@ -247,6 +267,37 @@ mod tests {
         let chunked = b"POST / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n";
         assert_eq!(read(chunked).unwrap_err().status, 501);
         assert_eq!(read(b"GET / HTTP/1.1\r\n").unwrap_err().status, 400);
+    }
+
+    #[test]
+    fn a_client_reading_a_trickle_cannot_hold_the_response_past_its_deadline() {
+        let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap();
+        // The client reads 1 KiB every 10 ms, so every write makes a little progress and no
+        // per-write timeout would ever fire.
+        let done = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let stop = done.clone();
+        let client = std::thread::spawn(move || {
+            let mut c = TcpStream::connect(addr).unwrap();
+            let mut buf = [0u8; 1024];
+            while !stop.load(std::sync::atomic::Ordering::Relaxed)
+                && matches!(c.read(&mut buf), Ok(n) if n > 0)
+            {
+                std::thread::sleep(Duration::from_millis(10));
+            }
+        });
+        let (server, _) = listener.accept().unwrap();
+        let body = vec![b'x'; 64 << 20];
+        let t0 = Instant::now();
+        let total = Duration::from_millis(300);
+        let r = Deadline::new(&server, total).write_all(&body);
+        let took = t0.elapsed();
+        done.store(true, std::sync::atomic::Ordering::Relaxed);
+        drop(server);
+        client.join().unwrap();
+        assert_eq!(r.unwrap_err().kind(), std::io::ErrorKind::TimedOut);
+        // One write's wait is at most what is left of the deadline: the whole stays near it.
+        assert!(took < total * 3, "{took:?}");
     }
 
     #[test]

@@ -90,8 +90,7 @@ impl Server {
 
 /// Answers one connection: one request, one response, closed. A handler that panics answers
 /// 500 and the worker lives on.
-fn serve(reg: &Registry, hosts: &[String], mut stream: TcpStream) {
-    let _ = stream.set_write_timeout(Some(http::WRITE_TIMEOUT));
+fn serve(reg: &Registry, hosts: &[String], stream: TcpStream) {
     let read = http::read_request(&mut http::Deadline::new(&stream, http::READ_TIMEOUT));
     let (response, head_only) = match read {
         Ok(req) => {
@@ -103,6 +102,7 @@ fn serve(reg: &Registry, hosts: &[String], mut stream: TcpStream) {
         }
         Err(r) => (r, false),
     };
-    let _ = http::write_response(&mut stream, &response, head_only);
+    let mut out = http::Deadline::new(&stream, http::WRITE_TIMEOUT);
+    let _ = http::write_response(&mut out, &response, head_only);
     let _ = stream.shutdown(std::net::Shutdown::Write);
 }
