@@ -290,4 +290,28 @@ mod tests {
         let body = eval::polar(lambert.as_ref(), 30.0, 5).to_string();
         assert_eq!(answer(lambert.as_ref(), body).unwrap().status, 200);
     }
+
+    #[test]
+    fn a_delta_lobe_is_announced_since_no_plot_of_f_r_shows_it() {
+        let open = |s: &str| {
+            brdftab::ModelSpec::parse(s)
+                .unwrap()
+                .build(&Channels::Rgb)
+                .unwrap()
+        };
+        let smooth = open(r#"{"model": "lambert", "kd": 0.3}"#);
+        let mirror = open(r#"{"model": "mirror", "fresnel": {"conductor": "Ag"}}"#);
+        let sum = open(
+            r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.3},
+                {"model": "mirror", "fresnel": {"conductor": "Ag"}}]}"#,
+        );
+        for (b, want) in [(&smooth, false), (&mirror, true), (&sum, true)] {
+            assert_eq!(
+                eval::polar(b.as_ref(), 30.0, 5)["delta"],
+                want,
+                "{}",
+                b.describe()
+            );
+        }
+    }
 }

@@ -68,7 +68,14 @@ pub fn polar(brdf: &dyn Brdf, theta_i_deg: f64, n: usize) -> Value {
     let per_channel: Vec<Vec<f32>> = (0..c)
         .map(|ch| f.iter().skip(ch).step_by(c).copied().collect())
         .collect();
-    json!({ "theta_o": thetas, "y": luminances(brdf, &f), "f": per_channel })
+    json!({ "theta_o": thetas, "y": luminances(brdf, &f), "f": per_channel, "delta": has_delta(brdf) })
+}
+
+/// Whether `brdf` has a delta lobe (a mirror or refractor, alone or as a term of a sum): f_r
+/// holds none of it, so no plot of f_r shows it, while the albedo counts it.
+pub fn has_delta(brdf: &dyn Brdf) -> bool {
+    let f = brdf.flags();
+    f.delta || f.lobes.delta
 }
 
 /// The lobe for light at (θi, φ = 180°): the luminance of f_r over the outgoing hemisphere on an

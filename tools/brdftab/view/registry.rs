@@ -135,6 +135,7 @@ fn material(
         "kind": kind.name(),
         "channels": brdf.channels().names(),
         "description": brdf.describe(),
+        "delta": super::eval::has_delta(brdf.as_ref()),
     });
     if kind == SourceKind::Spec {
         info["spec"] =

@@ -33,6 +33,9 @@ GOLD = '{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}'
 PLASTIC = ('{"model": "sum", "terms": [{"model": "lambert", "kd": [0.05, 0.12, 0.2]}, '
            '{"model": "ggx", "alpha": 0.15, "fresnel": {"schlick": 0.04}}]}')
 
+GLAZED = ('{"model": "sum", "terms": [{"model": "lambert", "kd": 0.2}, '
+          '{"model": "mirror", "fresnel": {"schlick": 0.04}}]}')
+
 
 def run(cmd):
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
@@ -40,8 +43,8 @@ def run(cmd):
         sys.exit(f"FAILED: {' '.join(cmd)}\n{r.stderr}")
 
 
-def start_server(brdftab, db):
-    proc = subprocess.Popen([brdftab, "view", db, "--port", "0"], stdout=subprocess.PIPE,
+def start_server(brdftab, db, extra=()):
+    proc = subprocess.Popen([brdftab, "view", db, *extra, "--port", "0"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     line = proc.stdout.readline()
     if "http://" not in line:
@@ -76,10 +79,18 @@ def main():
             driver = browser(os.path.join(tmp, "profile"))
             check(driver, url, a.screenshot)
         finally:
+            server.kill()
+            server.wait()
+        # Four materials: the database's two, a sum with a mirror term and a Lambert.
+        server, url = start_server(a.brdftab, db, [GLAZED, '{"model": "lambert", "kd": 0.3}'])
+        try:
+            check_delta_and_four_curves(driver, url)
+        finally:
             if driver is not None:
                 driver.quit()
             server.kill()
             server.wait()
+    print("1 passed, 0 failed")
 
 
 def check(driver, url, screenshot):
@@ -126,7 +137,6 @@ def check(driver, url, screenshot):
           f"over {len(times)} steps (budget {BUDGET_MS:.0f} ms)")
     assert median <= BUDGET_MS, f"median redraw {median:.1f} ms > {BUDGET_MS} ms"
     print(f"screenshot: {screenshot}")
-    print("1 passed, 0 failed")
 
 
 def check_downloads(driver, wait):
@@ -229,6 +239,30 @@ def check_ggx_sliders(driver, wait):
     assert '"alpha_x"' in driver.find_element(By.ID, "spec-json").get_attribute("value")
     errs = [e.text for e in driver.find_elements(By.CSS_SELECTOR, ".panel .error") if e.text]
     assert not errs, errs
+
+
+def check_delta_and_four_curves(driver, url):
+    """A material with a mirror lobe says that no plot of f_r shows it; with four materials
+    selected the spec waits for a free place instead of dropping one of them."""
+    wait = WebDriverWait(driver, 30)
+    driver.get("about:blank")
+    driver.get(url.split("#")[0] + "#m=2")
+    wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#materials li")) == 4)
+    items = driver.find_elements(By.CSS_SELECTOR, "#materials li")
+    assert "delta lobe" in items[2].text and "delta lobe" not in items[3].text, [i.text for i in items]
+    note = lambda d: d.find_element(By.CSS_SELECTOR, '.panel[data-plot="polar"] .note').text
+    wait.until(lambda d: "delta" in note(d))
+    for k in [0, 1, 3]:
+        driver.find_elements(By.CSS_SELECTOR, "#materials li")[k].click()
+    wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#materials li.selected")) == 4)
+    driver.find_element(By.ID, "spec-on").click()
+    time.sleep(0.3)
+    assert not driver.find_element(By.ID, "spec-on").is_selected()
+    assert "four curves" in driver.find_element(By.ID, "spec-error").text
+    assert len(driver.find_elements(By.CSS_SELECTOR, "#materials li.selected")) == 4
+    assert "on=1" not in driver.current_url, driver.current_url
+    errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+    assert not errors, f"console errors: {errors}"
 
 
 if __name__ == "__main__":

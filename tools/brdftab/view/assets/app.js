@@ -122,6 +122,10 @@ async function fastViews() {
   const t0 = performance.now();
   const p = view("polar", `theta_i=${state.ti}&n=180`, (list, got) => {
     data.polar = list.map((e, k) => ({ e, v: got[k] }));
+    // A mirror or refraction lobe is a delta: f_r has none of it, the albedo has it all.
+    const delta = list.filter((e, k) => got[k].delta).map((e) => e.label);
+    document.querySelector('.panel[data-plot="polar"] .note').textContent = delta.length
+      ? `${delta.join(", ")}: the delta (mirror/refraction) lobe is not drawn; the albedo counts it` : "";
     drawPolar();
   });
   const l = view("lobe", `theta_i=${state.ti}&nt=19&np=36`, (list, got) => {
@@ -223,8 +227,14 @@ function bind() {
   $("cosine").addEventListener("change", () => { state.cos = $("cosine").checked; writeHash(); drawPolar(); drawLobe(); });
   $("vs-source").addEventListener("change", () => { state.src = $("vs-source").checked; redrawAll(); });
   $("spec-on").addEventListener("change", () => {
+    // Four curves at most: with four materials selected the spec waits for a free place
+    // rather than dropping one of them unasked.
+    if ($("spec-on").checked && state.sel.length >= 4) {
+      $("spec-on").checked = false;
+      $("spec-error").textContent = "four curves at most: deselect a material to show the spec";
+      return;
+    }
     state.on = $("spec-on").checked && state.spec !== "";
-    if (state.on) state.sel = state.sel.slice(0, 3); // four curves at most
     redrawAll();
   });
   $("model").addEventListener("change", () => {
@@ -248,6 +258,7 @@ function bind() {
   for (const panel of document.querySelectorAll(".panel[data-plot]")) {
     addDownloads(panel, panel.querySelector("svg"), "brdftab-" + panel.dataset.plot);
     panel.appendChild(Object.assign(document.createElement("p"), { className: "error" }));
+    panel.appendChild(Object.assign(document.createElement("p"), { className: "note" }));
   }
 }
 

@@ -14,7 +14,8 @@ function renderList() {
       const kb = m.bytes !== undefined ? `${(m.bytes / 1024).toFixed(1)} KiB, ${m.ratio.toFixed(1)}× vs f32, ${m.codec.quant}` : "";
       meta.innerHTML = `<div class="name">${escapeHtml(m.name)}</div>${m.kind} · ${m.channels.join(" ")}` +
         (m.grid ? `<br>${escapeHtml(m.grid)}<br>${kb}` : "") + (m.has_source ? "<br>source: opens" : "") +
-        (m.source_note ? `<br>source: not paired, ${escapeHtml(m.source_note)}` : "");
+        (m.source_note ? `<br>source: not paired, ${escapeHtml(m.source_note)}` : "") +
+        (m.delta ? "<br>delta lobe: not in the plots, in the albedo" : "");
       li.append(c, meta);
       li.addEventListener("click", () => toggle(m.id));
       ul.appendChild(li);
