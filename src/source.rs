@@ -216,6 +216,14 @@ impl OpenOptions {
 /// let e = brdftab::open("no-such-material.binary").unwrap_err();
 /// assert!(e.to_string().contains("no-such-material.binary"));
 /// ```
+/// To share one opened source between threads or materials, make the box an `Arc` of the same
+/// type (`From<Box<T>>`), which then coerces to `Arc<dyn Brdf>`:
+/// ```
+/// use std::sync::Arc;
+/// let shared: Arc<dyn brdftab::Brdf + Send + Sync> = brdftab::open(r#"{"model": "lambert", "kd": 0.2}"#)?.into();
+/// let material: Arc<dyn brdftab::Brdf> = shared.clone();
+/// # Ok::<(), brdftab::Error>(())
+/// ```
 pub fn open(source: &str) -> Result<Box<dyn Brdf + Send + Sync>> {
     open_with(source, &OpenOptions::default())
 }

@@ -355,3 +355,21 @@ fn sources_with_a_delta_lobe_are_refused_by_every_bake_and_conversion() {
         );
     }
 }
+
+#[test]
+fn an_opened_source_is_shared_between_threads_as_an_arc() {
+    // What a renderer holding materials in `Arc<dyn Brdf>` writes.
+    let opened = brdftab::open(r#"{"model": "lambert", "kd": 0.25}"#).unwrap();
+    let shared: std::sync::Arc<dyn brdftab::Brdf + Send + Sync> = opened.into();
+    let shared: std::sync::Arc<dyn brdftab::Brdf> = shared;
+    let other = std::sync::Arc::clone(&shared);
+    let wi = glam::DVec3::new(0.0, 0.6, 0.8);
+    let f = std::thread::spawn(move || {
+        let mut out = [0.0f32; 3];
+        other.eval(wi, wi, &mut out);
+        out
+    })
+    .join()
+    .unwrap();
+    assert_eq!(f, [0.25; 3]);
+}
