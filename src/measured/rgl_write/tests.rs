@@ -399,3 +399,86 @@ fn the_fill_continues_valid_values_linearly() {
     super::values::fill_below_horizon(&mut plane, &valid, n);
     assert!(plane.iter().all(|&v| v == 2.5), "{plane:?}");
 }
+
+/// The checks pbrt-v4's `MeasuredBxDFData::Create` (src/pbrt/bxdfs.cpp) makes before it accepts
+/// a file, restated here from its source: a spectral file that fails one is refused there with
+/// "invalid BRDF file structure", and an anisotropic one whose φi do not span 2π ("reduction")
+/// ends the render.
+fn pbrt_v4_accepts(t: &TensorFile) -> std::result::Result<(), String> {
+    use crate::measured::tensor::Dtype::{F32, U8};
+    let f = |n: &str| t.get(n).ok_or(format!("no field {n}"));
+    let (desc, theta, phi, wl) = (
+        f("description")?,
+        f("theta_i")?,
+        f("phi_i")?,
+        f("wavelengths")?,
+    );
+    let (ndf, sigma, vndf, lum, spectra, jac) = (
+        f("ndf")?,
+        f("sigma")?,
+        f("vndf")?,
+        f("luminance")?,
+        f("spectra")?,
+        f("jacobian")?,
+    );
+    let is = |x: &crate::measured::tensor::Field, dt, dims: usize| {
+        x.dtype == dt && x.shape.len() == dims
+    };
+    let checks = [
+        ("description u8[n]", is(desc, U8, 1)),
+        (
+            "theta_i, phi_i, wavelengths f32[n]",
+            is(theta, F32, 1) && is(phi, F32, 1) && is(wl, F32, 1),
+        ),
+        ("ndf, sigma f32[r, c]", is(ndf, F32, 2) && is(sigma, F32, 2)),
+        (
+            "vndf f32[φi, θi, n, m]",
+            is(vndf, F32, 4) && vndf.shape[..2] == [phi.shape[0], theta.shape[0]],
+        ),
+        (
+            "luminance f32[φi, θi, n, n]",
+            is(lum, F32, 4)
+                && lum.shape[..2] == [phi.shape[0], theta.shape[0]]
+                && lum.shape[2] == lum.shape[3],
+        ),
+        (
+            "spectra f32[φi, θi, λ, n, n] on luminance's n",
+            is(spectra, F32, 5)
+                && spectra.shape[..3] == [phi.shape[0], theta.shape[0], wl.shape[0]]
+                && spectra.shape[3..] == lum.shape[2..],
+        ),
+        ("jacobian u8[1]", is(jac, U8, 1) && jac.shape[0] == 1),
+    ];
+    if let Some((what, _)) = checks.iter().find(|(_, ok)| !ok) {
+        return Err(format!("invalid BRDF file structure: {what}"));
+    }
+    if phi.shape[0] > 2 {
+        let p = t.to_f32(phi).map_err(|e| e.to_string())?;
+        let reduction = (std::f32::consts::TAU / (p[p.len() - 1] - p[0])).round();
+        if reduction != 1.0 {
+            return Err(format!("reduction {reduction} (!= 1) not supported"));
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn spectral_files_pass_pbrt_v4s_structure_checks_and_rgb_files_fail_them() {
+    let ch = Channels::wavelengths(vec![400.0, 500.0, 600.0, 700.0]).unwrap();
+    let aniso = r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.1}, {"model": "ggx", "alpha_x": 0.2, "alpha_y": 0.5}]}"#;
+    for (spec, phi_i) in [(GGX_COPPER, 1), (aniso, 17)] {
+        let f = encode(&*model(spec, &ch), &Options::default(), &Silent).unwrap();
+        let t = TensorFile::from_bytes("mem.bsdf", f.to_bytes()).unwrap();
+        assert_eq!(t.field("phi_i").unwrap().shape, [phi_i]);
+        pbrt_v4_accepts(&t).unwrap();
+    }
+    // The README's warning: an RGB file has no `spectra`, so pbrt-v4 cannot read it.
+    let f = encode(
+        &*model(GGX_COPPER, &Channels::Rgb),
+        &Options::default(),
+        &Silent,
+    )
+    .unwrap();
+    let t = TensorFile::from_bytes("mem.bsdf", f.to_bytes()).unwrap();
+    assert!(pbrt_v4_accepts(&t).is_err());
+}
