@@ -6,9 +6,8 @@
 //! database or the new one, and an entry already stored is never lost. Writers serialize on an
 //! advisory lock file (`.NAME.lock` beside the database) so two concurrent `add`s cannot drop
 //! each other's table; readers take no lock and keep the version they opened. A database
-//! path that is a symbolic link is updated where it points
-//! ([`resolve_links`](crate::files::resolve_links)): the link stays a link, and writers through
-//! it and through the file's own name share the lock.
+//! path that is a symbolic link is updated where it points (`files::resolve_links`): the link
+//! stays a link, and writers through it and through the file's own name share the lock.
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
