@@ -13,9 +13,9 @@
 //! - The directory is [`default_dir`] unless given: `$BRDFTAB_CACHE_DIR`, else
 //!   `$XDG_CACHE_HOME/brdftab`, else `$HOME/.cache/brdftab`.
 //! - Concurrent loads are safe: a bake writes a temporary file and renames it into place
-//!   (the library's atomic write, under a writer lock whose empty `.<key>.btdb.lock` file
-//!   stays beside the table), so a reader sees no file or a whole one; processes baking the
-//!   same key at once all succeed and leave one file.
+//!   (the library's atomic write), so a reader sees no file or a whole one; and it runs under
+//!   a writer lock whose empty `.<key>.btdb.lock` file stays beside the table, so processes
+//!   asking for the same key at once bake it once: the others wait and get the hit.
 //! - A cached file that no longer opens (truncated, a chunk failing its checksum when read)
 //!   is re-baked by asking again with `refresh`.
 //!
@@ -151,6 +151,12 @@ pub fn bake_cached(
         return Ok(Cached { path, hit: true });
     }
     std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    // One bake per key at a time: a process (or thread) that finds the bake under way waits
+    // for it and is then a hit, rather than baking the same table beside it.
+    let _lock = crate::store::db::lock(&path)?;
+    if !refresh && path.is_file() {
+        return Ok(Cached { path, hit: true });
+    }
     let mut s = settings.clone();
     s.replace = true;
     let out = path.to_string_lossy();
@@ -220,16 +226,35 @@ mod tests {
         assert!(!c.hit);
         assert!(crate::open(&c.path.to_string_lossy()).is_ok());
         // One table; beside it only the writer's lock file, no temporary file.
-        let names: Vec<String> = std::fs::read_dir(d.path())
+        let mut names: Vec<String> = std::fs::read_dir(d.path())
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .collect();
-        assert!(names.iter().all(|n| !n.contains(".tmp")), "{names:?}");
-        assert_eq!(
-            names.iter().filter(|n| n.ends_with(".btdb")).count(),
-            1,
-            "{names:?}"
-        );
+        names.sort();
+        let table = a.path.file_name().unwrap().to_string_lossy().into_owned();
+        assert_eq!(names, [format!(".{table}.lock"), table]);
+    }
+
+    #[test]
+    fn threads_asking_for_one_key_at_once_bake_it_once() {
+        let d = TempDir::new("cache-race");
+        let n = 4;
+        let start = std::sync::Barrier::new(n);
+        let hits: Vec<Cached> = std::thread::scope(|s| {
+            let hs: Vec<_> = (0..n)
+                .map(|_| {
+                    s.spawn(|| {
+                        start.wait();
+                        bake_cached(SPEC, &small(), Some(d.path()), false).unwrap()
+                    })
+                })
+                .collect();
+            hs.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        assert!(hits.iter().all(|c| c.path == hits[0].path));
+        let baked = hits.iter().filter(|c| !c.hit).count();
+        assert_eq!(baked, 1, "one bake, the others wait for it: {hits:?}");
+        assert!(crate::open(&hits[0].path.to_string_lossy()).is_ok());
     }
 
     #[test]

@@ -11,6 +11,9 @@
 //! - Outputs are written atomically through a temporary file beside them ([`temp_path`],
 //!   [`write_atomic`]); an output directory that does not exist is reported with the user's
 //!   path, and temporary files that killed writers left behind are removed by the next write.
+//! - A database reached through a symbolic link is updated where the link points
+//!   ([`resolve_links`]): the rename of an atomic write would otherwise replace the link with a
+//!   file, and the database itself would not get the change.
 
 use std::path::{Path, PathBuf};
 
@@ -144,6 +147,34 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     r
 }
 
+/// The file a change of `path` must replace: `path`, or where it is a symbolic link the file
+/// it points to (followed link by link, relative targets from the link's directory; the target
+/// need not exist yet). A database updated through a link then stays the one file, and its
+/// writers, whichever name they use, take one lock.
+///
+/// # Errors
+/// A link that cannot be read, or a chain of more than 40 links ([`Error::Io`] naming `path`).
+pub fn resolve_links(path: &Path) -> Result<PathBuf> {
+    let mut p = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let target = std::fs::read_link(&p).map_err(|e| Error::io(&p, e))?;
+                p = if target.is_absolute() {
+                    target
+                } else {
+                    parent(&p).join(target)
+                };
+            }
+            _ => return Ok(p),
+        }
+    }
+    Err(Error::io(
+        path,
+        std::io::Error::other("more than 40 symbolic links"),
+    ))
+}
+
 /// An output's directory must exist (checked up front: the error then names `path`).
 pub fn check_dir(path: &Path, dir: &Path) -> Result<()> {
     match std::fs::metadata(dir) {
@@ -204,6 +235,28 @@ mod tests {
         let e = require_regular(&d).unwrap_err().to_string();
         assert!(e.contains("a directory"), "{e}");
         assert!(require_regular(d.join("brdftab-no-such-file.btdb")).is_ok());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn links_resolve_to_their_target_and_loops_are_an_error() {
+        use std::os::unix::fs::symlink;
+        let d = crate::testkit::TempDir::new("links");
+        let a = d.join("a.btdb");
+        assert_eq!(
+            resolve_links(&a).unwrap(),
+            a,
+            "a path that does not exist is itself"
+        );
+        std::fs::create_dir(d.join("sub")).unwrap();
+        symlink("../a.btdb", d.join("sub/l1")).unwrap(); // relative to the link's directory
+        symlink(d.join("sub/l1"), d.join("l2")).unwrap();
+        assert_eq!(
+            resolve_links(&d.join("l2")).unwrap(),
+            d.join("sub/../a.btdb")
+        );
+        symlink("loop", d.join("loop")).unwrap();
+        assert!(resolve_links(&d.join("loop")).is_err());
     }
 
     #[test]

@@ -5,7 +5,9 @@
 //! file and fsyncs the directory. A process killed at any moment therefore leaves the old
 //! database or the new one, and an entry already stored is never lost. Writers serialize on an
 //! advisory lock file (`.NAME.lock` beside the database) so two concurrent `add`s cannot drop
-//! each other's table; readers take no lock and keep the version they opened.
+//! each other's table; readers take no lock and keep the version they opened. A database
+//! path that is a symbolic link is updated where it points (`files::resolve_links`): the link
+//! stays a link, and writers through it and through the file's own name share the lock.
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -18,8 +20,10 @@ pub struct Lock {
     _file: File,
 }
 
-/// Takes the exclusive writer lock of the database at `path` (blocks until free).
+/// Takes the exclusive writer lock of the database at `path` (blocks until free); a symbolic
+/// link's is its target's.
 pub fn lock(path: &Path) -> Result<Lock> {
+    let path = &crate::files::resolve_links(path)?;
     let name = path
         .file_name()
         .ok_or_else(|| Error::arg("DB", format!("{} has no file name", path.display())))?
@@ -106,9 +110,10 @@ pub fn put(
     replace: bool,
     write: impl FnOnce(&mut Writer) -> Result<()>,
 ) -> Result<()> {
-    let path = path.as_ref();
     // Before the lock file or the database is touched.
     super::name::check("name", &header.name)?;
+    let user = path.as_ref(); // the name errors give
+    let path = &crate::files::resolve_links(user)?;
     let _lock = lock(path)?;
     let old = existing(path)?;
     let name = header.name.clone();
@@ -117,7 +122,7 @@ pub fn put(
         && s.tables().iter().any(|t| t.name == name)
     {
         return Err(Error::Duplicate {
-            container: path.display().to_string(),
+            container: user.display().to_string(),
             name,
         });
     }
@@ -161,13 +166,14 @@ pub fn write_table(
 
 /// Removes table `name`. Errors with [`Error::NotFound`] if absent.
 pub fn remove(path: impl AsRef<Path>, name: &str) -> Result<()> {
-    let path = path.as_ref();
+    let user = path.as_ref(); // the name errors give
+    let path = &crate::files::resolve_links(user)?;
     let _lock = lock(path)?;
     let s = Store::open(path)?;
     if !s.tables().iter().any(|t| t.name == name) {
         return Err(Error::NotFound(format!(
             "table `{name}` in {}",
-            path.display()
+            user.display()
         )));
     }
     let mut w = Writer::create(path)?;

@@ -384,12 +384,103 @@ fn the_header_declares_exactly_the_exported_functions() {
     let mut exported: Vec<String> = nm
         .lines()
         .filter_map(|l| l.split_whitespace().nth(2))
-        .filter(|s| s.starts_with("brdftab_"))
         .map(str::to_owned)
         .collect();
     exported.sort();
+    // Nothing but the header's functions: no Rust symbol, no allocator, no other name.
     assert_eq!(declared, exported);
     assert!(declared.len() >= 11, "{declared:?}");
+}
+
+/// The header alone compiles without a warning as strict C99 and C++17 (and C89: it uses no
+/// `//` comment, no `inline`, no declaration after a statement).
+#[test]
+fn the_header_compiles_cleanly_as_c89_c99_and_cpp17() {
+    let dir = TempDir::new("c-header");
+    for (compiler, std, file) in [
+        ("cc", "-std=c89", "h.c"),
+        ("cc", "-std=c99", "h.c"),
+        ("c++", "-std=c++17", "h.cpp"),
+    ] {
+        let src = dir.join(file);
+        std::fs::write(
+            &src,
+            "#include \"brdftab.h\"\nint main(void) { return 0; }\n",
+        )
+        .unwrap();
+        run(Command::new(compiler)
+            .args([std, "-Wall", "-Wextra", "-pedantic", "-Werror", "-c"])
+            .arg(format!("-I{CRATE}/include"))
+            .arg(&src)
+            .arg("-o")
+            .arg(dir.join("h.o")));
+    }
+}
+
+/// The README's install block and build block (bindings/c/README.md, **Install**) run as a
+/// user runs them — with PREFIX a scratch directory and LIB where this test run's libraries
+/// are — and the programs they build (shared with an rpath, static from the archive) run.
+#[test]
+fn the_readmes_install_and_pkg_config_flow_works_as_written() {
+    let readme = std::fs::read_to_string(Path::new(CRATE).join("README.md")).unwrap();
+    let from = readme
+        .find("**Install**")
+        .expect("README.md: the **Install** section");
+    let blocks: Vec<&str> = readme[from..]
+        .split("```sh\n")
+        .skip(1)
+        .take(2)
+        .map(|b| b.split("```").next().unwrap())
+        .collect();
+    assert_eq!(blocks.len(), 2, "README.md: the install and build blocks");
+    let (install, build) = (blocks[0], blocks[1]);
+    let dir = TempDir::new("c-install");
+    let prefix = dir.join("prefix");
+    let app = dir.join("app");
+    std::fs::create_dir(&app).unwrap();
+    std::fs::write(
+        app.join("app.c"),
+        r#"#include <stdio.h>
+#include <brdftab.h>
+int main(void) {
+    double wi[3] = {0, 0.6, 0.8}, wo[3] = {0, 0, 1};
+    float f[3];
+    brdftab_brdf *b = brdftab_open("{\"model\": \"lambert\", \"kd\": 0.5}");
+    if (!b || brdftab_eval(b, 1, wi, wo, f) != 0) {
+        fprintf(stderr, "error: %s\n", brdftab_last_error());
+        return 1;
+    }
+    printf("%g %g %g\n", f[0], f[1], f[2]);
+    brdftab_close(b);
+    return 0;
+}
+"#,
+    )
+    .unwrap();
+    let mut install = install.to_owned();
+    for (line, value) in [
+        ("PREFIX=/usr/local\n", prefix.clone()),
+        ("LIB=target/release\n", lib_dir()),
+    ] {
+        assert!(install.contains(line), "README.md: `{line}` in {install}");
+        let name = line.split('=').next().unwrap();
+        install = install.replace(line, &format!("{name}='{}'\n", value.display()));
+    }
+    let root = Path::new(CRATE).join("../..");
+    let script = format!(
+        "set -eu\ncd '{}'\n{install}cd '{}'\n{build}",
+        root.display(),
+        app.display()
+    );
+    run(Command::new("sh").arg("-c").arg(&script));
+    for exe in ["app", "app-static"] {
+        // Without cargo's LD_LIBRARY_PATH: the program finds the installed library (or none).
+        let out = run(Command::new(app.join(exe)).env_remove("LD_LIBRARY_PATH"));
+        assert_eq!(out.trim(), "0.5 0.5 0.5", "{exe}");
+    }
+    let needed = |exe: &str| run(Command::new("readelf").arg("-d").arg(app.join(exe)));
+    assert!(needed("app").contains("[libbrdftab_c.so]"));
+    assert!(!needed("app-static").contains("libbrdftab_c"));
 }
 
 /// A copy of table file `good` with one bit of chunk 0 flipped (its checksum then fails).

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import brdftab
+from conftest import unavailable
 
 SPEC = '{"model": "ggx", "alpha": 0.3, "fresnel": {"conductor": "Cu"}}'
 
@@ -69,28 +70,33 @@ def _load(args):
     d, spec = args
     r = brdftab.bake_cached(spec, d, preset="small")
     t = brdftab.open(r["path"], eager=True)  # every chunk read: a torn file would fail here
-    return r["path"], t.eval([0.3, 0.1, 0.9], [0, 0, 1]).tolist()
+    return r["path"], t.eval([0.3, 0.1, 0.9], [0, 0, 1]).tolist(), r["hit"]
 
 
 def test_concurrent_loads_from_many_processes(tmp_path):
-    """Eight processes ask for the same table at once: every one gets a whole table, the same
-    values, and one file is left (no temporary files)."""
+    """Eight processes ask for the same table at once: one bakes it (the others wait on the
+    key's lock and get the hit), every one gets a whole table, the same values, and one file is
+    left (no temporary files)."""
     ctx = multiprocessing.get_context("spawn")
     with ctx.Pool(4) as pool:
         out = pool.map(_load, [(str(tmp_path), SPEC)] * 8)
-    assert len({p for p, _ in out}) == 1
-    assert all(v == out[0][1] for _, v in out)
+    assert len({p for p, _, _ in out}) == 1
+    assert all(v == out[0][1] for _, v, _ in out)
+    assert sum(not hit for _, _, hit in out) == 1, "one bake"
     names = os.listdir(tmp_path)
     assert tables(tmp_path) == [os.path.basename(out[0][0])]
     assert not [n for n in names if ".tmp" in n], names
 
 
 def test_the_mitsuba_plugin_bakes_once(rgl, tmp_path):
-    mi = pytest.importorskip("mitsuba")
+    try:
+        import mitsuba as mi
+    except ImportError:
+        unavailable("mitsuba is not installed (pip install mitsuba)")
     try:
         mi.set_variant("llvm_ad_rgb")
     except Exception:
-        pytest.skip("llvm_ad_rgb unavailable (libLLVM)")
+        unavailable("llvm_ad_rgb needs libLLVM (apt-get install libllvm19; DRJIT_LIBLLVM_PATH)")
     import brdftab.mitsuba
 
     brdftab.mitsuba.register()

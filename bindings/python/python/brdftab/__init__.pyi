@@ -1,19 +1,35 @@
 """Type stubs of the brdftab package (the Rust extension `brdftab._native` and its wrappers)."""
 
 from os import PathLike
-from typing import Any, Iterator, Literal, Sequence, Union, overload
+from typing import Any, Iterator, Literal, Sequence, Union, final, overload
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
 
-ArrayLike = npt.ArrayLike
-Wavelengths = Union[None, str, Sequence[float]]
+__all__ = [
+    "Brdf",
+    "Database",
+    "Error",
+    "Table",
+    "bake",
+    "bake_cached",
+    "check",
+    "convert",
+    "fit",
+    "info",
+    "open",
+]
+
+# Aliases of the stubs only (private: not names of the package).
+_ArrayLike = npt.ArrayLike
+_Wavelengths = Union[None, str, Sequence[float]]
 
 class Error(Exception):
     """An error of the brdftab library; the message is the library's."""
 
+@final
 class Brdf:
     """A BRDF opened from a SOURCE (spec, table, DB#NAME, MERL .binary, RGL .bsdf).
 
@@ -46,19 +62,19 @@ class Brdf:
         table's grid chose), or the interpolation asked for when the source is no table."""
     def describe(self) -> str:
         """A one-line description (model and parameters, or table and source)."""
-    def eval(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float32]:
+    def eval(self, wi: _ArrayLike, wo: _ArrayLike) -> npt.NDArray[np.float32]:
         """f_r(wi, wo) in 1/sr: (n, c) float32, or (c,) for one pair of shape (3,).
 
         NaN, infinite or zero directions give 0 (not an error), as in every host."""
-    def eval_spectral(self, wi: ArrayLike, wo: ArrayLike, nm: ArrayLike) -> npt.NDArray[np.float32]:
+    def eval_spectral(self, wi: _ArrayLike, wo: _ArrayLike, nm: _ArrayLike) -> npt.NDArray[np.float32]:
         """f_r at wavelengths nm ((k,) or (n, k); each finite and > 0, else ValueError):
         (n, k) float32, or (k,) for one pair of shape (3,)."""
-    def pdf(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float64]:
+    def pdf(self, wi: _ArrayLike, wo: _ArrayLike) -> npt.NDArray[np.float64]:
         """Density of `sample` drawing wi given wo: (n,) float64, or 0-d for one pair of shape
         (3,)."""
     @overload
     def sample(
-        self, wo: ArrayLike, u: ArrayLike, *, nm: ArrayLike | None = None,
+        self, wo: _ArrayLike, u: _ArrayLike, *, nm: _ArrayLike | None = None,
         delta: Literal[False] = False
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32]]:
         """(wi (n, 3), pdf (n,), weight = f cos θi / pdf (n, c)) for u in [0, 1)² of shape (n, 2);
@@ -69,12 +85,12 @@ class Brdf:
         shapes, as in `eval`."""
     @overload
     def sample(
-        self, wo: ArrayLike, u: ArrayLike, *, nm: ArrayLike | None = None, delta: Literal[True]
+        self, wo: _ArrayLike, u: _ArrayLike, *, nm: _ArrayLike | None = None, delta: Literal[True]
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32],
                npt.NDArray[np.bool_]]:
         """The same and a bool (n,): the draws of a delta lobe (their pdf is the probability
         of choosing that lobe; `pdf()` does not contain them)."""
-    def albedo(self, theta: ArrayLike) -> npt.NDArray[np.float64]:
+    def albedo(self, theta: _ArrayLike) -> npt.NDArray[np.float64]:
         """Directional albedo at θ′ in radians, 0 ≤ θ′ < π/2 (light above the horizon; else
         ValueError naming theta): (k, c) float64.
 
@@ -107,6 +123,7 @@ class Brdf:
         convention)."""
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
 
+@final
 class Table:
     """A decoded table: `values` shares its memory (read-only float32, stored axes + channels,
     λ innermost; flat when packed), `grid` describes it. The values are the stored quantity
@@ -128,7 +145,7 @@ class Table:
         device layout, a dict with "version", "kind" ("kernel" or "grid"), "channels",
         "channel_names", "quantity", "calibration", "kernel" and "grid" (None or the layout's
         fields, each with its float32 "values")."""
-    def with_values(self, values: ArrayLike, *, calibration: bool = True) -> Table:
+    def with_values(self, values: _ArrayLike, *, calibration: bool = True) -> Table:
         """The same table (grid: stored layout, symmetry, quantity, albedo calibration) holding
         `values`: any array-like of real numbers the size of `values` — shaped as it is (stored
         axes + channels), flat, or for a packed table the rectangle `brdftab export --npy`
@@ -177,12 +194,12 @@ def open(
     source: str | PathLike[str],
     *,
     interp: str = "auto",
-    wavelengths: Wavelengths = None,
+    wavelengths: _Wavelengths = None,
     eager: bool = True,
 ) -> Brdf:
     """Opens SOURCE. interp: "auto" (nearest on tables of MERL cells, linear otherwise),
     "nearest" or "linear"."""
-def check(source: str | PathLike[str], *, wavelengths: Wavelengths = None) -> dict[str, Any]:
+def check(source: str | PathLike[str], *, wavelengths: _Wavelengths = None) -> dict[str, Any]:
     """The plausibility report of SOURCE as a dict with the keys of `brdftab check --json`."""
 def info(source: str | PathLike[str]) -> dict[str, Any]:
     """What `brdftab info --json` reports of a table file (or, for DB#NAME, of one table): "file", "format", "bytes", "ratio_to_f32"
@@ -206,7 +223,7 @@ def bake(
     exhaustive: bool = ...,
     name: str | None = ...,
     supersample: int | None = ...,
-    wavelengths: Wavelengths = ...,
+    wavelengths: _Wavelengths = ...,
     target_error: float | str | None = ...,
     calibrate: bool | None = ...,
     replace: bool = ...,
@@ -249,7 +266,7 @@ def fit(
     seed: int | None = ...,
     fresnel: str | None = ...,
     grey: bool = ...,
-    wavelengths: Wavelengths = ...,
+    wavelengths: _Wavelengths = ...,
     specular_fraction: float | None = ...,
     max_iterations: int | None = ...,
 ) -> dict[str, Any]:

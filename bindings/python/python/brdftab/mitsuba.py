@@ -218,6 +218,7 @@ class _Common:
         self.delta = self.brdf.flags["delta"]
 
     def to_string(self):
+        """``BrdftabBSDF[source=..., <the source's description>]`` (Mitsuba's ``str``)."""
         return f"BrdftabBSDF[source={self.source!r}, {self.brdf.describe()}]"
 
 
@@ -246,6 +247,7 @@ class ScalarBrdftabBSDF(_Common):
         return [float(v[0]), float(v[1]), float(v[2])]
 
     def eval(self, ctx, si, wo, active=True):
+        """f_r · cos θ(wo) (Mitsuba's ``eval``): 0 below either horizon and for a delta source."""
         import mitsuba as mi
 
         wi, wo = self._vec(si.wi), self._vec(wo)
@@ -255,6 +257,7 @@ class ScalarBrdftabBSDF(_Common):
         return self._f(wi, wo, si) * cos_o
 
     def pdf(self, ctx, si, wo, active=True):
+        """The density of :meth:`sample` drawing wo given ``si.wi`` (0 for a delta source)."""
         wi, wo = self._vec(si.wi), self._vec(wo)
         if self.delta or not (wi[2] > 0 and wo[2] > 0) or not active:
             return 0.0
@@ -263,9 +266,12 @@ class ScalarBrdftabBSDF(_Common):
         return float(self.brdf.pdf(wo, wi))
 
     def eval_pdf(self, ctx, si, wo, active=True):
+        """``(eval(...), pdf(...))``."""
         return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
 
     def sample(self, ctx, si, sample1, sample2, active=True):
+        """A ``BSDFSample3f`` and its weight f_r · cos θ(wo) / pdf, drawn by the library's
+        sampler; a delta lobe's draw is a ``DeltaReflection`` sample."""
         import mitsuba as mi
 
         bs = mi.BSDFSample3f()
@@ -300,9 +306,11 @@ class ScalarBrdftabBSDF(_Common):
         return bs, value / pdf
 
     def traverse(self, callback):
+        """Nothing to expose: a scalar variant evaluates the source, which holds no values."""
         pass
 
     def parameters_changed(self, keys):
+        """Nothing to update (see :meth:`traverse`)."""
         pass
 
 
@@ -1077,6 +1085,7 @@ class JitBrdftabBSDF(_Common):
         return dr.select(active, self._f(wi, wo, lam, active) * dr.normalize(wo).z, 0.0)
 
     def eval(self, ctx, si, wo, active=True):
+        """f_r · cos θ(wo) from the table (0 below either horizon)."""
         import mitsuba as mi
 
         active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
@@ -1092,6 +1101,7 @@ class JitBrdftabBSDF(_Common):
         return self.sampler.pdf(dr.normalize(wi), dr.normalize(wo), active)
 
     def pdf(self, ctx, si, wo, active=True):
+        """The density of :meth:`sample` drawing wo given ``si.wi``."""
         import mitsuba as mi
 
         active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
@@ -1102,6 +1112,7 @@ class JitBrdftabBSDF(_Common):
                           lambda wi, wo, a, lam: mi.Float(0.0))
 
     def eval_pdf(self, ctx, si, wo, active=True):
+        """``(eval(...), pdf(...))`` in one table lookup."""
         import mitsuba as mi
 
         active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
@@ -1113,6 +1124,8 @@ class JitBrdftabBSDF(_Common):
                           lambda wi, wo, a, lam: (mi.Spectrum(0.0), mi.Float(0.0)))
 
     def sample(self, ctx, si, sample1, sample2, active=True):
+        """A ``BSDFSample3f`` and its weight f_r · cos θ(wo) / pdf, drawn by the library's
+        sampler (conditional half-vector warps, :mod:`brdftab._halfwarp`)."""
         import drjit as dr
         import mitsuba as mi
 

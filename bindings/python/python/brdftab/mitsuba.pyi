@@ -1,5 +1,7 @@
 from typing import Any
 
+import brdftab
+
 def register() -> None:
     """Registers the Mitsuba 3 BSDF plugin `brdftab` for the current variant."""
 
@@ -42,11 +44,65 @@ class JitTable:
         """Lookups read `params` from now on (after an in-place change, as
         `mi.SceneParameters.update` makes); raises brdftab.Error if their number changed."""
 
-class BrdftabBSDF:
-    """The plugin object of a JIT variant (what `mi.load_dict({"type": "brdftab", ...})`
-    returns; a subclass of the variant's `mi.BSDF`)."""
+class _Common:
+    """What both plugin flavours share: the properties, the flags, the description."""
+
+    source: str
+    """The SOURCE the plugin opened (a file found through Mitsuba's file resolver)."""
+    interp: str
+    """The `interp` property ("auto", "linear" or "nearest")."""
+    spectral: bool
+    """Whether the variant is spectral."""
+    brdf: brdftab.Brdf
+    """The source opened by the library."""
+    delta: bool
+    """Whether the source has a delta lobe (its draws are delta samples)."""
+    def to_string(self) -> str:
+        """`BrdftabBSDF[source=..., <the source's description>]`."""
+
+class ScalarBrdftabBSDF(_Common):
+    """The plugin's methods in a scalar variant (copied into `plugin_class()`, a subclass of
+    the variant's `mi.BSDF`): every query calls the library (the native source)."""
+
+    def __init__(self, props: Any) -> None: ...
+    def eval(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> Any:
+        """f_r · cos θ(wo) (Mitsuba's `eval`; 0 below either horizon and for a delta source)."""
+    def pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> Any:
+        """The density of `sample` drawing wo given `si.wi` (0 for a delta source)."""
+    def eval_pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> tuple[Any, Any]:
+        """`(eval(...), pdf(...))`."""
+    def sample(
+        self, ctx: Any, si: Any, sample1: Any, sample2: Any, active: Any = True
+    ) -> tuple[Any, Any]:
+        """(a `BSDFSample3f`, its weight f_r cos θ(wo) / pdf) drawn by the library's sampler;
+        a delta lobe's draw is a `DeltaReflection` sample."""
+    def traverse(self, callback: Any) -> None:
+        """Nothing to expose: a scalar variant evaluates the source, which has no values."""
+    def parameters_changed(self, keys: list[str]) -> None:
+        """Nothing to update (see `traverse`)."""
+
+class JitBrdftabBSDF(_Common):
+    """The plugin's methods in a JIT variant (copied into `plugin_class()`, a subclass of the
+    variant's `mi.BSDF`; what `mi.load_dict({"type": "brdftab", ...})` returns): a table
+    evaluated in Dr.Jit, the library's importance sampler."""
 
     table: JitTable
+    """The table the plugin evaluates."""
+    cache: bool
+    """The `cache` property: baked tables are kept in the cache of baked tables."""
+    cache_dir: str | None
+    """The `cache_dir` property."""
+    def __init__(self, props: Any) -> None: ...
+    def eval(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> Any:
+        """f_r · cos θ(wo) from the table (0 below either horizon)."""
+    def pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> Any:
+        """The density of `sample` drawing wo given `si.wi`."""
+    def eval_pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> tuple[Any, Any]:
+        """`(eval(...), pdf(...))` in one table lookup."""
+    def sample(
+        self, ctx: Any, si: Any, sample1: Any, sample2: Any, active: Any = True
+    ) -> tuple[Any, Any]:
+        """(a `BSDFSample3f`, its weight f_r cos θ(wo) / pdf) drawn by the library's sampler."""
     def traverse(self, callback: Any) -> None:
         """Exposes `values` (differentiable): the table's values before its albedo calibration;
         eval, eval_pdf and sample's weight are linear in them."""
@@ -55,6 +111,6 @@ class BrdftabBSDF:
         the loaded table (unbiased) until `resample`."""
     def resample(self) -> None:
         """Rebuilds the sampling distributions from the current `values` (between renders)."""
-    def export_table(self) -> Any:
+    def export_table(self) -> brdftab.Table:
         """The table with its current values, a `brdftab.Table` on the same grid (albedo
         calibration included); save it with `Table.save`."""

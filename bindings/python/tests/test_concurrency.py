@@ -1,0 +1,87 @@
+"""Concurrent use from Python: one table evaluated and sampled from many threads (the calls
+release the GIL) as from one; processes adding to one Database at once, some through a
+symbolic link to it, lose no table; a reader process sees whole states only."""
+
+import multiprocessing
+import os
+import threading
+
+import numpy as np
+
+import brdftab
+
+SPEC = '{"model": "ggx", "alpha": 0.3}'
+
+
+def test_one_table_from_many_threads_as_from_one(tmp_path):
+    db = brdftab.Database(tmp_path / "m.btdb")
+    db.add(SPEC, "ggx", preset="small")
+    lazy = db.open("ggx", eager=False)  # chunks decoded by whichever thread needs them first
+    ref = db.open("ggx")
+    rng = np.random.default_rng(3)
+    wi = rng.normal(size=(5000, 3))
+    wo = rng.normal(size=(5000, 3))
+    wi[:, 2] = abs(wi[:, 2]) + 0.1
+    wo[:, 2] = abs(wo[:, 2]) + 0.1
+    u = rng.random((5000, 2))
+    want = [ref.eval(wi, wo), ref.pdf(wi, wo), *ref.sample(wo, u)]
+    assert want[0].max() > 0
+    got, errors = [], []
+
+    def work():
+        try:
+            got.append([lazy.eval(wi, wo), lazy.pdf(wi, wo), *lazy.sample(wo, u)])
+            got.append([np.array([lazy.eval(wi[k], wo[k]) for k in range(300)])])
+        except Exception as e:  # noqa: BLE001 - reported below
+            errors.append(e)
+
+    threads = [threading.Thread(target=work) for _ in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors, errors
+    assert len(got) == 16
+    for g in got:
+        if len(g) == 1:
+            np.testing.assert_array_equal(g[0], want[0][:300])
+        else:
+            for a, b in zip(g, want):
+                np.testing.assert_array_equal(a, b)
+
+
+def _add(args):
+    path, k = args
+    db = brdftab.Database(path)
+    for i in range(3):
+        db.add('{"model": "lambert", "kd": 0.5}', f"p{k}_{i}", preset="small")
+    return k
+
+
+def _read(path):
+    """Opens the database until told to stop: every state whole (each table opens eagerly,
+    checksums checked), never fewer tables than before."""
+    seen, rounds = 0, 0
+    while not os.path.exists(path + ".stop"):
+        names = brdftab.Database(path).names()
+        assert len(names) >= seen, (seen, names)
+        seen = len(names)
+        brdftab.open(f"{path}#base")
+        rounds += 1
+    return rounds
+
+
+def test_processes_adding_at_once_lose_no_table(tmp_path):
+    path = str(tmp_path / "db.btdb")
+    brdftab.Database(path).add('{"model": "lambert", "kd": 0.2}', "base", preset="small")
+    link = str(tmp_path / "link.btdb")
+    os.symlink("db.btdb", link)
+    ctx = multiprocessing.get_context("spawn")
+    with ctx.Pool(5) as pool:
+        reader = pool.apply_async(_read, (path,))
+        pool.map(_add, [(path if k % 2 == 0 else link, k) for k in range(4)])
+        open(path + ".stop", "w").close()
+        assert reader.get(timeout=120) >= 1
+    want = {"base"} | {f"p{k}_{i}" for k in range(4) for i in range(3)}
+    assert set(brdftab.Database(path).names()) == want
+    assert os.path.islink(link), "the link still names the database"
