@@ -50,6 +50,15 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
                     e.rel_rmse,
                     e.max_rel
                 )?;
+                let f = &e.fidelity;
+                outln!(
+                    "  over the whole domain (f_r cos θi cos θo): whole hemisphere {:.2} %, grazing band (a direction past 80°) {:.2} %, worst albedo {:.2} % at {}° (channel {})",
+                    100.0 * f.whole,
+                    100.0 * f.grazing,
+                    100.0 * f.albedo.worst,
+                    f.albedo.theta_deg,
+                    f.albedo.channel
+                )?;
             }
         }
         ConvertOutput::Table { report: r, interp } => {

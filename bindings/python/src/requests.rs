@@ -126,6 +126,9 @@ pub(crate) fn convert(
                         "rel_rmse": e.rel_rmse,
                         "per_channel": e.per_channel,
                         "max_rel": e.max_rel,
+                        "whole": e.fidelity.whole,
+                        "grazing": e.fidelity.grazing,
+                        "albedo": e.fidelity.albedo,
                     })),
                 })
             }

@@ -348,6 +348,10 @@ def test_convert_writes_bsdf_like_the_cli(tmp_path, cli):
         "--pairs", "500")
     assert r["format"] == "rgl" and r["theta_i"] == 4 and r["resolution"] == 16
     assert r["error"]["pairs"] == 500
+    # Beside the figure within 80°, the whole hemisphere, the grazing band and the albedo.
+    e = r["error"]
+    assert 0 <= e["rel_rmse"] and e["rel_rmse"] < e["grazing"] and 0 <= e["whole"]
+    assert 1 <= e["albedo"]["theta_deg"] <= 89 and e["albedo"]["worst"] >= 0
     assert pathlib.Path(a).read_bytes() == pathlib.Path(b).read_bytes()
     assert brdftab.open(a).channels == ["R", "G", "B"]
 

@@ -33,6 +33,16 @@ fn convert_writes_bsdf_files_and_reports_their_error() {
         .and_then(|t| t.trim().parse().ok())
         .unwrap_or_else(|| panic!("no error figure in {}", r.stdout));
     assert!(rmse < 0.02, "{}", r.stdout);
+    // What the cap hides is printed too: the whole hemisphere, the band past 80°, the albedo.
+    let band: f64 = r
+        .stdout
+        .split("grazing band (a direction past 80°) ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no grazing figure in {}", r.stdout));
+    assert!(band > 100.0 * rmse, "{}", r.stdout);
+    assert!(r.stdout.contains("whole hemisphere") && r.stdout.contains("worst albedo"));
     let r = brdftab(&["info", out_s]);
     assert!(
         r.ok && r.stdout.contains("rgb") && r.stdout.contains("φi 1 × θi 16"),

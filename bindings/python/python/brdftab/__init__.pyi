@@ -253,7 +253,10 @@ def convert(
 ) -> dict[str, Any]:
     """Converts SOURCE into OUTPUT, whose name says its kind: an RGL .bsdf (pbrt-v4 and
     Mitsuba 3 load it), a MERL .binary, DB#NAME, a .btdb file or a raw table. Takes the keywords
-    of `bake` plus these; returns {"output", "format", "source", ...}."""
+    of `bake` plus these; returns {"output", "format", "source", ...}. For a .bsdf, "error" is
+    the file read back against SOURCE: "rel_rmse" and "max_rel" within 80°, then "whole"
+    (hemisphere), "grazing" (a direction past 80°) and "albedo" (the worst directional albedo
+    error: "worst", "theta_deg", "channel", ...), relative, or None with pairs=0."""
 def fit(
     source: str | PathLike[str],
     model: str,
