@@ -201,7 +201,9 @@ impl Ggx {
         // + s_v cos θi p_l (q = cos θ p).
         let g = (l.z * v.z) * (pl * pv) + (sl * (v.z * pv) + sv * (l.z * pl));
         Some(Lobe {
-            dg: d_num * (pl * pv) / (e2 * g * 4.0),
+            // At subnormal cosines g underflows to 0 and f_r overflows (it grows like 1/cos θ):
+            // held at f64::MAX, so that a Fresnel term or k_s of 0 gives 0 rather than 0·∞.
+            dg: (d_num * (pl * pv) / (e2 * g * 4.0)).min(f64::MAX),
             l_dot_h: 0.5 * hh.sqrt(),
             pdf: d_num * pv / (e2 * (v.z * pv + sv) * 4.0),
         })

@@ -350,10 +350,11 @@ fn bad_input<B: Brdf + ?Sized>(brdf: &B, log: &mut Log) {
             log.fail("horizon", || format!("sample(wo = {b}) gave {s:?}"));
         }
     }
-    // A hair above the horizon (cosines a renderer's f64 directions can carry, down to 1e-300):
-    // values may overflow (f_r grows like 1/cos θ there for many lobes) but are never NaN or
-    // negative — an underflowed product must not turn into 0/0.
-    for z in [1e-20f64, 1e-100, 1e-200, 1e-300] {
+    // A hair above the horizon (cosines a renderer's f64 directions can carry, down to the
+    // smallest subnormal, 5e-324): values may overflow (f_r grows like 1/cos θ there for many
+    // lobes) but are never NaN or negative — an underflowed product must not turn into 0/0,
+    // nor an overflowed one times a zero factor (a Fresnel term or k_s of 0) into 0·∞.
+    for z in [1e-20f64, 1e-100, 1e-200, 1e-300, f64::from_bits(1)] {
         let r = (1.0 - z * z).sqrt();
         let g = |x: f64, y: f64| DVec3::new(x * r, y * r, z);
         let pairs = [
