@@ -109,7 +109,9 @@ pub fn conductor(cos_i: f64, n: f64, k: f64) -> f64 {
     let cos2 = c * c;
     let sin2 = 1.0 - cos2;
     let (n2, k2) = (n * n, k * k);
-    let t0 = n2 - k2 - sin2;
+    // η² − sin² θ′ as (n² − k² − 1) + cos² θ′: for an index near 1 + 0j the form with sin² =
+    // 1 − cos² cancelled to rounding noise (F ~ 1e-17 where it is 0).
+    let t0 = (n2 - k2 - 1.0) + cos2;
     let a2b2 = (t0 * t0 + 4.0 * n2 * k2).sqrt();
     let a = (0.5 * (a2b2 + t0)).max(0.0).sqrt();
     let t1 = a2b2 + cos2;
@@ -117,7 +119,23 @@ pub fn conductor(cos_i: f64, n: f64, k: f64) -> f64 {
     let t3 = cos2 * a2b2 + sin2 * sin2;
     let t4 = t2 * sin2;
     // ½ (F⊥ + F∥) = ½ F⊥ (1 + (t3 − t4)/(t3 + t4)) = F⊥ t3 / (t3 + t4): one division.
-    (t1 - t2) * t3 / ((t1 + t2) * (t3 + t4))
+    ratio(t1 - t2, t3, (t1 + t2) * (t3 + t4))
+}
+
+/// The closed form's last step, (t1 − t2) t3 / den, kept finite and non-negative.
+///
+/// t1 − t2 = |η² − sin²| + cos² − 2a cos ≥ (√|η² − sin²| − cos)² ≥ 0 (a ≤ √|η² − sin²|), but
+/// where the two nearly cancel (an index near 1 + 0j) rounding made it negative: F of −1e-17.
+/// den is 0 only for the index-matched 1 + 0j where cos² θ′ underflows (every term 0, which was
+/// 0/0 = NaN): that gives 1, as [`dielectric`] does at η = 1 there (its critical angle) and
+/// [`conductor`] at cos θ′ ≤ 0.
+#[inline(always)]
+fn ratio(d12: f64, t3: f64, den: f64) -> f64 {
+    if den > 0.0 {
+        d12.max(0.0) * t3 / den
+    } else {
+        1.0
+    }
 }
 
 /// [`conductor`] for `N` indices at once, lane by lane the same operations (so bit-identical
@@ -149,7 +167,7 @@ pub fn conductor_lanes_c2<const N: usize>(
     let mut a = [0.0; N];
     for i in 0..N {
         let (n2, k2) = (n[i] * n[i], k[i] * k[i]);
-        t0[i] = n2 - k2 - sin2;
+        t0[i] = (n2 - k2 - 1.0) + cos2;
         a2b2[i] = t0[i] * t0[i] + 4.0 * n2 * k2;
     }
     for v in &mut a2b2 {
@@ -166,7 +184,7 @@ pub fn conductor_lanes_c2<const N: usize>(
         let t2 = 2.0 * a[i] * c;
         let t3 = cos2 * a2b2[i] + sin2 * sin2;
         let t4 = t2 * sin2;
-        out[i] = (t1 - t2) * t3 / ((t1 + t2) * (t3 + t4));
+        out[i] = ratio(t1 - t2, t3, (t1 + t2) * (t3 + t4));
     }
     out
 }
@@ -197,7 +215,7 @@ pub fn conductor_lanes_scaled<const N: usize>(
     let mut a = [0.0; N];
     for i in 0..N {
         let (n2, k2) = (n[i] * n[i], k[i] * k[i]);
-        t0[i] = gg * (n2 - k2) - s;
+        t0[i] = gg * (n2 - k2 - 1.0) + x2;
         let nkg = 2.0 * n[i] * k[i] * gg;
         a2b2[i] = t0[i] * t0[i] + nkg * nkg;
     }
@@ -215,7 +233,7 @@ pub fn conductor_lanes_scaled<const N: usize>(
         let t2 = 2.0 * a[i] * x;
         let t3 = x2 * a2b2[i] + s * s;
         let t4 = t2 * s;
-        out[i] = (t1 - t2) * t3 / ((t1 + t2) * (t3 + t4));
+        out[i] = ratio(t1 - t2, t3, (t1 + t2) * (t3 + t4));
     }
     out
 }
@@ -231,11 +249,14 @@ pub fn dielectric(cos_i: f64, eta: f64) -> f64 {
         (cos_i, eta)
     };
     let cos_i = cos_i.min(1.0);
-    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
-    if sin2_t >= 1.0 {
+    // cos² θt η² = η² − sin² θ′ = (η² − 1) + cos² θ′, which is exact for η = 1 (no interface,
+    // F = 0) where 1 − (1 − cos²)/η² cancelled to rounding noise. ≤ 0: total internal
+    // reflection.
+    let ct2_eta2 = (eta * eta - 1.0) + cos_i * cos_i;
+    if ct2_eta2 <= 0.0 {
         return 1.0;
     }
-    let cos_t = (1.0 - sin2_t).sqrt();
+    let cos_t = ct2_eta2.sqrt() / eta;
     let r_par = (cos_t - eta * cos_i) / (cos_t + eta * cos_i);
     let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     0.5 * (r_par * r_par + r_perp * r_perp)
@@ -685,6 +706,51 @@ mod tests {
     fn grazing_incidence_reflects_everything() {
         assert!((conductor(1e-9, 0.2, 3.0) - 1.0).abs() < 1e-6);
         assert!((dielectric(1e-9, 1.5) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn an_index_matched_interface_reflects_nothing_and_never_nan() {
+        // n = 1 + 0j is no interface: F = 0 at every cosine whose fourth power is a normal
+        // number (the closed form's t1 − t2 and the dielectric's cos θt cancelled to ±1e-17
+        // there; below it (η² − sin²)² is subnormal and inexact), and a number in [0, 1] at any
+        // cosine (where cos² underflowed it was 0/0 = NaN: a mirror's sample weight).
+        let mut c = 1.0f64;
+        while c > 1e-75 {
+            assert_eq!(conductor(c, 1.0, 0.0), 0.0, "cos {c:e}");
+            assert_eq!(
+                conductor_lanes(c, [1.0; 4], [0.0; 4]),
+                [0.0; 4],
+                "cos {c:e}"
+            );
+            assert_eq!(conductor_lanes_scaled(c, 1.0, [1.0; 4], [0.0; 4]), [0.0; 4]);
+            assert_eq!(dielectric(c, 1.0), 0.0, "cos {c:e}");
+            c *= 0.37;
+        }
+        for c in [1e-80, 1e-160, 1e-170, 1e-300, f64::from_bits(1)] {
+            for f in [conductor(c, 1.0, 0.0), dielectric(c, 1.0)]
+                .into_iter()
+                .chain(conductor_lanes(c, [1.0; 4], [0.0; 4]))
+                .chain(conductor_lanes_scaled(c, 1.0, [1.0; 4], [0.0; 4]))
+            {
+                assert!((0.0..=1.0).contains(&f), "cos {c:e}: {f}");
+            }
+        }
+        // Near 1 + 0j the closed form stays non-negative (it gave −1e-17 for n = 1 at some
+        // cosines) and agrees with the complex form.
+        let mut rng = crate::rng::Pcg32::new(11);
+        for _ in 0..100_000 {
+            let c = rng.next_f64();
+            let n = 1.0 + (rng.next_f64() - 0.5) * 1e-6;
+            let k = rng.next_f64() * 1e-6;
+            let f = conductor(c, n, k);
+            let (p, q) = conductor_polarized(c, n, k);
+            // Both forms cancel near 1 + 0j (the complex one in 1 − sin²/η², to ~1e-9 of F).
+            let want = 0.5 * (p + q);
+            assert!(
+                f >= 0.0 && (f - want).abs() <= 1e-6 * want + 1e-15,
+                "{c} {n} {k}: {f}"
+            );
+        }
     }
 
     #[test]

@@ -9,14 +9,33 @@ use glam::{DVec2, DVec3};
 use std::f64::consts::FRAC_PI_4;
 
 /// Normalizes `v`, or returns `None` for zero, infinite or NaN vectors.
+///
+/// Any other vector is a direction, however short or long: one whose squared length is not a
+/// normal f64 (|v| below 1.5e-154, where it is subnormal and inexact or 0, or above 1.3e154,
+/// where it overflows) is scaled to a largest component of 1 first.
 #[inline]
 pub fn normalize(v: DVec3) -> Option<DVec3> {
     let l2 = v.length_squared();
-    if l2 > 0.0 && l2.is_finite() {
+    if (f64::MIN_POSITIVE..f64::INFINITY).contains(&l2) {
         Some(v / l2.sqrt())
     } else {
-        None
+        normalize_scaled(v)
     }
+}
+
+/// [`normalize`] of a vector whose squared length under- or overflows (out of line: rare).
+#[cold]
+#[inline(never)]
+pub(crate) fn normalize_scaled(v: DVec3) -> Option<DVec3> {
+    if !v.is_finite() {
+        return None;
+    }
+    let m = v.abs().max_element();
+    if m == 0.0 {
+        return None;
+    }
+    let s = v / m;
+    Some(s / s.length())
 }
 
 /// Like [`normalize`], but returns `v` unchanged when it is already unit to within 2⁻⁴⁰ in
@@ -41,8 +60,7 @@ pub fn is_unit_l2(l2: f64) -> bool {
 
 /// True when `v` is finite and strictly above the horizon (z > 0): all a sampler needs to know
 /// about `wo` when only the sign of cos θo matters. Agrees with
-/// `normalize(v).is_some_and(|w| w.z > 0.0)` except for finite vectors so long that their
-/// squared length overflows, which this accepts.
+/// `normalize(v).is_some_and(|w| w.z > 0.0)`.
 #[inline]
 pub fn is_upper(v: DVec3) -> bool {
     v.z > 0.0 && v.z < f64::INFINITY && v.x.is_finite() && v.y.is_finite()
@@ -292,6 +310,11 @@ mod tests {
             DVec3::new(0.0, f64::INFINITY, 1.0),
             DVec3::new(0.0, 0.0, f64::INFINITY),
             DVec3::ZERO,
+            // Finite and nonzero whatever their squared lengths: directions.
+            DVec3::new(1e-300, 0.0, 1e-300),
+            DVec3::new(0.0, 0.0, f64::from_bits(1)),
+            DVec3::new(1e300, -1e300, 1e300),
+            DVec3::new(0.0, 0.0, -f64::MAX),
         ];
         for v in cases {
             assert_eq!(is_upper(v), normalize(v).is_some_and(|w| w.z > 0.0), "{v}");
@@ -359,6 +382,26 @@ mod tests {
         assert!(unit(DVec3::ZERO).is_none());
         assert!(unit(DVec3::new(f64::NAN, 0.0, 1.0)).is_none());
         assert!(unit(DVec3::new(f64::INFINITY, 0.0, 1.0)).is_none());
+    }
+
+    #[test]
+    fn a_direction_of_any_finite_nonzero_length_normalizes() {
+        // Squared lengths that underflow to 0 or a subnormal (which lost bits: 4e-7 off at
+        // 1e-160) or overflow to ∞ used to give None.
+        let v = DVec3::new(0.3, -0.2, 0.9);
+        let want = v / v.length();
+        for k in [1e-300, 1e-160, 1e-154, 1e154, 1e160, 1e300, f64::MAX] {
+            let w = normalize(v * k).unwrap_or_else(|| panic!("{k:e}"));
+            assert!((w - want).length() < 1e-15, "{k:e}: {w}");
+            assert_eq!(unit(v * k), Some(w), "{k:e}");
+            let p = upper_pair(v * k, want).unwrap_or_else(|| panic!("{k:e}"));
+            assert!((p.0 - want).length() < 1e-15, "{k:e}");
+        }
+        // A subnormal component beside a normal one is kept as it is.
+        assert_eq!(
+            normalize(DVec3::new(5e-324, 0.0, 1.0)),
+            Some(DVec3::new(5e-324, 0.0, 1.0))
+        );
     }
 
     #[test]

@@ -59,6 +59,17 @@ fn every_model_keeps_the_contract_in_rgb_and_spectral() {
         r#"{"model": "ggx", "alpha_x": 0.1, "alpha_y": 0.4, "fresnel": {"conductor": "Cu"}}"#,
         r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}"#,
         r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.2}, {"model": "cook_torrance", "m": 0.2, "fresnel": {"eta": 1.5}}]}"#,
+        // Parameters at the edges: a Fresnel term or k_s of 0 (0 times an f_r that overflows
+        // at a subnormal cosine), an index-matched conductor (0/0 in the closed form at
+        // grazing), a sharp pumped-up lobe (cos^n ψ underflows where X does).
+        r#"{"model": "ggx", "alpha": 0.2, "fresnel": {"eta": 1.0}}"#,
+        r#"{"model": "ggx", "alpha": 0.2, "ks": 0}"#,
+        r#"{"model": "ggx", "alpha": 0.2, "fresnel": {"n": 1.0, "k": 0}}"#,
+        r#"{"model": "mirror", "fresnel": {"n": 1.0, "k": 0}}"#,
+        r#"{"model": "cook_torrance", "m": 0.2, "fresnel": {"schlick": 0}}"#,
+        r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.01, "alpha_y": 0.01}"#,
+        r#"{"model": "pumped_phong", "ks": 0.5, "n": 1e5, "x": "product"}"#,
+        r#"{"model": "pumped_phong", "ks": 0.5, "n": 1e5, "x": "sqrt"}"#,
     ] {
         sources.push((spec.to_owned(), open(spec, "auto")));
     }

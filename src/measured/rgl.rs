@@ -603,9 +603,15 @@ impl Brdf for RglBrdf {
                 v = (1.0 - t) * v + t * self.channel(sample, &k, c1);
             }
             let f = v * scale / cos_o;
-            // Negative ndf/sigma (only in corrupt files) or overflow must not leak out.
-            let f = f as f32;
-            *o = if f.is_finite() && f > 0.0 { f } else { 0.0 };
+            // Negative ndf/sigma (only in corrupt files) or NaN must not leak out; a value
+            // beyond f32 (measured f_r grows like 1/cos θo: 3.7e99 at cos 1e-100) saturates, as
+            // the original Phong's does, rather than dropping to 0 where `eval_wavelength`
+            // gives it.
+            *o = if f > 0.0 {
+                f.min(f32::MAX as f64) as f32
+            } else {
+                0.0
+            };
         }
     }
 

@@ -45,18 +45,21 @@ pub(crate) fn unit_upper_pair(
     wo: glam::DVec3,
 ) -> Option<(glam::DVec3, glam::DVec3)> {
     let (l2, v2) = (wi.length_squared(), wo.length_squared());
-    if !(wi.z > 0.0 && wo.z > 0.0 && l2 < f64::INFINITY && v2 < f64::INFINITY) {
+    if !(wi.z > 0.0 && wo.z > 0.0) {
         return None;
     }
     // Unit inputs (what renderers and samplers pass) are used as they are.
     if crate::geometry::is_unit_l2(l2) && crate::geometry::is_unit_l2(v2) {
         return Some((wi, wo));
     }
+    let normal = f64::MIN_POSITIVE..f64::INFINITY;
+    if !(normal.contains(&l2) && normal.contains(&v2)) {
+        // Lengths whose squares under- or overflow (or NaN, infinite): scaled one by one.
+        return crate::geometry::upper_pair(wi, wo);
+    }
+    // 1/(|wi| |wo|) ≤ 1/MIN_POSITIVE: finite.
     let (sl, sv) = (l2.sqrt(), v2.sqrt());
     let r = 1.0 / (sl * sv);
-    if !r.is_finite() {
-        return None;
-    }
     Some((wi * (sv * r), wo * (sl * r)))
 }
 

@@ -140,7 +140,14 @@ impl Phong {
         if cos_psi.is_nan() || cos_psi <= 0.0 {
             return 0.0;
         }
-        self.pow_n(cos_psi) / self.x(wi.z, wo.z)
+        let lobe = self.pow_n(cos_psi);
+        if lobe == 0.0 {
+            // cos^n ψ underflowed (a sharp lobe far from its axis) where X may have too (the
+            // product and sqrt X at subnormal cosines): 0, not 0/0 (which `eval` saturated to
+            // f32::MAX).
+            return 0.0;
+        }
+        lobe / self.x(wi.z, wo.z)
     }
 
     /// The variant's divisor x(cos θi, cos θo) of cos^n ψ.

@@ -99,9 +99,13 @@ impl Ward {
     #[inline]
     fn lobe(&self, wi: DVec3, wo: DVec3) -> f64 {
         let s = wi + wo;
+        let e = (-self.exponent(s)).exp();
+        if e == 0.0 {
+            // At subnormal cosines the denominator underflows to 0 as well: 0, not 0/0.
+            return 0.0;
+        }
         // √cos θi √cos θo rather than √(cos θi cos θo), whose product underflows below 1e-154.
-        (-self.exponent(s)).exp()
-            / (4.0 * PI * self.alpha_x * self.alpha_y * (wi.z.sqrt() * wo.z.sqrt()))
+        e / (4.0 * PI * self.alpha_x * self.alpha_y * (wi.z.sqrt() * wo.z.sqrt()))
     }
 
     /// The density of sampled half vectors (solid angle), exp(−tan²θh (…)) / (π α_x α_y cos³θh);

@@ -135,6 +135,7 @@ pub fn check_contract(brdf: &dyn Brdf, opts: &Contract) -> Result<(), Vec<String
     values_and_symmetry(brdf, opts, &pairs, &mut log);
     batches(brdf, opts, &pairs, &mut log);
     bad_input(brdf, &mut log);
+    lengths(brdf, opts, &pairs, &mut log);
     if opts.samples > 0 {
         sampling(brdf, opts, &views(), &mut rng, &mut log);
     }
@@ -350,10 +351,11 @@ fn bad_input<B: Brdf + ?Sized>(brdf: &B, log: &mut Log) {
             log.fail("horizon", || format!("sample(wo = {b}) gave {s:?}"));
         }
     }
-    // A hair above the horizon (cosines a renderer's f64 directions can carry, down to 1e-300):
-    // values may overflow (f_r grows like 1/cos θ there for many lobes) but are never NaN or
-    // negative — an underflowed product must not turn into 0/0.
-    for z in [1e-20f64, 1e-100, 1e-200, 1e-300] {
+    // A hair above the horizon (cosines a renderer's f64 directions can carry, down to the
+    // smallest subnormal, 5e-324): values may overflow (f_r grows like 1/cos θ there for many
+    // lobes) but are never NaN or negative — an underflowed product must not turn into 0/0,
+    // nor an overflowed one times a zero factor (a Fresnel term or k_s of 0) into 0·∞.
+    for z in [1e-20f64, 1e-100, 1e-200, 1e-300, f64::from_bits(1)] {
         let r = (1.0 - z * z).sqrt();
         let g = |x: f64, y: f64| DVec3::new(x * r, y * r, z);
         let pairs = [
@@ -409,6 +411,72 @@ fn bad_input<B: Brdf + ?Sized>(brdf: &B, log: &mut Log) {
             });
         }
     }
+}
+
+/// Directions of any finite nonzero length are directions: scaled by 1e-300 … 1e300 (squared
+/// lengths that underflow to 0 or overflow to ∞; they gave 0 in `eval` and `pdf` while the
+/// samplers that look only at the sign of cos θo drew), every output equals the unit pair's.
+fn lengths<B: Brdf + ?Sized>(brdf: &B, opts: &Contract, pairs: &[(DVec3, DVec3)], log: &mut Log) {
+    let c = brdf.channels().len();
+    let nm = brdf.channels().wavelength(0);
+    // Scaling and normalizing again moves each component by a few ulps: the tolerances of two
+    // computations of the same coordinates.
+    let (rel, prel) = (opts.symmetry_tolerance, opts.symmetry_tolerance);
+    for &(wi, wo) in pairs.iter().take(40) {
+        let (f, p, fw) = (
+            eval(brdf, wi, wo),
+            brdf.pdf(wi, wo),
+            brdf.eval_wavelength(wi, wo, nm),
+        );
+        for k in [1e-300, 1e-160, 3.0, 1e160, 1e300] {
+            for (a, b) in [(wi * k, wo), (wi, wo * k), (wi * k, wo * k)] {
+                let g = eval(brdf, a, b);
+                let (q, gw) = (brdf.pdf(a, b), brdf.eval_wavelength(a, b, nm));
+                let same = (0..c).all(|ch| close(f[ch] as f64, g[ch] as f64, rel))
+                    && close(p, q, prel)
+                    && close(fw, gw, rel);
+                if !same {
+                    log.fail("lengths", || {
+                        format!(
+                            "({}, {}): f {:?}, pdf {q}, at {nm} nm {gw}; unit: {:?}, {p}, {fw}",
+                            sci(a),
+                            sci(b),
+                            &g[..c],
+                            &f[..c]
+                        )
+                    });
+                }
+            }
+        }
+    }
+    let u = DVec2::new(0.3, 0.6);
+    for wo in views() {
+        let mut w = [0.0f32; MAX_CHANNELS];
+        let s = brdf.sample(wo, u, &mut w[..c]);
+        for k in [1e-300, 1e-160, 1e160, 1e300] {
+            let mut v = [0.0f32; MAX_CHANNELS];
+            let t = brdf.sample(wo * k, u, &mut v[..c]);
+            let same = match (s, t) {
+                (None, None) => true,
+                (Some(s), Some(t)) => {
+                    (s.wi - t.wi).length() < 1e-9
+                        && close(s.pdf, t.pdf, prel)
+                        && (0..c).all(|ch| close(w[ch] as f64, v[ch] as f64, rel))
+                }
+                _ => false,
+            };
+            if !same {
+                log.fail("lengths", || {
+                    format!("sample(wo {wo} × {k:e}) = {t:?} {:?}; unit: {s:?}", &v[..c])
+                });
+            }
+        }
+    }
+}
+
+/// A vector in scientific notation (the lengths check's are far from 1).
+fn sci(v: DVec3) -> String {
+    format!("[{:e}, {:e}, {:e}]", v.x, v.y, v.z)
 }
 
 /// The bad-input part of the contract alone, panicking with the violations (the crate's model

@@ -9,8 +9,11 @@
 //!   nothing), bilateral symmetry (nor does a mirror in the plane of incidence);
 //! - **the horizon and bad input**: a direction below the horizon, NaN, infinite or zero gives
 //!   f_r = 0, pdf = 0 and no sample, and so does a `u` outside [0, 1)² (an edge's 1, beyond,
-//!   NaN); a pair a hair above it (cosines down to 1e-300) gives no NaN and nothing negative
-//!   (values may overflow where f_r grows like 1/cos θ);
+//!   NaN); a pair a hair above it (cosines down to the smallest subnormal, 5e-324) gives no NaN
+//!   and nothing negative (values may overflow where f_r grows like 1/cos θ);
+//! - **lengths**: directions need not be unit — any finite nonzero length, 1e-300 to 1e300
+//!   (whose squares under- or overflow), gives what the unit direction gives: f_r, pdf and the
+//!   sample;
 //! - **batches**: `eval_batch` gives what `eval` gives, pair by pair;
 //! - **sampling**: a sample's pdf is `pdf(wi, wo)`, its weight is f_r cos θi / pdf, the fused
 //!   `eval_pdf` agrees with both, and sampled directions are unit and above the horizon (a delta

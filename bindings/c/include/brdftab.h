@@ -7,7 +7,8 @@
  *
  * Conventions (those of the Rust `Brdf` trait):
  *   - local shading frame, z is the normal; wi (to the light) and wo (to the viewer) both point
- *     away from the surface; directions need not be normalized; below the horizon f_r = 0;
+ *     away from the surface; directions need not be normalized (any finite nonzero length,
+ *     1e-300 and 1e308 included); below the horizon f_r = 0;
  *   - brdftab_eval returns f_r in 1/sr, NOT multiplied by a cosine;
  *   - brdftab_sample draws wi for a given wo; weight = f_r * cos(theta_i) / pdf;
  *   - arrays are pair-major: wi, wo are n x 3 doubles (x, y, z), u is n x 2, f and weight are

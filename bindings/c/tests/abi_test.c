@@ -116,6 +116,33 @@ int main(int argc, char **argv) {
                   "u outside [0, 1) has no sample; u inside has one");
         }
     }
+    {
+        /* A direction of any finite nonzero length is a direction: scaled by 1e308 or 1e-300
+         * (squared lengths that overflow or underflow) eval, pdf and sample give what the unit
+         * pair gives (pdf gave 0 at 1e308 while eval normalized). */
+        double wi1[3] = {-0.3, 0.1, 0.9}, wo1[3] = {0.4, 0.2, 0.85}, u1[2] = {0.3, 0.6};
+        float f1[64], f2[64], w1[64], w2[64];
+        double p1, p2, s1[3], s2[3], sp1, sp2;
+        CHECK(brdftab_eval(b, 1, wi1, wo1, f1) == 0 && brdftab_pdf(b, 1, wi1, wo1, &p1) == 0 &&
+              brdftab_sample(b, 1, wo1, u1, s1, &sp1, w1) == 0, "unit pair");
+        double scales[2] = {1e308, 1e-300};
+        for (int k = 0; k < 2; k++) {
+            double a[3], o[3];
+            for (int i = 0; i < 3; i++) {
+                a[i] = wi1[i] / sqrt(0.91) * scales[k];
+                o[i] = wo1[i] / sqrt(0.9225) * scales[k];
+            }
+            CHECK(brdftab_eval(b, 1, a, o, f2) == 0 && brdftab_pdf(b, 1, a, o, &p2) == 0 &&
+                  brdftab_sample(b, 1, o, u1, s2, &sp2, w2) == 0, "scaled pair");
+            for (size_t i = 0; i < c; i++)
+                CHECK(fabs(f2[i] - f1[i]) <= 1e-5 * fabs(f1[i]) && fabs(w2[i] - w1[i]) <= 1e-5 * fabs(w1[i]),
+                      "eval and sample weights of a scaled pair");
+            CHECK(fabs(p2 - p1) <= 1e-9 * p1 && fabs(sp2 - sp1) <= 1e-9 * sp1 && p1 > 0.0,
+                  "pdf and sample pdf of a scaled pair");
+            CHECK(fabs(s2[0] - s1[0]) + fabs(s2[1] - s1[1]) + fabs(s2[2] - s1[2]) < 1e-9,
+                  "sampled direction of a scaled wo");
+        }
+    }
     CHECK(brdftab_albedo(b, 30.0 * BRDFTAB_PI / 180.0, alb) == 0, "albedo");
     {
         /* brdftab_sample_delta: the same draws as brdftab_sample, and a delta flag per draw — a

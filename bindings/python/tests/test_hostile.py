@@ -1,6 +1,8 @@
 """Hostile input through the Python package: fork-started workers, corrupt tables read lazily,
-FIFOs as SOURCE, NaN directions, huge specs. Nothing hangs, nothing is silently wrong."""
+FIFOs as SOURCE, NaN directions, directions of extreme lengths, huge specs. Nothing hangs,
+nothing is silently wrong."""
 
+import math
 import multiprocessing
 import os
 import subprocess
@@ -120,6 +122,29 @@ def test_nan_directions_give_zero_as_in_every_host(tmp_path, source):
     assert (f[1] == 0).all() and (f[0] > 0).all() and (f[0] == f[2]).all()
     with pytest.raises(ValueError, match=r"\[0, 1\)"):
         b.sample([0, 0, 1], [np.nan, 0.5])
+
+
+@pytest.mark.parametrize("source", ["spec", "table"])
+def test_directions_of_any_finite_length_are_directions(tmp_path, source):
+    # Scaled by 1e308 or 1e-300 (squared lengths that overflow or underflow) a pair gives what
+    # the unit pair gives; f and pdf were 0 while sample drew from the same wo.
+    if source == "table":
+        brdftab.bake(GGX, str(tmp_path / "t.btdb"), preset="small")
+        b = brdftab.open(str(tmp_path / "t.btdb"))
+    else:
+        b = brdftab.open(GGX)
+    wi = np.array([-0.3, 0.1, 0.9]) / math.sqrt(0.91)
+    wo = np.array([0.4, 0.2, 0.85]) / math.sqrt(0.9225)
+    f, p = b.eval(wi, wo), b.pdf(wi, wo)
+    s_wi, s_pdf, s_w = b.sample(wo, [0.3, 0.6])
+    assert p > 0 and s_pdf > 0
+    for k in [1e308, 1e-300]:
+        np.testing.assert_allclose(b.eval(wi * k, wo * k), f, rtol=1e-6)
+        np.testing.assert_allclose(b.pdf(wi * k, wo * k), p, rtol=1e-9)
+        t_wi, t_pdf, t_w = b.sample(wo * k, [0.3, 0.6])
+        np.testing.assert_allclose(t_wi, s_wi, atol=1e-12)
+        np.testing.assert_allclose(t_pdf, s_pdf, rtol=1e-9)
+        np.testing.assert_allclose(t_w, s_w, rtol=1e-6)
 
 
 def test_an_error_about_a_huge_spec_is_short(tmp_path):

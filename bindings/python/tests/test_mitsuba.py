@@ -484,6 +484,30 @@ def test_jit_renders_the_issue_22_scenes_as_measured_does(rgl, name):
     assert not bad, bad
 
 
+def test_scalar_nan_and_infinite_directions_give_zero():
+    # The NaN rule of every host: f_r = 0, pdf = 0, no sample. eval multiplied the library's 0
+    # by cos θo computed from wo, which a NaN component of wo made NaN.
+    use("scalar_rgb")
+    ctx = mi.BSDFContext()
+    for source in ['{"model": "ggx", "alpha": 0.3}', '{"model": "lambert", "kd": 0.3}']:
+        b = mi.load_dict({"type": "brdftab", "source": source})
+        good = (0.3, 0.1, 0.9)
+        bad = [(math.nan, 0.0, 1.0), (0.0, math.nan, 1.0), (math.inf, 0.0, 1.0), (0.0, 0.0, 0.0)]
+        for wi, wo in [(g, x) for x in bad for g in [good]] + [(x, good) for x in bad]:
+            si = mi.SurfaceInteraction3f()
+            si.wi = mi.Vector3f(*wi)
+            v = mi.Vector3f(*wo)
+            assert np.array_equal(np.array(b.eval(ctx, si, v)), np.zeros(3)), (source, wi, wo)
+            assert b.pdf(ctx, si, v) == 0.0, (source, wi, wo)
+            e, p = b.eval_pdf(ctx, si, v)
+            assert np.array_equal(np.array(e), np.zeros(3)) and p == 0.0, (source, wi, wo)
+        for wi in bad:
+            si = mi.SurfaceInteraction3f()
+            si.wi = mi.Vector3f(*wi)
+            bs, w = b.sample(ctx, si, 0.5, mi.Point2f(0.3, 0.6))
+            assert bs.pdf == 0.0 and np.array_equal(np.array(w), np.zeros(3)), (source, wi)
+
+
 def test_jit_bad_input():
     use("llvm_ad_rgb")
     with pytest.raises(Exception, match="no-such-file"):

@@ -254,6 +254,10 @@ class ScalarBrdftabBSDF(_Common):
         if self.delta or not (wi[2] > 0 and wo[2] > 0) or not active:
             return mi.Spectrum(0.0)
         cos_o = wo[2] / math.sqrt(wo[0] ** 2 + wo[1] ** 2 + wo[2] ** 2)
+        if not cos_o > 0:
+            # A NaN or infinite component of wo (the library's f_r is 0 for it, but 0 · NaN is
+            # NaN): 0, the NaN rule of every host.
+            return mi.Spectrum(0.0)
         return self._f(wi, wo, si) * cos_o
 
     def pdf(self, ctx, si, wo, active=True):
