@@ -150,7 +150,7 @@ impl CookTorrance {
     /// Written for speed with the half vector left unnormalized: with l, v unit and h = l + v,
     /// cos² α = h_z² / |h|², L·H = V·H = |h| / 2, and the V-cavity factor
     /// 2 (N·H) / (V·H) = 4 h_z / |h|². Two square roots and one division normalize the inputs,
-    /// one root gives L·H, one division each D, G and the final quotient; every expression is
+    /// one root gives L·H, one division D and two G / (4 cos θl cos θv); every expression is
     /// symmetric in (l, v), so reciprocity holds bit for bit.
     #[inline(always)]
     fn geometry(&self, wi: DVec3, wo: DVec3) -> Option<Geometry> {
@@ -171,9 +171,14 @@ impl CookTorrance {
         // Everything but exp(−x) is grouped into factors computed while `exp` runs, so only
         // one multiplication follows it on each output's dependency chain.
         let inv_hh = 1.0 / hh;
-        let g = (4.0 * h.z * inv_hh * l.z.min(v.z)).min(1.0);
+        // G / (4 cos θl cos θv) with G = min(4 h_z min(l_z, v_z) / |h|², 1), as
+        // min(h_z / (|h|² max(l_z, v_z)), 1 / (4 l_z v_z)): the cosine G shares with the
+        // denominator cancels before anything is multiplied, so a subnormal cosine cannot
+        // underflow the product into a wrong or infinite f
+        // (`weights_and_values_stay_bounded_at_subnormal_view_cosines`).
+        let g_over = (h.z * inv_hh / l.z.max(v.z)).min(1.0 / (4.0 * l.z * v.z));
         let d_scale = self.d.inv_pi_m2() * (inv_c2 * inv_c2);
-        let dg_scale = d_scale * (g / (4.0 * l.z * v.z));
+        let dg_scale = d_scale * g_over;
         let e = (-x).exp();
         Some(Geometry {
             dg: e * dg_scale,
@@ -282,9 +287,10 @@ impl Brdf for CookTorrance {
         let drawn = (2.0 * vh) * h - v;
         let other = geometry::mirror_z(drawn);
         let (l, dg, l_dot_h, pdf) = if drawn.z > 0.0 {
-            // f at the drawn normal: D·G / (4 cos θl cos θv), L·H = V·H.
-            let g = (2.0 * cos_a * drawn.z.min(v.z) / vh).min(1.0);
-            let dg = d * g / (4.0 * drawn.z * v.z);
+            // f at the drawn normal: D·G / (4 cos θl cos θv), L·H = V·H, with
+            // G = min(2 cos α min(l_z, v_z) / (V·H), 1) cancelled as in `geometry`.
+            let g_over = (cos_a / (2.0 * vh * drawn.z.max(v.z))).min(1.0 / (4.0 * drawn.z * v.z));
+            let dg = d * g_over;
             (
                 drawn,
                 dg,
@@ -547,6 +553,39 @@ mod tests {
                     ws.len()
                 );
             }
+        }
+    }
+
+    /// The bound holds at views a hair above the horizon too, down to the smallest subnormal
+    /// cosine: G's factor cos θv cancels f's 1/cos θv (f is bounded there away from the mirror
+    /// corner), so neither f nor a weight may overflow through an underflowed 4 cos θl cos θv.
+    #[test]
+    fn weights_and_values_stay_bounded_at_subnormal_view_cosines() {
+        let ct =
+            CookTorrance::new(0.3, Value::Grey(0.8), &FresnelSpec::None, &Channels::Rgb).unwrap();
+        let ks = 0.8f32 as f64;
+        let mut rng = crate::rng::Pcg32::new(11);
+        for z in [1e-6f64, 1e-20, 1e-100, 1e-300, f64::from_bits(1)] {
+            let wo = DVec3::new((1.0 - z * z).sqrt(), 0.0, z);
+            let mut drawn = 0;
+            for _ in 0..2_000 {
+                let mut w = [0.0f32; 3];
+                let Some(s) = ct.sample(wo, rng.next_dvec2(), &mut w) else {
+                    continue;
+                };
+                drawn += 1;
+                let w = w[0] as f64;
+                assert!(
+                    w.is_finite() && w <= ks * (1.0 + 1e-6),
+                    "cos θv {z:e}: weight {w}"
+                );
+                let mut f = [0.0f32; 3];
+                ct.eval(s.wi, wo, &mut f);
+                // f = k_s D G / (4 cos θl cos θv) with G ≤ 2 (N·H)(N·V)/(V·H): bounded by
+                // k_s D (N·H) / (2 cos θl (V·H)), finite for these draws.
+                assert!(f[0].is_finite(), "cos θv {z:e}: f({}) = {}", s.wi, f[0]);
+            }
+            assert!(drawn > 1_000, "cos θv {z:e}: {drawn} of 2 000 drawn");
         }
     }
 }
