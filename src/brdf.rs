@@ -168,15 +168,15 @@ pub trait Brdf: Send + Sync {
         false
     }
 
-    /// f_r at one wavelength in nm. The default interpolates linearly between the channels
-    /// (constant outside them); analytic models with spectral parameters override it to use
-    /// their spectral data directly.
+    /// f_r at one wavelength in nm. The default reads the channels as [`Channels::mix_at`] says:
+    /// interpolated linearly between wavelength channels (constant outside them), RGB through the
+    /// colour-preserving basis of [`crate::colour`]; analytic models with spectral parameters
+    /// override it to use their spectral data directly.
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
         let mut buf = [0.0f32; MAX_CHANNELS];
         let n = self.channels().len().min(MAX_CHANNELS);
         self.eval(wi, wo, &mut buf[..n]);
-        let (i0, i1, t) = self.channels().lerp_at(nm);
-        (1.0 - t) * buf[i0] as f64 + t * buf[i1] as f64
+        self.channels().mix_at(nm).apply(|i| buf[i] as f64)
     }
 
     /// Evaluates many pairs: `out[k * c .. (k + 1) * c]` receives `f_r(wi[k], wo[k])` where `c` is
@@ -336,7 +336,7 @@ pub trait Brdf: Send + Sync {
         let c = self.channels().len().min(MAX_CHANNELS);
         let s = self.sample(wo, u, &mut buf[..c])?;
         if s.delta {
-            lerp_channels(self.channels(), &buf[..c], nm, weight);
+            mix_channels(self.channels(), &buf[..c], nm, weight);
         } else {
             let k = s.wi.z.abs() / s.pdf;
             for (w, &x) in weight.iter_mut().zip(nm) {
@@ -426,12 +426,11 @@ pub fn check_batch(wi: &[DVec3], wo: &[DVec3], out: &[f32], c: usize) -> usize {
 }
 
 /// Per-channel values `v` read at the wavelengths `nm` into `out` as
-/// [`Brdf::eval_wavelength`]'s default reads channels ([`Channels::lerp_at`]): what a source whose
-/// spectral values are its channels' interpolation gives at a wavelength.
-pub fn lerp_channels(channels: &Channels, v: &[f32], nm: &[f64], out: &mut [f32]) {
+/// [`Brdf::eval_wavelength`]'s default reads channels ([`Channels::mix_at`]): what a source whose
+/// spectral values come from its channels gives at a wavelength.
+pub fn mix_channels(channels: &Channels, v: &[f32], nm: &[f64], out: &mut [f32]) {
     for (o, &x) in out.iter_mut().zip(nm) {
-        let (i0, i1, t) = channels.lerp_at(x);
-        *o = ((1.0 - t) * v[i0] as f64 + t * v[i1] as f64) as f32;
+        *o = channels.mix_at(x).apply(|i| v[i] as f64) as f32;
     }
 }
 

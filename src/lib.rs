@@ -34,6 +34,7 @@ pub mod batch;
 pub mod brdf;
 pub mod cache;
 pub mod codec;
+pub mod colour;
 pub mod error;
 pub(crate) mod fastmath;
 pub(crate) mod files;

@@ -5,12 +5,14 @@
 //! or sampled spectra; they are resolved once, when a model is built for a channel set, so that
 //! evaluation never allocates or interpolates parameters.
 //!
-//! RGB and wavelengths meet at the *representative wavelengths* [`RGB_WAVELENGTHS`]: an RGB
-//! channel is treated as the spectrum at that wavelength when spectral data (e.g. a metal's n, k)
-//! must be evaluated for RGB, and an RGB parameter is interpolated piecewise linearly between
-//! those wavelengths (constant outside) when a spectral channel set asks for it. This is the
-//! "representative wavelength" convention of simple spectral renderers; it keeps a grey parameter
-//! exactly grey in either mode.
+//! RGB and wavelengths meet in two directions:
+//! - **RGB → spectrum** (RGB data or an RGB parameter asked at a wavelength): the colour-preserving
+//!   basis of [`crate::colour`], RGB (r, g, b) at λ = r b_R(λ) + g b_G(λ) + b b_B(λ), whose CIE
+//!   projection under D65 — what a spectral renderer's pixel is — gives (r, g, b) back. Grey
+//!   stays exactly flat, non-negative RGB gives a non-negative spectrum ([`Channels::mix_at`]).
+//! - **spectrum → RGB** (spectral data such as a metal's n, k evaluated for RGB): the spectrum at
+//!   the channel's *representative wavelength* [`RGB_WAVELENGTHS`], as renderers evaluate
+//!   optical constants for RGB.
 
 use serde::{Deserialize, Serialize};
 
@@ -105,20 +107,47 @@ impl Channels {
         }
     }
 
-    /// Interpolation weights to evaluate channel data at wavelength `nm`:
-    /// returns `(i0, i1, t)` so that `value = (1 - t) v[i0] + t v[i1]`. Outside the range the
-    /// nearest end channel is used. For RGB the channels are ordered by their representative
-    /// wavelengths (B < G < R).
-    pub fn lerp_at(&self, nm: f64) -> (usize, usize, f64) {
+    /// How channel data gives a value at wavelength `nm`: for wavelengths, linear interpolation
+    /// between the two channels around `nm` (the nearest end channel outside them); for RGB, the
+    /// colour-preserving basis [`crate::colour::rgb_basis_at`].
+    pub fn mix_at(&self, nm: f64) -> ChannelMix {
         match self {
-            Channels::Rgb => {
-                // Wavelength order: B (2) at 444, G (1) at 526, R (0) at 645.
-                let order = [2usize, 1, 0];
-                let w = [444.0, 526.0, 645.0];
-                lerp_sorted(&w, nm, |k| order[k])
+            Channels::Rgb => ChannelMix {
+                index: [0, 1, 2],
+                weight: crate::colour::rgb_basis_at(nm),
+            },
+            Channels::Wavelengths(w) => {
+                let (i0, i1, t) = lerp_sorted(w, nm, |k| k);
+                ChannelMix {
+                    index: [i0, i1, i1],
+                    weight: [1.0 - t, t, 0.0],
+                }
             }
-            Channels::Wavelengths(w) => lerp_sorted(w, nm, |k| k),
         }
+    }
+}
+
+/// Channel data at one wavelength ([`Channels::mix_at`]): value = Σ `weight[k]` · `v[index[k]]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChannelMix {
+    /// The channels read.
+    pub index: [usize; 3],
+    /// Their weights (≥ 0, summing to 1).
+    pub weight: [f64; 3],
+}
+
+impl ChannelMix {
+    /// The mix of the channel values `v(i)`; channels of weight 0 are not read (an infinite
+    /// value there does not turn the result into NaN).
+    #[inline]
+    pub fn apply(&self, v: impl Fn(usize) -> f64) -> f64 {
+        let mut s = 0.0;
+        for k in 0..3 {
+            if self.weight[k] != 0.0 {
+                s += self.weight[k] * v(self.index[k]);
+            }
+        }
+        s
     }
 }
 
@@ -161,14 +190,12 @@ pub enum Value {
 }
 
 impl Value {
-    /// The value at wavelength `nm` (RGB values are placed at [`RGB_WAVELENGTHS`]).
+    /// The value at wavelength `nm` (RGB values through the colour-preserving basis,
+    /// [`Channels::mix_at`]).
     pub fn at(&self, nm: f64) -> f64 {
         match self {
             Value::Grey(v) => *v,
-            Value::Rgb(rgb) => {
-                let (i0, i1, t) = Channels::Rgb.lerp_at(nm);
-                (1.0 - t) * rgb[i0] + t * rgb[i1]
-            }
+            Value::Rgb(rgb) => Channels::Rgb.mix_at(nm).apply(|i| rgb[i]),
             Value::Spectral {
                 wavelengths,
                 values,
@@ -394,11 +421,35 @@ mod tests {
     }
 
     #[test]
-    fn rgb_at_representative_wavelengths() {
+    fn an_rgb_value_as_a_spectrum_keeps_its_colour() {
+        // What a spectral renderer shows of the parameter (its CIE projection) is the RGB given.
         let v = Value::Rgb([1.0, 2.0, 3.0]);
-        for (i, &nm) in RGB_WAVELENGTHS.iter().enumerate() {
-            assert!((v.at(nm) - (i as f64 + 1.0)).abs() < 1e-12);
+        let back = crate::colour::srgb_of(|nm| v.at(nm));
+        for (i, c) in back.iter().enumerate() {
+            assert!((c - (i as f64 + 1.0)).abs() < 1e-11, "{back:?}");
         }
+        // On spectral channels it is that spectrum at each wavelength.
+        let ch = Channels::linspace(400.0, 700.0, 4).unwrap();
+        let r = v.resolve(&ch);
+        for (i, x) in r.iter().enumerate() {
+            assert_eq!(*x, v.at(ch.wavelength(i)));
+        }
+    }
+
+    #[test]
+    fn wavelength_mixes_interpolate_between_neighbours() {
+        let ch = Channels::wavelengths(vec![400.0, 500.0, 600.0]).unwrap();
+        let m = ch.mix_at(450.0);
+        assert_eq!(m.apply(|i| [1.0, 3.0, 100.0][i]), 2.0);
+        assert_eq!(ch.mix_at(300.0).apply(|i| [1.0, 3.0, 5.0][i]), 1.0);
+        assert_eq!(
+            ch.mix_at(900.0).apply(|i| [1.0, 3.0, f64::INFINITY][i]),
+            f64::INFINITY
+        );
+        assert_eq!(
+            ch.mix_at(500.0).apply(|i| [f64::INFINITY, 3.0, 5.0][i]),
+            3.0
+        );
     }
 
     #[test]

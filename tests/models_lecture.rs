@@ -270,9 +270,11 @@ fn delta_models_sample_one_direction() {
 
 #[test]
 fn eval_wavelength_agrees_with_channels_at_rgb_wavelengths() {
+    // Spectral data (a metal's n, k) is read for RGB at the representative wavelengths, so a
+    // model with spectral or grey parameters gives its RGB channels there.
     let wi = geometry::spherical(0.5, 0.0);
     let wo = geometry::spherical(0.45, 3.0);
-    for json in SMOOTH {
+    for json in SMOOTH.iter().filter(|j| !j.contains(": [")) {
         let brdf = build(json);
         let mut f = [0.0f32; 3];
         brdf.eval(wi, wo, &mut f);
@@ -301,6 +303,33 @@ fn eval_wavelength_agrees_with_channels_at_rgb_wavelengths() {
         f[6] > f[0] * 1.5,
         "gold reflects red much more than violet: {f:?}"
     );
+}
+
+#[test]
+fn an_rgb_parameter_at_a_wavelength_keeps_its_colour() {
+    // RGB parameters are read at a wavelength through the colour-preserving basis: a Lambertian
+    // (linear in k_d) gives the basis mix of its RGB channels, a spectrum whose CIE projection
+    // is its RGB value.
+    let (wi, wo) = (
+        geometry::spherical(0.5, 0.0),
+        geometry::spherical(0.45, 3.0),
+    );
+    let brdf = build(SMOOTH[0]);
+    let mut f = [0.0f32; 3];
+    brdf.eval(wi, wo, &mut f);
+    for nm in [380.0, 444.0, 500.0, 526.0, 600.0, 645.0, 720.0] {
+        let b = brdftab::colour::rgb_basis_at(nm);
+        let want: f64 = (0..3).map(|c| b[c] * f[c] as f64).sum();
+        let v = brdf.eval_wavelength(wi, wo, nm);
+        assert!((v - want).abs() <= 1e-7 * want, "{nm}: {v} vs {want}");
+    }
+    let back = brdftab::colour::srgb_of(|nm| brdf.eval_wavelength(wi, wo, nm));
+    for c in 0..3 {
+        assert!(
+            (back[c] - f[c] as f64).abs() <= 1e-7 * f[c] as f64,
+            "{back:?} vs {f:?}"
+        );
+    }
 }
 
 #[test]

@@ -705,11 +705,14 @@ fn batch_equals_single_and_invalid_input_gives_zero() {
     ] {
         assert_eq!(eval3(&tb, a, b), [0.0; 3]);
     }
-    // Wavelength interpolation between channels (RGB: B < G < R).
+    // At a wavelength an RGB table reads its channels through the RGB basis.
     let (wi, wo) = (spherical(0.3, 0.0), spherical(0.4, 2.0));
     let f = eval3(&tb, wi, wo);
-    let mid = tb.eval_wavelength(wi, wo, (526.0 + 645.0) / 2.0);
-    assert!((mid - (f[0] as f64 + f[1] as f64) / 2.0).abs() < 1e-6);
+    for nm in [444.0, 585.5, 700.0] {
+        let w = brdftab::colour::rgb_basis_at(nm);
+        let want: f64 = (0..3).map(|c| w[c] * f[c] as f64).sum();
+        assert!((tb.eval_wavelength(wi, wo, nm) - want).abs() < 1e-6 * want);
+    }
 }
 
 #[test]

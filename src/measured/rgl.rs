@@ -43,7 +43,7 @@ use super::tensor::{Dtype, Field, TensorFile};
 use crate::brdf::{BakeSource, Brdf, Flags};
 use crate::error::{Error, Result};
 use crate::geometry;
-use crate::spectrum::{Channels, MAX_CHANNELS};
+use crate::spectrum::{ChannelMix, Channels, MAX_CHANNELS};
 use crate::table::sampling::TableSampler;
 pub(crate) use crate::table::warp2d::{Corners, Planes, Warp};
 use crate::table::warp2d::{NO_PARAMS, bilinear};
@@ -71,6 +71,15 @@ fn param_weight(values: &[f32], x: f64) -> (usize, usize, f64) {
     let (p0, p1) = (values[i] as f64, values[i + 1] as f64);
     let w = ((x - p0) / (p1 - p0)).clamp(0.0, 1.0);
     (i, i + 1, w)
+}
+
+/// The file's spectral channels read at `nm`: linear between the two around it.
+fn spectral_mix(wavelengths: &[f32], nm: f64) -> ChannelMix {
+    let (c0, c1, t) = param_weight(wavelengths, nm);
+    ChannelMix {
+        index: [c0, c1, c1],
+        weight: [1.0 - t, t, 0.0],
+    }
 }
 
 /// Where a bake's view of an isotropic file ([`BakeSource::bake_view`]) replaces the normal slice's
@@ -123,8 +132,8 @@ pub struct RglBrdf {
     table: Planes,
     /// File channels: 3 for RGB, else the wavelengths (nm) of `spectra`.
     wavelengths: Option<Vec<f32>>,
-    /// Per output channel: file channels (c0, c1) and weight of c1.
-    out_map: Vec<(usize, usize, f64)>,
+    /// Per output channel: the file channels it reads and their weights.
+    out_map: Vec<ChannelMix>,
     /// The azimuthal mean of the θi = 0 slice (isotropic files; made on the first
     /// [`BakeSource::bake_view`]).
     normal_limit: std::sync::OnceLock<NormalLimit>,
@@ -160,9 +169,10 @@ impl RglBrdf {
         Self::from_tensor(&TensorFile::open(path)?, None)
     }
 
-    /// Opens a `.bsdf` file for a chosen channel set: channels are evaluated at their wavelengths
-    /// (RGB: the representative wavelengths) by interpolating the file's channels — for an RGB
-    /// file asked for RGB, exactly its R, G, B.
+    /// Opens a `.bsdf` file for a chosen channel set. A spectral file's channels are interpolated
+    /// at the set's wavelengths (RGB: the representative wavelengths); an RGB file asked for
+    /// wavelengths gives its R, G, B through the colour-preserving basis
+    /// ([`Channels::mix_at`]); an RGB file asked for RGB, exactly its R, G, B.
     pub fn open_with_channels(path: impl AsRef<Path>, channels: &Channels) -> Result<Self> {
         Self::from_tensor(&TensorFile::open(path)?, Some(channels))
     }
@@ -340,15 +350,17 @@ impl RglBrdf {
             }
         };
         let out_map = match (&channels, &wavelengths) {
-            (Channels::Rgb, None) => vec![(0, 0, 0.0), (1, 1, 0.0), (2, 2, 0.0)],
-            (c, None) => (0..c.len())
-                .map(|i| {
-                    let (a, b, t) = Channels::Rgb.lerp_at(c.wavelength(i));
-                    (a, b, t)
+            (Channels::Rgb, None) => (0..3)
+                .map(|i| ChannelMix {
+                    index: [i; 3],
+                    weight: [1.0, 0.0, 0.0],
                 })
                 .collect(),
+            (c, None) => (0..c.len())
+                .map(|i| Channels::Rgb.mix_at(c.wavelength(i)))
+                .collect(),
             (c, Some(wl)) => (0..c.len())
-                .map(|i| param_weight(wl, c.wavelength(i)))
+                .map(|i| spectral_mix(wl, c.wavelength(i)))
                 .collect(),
         };
 
@@ -597,11 +609,8 @@ impl Brdf for RglBrdf {
         let Some((sample, k, scale, cos_o)) = self.prepare(wi, wo) else {
             return;
         };
-        for (o, &(c0, c1, t)) in out.iter_mut().zip(&self.out_map) {
-            let mut v = self.channel(sample, &k, c0);
-            if t != 0.0 {
-                v = (1.0 - t) * v + t * self.channel(sample, &k, c1);
-            }
+        for (o, mix) in out.iter_mut().zip(&self.out_map) {
+            let v = mix.apply(|c| self.channel(sample, &k, c));
             let f = v * scale / cos_o;
             // Negative ndf/sigma (only in corrupt files) or NaN must not leak out; a value
             // beyond f32 (measured f_r grows like 1/cos θo: 3.7e99 at cos 1e-100) saturates, as
@@ -616,14 +625,14 @@ impl Brdf for RglBrdf {
     }
 
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
-        let (c0, c1, t) = match &self.wavelengths {
-            Some(wl) => param_weight(wl, nm),
-            None => Channels::Rgb.lerp_at(nm),
+        let mix = match &self.wavelengths {
+            Some(wl) => spectral_mix(wl, nm),
+            None => Channels::Rgb.mix_at(nm),
         };
         let Some((sample, k, scale, cos_o)) = self.prepare(wi, wo) else {
             return 0.0;
         };
-        let v = (1.0 - t) * self.channel(sample, &k, c0) + t * self.channel(sample, &k, c1);
+        let v = mix.apply(|c| self.channel(sample, &k, c));
         let f = v * scale / cos_o;
         if f.is_finite() && f > 0.0 { f } else { 0.0 }
     }

@@ -592,7 +592,7 @@ impl Brdf for TabulatedBrdf {
         let mut buf = [0.0f32; crate::spectrum::MAX_CHANNELS];
         let c = self.lookup.channels().min(buf.len());
         let s = self.sample(wo, u, &mut buf[..c])?;
-        crate::brdf::lerp_channels(self.channels(), &buf[..c], nm, weight);
+        crate::brdf::mix_channels(self.channels(), &buf[..c], nm, weight);
         Some(s)
     }
 
