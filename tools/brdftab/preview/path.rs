@@ -14,10 +14,11 @@
 //!
 //! Transmission is not traced: a path whose sampled direction enters the sphere ends there.
 //!
-//! Spectral BRDFs are rendered in RGB: each RGB channel takes the BRDF's channel values linearly
-//! interpolated at [`RGB_WAVELENGTHS`] (645, 526, 444 nm) — the same rule as the default
-//! `Brdf::eval_wavelength` — for evaluation and for sample weights alike, so MIS stays
-//! consistent. This is a preview, not a colorimetric conversion.
+//! Spectral BRDFs are rendered in RGB as a spectral renderer's pixel shows them: the channels'
+//! spectrum (linear between the channels' wavelengths, held at the ends) projected to linear
+//! sRGB under D65 ([`brdftab::colour::srgb_weights`]; a flat spectrum gives grey exactly), and
+//! negative sRGB (a spectrum outside the gamut) clipped at 0 — for evaluation and for sample
+//! weights alike, so MIS stays consistent.
 
 use std::f64::consts::{FRAC_1_PI, PI};
 use std::sync::Arc;
@@ -32,7 +33,7 @@ use brdftab::brdf::Brdf;
 use brdftab::error::{Error, Result};
 use brdftab::geometry::{self, Frame};
 use brdftab::progress::{Progress, Stage};
-use brdftab::spectrum::{Channels, MAX_CHANNELS, RGB_WAVELENGTHS};
+use brdftab::spectrum::{Channels, MAX_CHANNELS};
 
 /// What to compute.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -253,8 +254,8 @@ impl RenderOptions {
 struct RgbMaterial<'a> {
     brdf: &'a dyn Brdf,
     n: usize,
-    /// For each of R, G, B: (i0, i1, t) — lerp between channel i0 and i1.
-    map: Option<[(usize, usize, f64); 3]>,
+    /// Spectral channels: each channel's weight in R, G, B.
+    map: Option<Vec<[f64; 3]>>,
     delta: bool,
 }
 
@@ -269,7 +270,7 @@ impl<'a> RgbMaterial<'a> {
         }
         let map = match ch {
             Channels::Rgb => None,
-            _ => Some(RGB_WAVELENGTHS.map(|nm| ch.lerp_at(nm))),
+            Channels::Wavelengths(w) => Some(brdftab::colour::srgb_weights(w)),
         };
         Ok(RgbMaterial {
             brdf,
@@ -284,9 +285,11 @@ impl<'a> RgbMaterial<'a> {
         match &self.map {
             None => DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64),
             Some(m) => {
-                let c =
-                    |(i0, i1, t): (usize, usize, f64)| (1.0 - t) * v[i0] as f64 + t * v[i1] as f64;
-                DVec3::new(c(m[0]), c(m[1]), c(m[2]))
+                let mut c = DVec3::ZERO;
+                for (w, &x) in m.iter().zip(v) {
+                    c += DVec3::from(*w) * x as f64;
+                }
+                c
             }
         }
     }
@@ -1038,7 +1041,7 @@ mod tests {
     }
 
     #[test]
-    fn spectral_brdf_renders_through_rgb_wavelengths() {
+    fn spectral_brdf_renders_as_its_colour() {
         // A grey spectral Lambertian renders like the RGB one (to f32 rounding).
         let ch = Channels::wavelengths(vec![400.0, 500.0, 600.0, 700.0]).unwrap();
         let spectral = Lambert::new(Value::Grey(0.2), &ch).unwrap();
@@ -1047,6 +1050,37 @@ mod tests {
         let a = render(&spectral, &opts, &Silent).unwrap();
         let b = render(&rgb, &opts, &Silent).unwrap();
         assert!(compare(&a, &b).unwrap().rel_rmse < 1e-6);
+    }
+
+    #[test]
+    fn an_rgb_colour_made_spectral_renders_as_that_colour() {
+        // k_d given in RGB on spectral channels (the colour-preserving basis, sampled every
+        // 10 nm) renders as the RGB Lambertian, up to what sampling the basis changes: the
+        // projection of the sampled k_d spectrum against k_d, channel by channel.
+        let ch = Channels::linspace(360.0, 830.0, 48).unwrap();
+        let kd = Value::Rgb([0.25, 0.06, 0.02]);
+        let sampled = kd.resolve(&ch);
+        let Channels::Wavelengths(nm) = &ch else {
+            unreachable!()
+        };
+        let w = brdftab::colour::srgb_weights(nm);
+        let Value::Rgb(rgb) = kd else { unreachable!() };
+        let colour_error = (0..3)
+            .map(|c| {
+                let p: f64 = w.iter().zip(&sampled).map(|(w, v)| w[c] * v).sum();
+                (p / rgb[c] - 1.0).abs()
+            })
+            .fold(0.0, f64::max);
+        assert!(colour_error < 1e-2, "{colour_error}"); // the dim blue channel: 0.5 %
+        let spectral = Lambert::new(kd.clone(), &ch).unwrap();
+        let rgb = Lambert::new(kd, &Channels::Rgb).unwrap();
+        let opts = RenderOptions { spp: 2, ..tiny() };
+        let a = render(&spectral, &opts, &Silent).unwrap();
+        let b = render(&rgb, &opts, &Silent).unwrap();
+        let e = compare(&a, &b).unwrap();
+        // Same paths (Lambert's draws do not depend on channels): pixels differ by at most the
+        // colour error (and f32 rounding).
+        assert!(e.rel_rmse <= colour_error + 1e-5, "{e:?} vs {colour_error}");
     }
 
     #[test]
