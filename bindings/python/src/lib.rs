@@ -14,11 +14,12 @@
 //! the GIL and panic plumbing every call goes through), `values.rs` (Python arguments to the
 //! library's values and settings, JSON results to Python), `arrays.rs` (numpy arrays in and out
 //! of batch calls), `brdf/` (the `Brdf` class), `table.rs` (the `Table` class and device
-//! layouts), `sources.rs` (`open`, `check`, `info`), `db.rs` (the database functions) and
-//! `requests.rs` (`bake`, `bake_cached`, `convert`, `fit`).
+//! layouts), `sources.rs` (`open`, `check`, `info`), `db.rs` (the database functions),
+//! `requests.rs` (`bake`, `bake_cached`, `convert`, `fit`) and `colour.rs` (`rgb_basis`).
 
 mod arrays;
 mod brdf;
+mod colour;
 mod db;
 mod errors;
 mod requests;
@@ -47,6 +48,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(requests::bake_cached, m)?)?;
     m.add_function(wrap_pyfunction!(requests::convert, m)?)?;
     m.add_function(wrap_pyfunction!(requests::fit, m)?)?;
+    m.add_function(wrap_pyfunction!(colour::rgb_basis, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -33,6 +33,7 @@ from ._native import (  # noqa: F401
     fit,
     info,
     open,
+    rgb_basis,
 )
 from . import _native
 
@@ -48,6 +49,7 @@ __all__ = [
     "fit",
     "info",
     "open",
+    "rgb_basis",
 ]
 
 

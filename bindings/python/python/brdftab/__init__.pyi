@@ -20,6 +20,7 @@ __all__ = [
     "fit",
     "info",
     "open",
+    "rgb_basis",
 ]
 
 # Aliases of the stubs only (private: not names of the package).
@@ -199,6 +200,11 @@ def open(
 ) -> Brdf:
     """Opens SOURCE. interp: "auto" (nearest on tables of MERL cells, linear otherwise),
     "nearest" or "linear"."""
+def rgb_basis(nm: _ArrayLike) -> npt.NDArray[np.float64]:
+    """The weights of R, G, B at wavelengths `nm` (nm; result shape: nm's + (3,)): RGB data
+    (r, g, b) at a wavelength is r w[0] + g w[1] + b w[2], as `Brdf.eval_spectral` reads an RGB
+    source. Weights >= 0 summing to 1; the spectrum they make projects (CIE 1931 2°, D65,
+    linear sRGB) to the RGB it came from, so colour survives a spectral renderer."""
 def check(source: str | PathLike[str], *, wavelengths: _Wavelengths = None) -> dict[str, Any]:
     """The plausibility report of SOURCE as a dict with the keys of `brdftab check --json`."""
 def info(source: str | PathLike[str]) -> dict[str, Any]:

@@ -32,7 +32,8 @@ brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only (so a sour
   the path's wavelengths, :meth:`brdftab.Brdf.sample` with ``nm``); smooth draws carry the
   smooth lobes' flags.
 - In a spectral variant an RGB source is read at each wavelength as the library reads RGB
-  channels (:data:`RGB_WAVELENGTHS`, linear between), in the scalar and the JIT variants.
+  channels (:func:`brdftab.rgb_basis`: a spectrum whose colour, as the variant's film shows it,
+  is the source's RGB), in the scalar and the JIT variants.
 - JIT variants (``llvm_ad_rgb``, ``cuda_ad_rgb``; sources with a delta lobe are refused: a
   table cannot hold one) cannot call back into the host per query:
   the plugin bakes (or loads) a table, uploads the library's *device layout* of it once
@@ -66,9 +67,9 @@ from brdftab._halfwarp import HalfVectorSampler
 
 _REGISTERED = set()
 
-#: Where the library places the B, G and R channels of an RGB source on the wavelength axis
-#: (nm; `brdftab::spectrum::RGB_WAVELENGTHS`): a spectral variant reads RGB tables there.
-RGB_WAVELENGTHS = (444.0, 526.0, 645.0)
+#: The wavelengths (nm, 1 nm apart) at which the JIT path tabulates :func:`brdftab.rgb_basis`
+#: to read RGB tables in spectral variants (held at the ends outside, as the library holds it).
+_BASIS_NM = np.arange(360.0, 831.0)
 
 #: The error target of the JIT variants' tables of isotropic models (relative RMSE of
 #: f_r cos θi cos θo, ``brdftab.bake``'s ``target_error``). The medium preset (4.4 M values,
@@ -960,7 +961,12 @@ class JitBrdftabBSDF(_Common):
             v = _prop(props, key)
             if v is not None:
                 options[key] = str(v)
-        if self.spectral and brdftab_kind(self.source) in ("spec", "rgl"):
+        # A spectral variant bakes a model or a spectral RGL file at 21 wavelengths; an RGB
+        # source stays an RGB table, read at each wavelength through the RGB basis in `_f`
+        # (exact: sampling the basis every 20 nm would move a saturated colour by ~1 %).
+        kind = brdftab_kind(self.source)
+        rgb_source = list(self.brdf.channels) == ["R", "G", "B"]
+        if self.spectral and (kind == "spec" or (kind == "rgl" and not rgb_source)):
             options.setdefault("wavelengths", list(range(380, 781, 20)))
         # The table as the library describes it for devices (`device_layout`): the JIT lookup
         # implements that layout, not the grid's description. An opened table moves its values
@@ -969,6 +975,11 @@ class JitBrdftabBSDF(_Common):
         # cells, linear otherwise).
         layout = self._table(options)
         self.table = JitTable(layout)
+        # An RGB table in a spectral variant: the RGB basis, uploaded once (see `_f`).
+        self._basis = None
+        if self.spectral and self.table.wavelengths is None:
+            b = brdftab.rgb_basis(_BASIS_NM)
+            self._basis = [mi.Float(np.ascontiguousarray(b[:, k])) for k in range(3)]
         # The library's importance sampler (conditional half-vector warps of f_r cos θo given
         # wi), on the densities it exports for the table (or the source): brdftab._halfwarp.
         # (A kernel layout is of an isotropic table.)
@@ -1055,9 +1066,21 @@ class JitBrdftabBSDF(_Common):
         wl = self.table.wavelengths
         if wl is None:
             # An RGB table in a spectral variant: the library's reading of RGB channels at a
-            # wavelength (`Brdf.eval_spectral`, `Channels::lerp_at`: B, G, R placed at
-            # RGB_WAVELENGTHS and interpolated linearly), as the scalar variants give it.
-            wl, f = RGB_WAVELENGTHS, [f[2], f[1], f[0]]
+            # wavelength (`Brdf.eval_spectral`, `Channels::mix_at`: the colour-preserving basis
+            # `brdftab.rgb_basis`, tabulated at 1 nm and interpolated as the library does), as
+            # the scalar variants give it.
+            out = []
+            for i in range(len(lam)):
+                u = dr.clip(lam[i] - float(_BASIS_NM[0]), 0.0, float(len(_BASIS_NM) - 1))
+                j = dr.minimum(mi.UInt32(u), len(_BASIS_NM) - 2)
+                t = u - mi.Float(j)
+                v = 0
+                for k in range(3):
+                    w = dr.lerp(dr.gather(mi.Float, self._basis[k], j),
+                                dr.gather(mi.Float, self._basis[k], j + 1), t)
+                    v = v + w * f[k]
+                out.append(v)
+            return mi.Spectrum(out)
         out = []
         for i in range(len(lam)):
             x = lam[i]

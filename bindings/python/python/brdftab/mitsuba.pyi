@@ -17,8 +17,6 @@ JIT_TABLE_PROPERTIES: tuple[str, ...]
 variants accept them and ignore them (they evaluate the source itself)."""
 LAYOUT_VERSION: int
 """The device-layout version JitTable implements (Rust `brdftab::table::device::VERSION`)."""
-RGB_WAVELENGTHS: tuple[float, float, float]
-"""Where B, G and R of an RGB table sit on the wavelength axis (nm) in a spectral variant."""
 MODEL_TARGET_ERROR: float
 """The error target of the JIT variants' tables of isotropic models (`bake`'s target_error)."""
 
