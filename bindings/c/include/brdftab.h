@@ -91,8 +91,9 @@ int brdftab_sample_delta(const brdftab_brdf *b, size_t n, const double *wo, cons
                          double *wi, double *pdf, float *weight, unsigned char *delta);
 /* f_r of n pairs at the k wavelengths nm (the same for every pair, each a finite number of nm
  * > 0) into f (n x k): the source's own spectral data where it has them (models, spectral RGL
- * files), its channels interpolated otherwise (RGB at 645, 526 and 444 nm). For renderers that
- * draw their wavelengths per path (pbrt-v4). */
+ * files), its channels otherwise (wavelength channels interpolated; RGB through a
+ * colour-preserving basis: the spectrum's CIE 1931 / D65 sRGB is the source's RGB). For
+ * renderers that draw their wavelengths per path (pbrt-v4). */
 int brdftab_eval_spectral(const brdftab_brdf *b, size_t n, const double *wi, const double *wo,
                           size_t k, const double *nm, float *f);
 /* brdftab_sample_delta with the weights at the k wavelengths nm (weight: n x k), a mirror's

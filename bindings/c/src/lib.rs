@@ -526,8 +526,9 @@ unsafe fn wavelengths<'a>(k: usize, nm: *const f64) -> Result<&'a [f64], String>
 }
 
 /// f_r of `n` pairs at the `k` wavelengths `nm` into `f` (n × k): a source's own spectral data
-/// where it has them (models, spectral RGL files), its channels interpolated otherwise (RGB at
-/// 645, 526 and 444 nm) — [`brdftab::brdf::eval_wavelengths`]. For renderers that draw their
+/// where it has them (models, spectral RGL files), its channels otherwise (wavelength channels
+/// interpolated; RGB through the colour-preserving basis of [`brdftab::colour`], whose
+/// spectrum renders as the RGB) — [`brdftab::brdf::eval_wavelengths`]. For renderers that draw their
 /// wavelengths per path (pbrt-v4), where a handle opened at fixed wavelengths does not serve.
 ///
 /// # Safety
