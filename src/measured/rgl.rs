@@ -73,6 +73,42 @@ fn param_weight(values: &[f32], x: f64) -> (usize, usize, f64) {
     (i, i + 1, w)
 }
 
+/// The planes of a spectral table (`slices × wavelengths × ny × nx`) projected to linear sRGB
+/// per texel (`slices × 3 × ny × nx`): what a spectral renderer's pixel shows of each measured
+/// spectrum, read linearly between the file's wavelengths as everywhere. Negative values (noise
+/// in dark channels) are clipped first, as the reader clips what it interpolates.
+fn project_to_rgb(table: &Planes, wavelengths: &[f32]) -> Planes {
+    let nm: Vec<f64> = wavelengths.iter().map(|&x| x as f64).collect();
+    let w = crate::colour::srgb_weights(&nm);
+    let (n, plane) = (nm.len(), table.plane_len());
+    let slices = table.data.len() / (n * plane).max(1);
+    let mut data = vec![0f32; slices * 3 * plane];
+    let mut acc = vec![[0f64; 3]; plane];
+    for s in 0..slices {
+        acc.fill([0.0; 3]);
+        for (k, wk) in w.iter().enumerate() {
+            let src = &table.data[(s * n + k) * plane..][..plane];
+            for (a, &v) in acc.iter_mut().zip(src) {
+                let v = (v as f64).max(0.0);
+                for c in 0..3 {
+                    a[c] += wk[c] * v;
+                }
+            }
+        }
+        for c in 0..3 {
+            let dst = &mut data[(s * 3 + c) * plane..][..plane];
+            for (d, a) in dst.iter_mut().zip(&acc) {
+                *d = a[c] as f32;
+            }
+        }
+    }
+    Planes {
+        nx: table.nx,
+        ny: table.ny,
+        data,
+    }
+}
+
 /// The file's spectral channels read at `nm`: linear between the two around it.
 fn spectral_mix(wavelengths: &[f32], nm: f64) -> ChannelMix {
     let (c0, c1, t) = param_weight(wavelengths, nm);
@@ -134,6 +170,10 @@ pub struct RglBrdf {
     wavelengths: Option<Vec<f32>>,
     /// Per output channel: the file channels it reads and their weights.
     out_map: Vec<ChannelMix>,
+    /// A spectral file asked for RGB: each texel's spectrum projected to linear sRGB
+    /// ([`crate::colour::srgb_weights`], negative values clipped first), three channels that
+    /// `eval` reads ([`RglBrdf::out_channel`]); `eval_wavelength` reads the file's spectra.
+    rgb_of_spectra: Option<Planes>,
     /// The azimuthal mean of the θi = 0 slice (isotropic files; made on the first
     /// [`BakeSource::bake_view`]).
     normal_limit: std::sync::OnceLock<NormalLimit>,
@@ -170,7 +210,8 @@ impl RglBrdf {
     }
 
     /// Opens a `.bsdf` file for a chosen channel set. A spectral file's channels are interpolated
-    /// at the set's wavelengths (RGB: the representative wavelengths); an RGB file asked for
+    /// at the set's wavelengths; asked for RGB, its spectra are projected to linear sRGB (CIE
+    /// 1931, D65: the colour a spectral renderer shows); an RGB file asked for
     /// wavelengths gives its R, G, B through the colour-preserving basis
     /// ([`Channels::mix_at`]); an RGB file asked for RGB, exactly its R, G, B.
     pub fn open_with_channels(path: impl AsRef<Path>, channels: &Channels) -> Result<Self> {
@@ -349,8 +390,12 @@ impl RglBrdf {
                 Channels::linspace(wl[0] as f64, wl[wl.len() - 1] as f64, MAX_CHANNELS)?
             }
         };
+        let rgb_of_spectra = match (&channels, &wavelengths) {
+            (Channels::Rgb, Some(wl)) => Some(project_to_rgb(&table, wl)),
+            _ => None,
+        };
         let out_map = match (&channels, &wavelengths) {
-            (Channels::Rgb, None) => (0..3)
+            (Channels::Rgb, _) => (0..3)
                 .map(|i| ChannelMix {
                     index: [i; 3],
                     weight: [1.0, 0.0, 0.0],
@@ -383,6 +428,7 @@ impl RglBrdf {
             table,
             wavelengths,
             out_map,
+            rgb_of_spectra,
             normal_limit: std::sync::OnceLock::new(),
             sampler: std::sync::OnceLock::new(),
         })
@@ -472,6 +518,19 @@ impl RglBrdf {
             1.0
         };
         Some((sample, k, scale, cos_o))
+    }
+
+    /// Output channel `c`'s value before the cosine: the file's channel, or for a spectral file
+    /// asked for RGB the projected planes'.
+    #[inline]
+    fn out_channel(&self, sample: [f64; 2], k: &Corners, c: usize) -> f64 {
+        match &self.rgb_of_spectra {
+            Some(t) => {
+                let plane = t.plane_len();
+                bilinear(t, k, 3 * plane, c * plane, sample).max(0.0)
+            }
+            None => self.channel(sample, k, c),
+        }
     }
 
     /// The stored reflectance of file channel `c` at the warped point, clipped at 0.
@@ -610,7 +669,7 @@ impl Brdf for RglBrdf {
             return;
         };
         for (o, mix) in out.iter_mut().zip(&self.out_map) {
-            let v = mix.apply(|c| self.channel(sample, &k, c));
+            let v = mix.apply(|c| self.out_channel(sample, &k, c));
             let f = v * scale / cos_o;
             // Negative ndf/sigma (only in corrupt files) or NaN must not leak out; a value
             // beyond f32 (measured f_r grows like 1/cos θo: 3.7e99 at cos 1e-100) saturates, as
