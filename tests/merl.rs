@@ -500,3 +500,49 @@ fn a_merl_file_of_an_anisotropic_source_holds_its_mean_over_phi_h() {
         }
     }
 }
+
+#[test]
+fn a_spectral_source_written_to_merl_keeps_its_colour() {
+    // A Lambertian whose green k_d is given in RGB, built on wavelength channels (the RGB basis
+    // sampled every 10 nm), written to MERL: each cell holds the channels' spectrum projected
+    // to linear sRGB — A · k_d exactly (a constant's cell mean is the constant), A the
+    // projection of the sampled basis. Reading the spectrum at 645/526/444 nm gave green 3.4 %
+    // low.
+    let kd = [0.02, 0.25, 0.02];
+    let nm: Vec<f64> = (0..48).map(|i| 360.0 + 10.0 * i as f64).collect();
+    let ch = brdftab::Channels::wavelengths(nm.clone()).unwrap();
+    let src = brdftab::spec::ModelSpec::parse(&format!(
+        r#"{{"model": "lambert", "kd": [{}, {}, {}]}}"#,
+        kd[0], kd[1], kd[2]
+    ))
+    .unwrap()
+    .build(&ch)
+    .unwrap();
+    let m = MerlBrdf::from_brdf(src.as_ref());
+    let w = brdftab::colour::srgb_weights(&nm);
+    let want: Vec<f64> = (0..3)
+        .map(|r| {
+            w.iter()
+                .zip(&nm)
+                .map(|(w, &x)| {
+                    let b = brdftab::colour::rgb_basis_at(x);
+                    w[r] * (b[0] * kd[0] + b[1] * kd[1] + b[2] * kd[2])
+                })
+                .sum()
+        })
+        .collect();
+    assert!((want[1] / kd[1] - 1.0).abs() < 5e-3, "{want:?}");
+    let mut f = [0f32; 3];
+    for (ti, to, po) in [(10.0f64, 30.0f64, 100.0f64), (50.0, 70.0, 170.0)] {
+        let wi = brdftab::geometry::spherical(ti.to_radians(), 0.0);
+        let wo = brdftab::geometry::spherical(to.to_radians(), po.to_radians());
+        m.eval(wi, wo, &mut f);
+        for c in 0..3 {
+            // the MERL format stores f_r / scale as f64: the cells' f32 sums' rounding
+            assert!(
+                (f[c] as f64 / want[c] - 1.0).abs() < 1e-5,
+                "{f:?} vs {want:?}"
+            );
+        }
+    }
+}

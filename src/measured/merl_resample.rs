@@ -50,7 +50,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use crate::brdf::Brdf;
 use crate::geometry::{self, HalfDiff};
 use crate::progress::{Progress, Silent, Stage};
-use crate::spectrum::{Channels, RGB_WAVELENGTHS};
+use crate::spectrum::{Channels, MAX_CHANNELS};
 
 use super::merl::{MerlBrdf, RES_PHI_D, RES_THETA_D, RES_THETA_H, SAMPLES, SCALE, cell_center};
 
@@ -63,8 +63,8 @@ impl MerlBrdf {
     /// [`BakeSource::stored_node`](crate::brdf::BakeSource::stored_node) — and every unmeasured cell: a negative stored value is written as
     /// the database's −1. Any other source gives each cell the mean of its f_r over the cell
     /// ([`merl_resample::cell_mean`](super::merl_resample::cell_mean): both orientations of
-    /// every pair, weighted for the directional albedos; RGB channels by `eval`, other channel
-    /// sets by [`Brdf::eval_wavelength`] at the representative RGB wavelengths); a cell with no
+    /// every pair, weighted for the directional albedos; RGB channels as they are, a spectral
+    /// source's channels projected to linear sRGB); a cell with no
     /// point above the horizon is stored as −1 (unmeasured), as in the database. The format is
     /// isotropic: an anisotropic source's cells hold its mean over φh as well. Runs in
     /// parallel.
@@ -91,6 +91,8 @@ impl MerlBrdf {
         let _stage = Stage::begin(progress, "resampling on the MERL grid", RES_THETA_H as u64);
         let done = AtomicUsize::new(0);
         let rgb = *brdf.channels() == Channels::Rgb;
+        let weights = rgb_weights(brdf.channels());
+        let to_rgb = weights.as_deref();
         // A stored node is one φh of its cell: only an isotropic source's is the cell's value.
         let stored = rgb && brdf.flags().isotropic;
         let plane = RES_THETA_D * RES_PHI_D;
@@ -121,7 +123,7 @@ impl MerlBrdf {
                                 }
                                 continue;
                             }
-                            *cell = match cell_mean(brdf, ith, itd, ipd) {
+                            *cell = match cell_mean_with(brdf, to_rgb, ith, itd, ipd) {
                                 Some(m) => std::array::from_fn(|c| m[c] / SCALE[c]),
                                 // No point of the cell above the horizon: unmeasured, as in
                                 // the database.
@@ -177,18 +179,41 @@ const PHI_H_UNIT: [f64; PHI_H_POINTS] = {
 /// The golden ratio's fractional part, the step of the points' φh offsets.
 const GOLDEN: f64 = 0.618_033_988_749_894_8;
 
+/// How a source's channels become the format's RGB: as they are, or (wavelength channels) the
+/// projection of their spectrum to linear sRGB, [`crate::colour::srgb_weights`] — the colour a
+/// spectral renderer shows, as the RGL reader gives a spectral file for RGB.
+fn rgb_weights(channels: &Channels) -> Option<Vec<[f64; 3]>> {
+    match channels {
+        Channels::Rgb => None,
+        Channels::Wavelengths(nm) => Some(crate::colour::srgb_weights(nm)),
+    }
+}
+
 /// The mean of `brdf`'s f_r over MERL cell (`ith`, `itd`, `ipd`) (see the module docs), per
-/// RGB channel, or `None` when no point of the cell has both directions above the horizon.
+/// RGB channel (a spectral source's channels projected to linear sRGB, clipped at 0), or `None`
+/// when no point of the cell has both directions above the horizon.
 pub fn cell_mean(brdf: &dyn Brdf, ith: usize, itd: usize, ipd: usize) -> Option<[f64; 3]> {
+    cell_mean_with(brdf, rgb_weights(brdf.channels()).as_deref(), ith, itd, ipd)
+}
+
+fn cell_mean_with(
+    brdf: &dyn Brdf,
+    to_rgb: Option<&[[f64; 3]]>,
+    ith: usize,
+    itd: usize,
+    ipd: usize,
+) -> Option<[f64; 3]> {
     let n = POINTS_PER_AXIS;
     let reciprocal = brdf.flags().reciprocal;
-    let rgb = *brdf.channels() == Channels::Rgb;
-    let eval = |wi, wo, f: &mut [f32; 3]| {
-        if rgb {
-            brdf.eval(wi, wo, f);
-        } else {
-            for (c, nm) in RGB_WAVELENGTHS.iter().enumerate() {
-                f[c] = brdf.eval_wavelength(wi, wo, *nm) as f32;
+    let eval = |wi, wo, f: &mut [f32; 3]| match to_rgb {
+        None => brdf.eval(wi, wo, f),
+        Some(w) => {
+            let mut buf = [0f32; MAX_CHANNELS];
+            let k = w.len().min(MAX_CHANNELS);
+            brdf.eval(wi, wo, &mut buf[..k]);
+            for (c, fc) in f.iter_mut().enumerate() {
+                let v: f64 = w.iter().zip(&buf[..k]).map(|(w, &x)| w[c] * x as f64).sum();
+                *fc = v.max(0.0) as f32;
             }
         }
     };
