@@ -1,9 +1,11 @@
 //! The numbers behind each view, computed from any `&dyn Brdf` in one batched evaluation each.
 //!
 //! Angles arrive in degrees (the page's units) and are turned into directions here; every
-//! result is plain arrays the page draws. A view's luminance `y` (Rec. 709 weights for RGB, the
-//! mean of a spectrum) is what one curve or one surface shows; the per-channel values ride along
-//! where the page can use them.
+//! result is plain arrays the page draws. A view's luminance `y` (Rec. 709 weights of linear
+//! sRGB) is what one curve or one surface shows; the per-channel values ride along where the
+//! page can use them. A spectral material is seen as a spectral renderer shows it: its channels'
+//! spectrum projected to linear sRGB ([`brdftab::colour::srgb_weights`]), so its sphere has its
+//! colour and its luminance is the photometric one (CIE ȳ), not the channels' plain mean.
 //!
 //! Every sweep samples the centres of equal cells (`centre`), as the library's tables and
 //! `brdftab slice` do, so no direction lies at the horizon: there cos θ is 6e-17 and a measured
@@ -32,18 +34,58 @@ fn eval_pairs(brdf: &dyn Brdf, wi: &[DVec3], wo: &[DVec3]) -> Vec<f32> {
     out
 }
 
-/// The luminance of one pixel's channels.
-fn luminance(channels: &Channels, f: &[f32]) -> f32 {
-    match (channels, f) {
-        (Channels::Rgb, [r, g, b]) => 0.2126 * r + 0.7152 * g + 0.0722 * b,
-        _ => f.iter().sum::<f32>() / f.len().max(1) as f32,
+/// How a material's channels are seen: linear sRGB as they are, or a spectrum's projection.
+struct Seen {
+    /// Wavelength channels: each channel's weight in R, G, B.
+    weights: Option<Vec<[f64; 3]>>,
+}
+
+impl Seen {
+    fn new(channels: &Channels) -> Self {
+        Seen {
+            weights: match channels {
+                Channels::Rgb => None,
+                Channels::Wavelengths(nm) => Some(brdftab::colour::srgb_weights(nm)),
+            },
+        }
+    }
+
+    /// Linear sRGB of one pair's channels, unclipped.
+    fn project(&self, f: &[f32]) -> [f64; 3] {
+        match (&self.weights, f) {
+            (None, [r, g, b]) => [*r as f64, *g as f64, *b as f64],
+            (None, _) => [0.0; 3],
+            (Some(w), _) => {
+                let mut c = [0f64; 3];
+                for (wk, &x) in w.iter().zip(f) {
+                    for (ci, wc) in c.iter_mut().zip(wk) {
+                        *ci += wc * x as f64;
+                    }
+                }
+                c
+            }
+        }
+    }
+
+    /// Linear sRGB for display (a spectrum's projection may leave the gamut: negative
+    /// components are clipped).
+    fn rgb(&self, f: &[f32]) -> [f32; 3] {
+        self.project(f).map(|v| v.max(0.0) as f32)
+    }
+
+    /// The luminance: Y of the unclipped linear sRGB (Rec. 709 weights; for a spectrum, the
+    /// photometric luminance).
+    fn luminance(&self, f: &[f32]) -> f32 {
+        let c = self.project(f);
+        (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]) as f32
     }
 }
 
 /// The luminance of each pair of an interleaved result.
 fn luminances(brdf: &dyn Brdf, f: &[f32]) -> Vec<f32> {
     let c = brdf.channels().len().max(1);
-    f.chunks(c).map(|p| luminance(brdf.channels(), p)).collect()
+    let seen = Seen::new(brdf.channels());
+    f.chunks(c).map(|p| seen.luminance(p)).collect()
 }
 
 /// The centre of cell `k` of `n` equal cells over [`lo`, `hi`].
@@ -153,14 +195,12 @@ pub fn sphere(
     }
     let f = eval_pairs(brdf, &wi, &wo);
     let c = brdf.channels().len().max(1);
+    let seen = Seen::new(brdf.channels());
     let mut rgb = vec![0u8; size * size * 3];
     for (k, &p) in pixels.iter().enumerate() {
         let cos = wi[k].z.max(0.0) * std::f64::consts::PI * exposure;
         let v = &f[k * c..(k + 1) * c];
-        let px: [f32; 3] = match (brdf.channels(), v) {
-            (Channels::Rgb, [r, g, b]) => [*r, *g, *b],
-            _ => [luminance(brdf.channels(), v); 3],
-        };
+        let px = seen.rgb(v);
         for (ch, x) in px.iter().enumerate() {
             rgb[p * 3 + ch] = to_srgb8((*x as f64 * cos) as f32, 1.0);
         }
@@ -182,12 +222,51 @@ pub fn albedo(brdf: &(dyn Brdf + Sync)) -> Value {
             })
             .collect()
     });
+    let seen = Seen::new(brdf.channels());
     let y: Vec<f64> = a
         .iter()
         .map(|row| {
             let f: Vec<f32> = row.iter().map(|&x| x as f32).collect();
-            luminance(brdf.channels(), &f) as f64
+            seen.luminance(&f) as f64
         })
         .collect();
     json!({ "theta": deg, "y": y, "a": a })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use brdftab::spec::ModelSpec;
+
+    fn build(spec: &str, ch: &Channels) -> Box<dyn Brdf + Send + Sync> {
+        ModelSpec::parse(spec).unwrap().build(ch).unwrap()
+    }
+
+    #[test]
+    fn a_spectral_material_is_seen_in_its_colour() {
+        // An RGB k_d on 10 nm channels (the RGB basis) and the RGB Lambertian: the same sphere
+        // to an 8-bit code (the sampled basis's colour error is ≤ 0.5 %); it used to be grey.
+        let spec = r#"{"model": "lambert", "kd": [0.25, 0.06, 0.02]}"#;
+        let ch = Channels::linspace(360.0, 830.0, 48).unwrap();
+        let (a, b) = (build(spec, &Channels::Rgb), build(spec, &ch));
+        let (a, b) = (
+            sphere(a.as_ref(), 30.0, 0.0, 16, 1.0),
+            sphere(b.as_ref(), 30.0, 0.0, 16, 1.0),
+        );
+        let (a, b) = (a["rgb"].as_array().unwrap(), b["rgb"].as_array().unwrap());
+        assert_eq!(a.len(), b.len());
+        let worst = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (x.as_i64().unwrap() - y.as_i64().unwrap()).abs())
+            .max()
+            .unwrap();
+        assert!(worst <= 1, "{worst}");
+        assert!(a.iter().any(|x| x.as_i64().unwrap() > 100));
+        // A flat spectrum's luminance is its value (the photometric weights sum to 1).
+        let grey = build(r#"{"model": "lambert", "kd": 0.2}"#, &ch);
+        for y in polar(grey.as_ref(), 30.0, 8)["y"].as_array().unwrap() {
+            assert!((y.as_f64().unwrap() - 0.2).abs() < 1e-6, "{y}");
+        }
+    }
 }
