@@ -282,20 +282,10 @@ fn spectral_file_matches_rgb_at_channel_wavelengths() {
     }
 }
 
-#[test]
-fn a_spectral_file_asked_for_rgb_gives_the_colour_of_its_spectra() {
-    // cc_ibiza (saturated) made spectral as `convert` makes it — each texel's RGB (clipped at 0)
-    // through the RGB basis every 10 nm — and opened for RGB: its spectra projected to sRGB.
-    // Projection is linear, so the result is A · (the RGB file's value) with A the projection
-    // of the sampled basis (A = I but for the 10 nm sampling); reading the spectra at
-    // representative wavelengths instead gave up to 3 % cross-talk between channels.
-    let name = "cc_ibiza_sunset_rgb.bsdf";
+/// The shipped RGB file `name` made spectral at wavelengths `nm`: each texel's value at λ is
+/// `value(its RGB clipped at 0, λ)`.
+fn spectral_copy(name: &str, nm: &[f64], value: impl Fn([f64; 3], f64) -> f32) -> TensorFile {
     let t = TensorFile::open(rgl(name)).unwrap();
-    let nm: Vec<f64> = (0..48).map(|i| 360.0 + 10.0 * i as f64).collect();
-    let basis: Vec<[f64; 3]> = nm
-        .iter()
-        .map(|&x| brdftab::colour::rgb_basis_at(x))
-        .collect();
     let mut w = TensorWriter::new();
     for f in t.fields() {
         let mut shape: Vec<u64> = f.shape.iter().map(|&d| d as u64).collect();
@@ -309,10 +299,10 @@ fn a_spectral_file_asked_for_rgb_gives_the_colour_of_its_spectra() {
             };
             let mut out = Vec::with_capacity(slices * nm.len() * plane * 4);
             for s in 0..slices {
-                for b in &basis {
+                for &x in nm {
                     for i in 0..plane {
-                        let x = b[0] * v(s, 0, i) + b[1] * v(s, 1, i) + b[2] * v(s, 2, i);
-                        out.extend_from_slice(&(x as f32).to_le_bytes());
+                        let rgb = [v(s, 0, i), v(s, 1, i), v(s, 2, i)];
+                        out.extend_from_slice(&value(rgb, x).to_le_bytes());
                     }
                 }
             }
@@ -324,7 +314,26 @@ fn a_spectral_file_asked_for_rgb_gives_the_colour_of_its_spectra() {
             w = w.raw(&f.name, f.dtype, &shape, t.raw(f).to_vec());
         }
     }
-    let file = TensorFile::from_bytes("s.bsdf", w.to_bytes()).unwrap();
+    TensorFile::from_bytes("s.bsdf", w.to_bytes()).unwrap()
+}
+
+#[test]
+fn a_spectral_file_asked_for_rgb_gives_the_colour_of_its_spectra() {
+    // cc_ibiza (saturated) made spectral as `convert` makes it — each texel's RGB (clipped at 0)
+    // through the RGB basis every 10 nm — and opened for RGB: its spectra projected to sRGB.
+    // Projection is linear, so the result is A · (the RGB file's value) with A the projection
+    // of the sampled basis (A = I but for the 10 nm sampling); reading the spectra at
+    // representative wavelengths instead gave up to 3 % cross-talk between channels.
+    let name = "cc_ibiza_sunset_rgb.bsdf";
+    let nm: Vec<f64> = (0..48).map(|i| 360.0 + 10.0 * i as f64).collect();
+    let basis: Vec<[f64; 3]> = nm
+        .iter()
+        .map(|&x| brdftab::colour::rgb_basis_at(x))
+        .collect();
+    let file = spectral_copy(name, &nm, |rgb, x| {
+        let b = brdftab::colour::rgb_basis_at(x);
+        (b[0] * rgb[0] + b[1] * rgb[1] + b[2] * rgb[2]) as f32
+    });
     let spec = RglBrdf::from_tensor(&file, Some(&brdftab::Channels::Rgb)).unwrap();
     let rgb = RglBrdf::open(rgl(name)).unwrap();
     let weights = brdftab::colour::srgb_weights(&nm);

@@ -98,7 +98,9 @@ fn project_to_rgb(table: &Planes, wavelengths: &[f32]) -> Planes {
         for c in 0..3 {
             let dst = &mut data[(s * 3 + c) * plane..][..plane];
             for (d, a) in dst.iter_mut().zip(&acc) {
-                *d = a[c] as f32;
+                // Finite data near f32's limit must not project to inf (0 · inf is NaN in the
+                // interpolation): saturate, as `eval` saturates.
+                *d = a[c].clamp(-(f32::MAX as f64), f32::MAX as f64) as f32;
             }
         }
     }
