@@ -33,7 +33,8 @@ brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only (so a sour
   smooth lobes' flags.
 - In a spectral variant an RGB source is read at each wavelength as the library reads RGB
   channels (:func:`brdftab.rgb_basis`: a spectrum whose colour, as the variant's film shows it,
-  is the source's RGB), in the scalar and the JIT variants.
+  is the source's RGB), in the scalar and the JIT variants; the JIT variants keep such a source
+  (and a model whose spectrum is the basis mix of its RGB) an RGB table.
 - JIT variants (``llvm_ad_rgb``, ``cuda_ad_rgb``; sources with a delta lobe are refused: a
   table cannot hold one) cannot call back into the host per query:
   the plugin bakes (or loads) a table, uploads the library's *device layout* of it once
@@ -938,6 +939,26 @@ class JitTable:
         return out, inside, valid
 
 
+def _spectrum_is_its_rgb(brdf):
+    """Whether `brdf` at any wavelength is its RGB read through the RGB basis
+    (:func:`brdftab.rgb_basis`): RGB sources, and models linear in their one coloured parameter
+    (an RGB k_d, k_s or Schlick F0). Checked on 16 fixed pairs at 10 wavelengths, to float32
+    rounding; a spectrum that is not the basis mix of its RGB (n, k data, an RGB index of
+    refraction, two coloured factors) differs there by far more."""
+    if list(brdf.channels) != ["R", "G", "B"]:
+        return False
+    t = np.radians(np.array([5.0, 20.0, 35.0, 50.0, 65.0, 80.0, 30.0, 60.0]))
+    p = np.radians(np.array([0.0, 40.0, 100.0, 170.0, 220.0, 300.0, 130.0, 250.0]))
+    d = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], 1)
+    wi = np.concatenate([d, d[::-1]])
+    wo = np.concatenate([np.roll(d, 1, axis=0), d * np.array([-1.0, -1.0, 1.0])])
+    nm = np.array([380.0, 420.0, 460.0, 500.0, 540.0, 580.0, 620.0, 660.0, 700.0, 760.0])
+    f = brdf.eval(wi, wo).astype(np.float64)
+    s = brdf.eval_spectral(wi, wo, nm).astype(np.float64)
+    mix = f @ brdftab.rgb_basis(nm).T
+    return bool(np.allclose(s, mix, rtol=1e-5, atol=1e-6 * max(1.0, float(mix.max()))))
+
+
 class JitBrdftabBSDF(_Common):
     """JIT variants: a table evaluated in Dr.Jit, tabulated importance sampling."""
 
@@ -961,12 +982,13 @@ class JitBrdftabBSDF(_Common):
             v = _prop(props, key)
             if v is not None:
                 options[key] = str(v)
-        # A spectral variant bakes a model or a spectral RGL file at 21 wavelengths; an RGB
-        # source stays an RGB table, read at each wavelength through the RGB basis in `_f`
-        # (exact: sampling the basis every 20 nm would move a saturated colour by ~1 %).
+        # A spectral variant bakes a spectral source (a spectral RGL file, a model whose
+        # spectrum is not its RGB through the basis: a metal's n, k, an RGB refractive index) at
+        # 21 wavelengths; any other source stays an RGB table, read at each wavelength through
+        # the RGB basis in `_f` — exact, where sampling the basis every 20 nm would move a
+        # saturated colour by ~1 %.
         kind = brdftab_kind(self.source)
-        rgb_source = list(self.brdf.channels) == ["R", "G", "B"]
-        if self.spectral and (kind == "spec" or (kind == "rgl" and not rgb_source)):
+        if self.spectral and kind in ("spec", "rgl") and not _spectrum_is_its_rgb(self.brdf):
             options.setdefault("wavelengths", list(range(380, 781, 20)))
         # The table as the library describes it for devices (`device_layout`): the JIT lookup
         # implements that layout, not the grid's description. An opened table moves its values
