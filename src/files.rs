@@ -135,8 +135,10 @@ pub fn temp_path(path: &Path) -> Result<PathBuf> {
 }
 
 /// Writes `bytes` to `path` atomically (through [`temp_path`], renamed into place; the
-/// temporary file is removed on failure).
+/// temporary file is removed on failure). A `path` that is a symbolic link is written where it
+/// points ([`resolve_links`]): the link stays a link, as a shell's `>` leaves it.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let path = &resolve_links(path)?;
     let tmp = temp_path(path)?;
     let r = std::fs::write(&tmp, bytes)
         .map_err(|e| Error::io(path, e))
@@ -150,7 +152,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 /// The file a change of `path` must replace: `path`, or where it is a symbolic link the file
 /// it points to (followed link by link, relative targets from the link's directory; the target
 /// need not exist yet). A database updated through a link then stays the one file, and its
-/// writers, whichever name they use, take one lock.
+/// writers, whichever name they use, take one lock; every other output written through a link
+/// (a table file, a `.bsdf`, a MERL file, a raw table, an `.npy`) replaces the file, not the
+/// link.
 ///
 /// # Errors
 /// A link that cannot be read, or a chain of more than 40 links ([`Error::Io`] naming `path`).

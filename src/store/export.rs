@@ -23,7 +23,7 @@ pub type NodeOffset<'a> = Option<&'a (dyn Fn(&[usize]) -> Option<usize> + Sync)>
 /// The file is written through a temporary file renamed into place: a chunk that fails (its
 /// checksum, its decoding) leaves no partial `.npy` behind.
 pub fn npy(table: &StoredTable, out: impl AsRef<Path>, offset: NodeOffset<'_>) -> Result<()> {
-    let path = out.as_ref();
+    let path = &crate::files::resolve_links(out.as_ref())?;
     crate::files::refuse_input(path, &[table.file()])?;
     let tmp = crate::files::temp_path(path)?;
     let r = npy_to(table, &tmp, path, offset)

@@ -37,9 +37,10 @@ struct Open {
 }
 
 impl Writer {
-    /// Starts writing a file that will replace `path` when finished.
+    /// Starts writing a file that will replace `path` when finished (where `path` is a symbolic
+    /// link, the file it points to: [`crate::files::resolve_links`]).
     pub fn create(path: impl AsRef<Path>) -> Result<Writer> {
-        let path = path.as_ref().to_path_buf();
+        let path = crate::files::resolve_links(path.as_ref())?;
         let tmp = crate::files::temp_path(&path)?;
         let f = File::options()
             .write(true)

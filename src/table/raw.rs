@@ -44,7 +44,8 @@ pub struct RawWriter {
 impl RawWriter {
     /// Starts a raw file for a table on `grid`.
     pub fn create(path: impl AsRef<Path>, grid: &Grid, description: &str) -> Result<RawWriter> {
-        let path = path.as_ref().to_path_buf();
+        // Through a symbolic link: the file it points to (`files::resolve_links`).
+        let path = crate::files::resolve_links(path.as_ref())?;
         let header = serde_json::to_vec(&Header {
             format: 1,
             grid: grid.clone(),
