@@ -38,7 +38,7 @@ struct Open {
 
 impl Writer {
     /// Starts writing a file that will replace `path` when finished (where `path` is a symbolic
-    /// link, the file it points to: [`crate::files::resolve_links`]).
+    /// link, the file it points to, followed link by link).
     pub fn create(path: impl AsRef<Path>) -> Result<Writer> {
         let path = crate::files::resolve_links(path.as_ref())?;
         let tmp = crate::files::temp_path(&path)?;
