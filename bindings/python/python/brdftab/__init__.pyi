@@ -69,7 +69,9 @@ class Brdf:
         NaN, infinite or zero directions give 0 (not an error), as in every host."""
     def eval_spectral(self, wi: _ArrayLike, wo: _ArrayLike, nm: _ArrayLike) -> npt.NDArray[np.float32]:
         """f_r at wavelengths nm ((k,) or (n, k); each finite and > 0, else ValueError):
-        (n, k) float32, or (k,) for one pair of shape (3,)."""
+        (n, k) float32, or (k,) for one pair of shape (3,). Spectral channels are interpolated,
+        models use their spectral data, RGB channels become a spectrum of their colour
+        (`rgb_basis`)."""
     def pdf(self, wi: _ArrayLike, wo: _ArrayLike) -> npt.NDArray[np.float64]:
         """Density of `sample` drawing wi given wo: (n,) float64, or 0-d for one pair of shape
         (3,)."""

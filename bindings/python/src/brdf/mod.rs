@@ -184,7 +184,8 @@ impl PyBrdf {
     }
 
     /// f_r(wi, wo) at wavelengths `nm` (shape (k,) for every pair, or (n, k)): float32 (n, k).
-    /// Spectral channels are interpolated; analytic models use their spectral data. A
+    /// Spectral channels are interpolated; analytic models use their spectral data; RGB
+    /// channels become a spectrum of their colour (`brdftab.rgb_basis`). A
     /// wavelength must be finite and > 0 (the library's rule, as for `wavelengths=`): any
     /// other is a `ValueError`.
     fn eval_spectral(
