@@ -28,11 +28,12 @@ pub struct ConvertSettings {
     /// Interpolation for the reported accuracy of a table: nearest or linear (default).
     #[cfg_attr(feature = "clap", arg(long))]
     pub interp: Option<String>,
-    /// .bsdf output: reflectance table resolution N (default 64, a .bsdf input's own).
+    /// .bsdf output: reflectance table resolution N (default 64, or 128 where 64 stays past the
+    /// accuracy bars; a .bsdf input's own).
     #[cfg_attr(feature = "clap", arg(long))]
     pub resolution: Option<usize>,
-    /// .bsdf output: number of incident elevations θi (default 16; 8 = the RGL database's
-    /// spacing).
+    /// .bsdf output: number of incident elevations θi, even in cos θi (default: 16 to 32 placed
+    /// where the written file is farthest from the source; 8 = the RGL database's spacing).
     #[cfg_attr(feature = "clap", arg(long))]
     pub theta_i: Option<usize>,
     /// .bsdf output: number of incident azimuths φi (default 1 if isotropic, else 17).

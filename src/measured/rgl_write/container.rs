@@ -86,6 +86,13 @@ pub fn pack_bits(bits: &[bool]) -> Vec<u8> {
         .collect()
 }
 
+/// The first `len` bits of [`pack_bits`]' bytes.
+pub fn unpack_bits(bytes: &[u8], len: usize) -> Vec<bool> {
+    (0..len)
+        .map(|i| bytes.get(i / 8).is_some_and(|b| b & (0x80 >> (i % 8)) != 0))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -94,5 +101,6 @@ mod tests {
     fn bits_pack_most_significant_first() {
         let b = [true, false, false, false, false, false, true, true, true];
         assert_eq!(pack_bits(&b), [0b1000_0011, 0b1000_0000]);
+        assert_eq!(unpack_bits(&pack_bits(&b), b.len()), b);
     }
 }

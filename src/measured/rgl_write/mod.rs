@@ -24,14 +24,21 @@
 //! The positions in step 3 are found with the reader's warp code itself
 //! ([`rgl`](super::rgl)), so writer and reader agree on where every stored value lives.
 //!
-//! Defaults (measured, see the tests): N = 64, 16 incident elevations evenly spaced in cos θi,
-//! one φi = 0 for isotropic sources, 128 × 128 warps, NDF and σ on 128 elevations (2 identical
-//! azimuth rows when isotropic, 64 rows over [−π, π] otherwise); anisotropic sources get 17 φi
-//! evenly over [−π, π] (no symmetry reduction assumed). The published files' layout (N = 32,
-//! the database's 8 non-uniform elevations, asked for with 8) serves measurements, whose
-//! parameterization follows the material, but it interpolates analytic lobes poorly over θi:
-//! Cook-Torrance m = 0.3 gold measured 3.6% with it, 1.3% with 16 elevations at N = 32, 0.35%
-//! at N = 64 (the metric of [`report()`]). `.bsdf` sources are instead resampled into their own
+//! Defaults (measured, see the tests and BENCHMARKS.md "Written files placed where they are
+//! wrong"): incident elevations placed per source by [`elevations`] — from 16 even in cos θi,
+//! split where the file's own reader is farthest from the source over the whole domain, up to
+//! 32 — at N = 64, or N = 128 when a figure stays past its bar and 128 does better (isotropic sources;
+//! anisotropic ones keep 16 elevations even in cos θi at N = 64: their error lies in the
+//! interpolation over azimuths); one φi = 0 for isotropic sources, 128 × 128 warps, NDF and σ on 128 elevations (2 identical azimuth rows
+//! when isotropic, 64 rows over [−π, π] otherwise); anisotropic sources get 17 φi evenly over
+//! [−π, π] (no symmetry reduction assumed). One fixed spacing served no source over the whole
+//! domain: 16 elevations even in cos θi left a Lambertian's grazing band 6.3 % off and
+//! Cook-Torrance gold's albedo 4.5 % off at 89°; even in θi, gold's grazing band 10 %. A
+//! given count of elevations (`theta_i`) is even in cos θi as before. The published files'
+//! layout (N = 32, the database's 8 non-uniform elevations, asked for with 8) serves
+//! measurements, whose parameterization follows the material, but it interpolates analytic
+//! lobes poorly over θi: Cook-Torrance m = 0.3 gold measured 3.6% with it, 1.3% with 16
+//! elevations at N = 32, 0.35% at N = 64 (the metric of [`report()`]). `.bsdf` sources are instead resampled into their own
 //! parameterization ([`Options::reuse_source_file`]): same elevations, NDF, warps and N, and
 //! the stored values at below-horizon grid points kept; where the source evaluates to the
 //! file's own values at every grid point (it is the file), they are copied as stored, so a
@@ -53,7 +60,10 @@
 //!   marks them 0 (a bit per sample, packed most significant bit first over φi × θi × N × N —
 //!   the published files' `valid` has exactly that many bytes, φi·θi·N²/8, though what their bits
 //!   mean is not documented; no reader uses the field);
-//! - D is floored at 10⁻⁵ of its maximum so that every warp covers the whole hemisphere;
+//! - D is floored at 10⁻⁵ of its maximum so that every warp covers the whole hemisphere, and
+//!   for isotropic sources raised to a tenth of what any incidence up to 80° needs
+//!   ([`ndf::COVERAGE`]): a lobe that the retro-reflection misses (Phong's, about the mirror
+//!   direction) otherwise gets a few cells for the whole lobe;
 //! - a luminance slice that is zero everywhere (a source black for that incidence) is stored
 //!   uniform, which keeps the file loadable.
 //!
@@ -62,6 +72,7 @@
 //! as 0 in the source and are written as 0.
 
 pub mod container;
+pub mod elevations;
 pub mod ndf;
 pub mod report;
 pub mod values;
@@ -91,7 +102,12 @@ pub const DATABASE_THETA_I: [f32; 8] = [
 /// Default reflectance table resolution N for sources without a parameterization of their own.
 pub const DEFAULT_RESOLUTION: usize = 64;
 
-/// Default number of incident elevations for sources without a parameterization of their own.
+/// The resolution N a source gets by default when at [`DEFAULT_RESOLUTION`] a figure stays past
+/// its bar ([`elevations::Placement::past_bar`]).
+pub const FINE_RESOLUTION: usize = 128;
+
+/// The number of incident elevations of anisotropic sources (even in cos θi); isotropic ones
+/// get theirs placed ([`elevations`]).
 pub const DEFAULT_THETA_I: usize = 16;
 
 /// The most f32 values a written file may hold (1 GiB), so that no option allocates without bound.
@@ -101,10 +117,12 @@ pub const MAX_FLOATS: usize = 1 << 28;
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Options {
     /// Reflectance table resolution N (N × N per incident direction), 2..=1024; `None`:
-    /// [`DEFAULT_RESOLUTION`], or the parameterization's own.
+    /// [`DEFAULT_RESOLUTION`] ([`FINE_RESOLUTION`] when elevations are placed, a figure stays
+    /// past its bar at N = 64 and N = 128 does better), or the parameterization's own.
     pub resolution: Option<usize>,
-    /// Number of incident elevations θi (from 0 to 90°), 2..=256; `None`: [`DEFAULT_THETA_I`].
-    /// 8 gives the database's spacing, other counts are even in cos θi. Must be `None` with a
+    /// Number of incident elevations θi (from 0 to 90°), 2..=256; `None`: placed per source
+    /// ([`elevations::place`], 16 to 32) when it is isotropic, else [`DEFAULT_THETA_I`]. 8 gives
+    /// the database's spacing, other counts are even in cos θi. Must be `None` with a
     /// parameterization (which fixes them).
     pub theta_i: Option<usize>,
     /// Number of incident azimuths: `None` = 1 for isotropic sources, 17 otherwise. 1 writes an
@@ -332,7 +350,7 @@ impl Options {
 /// Builds every field of the `.bsdf` file for `brdf` (see the module docs), reporting the
 /// incident directions done to `progress` ([`Silent`](crate::progress::Silent) for none).
 pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Result<Fields> {
-    let layout = opts.layout(brdf.flags().isotropic)?;
+    let mut layout = opts.layout(brdf.flags().isotropic)?;
     let nch = brdf.channels().len();
     if nch == 0 {
         return Err(Error::arg("source", "the source has no channels"));
@@ -356,6 +374,26 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
         }
         None => {
             let ndf = ndf::recover(brdf, &layout)?;
+            // Anisotropic files interpolate over 17 azimuths as well, and that is where their
+            // error is: placing elevations changed none of their figures (Lambert + GGX
+            // α = (0.2, 0.5): grazing band 4.0 → 3.8 % on the pair rule) for 2.3× the bytes.
+            if opts.theta_i.is_none() && layout.isotropic {
+                let mut placed = elevations::place(brdf, &ndf, &layout, elevations::MAX, progress)?;
+                if placed.past_bar() && opts.resolution.is_none() {
+                    // Still past a bar at the most elevations or at the slices' own limit: a
+                    // finer table, placed again, kept when its worst figure is lower (Ward's
+                    // albedo at 89°, which grows like 1/√cos θ, is not).
+                    let coarse = layout.n;
+                    layout.n = FINE_RESOLUTION;
+                    let fine = elevations::place(brdf, &ndf, &layout, elevations::MAX, progress)?;
+                    if fine.worst() < placed.worst() {
+                        placed = fine;
+                    } else {
+                        layout.n = coarse;
+                    }
+                }
+                layout.theta_i = placed.theta_i;
+            }
             let warps = warps::vndf(&ndf, &layout)?;
             (ndf, warps)
         }
@@ -390,11 +428,16 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
         n: layout.n,
         values: values.data,
         valid: values.valid,
-        wavelengths: match brdf.channels() {
-            crate::spectrum::Channels::Rgb => None,
-            c => Some((0..c.len()).map(|i| c.wavelength(i) as f32).collect()),
-        },
+        wavelengths: wavelengths_of(brdf.channels()),
     })
+}
+
+/// The `wavelengths` field for `channels` (`None`: an RGB file).
+fn wavelengths_of(channels: &crate::spectrum::Channels) -> Option<Vec<f32>> {
+    match channels {
+        crate::spectrum::Channels::Rgb => None,
+        c => Some((0..c.len()).map(|i| c.wavelength(i) as f32).collect()),
+    }
 }
 
 /// Whether a file's channels (`None`: RGB) are `channels`.

@@ -20,11 +20,17 @@ fn convert_writes_bsdf_files_and_reports_their_error() {
     let spec = r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#;
     let r = brdftab(&["convert", spec, out_s, "--pairs", "20000"]);
     assert!(r.ok, "{}", r.stderr);
-    assert!(
-        r.stdout.contains("1 φi × 16 θi, 64×64 table"),
-        "{}",
-        r.stdout
-    );
+    // The elevations are placed per source (16 to 32), the table 64 × 64 or 128 × 128.
+    let layout = r
+        .stdout
+        .split("1 φi × ")
+        .nth(1)
+        .and_then(|t| t.split(" table").next())
+        .unwrap_or_else(|| panic!("no layout in {}", r.stdout));
+    let (nt, n) = layout.split_once(" θi, ").expect("θi, N×N");
+    let nt: usize = nt.parse().unwrap();
+    assert!((16..=32).contains(&nt), "{}", r.stdout);
+    assert!(n == "64×64" || n == "128×128", "{}", r.stdout);
     let rmse: f64 = r
         .stdout
         .split("cos θi cos θo ")
@@ -45,7 +51,7 @@ fn convert_writes_bsdf_files_and_reports_their_error() {
     assert!(r.stdout.contains("whole hemisphere") && r.stdout.contains("worst albedo"));
     let r = brdftab(&["info", out_s]);
     assert!(
-        r.ok && r.stdout.contains("rgb") && r.stdout.contains("φi 1 × θi 16"),
+        r.ok && r.stdout.contains("rgb") && r.stdout.contains(&format!("φi 1 × θi {nt}")),
         "{}",
         r.stdout
     );
