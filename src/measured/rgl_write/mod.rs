@@ -16,8 +16,9 @@
 //!    f_r·cos θo · 4σ(ωi) / D(m) (the `jacobian` = 1 convention: readers multiply by
 //!    D(m) / (4σ(ωi)), interpolated from the same tables, so at the grid points they return
 //!    exactly f_r·cos θo), clipped at 0 as the readers clip;
-//! 4. the `luminance` table (Rec. 709 Y of the stored values; the channel mean for spectra) that
-//!    the readers sample by, and [`container`] lays the fields out as the published files do.
+//! 4. the `luminance` table (Rec. 709 Y of the stored values; for spectra their photometric Y
+//!    under D65, [`ndf::luminance_weights`]) that the readers sample by, and [`container`] lays
+//!    the fields out as the published files do.
 //!
 //! [`report()`] measures a written file against its source with brdftab's own reader.
 //!

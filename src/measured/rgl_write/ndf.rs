@@ -11,8 +11,8 @@
 //! ```
 //!
 //! Iterating D ← f(ω, ω) cos θ σ_D(ω), normalized to ∫ D cos θ dω = 1 (so σ(normal) = 1, as in
-//! the published files), converges to it. The source's luminance (Rec. 709 Y; the channel mean
-//! for spectra) stands for f; where f(ω, ω) is 0 (a hole in measured data) the mean of four
+//! the published files), converges to it. The source's luminance (Rec. 709 Y; for spectra the
+//! photometric Y under D65, [`luminance_weights`]) stands for f; where f(ω, ω) is 0 (a hole in measured data) the mean of four
 //! pairs 2° from retro-reflection stands in. Any source works — for non-microfacet ones D is simply an adapted
 //! sampling density — because the values stored later are divided by the same tables.
 //!
@@ -124,11 +124,21 @@ impl Ndf {
     }
 }
 
-/// Scalar weights turning a channel vector into the luminance used for D and for sampling.
+/// Scalar weights turning a channel vector into the luminance used for D and for sampling:
+/// Rec. 709 Y of RGB; of sampled spectra, the photometric Y of the spectrum they sample under
+/// D65 (the same Y of its projection to linear sRGB, [`crate::colour::srgb_weights`]; the
+/// weights sum to 1), so that a renderer samples a spectral file by what it shows.
 pub fn luminance_weights(channels: &Channels) -> Vec<f64> {
+    const Y: [f64; 3] = [0.2126, 0.7152, 0.0722];
     match channels {
-        Channels::Rgb => vec![0.2126, 0.7152, 0.0722],
-        c => vec![1.0 / c.len() as f64; c.len()],
+        Channels::Rgb => Y.to_vec(),
+        c => {
+            let nm: Vec<f64> = (0..c.len()).map(|i| c.wavelength(i)).collect();
+            crate::colour::srgb_weights(&nm)
+                .iter()
+                .map(|w| (Y[0] * w[0] + Y[1] * w[1] + Y[2] * w[2]).max(0.0))
+                .collect()
+        }
     }
 }
 

@@ -563,3 +563,18 @@ fn a_lobe_the_retro_reflection_misses_is_covered() {
     assert!(fid.rule.cap < 0.015, "{ctx}");
     assert!(fid.albedo.worst < 0.02, "{ctx}");
 }
+
+#[test]
+fn a_spectral_files_luminance_is_its_photometric_y() {
+    // Weights of the luminance a renderer samples a spectral file by: Y under D65, so a
+    // channel the eye barely sees (400 nm) counts for little and one at 560 nm for much.
+    let ch = Channels::wavelengths(vec![400.0, 480.0, 560.0, 640.0, 720.0]).unwrap();
+    let w = ndf::luminance_weights(&ch);
+    let sum: f64 = w.iter().sum();
+    assert!((sum - 1.0).abs() < 1e-9, "{w:?}");
+    assert!(w.iter().all(|&x| x >= 0.0), "{w:?}");
+    assert!(w[2] > 10.0 * w[0] && w[2] > 10.0 * w[4], "{w:?}");
+    // A grey spectrum's Y is its value, like RGB's.
+    let rgb = ndf::luminance_weights(&Channels::Rgb);
+    assert!((rgb.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+}
