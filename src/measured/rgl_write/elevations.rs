@@ -27,7 +27,7 @@ use std::collections::HashMap;
 use std::f64::consts::{PI, TAU};
 
 use super::ndf::Ndf;
-use super::{Fields, Layout, Progress, values, warps};
+use super::{Layout, Progress, values, warps};
 use crate::analysis::fidelity::mirror_albedo;
 use crate::brdf::Brdf;
 use crate::error::Result;
@@ -266,21 +266,7 @@ fn reader(
         data,
         valid: super::container::pack_bits(&valid),
     };
-    let fields = Fields {
-        description: String::new(),
-        phi_i: layout.phi_i.clone(),
-        theta_i: layout.theta_i.clone(),
-        ndf_shape: [layout.ndf_ny, layout.ndf_nx],
-        sigma: ndf.sigma.clone(),
-        ndf: ndf.ndf.clone(),
-        vndf_shape: layout.vndf,
-        luminance: warps::luminance(&values, brdf.channels(), &layout),
-        vndf,
-        n,
-        values: values.data,
-        valid: values.valid,
-        wavelengths: super::wavelengths_of(brdf.channels()),
-    };
+    let fields = super::fields_of(String::new(), &layout, ndf, vndf, values, brdf.channels());
     let tf = TensorFile::from_bytes("(placing elevations)", fields.to_bytes())?;
     RglBrdf::from_tensor(&tf, None)
 }

@@ -411,12 +411,30 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
             "the source is zero at every sampled direction pair: nothing to write",
         ));
     }
-    let luminance = warps::luminance(&values, brdf.channels(), &layout);
     let description = opts
         .description
         .clone()
         .unwrap_or_else(|| format!("brdftab: {}", brdf.describe()));
-    Ok(Fields {
+    Ok(fields_of(
+        description,
+        &layout,
+        &ndf,
+        warps.data,
+        values,
+        brdf.channels(),
+    ))
+}
+
+/// The fields of a file of `layout` from its parts (the luminance computed from the values).
+fn fields_of(
+    description: String,
+    layout: &Layout,
+    ndf: &ndf::Ndf,
+    vndf: Vec<f32>,
+    values: Values,
+    channels: &crate::spectrum::Channels,
+) -> Fields {
+    Fields {
         description,
         phi_i: layout.phi_i.clone(),
         theta_i: layout.theta_i.clone(),
@@ -424,13 +442,13 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
         sigma: ndf.sigma.clone(),
         ndf: ndf.ndf.clone(),
         vndf_shape: layout.vndf,
-        vndf: warps.data,
-        luminance,
+        luminance: warps::luminance(&values, channels, layout),
+        vndf,
         n: layout.n,
         values: values.data,
         valid: values.valid,
-        wavelengths: wavelengths_of(brdf.channels()),
-    })
+        wavelengths: wavelengths_of(channels),
+    }
 }
 
 /// The `wavelengths` field for `channels` (`None`: an RGB file).
