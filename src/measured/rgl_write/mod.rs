@@ -356,8 +356,16 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
     if nch == 0 {
         return Err(Error::arg("source", "the source has no channels"));
     }
-    let slices = layout.phi_i.len() * layout.theta_i.len();
-    let floats = slices * ((nch + 1) * layout.n * layout.n + layout.vndf[0] * layout.vndf[1]);
+    // Placed elevations may grow to elevations::MAX, and the table to FINE_RESOLUTION: the
+    // largest file the options allow is what is checked.
+    let placing = opts.parameterization.is_none() && opts.theta_i.is_none() && layout.isotropic;
+    let (nt, n) = match (placing, opts.resolution) {
+        (false, _) => (layout.theta_i.len(), layout.n),
+        (true, Some(n)) => (elevations::MAX, n),
+        (true, None) => (elevations::MAX, FINE_RESOLUTION.max(layout.n)),
+    };
+    let slices = layout.phi_i.len() * nt;
+    let floats = slices * ((nch + 1) * n * n + layout.vndf[0] * layout.vndf[1]);
     if floats > MAX_FLOATS {
         return Err(Error::arg(
             "resolution",
@@ -378,7 +386,7 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
             // Anisotropic files interpolate over 17 azimuths as well, and that is where their
             // error is: placing elevations changed none of their figures (Lambert + GGX
             // α = (0.2, 0.5): grazing band 4.0 → 3.8 % on the pair rule) for 2.3× the bytes.
-            if opts.theta_i.is_none() && layout.isotropic {
+            if placing {
                 let mut placed = elevations::place(brdf, &ndf, &layout, elevations::MAX, progress)?;
                 if placed.past_bar() && opts.resolution.is_none() {
                     // Still past a bar at the most elevations or at the slices' own limit: a

@@ -320,6 +320,21 @@ fn bad_options_are_errors() {
             "{o:?}"
         );
     }
+    // The size check counts the most elevations placement may reach: 10 channels at N = 1024
+    // are 1.8e8 values with 16 elevations, past the limit (2.7e8) with 32.
+    let ch = Channels::wavelengths((0..10).map(|k| 400.0 + 30.0 * k as f64).collect()).unwrap();
+    let spectral = model(r#"{"model": "lambert", "kd": 0.2}"#, &ch);
+    let big = Options {
+        resolution: Some(1024),
+        ..Options::default()
+    };
+    assert!(
+        matches!(
+            encode(&*spectral, &big, &Silent),
+            Err(Error::InvalidArgument { .. })
+        ),
+        "{big:?}"
+    );
     // Layout options and a given parameterization exclude each other.
     let p = Parameterization::from_file(rgl_dir().join("paper_white_rgb.bsdf")).unwrap();
     let o = Options {
