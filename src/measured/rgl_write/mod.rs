@@ -26,21 +26,22 @@
 //! ([`rgl`](super::rgl)), so writer and reader agree on where every stored value lives.
 //!
 //! Defaults (measured, see the tests and BENCHMARKS.md "Written files placed where they are
-//! wrong"): incident elevations placed per source by [`elevations`] — from 16 even in cos θi,
-//! split where the file's own reader is farthest from the source over the whole domain, up to
-//! 32 — at N = 64, or N = 128 when a figure stays past its bar and 128 does better (isotropic sources;
-//! anisotropic ones keep 16 elevations even in cos θi at N = 64: their error lies in the
-//! interpolation over azimuths); one φi = 0 for isotropic sources, 128 × 128 warps, NDF and σ on 128 elevations (2 identical azimuth rows
-//! when isotropic, 64 rows over [−π, π] otherwise); anisotropic sources get 17 φi evenly over
-//! [−π, π] (no symmetry reduction assumed). One fixed spacing served no source over the whole
-//! domain: 16 elevations even in cos θi left a Lambertian's grazing band 6.3 % off and
-//! Cook-Torrance gold's albedo 4.5 % off at 89°; even in θi, gold's grazing band 10 %. A
-//! given count of elevations (`theta_i`) is even in cos θi as before. The published files'
-//! layout (N = 32, the database's 8 non-uniform elevations, asked for with 8) serves
-//! measurements, whose parameterization follows the material, but it interpolates analytic
-//! lobes poorly over θi: Cook-Torrance m = 0.3 gold measured 3.6% with it, 1.3% with 16
-//! elevations at N = 32, 0.35% at N = 64 (the metric of [`report()`]). `.bsdf` sources are instead resampled into their own
-//! parameterization ([`Options::reuse_source_file`]): same elevations, NDF, warps and N, and
+//! wrong"): an isotropic source's incident elevations are placed by [`elevations`] — from 16
+//! even in cos θi, split where the file's own reader is farthest from the source over the whole
+//! domain, up to 32 within [`PLACED_BYTES`] — at N = 64, or at N = 128 when a figure stays past
+//! its bar, 128 does better and 16 elevations of it fit the budget; an anisotropic source keeps
+//! 16 elevations even in cos θi at N = 64 (its error lies in the interpolation over azimuths)
+//! and gets 17 φi evenly over [−π, π] (no symmetry reduction assumed), an isotropic one φi = 0.
+//! Warps are 128 × 128, NDF and σ on 128 elevations (2 identical azimuth rows when isotropic,
+//! 64 rows over [−π, π] otherwise). One fixed spacing served no source over the whole domain:
+//! 16 elevations even in cos θi left a Lambertian's grazing band 6.3 % off and Cook-Torrance
+//! gold's albedo 4.5 % off at 89°; even in θi, a Cook-Torrance's grazing band 10 %. A given
+//! count of elevations (`theta_i`) is even in cos θi as before. The published files' layout
+//! (N = 32, the database's 8 non-uniform elevations, asked for with 8) serves measurements,
+//! whose parameterization follows the material, but it interpolates analytic lobes poorly over
+//! θi: Cook-Torrance m = 0.3 gold measured 3.6% with it, 1.3% with 16 elevations at N = 32,
+//! 0.35% at N = 64 (the metric of [`report()`]). `.bsdf` sources are instead resampled into
+//! their own parameterization ([`Options::reuse_source_file`]): same elevations, NDF, warps and N, and
 //! the stored values at below-horizon grid points kept; where the source evaluates to the
 //! file's own values at every grid point (it is the file), they are copied as stored, so a
 //! re-encoded file is the original's table exactly (it used to evaluate them clipped at 0,
@@ -107,6 +108,17 @@ pub const DEFAULT_RESOLUTION: usize = 64;
 /// its bar ([`elevations::Placement::past_bar`]).
 pub const FINE_RESOLUTION: usize = 128;
 
+/// The most bytes placement lets a file grow to (the values, luminance and VNDF of every
+/// elevation): more elevations or the finer table only while they fit. 16 elevations always
+/// fit (the count written before placement); a spectral file of 48 wavelengths stays at
+/// N = 64 (at N = 128 and 32 elevations it took 105 MB and 12 s).
+pub const PLACED_BYTES: usize = 32 << 20;
+
+/// Bytes of one incident elevation of `layout` (every azimuth) for `nch` channels.
+fn elevation_bytes(layout: &Layout, nch: usize) -> usize {
+    4 * layout.phi_i.len() * ((nch + 1) * layout.n * layout.n + layout.vndf[0] * layout.vndf[1])
+}
+
 /// The number of incident elevations of anisotropic sources (even in cos θi); isotropic ones
 /// get theirs placed ([`elevations`]).
 pub const DEFAULT_THETA_I: usize = 16;
@@ -119,7 +131,8 @@ pub const MAX_FLOATS: usize = 1 << 28;
 pub struct Options {
     /// Reflectance table resolution N (N × N per incident direction), 2..=1024; `None`:
     /// [`DEFAULT_RESOLUTION`] ([`FINE_RESOLUTION`] when elevations are placed, a figure stays
-    /// past its bar at N = 64 and N = 128 does better), or the parameterization's own.
+    /// past its bar at N = 64, N = 128 does better and fits [`PLACED_BYTES`]), or the
+    /// parameterization's own.
     pub resolution: Option<usize>,
     /// Number of incident elevations θi (from 0 to 90°), 2..=256; `None`: placed per source
     /// ([`elevations::place`], 16 to 32) when it is isotropic, else [`DEFAULT_THETA_I`]. 8 gives
@@ -387,18 +400,25 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
             // error is: placing elevations changed none of their figures (Lambert + GGX
             // α = (0.2, 0.5): grazing band 4.0 → 3.8 % on the pair rule) for 2.3× the bytes.
             if placing {
-                let mut placed = elevations::place(brdf, &ndf, &layout, elevations::MAX, progress)?;
-                if placed.past_bar() && opts.resolution.is_none() {
+                let most = |l: &Layout| PLACED_BYTES / elevation_bytes(l, nch);
+                let max = most(&layout).clamp(elevations::START, elevations::MAX);
+                let mut placed = elevations::place(brdf, &ndf, &layout, max, progress)?;
+                let fine = Layout {
+                    n: FINE_RESOLUTION,
+                    ..layout.clone()
+                };
+                if placed.past_bar()
+                    && opts.resolution.is_none()
+                    && most(&fine) >= elevations::START
+                {
                     // Still past a bar at the most elevations or at the slices' own limit: a
                     // finer table, placed again, kept when its worst figure is lower (Ward's
                     // albedo at 89°, which grows like 1/√cos θ, is not).
-                    let coarse = layout.n;
-                    layout.n = FINE_RESOLUTION;
-                    let fine = elevations::place(brdf, &ndf, &layout, elevations::MAX, progress)?;
-                    if fine.worst() < placed.worst() {
-                        placed = fine;
-                    } else {
-                        layout.n = coarse;
+                    let max = most(&fine).min(elevations::MAX);
+                    let finer = elevations::place(brdf, &ndf, &fine, max, progress)?;
+                    if finer.worst() < placed.worst() {
+                        placed = finer;
+                        layout.n = FINE_RESOLUTION;
                     }
                 }
                 layout.theta_i = placed.theta_i;

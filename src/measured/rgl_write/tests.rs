@@ -593,3 +593,18 @@ fn a_spectral_files_luminance_is_its_photometric_y() {
     let rgb = ndf::luminance_weights(&Channels::Rgb);
     assert!((rgb.iter().sum::<f64>() - 1.0).abs() < 1e-12);
 }
+
+#[test]
+fn placement_keeps_a_spectral_file_within_its_byte_budget() {
+    // 48 wavelengths: at N = 128 and 32 elevations Cook-Torrance gold took 105 MB.
+    let ch = Channels::wavelengths((0..48).map(|k| 360.0 + 10.0 * k as f64).collect()).unwrap();
+    let src = model(CT_GOLD, &ch);
+    let f = encode(&*src, &Options::default(), &Silent).unwrap();
+    let bytes = f.to_bytes().len();
+    assert!(
+        bytes <= PLACED_BYTES + (1 << 20),
+        "{bytes} bytes, {:?}",
+        f.theta_i.len()
+    );
+    assert!(f.theta_i.len() >= elevations::START, "{}", f.theta_i.len());
+}
