@@ -114,6 +114,12 @@ pub const FINE_RESOLUTION: usize = 128;
 /// N = 64 (at N = 128 and 32 elevations it took 105 MB and 12 s).
 pub const PLACED_BYTES: usize = 32 << 20;
 
+/// The most elevations placement may give `layout` with `nch` channels: as many as fit
+/// [`PLACED_BYTES`], at least [`elevations::START`], at most [`elevations::MAX`].
+fn most_elevations(layout: &Layout, nch: usize) -> usize {
+    (PLACED_BYTES / elevation_bytes(layout, nch)).clamp(elevations::START, elevations::MAX)
+}
+
 /// Bytes of one incident elevation of `layout` (every azimuth) for `nch` channels.
 fn elevation_bytes(layout: &Layout, nch: usize) -> usize {
     4 * layout.phi_i.len() * ((nch + 1) * layout.n * layout.n + layout.vndf[0] * layout.vndf[1])
@@ -369,16 +375,17 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
     if nch == 0 {
         return Err(Error::arg("source", "the source has no channels"));
     }
-    // Placed elevations may grow to elevations::MAX, and the table to FINE_RESOLUTION: the
-    // largest file the options allow is what is checked.
+    // Placement adds elevations (and tries the finer table) only within PLACED_BYTES, far
+    // below the limit, so the largest file it may build has the layout's own count or fits
+    // the budget.
     let placing = opts.parameterization.is_none() && opts.theta_i.is_none() && layout.isotropic;
-    let (nt, n) = match (placing, opts.resolution) {
-        (false, _) => (layout.theta_i.len(), layout.n),
-        (true, Some(n)) => (elevations::MAX, n),
-        (true, None) => (elevations::MAX, FINE_RESOLUTION.max(layout.n)),
+    let nt = if placing {
+        most_elevations(&layout, nch)
+    } else {
+        layout.theta_i.len()
     };
     let slices = layout.phi_i.len() * nt;
-    let floats = slices * ((nch + 1) * n * n + layout.vndf[0] * layout.vndf[1]);
+    let floats = slices * ((nch + 1) * layout.n * layout.n + layout.vndf[0] * layout.vndf[1]);
     if floats > MAX_FLOATS {
         return Err(Error::arg(
             "resolution",
@@ -400,8 +407,7 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
             // error is: placing elevations changed none of their figures (Lambert + GGX
             // α = (0.2, 0.5): grazing band 4.0 → 3.8 % on the pair rule) for 2.3× the bytes.
             if placing {
-                let most = |l: &Layout| PLACED_BYTES / elevation_bytes(l, nch);
-                let max = most(&layout).clamp(elevations::START, elevations::MAX);
+                let max = most_elevations(&layout, nch);
                 let mut placed = elevations::place(brdf, &ndf, &layout, max, progress)?;
                 let fine = Layout {
                     n: FINE_RESOLUTION,
@@ -409,12 +415,12 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
                 };
                 if placed.past_bar()
                     && opts.resolution.is_none()
-                    && most(&fine) >= elevations::START
+                    && PLACED_BYTES / elevation_bytes(&fine, nch) >= elevations::START
                 {
                     // Still past a bar at the most elevations or at the slices' own limit: a
                     // finer table, placed again, kept when its worst figure is lower (Ward's
                     // albedo at 89°, which grows like 1/√cos θ, is not).
-                    let max = most(&fine).min(elevations::MAX);
+                    let max = most_elevations(&fine, nch);
                     let finer = elevations::place(brdf, &ndf, &fine, max, progress)?;
                     if finer.worst() < placed.worst() {
                         placed = finer;
