@@ -39,13 +39,18 @@ pub(crate) fn normalize_scaled(v: DVec3) -> Option<DVec3> {
 }
 
 /// Like [`normalize`], but returns `v` unchanged when it is already unit to within 2⁻⁴⁰ in
-/// squared length (the usual case: renderers pass unit directions), saving the square root and
-/// division that would otherwise head the dependency chain of every sampler.
+/// squared length, and corrects it without a square root or division when it is unit to
+/// within 2⁻²⁰ ([`near_unit`]). Renderers pass unit directions — in f64 exactly, from f32
+/// (pbrt-v4, Mitsuba 3, any C or numpy float32 caller) only to the f32 rounding of their
+/// normalization, |l² − 1| up to a few 2⁻²⁴ — and either way this saves the square root and
+/// division that would otherwise head the dependency chain of every sampler and lookup.
 #[inline]
 pub fn unit(v: DVec3) -> Option<DVec3> {
     let l2 = v.length_squared();
     if is_unit_l2(l2) {
         Some(v)
+    } else if is_near_unit_l2(l2) {
+        Some(near_unit(v, l2))
     } else {
         normalize(v)
     }
@@ -56,6 +61,35 @@ pub fn unit(v: DVec3) -> Option<DVec3> {
 #[inline]
 pub fn is_unit_l2(l2: f64) -> bool {
     (l2 - 1.0).abs() <= 1.0 / (1u64 << 40) as f64
+}
+
+/// How far from 1 a squared length may be for [`near_unit`]: 2⁻²⁰, 16× the deviation of a unit
+/// vector rounded to f32 and renormalized in f32 (|l² − 1| ≤ ~2⁻²⁴ · 3).
+pub const NEAR_UNIT_L2: f64 = 1.0 / (1u64 << 20) as f64;
+
+/// True when a squared length is 1 to within [`NEAR_UNIT_L2`]: [`near_unit`] makes the vector
+/// unit to within 2⁻⁴⁰ ([`is_unit_l2`]).
+#[inline]
+pub fn is_near_unit_l2(l2: f64) -> bool {
+    (l2 - 1.0).abs() <= NEAR_UNIT_L2
+}
+
+/// `v` (squared length `l2`, with [`is_near_unit_l2`]) made unit by one Newton step of
+/// 1/√l2 from 1: v (3 − l2)/2. For l2 = 1 + δ the result's squared length is
+/// (1 + δ)(1 − δ/2)² = 1 − ¾δ² + ¼δ³, within ¾ · 2⁻⁴⁰ of 1 for |δ| ≤ 2⁻²⁰ — what
+/// [`normalize`] gives to the same tolerance, at the cost of two multiplications instead of a
+/// square root and a division (the reference version: `normalize`, tested against).
+#[inline(always)]
+pub fn near_unit(v: DVec3, l2: f64) -> DVec3 {
+    v * (1.5 - 0.5 * l2)
+}
+
+/// `v` (squared length `l2`, with [`is_near_unit_l2`]) as [`unit()`] returns it: unchanged
+/// when it is unit to within 2⁻⁴⁰ (multiplied by exactly 1), else [`near_unit`]. A select,
+/// not a branch: exact and f32-rounded inputs take the same path.
+#[inline(always)]
+pub fn unit_or_near(v: DVec3, l2: f64) -> DVec3 {
+    v * if is_unit_l2(l2) { 1.0 } else { 1.5 - 0.5 * l2 }
 }
 
 /// True when `v` is finite and strictly above the horizon (z > 0): all a sampler needs to know
@@ -76,15 +110,38 @@ pub fn in_unit_square(u: DVec2) -> bool {
 
 /// Normalizes a pair of directions and checks that both lie strictly above the horizon
 /// (z > 0). Returns `None` otherwise — the caller then returns 0 (see the `Brdf` conventions).
+///
+/// The hot path of every model's evaluation: directions unit to within 2⁻⁴⁰ in squared length
+/// are returned unchanged and ones unit to within 2⁻²⁰ (a renderer's f32 directions) corrected
+/// without a root ([`unit_or_near`]) — one branch, taken the same way for both —; any other
+/// pair is normalized out of line with one division (1 / (|wi| |wo|)) instead of six.
+/// Symmetric: swapping the arguments swaps the results bit for bit.
 #[inline]
 pub fn upper_pair(wi: DVec3, wo: DVec3) -> Option<(DVec3, DVec3)> {
-    let wi = normalize(wi)?;
-    let wo = normalize(wo)?;
-    if wi.z > 0.0 && wo.z > 0.0 {
-        Some((wi, wo))
-    } else {
-        None
+    let (l2, v2) = (wi.length_squared(), wo.length_squared());
+    if !(wi.z > 0.0 && wo.z > 0.0) {
+        return None;
     }
+    if is_near_unit_l2(l2) & is_near_unit_l2(v2) {
+        return Some((unit_or_near(wi, l2), unit_or_near(wo, v2)));
+    }
+    other_lengths(wi, wo, l2, v2)
+}
+
+/// [`upper_pair`] of a pair whose lengths are not both near 1 (out of the hot path).
+#[cold]
+#[inline(never)]
+fn other_lengths(wi: DVec3, wo: DVec3, l2: f64, v2: f64) -> Option<(DVec3, DVec3)> {
+    let normal = f64::MIN_POSITIVE..f64::INFINITY;
+    if !(normal.contains(&l2) && normal.contains(&v2)) {
+        // Lengths whose squares under- or overflow (or NaN, infinite): scaled one by one.
+        let (wi, wo) = (normalize(wi)?, normalize(wo)?);
+        return (wi.z > 0.0 && wo.z > 0.0).then_some((wi, wo));
+    }
+    // 1/(|wi| |wo|) ≤ 1/MIN_POSITIVE: finite.
+    let (sl, sv) = (l2.sqrt(), v2.sqrt());
+    let r = 1.0 / (sl * sv);
+    Some((wi * (sv * r), wo * (sl * r)))
 }
 
 /// The unit direction with polar angle `theta` from +z and azimuth `phi` from +x:
@@ -297,6 +354,74 @@ mod tests {
                 assert!(w.z >= 0.0);
             }
         }
+    }
+
+    #[test]
+    fn upper_pair_keeps_unit_inputs_and_normalizes_others() {
+        let mut rng = Pcg32::new(12);
+        for _ in 0..2000 {
+            let a = cosine_hemisphere(rng.next_dvec2());
+            let b = cosine_hemisphere(rng.next_dvec2());
+            let Some((l, v)) = upper_pair(a, b) else {
+                continue;
+            };
+            assert_eq!((l, v), (a, b), "unit inputs are returned as they are");
+            let (l2, v2) = upper_pair(a * 3.0, b * 0.25).unwrap();
+            assert!((l2 - a).length() < 1e-15 && (v2 - b).length() < 1e-15);
+            // Symmetric bit for bit.
+            assert_eq!(upper_pair(b * 0.25, a * 3.0), Some((v2, l2)));
+        }
+        assert!(upper_pair(DVec3::new(0.0, 0.0, -1.0), DVec3::Z).is_none());
+        assert!(upper_pair(DVec3::new(f64::NAN, 0.0, 1.0), DVec3::Z).is_none());
+        assert!(upper_pair(DVec3::ZERO, DVec3::Z).is_none());
+        let tiny = DVec3::new(1e-200, 0.0, 1e-200);
+        let (t, _) = upper_pair(tiny, DVec3::Z).unwrap();
+        assert!((t - DVec3::new(1.0, 0.0, 1.0).normalize()).length() < 1e-15);
+    }
+
+    /// Directions as renderers pass them — unit in f32, rounded and renormalized there, and
+    /// anything within [`NEAR_UNIT_L2`] — come out of [`near_unit`] (and so of [`unit()`] and
+    /// [`upper_pair`]) as unit as [`normalize`] makes them (within 2⁻⁴⁰ in squared length) and
+    /// within 1e-12 of `normalize`'s direction: ¾δ² ≤ ¾ · 2⁻⁴⁰ by the Newton step's error.
+    #[test]
+    fn near_unit_directions_are_corrected_as_normalize_corrects_them() {
+        let mut rng = Pcg32::new(5);
+        let mut corrected = 0;
+        for k in 0..20_000 {
+            let exact = uniform_sphere(rng.next_dvec2());
+            let v = match k % 3 {
+                0 => exact.as_vec3().as_dvec3(),
+                1 => exact.as_vec3().normalize().as_dvec3(),
+                // Anywhere in the band, to its edges.
+                _ => exact * (1.0 + NEAR_UNIT_L2 * (rng.next_f64() - 0.5) * 0.999).sqrt(),
+            };
+            let l2 = v.length_squared();
+            assert!(is_near_unit_l2(l2), "{v}: {l2}");
+            let reference = normalize(v).unwrap();
+            let u = unit(v).unwrap();
+            assert!(
+                is_unit_l2(u.length_squared()),
+                "{v}: |u|² − 1 = {}",
+                u.length_squared() - 1.0
+            );
+            assert!(
+                (u - reference).length() < 1e-12,
+                "{v}: {u} against {reference}"
+            );
+            if !is_unit_l2(l2) {
+                corrected += 1;
+                assert_eq!(u, near_unit(v, l2));
+            }
+            if let Some((a, b)) = upper_pair(v, DVec3::new(0.0, 0.6, 0.8)) {
+                assert_eq!(a, u);
+                assert_eq!(b, DVec3::new(0.0, 0.6, 0.8));
+            }
+        }
+        assert!(corrected > 10_000, "{corrected} inputs needed a correction");
+        // Outside the band: normalized as before.
+        let far = DVec3::new(0.0, 0.0, 1.0 + 2.0 * NEAR_UNIT_L2);
+        assert!(!is_near_unit_l2(far.length_squared()));
+        assert_eq!(unit(far), Some(DVec3::Z));
     }
 
     #[test]

@@ -154,7 +154,7 @@ impl CookTorrance {
     /// symmetric in (l, v), so reciprocity holds bit for bit.
     #[inline(always)]
     fn geometry(&self, wi: DVec3, wo: DVec3) -> Option<Geometry> {
-        let (l, v) = super::unit_upper_pair(wi, wo)?;
+        let (l, v) = crate::geometry::upper_pair(wi, wo)?;
         let h = l + v;
         let hh = h.length_squared();
         let hz2 = h.z * h.z;

@@ -182,7 +182,7 @@ impl Ggx {
     /// symmetrically in (l, v), so reciprocity holds bit for bit.
     #[inline(always)]
     fn lobe(&self, wi: DVec3, wo: DVec3) -> Option<Lobe> {
-        let (l, v) = super::unit_upper_pair(wi, wo)?;
+        let (l, v) = crate::geometry::upper_pair(wi, wo)?;
         let h = l + v;
         let hh = h.length_squared();
         let (x, y) = (h.x * self.inv_alpha.0, h.y * self.inv_alpha.1);

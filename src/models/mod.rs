@@ -35,60 +35,6 @@ pub(crate) fn put_channels(out: &mut [f32], src: &[f32], on: bool) {
     }
 }
 
-/// [`geometry::upper_pair`](crate::geometry::upper_pair) for the hot path: normalizes both
-/// directions with one division (1 / (|wi| |wo|)) instead of six, and checks both are strictly
-/// above the horizon and finite. Directions that are already unit to within 2⁻⁴⁰ in squared
-/// length are returned unchanged. Symmetric: swapping the arguments swaps the results bit for bit.
-#[inline]
-pub(crate) fn unit_upper_pair(
-    wi: glam::DVec3,
-    wo: glam::DVec3,
-) -> Option<(glam::DVec3, glam::DVec3)> {
-    let (l2, v2) = (wi.length_squared(), wo.length_squared());
-    if !(wi.z > 0.0 && wo.z > 0.0) {
-        return None;
-    }
-    // Unit inputs (what renderers and samplers pass) are used as they are.
-    if crate::geometry::is_unit_l2(l2) && crate::geometry::is_unit_l2(v2) {
-        return Some((wi, wo));
-    }
-    let normal = f64::MIN_POSITIVE..f64::INFINITY;
-    if !(normal.contains(&l2) && normal.contains(&v2)) {
-        // Lengths whose squares under- or overflow (or NaN, infinite): scaled one by one.
-        return crate::geometry::upper_pair(wi, wo);
-    }
-    // 1/(|wi| |wo|) ≤ 1/MIN_POSITIVE: finite.
-    let (sl, sv) = (l2.sqrt(), v2.sqrt());
-    let r = 1.0 / (sl * sv);
-    Some((wi * (sv * r), wo * (sl * r)))
-}
-
-#[cfg(test)]
-mod unit_pair_tests {
-    use super::unit_upper_pair;
-    use crate::geometry;
-    use crate::rng::Pcg32;
-
-    #[test]
-    fn unit_and_scaled_inputs_give_the_same_pair() {
-        let mut rng = Pcg32::new(12);
-        for _ in 0..2000 {
-            let a = geometry::cosine_hemisphere(rng.next_dvec2());
-            let b = geometry::cosine_hemisphere(rng.next_dvec2());
-            let Some((l, v)) = unit_upper_pair(a, b) else {
-                continue;
-            };
-            assert_eq!((l, v), (a, b), "unit inputs are returned as they are");
-            let (l2, v2) = unit_upper_pair(a * 3.0, b * 0.25).unwrap();
-            assert!((l2 - a).length() < 1e-15 && (v2 - b).length() < 1e-15);
-            // Symmetric bit for bit.
-            assert_eq!(unit_upper_pair(b * 0.25, a * 3.0), Some((v2, l2)));
-        }
-        assert!(unit_upper_pair(glam::DVec3::new(0.0, 0.0, -1.0), glam::DVec3::Z).is_none());
-        assert!(unit_upper_pair(glam::DVec3::new(f64::NAN, 0.0, 1.0), glam::DVec3::Z).is_none());
-    }
-}
-
 #[cfg(test)]
 mod range_tests {
     use crate::error::Error;

@@ -87,7 +87,7 @@ impl Brdf for OrenNayar {
     #[inline]
     fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
         let out = &mut out[..self.kd.len()];
-        let Some((wi, wo)) = geometry::upper_pair(wi, wo) else {
+        let Some((wi, wo)) = crate::geometry::upper_pair(wi, wo) else {
             out.fill(0.0);
             return;
         };
@@ -98,7 +98,7 @@ impl Brdf for OrenNayar {
     }
 
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
-        match geometry::upper_pair(wi, wo) {
+        match crate::geometry::upper_pair(wi, wo) {
             Some((wi, wo)) => self.kd_spec.at(nm) * self.factor(wi, wo),
             None => 0.0,
         }

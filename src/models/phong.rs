@@ -191,7 +191,7 @@ impl Brdf for Phong {
     #[inline]
     fn eval(&self, wi: DVec3, wo: DVec3, out: &mut [f32]) {
         let out = &mut out[..self.ks.len()];
-        let Some((wi, wo)) = super::unit_upper_pair(wi, wo) else {
+        let Some((wi, wo)) = crate::geometry::upper_pair(wi, wo) else {
             out.fill(0.0);
             return;
         };
