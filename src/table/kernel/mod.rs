@@ -266,10 +266,19 @@ impl Kernel {
     /// (cos θi, cos θo) come last.
     #[inline(always)]
     fn vars_lanes(&self, wi: DVec3, wo: DVec3) -> Option<(F4, f32, [f32; 2])> {
-        // One branch for the usual unit pair; anything else goes through `geometry::unit`.
-        let unit =
-            geometry::is_unit_l2(wi.length_squared()) & geometry::is_unit_l2(wo.length_squared());
-        let (wi, wo) = if unit { (wi, wo) } else { unit_pair(wi, wo)? };
+        // One branch for the usual unit pair (exact, or unit to f32 precision and corrected
+        // without a root: `geometry::near_unit`); anything else goes through `geometry::unit`.
+        let (li, lo) = (wi.length_squared(), wo.length_squared());
+        let (wi, wo) = if geometry::is_unit_l2(li) & geometry::is_unit_l2(lo) {
+            (wi, wo)
+        } else if geometry::is_near_unit_l2(li) & geometry::is_near_unit_l2(lo) {
+            (
+                geometry::unit_or_near(wi, li),
+                geometry::unit_or_near(wo, lo),
+            )
+        } else {
+            unit_pair(wi, wo)?
+        };
         if !(wi.z > 0.0 && wo.z > 0.0) {
             return None;
         }
