@@ -129,6 +129,12 @@ pub fn bench(a: BenchArgs) -> Result<()> {
         );
         let _ = writeln!(
             o,
+            "f32:     {:.1} ns per lookup wall, {:.2} M/s per core batch: the same pairs rounded to f32 as renderers pass them (median of {r})",
+            t.ns_per_lookup_f32_directions,
+            t.lookups_per_s_batch_f32_directions_per_core_cpu_time / 1e6
+        );
+        let _ = writeln!(
+            o,
             "sample:  {:.1} ns per sample (direction, pdf and weight) = {:.2}× one lookup (median of {r} rounds timing both, one thread)",
             t.ns_per_sample_single_thread, t.sample_over_eval
         );
