@@ -179,6 +179,17 @@ pub trait Brdf: Send + Sync {
         self.channels().mix_at(nm).apply(|i| buf[i] as f64)
     }
 
+    /// f_r at each of the wavelengths `nm` into `out[..nm.len()]`: [`Brdf::eval_wavelength`]
+    /// of each, as f32. What a spectral renderer asks per path vertex (pbrt-v4: four
+    /// wavelengths). The default calls `eval_wavelength` once per wavelength; sources whose
+    /// wavelengths are read from their channels (tables, MERL and RGL files) override it with
+    /// one lookup for all of them ([`channels_at_wavelengths`]), the same values bit for bit.
+    fn eval_at_wavelengths(&self, wi: DVec3, wo: DVec3, nm: &[f64], out: &mut [f32]) {
+        for (o, &x) in out.iter_mut().zip(nm) {
+            *o = self.eval_wavelength(wi, wo, x) as f32;
+        }
+    }
+
     /// Evaluates many pairs: `out[k * c .. (k + 1) * c]` receives `f_r(wi[k], wo[k])` where `c` is
     /// the channel count. Batches of 16 384 pairs or more run on rayon's threads; tables
     /// override this for throughput.
@@ -339,8 +350,10 @@ pub trait Brdf: Send + Sync {
             mix_channels(self.channels(), &buf[..c], nm, weight);
         } else {
             let k = s.wi.z.abs() / s.pdf;
-            for (w, &x) in weight.iter_mut().zip(nm) {
-                *w = (self.eval_wavelength(s.wi, wo, x) * k) as f32;
+            let n = nm.len().min(weight.len());
+            self.eval_at_wavelengths(s.wi, wo, &nm[..n], &mut weight[..n]);
+            for w in &mut weight[..n] {
+                *w = (*w as f64 * k) as f32;
             }
         }
         Some(s)
@@ -432,6 +445,21 @@ pub fn mix_channels(channels: &Channels, v: &[f32], nm: &[f64], out: &mut [f32])
     for (o, &x) in out.iter_mut().zip(nm) {
         *o = channels.mix_at(x).apply(|i| v[i] as f64) as f32;
     }
+}
+
+/// [`Brdf::eval_at_wavelengths`] of a source whose [`Brdf::eval_wavelength`] is the default
+/// (its channels mixed at each wavelength): one [`Brdf::eval`], then [`mix_channels`].
+pub fn channels_at_wavelengths<B: Brdf + ?Sized>(
+    brdf: &B,
+    wi: DVec3,
+    wo: DVec3,
+    nm: &[f64],
+    out: &mut [f32],
+) {
+    let mut buf = [0.0f32; MAX_CHANNELS];
+    let c = brdf.channels().len().min(MAX_CHANNELS);
+    brdf.eval(wi, wo, &mut buf[..c]);
+    mix_channels(brdf.channels(), &buf[..c], nm, out);
 }
 
 /// One block of [`sample_flagged`]'s outputs, numbered: (block, (((wi, pdf), weights), flags)).
@@ -565,7 +593,7 @@ fn flagged_blocks(
 }
 
 /// f_r at the wavelengths `nm` for every pair: `out[p * k .. (p + 1) * k]` receives
-/// [`Brdf::eval_wavelength`] of pair `p` at each of the `k = nm.len()` wavelengths, on the
+/// [`Brdf::eval_at_wavelengths`] of pair `p` at the `k = nm.len()` wavelengths, on the
 /// library's pool from [`crate::batch::PARALLEL`] pairs on.
 ///
 /// # Panics
@@ -586,9 +614,7 @@ pub fn eval_wavelengths<B: Brdf + ?Sized>(
     }
     crate::batch::blocks(out, k, |s, o| {
         for (r, o) in o.chunks_exact_mut(k).enumerate() {
-            for (o, &x) in o.iter_mut().zip(nm) {
-                *o = brdf.eval_wavelength(wi[s + r], wo[s + r], x) as f32;
-            }
+            brdf.eval_at_wavelengths(wi[s + r], wo[s + r], nm, o);
         }
     });
 }
@@ -615,6 +641,9 @@ macro_rules! forward_brdf {
             }
             fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
                 (**self).eval_wavelength(wi, wo, nm)
+            }
+            fn eval_at_wavelengths(&self, wi: DVec3, wo: DVec3, nm: &[f64], out: &mut [f32]) {
+                (**self).eval_at_wavelengths(wi, wo, nm, out)
             }
             fn eval_batch(&self, wi: &[DVec3], wo: &[DVec3], out: &mut [f32]) {
                 (**self).eval_batch(wi, wo, out)

@@ -433,6 +433,11 @@ impl Brdf for MerlBrdf {
         out.copy_from_slice(&self.cell_at(k));
     }
 
+    /// The channels mixed at each wavelength: one cell lookup for all of them.
+    fn eval_at_wavelengths(&self, wi: DVec3, wo: DVec3, nm: &[f64], out: &mut [f32]) {
+        crate::brdf::channels_at_wavelengths(self, wi, wo, nm, out)
+    }
+
     /// Importance sampling by conditional half-vector warps of f_r cos θi given `wo`
     /// ([`TableSampler`], built from this reader on first use: 197 k lookups, about
     /// 30 ms). A MERL file carries no sampling data of its own; the cosine-weighted

@@ -698,6 +698,27 @@ impl Brdf for RglBrdf {
         if f.is_finite() && f > 0.0 { f } else { 0.0 }
     }
 
+    /// [`RglBrdf::eval_wavelength`] at each wavelength with one warp inversion for all of
+    /// them (the inversion is most of a lookup's cost).
+    fn eval_at_wavelengths(&self, wi: DVec3, wo: DVec3, nm: &[f64], out: &mut [f32]) {
+        let Some((sample, k, scale, cos_o)) = self.prepare(wi, wo) else {
+            out.iter_mut().take(nm.len()).for_each(|o| *o = 0.0);
+            return;
+        };
+        for (o, &x) in out.iter_mut().zip(nm) {
+            let mix = match &self.wavelengths {
+                Some(wl) => spectral_mix(wl, x),
+                None => Channels::Rgb.mix_at(x),
+            };
+            let f = mix.apply(|c| self.channel(sample, &k, c)) * scale / cos_o;
+            *o = if f.is_finite() && f > 0.0 {
+                f as f32
+            } else {
+                0.0
+            };
+        }
+    }
+
     /// Importance sampling by conditional half-vector warps of f_r cos θi given `wo`
     /// ([`TableSampler`], built from this reader on first use: 131 k evaluations).
     ///

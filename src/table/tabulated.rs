@@ -580,6 +580,12 @@ impl Brdf for TabulatedBrdf {
         self.sampler().pdf(wi, wo)
     }
 
+    /// A table's f_r at a wavelength interpolates its channels: one lookup for every
+    /// wavelength.
+    fn eval_at_wavelengths(&self, wi: DVec3, wo: DVec3, nm: &[f64], out: &mut [f32]) {
+        crate::brdf::channels_at_wavelengths(self, wi, wo, nm, out)
+    }
+
     /// A table's f_r at a wavelength interpolates its channels, so the weights do too: one
     /// draw and one lookup, whatever the number of wavelengths.
     fn sample_wavelengths(

@@ -243,7 +243,36 @@ fn sensitivity(brdf: &dyn Brdf, wi: DVec3, wo: DVec3, ch: usize, angle: f64) -> 
 
 /// `eval_batch` against `eval` and `sample_batch` against `sample`, pair by pair
 /// (unnormalized, below-horizon and, for sampling, non-finite views included).
+/// `eval_at_wavelengths` is `eval_wavelength` at each wavelength (as f32), bit for bit, on
+/// pairs of every kind: wavelengths inside, between and outside the channels, one and many.
+fn at_wavelengths(brdf: &dyn Brdf, pairs: &[(DVec3, DVec3)], log: &mut Log) {
+    let mut nm: Vec<f64> = vec![380.0, 450.0, 517.3, 550.0, 612.5, 700.0, 830.0];
+    nm.extend((0..brdf.channels().len()).map(|i| brdf.channels().wavelength(i)));
+    let mut out = vec![0.0f32; nm.len()];
+    for (k, &(a, b)) in pairs.iter().enumerate().take(400) {
+        let (wi, wo) = match k % 7 {
+            0 => (a, DVec3::new(b.x, b.y, -b.z)),
+            1 => (a * 3.5, b * 0.25),
+            _ => (a, b),
+        };
+        let n = 1 + k % nm.len();
+        brdf.eval_at_wavelengths(wi, wo, &nm[..n], &mut out[..n]);
+        for (j, &x) in nm[..n].iter().enumerate() {
+            let want = brdf.eval_wavelength(wi, wo, x) as f32;
+            if out[j].to_bits() != want.to_bits() {
+                log.fail("eval_at_wavelengths", || {
+                    format!(
+                        "({wi}, {wo}) at {x} nm: {} vs eval_wavelength's {want}",
+                        out[j]
+                    )
+                });
+            }
+        }
+    }
+}
+
 fn batches(brdf: &dyn Brdf, opts: &Contract, pairs: &[(DVec3, DVec3)], log: &mut Log) {
+    at_wavelengths(brdf, pairs, log);
     let c = brdf.channels().len();
     let (wi, wo): (Vec<DVec3>, Vec<DVec3>) = pairs
         .iter()

@@ -8,7 +8,8 @@
  * Conventions (those of the Rust `Brdf` trait):
  *   - local shading frame, z is the normal; wi (to the light) and wo (to the viewer) both point
  *     away from the surface; directions need not be normalized (any finite nonzero length,
- *     1e-300 and 1e308 included); below the horizon f_r = 0;
+ *     1e-300 and 1e308 included); float directions normalized in float (unit to float
+ *     rounding) and widened to double cost no more than exact ones; below the horizon f_r = 0;
  *   - brdftab_eval returns f_r in 1/sr, NOT multiplied by a cosine;
  *   - brdftab_sample draws wi for a given wo; weight = f_r * cos(theta_i) / pdf;
  *   - arrays are pair-major: wi, wo are n x 3 doubles (x, y, z), u is n x 2, f and weight are
@@ -93,7 +94,8 @@ int brdftab_sample_delta(const brdftab_brdf *b, size_t n, const double *wo, cons
  * > 0) into f (n x k): the source's own spectral data where it has them (models, spectral RGL
  * files), its channels otherwise (wavelength channels interpolated; RGB through a
  * colour-preserving basis: the spectrum's CIE 1931 / D65 sRGB is the source's RGB). For
- * renderers that draw their wavelengths per path (pbrt-v4). */
+ * renderers that draw their wavelengths per path (pbrt-v4). Tables, MERL and RGL files look
+ * each pair up once for all k wavelengths. */
 int brdftab_eval_spectral(const brdftab_brdf *b, size_t n, const double *wi, const double *wo,
                           size_t k, const double *nm, float *f);
 /* brdftab_sample_delta with the weights at the k wavelengths nm (weight: n x k), a mirror's

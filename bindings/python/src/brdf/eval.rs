@@ -84,8 +84,14 @@ impl PyBrdf {
                         true => nm.index_axis(numpy::ndarray::Axis(0), s + r),
                         false => nm.view(),
                     };
-                    for (o, &x) in o.iter_mut().zip(l.iter()) {
-                        *o = brdf.eval_wavelength(a[r], b[r], x) as f32;
+                    match l.as_slice() {
+                        // One lookup for every wavelength where the source allows it.
+                        Some(l) => brdf.eval_at_wavelengths(a[r], b[r], l, o),
+                        None => {
+                            for (o, &x) in o.iter_mut().zip(l.iter()) {
+                                *o = brdf.eval_wavelength(a[r], b[r], x) as f32;
+                            }
+                        }
                     }
                 }
             })

@@ -187,7 +187,8 @@ impl PyBrdf {
     /// Spectral channels are interpolated; analytic models use their spectral data; RGB
     /// channels become a spectrum of their colour (`brdftab.rgb_basis`). A
     /// wavelength must be finite and > 0 (the library's rule, as for `wavelengths=`): any
-    /// other is a `ValueError`.
+    /// other is a `ValueError`. Tables, MERL and RGL files look each pair up once for all k
+    /// wavelengths.
     fn eval_spectral(
         &self,
         py: Python<'_>,
