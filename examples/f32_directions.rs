@@ -22,14 +22,8 @@ fn main() -> brdftab::Result<()> {
     const BLOCK: usize = 4096;
     for source in std::env::args().skip(1) {
         let b = brdftab::open(&source)?;
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut pair = move || DVec2::new(next(), next());
+        let mut rng = brdftab::testkit::Pcg32::new(35);
+        let mut pair = move || rng.next_dvec2();
         let exact: Pairs = (0..N)
             .map(|_| {
                 (
