@@ -7,7 +7,10 @@
 //! - `lookup/measured_{single,block}`: the default table of the shipped `cc_ibiza_sunset`
 //!   (an adaptive kernel table, cache resident) on one thread, one `eval` per pair against
 //!   `eval_batch` on the same 4096 pairs (below the parallel threshold, so one thread: the
-//!   eight-lane AVX2 path against the one-pair path, in the same run).
+//!   eight-lane AVX2 path against the one-pair path, in the same run);
+//! - `lookup/measured_{single,block}_f32`: the same pairs rounded to f32 and normalized there,
+//!   as pbrt-v4, Mitsuba 3 and float32 arrays hand them over (before session 35 these took the
+//!   normalizing path: 1.8× one `eval`, 5–6× a batch).
 //!
 //! Run: `cargo bench --bench lookup`. The machine may be shared: compare with CPU time
 //! (`brdftab bench FILE` prints both).
@@ -80,6 +83,28 @@ fn bench(c: &mut Criterion) {
     g.bench_function("measured_block", |b| {
         b.iter(|| {
             measured.eval_batch(&wi, &wo, &mut block);
+            black_box(&block);
+        })
+    });
+    // The same pairs as renderers hand them over: rounded to f32 and normalized there.
+    let f32_dirs = |w: &[DVec3]| -> Vec<DVec3> {
+        w.iter()
+            .map(|d| d.as_vec3().normalize().as_dvec3())
+            .collect()
+    };
+    let (fi, fo) = (f32_dirs(&wi), f32_dirs(&wo));
+    g.bench_function("measured_single_f32", |b| {
+        let mut f = [0.0f32; 3];
+        b.iter(|| {
+            for k in 0..fi.len() {
+                measured.eval(fi[k], fo[k], &mut f);
+                black_box(&f);
+            }
+        })
+    });
+    g.bench_function("measured_block_f32", |b| {
+        b.iter(|| {
+            measured.eval_batch(&fi, &fo, &mut block);
             black_box(&block);
         })
     });
