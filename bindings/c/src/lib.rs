@@ -69,20 +69,23 @@ pub struct brdftab_open_options {
 }
 
 thread_local! {
-    static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
+    /// This thread's last failure (`None`: the last call succeeded). Initialized by a constant,
+    /// so that each call's access is a plain thread-local read with no lazy-initialization
+    /// check (a successful one-pair call pays it on every call).
+    static LAST_ERROR: RefCell<Option<CString>> = const { RefCell::new(None) };
 }
 
 fn set_error(msg: &str) {
     let c = CString::new(msg.replace('\0', " ")).unwrap_or_default();
-    LAST_ERROR.with(|e| *e.borrow_mut() = c);
+    LAST_ERROR.with(|e| *e.borrow_mut() = Some(c));
 }
 
-/// Empties the last error; allocates nothing when it is already empty (the common case), so a
-/// successful call costs no allocation.
+/// Empties the last error; allocates nothing, and writes nothing when it is already empty (the
+/// common case).
 fn clear_error() {
     LAST_ERROR.with(|e| {
-        if !e.borrow().as_bytes().is_empty() {
-            *e.borrow_mut() = CString::default();
+        if e.borrow().is_some() {
+            *e.borrow_mut() = None;
         }
     });
 }
@@ -277,7 +280,7 @@ pub unsafe extern "C" fn brdftab_open_with(
 /// brdftab call.
 #[unsafe(no_mangle)]
 pub extern "C" fn brdftab_last_error() -> *const c_char {
-    LAST_ERROR.with(|e| e.borrow().as_ptr())
+    LAST_ERROR.with(|e| e.borrow().as_deref().unwrap_or(c"").as_ptr())
 }
 
 /// Closes a handle; NULL is a no-op.
@@ -361,7 +364,11 @@ pub unsafe extern "C" fn brdftab_eval(
         // SAFETY (both): the header's contract on sizes; NULL and alignment are checked.
         let (b, wi, wo) = unsafe { pair_args(b, n, wi, wo) }?;
         let f = unsafe { slice_mut(f, times(n, b.names.len(), "f")?, "f") }?;
-        b.brdf.eval_batch(wi, wo, f);
+        match n {
+            // A renderer's call per shading point: the lookup itself, not the batch's dispatch.
+            1 => b.brdf.eval(wi[0], wo[0], f),
+            _ => b.brdf.eval_batch(wi, wo, f),
+        }
         healthy(b)
     })
 }
@@ -385,7 +392,10 @@ pub unsafe extern "C" fn brdftab_pdf(
         // SAFETY (both): the header's contract on sizes; NULL and alignment are checked.
         let (b, wi, wo) = unsafe { pair_args(b, n, wi, wo) }?;
         let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
-        b.brdf.pdf_batch(wi, wo, pdf);
+        match n {
+            1 => pdf[0] = b.brdf.pdf(wi[0], wo[0]),
+            _ => b.brdf.pdf_batch(wi, wo, pdf),
+        }
         healthy(b)
     })
 }
