@@ -66,7 +66,8 @@ fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
             "columns: error is the relative RMSE of f_r cos θi cos θo, both directions within 80°, {} pairs; \
              ns: wall time per lookup on one thread, median of {} rounds each timing the native \
              evaluation then the table on the same pairs (speedup: median of the per-round \
-             ratios); batch: eval_batch lookups per second of CPU time",
+             ratios); f32 pairs: the table on the same pairs rounded to f32 and normalized \
+             there, as renderers pass them; batch: eval_batch lookups per second of CPU time",
             opts.error_pairs, opts.repeats
         );
         let _ = writeln!(o, "\n{}", measured::fidelity_markdown(&rows));

@@ -89,6 +89,9 @@ pub struct MeasuredRow {
     /// Median over rounds of native ns / table ns within the round (paired, so the machine's
     /// changing speed cancels).
     pub speedup: f64,
+    /// ns per table lookup on the same pairs rounded to f32 (as renderers pass them; one
+    /// thread, median over rounds of [`timing::lookups`]).
+    pub table_ns_f32: f64,
     /// Native batch rate, lookups per second per core of CPU time.
     pub native_batch_per_core: f64,
     /// Table batch rate, lookups per second per core of CPU time.
@@ -178,6 +181,7 @@ fn row(f: &Path, opts: &MeasuredOptions) -> Result<MeasuredRow> {
         native_ns: single.0,
         table_ns: single.1,
         speedup: single.2,
+        table_ns_f32: tt.ns_per_lookup_f32_directions,
         native_batch_per_core: tn.lookups_per_s_batch_per_core_cpu_time,
         table_batch_per_core: tt.lookups_per_s_batch_per_core_cpu_time,
         bake_seconds: report.seconds,
@@ -251,12 +255,12 @@ pub fn fidelity_markdown(rows: &[MeasuredRow]) -> String {
 /// The rows as a Markdown table (the form BENCHMARKS.md quotes).
 pub fn markdown(rows: &[MeasuredRow]) -> String {
     let mut s = String::from(
-        "| file | error (seed 1 / 2) | RGL bytes | table bytes | resident | native ns | table ns | speedup | batch M/s/core (table / native) |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
+        "| file | error (seed 1 / 2) | RGL bytes | table bytes | resident | native ns | table ns | speedup | table ns, f32 pairs | batch M/s/core (table / native) |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         s += &format!(
-            "| {} | {:.2}% / {:.2}% | {} | {} ({:.2}×) | {:.2} MB | {:.0} | {:.1} | {:.1}× | {:.1} / {:.2} |\n",
+            "| {} | {:.2}% / {:.2}% | {} | {} ({:.2}×) | {:.2} MB | {:.0} | {:.1} | {:.1}× | {:.1} | {:.1} / {:.2} |\n",
             r.file,
             r.rel_rmse_80 * 100.0,
             r.rel_rmse_80_seed2 * 100.0,
@@ -267,6 +271,7 @@ pub fn markdown(rows: &[MeasuredRow]) -> String {
             r.native_ns,
             r.table_ns,
             r.speedup,
+            r.table_ns_f32,
             r.table_batch_per_core / 1e6,
             r.native_batch_per_core / 1e6,
         );

@@ -211,6 +211,8 @@ fn bench_measured_prints_no_line_that_looks_like_an_error() {
     let o = brdftab(&["bench", "--measured", dir, "--pairs", "1000"]);
     assert!(o.ok, "{}", o.stderr);
     assert!(o.stdout.contains("paper_white_rgb"), "{}", o.stdout);
+    // The table's speed on a renderer's f32 directions is reported beside the exact pairs'.
+    assert!(o.stdout.contains("table ns, f32 pairs"), "{}", o.stdout);
     assert!(
         !o.stdout.lines().any(|l| l.starts_with("error")),
         "{}",
