@@ -3,9 +3,12 @@
 //!
 //! Why a module: a batch call's cost should be the library's. Directions arrive as `(n, 3)`
 //! arrays; a C-contiguous, aligned float64 array is read in place as `[DVec3]` (glam's `DVec3`
-//! is `#[repr(C)]` of three f64, as the C ABI reads `double[n][3]`); anything else — float32,
-//! a strided view, a list — is converted by numpy once. Results are written straight into the
-//! numpy arrays returned, with the GIL released, so a large call's memory is its output.
+//! is `#[repr(C)]` of three f64, as the C ABI reads `double[n][3]`); a C-contiguous float32
+//! array — what Mitsuba, PyTorch and most renderers' buffers hold — is read in place too, each
+//! block of rows widened to f64 as the block is evaluated (the same values numpy's `astype`
+//! gives, without an n-sized float64 copy before the call); anything else — a strided view,
+//! integers, a list — is converted by numpy once. Results are written straight into the numpy
+//! arrays returned, with the GIL released, so a large call's memory is its output.
 
 use brdftab::batch::{BLOCK, blocks};
 use glam::{DVec2, DVec3};
@@ -111,30 +114,46 @@ pub(crate) fn shape_str(shape: &[usize]) -> String {
     }
 }
 
-/// Rows of `W` float64 numbers, `(n, W)` or one row `(W,)`, as `[T]` (`T` = `DVec3` or
-/// `DVec2`): borrowed in place when C-contiguous and aligned, else copied once.
+/// Rows of `W` numbers, `(n, W)` or one row `(W,)`, as `T` (`T` = `DVec3` or `DVec2`):
+/// float64 borrowed in place as `[T]` when C-contiguous and aligned, float32 borrowed in place
+/// when C-contiguous (widened block by block: [`Rows::rows`]), anything else converted or
+/// copied once.
 pub(crate) struct Rows<'py, T> {
-    /// Keeps the numpy array (and its read borrow) alive while `ptr` is used.
-    _array: PyReadonlyArrayDyn<'py, f64>,
+    /// Keeps the numpy array (and its read borrow) alive while `ptr` or `narrow` is used.
+    _array: Held<'py>,
     owned: Vec<T>,
+    /// Rows in place as `T` (float64), or null.
     ptr: *const T,
+    /// Rows in place as `W` f32 each (float32), or null.
+    narrow: *const f32,
     len: usize,
     /// The input was one row of shape `(W,)`.
     pub single: bool,
 }
 
-/// Row types read from float64 arrays: `W` numbers, `#[repr(C)]` of f64.
+/// The numpy array a [`Rows`] reads.
+enum Held<'py> {
+    F64 { _a: PyReadonlyArrayDyn<'py, f64> },
+    F32 { _a: PyReadonlyArrayDyn<'py, f32> },
+}
+
+/// Row types read from numpy arrays: `W` numbers, `#[repr(C)]` of f64.
 pub(crate) trait Row: Copy + Send + Sync {
     /// Numbers per row.
     const W: usize;
     /// A row from its `W` numbers.
     fn from(s: &[f64]) -> Self;
+    /// A row from its `W` numbers in f32 (widened exactly, as numpy's `astype` does).
+    fn from_f32(s: &[f32]) -> Self;
 }
 
 impl Row for DVec3 {
     const W: usize = 3;
     fn from(s: &[f64]) -> Self {
         DVec3::new(s[0], s[1], s[2])
+    }
+    fn from_f32(s: &[f32]) -> Self {
+        DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64)
     }
 }
 
@@ -143,12 +162,40 @@ impl Row for DVec2 {
     fn from(s: &[f64]) -> Self {
         DVec2::new(s[0], s[1])
     }
+    fn from_f32(s: &[f32]) -> Self {
+        DVec2::new(s[0] as f64, s[1] as f64)
+    }
+}
+
+/// Whether `obj` is a C-contiguous float32 ndarray of shape `(n, w)` or `(w,)` (read in place).
+fn narrow_rows<'py>(obj: &Bound<'py, PyAny>, w: usize) -> Option<PyReadonlyArrayDyn<'py, f32>> {
+    use numpy::PyUntypedArray;
+    // A subclass (a masked array) goes the general way, which looks at its mask.
+    if !obj.is_exact_instance_of::<PyUntypedArray>() {
+        return None;
+    }
+    let a = obj.extract::<PyReadonlyArrayDyn<'py, f32>>().ok()?;
+    let shaped = matches!(a.shape(), [x] | [_, x] if *x == w);
+    (shaped && a.is_c_contiguous()).then_some(a)
 }
 
 impl<'py, T: Row> Rows<'py, T> {
     /// Reads `obj` as rows of `T::W` numbers; wrong shapes are a `ValueError` naming `name`.
     pub(crate) fn new(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Self> {
         let w = T::W;
+        if let Some(a) = narrow_rows(obj, w) {
+            let flat = a
+                .as_slice()
+                .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
+            return Ok(Rows {
+                narrow: flat.as_ptr(),
+                ptr: std::ptr::null(),
+                owned: Vec::new(),
+                len: flat.len() / w,
+                single: a.ndim() == 1,
+                _array: Held::F32 { _a: a },
+            });
+        }
         let mut a = f64_array(obj, name)?;
         let single = match a.shape() {
             [x] if *x == w => true,
@@ -189,9 +236,10 @@ impl<'py, T: Row> Rows<'py, T> {
             (v, p)
         };
         Ok(Rows {
-            _array: a,
+            _array: Held::F64 { _a: a },
             owned,
             ptr,
+            narrow: std::ptr::null(),
             len,
             single,
         })
@@ -202,22 +250,78 @@ impl<'py, T: Row> Rows<'py, T> {
         self.len
     }
 
-    /// The rows, in place.
-    pub(crate) fn as_slice(&self) -> &[T] {
+    /// The rows as they are held: `[T]` or float32 numbers (shared across threads).
+    pub(crate) fn view(&self) -> View<'_, T> {
         if !self.owned.is_empty() {
-            return &self.owned;
+            return View::Wide(&self.owned);
+        }
+        if !self.narrow.is_null() {
+            // SAFETY: `narrow` points to `len * W` f32 of the C-contiguous array kept alive
+            // (and read-borrowed) by `_array`.
+            return View::Narrow(unsafe {
+                std::slice::from_raw_parts(self.narrow, self.len * T::W)
+            });
+        }
+        if self.ptr.is_null() {
+            return View::Wide(&[]);
         }
         // SAFETY: `ptr` points to `len * W` f64 of the C-contiguous, aligned array kept alive
         // (and read-borrowed) by `_array`; `T` is `#[repr(C)]` of `W` f64 (asserted above).
-        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+        View::Wide(unsafe { std::slice::from_raw_parts(self.ptr, self.len) })
+    }
+
+    /// Row `i` (< [`Rows::len`]).
+    pub(crate) fn row(&self, i: usize) -> T {
+        self.view().row(i)
+    }
+}
+
+/// [`Rows`] as held: rows of `T` (float64 in place, or a copy), or float32 numbers in place.
+#[derive(Clone, Copy)]
+pub(crate) enum View<'a, T> {
+    Wide(&'a [T]),
+    Narrow(&'a [f32]),
+}
+
+impl<'a, T: Row> View<'a, T> {
+    /// Number of rows.
+    fn len(&self) -> usize {
+        match self {
+            View::Wide(x) => x.len(),
+            View::Narrow(x) => x.len() / T::W,
+        }
+    }
+
+    /// Row `i` (< `len`).
+    fn row(&self, i: usize) -> T {
+        match self {
+            View::Wide(x) => x[i],
+            View::Narrow(x) => T::from_f32(&x[i * T::W..(i + 1) * T::W]),
+        }
+    }
+
+    /// The `k` rows from `s` on: in place, or widened from float32 into `buf`.
+    fn rows<'s>(&self, s: usize, k: usize, buf: &'s mut Vec<T>) -> &'s [T]
+    where
+        'a: 's,
+    {
+        match *self {
+            View::Wide(x) => &x[s..s + k],
+            View::Narrow(x) => {
+                let w = T::W;
+                buf.clear();
+                buf.extend(x[s * w..(s + k) * w].chunks_exact(w).map(T::from_f32));
+                buf
+            }
+        }
     }
 }
 
 /// Two row sets paired for a call: the same count, or one row against many (broadcast, the
 /// single row repeated into a block-sized buffer: no n-sized copy).
 pub(crate) struct Pairs<'a, A, B> {
-    a: &'a [A],
-    b: &'a [B],
+    a: View<'a, A>,
+    b: View<'a, B>,
     /// `a`'s single row repeated `min(n, BLOCK)` times when it broadcasts, else empty.
     ra: Vec<A>,
     /// The same for `b`.
@@ -227,6 +331,9 @@ pub(crate) struct Pairs<'a, A, B> {
     /// Both inputs were single rows: results drop their leading axis.
     pub single: bool,
 }
+
+/// Per-block room for rows widened from float32 ([`Pairs::block`]).
+pub(crate) type Scratch<A, B> = (Vec<A>, Vec<B>);
 
 impl<'a, A: Row, B: Row> Pairs<'a, A, B> {
     /// Pairs `a` (named `an`) with `b` (named `bn`).
@@ -248,47 +355,58 @@ impl<'a, A: Row, B: Row> Pairs<'a, A, B> {
             }
         };
         let single = a.single && b.single;
-        let (a, b) = (a.as_slice(), b.as_slice());
         let m = n.min(BLOCK);
         Ok(Pairs {
-            ra: if a.len() == n {
+            ra: if na == n {
                 Vec::new()
             } else {
-                vec![a[0]; m]
+                vec![a.row(0); m]
             },
-            rb: if b.len() == n {
+            rb: if nb == n {
                 Vec::new()
             } else {
-                vec![b[0]; m]
+                vec![b.row(0); m]
             },
-            a,
-            b,
+            a: a.view(),
+            b: b.view(),
             n,
             single,
         })
     }
 
-    /// Both sides whole (no broadcast): the arrays as they are.
+    /// Both sides whole (no broadcast) and in place as float64: the arrays as they are.
     pub(crate) fn whole(&self) -> Option<(&[A], &[B])> {
-        (self.a.len() == self.n && self.b.len() == self.n).then_some((self.a, self.b))
+        match (self.a, self.b) {
+            (View::Wide(a), View::Wide(b)) if a.len() == self.n && b.len() == self.n => {
+                Some((a, b))
+            }
+            _ => None,
+        }
     }
 
-    /// The `k` pairs from `s` on (`k` ≤ [`BLOCK`] when a side broadcasts).
-    pub(crate) fn block(&self, s: usize, k: usize) -> (&[A], &[B]) {
+    /// The `k` pairs from `s` on (`k` ≤ [`BLOCK`] when a side broadcasts); float32 rows are
+    /// widened into `scratch`.
+    pub(crate) fn block<'s>(
+        &'s self,
+        s: usize,
+        k: usize,
+        scratch: &'s mut Scratch<A, B>,
+    ) -> (&'s [A], &'s [B]) {
+        let (sa, sb) = (&mut scratch.0, &mut scratch.1);
         let a = match self.a.len() == self.n {
-            true => &self.a[s..s + k],
+            true => self.a.rows(s, k, sa),
             false => &self.ra[..k],
         };
         let b = match self.b.len() == self.n {
-            true => &self.b[s..s + k],
+            true => self.b.rows(s, k, sb),
             false => &self.rb[..k],
         };
         (a, b)
     }
 
     /// Runs `f(a, b, out)` over all pairs: once on the whole arrays (the library
-    /// parallelizes), or block by block on the library's pool when a side broadcasts.
-    /// `width` = outputs per pair.
+    /// parallelizes), or block by block on the library's pool when a side broadcasts or is
+    /// float32. `width` = outputs per pair.
     pub(crate) fn run<T: Send>(
         &self,
         out: &mut [T],
@@ -299,7 +417,8 @@ impl<'a, A: Row, B: Row> Pairs<'a, A, B> {
             return f(a, b, out);
         }
         blocks(out, width, |s, o| {
-            let (a, b) = self.block(s, o.len() / width.max(1));
+            let mut scratch = Scratch::default();
+            let (a, b) = self.block(s, o.len() / width.max(1), &mut scratch);
             f(a, b, o)
         });
     }

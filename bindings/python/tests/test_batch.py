@@ -62,6 +62,37 @@ def test_every_layout_gives_the_contiguous_result(table, layout):
         np.asarray(convert(wi), np.float64), np.asarray(convert(wo), np.float64)))
 
 
+def test_float32_arrays_read_in_place_give_their_float64_values(table):
+    """C-contiguous float32 rows are widened block by block in the binding, not copied by numpy
+    before the call: every call gives exactly what the same numbers in float64 give — whole
+    arrays past the parallel threshold, one float32 row against float64 rows, float32 u, a
+    float32 view that is not contiguous (numpy's copy), a masked float32 array without masked
+    entries, no rows."""
+    wi, wo = upper(N, 6).astype(np.float32), upper(N, 7).astype(np.float32)
+    u = np.random.default_rng(8).random((N, 2)).astype(np.float32)
+    w64 = lambda a: np.asarray(a, np.float64)  # noqa: E731
+    nm = np.array([450.0, 550.0, 650.0])
+    cases = [
+        (lambda a, b: table.eval(a, b), (wi, wo)),
+        (lambda a, b: table.pdf(a, b), (wi, wo)),
+        (lambda a, b: table.eval(a, b), (wi, w64(wo[5]))),
+        (lambda a, b: table.eval(a, b), (wi[3], w64(wo))),
+        (lambda a, b: table.eval_spectral(a, b, nm), (wi, wo)),
+        (lambda a, b: table.sample(a, b), (wo, u)),
+        (lambda a, b: table.sample(a, b), (wo[9], u)),
+        (lambda a, b: table.sample(a, b, nm=nm), (wo, u)),
+        (lambda a, b: table.sample(a, b, delta=True), (wo, u)),
+        (lambda a, b: table.eval(a, b), (wi[::2], wo[::2])),
+        (lambda a, b: table.eval(a, b), (np.ma.MaskedArray(wi), wo)),
+        (lambda a, b: table.eval(a, b), (wi[:0], wo[:0])),
+    ]
+    for k, (f, (a, b)) in enumerate(cases):
+        got, ref = f(a, b), f(w64(a), w64(b))
+        for g, r in zip(*[(x,) if isinstance(x, np.ndarray) else x for x in (got, ref)]):
+            assert g.dtype == r.dtype and g.shape == r.shape, k
+            np.testing.assert_array_equal(g, r, err_msg=f"case {k}")
+
+
 def test_a_single_row_broadcasts_like_its_repeat(table):
     """One row against many, past the block size and the parallel threshold: the same numbers
     as the row repeated (the binding repeats it per block, never n times)."""
@@ -137,6 +168,7 @@ n = 4_000_000
 rng = np.random.default_rng(1)
 wi = rng.normal(size=(n, 3)); wi[:, 2] = abs(wi[:, 2])
 wo = rng.normal(size=(n, 3)); wo[:, 2] = abs(wo[:, 2])
+wi, wo = wi.astype(sys.argv[2]), wo.astype(sys.argv[2])
 b.eval(wi[:10], wo[:10])
 def status(key):
     for line in open("/proc/self/status"):
@@ -155,9 +187,11 @@ print(peak - rss - max(status("RssFile") - file0, 0), f.nbytes)
 """
 
 
-def test_a_large_eval_needs_about_its_output(tmp_path):
+@pytest.mark.parametrize("dtype", ["float64", "float32"])
+def test_a_large_eval_needs_about_its_output(tmp_path, dtype):
     """4e6 pairs (inputs 192 MB, result 48 MB): the process grows by the result, not by
-    copies of the inputs (432 MB before the inputs were read in place). Measured in a fresh
+    copies of the inputs (432 MB before the inputs were read in place; float32 inputs, 96 MB,
+    grew it by their float64 copies, 192 MB, before they were read in place). Measured in a fresh
     process, whatever ran before in this one: the peak below stands for earlier tests (the
     Mitsuba plugin's, a large batch) that left this process with a high-water mark above the
     child's."""
@@ -165,11 +199,12 @@ def test_a_large_eval_needs_about_its_output(tmp_path):
     brdftab.bake(GGX, str(p), preset="small")
     peak = np.ones(600_000_000 // 8)  # 600 MB touched: this process's peak, above the child's
     del peak
-    r = subprocess.run([sys.executable, "-c", MEMORY, str(p)], capture_output=True, text=True,
-                       check=True)
+    r = subprocess.run([sys.executable, "-c", MEMORY, str(p), dtype], capture_output=True,
+                       text=True, check=True)
     growth, out = map(int, r.stdout.split())
     # The result (locally to 0.1 MB), plus slack: one CI run on a busy machine saw 49 MB more
     # in the whole RSS, not reproduced — file-backed pages of the 40 MB extension evicted and
     # faulted in again are the suspect, now subtracted; the slack stays in case it was
-    # something else. A copy of one input alone is 96 MB (the old binding grew by 432 MB).
+    # something else. A float64 copy of one input alone is 96 MB (the old binding grew by
+    # 432 MB; on float32 inputs by 240 MB).
     assert growth < out + 64e6, (growth, out)

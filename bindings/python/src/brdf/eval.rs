@@ -78,7 +78,8 @@ impl PyBrdf {
         let brdf = &self.inner;
         batch(py, n * k, || {
             brdftab::batch::blocks(o, k, |s, o| {
-                let (a, b) = p.block(s, o.len() / k.max(1));
+                let mut scratch = arrays::Scratch::default();
+                let (a, b) = p.block(s, o.len() / k.max(1), &mut scratch);
                 for (r, o) in o.chunks_exact_mut(k.max(1)).enumerate() {
                     let l = match per_row {
                         true => nm.index_axis(numpy::ndarray::Axis(0), s + r),

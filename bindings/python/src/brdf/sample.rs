@@ -32,8 +32,8 @@ type FlaggedBlock<'a> = (
 );
 
 /// `u` in [0, 1)², row by row: anything else (NaN included) is a `ValueError` naming the row.
-fn check_u(u: &[DVec2]) -> PyResult<()> {
-    for (k, u) in u.iter().enumerate() {
+fn check_u(u: &Rows<'_, DVec2>) -> PyResult<()> {
+    for (k, u) in (0..u.len()).map(|k| (k, u.row(k))) {
         if let Some(x) = [u.x, u.y].into_iter().find(|x| !(0.0..1.0).contains(x)) {
             return Err(PyValueError::new_err(format!(
                 "u: row {k}: {x} is outside [0, 1)"
@@ -74,7 +74,7 @@ impl PyBrdf {
         u: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyTuple>> {
         let (a, b) = (Rows::<DVec3>::new(wo, "wo")?, Rows::<DVec2>::new(u, "u")?);
-        check_u(b.as_slice())?;
+        check_u(&b)?;
         let p = Pairs::new(&a, "wo", &b, "u")?;
         let (n, c) = (p.n, self.c());
         let (s3, s1, sc): (&[usize], &[usize], &[usize]) = match p.single {
@@ -107,7 +107,8 @@ impl PyBrdf {
             None => {
                 let cw = c.max(1);
                 let go = |(k, ((wi, pd), w)): SampleBlock<'_>| {
-                    let (a, b) = p.block(k * BLOCK, pd.len());
+                    let mut scratch = arrays::Scratch::default();
+                    let (a, b) = p.block(k * BLOCK, pd.len(), &mut scratch);
                     brdf.sample_batch(
                         a,
                         b,
@@ -153,7 +154,7 @@ impl PyBrdf {
     ) -> PyResult<Py<PyTuple>> {
         use numpy::PyUntypedArrayMethods;
         let (a, b) = (Rows::<DVec3>::new(wo, "wo")?, Rows::<DVec2>::new(u, "u")?);
-        check_u(b.as_slice())?;
+        check_u(&b)?;
         let p = Pairs::new(&a, "wo", &b, "u")?;
         let (n, c) = (p.n, self.c());
         let l = nm.map(|x| arrays::f64_array(x, "nm")).transpose()?;
@@ -223,7 +224,8 @@ impl PyBrdf {
                 };
             }
             let go = |(s, (((wi, pd), w), d)): FlaggedBlock<'_>| {
-                let (a, b) = p.block(s * BLOCK, pd.len());
+                let mut scratch = arrays::Scratch::default();
+                let (a, b) = p.block(s * BLOCK, pd.len(), &mut scratch);
                 let mut nm = [0.0f64; brdftab::spectrum::MAX_CHANNELS];
                 for r in 0..pd.len() {
                     let w = &mut w[r * k..(r + 1) * k];
