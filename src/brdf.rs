@@ -442,8 +442,24 @@ pub fn check_batch(wi: &[DVec3], wo: &[DVec3], out: &[f32], c: usize) -> usize {
 /// [`Brdf::eval_wavelength`]'s default reads channels ([`Channels::mix_at`]): what a source whose
 /// spectral values come from its channels gives at a wavelength.
 pub fn mix_channels(channels: &Channels, v: &[f32], nm: &[f64], out: &mut [f32]) {
-    for (o, &x) in out.iter_mut().zip(nm) {
-        *o = channels.mix_at(x).apply(|i| v[i] as f64) as f32;
+    match (channels, v) {
+        // RGB (the common case: a pbrt-v4 renderer's four wavelengths on an RGB table): the
+        // basis read in line — the same arithmetic as `mix_at(x).apply`, bit for bit.
+        (Channels::Rgb, &[r, g, b, ..]) => {
+            let v = [r as f64, g as f64, b as f64];
+            for (o, &x) in out.iter_mut().zip(nm) {
+                let m = crate::spectrum::ChannelMix {
+                    index: [0, 1, 2],
+                    weight: crate::colour::rgb_basis_at(x),
+                };
+                *o = m.apply(|i| v[i]) as f32;
+            }
+        }
+        _ => {
+            for (o, &x) in out.iter_mut().zip(nm) {
+                *o = channels.mix_at(x).apply(|i| v[i] as f64) as f32;
+            }
+        }
     }
 }
 

@@ -110,6 +110,7 @@ impl Channels {
     /// How channel data gives a value at wavelength `nm`: for wavelengths, linear interpolation
     /// between the two channels around `nm` (the nearest end channel outside them); for RGB, the
     /// colour-preserving basis [`crate::colour::rgb_basis_at`].
+    #[inline]
     pub fn mix_at(&self, nm: f64) -> ChannelMix {
         match self {
             Channels::Rgb => ChannelMix {

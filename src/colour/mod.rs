@@ -59,6 +59,7 @@ struct Tables {
     basis: [[f64; 3]; N],
 }
 
+#[inline]
 fn tables() -> &'static Tables {
     static T: OnceLock<Box<Tables>> = OnceLock::new();
     T.get_or_init(|| {
@@ -242,6 +243,7 @@ fn solve6(mut a: [[f64; 6]; 6], mut b: [f64; 6]) -> [f64; 6] {
 /// `r w[0] + g w[1] + b w[2]`. The weights are ≥ 0 and sum to 1; they are interpolated linearly
 /// between 1 nm points and held at their end values outside [`RANGE_NM`] (NaN gives the short
 /// end's).
+#[inline]
 pub fn rgb_basis_at(nm: f64) -> [f64; 3] {
     let b = &tables().basis;
     let u = nm - RANGE_NM.0;
