@@ -127,10 +127,28 @@ impl Kernel {
         out: &mut [f32],
         values: &Packed,
     ) {
+        let c = self.channels.min(crate::spectrum::MAX_CHANNELS);
+        let (rows, w, (wp0, wp1)) = self.corners(v, c);
+        let weights = w.map(|w| (w * wp0, w * wp1));
+        self.blend_runs::<F16C, EXACT>(rows, weights, out, values)
+    }
+
+    /// The blend of [`Kernel::blend_lanes`] from the four (θh, θd) corner rows' offsets and
+    /// the weights of each row's two φd corners: shared by the one-pair path and the
+    /// eight-lane one ([`x8`]), so both compute the same operations.
+    ///
+    /// [`x8`]: super::x8
+    #[inline(always)]
+    pub(super) fn blend_runs<const F16C: bool, const EXACT: bool>(
+        &self,
+        rows: [usize; 4],
+        weights: [(f32, f32); 4],
+        out: &mut [f32],
+        values: &Packed,
+    ) {
         const RUNS: usize = crate::spectrum::MAX_CHANNELS.div_ceil(4);
         let c = self.channels.min(4 * RUNS);
         let runs = c.div_ceil(4);
-        let (rows, w, (wp0, wp1)) = self.corners(v, c);
         let mut acc = [F4::splat(0.0); RUNS];
         let n = values.len();
         let load = |r: usize| -> Option<F4> {
@@ -146,10 +164,10 @@ impl Kernel {
             }
             F4::from_f16_normal(x)
         };
-        for (r, w) in rows.iter().zip(w) {
+        for (r, (w0, w1)) in rows.iter().zip(weights) {
             // The reference's condition: both corners within the values.
             if *r + 2 * c <= n {
-                let (w0, w1) = (F4::splat(w * wp0), F4::splat(w * wp1));
+                let (w0, w1) = (F4::splat(w0), F4::splat(w1));
                 for (q, acc) in acc.iter_mut().enumerate().take(runs) {
                     if let (Some(a), Some(b)) = (load(r + 4 * q), load(r + c + 4 * q)) {
                         *acc = *acc + (w0 * a + w1 * b);

@@ -107,8 +107,8 @@ pub struct Kernel {
     calibration: Option<Calibration>,
     /// Values are read exact ([`Packed::exact`]): some axis is resampled.
     exact: bool,
-    /// [`Kernel::eval_x8`] runs: three channels, offsets within i32, and the CPU has AVX2 and
-    /// F16C (checked once, at construction).
+    /// [`Kernel::eval_x8`] runs: offsets within i32, and the CPU has AVX2 and F16C (checked
+    /// once, at construction).
     x8: bool,
 }
 
@@ -177,7 +177,9 @@ impl Kernel {
         let axes: [Axis; 3] = axes.try_into().ok()?;
         let channels = grid.channels().len();
         // The eight-lane path computes corner offsets in i32 lanes.
-        let x8 = channels == 3 && grid.stored_values() < (i32::MAX as usize) / 2 && x8::available();
+        let x8 = channels <= crate::spectrum::MAX_CHANNELS
+            && grid.stored_values() < (i32::MAX as usize) / 2
+            && x8::available();
         let per = |f: &dyn Fn(&Axis) -> f32| F4::new(f(&axes[0]), f(&axes[1]), f(&axes[2]), 0.0);
         let lanes = [
             per(&|a| a.k),
@@ -346,13 +348,17 @@ impl Kernel {
                 self.rgb::<false, false, false>(wi, wo, out, values)
             };
         }
-        let Some((v, cos)) = warp_vars(wi, wo, self.h_quarter_power, self.quarter) else {
+        // The RGB path's variables (the same values as `warp_vars`, tested; its one branch
+        // for unit and near-unit pairs).
+        let Some((v, _, cos)) = self.vars_lanes(wi, wo) else {
             out[..self.channels].fill(0.0);
             return true;
         };
-        if F4::new(v[0], v[1], v[2], 0.0).any_ge(self.cut) {
+        if v.any_ge(self.cut) {
             return false;
         }
+        let [v0, v1, v2, _] = v.to_array();
+        let v = [v0, v1, v2];
         // The calibration's cells first: they need only the cosines (see `rgb`).
         let cells = (self.calibration.as_ref()).map(|c| c.cells(cos[0], cos[1]));
         #[cfg(target_arch = "x86_64")]

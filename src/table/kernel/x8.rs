@@ -1,4 +1,5 @@
-//! Eight lookups at once: the kernel's RGB path with one pair per AVX2 lane.
+//! Eight lookups at once: the kernel's warp variables, knot lines, nodes and corner weights with
+//! one pair per AVX2 lane, then each pair's blend (RGB, or any channel count four at a time).
 //!
 //! Why: one lookup of a measured table is a chain of dependent steps — three square roots and a
 //! division for the warp variables, a knot line per axis, then the corner rows — about 180
@@ -12,7 +13,8 @@
 //!
 //! Every lane performs the IEEE operations of the one-pair path in the same order (no fused
 //! multiply-add), and the blend and its end are the one-pair path's own code
-//! ([`Kernel::blend_rows`], [`Kernel::finish_rgb`]), so the results are bit-equal to
+//! ([`Kernel::blend_rows`], [`Kernel::finish_rgb`]; for other channel counts
+//! [`Kernel::blend_runs`], the projection and the calibration), so the results are bit-equal to
 //! [`Kernel::eval`]'s (tested); the one-pair path stays the reference. Groups holding a pair
 //! the lanes do not take — a direction that is not unit length, a pair beyond a resampled
 //! axis's cut, a table too short for a corner — are left to the caller's one-pair loop.
@@ -20,7 +22,7 @@
 use glam::DVec3;
 
 #[cfg(target_arch = "x86_64")]
-use super::{Calibration, MIN_COS_PRODUCT, Quantity};
+use super::{Calibration, MIN_COS_PRODUCT, Quantity, project_f32_lanes};
 use super::{Kernel, Packed};
 #[cfg(target_arch = "x86_64")]
 use crate::simd::F4;
@@ -44,13 +46,14 @@ pub(super) fn available() -> bool {
 }
 
 impl Kernel {
-    /// Whether [`Kernel::eval_x8`] runs for this kernel on this CPU: an RGB table and a CPU with
-    /// AVX2 and F16C.
+    /// Whether [`Kernel::eval_x8`] runs for this kernel on this CPU: a CPU with AVX2 and F16C
+    /// (and corner offsets within i32).
     pub fn has_x8(&self) -> bool {
         self.x8
     }
 
-    /// Evaluates the first [`LANES`] pairs of `wi`, `wo` into `out[..3 · LANES]` (RGB per pair)
+    /// Evaluates the first [`LANES`] pairs of `wi`, `wo` into `out[..c · LANES]` (c channels per
+    /// pair)
     /// from the table's `values` ([`Packed::for_kernel`]), bit-equal to [`Kernel::eval`] pair by
     /// pair. Returns the lanes left to the caller's one-pair path (bit k: pair k; its output
     /// is unspecified): a direction that is not unit length (within
@@ -65,7 +68,7 @@ impl Kernel {
         if let (Some(wi), Some(wo), Some(out)) = (
             wi.first_chunk::<LANES>(),
             wo.first_chunk::<LANES>(),
-            out.first_chunk_mut::<{ 3 * LANES }>(),
+            out.get_mut(..self.channels * LANES),
         ) {
             // SAFETY: `x8` is set only when the CPU has AVX2 and F16C (`available`).
             return unsafe {
@@ -87,7 +90,7 @@ impl Kernel {
         &self,
         wi: &[DVec3; LANES],
         wo: &[DVec3; LANES],
-        out: &mut [f32; 3 * LANES],
+        out: &mut [f32],
         values: &Packed,
     ) -> u8 {
         use std::arch::x86_64::*;
@@ -204,7 +207,7 @@ impl Kernel {
                 _mm256_mullo_epi32(node[0], _mm256_set1_epi32(self.chunk as i32)),
                 _mm256_mullo_epi32(node[1], _mm256_set1_epi32(self.row as i32)),
             ),
-            _mm256_mullo_epi32(node[2], _mm256_set1_epi32(3)),
+            _mm256_mullo_epi32(node[2], _mm256_set1_epi32(self.channels as i32)),
         );
         let (mut o, mut inv) = ([0u32; LANES], [0f32; LANES]);
         sti(&mut o, offset);
@@ -215,7 +218,9 @@ impl Kernel {
         } else {
             values.bits.len()
         };
-        let reach = self.chunk + self.row + 7;
+        // (RGB: a row's two corners as two loads of four, the last at r + 3.)
+        let c = self.channels;
+        let reach = self.chunk + self.row + c + 4 * c.div_ceil(4);
         if o.iter().any(|&o| o as usize + reach > len) {
             return ALL;
         }
@@ -232,6 +237,35 @@ impl Kernel {
                 sti(&mut cell[side], j);
                 st(&mut frac[side], sub(s, _mm256_cvtepi32_ps(j)));
             }
+        }
+
+        if c != 3 {
+            // Any other channel count: `Kernel::eval`'s general path at the lanes' corners.
+            let (mut cos_i, mut cos_o) = ([0f32; LANES], [0f32; LANES]);
+            st(&mut cos_i, iz);
+            st(&mut cos_o, oz);
+            for (k, dst) in out.chunks_exact_mut(c).enumerate().take(LANES) {
+                if left & (1 << k) != 0 {
+                    continue;
+                }
+                if upper & (1 << k) == 0 {
+                    dst.fill(0.0);
+                    continue;
+                }
+                let cos = [cos_i[k], cos_o[k]];
+                let cells = (self.calibration.as_ref()).map(|c| c.cells(cos[0], cos[1]));
+                let o = o[k] as usize;
+                let rows = [o, o + self.row, o + self.chunk, o + self.chunk + self.row];
+                let weights = std::array::from_fn(|r| (p[r][k], p[4 + r][k]));
+                self.blend_runs::<true, EXACT>(rows, weights, dst, values);
+                if self.quantity != Quantity::Fr {
+                    project_f32_lanes(self.quantity, None, cos, dst);
+                }
+                if let (Some(cal), Some(cells)) = (&self.calibration, cells) {
+                    cal.apply_lanes_cells(cells, dst);
+                }
+            }
+            return left;
         }
 
         // Eight independent blends: the one-pair path's own.
@@ -381,7 +415,67 @@ mod tests {
             .unzip()
     }
 
+    /// RGB tables of every kind, and spectral ones (4, 5, 7 and 10 channels: whole and partial
+    /// runs of four) of the kinds that change the general path's end (quantity, calibration,
+    /// exact values).
     fn tables() -> Vec<(String, Table)> {
+        let mut out = rgb_tables();
+        let spectral = [
+            (
+                7,
+                (
+                    false,
+                    Quantity::FrCosOut,
+                    super::super::WarpVar::QuarterPower,
+                ),
+            ),
+            (
+                5,
+                (true, Quantity::FrCosCos, super::super::WarpVar::SqrtSine),
+            ),
+            (4, (false, Quantity::Fr, super::super::WarpVar::SqrtSine)),
+        ];
+        let sym = |reciprocal| Symmetry {
+            isotropic: true,
+            reciprocal,
+            bilateral: true,
+        };
+        let ggx_at = |c: usize| {
+            let ch = Channels::linspace(420.0, 680.0, c).unwrap();
+            let spec = r#"{"model": "ggx", "alpha": 0.05, "fresnel": {"conductor": "Au"}}"#;
+            (ModelSpec::parse(spec).unwrap().build(&ch).unwrap(), ch)
+        };
+        for (c, (reciprocal, quantity, h_var)) in spectral {
+            let (ggx, _) = ggx_at(c);
+            let opts = super::super::test_adaptive_options(quantity, h_var);
+            let grid = adaptive_grid(ggx.as_ref(), sym(reciprocal), &opts).unwrap();
+            let (t, _) = bake(ggx.as_ref(), &grid, &BakeOptions::default()).unwrap();
+            let name = format!("{c} channels, adaptive {quantity:?} {h_var:?}");
+            if quantity == Quantity::FrCosOut {
+                let f: Vec<f32> = (0..9 * c).map(|i| 0.9 + 0.02 * (i % 11) as f32).collect();
+                let o: Vec<f32> = f.iter().rev().copied().collect();
+                let cal = Calibration::new(f, Some(o), c, 0.95).unwrap();
+                let (g, v, _) = t.clone().into_parts();
+                let cal = Table::new(g.with_calibration(cal).unwrap(), v, "calibrated").unwrap();
+                out.push((format!("{name}, calibrated"), cal));
+            }
+            out.push((name, t));
+        }
+        let (ggx, ch) = ggx_at(10);
+        let grid = Grid::with_sizes(
+            Param::HalfDiff,
+            [16, 1, 16, 32],
+            [Mapping::Sqrt, Mapping::Cos],
+            ch,
+            sym(true),
+        )
+        .unwrap();
+        let (t, _) = bake(ggx.as_ref(), &grid, &BakeOptions::default()).unwrap();
+        out.push(("10 channels, resampled θd Cos".into(), t));
+        out
+    }
+
+    fn rgb_tables() -> Vec<(String, Table)> {
         let ggx = ModelSpec::parse(r#"{"model": "ggx", "alpha": 0.05}"#)
             .unwrap()
             .build(&Channels::Rgb)
@@ -445,7 +539,9 @@ mod tests {
             let k = Kernel::new(t.grid()).expect("every case has a kernel");
             let packed = Packed::for_kernel(&k, t.values());
             let peak = t.values().iter().fold(0f32, |m, &x| m.max(x.abs()));
-            let (mut a, mut b) = ([0f32; 3], [0f32; 3]);
+            let c = t.grid().channels().len();
+            let (mut a, mut b) = ([0f32; 16], [0f32; 16]);
+            let (a, b) = (&mut a[..c], &mut b[..c]);
             let mut rounded = 0;
             for _ in 0..5000 {
                 let wi = crate::geometry::uniform_hemisphere(r.next_dvec2());
@@ -455,10 +551,10 @@ mod tests {
                     wo.as_vec3().normalize().as_dvec3(),
                 );
                 rounded += usize::from(!crate::geometry::is_unit_l2(fi.length_squared()));
-                let fast = k.eval(fi, fo, &mut a, &packed);
-                let reference = k.eval(fi.normalize(), fo.normalize(), &mut b, &packed);
+                let fast = k.eval(fi, fo, a, &packed);
+                let reference = k.eval(fi.normalize(), fo.normalize(), b, &packed);
                 assert_eq!(fast, reference, "{name}: {fi} {fo}");
-                for c in 0..3 {
+                for c in 0..c {
                     assert!(
                         (a[c] - b[c]).abs() <= 1e-6 * b[c].abs() + 1e-7 * peak,
                         "{name}: {fi} {fo}: {a:?} against {b:?}"
@@ -472,7 +568,7 @@ mod tests {
             if available() {
                 // The eight-lane path takes them (it used to leave every such group to the
                 // one-pair path, whose general path normalized each: 4.5–5.5× slower batches).
-                let (mut left, mut lanes) = (0u32, [0f32; 3 * LANES]);
+                let (mut left, mut lanes) = (0u32, vec![0f32; c * LANES]);
                 for _ in 0..500 {
                     let gi: Vec<DVec3> = (0..LANES)
                         .map(|_| crate::geometry::uniform_hemisphere(r.next_dvec2()))
@@ -499,12 +595,13 @@ mod tests {
             let k = Kernel::new(t.grid()).expect("every case has a kernel");
             let packed = Packed::for_kernel(&k, t.values());
             assert_eq!(k.has_x8(), available(), "{name}");
+            let c = t.grid().channels().len();
             let (mut taken, mut left) = (0usize, 0usize);
-            let mut lanes = [0f32; 3 * LANES];
+            let mut lanes = vec![0f32; c * LANES];
+            let mut one = vec![0f32; c];
             for (gi, go) in wi.chunks_exact(LANES).zip(wo.chunks_exact(LANES)) {
                 let mask = k.eval_x8(gi, go, &mut lanes, &packed);
                 for j in 0..LANES {
-                    let mut one = [0f32; 3];
                     let fast = k.eval(gi[j], go[j], &mut one, &packed);
                     if mask & (1 << j) != 0 {
                         left += 1;
@@ -512,10 +609,10 @@ mod tests {
                     }
                     taken += 1;
                     assert!(fast, "{name}: a pair the one-pair path leaves was taken");
-                    let got: [f32; 3] = lanes[3 * j..3 * j + 3].try_into().unwrap();
+                    let got = &lanes[c * j..c * (j + 1)];
                     assert_eq!(
-                        got.map(f32::to_bits),
-                        one.map(f32::to_bits),
+                        got.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                        one.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
                         "{name}: {} {}: {got:?} vs {one:?}",
                         gi[j],
                         go[j]
@@ -534,15 +631,14 @@ mod tests {
             // the one-pair values, remainder included.
             let tb = TabulatedBrdf::from_table(t);
             let n = wi.len() - 5;
-            let mut batch = vec![0f32; 3 * n];
+            let mut batch = vec![0f32; c * n];
             tb.eval_batch(&wi[..n], &wo[..n], &mut batch);
             for j in 0..n {
-                let mut one = [0f32; 3];
                 tb.eval(wi[j], wo[j], &mut one);
-                let got: [f32; 3] = batch[3 * j..3 * j + 3].try_into().unwrap();
+                let got = &batch[c * j..c * (j + 1)];
                 assert_eq!(
-                    got.map(f32::to_bits),
-                    one.map(f32::to_bits),
+                    got.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                    one.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
                     "{name}: pair {j}"
                 );
             }
