@@ -8,6 +8,8 @@
 //! - An output must not be one of the command's inputs ([`refuse_input`]): `convert p.bsdf
 //!   p.bsdf` would replace a measurement with its lossy resample. Files are compared by device
 //!   and inode (a symlink, a hard link or another spelling of the same path is caught too).
+//! - An output must be absent or a regular file ([`check_output`]): the rename of an atomic
+//!   write would replace a FIFO or a device (as root, `/dev/null` itself) with a plain file.
 //! - Outputs are written atomically through a temporary file beside them ([`temp_path`],
 //!   [`write_atomic`]); an output directory that does not exist is reported with the user's
 //!   path, and temporary files that killed writers left behind are removed by the next write.
@@ -112,17 +114,53 @@ pub fn refuse_input(output: &Path, inputs: &[&str]) -> Result<()> {
     Ok(())
 }
 
+/// An output path must name a file that is absent or a regular file (links followed): a write
+/// goes to a new file renamed over `path`, which would replace a named pipe, a device (as
+/// root, `/dev/null` itself) or a socket with a plain file, and a directory cannot be replaced.
+/// Checked by [`temp_path`], so by every writer, and by tools before long work.
+///
+/// # Errors
+/// [`Error::Unsupported`] naming `path` and what it is.
+pub fn check_output(path: &Path) -> Result<()> {
+    if path.as_os_str().is_empty() {
+        return Err(Error::Unsupported(
+            "an empty output path: name the file to write".into(),
+        ));
+    }
+    let kind = match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => return Ok(()),
+        Ok(m) => kind_name(&m.file_type()),
+        Err(_) if path.file_name().is_none() => "a directory",
+        Err(_) => return Ok(()),
+    };
+    Err(Error::Unsupported(match kind {
+        "a directory" => format!("{}: is a directory (name a file to write)", path.display()),
+        _ => format!(
+            "{}: is {kind}, not a regular file: an output written there would replace it or \
+             block on it (name a regular file)",
+            path.display()
+        ),
+    }))
+}
+
 /// The temporary file an atomic write of `path` goes through: `.NAME.tmp.PID.NANOS` in the
 /// same directory (so the final rename stays on one file system).
 ///
-/// Checks first that the directory exists, so that error names the user's path and not the
-/// temporary file, and removes the temporary files of `path` that earlier writers killed before
-/// they could clean up left behind (on Linux: those whose PID is no longer running).
+/// Checks first that `path` may be written ([`check_output`]) and that the directory exists,
+/// so those errors name the user's path and not the temporary file, and removes the temporary
+/// files of `path` that earlier writers killed before they could clean up left behind (on
+/// Linux: those whose PID is no longer running).
 pub fn temp_path(path: &Path) -> Result<PathBuf> {
+    check_output(path)?;
     let dir = parent(path);
     let fname = path
         .file_name()
-        .ok_or_else(|| Error::arg("path", format!("{} has no file name", path.display())))?
+        .ok_or_else(|| {
+            Error::Unsupported(format!(
+                "{}: names no file (an output must name a file)",
+                path.display()
+            ))
+        })?
         .to_string_lossy()
         .into_owned();
     check_dir(path, &dir)?;
@@ -232,6 +270,33 @@ fn parent(p: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn outputs_must_be_absent_or_regular_files() {
+        let d = std::env::temp_dir().join(format!("brdftab-out-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let f = d.join("f");
+        assert!(check_output(&f).is_ok()); // absent
+        std::fs::write(&f, b"x").unwrap();
+        assert!(check_output(&f).is_ok());
+        for p in [d.as_path(), Path::new(""), Path::new("/dev/null")] {
+            let e = check_output(p).unwrap_err().to_string();
+            assert!(
+                e.contains("not a regular file") || e.contains("directory") || e.contains("empty"),
+                "{e}"
+            );
+        }
+        // Every atomic writer goes through `temp_path`: a FIFO stays one.
+        let fifo = d.join("pipe");
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: a valid NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let e = write_atomic(&fifo, b"x").unwrap_err().to_string();
+        assert!(e.contains("is a FIFO, not a regular file"), "{e}");
+        use std::os::unix::fs::FileTypeExt;
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
 
     #[test]
     fn directories_are_refused_and_missing_files_pass() {

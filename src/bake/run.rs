@@ -30,6 +30,9 @@ impl BakeRequest {
     /// [`run`](Self::run), reporting progress.
     pub fn run_with(&self, target: &BakeTarget, progress: &dyn Progress) -> Result<BakeReport> {
         self.validate()?;
+        // An output that is not a regular file (a FIFO, a device, a directory), before any
+        // work and before a database there is read.
+        crate::files::check_output(&crate::files::resolve_links(Path::new(target.path()))?)?;
         self.refuse_overwrite(target)?;
         let name = match (target, &self.name) {
             (BakeTarget::Db { name, .. }, _) => name.clone(),

@@ -24,6 +24,9 @@ pub struct Lock {
 /// link's is its target's.
 pub fn lock(path: &Path) -> Result<Lock> {
     let path = &crate::files::resolve_links(path)?;
+    // A database is written through a new file renamed over it: a pipe or a device there is
+    // refused before the lock, in output terms.
+    crate::files::check_output(path)?;
     let name = path
         .file_name()
         .ok_or_else(|| Error::arg("DB", format!("{} has no file name", path.display())))?

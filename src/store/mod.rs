@@ -62,6 +62,7 @@ use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
+pub use crate::files::check_output;
 use format::{ChunkEntry, Superblock, Toc};
 pub use format::{Source, TableHeader, TocEntry};
 pub use writer::Writer;

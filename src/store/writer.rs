@@ -46,7 +46,7 @@ impl Writer {
             .write(true)
             .create_new(true)
             .open(&tmp)
-            .map_err(|e| Error::io(&tmp, e))?;
+            .map_err(|e| Error::io(&path, e))?;
         let mut w = Writer {
             path,
             tmp,
@@ -62,7 +62,7 @@ impl Writer {
     fn write(&mut self, b: &[u8]) -> Result<u64> {
         let at = self.pos;
         let out = self.out.as_mut().expect("writer is open");
-        out.write_all(b).map_err(|e| Error::io(&self.tmp, e))?;
+        out.write_all(b).map_err(|e| Error::io(&self.path, e))?;
         self.pos += b.len() as u64;
         Ok(at)
     }
@@ -247,7 +247,7 @@ impl Writer {
             file_len: self.pos,
         };
         let mut out = self.out.take().expect("writer is open");
-        let io = |e| Error::io(&self.tmp, e);
+        let io = |e| Error::io(&self.path, e);
         out.flush().map_err(io)?;
         let mut f = out.into_inner().map_err(|e| io(e.into_error()))?;
         f.seek(SeekFrom::Start(0)).map_err(io)?;

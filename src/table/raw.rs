@@ -57,12 +57,12 @@ impl RawWriter {
             source: e,
         })?;
         let tmp = crate::files::temp_path(&path)?;
-        let f = std::fs::File::create(&tmp).map_err(|e| Error::io(&tmp, e))?;
+        let f = std::fs::File::create(&tmp).map_err(|e| Error::io(&path, e))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
         let mut head = MAGIC.to_vec();
         head.extend_from_slice(&(header.len() as u64).to_le_bytes());
         head.extend_from_slice(&header);
-        w.write_all(&head).map_err(|e| Error::io(&tmp, e))?;
+        w.write_all(&head).map_err(|e| Error::io(&path, e))?;
         Ok(RawWriter {
             tmp,
             path,
@@ -83,7 +83,7 @@ impl RawWriter {
             self.bytes.extend(part.iter().flat_map(|v| v.to_le_bytes()));
             self.w
                 .write_all(&self.bytes)
-                .map_err(|e| Error::io(&self.tmp, e))?;
+                .map_err(|e| Error::io(&self.path, e))?;
         }
         Ok(())
     }
@@ -97,7 +97,7 @@ impl RawWriter {
                 format!("{} values missing", self.remaining),
             ));
         }
-        self.w.flush().map_err(|e| Error::io(&self.tmp, e))?;
+        self.w.flush().map_err(|e| Error::io(&self.path, e))?;
         std::fs::rename(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))
     }
 }

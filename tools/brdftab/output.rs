@@ -6,9 +6,11 @@ use std::path::Path;
 use brdftab::{Error, Result};
 
 /// Refuses `path` (given as `flag`) unless it ends in one of `exts` (lowercase, no dot; any
-/// case matches) and its directory exists.
+/// case matches), its directory exists and it is absent or a regular file
+/// ([`brdftab::store::check_output`]: a named pipe would block the write, a device be replaced).
 pub fn check(path: impl AsRef<Path>, flag: &str, exts: &[&str]) -> Result<()> {
     let path = path.as_ref();
+    brdftab::store::check_output(path)?;
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());

@@ -137,6 +137,68 @@ fn a_fifo_or_a_directory_as_source_is_refused_at_once() {
     assert!(!r.ok && r.stderr.contains("a FIFO"), "{}", r.stderr);
 }
 
+/// An output that is a FIFO (or a directory) is refused at once by every writer, before any
+/// work, and left as it is: the atomic rename used to replace a FIFO (as root, `/dev/null`
+/// itself) with a plain file, and the image writers blocked on it until killed.
+#[test]
+fn a_fifo_or_a_directory_as_output_is_refused_and_kept() {
+    let d = TempDir::new("hostile-fifo-out");
+    let (good, _) = good_and_bad(d.path());
+    let rgl = brdftab::measured::data::rgl_dir().expect("data/rgl ships");
+    let pw = rgl.join("paper_white_rgb.bsdf");
+    let lam = r#"{"model": "lambert", "kd": 0.3}"#;
+    let npy = d.join("v.npy");
+    let r = brdftab(&["export", s(&good), "--npy", s(&npy)]);
+    assert!(r.ok, "{}", r.stderr);
+    for name in [
+        "t.btdb", "t.npy", "t.png", "t.exr", "t.bsdf", "t.binary", "db.btdb",
+    ] {
+        let fifo = d.join(name);
+        let c = std::ffi::CString::new(s(&fifo)).unwrap();
+        // SAFETY: a valid NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let f = s(&fifo);
+        let args: Vec<Vec<&str>> = match name {
+            "t.btdb" => vec![
+                vec!["bake", lam, "--preset", "small", "-o", f],
+                vec!["import", s(&npy), "--like", s(&good), "-o", f],
+            ],
+            "t.npy" => vec![vec!["export", s(&good), "--npy", f]],
+            "t.png" => vec![
+                vec!["render", lam, "--size", "16", "--spp", "1", "-o", f],
+                vec!["slice", lam, "-o", f],
+            ],
+            "t.exr" => vec![vec!["export", s(&good), "--exr", f, "--slice", "0,2"]],
+            "t.bsdf" => vec![vec!["convert", s(&pw), f, "--pairs", "0"]],
+            "t.binary" => vec![vec!["convert", lam, f]],
+            _ => vec![vec![
+                "db", "add", f, lam, "--name", "a", "--preset", "small",
+            ]],
+        };
+        for a in args {
+            let t0 = Instant::now();
+            let r = brdftab(&a);
+            assert!(
+                !r.ok && r.stderr.contains("is a FIFO, not a regular file"),
+                "{a:?}: {}",
+                r.stderr
+            );
+            assert!(t0.elapsed() < Duration::from_secs(20), "{a:?} was slow");
+            let m = std::fs::symlink_metadata(&fifo).unwrap();
+            use std::os::unix::fs::FileTypeExt;
+            assert!(m.file_type().is_fifo(), "{a:?} replaced the FIFO");
+        }
+    }
+    let r = brdftab(&["bake", lam, "--preset", "small", "-o", s(d.path())]);
+    assert!(!r.ok && r.stderr.contains("is a directory"), "{}", r.stderr);
+    let r = brdftab(&["bake", lam, "--preset", "small", "-o", ""]);
+    assert!(
+        !r.ok && r.stderr.contains("empty output path"),
+        "{}",
+        r.stderr
+    );
+}
+
 #[test]
 fn an_output_that_is_the_input_is_refused_and_the_input_kept() {
     let d = TempDir::new("hostile-same");
