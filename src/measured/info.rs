@@ -1,7 +1,10 @@
 //! What `brdftab info` says of a measured file (MERL `.binary`, RGL `.bsdf`), as text every host
-//! can show: description, dimensions, channels, sha256.
+//! can show ([`describe`]) and as JSON (`info --json`, Python `brdftab.info`: [`info`]):
+//! description, dimensions, channels, sha256.
 
 use std::fmt::Write as _;
+
+use serde_json::{Value, json};
 
 use super::{MerlBrdf, RglBrdf, merl, tensor::TensorFile};
 use crate::brdf::Brdf;
@@ -18,6 +21,56 @@ pub fn describe(path: &str) -> Result<String> {
         Err(Error::Unsupported(format!(
             "{path}: not a measured file (.binary, .bsdf)"
         )))
+    }
+}
+
+/// [`describe`] as JSON: `file`, `format` (`merl` or `rgl`), `bytes`, `channels`, `sha256`,
+/// and per format: MERL `material` (the published name, or null), `dims` (θh, θd, φd),
+/// `unmeasured` and `cells`; RGL `description`, `kind`, `isotropic`, `reduction`, `phi_i`,
+/// `theta_i`, `resolution`, `vndf_resolution` and `fields` (name, type, offset).
+pub fn info(path: &str) -> Result<Value> {
+    let lower = path.to_ascii_lowercase();
+    if lower.ends_with(".binary") {
+        let sha = merl::sha256_file(path)?;
+        let m = MerlBrdf::open(path)?;
+        Ok(json!({
+            "file": path,
+            "format": "merl",
+            "bytes": merl::FILE_SIZE,
+            "material": merl::material_of(&sha),
+            "dims": [merl::RES_THETA_H, merl::RES_THETA_D, merl::RES_PHI_D],
+            "channels": m.channels().names(),
+            "unmeasured": m.invalid_cells(),
+            "cells": merl::SAMPLES,
+            "sha256": sha,
+        }))
+    } else if lower.ends_with(".bsdf") {
+        let t = TensorFile::open(path)?;
+        let b = RglBrdf::from_tensor(&t, None)?;
+        let s = b.summary();
+        let fields: Vec<Value> = t
+            .fields()
+            .iter()
+            .map(|f| json!({"name": f.name, "type": f.describe(), "offset": f.offset}))
+            .collect();
+        Ok(json!({
+            "file": path,
+            "format": "rgl",
+            "bytes": t.size(),
+            "description": s.description,
+            "kind": s.kind,
+            "isotropic": s.isotropic,
+            "reduction": s.reduction,
+            "phi_i": s.phi_i,
+            "theta_i": s.theta_i,
+            "resolution": [s.resolution.0, s.resolution.1],
+            "vndf_resolution": [s.vndf_resolution.0, s.vndf_resolution.1],
+            "channels": b.channels().names(),
+            "fields": fields,
+            "sha256": b.sha256(),
+        }))
+    } else {
+        describe(path).map(|_| Value::Null)
     }
 }
 

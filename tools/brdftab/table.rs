@@ -19,12 +19,17 @@ pub struct InfoArgs {
     json: bool,
 }
 
-/// `brdftab info`: measured files as text, brdftab and raw files as JSON or text.
+/// `brdftab info`: measured, brdftab and raw files as text or JSON.
 pub fn info(a: InfoArgs) -> Result<()> {
     if matches!(
         source::kind(&a.file),
         source::Kind::Merl | source::Kind::Rgl
     ) {
+        if a.json {
+            let v = brdftab::measured::info::info(&a.file)?;
+            let json = serde_json::to_string_pretty(&v).unwrap_or_default();
+            return print_out(&format!("{json}\n"));
+        }
         return print_out(&brdftab::measured::info::describe(&a.file)?);
     }
     let (v, text): (_, fn(&serde_json::Value) -> String) =

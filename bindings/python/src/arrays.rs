@@ -317,8 +317,8 @@ impl<'a, T: Row> View<'a, T> {
     }
 }
 
-/// Two row sets paired for a call: the same count, or one row against many (broadcast, the
-/// single row repeated into a block-sized buffer: no n-sized copy).
+/// Two row sets paired for a call: the same count, or one row — `(W,)` or `(1, W)` — against
+/// many (broadcast, the single row repeated into a block-sized buffer: no n-sized copy).
 pub(crate) struct Pairs<'a, A, B> {
     a: View<'a, A>,
     b: View<'a, B>,
@@ -344,10 +344,11 @@ impl<'a, A: Row, B: Row> Pairs<'a, A, B> {
         bn: &str,
     ) -> PyResult<Self> {
         let (na, nb) = (a.len(), b.len());
-        let n = match (a.single, b.single) {
-            (true, false) => nb,
-            (false, true) => na,
+        // numpy's rule: one row — shape (W,) or (1, W) — against any number.
+        let n = match (na, nb) {
             _ if na == nb => na,
+            (1, _) => nb,
+            (_, 1) => na,
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "{an} and {bn}: {na} and {nb} rows; expected the same number (or one row)"

@@ -18,6 +18,16 @@ pub(crate) fn rgb_basis<'py>(
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     guard(|| {
         let nm = f64_array(nm, "nm")?;
+        // The rule of every host's wavelengths (`eval_spectral`, the C ABI).
+        if let Some(x) = nm
+            .as_array()
+            .iter()
+            .find(|&&x| !brdftab::spectrum::is_wavelength(x))
+        {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "nm: {x} is not a wavelength (a finite number of nm > 0)"
+            )));
+        }
         let mut shape = nm.shape().to_vec();
         shape.push(3);
         let out = zeros::<f64>(py, &shape)?;

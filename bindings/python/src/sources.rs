@@ -73,16 +73,19 @@ pub(crate) fn check(
     })
 }
 
-/// What `brdftab info --json` reports of a brdftab file (`FILE`) or one table (`DB#NAME`).
+/// What `brdftab info --json` reports of a brdftab file (`FILE`), one table (`DB#NAME`) or a
+/// measured file (MERL `.binary`, RGL `.bsdf`).
 #[pyfunction]
 pub(crate) fn info(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
     guard(|| {
         let source = text_arg(source, "source")?;
         let source = source.as_str();
-        to_py(
-            py,
-            &brdftab::store::info::file_info(source).map_err(lib_err)?,
-        )
+        use brdftab::SourceKind;
+        let v = match brdftab::classify(source) {
+            SourceKind::Merl | SourceKind::Rgl => brdftab::measured::info::info(source),
+            _ => brdftab::store::info::file_info(source),
+        };
+        to_py(py, &v.map_err(lib_err)?)
     })
 }
 

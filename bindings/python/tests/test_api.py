@@ -253,6 +253,13 @@ def test_paths_may_be_pathlike(tmp_path, paper):
         brdftab.open(_BytesPath(paper))
 
 
+def test_info_describes_measured_files_as_the_cli_does(cli, paper):
+    """brdftab.info on an RGL file: the CLI's `info --json` (it used to raise "wrong magic")."""
+    got = brdftab.info(paper)
+    assert got["format"] == "rgl" and got["description"] == "White A4 paper (160 gsm)"
+    assert json.loads(cli("info", paper, "--json")) == got
+
+
 class _BytesPath:
     """An os.PathLike whose path is bytes (not supported: sources are text)."""
 

@@ -100,6 +100,11 @@ def test_a_single_row_broadcasts_like_its_repeat(table):
     one = wo[17]
     rep = np.repeat(one[None, :], N, axis=0)
     np.testing.assert_array_equal(table.eval(wi, one), table.eval(wi, rep))
+    # One row of shape (1, 3) broadcasts as (3,) does (numpy's rule; it used to be refused
+    # with a message that offered "or one row").
+    np.testing.assert_array_equal(table.eval(wi, one[None, :]), table.eval(wi, rep))
+    np.testing.assert_array_equal(table.eval(one[None, :], wi), table.eval(rep, wi))
+    assert table.eval(one[None, :], one).shape == (1, 3)
     np.testing.assert_array_equal(table.eval(one, wi), table.eval(rep, wi))
     np.testing.assert_array_equal(table.pdf(wi, one), table.pdf(wi, rep))
     u = np.random.default_rng(5).random((N, 2))

@@ -49,7 +49,11 @@ def test_rgb_basis_makes_spectra_of_the_primaries_colours():
     for k in range(3):
         np.testing.assert_allclose(mi_srgb(b[:, k]), np.eye(3)[k], atol=TOL)
     # any shape in, that shape + (3,) out; held at the ends outside 360-830 nm
-    assert brdftab.rgb_basis(np.zeros((2, 5))).shape == (2, 5, 3)
+    assert brdftab.rgb_basis(np.full((2, 5), 500.0)).shape == (2, 5, 3)
+    # what is not a wavelength is refused, as eval_spectral and the C ABI refuse it
+    for bad in [0.0, -5.0, np.nan, np.inf]:
+        with pytest.raises(ValueError, match="not a wavelength"):
+            brdftab.rgb_basis([500.0, bad])
     np.testing.assert_array_equal(brdftab.rgb_basis(200.0), b[0])
     np.testing.assert_array_equal(brdftab.rgb_basis([1e4]), b[-1:])
 

@@ -64,6 +64,25 @@ fn info_eval_slice_convert() {
     assert!(r.ok, "{}", r.stderr);
     assert!(r.stdout.contains("material:    unknown"), "{}", r.stdout);
 
+    // `--json` on measured files (it used to print the text): the same facts.
+    let j = |file: &str| -> serde_json::Value {
+        let r = brdftab(&["info", file, "--json"]);
+        assert!(r.ok, "{}", r.stderr);
+        serde_json::from_str(&r.stdout).unwrap_or_else(|e| panic!("{e}: {}", r.stdout))
+    };
+    let v = j(&f);
+    assert_eq!(v["format"], "rgl");
+    assert_eq!(v["description"], "White A4 paper (160 gsm)");
+    assert_eq!(
+        v["sha256"],
+        "9d641fbb56358275509b2b1053d1002313e2dabc7b3ec202eb5c5a6943f7b70e"
+    );
+    assert_eq!(v["channels"], serde_json::json!(["R", "G", "B"]));
+    let v = j(bin.to_str().unwrap());
+    assert_eq!(v["format"], "merl");
+    assert_eq!(v["material"], serde_json::Value::Null);
+    assert_eq!(v["dims"], serde_json::json!([90, 90, 180]));
+
     // A truncated file is an error with the file name, exit code 1, no panic.
     let bad = dir.join("bad.bsdf");
     std::fs::write(&bad, &std::fs::read(&f).unwrap()[..500]).unwrap();

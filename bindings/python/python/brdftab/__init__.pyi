@@ -206,14 +206,18 @@ def rgb_basis(nm: _ArrayLike) -> npt.NDArray[np.float64]:
     """The weights of R, G, B at wavelengths `nm` (nm; result shape: nm's + (3,)): RGB data
     (r, g, b) at a wavelength is r w[0] + g w[1] + b w[2], as `Brdf.eval_spectral` reads an RGB
     source. Weights >= 0 summing to 1; the spectrum they make projects (CIE 1931 2°, D65,
-    linear sRGB) to the RGB it came from, so colour survives a spectral renderer."""
+    linear sRGB) to the RGB it came from, so colour survives a spectral renderer. A value that
+    is not a wavelength (a finite number > 0) is a ValueError."""
 def check(source: str | PathLike[str], *, wavelengths: _Wavelengths = None) -> dict[str, Any]:
     """The plausibility report of SOURCE as a dict with the keys of `brdftab check --json`."""
 def info(source: str | PathLike[str]) -> dict[str, Any]:
     """What `brdftab info --json` reports of a table file (or, for DB#NAME, of one table): "file", "format", "bytes", "ratio_to_f32"
     and "tables", one dict per table with "name", "source", "parameterization", "symmetry",
     "channels", "units", "codec", "tool", "shape", "values", "chunks", "bytes", "ratio_to_f32",
-    "sampling_bytes", "quantity" (what the stored values are) and "calibrated"."""
+    "sampling_bytes", "quantity" (what the stored values are) and "calibrated". Of a measured
+    file (MERL .binary, RGL .bsdf): "file", "format" ("merl" or "rgl"), "bytes", "channels",
+    "sha256", and MERL "material", "dims", "unmeasured", "cells" or RGL "description", "kind",
+    "isotropic", "reduction", "phi_i", "theta_i", "resolution", "vndf_resolution", "fields"."""
 def bake(
     source: str | PathLike[str],
     output: str | PathLike[str],

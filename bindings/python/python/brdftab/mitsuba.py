@@ -9,7 +9,8 @@ Properties: ``source`` (string, any SOURCE: spec, table, ``DB#NAME``, MERL, RGL;
 ``filename``, the name Mitsuba's own file-reading plugins such as ``measured`` use), optional
 ``interp`` (``"auto"``, the default: nearest on tables of MERL cells as every host of the
 library reads them, linear otherwise; or ``"linear"`` or ``"nearest"``), and for JIT variants optional ``preset`` / ``grid``
-(the table a non-table source is baked on; default: for an isotropic model the smallest
+(the table a non-table source is baked on — given with a table source they are an error in
+every variant; default: for an isotropic model the smallest
 adaptive grid within :data:`MODEL_TARGET_ERROR`, calibrated to the model's albedo, for other
 models the library's default bake — the ``medium`` preset, calibrated where its albedo misses
 the model's by over 1 % (Ward's anisotropic lobes at the horizon); RGL files: the library's adaptive grid, MERL files: their own cells),
@@ -197,6 +198,15 @@ class _Common:
                 "brdftab plugin: the string property `source` (or `filename`) is required"
             )
         src = _resolve(src)
+        given = [k for k in ("preset", "grid") if _prop(props, k) is not None]
+        if given and brdftab_kind(src) == "table":
+            # The JIT variants baked the table again from itself (a resample) where the scalar
+            # ones read it as stored: one scene, two materials. Refused in both.
+            raise ValueError(
+                f"brdftab plugin: {src} is a table, evaluated as it is stored; `{given[0]}` "
+                "chooses the table a non-table source is baked on (bake the table again with "
+                "brdftab.bake to change its grid)"
+            )
         self.source = src
         self.interp = str(_prop(props, "interp", "auto"))
         self.spectral = mi.is_spectral
