@@ -54,7 +54,13 @@ impl Channels {
         }
         for (i, &w) in nm.iter().enumerate() {
             if !is_wavelength(w) {
-                return Err(Error::arg("wavelengths", format!("wavelength {i} is {w}")));
+                return Err(Error::arg(
+                    "wavelengths",
+                    format!(
+                        "{w} (item {} of the list) is not a wavelength (a finite number of nm > 0)",
+                        i + 1
+                    ),
+                ));
             }
             if i > 0 && w <= nm[i - 1] {
                 return Err(Error::arg(

@@ -66,7 +66,13 @@ pub fn codec(
             ));
         }
     }
-    let quant = Quant::parse(name.trim(), tolerance.or(tol), floor)?;
+    let quant = Quant::parse(name.trim(), tolerance.or(tol), floor).map_err(|e| match e {
+        // A tolerance written into the codec (`log16:0`) is the codec's field.
+        Error::InvalidArgument { name: f, msg } if f == "codec_tolerance" && tol.is_some() => {
+            Error::arg("codec", msg)
+        }
+        e => e,
+    })?;
     let level = level.unwrap_or(quant.default_level());
     if !(1..=22).contains(&level) {
         return Err(Error::arg(
@@ -108,6 +114,13 @@ mod tests {
         assert_eq!(field(codec("f32", None, Some(1e-3), None, false)), "floor");
         assert_eq!(field(codec("f16", None, Some(1e-3), None, false)), "floor");
         assert_eq!(field(codec("zip:1e-2", None, None, None, false)), "codec");
+        // A tolerance out of range written into the codec is the codec's (`--codec log16:0`
+        // was reported as `--codec-tolerance`); given on its own, the tolerance's.
+        assert_eq!(field(codec("log16:0", None, None, None, false)), "codec");
+        assert_eq!(
+            field(codec("log16", Some(0.0), None, None, false)),
+            "codec_tolerance"
+        );
         let q = |r: Result<Codec>| r.unwrap().quant;
         assert_eq!(
             q(codec("log16:1e-2", None, Some(1e-6), None, false)),

@@ -682,9 +682,10 @@ mod tests {
             codec: Some("log16:0".into()),
             ..Default::default()
         };
+        // A tolerance written into the codec is the codec field's error.
         assert!(matches!(
             req.request("x.json"),
-            Err(Error::InvalidArgument { ref name, .. }) if name == "codec_tolerance"
+            Err(Error::InvalidArgument { ref name, .. }) if name == "codec"
         ));
     }
 

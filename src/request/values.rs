@@ -64,18 +64,32 @@ impl TryFrom<NumbersOrText> for Wavelengths {
 #[serde(try_from = "NumberOrText", into = "f64")]
 pub struct ErrorTarget(pub f64);
 
+/// What is wrong with a written value, without the field's name: the parsers that report it
+/// (the settings' `from_value`, a command line's flag) name the field or flag themselves, so
+/// the message says it once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BadValue(pub String);
+
+impl std::fmt::Display for BadValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for BadValue {}
+
 impl std::str::FromStr for ErrorTarget {
-    type Err = Error;
+    type Err = BadValue;
 
     /// `0.5%` or `0.005`.
-    fn from_str(s: &str) -> Result<ErrorTarget> {
+    fn from_str(s: &str) -> std::result::Result<ErrorTarget, BadValue> {
         let t = s.trim();
         let (num, scale) = match t.strip_suffix('%') {
             Some(n) => (n.trim(), 0.01),
             None => (t, 1.0),
         };
-        let x = num.parse::<f64>().map_err(|_| bad_target(s))?;
-        ErrorTarget::new(x * scale).map_err(|_| bad_target(s))
+        let x = num.parse::<f64>().map_err(|_| bad_target_msg(s))?;
+        ErrorTarget::new(x * scale).map_err(|_| bad_target_msg(s))
     }
 }
 
@@ -91,10 +105,13 @@ impl ErrorTarget {
 }
 
 fn bad_target(s: &str) -> Error {
-    Error::arg(
-        "target_error",
-        format!("`{s}`: expected a positive error such as 0.5% or 0.005"),
-    )
+    Error::arg("target_error", bad_target_msg(s).0)
+}
+
+fn bad_target_msg(s: &str) -> BadValue {
+    BadValue(format!(
+        "`{s}`: expected a positive error such as 0.5% or 0.005"
+    ))
 }
 
 impl From<ErrorTarget> for f64 {
@@ -112,10 +129,12 @@ enum NumberOrText {
 }
 
 impl TryFrom<NumberOrText> for ErrorTarget {
-    type Error = Error;
-    fn try_from(v: NumberOrText) -> Result<ErrorTarget> {
+    type Error = BadValue;
+    fn try_from(v: NumberOrText) -> std::result::Result<ErrorTarget, BadValue> {
         match v {
-            NumberOrText::Number(x) => ErrorTarget::new(x),
+            NumberOrText::Number(x) => {
+                ErrorTarget::new(x).map_err(|_| bad_target_msg(&x.to_string()))
+            }
             NumberOrText::Text(s) => s.parse(),
         }
     }
@@ -181,6 +200,13 @@ mod tests {
         for bad in ["0", "-0.1", "\"x\"", "\"-1%\""] {
             assert!(serde_json::from_str::<ErrorTarget>(bad).is_err(), "{bad}");
         }
+        // The field is named once, by the settings parser (it was named twice: "invalid
+        // argument `target_error`: invalid argument `target_error`: ...").
+        let e =
+            crate::request::from_json::<crate::request::BakeSettings>(r#"{"target_error": -1}"#)
+                .unwrap_err()
+                .to_string();
+        assert_eq!(e.matches("target_error").count(), 1, "{e}");
         let a: Names = serde_json::from_str("\"kd, ks,,n\"").unwrap();
         let b: Names = serde_json::from_str("[\"kd\", \"ks\", \"n\"]").unwrap();
         assert_eq!(a, b);

@@ -115,7 +115,7 @@ fn check_len<T>(len: usize, what: &str) -> Result<(), String> {
     match len.checked_mul(std::mem::size_of::<T>()) {
         Some(bytes) if bytes <= isize::MAX as usize => Ok(()),
         _ => Err(format!(
-            "`{what}`: {len} elements of {} bytes exceed the largest array (isize::MAX bytes)",
+            "`{what}`: {len} elements of {} bytes exceed the largest array (PTRDIFF_MAX bytes)",
             std::mem::size_of::<T>()
         )),
     }

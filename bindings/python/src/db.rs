@@ -56,8 +56,21 @@ pub(crate) fn db_import(
         };
         let data = pyo3::pybacked::PyBackedBytes::from(data);
         unlocked(py, || {
-            let s = brdftab::store::Store::from_bytes("<bytes>", data, opts)?;
-            let from = s.single()?.header().name.clone();
+            let s = brdftab::store::Store::from_bytes("the bytes", data, opts)?;
+            let from = match s.tables() {
+                [t] => t.name.clone(),
+                ts => {
+                    return Err(brdftab::Error::arg(
+                        "data",
+                        format!(
+                            "the bytes hold {} tables; add_bytes takes a single-table file's \
+                             bytes (import a database's tables one by one: Database.add with \
+                             DB#NAME)",
+                            ts.len()
+                        ),
+                    ));
+                }
+            };
             brdftab::store::db::import(path, &s, &from, name, replace)
         })?
         .map_err(lib_err)

@@ -17,14 +17,25 @@ use crate::errors::{Error, lib_err};
 /// whose `os.fspath` is a `str` (a `pathlib.Path`); anything else is a `TypeError`.
 pub(crate) fn text_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<String> {
     use pyo3::types::PyString;
+    // A str that is not UTF-8: a file name of undecodable bytes (surrogate escapes).
+    let utf8 = |p: &Bound<'_, PyAny>| {
+        p.extract::<String>().map_err(|_| {
+            PyValueError::new_err(format!(
+                "{what}: a path that is not valid UTF-8 is not supported (rename the file)"
+            ))
+        })
+    };
     if obj.is_instance_of::<PyString>() {
-        return obj.extract::<String>();
+        return utf8(obj);
     }
     if obj.hasattr("__fspath__")? {
         let p = obj.py().import("os")?.call_method1("fspath", (obj,))?;
-        return p.extract::<String>().map_err(|_| {
-            PyTypeError::new_err(format!("{what}: a bytes path is not supported; pass a str"))
-        });
+        if p.is_instance_of::<PyString>() {
+            return utf8(&p);
+        }
+        return Err(PyTypeError::new_err(format!(
+            "{what}: a bytes path is not supported; pass a str"
+        )));
     }
     Err(PyTypeError::new_err(format!(
         "{what}: expected a str or an os.PathLike, got {}",

@@ -2,6 +2,7 @@
 
 import json
 import multiprocessing
+import os
 import pathlib
 import pickle
 import shutil
@@ -235,6 +236,11 @@ def test_bake_target_error_matches_the_cli(tmp_path, cli):
     assert ta["shape"] == tb["shape"]
     with pytest.raises((brdftab.Error, ValueError), match="target_error"):
         brdftab.bake(GGX, a, preset="small", target_error=0.01)
+    # a bad value names its field once (it was "invalid argument `target_error`: invalid
+    # argument `target_error`: ...")
+    with pytest.raises((brdftab.Error, ValueError)) as e:
+        brdftab.bake(GGX, a, target_error=-1)
+    assert str(e.value).count("target_error") == 1, str(e.value)
 
 
 def test_paths_may_be_pathlike(tmp_path, paper):
@@ -251,6 +257,11 @@ def test_paths_may_be_pathlike(tmp_path, paper):
         brdftab.open(42)
     with pytest.raises(TypeError, match="bytes"):
         brdftab.open(_BytesPath(paper))
+    # a file name that is not UTF-8 (a str of surrogate escapes): said so, not "bytes"
+    name = os.fsdecode(b"m\xff.btdb")
+    for p in [name, pathlib.Path(name)]:
+        with pytest.raises(ValueError, match="not valid UTF-8"):
+            brdftab.open(p)
 
 
 def test_info_describes_measured_files_as_the_cli_does(cli, paper):

@@ -75,6 +75,12 @@ def test_add_bytes_refuses_a_damaged_table(tmp_path):
     assert db.names() == ["ok"]
     with pytest.raises(ValueError):
         db.add_bytes("a#b", t.read_bytes())
+    # a database of two tables: said in the caller's terms (it was "<bytes> is a database of 2
+    # tables; name one as <bytes>#NAME")
+    db.add_bytes("ok2", t.read_bytes())
+    with pytest.raises((brdftab.Error, ValueError), match="hold 2 tables") as e:
+        db.add_bytes("c", (tmp_path / "db.btdb").read_bytes())
+    assert "<bytes>" not in str(e.value)
 
 
 def test_add_bytes_takes_any_buffer_and_refuses_other_types(tmp_path):
