@@ -21,23 +21,16 @@ pub struct InfoArgs {
 
 /// `brdftab info`: measured, brdftab and raw files as text or JSON.
 pub fn info(a: InfoArgs) -> Result<()> {
-    if matches!(
-        source::kind(&a.file),
-        source::Kind::Merl | source::Kind::Rgl
-    ) {
-        if a.json {
-            let v = brdftab::measured::info::info(&a.file)?;
-            let json = serde_json::to_string_pretty(&v).unwrap_or_default();
-            return print_out(&format!("{json}\n"));
-        }
-        return print_out(&brdftab::measured::info::describe(&a.file)?);
-    }
-    let (v, text): (_, fn(&serde_json::Value) -> String) =
-        if tables::is_store_file(db::split_source(&a.file)?.0) {
+    use brdftab::measured::info as measured;
+    use source::Kind::{Merl, Rgl};
+    let (v, text): (_, fn(&serde_json::Value) -> String) = match source::kind(&a.file) {
+        Merl | Rgl if !a.json => return print_out(&measured::describe(&a.file)?),
+        Merl | Rgl => (measured::info(&a.file)?, |_| String::new()),
+        _ if tables::is_store_file(db::split_source(&a.file)?.0) => {
             (info::file_info(&a.file)?, info::file_text)
-        } else {
-            (info::raw_info(&a.file)?, info::raw_text)
-        };
+        }
+        _ => (info::raw_info(&a.file)?, info::raw_text),
+    };
     if a.json {
         let json = serde_json::to_string_pretty(&v).unwrap_or_default();
         print_out(&format!("{json}\n"))
