@@ -473,7 +473,9 @@ pub fn fit_with_progress(
     }
     let Some((best_start, t_best)) = best else {
         return Err(Error::Unsupported(
-            "every start of the fit failed (the model could not be evaluated)".into(),
+            "every start of the fit failed: the optimizer left the model's valid parameters \
+             at every start (try other starts, bounds or a simpler model)"
+                .into(),
         ));
     };
     let spec = problem.spec_at(&t_best)?;
@@ -737,6 +739,23 @@ mod tests {
         assert!(
             matches!(r.spec, ModelSpec::Lambert { kd: crate::Value::Grey(k) } if (k - 0.2).abs() < 1e-4)
         );
+    }
+
+    /// A term the source does not have heads for its lower bound of 0; on the way its value
+    /// passed below 1e-12, which a spec refuses, and the start was dropped (every start of
+    /// Lambert fitted with lambert+ggx failed). Now such a value is 0 and every start ends.
+    #[test]
+    fn a_term_heading_for_zero_does_not_lose_its_start() {
+        let src = build(r#"{"model": "lambert", "kd": 0.2}"#);
+        let r = fit(src.as_ref(), &preset("lambert+ggx").unwrap(), &quick()).unwrap();
+        for s in &r.starts {
+            assert!(s.objective.is_finite(), "{s:?}");
+        }
+        assert!(r.rmse < 1e-3, "{}", r.rmse);
+        let b = Bounds::linear(0.0, 1.0);
+        assert_eq!(b.from_unit(1e-14), 0.0);
+        assert_eq!(b.from_unit(1e-11), 1e-11);
+        assert_eq!(Bounds::linear(-1.0, 1.0).from_unit(0.5 + 1e-14), 0.0);
     }
 
     #[test]

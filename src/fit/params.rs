@@ -94,7 +94,10 @@ impl Bounds {
         ((y - a) / (b - a)).clamp(0.0, 1.0)
     }
 
-    /// The value at unit position `u ∈ [0, 1]`.
+    /// The value at unit position `u ∈ [0, 1]`. A value nearer 0 than a spec may hold
+    /// ([`crate::spectrum::NUMBER_RANGE`]: 0 or a magnitude of at least 1e-12) is 0 where the
+    /// bounds hold 0: a start heading for a lower bound of 0 (a Lambert term the source does not
+    /// have) passed through such values, failed the spec's check and was dropped.
     pub fn from_unit(&self, u: f64) -> f64 {
         let (a, b) = self.ends();
         let y = a + (b - a) * u;
@@ -102,7 +105,13 @@ impl Bounds {
             Scale::Linear => y,
             Scale::Log => y.exp(),
         };
-        x.clamp(self.lo, self.hi)
+        let x = x.clamp(self.lo, self.hi);
+        let tiny = x != 0.0 && x.abs() < *crate::spectrum::NUMBER_RANGE.start();
+        if tiny && (self.lo..=self.hi).contains(&0.0) {
+            0.0
+        } else {
+            x
+        }
     }
 
     /// Unconstrained variable → parameter value (always within the bounds).

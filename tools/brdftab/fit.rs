@@ -34,6 +34,14 @@ pub fn fit(a: FitArgs) -> Result<()> {
             source: e,
         })?
     } else {
+        // A value at a bound is a bound the data pushed against (`--json`: `at_bound`).
+        for p in result.params.iter().filter(|p| p.at_bound) {
+            let (b, v) = (&p.bounds, &p.value);
+            eprintln!(
+                "note: {} = {v:?} ended at a bound of {}..{} (--params {}=LO:HI moves it)",
+                p.path, b.lo, b.hi, p.path
+            );
+        }
         result.spec.to_json()
     };
     outln!("{text}")?;

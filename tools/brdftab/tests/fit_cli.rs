@@ -26,6 +26,23 @@ fn fit_prints_a_spec_usable_as_a_source() {
     }
 }
 
+/// A value the data pushed to a bound is flagged on stderr (the README says so; only `--json`
+/// told), and stdout stays the spec alone.
+#[test]
+fn a_value_at_a_bound_is_flagged_in_plain_output() {
+    let bright = r#"{"model": "lambert", "kd": 0.5}"#; // above kd's default bound 1.2/π
+    let r = brdftab(&["fit", bright, "--model", "lambert", "--pairs", "300"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(r.stdout.lines().count(), 1, "{}", r.stdout);
+    assert!(
+        r.stderr.contains("note: kd = ") && r.stderr.contains("ended at a bound"),
+        "{}",
+        r.stderr
+    );
+    let r = brdftab(&["fit", LAMBERT, "--model", "lambert", "--pairs", "300"]);
+    assert!(!r.stderr.contains("ended at a bound"), "{}", r.stderr);
+}
+
 #[test]
 fn fit_json_has_spec_rmse_and_starts() {
     let r = brdftab(&[
