@@ -177,6 +177,22 @@ pub struct FitResult {
     pub seconds: f64,
 }
 
+impl FitResult {
+    /// One line per parameter whose value ended at a bound (`kd = [..] ended at a bound of
+    /// 0..0.38 (...)`): the data pushed against it, and a wider `--params` range may fit
+    /// better. What the CLI notes on stderr.
+    pub fn bound_notes(&self) -> Vec<String> {
+        (self.params.iter().filter(|p| p.at_bound))
+            .map(|p| {
+                format!(
+                    "{} = {:?} ended at a bound of {}..{} (--params {}=LO:HI moves it)",
+                    p.path, p.value, p.bounds.lo, p.bounds.hi, p.path
+                )
+            })
+            .collect()
+    }
+}
+
 /// Default starting spec for a model name, or a sum of them joined with `+`
 /// (`lambert+cook_torrance`, `lambert+ggx`, `lambert+blinn_phong`, `lambert+ward`, `ggx`, ...).
 /// An inline JSON spec (starting with `{`) is parsed and used as given. Fresnel terms are

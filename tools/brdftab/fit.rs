@@ -34,13 +34,8 @@ pub fn fit(a: FitArgs) -> Result<()> {
             source: e,
         })?
     } else {
-        // A value at a bound is a bound the data pushed against (`--json`: `at_bound`).
-        for p in result.params.iter().filter(|p| p.at_bound) {
-            let (b, v) = (&p.bounds, &p.value);
-            eprintln!(
-                "note: {} = {v:?} ended at a bound of {}..{} (--params {}=LO:HI moves it)",
-                p.path, b.lo, b.hi, p.path
-            );
+        for n in result.bound_notes() {
+            eprintln!("note: {n}"); // (`--json`: each parameter's `at_bound`)
         }
         result.spec.to_json()
     };
