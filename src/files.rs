@@ -117,7 +117,8 @@ pub fn refuse_input(output: &Path, inputs: &[&str]) -> Result<()> {
 /// An output path must name a file that is absent or a regular file (links followed): a write
 /// goes to a new file renamed over `path`, which would replace a named pipe, a device (as
 /// root, `/dev/null` itself) or a socket with a plain file, and a directory cannot be replaced.
-/// Checked by [`temp_path`], so by every writer, and by tools before long work.
+/// Checked by every writer of the library (before its temporary file) and by tools before
+/// long work.
 ///
 /// # Errors
 /// [`Error::Unsupported`] naming `path` and what it is.
