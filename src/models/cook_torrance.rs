@@ -158,9 +158,12 @@ impl CookTorrance {
         let h = l + v;
         let hh = h.length_squared();
         let hz2 = h.z * h.z;
-        // 1 / cos² α and tan² α = 1/cos² α − 1.
-        let inv_c2 = hh / hz2;
-        let x = (inv_c2 - 1.0) * self.d.inv_m2();
+        // tan² α = (h_x² + h_y²) / h_z² and 1 / cos² α = 1 + tan² α. (As |h|²/h_z² − 1 it
+        // cancelled below tan² α ≈ 1e-16: for m ≤ 1e-8 every half vector within ~1e-8 rad of
+        // the normal read the peak of D, and the albedo of m = 1e-9 came out as 83.)
+        let tan2 = (h.x * h.x + h.y * h.y) / hz2;
+        let inv_c2 = 1.0 + tan2;
+        let x = tan2 * self.d.inv_m2();
         if x.is_nan() || x >= 700.0 {
             // exp(−x) underflows (or h_z² did): D = 0, and inv_c2 may be infinite.
             return Some(Geometry {
@@ -211,6 +214,22 @@ impl Brdf for CookTorrance {
 
     fn flags(&self) -> Flags {
         Flags::SMOOTH_SYMMETRIC
+    }
+
+    /// The quadrature's albedo, or where the lobe is far narrower than any quadrature
+    /// resolves (m < 1e-6) and than the view's height above the horizon (m < 1e-3 cos θi), its
+    /// m → 0 limit k_s F(cos θi): D tends to δ(H − N), where V·H = cos θi and the V-cavity's
+    /// G = 1 (corrections of order (m / cos θi)²). Below m ≈ 1e-10 the Beckmann lobe, with no
+    /// tails, fell between every node and the albedo read 0.
+    fn albedo(&self, wi: DVec3, out: &mut [f64]) {
+        let cos = geometry::normalize(wi).map_or(0.0, |w| w.z);
+        if self.d.m < 1e-6 && self.d.m < 1e-3 * cos {
+            for (c, o) in out[..self.ks.len()].iter_mut().enumerate() {
+                *o = self.ks[c] * self.fresnel.eval(cos, c);
+            }
+            return;
+        }
+        crate::analysis::albedo::quadrature(self, wi, out)
     }
 
     /// False, although f_r is unbounded in one corner: where both directions near the horizon
@@ -354,6 +373,43 @@ impl Brdf for CookTorrance {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// tan² α read as |h|²/h_z² − 1 cancelled below 1e-16: with m = 1e-9 a half vector 1e-9
+    /// from the normal read D's peak instead of e⁻¹ of it (and the albedo came out as 83).
+    #[test]
+    fn a_lobe_narrower_than_f64_cancellation_is_evaluated_and_integrated() {
+        let m = 1e-9;
+        let ct =
+            CookTorrance::new(m, Value::Grey(1.0), &FresnelSpec::None, &Channels::Rgb).unwrap();
+        // h at angle m from the normal: l and v mirror each other about it.
+        let h = geometry::spherical(m, 0.0);
+        let v = geometry::spherical(0.3, std::f64::consts::PI);
+        let l = 2.0 * v.dot(h) * h - v;
+        let mut f = [0.0f32; 3];
+        ct.eval(l, v, &mut f);
+        let tan2 = (m.tan()).powi(2);
+        let d = (-tan2 / (m * m)).exp() / (std::f64::consts::PI * m * m * h.z.powi(4));
+        let expect = d / (4.0 * v.z * l.z); // G = 1 here
+        assert!(
+            (f[0] as f64 / expect - 1.0).abs() < 1e-6,
+            "{} vs {expect}",
+            f[0]
+        );
+        // Albedo: the m → 0 limit k_s F below m = 1e-6, continuous with the quadrature above.
+        let au = FresnelSpec::Conductor("Au".into());
+        let narrow = CookTorrance::new(5e-7, Value::Grey(1.0), &au, &Channels::Rgb).unwrap();
+        let resolved = CookTorrance::new(2e-6, Value::Grey(1.0), &au, &Channels::Rgb).unwrap();
+        for deg in [0.0f64, 60.0, 89.0] {
+            let t = deg.to_radians();
+            let wi = DVec3::new(t.sin(), 0.0, t.cos());
+            let (mut a, mut b) = ([0.0; 3], [0.0; 3]);
+            narrow.albedo(wi, &mut a);
+            resolved.albedo(wi, &mut b);
+            for c in 0..3 {
+                assert!((a[c] / b[c] - 1.0).abs() < 1e-5, "{deg}°: {a:?} vs {b:?}");
+            }
+        }
+    }
 
     #[test]
     fn matches_the_formula_at_a_hand_computed_pair() {
