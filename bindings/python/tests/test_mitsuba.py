@@ -736,6 +736,24 @@ def test_a_scalar_variant_loads_a_scene_written_for_the_jit_variants(tmp_path):
 
 
 @pytest.mark.parametrize("variant", ["scalar_rgb", "llvm_ad_rgb"])
+def test_cache_and_sampling_res_are_checked_in_every_variant(variant):
+    """`cache: "no"` was true (bool of a string) and `sampling_res` 0..2 were taken (the JIT
+    draw's density then 5.7x its pdf), -4 a raw OverflowError; the scalar variants took
+    anything. Now both refuse the same values, and accept the same ones."""
+    import brdftab.mitsuba as bm
+
+    use(variant)
+    for bad in [{"sampling_res": 2}, {"sampling_res": -4}, {"sampling_res": "abc"},
+                {"sampling_res": 16.5}, {"cache": "maybe"}]:
+        with pytest.raises(Exception, match="brdftab plugin: `(sampling_res|cache)`"):
+            mi.load_dict({"type": "brdftab", "source": GGX_SPEC, **bad})
+    assert bm._bool_prop({"cache": "no"}, "cache", True) is False
+    assert bm._bool_prop({"cache": "True"}, "cache", False) is True
+    mi.load_dict({"type": "brdftab", "source": GGX_SPEC, "preset": "small", "cache": "false",
+                  "sampling_res": bm.SAMPLING_RES_RANGE[0]})
+
+
+@pytest.mark.parametrize("variant", ["scalar_rgb", "llvm_ad_rgb"])
 def test_preset_or_grid_with_a_table_source_is_refused_in_every_variant(tmp_path, variant):
     """A table source is evaluated as stored: `preset` made the JIT variants bake it again
     from itself (0.86067 against the table's 0.86206 at one pair) while the scalar ones read
