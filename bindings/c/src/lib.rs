@@ -560,7 +560,12 @@ pub unsafe extern "C" fn brdftab_eval_spectral(
         // SAFETY (all four): the header's contract on sizes; NULL and alignment are checked.
         let (b, wi, wo) = unsafe { pair_args(b, n, wi, wo) }?;
         let nm = unsafe { wavelengths(k, nm) }?;
-        let f = unsafe { slice_mut(f, times(n, k, "f")?, "f") }?;
+        // No wavelengths, no values: `f` may be NULL, as `nm` may (and as
+        // brdftab_sample_spectral's `weight` may).
+        let f = match k {
+            0 => &mut [][..],
+            _ => unsafe { slice_mut(f, times(n, k, "f")?, "f") }?,
+        };
         brdftab::brdf::eval_wavelengths(&b.brdf, wi, wo, nm, f);
         healthy(b)
     })

@@ -214,6 +214,7 @@ int main(int argc, char **argv) {
         CHECK(brdftab_sample_spectral(au, 1, wo1, u1, 2, nan_nm, wi1, &p1, ws, &d1) == -1,
               "NaN in nm (sample)");
         CHECK(brdftab_eval_spectral(g, 1, wi, wo, 0, NULL, fs) == 0, "k = 0");
+        CHECK(brdftab_eval_spectral(g, 1, wi, wo, 0, NULL, NULL) == 0, "k = 0: f may be NULL");
         brdftab_close(g);
         brdftab_close(g3);
         brdftab_close(au);
