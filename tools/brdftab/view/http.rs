@@ -150,7 +150,7 @@ pub fn read_request(stream: &mut impl Read) -> Result<Request, Response> {
 fn head_of(req: &httparse::Request) -> Result<(Request, usize), Response> {
     let mut host = None;
     let mut hosts = 0;
-    let mut body_len = 0usize;
+    let (mut body_len, mut lengths) = (0usize, 0);
     for h in req.headers.iter() {
         let value = std::str::from_utf8(h.value)
             .map_err(|_| Response::error(400, "a header is not UTF-8"))?
@@ -159,9 +159,14 @@ fn head_of(req: &httparse::Request) -> Result<(Request, usize), Response> {
             hosts += 1;
             host = Some(value.to_owned());
         } else if h.name.eq_ignore_ascii_case("content-length") {
-            body_len = value
+            let len = value
                 .parse()
                 .map_err(|_| Response::error(400, "bad Content-Length"))?;
+            // Two that differ frame the body two ways (RFC 9112 §6.3: an error).
+            if lengths > 0 && len != body_len {
+                return Err(Response::error(400, "conflicting Content-Length headers"));
+            }
+            (body_len, lengths) = (len, lengths + 1);
         } else if h.name.eq_ignore_ascii_case("transfer-encoding") {
             return Err(Response::error(501, "chunked bodies are not accepted"));
         }
@@ -267,6 +272,10 @@ mod tests {
         let chunked = b"POST / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n";
         assert_eq!(read(chunked).unwrap_err().status, 501);
         assert_eq!(read(b"GET / HTTP/1.1\r\n").unwrap_err().status, 400);
+        let two = b"POST / HTTP/1.1\r\nContent-Length: 3\r\nContent-Length: 0\r\n\r\nabc";
+        assert_eq!(read(two).unwrap_err().status, 400);
+        let same = b"POST / HTTP/1.1\r\nContent-Length: 3\r\nContent-Length: 3\r\n\r\nabc";
+        assert_eq!(read(same).unwrap().body, b"abc");
     }
 
     #[test]
