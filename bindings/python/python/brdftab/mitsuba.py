@@ -146,8 +146,8 @@ def _flags(brdf, source):
 
 JIT_TABLE_PROPERTIES = ("preset", "grid", "cache", "cache_dir", "sampling_res")
 """Properties of the JIT variants' table (how a non-table source is baked, where the bake is
-cached, the sampler's resolution). The scalar variants accept them and ignore them: they
-evaluate the source itself."""
+cached, the sampler's resolution). The scalar variants accept them and ignore them — they
+evaluate the source itself — but check ``cache`` and ``sampling_res`` as the JIT variants do."""
 
 
 #: The range of the ``sampling_res`` property (half-vector nodes per axis). Below 16 the JIT

@@ -14,7 +14,11 @@ def brdftab_kind(source: str) -> str:
 
 JIT_TABLE_PROPERTIES: tuple[str, ...]
 """Properties of the JIT variants' table (preset, grid, cache, cache_dir, sampling_res); the scalar
-variants accept them and ignore them (they evaluate the source itself)."""
+variants accept them and ignore them (they evaluate the source itself), checking cache and
+sampling_res as the JIT variants do."""
+SAMPLING_RES_RANGE: tuple[int, int]
+"""The range of the ``sampling_res`` property (half-vector nodes per axis), checked in every
+variant."""
 LAYOUT_VERSION: int
 """The device-layout version JitTable implements (Rust `brdftab::table::device::VERSION`)."""
 MODEL_TARGET_ERROR: float
