@@ -46,6 +46,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(db::db_import, m)?)?;
     m.add_function(wrap_pyfunction!(requests::bake, m)?)?;
     m.add_function(wrap_pyfunction!(requests::bake_cached, m)?)?;
+    m.add_function(wrap_pyfunction!(requests::_check_bake_options, m)?)?;
     m.add_function(wrap_pyfunction!(requests::convert, m)?)?;
     m.add_function(wrap_pyfunction!(requests::fit, m)?)?;
     m.add_function(wrap_pyfunction!(colour::rgb_basis, m)?)?;

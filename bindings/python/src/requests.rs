@@ -55,6 +55,24 @@ pub(crate) fn bake(
     })
 }
 
+/// Checks `options` (the keywords of `bake`) for SOURCE as `bake` does before its work — every
+/// field's value, nothing opened or baked — so that the Mitsuba plugin's scalar variants, which
+/// evaluate the source itself, refuse the same `preset`/`grid` values as the JIT variants,
+/// which bake a table with them.
+#[pyfunction]
+#[pyo3(signature = (source, **options))]
+pub(crate) fn _check_bake_options(
+    source: &Bound<'_, PyAny>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<()> {
+    guard(|| {
+        let source = text_arg(source, "source")?;
+        let settings: BakeSettings = settings_of(options)?;
+        settings.request(source.as_str()).map_err(lib_err)?;
+        Ok(())
+    })
+}
+
 /// The table of SOURCE baked with `options` (the keywords of `bake`), from the cache of baked
 /// tables or baked into it now ([`brdftab::cache`]): keyed by the source's content, the
 /// settings and the library's version, in `cache_dir` (default `$BRDFTAB_CACHE_DIR`, else

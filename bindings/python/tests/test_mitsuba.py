@@ -736,7 +736,7 @@ def test_a_scalar_variant_loads_a_scene_written_for_the_jit_variants(tmp_path):
 
 
 @pytest.mark.parametrize("variant", ["scalar_rgb", "llvm_ad_rgb"])
-def test_cache_and_sampling_res_are_checked_in_every_variant(variant):
+def test_table_properties_are_checked_in_every_variant(variant):
     """`cache: "no"` was true (bool of a string) and `sampling_res` 0..2 were taken (the JIT
     draw's density then 5.7x its pdf), -4 a raw OverflowError; the scalar variants took
     anything. Now both refuse the same values, and accept the same ones."""
@@ -747,6 +747,11 @@ def test_cache_and_sampling_res_are_checked_in_every_variant(variant):
                 {"sampling_res": 16.5}, {"cache": "maybe"}]:
         with pytest.raises(Exception, match="brdftab plugin: `(sampling_res|cache)`"):
             mi.load_dict({"type": "brdftab", "source": GGX_SPEC, **bad})
+    # `preset`/`grid` as the bake takes them: `preset: "huge"` loaded in the scalar variants
+    # (which ignore the value) and failed in the JIT ones (which bake with it).
+    for bad in [{"preset": "huge"}, {"grid": "32x17"}, {"preset": "small", "grid": "nope"}]:
+        with pytest.raises(Exception, match="invalid argument `(preset|grid)`"):
+            mi.load_dict({"type": "brdftab", "source": GGX_SPEC, "cache": False, **bad})
     assert bm._bool_prop({"cache": "no"}, "cache", True) is False
     assert bm._bool_prop({"cache": "True"}, "cache", False) is True
     mi.load_dict({"type": "brdftab", "source": GGX_SPEC, "preset": "small", "cache": "false",

@@ -147,7 +147,8 @@ def _flags(brdf, source):
 JIT_TABLE_PROPERTIES = ("preset", "grid", "cache", "cache_dir", "sampling_res")
 """Properties of the JIT variants' table (how a non-table source is baked, where the bake is
 cached, the sampler's resolution). The scalar variants accept them and ignore them — they
-evaluate the source itself — but check ``cache`` and ``sampling_res`` as the JIT variants do."""
+evaluate the source itself — but check ``preset``, ``grid``, ``cache`` and ``sampling_res`` as
+the JIT variants do."""
 
 
 #: The range of the ``sampling_res`` property (half-vector nodes per axis). Below 16 the JIT
@@ -188,6 +189,13 @@ def _sampling_res_prop(props):
             f"nodes per axis), got {v!r}"
         )
     return n
+
+
+def _check_bake_props(props, source):
+    """Refuses ``preset``/``grid`` values the JIT variants' bake would refuse, without baking."""
+    options = {k: str(_prop(props, k)) for k in ("preset", "grid") if _prop(props, k) is not None}
+    if options:
+        brdftab._native._check_bake_options(source, **options)
 
 
 def brdftab_kind(source):
@@ -289,9 +297,12 @@ class ScalarBrdftabBSDF(_Common):
         # variant evaluates and samples the source itself, not a table baked from it.
         for key in JIT_TABLE_PROPERTIES:
             _prop(props, key)
-        # Checked as the JIT variants check them, so a scene loads in both or in neither.
+        # Checked as the JIT variants check them, so a scene loads in both or in neither:
+        # `preset`/`grid` as the bake would take them (a scene with `preset: "huge"` loaded
+        # here and failed in a JIT variant).
         _bool_prop(props, "cache", True)
         _sampling_res_prop(props)
+        _check_bake_props(props, self.source)
 
     def _f(self, wi, wo, si):
         import mitsuba as mi
