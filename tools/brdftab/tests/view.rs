@@ -149,6 +149,26 @@ fn requests_cannot_reach_beyond_the_materials_named_at_start() {
         200
     );
 
+    // An absolute-form target (RFC 9112 3.2.2: a server must accept it) is served, and its
+    // authority, not the Host header, is what the rebinding check reads.
+    let abs = |authority: &str, host: &str| {
+        let r = format!("GET http://{authority}/api/materials HTTP/1.1\r\nHost: {host}\r\n\r\n");
+        send(p, r.as_bytes()).0
+    };
+    assert_eq!(
+        abs(&format!("127.0.0.1:{p}"), &format!("127.0.0.1:{p}")),
+        200
+    );
+    assert_eq!(abs(&format!("localhost:{p}"), "evil.example"), 200);
+    assert_eq!(
+        abs(&format!("evil.example:{p}"), &format!("127.0.0.1:{p}")),
+        403
+    );
+    assert_eq!(
+        abs(&format!("x@127.0.0.1:{p}"), &format!("127.0.0.1:{p}")),
+        400
+    );
+
     // Path traversal, plain or encoded, and unknown routes.
     for target in [
         "/../../etc/passwd",

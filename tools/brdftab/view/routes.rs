@@ -30,13 +30,17 @@ const ASSETS: &[(&str, &str, &str)] = &[
 
 /// The response to `req` for a server that answers to the `Host` values `hosts`.
 pub fn handle(reg: &Registry, hosts: &[String], req: &Request) -> Response {
-    if !security::host_allowed(req.host.as_deref(), hosts) {
+    let (host, target) = match security::effective(&req.target, req.host.as_deref()) {
+        Ok(x) => x,
+        Err(e) => return Response::error(400, e),
+    };
+    if !security::host_allowed(host, hosts) {
         return Response::error(403, "unexpected Host header");
     }
     if req.method != "GET" && req.method != "HEAD" {
         return Response::error(405, "only GET is served");
     }
-    let (path, params) = match security::split_target(&req.target) {
+    let (path, params) = match security::split_target(target) {
         Ok(x) => x,
         Err(e) => return Response::error(400, e),
     };

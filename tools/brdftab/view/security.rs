@@ -6,6 +6,8 @@
 //! - [`host_allowed`]: the `Host` header must name the bound address (or `localhost` on a
 //!   loopback bind). A page on another site that rebinds its DNS name to 127.0.0.1 sends its own
 //!   name as `Host` and is refused: that is the defence against DNS rebinding.
+//!   An absolute-form target (`http://HOST/path`) names its host itself ([`effective`]): its
+//!   authority is checked in the header's place.
 //! - [`split_target`]: the path must be plain (no `%`, no `..`, no backslash); only the query is
 //!   percent-decoded, and it only ever carries numbers, ids and inline specs.
 //! - [`inline_spec`]: a page-supplied SOURCE is accepted only if the library's own
@@ -35,6 +37,34 @@ pub fn allowed_hosts(addr: SocketAddr) -> Vec<String> {
 /// True if `host` (the request's `Host` header) is one of `allowed`.
 pub fn host_allowed(host: Option<&str>, allowed: &[String]) -> bool {
     host.is_some_and(|h| allowed.iter().any(|a| a.eq_ignore_ascii_case(h)))
+}
+
+/// The host and the origin-form target of a request: an absolute-form target
+/// (`http://127.0.0.1:8127/api/models`, what a client talking to a proxy sends) names the host
+/// itself, and RFC 9112 (3.2.2, 3.3) has the server accept it and ignore the `Host` header. Its
+/// authority then goes through [`host_allowed`] as a `Host` header would; userinfo is refused.
+pub fn effective<'a>(
+    target: &'a str,
+    host: Option<&'a str>,
+) -> Result<(Option<&'a str>, &'a str), &'static str> {
+    let scheme = "http://";
+    match target.get(..scheme.len()) {
+        Some(s) if s.eq_ignore_ascii_case(scheme) => {
+            let rest = &target[scheme.len()..];
+            let end = rest.find(['/', '?']).unwrap_or(rest.len());
+            let (authority, path) = rest.split_at(end);
+            if authority.contains('@') {
+                return Err("userinfo in the request target");
+            }
+            // An empty path is `/` (RFC 9112 3.2.1); `http://host?x` is not served.
+            match path {
+                "" => Ok((Some(authority), "/")),
+                p if p.starts_with('/') => Ok((Some(authority), p)),
+                _ => Err("bad path"),
+            }
+        }
+        _ => Ok((host, target)),
+    }
 }
 
 /// Decoded query parameters, in request order.
@@ -140,6 +170,25 @@ mod tests {
         assert_eq!(q[1], ("spec".to_owned(), "{\"a\" 1}".to_owned()));
         assert!(split_target("/x?a=%zz").is_err());
         assert!(split_target("/x?a=%00").is_err());
+    }
+
+    #[test]
+    fn absolute_form_targets_name_their_host() {
+        let ok = vec!["127.0.0.1:8127".to_owned()];
+        let (h, t) =
+            effective("http://127.0.0.1:8127/api/models?x=1", Some("evil.example")).unwrap();
+        assert_eq!((h, t), (Some("127.0.0.1:8127"), "/api/models?x=1"));
+        assert!(host_allowed(h, &ok));
+        assert_eq!(
+            effective("HTTP://127.0.0.1:8127", None).unwrap(),
+            (Some("127.0.0.1:8127"), "/")
+        );
+        // The authority is checked as a Host header would be, whatever the header says.
+        let (h, _) = effective("http://evil.example/api/models", Some("127.0.0.1:8127")).unwrap();
+        assert!(!host_allowed(h, &ok));
+        assert!(effective("http://u@127.0.0.1:8127/", None).is_err());
+        assert!(effective("http://127.0.0.1:8127?x", None).is_err());
+        assert_eq!(effective("/a", Some("h")).unwrap(), (Some("h"), "/a"));
     }
 
     #[test]
