@@ -212,6 +212,9 @@ fn requests_cannot_reach_beyond_the_materials_named_at_start() {
         "/api/polar?m=0&n=100000",
         "/api/sphere?m=0&size=5000",
         "/api/polar?m=0&theta_i=NaN",
+        "/api/polar?m=0&n=10.5",
+        "/api/sphere?m=0&size=1e2",
+        "/api/slice?m=0&n=+64",
     ] {
         assert_eq!(get(&v, target).0, 400, "{target}");
     }

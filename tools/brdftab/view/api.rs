@@ -40,9 +40,19 @@ impl Query {
         }
     }
 
-    /// Count `k` in [lo, hi] (`default` when absent).
+    /// Count `k`, an integer in [lo, hi] (`default` when absent). `n=10.5` is refused, not
+    /// rounded: a count the client did not ask for would be answered silently.
     fn count(&self, k: &str, default: usize, lo: usize, hi: usize) -> Result<usize, Response> {
-        Ok(self.num(k, default as f64, lo as f64, hi as f64)?.round() as usize)
+        let Some(v) = self.get(k) else {
+            return Ok(default);
+        };
+        match v.parse::<usize>() {
+            Ok(n) if (lo..=hi).contains(&n) => Ok(n),
+            _ => Err(Response::error(
+                400,
+                &format!("{k}: expected an integer in [{lo}, {hi}]"),
+            )),
+        }
     }
 }
 
