@@ -1,8 +1,9 @@
 //! numpy arrays in and out of batch calls without copies (and in as a table's values,
 //! `Table.with_values`).
 //!
-//! Why a module: a batch call's cost should be the library's. Directions arrive as `(n, 3)`
-//! arrays; a C-contiguous, aligned float64 array is read in place as `[DVec3]` (glam's `DVec3`
+//! Why a module: a batch call's cost should be the library's. Directions arrive as `(..., 3)`
+//! arrays (any leading shape, broadcast against each other by numpy's rules; results take the
+//! broadcast shape); a C-contiguous, aligned float64 array is read in place as `[DVec3]` (glam's `DVec3`
 //! is `#[repr(C)]` of three f64, as the C ABI reads `double[n][3]`); a C-contiguous float32
 //! array — what Mitsuba, PyTorch and most renderers' buffers hold — is read in place too, each
 //! block of rows widened to f64 as the block is evaluated (the same values numpy's `astype`
@@ -114,7 +115,7 @@ pub(crate) fn shape_str(shape: &[usize]) -> String {
     }
 }
 
-/// Rows of `W` numbers, `(n, W)` or one row `(W,)`, as `T` (`T` = `DVec3` or `DVec2`):
+/// Rows of `W` numbers, `(..., W)` (one row: `(W,)`), as `T` (`T` = `DVec3` or `DVec2`):
 /// float64 borrowed in place as `[T]` when C-contiguous and aligned, float32 borrowed in place
 /// when C-contiguous (widened block by block: [`Rows::rows`]), anything else converted or
 /// copied once.
@@ -127,8 +128,8 @@ pub(crate) struct Rows<'py, T> {
     /// Rows in place as `W` f32 each (float32), or null.
     narrow: *const f32,
     len: usize,
-    /// The input was one row of shape `(W,)`.
-    pub single: bool,
+    /// The input's leading shape (its shape without the last axis; `[]` for one row `(W,)`).
+    pub lead: Vec<usize>,
 }
 
 /// The numpy array a [`Rows`] reads.
@@ -167,7 +168,7 @@ impl Row for DVec2 {
     }
 }
 
-/// Whether `obj` is a C-contiguous float32 ndarray of shape `(n, w)` or `(w,)` (read in place).
+/// Whether `obj` is a C-contiguous float32 ndarray of shape `(..., w)` (read in place).
 fn narrow_rows<'py>(obj: &Bound<'py, PyAny>, w: usize) -> Option<PyReadonlyArrayDyn<'py, f32>> {
     use numpy::PyUntypedArray;
     // A subclass (a masked array) goes the general way, which looks at its mask.
@@ -175,7 +176,7 @@ fn narrow_rows<'py>(obj: &Bound<'py, PyAny>, w: usize) -> Option<PyReadonlyArray
         return None;
     }
     let a = obj.extract::<PyReadonlyArrayDyn<'py, f32>>().ok()?;
-    let shaped = matches!(a.shape(), [x] | [_, x] if *x == w);
+    let shaped = a.shape().last() == Some(&w);
     (shaped && a.is_c_contiguous()).then_some(a)
 }
 
@@ -192,18 +193,17 @@ impl<'py, T: Row> Rows<'py, T> {
                 ptr: std::ptr::null(),
                 owned: Vec::new(),
                 len: flat.len() / w,
-                single: a.ndim() == 1,
+                lead: a.shape()[..a.ndim() - 1].to_vec(),
                 _array: Held::F32 { _a: a },
             });
         }
         let mut a = f64_array(obj, name)?;
-        let single = match a.shape() {
-            [x] if *x == w => true,
-            [_, x] if *x == w => false,
-            s => {
+        let lead = match a.shape().split_last() {
+            Some((x, lead)) if *x == w => lead.to_vec(),
+            _ => {
                 return Err(PyValueError::new_err(format!(
-                    "{name}: expected shape (n, {w}) or ({w},), got {}",
-                    shape_str(s)
+                    "{name}: expected shape (..., {w}) ({w} numbers a row), got {}",
+                    shape_str(a.shape())
                 )));
             }
         };
@@ -241,7 +241,7 @@ impl<'py, T: Row> Rows<'py, T> {
             ptr,
             narrow: std::ptr::null(),
             len,
-            single,
+            lead,
         })
     }
 
@@ -317,7 +317,91 @@ impl<'a, T: Row> View<'a, T> {
     }
 }
 
-/// Two row sets paired for a call: the same count, or one row — `(W,)` or `(1, W)` — against
+/// numpy's broadcast of two leading shapes (aligned at their ends; an axis of 1 stretches),
+/// or `None` where they do not broadcast.
+pub(crate) fn broadcast(a: &[usize], b: &[usize]) -> Option<Vec<usize>> {
+    let n = a.len().max(b.len());
+    let at = |s: &[usize], i: usize| match (i + s.len()).checked_sub(n) {
+        Some(j) => s[j],
+        None => 1,
+    };
+    (0..n)
+        .map(|i| match (at(a, i), at(b, i)) {
+            (x, y) if x == y || y == 1 => Some(x),
+            (1, y) => Some(y),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Reads `a` and `b` as rows for one call whose leading shapes broadcast (numpy's rule). A
+/// side whose leading shape is the broadcast's (up to leading axes of 1) is read as it is, and
+/// so is a single row (repeated block by block by [`Pairs`]); only a side that broadcasts
+/// along some axes and not others — `(n, 1, 3)` against `(1, m, 3)` — is expanded by numpy
+/// into a C-contiguous copy of the broadcast shape.
+pub(crate) fn pair_rows<'py, A: Row, B: Row>(
+    a: &Bound<'py, PyAny>,
+    an: &str,
+    b: &Bound<'py, PyAny>,
+    bn: &str,
+) -> PyResult<(Rows<'py, A>, Rows<'py, B>)> {
+    let (mut ra, mut rb) = (Rows::<A>::new(a, an)?, Rows::<B>::new(b, bn)?);
+    let lead = broadcast(&ra.lead, &rb.lead).ok_or_else(|| mismatch(&ra, an, &rb, bn))?;
+    let n: usize = lead.iter().product();
+    if ra.len() != n && ra.len() != 1 {
+        ra = Rows::new(&expand(a, &lead, A::W)?, an)?;
+    }
+    if rb.len() != n && rb.len() != 1 {
+        rb = Rows::new(&expand(b, &lead, B::W)?, bn)?;
+    }
+    Ok((ra, rb))
+}
+
+/// The refusal of two row sets whose leading shapes do not broadcast.
+fn mismatch<A: Row, B: Row>(a: &Rows<'_, A>, an: &str, b: &Rows<'_, B>, bn: &str) -> PyErr {
+    let full = |lead: &[usize], w: usize| shape_str(&[lead, &[w]].concat());
+    PyValueError::new_err(format!(
+        "{an} and {bn}: shapes {} and {} do not broadcast (numpy's rule, the last axis aside)",
+        full(&a.lead, A::W),
+        full(&b.lead, B::W)
+    ))
+}
+
+/// `obj` broadcast to `lead + (w,)` as a C-contiguous array (numpy copies it).
+fn expand<'py>(obj: &Bound<'py, PyAny>, lead: &[usize], w: usize) -> PyResult<Bound<'py, PyAny>> {
+    let np = obj.py().import("numpy")?;
+    let shape = pyo3::types::PyTuple::new(obj.py(), [lead, &[w]].concat())?;
+    let b = np.call_method1("broadcast_to", (np.call_method1("asarray", (obj,))?, shape))?;
+    np.call_method1("ascontiguousarray", (b,))
+}
+
+/// Wavelengths for pairs of leading shape `lead` (`n` pairs): one set `(k,)` for every pair,
+/// or one set per pair, `lead + (k,)`. Returns `k`, whether the sets are per pair, and the
+/// array as `(k,)` or `(n, k)` (numpy reshapes an N-d one, a view where its strides allow).
+pub(crate) fn wavelength_rows<'py>(
+    nm: PyReadonlyArrayDyn<'py, f64>,
+    lead: &[usize],
+) -> PyResult<(usize, bool, PyReadonlyArrayDyn<'py, f64>)> {
+    let n: usize = lead.iter().product();
+    match nm.shape().split_last() {
+        Some((&k, [])) => Ok((k, false, nm)),
+        Some((&k, l)) if l == lead && l.len() == 1 => Ok((k, true, nm)),
+        Some((&k, l)) if l == lead => {
+            let flat = nm.as_any().call_method1("reshape", ((n, k),))?;
+            Ok((k, true, flat.extract()?))
+        }
+        _ => {
+            let per_pair: Vec<String> = lead.iter().map(|d| d.to_string()).collect();
+            Err(PyValueError::new_err(format!(
+                "nm: expected shape (k,) or ({}, k) (one set of k per pair), got {}",
+                per_pair.join(", "),
+                shape_str(nm.shape())
+            )))
+        }
+    }
+}
+
+/// Two row sets paired for a call (read by [`pair_rows`]): the same count, or one row against
 /// many (broadcast, the single row repeated into a block-sized buffer: no n-sized copy).
 pub(crate) struct Pairs<'a, A, B> {
     a: View<'a, A>,
@@ -328,8 +412,9 @@ pub(crate) struct Pairs<'a, A, B> {
     rb: Vec<B>,
     /// Number of pairs.
     pub n: usize,
-    /// Both inputs were single rows: results drop their leading axis.
-    pub single: bool,
+    /// The pairs' leading shape (numpy's broadcast of the inputs'; `[]` for one pair of single
+    /// rows): results have this shape, then their own axes.
+    pub lead: Vec<usize>,
 }
 
 /// Per-block room for rows widened from float32 ([`Pairs::block`]).
@@ -344,18 +429,13 @@ impl<'a, A: Row, B: Row> Pairs<'a, A, B> {
         bn: &str,
     ) -> PyResult<Self> {
         let (na, nb) = (a.len(), b.len());
-        // numpy's rule: one row — shape (W,) or (1, W) — against any number.
-        let n = match (na, nb) {
-            _ if na == nb => na,
-            (1, _) => nb,
-            (_, 1) => na,
-            _ => {
-                return Err(PyValueError::new_err(format!(
-                    "{an} and {bn}: {na} and {nb} rows; expected the same number (or one row)"
-                )));
-            }
-        };
-        let single = a.single && b.single;
+        // numpy's rule; a side that broadcasts along some axes only was expanded by
+        // `pair_rows`, so each side here is whole or one row.
+        let lead = broadcast(&a.lead, &b.lead).ok_or_else(|| mismatch(a, an, b, bn))?;
+        let n: usize = lead.iter().product();
+        if !(na == n || na == 1) || !(nb == n || nb == 1) {
+            return Err(mismatch(a, an, b, bn));
+        }
         let m = n.min(BLOCK);
         Ok(Pairs {
             ra: if na == n {
@@ -371,8 +451,13 @@ impl<'a, A: Row, B: Row> Pairs<'a, A, B> {
             a: a.view(),
             b: b.view(),
             n,
-            single,
+            lead,
         })
+    }
+
+    /// The shape of a result with `tail` axes per pair: the pairs' leading shape, then `tail`.
+    pub(crate) fn shape(&self, tail: &[usize]) -> Vec<usize> {
+        [&self.lead[..], tail].concat()
     }
 
     /// Both sides whole (no broadcast) and in place as float64: the arrays as they are.

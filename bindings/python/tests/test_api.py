@@ -470,7 +470,7 @@ def test_bad_arguments():
     for wi in ([0, 0], [[0, 0, 1, 1]], np.zeros((2, 3, 1)), 1.0):
         with pytest.raises(ValueError, match="shape"):
             b.eval(wi, [0, 0, 1])
-    with pytest.raises(ValueError, match="rows"):
+    with pytest.raises(ValueError, match="do not broadcast"):
         b.eval(upper(3), upper(4))
     for bad in ([np.nan, 0, 1], [0, np.inf, 1]):  # the NaN rule: 0, not an error
         assert b.eval(bad, [0, 0, 1]).tolist() == [0, 0, 0]

@@ -136,3 +136,73 @@ def test_a_misaligned_input_beyond_memory_is_a_memory_error():
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0 and r.stdout.strip() == "refused", (r.returncode, r.stdout,
                                                                  r.stderr[-2000:])
+
+
+def test_leading_shapes_broadcast_as_numpy_broadcasts():
+    """Directions (..., 3) and u (..., 2) of any leading shapes that broadcast (an image of
+    directions, a grid wi[:, None] against wo[None, :]) were refused ("expected shape (n, 3)
+    or (3,)"); numpy users broadcast. Each result equals the flat call on the arguments that
+    numpy.broadcast_arrays gives, value for value, in the broadcast shape."""
+    rng = np.random.default_rng(7)
+    b = brdftab.open(GGX)
+
+    def dirs(*shape):
+        v = rng.normal(size=shape + (3,))
+        v[..., 2] = np.abs(v[..., 2])
+        return v
+
+    def flat(x, lead, w):
+        return np.ascontiguousarray(np.broadcast_to(x, lead + (w,))).reshape(-1, w)
+
+    cases = [
+        (dirs(4, 5), dirs(4, 5)),          # an image of pairs
+        (dirs(4, 1), dirs(1, 5)),          # a grid: both sides copied by broadcasting
+        (dirs(6)[:, None], dirs(7)),       # (6, 1, 3) against (7, 3)
+        (dirs(2, 3, 4), dirs(4)),          # one side repeated along the leading axes
+        (dirs(1, 1), dirs(3, 2)),          # one row of shape (1, 1, 3)
+        (dirs(0, 4), dirs(1, 4)),          # no pairs
+        (dirs(2, 3).astype(np.float32), dirs(3)),  # float32 read in place
+    ]
+    for wi, wo in cases:
+        lead = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
+        fi, fo = flat(wi, lead, 3), flat(wo, lead, 3)
+        f = b.eval(wi, wo)
+        assert f.shape == lead + (3,) and f.dtype == np.float32
+        np.testing.assert_array_equal(f.reshape(-1, 3), b.eval(fi, fo))
+        p = b.pdf(wi, wo)
+        assert p.shape == lead
+        np.testing.assert_array_equal(p.reshape(-1), b.pdf(fi, fo))
+        s = b.eval_spectral(wi, wo, NM)
+        assert s.shape == lead + (3,)
+        np.testing.assert_array_equal(s.reshape(-1, 3), b.eval_spectral(fi, fo, NM))
+        # One set of wavelengths per pair, in the pairs' shape.
+        nm = 400.0 + 300.0 * rng.random(lead + (2,))
+        s = b.eval_spectral(wi, wo, nm)
+        np.testing.assert_array_equal(s.reshape(-1, 2),
+                                      b.eval_spectral(fi, fo, nm.reshape(-1, 2)))
+
+    u = rng.random((4, 1, 2))
+    wo = dirs(5)
+    fo, fu = flat(wo, (4, 5), 3), flat(u, (4, 5), 2)
+    for kw in ({}, {"delta": True}, {"nm": NM}):
+        got, want = b.sample(wo, u, **kw), b.sample(fo, fu, **kw)
+        assert got[0].shape == (4, 5, 3) and got[1].shape == (4, 5)
+        for g, w in zip(got, want):
+            np.testing.assert_array_equal(g.reshape(w.shape), w)
+    assert b.sample(wo, u, nm=np.full((4, 5, 2), 550.0))[2].shape == (4, 5, 2)
+
+    th = np.array([[0.1, 0.5], [0.9, 1.3]])
+    a = b.albedo(th)
+    assert a.shape == (2, 2, 3)
+    np.testing.assert_array_equal(a.reshape(-1, 3), b.albedo(th.reshape(-1)))
+
+    # Shapes that do not broadcast, and a last axis that is not a direction's, are refused.
+    with pytest.raises(ValueError, match=r"wi and wo: shapes \(4, 3\) and \(5, 3\) do not "
+                                         r"broadcast"):
+        b.eval(dirs(4), dirs(5))
+    with pytest.raises(ValueError, match=r"wi: expected shape \(\.\.\., 3\)"):
+        b.eval(np.zeros((3, 4)), dirs(3))
+    with pytest.raises(ValueError, match=r"nm: expected shape \(k,\) or \(4, 5, k\)"):
+        b.eval_spectral(dirs(4, 5), dirs(5), np.full((5, 2), 550.0))
+    with pytest.raises(ValueError, match="u: expected shape"):
+        b.sample(dirs(2), np.zeros(3))

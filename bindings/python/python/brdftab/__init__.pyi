@@ -64,24 +64,27 @@ class Brdf:
     def describe(self) -> str:
         """A one-line description (model and parameters, or table and source)."""
     def eval(self, wi: _ArrayLike, wo: _ArrayLike) -> npt.NDArray[np.float32]:
-        """f_r(wi, wo) in 1/sr: (n, c) float32, or (c,) for one pair of shape (3,).
+        """f_r(wi, wo) in 1/sr: (..., c) float32 for wi and wo of shapes (..., 3) whose leading
+        shapes broadcast by numpy's rules ((n, 3) against (n, 3) or (3,), an image (h, w, 3),
+        wi[:, None] against wo[None, :]); (c,) for one pair of shape (3,).
 
         NaN, infinite or zero directions give 0 (not an error), as in every host."""
     def eval_spectral(self, wi: _ArrayLike, wo: _ArrayLike, nm: _ArrayLike) -> npt.NDArray[np.float32]:
-        """f_r at wavelengths nm ((k,) or (n, k); each finite and > 0, else ValueError):
-        (n, k) float32, or (k,) for one pair of shape (3,). Spectral channels are interpolated,
+        """f_r at wavelengths nm ((k,), or (..., k) one set per pair; each finite and > 0, else
+        ValueError): (..., k) float32 in the pairs' shape as in `eval`, (k,) for one pair. Spectral channels are interpolated,
         models use their spectral data, RGB channels become a spectrum of their colour
         (`rgb_basis`)."""
     def pdf(self, wi: _ArrayLike, wo: _ArrayLike) -> npt.NDArray[np.float64]:
-        """Density of `sample` drawing wi given wo: (n,) float64, or 0-d for one pair of shape
-        (3,)."""
+        """Density of `sample` drawing wi given wo: float64 in the pairs' shape as in `eval`
+        ((n,), or 0-d for one pair of shape (3,))."""
     @overload
     def sample(
         self, wo: _ArrayLike, u: _ArrayLike, *, nm: _ArrayLike | None = None,
         delta: Literal[False] = False
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32]]:
-        """(wi (n, 3), pdf (n,), weight = f cos θi / pdf (n, c)) for u in [0, 1)² of shape (n, 2);
-        with `nm` (k,) or (n, k) the weights at those wavelengths, (n, k) (a delta draw: its
+        """(wi (..., 3), pdf (...), weight = f cos θi / pdf (..., c)) for wo (..., 3) and u in
+        [0, 1)² (..., 2), their leading shapes broadcast as in `eval`; with `nm` (k,) or
+        (..., k) the weights at those wavelengths, (..., k) (a delta draw: its
         lobe's reflectance there over its pdf, the probability of choosing that lobe).
 
         One wo of shape (3,) with u of shape (2,): wi (3,), pdf 0-d, weight (c,) — one pair's
@@ -91,11 +94,11 @@ class Brdf:
         self, wo: _ArrayLike, u: _ArrayLike, *, nm: _ArrayLike | None = None, delta: Literal[True]
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32],
                npt.NDArray[np.bool_]]:
-        """The same and a bool (n,): the draws of a delta lobe (their pdf is the probability
+        """The same and a bool (...): the draws of a delta lobe (their pdf is the probability
         of choosing that lobe; `pdf()` does not contain them)."""
     def albedo(self, theta: _ArrayLike) -> npt.NDArray[np.float64]:
         """Directional albedo at θ′ in radians, 0 ≤ θ′ < π/2 (light above the horizon; else
-        ValueError naming theta): (k, c) float64.
+        ValueError naming theta): float64 of θ′'s shape then c, (k, c) for k angles.
 
         A closed form where the model has one, else adaptive quadrature: 1e-6 relative for
         models, 1e-4 for tables and measured data.

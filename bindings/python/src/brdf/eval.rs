@@ -10,7 +10,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use super::PyBrdf;
-use crate::arrays::{self, Pairs, Rows};
+use crate::arrays::{self, Pairs};
 use crate::errors::{Error, batch, lib_err, unlocked};
 
 impl PyBrdf {
@@ -21,11 +21,10 @@ impl PyBrdf {
         wi: &Bound<'_, PyAny>,
         wo: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyAny>> {
-        let (a, b) = (Rows::<DVec3>::new(wi, "wi")?, Rows::<DVec3>::new(wo, "wo")?);
+        let (a, b) = arrays::pair_rows::<DVec3, DVec3>(wi, "wi", wo, "wo")?;
         let p = Pairs::new(&a, "wi", &b, "wo")?;
         let c = self.c();
-        let shape: &[usize] = if p.single { &[c] } else { &[p.n, c] };
-        let out = arrays::zeros::<f32>(py, shape)?;
+        let out = arrays::zeros::<f32>(py, &p.shape(&[c]))?;
         let mut w = out.readwrite();
         let o = w
             .as_slice_mut()
@@ -45,25 +44,14 @@ impl PyBrdf {
         wo: &Bound<'_, PyAny>,
         nm: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyAny>> {
-        let (a, b) = (Rows::<DVec3>::new(wi, "wi")?, Rows::<DVec3>::new(wo, "wo")?);
+        let (a, b) = arrays::pair_rows::<DVec3, DVec3>(wi, "wi", wo, "wo")?;
         let p = Pairs::new(&a, "wi", &b, "wo")?;
         let n = p.n;
-        let l = arrays::f64_array(nm, "nm")?;
-        let (k, per_row) = match l.shape() {
-            [k] => (*k, false),
-            [m, k] if *m == n => (*k, true),
-            s => {
-                return Err(PyValueError::new_err(format!(
-                    "nm: expected shape (k,) or ({n}, k), got {}",
-                    arrays::shape_str(s)
-                )));
-            }
-        };
+        let (k, per_row, l) = arrays::wavelength_rows(arrays::f64_array(nm, "nm")?, &p.lead)?;
         // Read in place: a broadcast `nm` (numpy.broadcast_to) of any length is no copy,
         // and the output is allocated (or refused by numpy) before its entries are checked.
         let nm = l.as_array();
-        let shape: &[usize] = if p.single { &[k] } else { &[n, k] };
-        let out = arrays::zeros::<f32>(py, shape)?;
+        let out = arrays::zeros::<f32>(py, &p.shape(&[k]))?;
         if n > 0
             && let Some(x) = nm.iter().find(|&&x| !brdftab::spectrum::is_wavelength(x))
         {
@@ -109,19 +97,12 @@ impl PyBrdf {
         theta: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyAny>> {
         let a = arrays::f64_array(theta, "theta")?;
-        let single = a.ndim() == 0;
-        if a.ndim() > 1 {
-            return Err(PyValueError::new_err(format!(
-                "theta: expected a number or a 1-d array, got shape {}",
-                arrays::shape_str(a.shape())
-            )));
-        }
         // Read in place and written into the numpy result, allocated (or refused by numpy)
         // before the angles are checked: a broadcast `theta` of any length is no copy.
         let t = a.as_array();
-        let (k, c) = (t.len(), self.c());
-        let shape: &[usize] = if single { &[c] } else { &[k, c] };
-        let out = arrays::zeros::<f64>(py, shape)?;
+        let c = self.c();
+        // One row of c per angle, in the angles' shape (a number: (c,)).
+        let out = arrays::zeros::<f64>(py, &[a.shape(), &[c]].concat())?;
         use brdftab::analysis::albedo::incidence;
         for &x in t.iter() {
             incidence(x).map_err(lib_err)?;

@@ -169,8 +169,11 @@ impl PyBrdf {
         )
     }
 
-    /// f_r(wi, wo) in 1/sr (not times a cosine) as float32 of shape (n, c), or (c,) when both
-    /// wi and wo have shape (3,). Directions need not be normalized; below the horizon, and
+    /// f_r(wi, wo) in 1/sr (not times a cosine) as float32 of shape (..., c): wi and wo are
+    /// (..., 3) arrays whose leading shapes broadcast by numpy's rules — (n, 3) against (n, 3)
+    /// or (3,), an image of directions (h, w, 3), a grid `wi[:, None]` against `wo[None, :]` —
+    /// and the result has the broadcast shape, (c,) for one pair of shape (3,). Directions need
+    /// not be normalized; below the horizon, and
     /// for a direction with a NaN or infinite component or a zero vector, f_r = 0 (as in the
     /// library and the C ABI). A lazily opened table (`eager=False`) whose chunk fails its
     /// checksum raises `brdftab.Error`, then and on every later call.
@@ -183,7 +186,8 @@ impl PyBrdf {
         guard(|| self.eval_pairs(py, wi, wo))
     }
 
-    /// f_r(wi, wo) at wavelengths `nm` (shape (k,) for every pair, or (n, k)): float32 (n, k).
+    /// f_r(wi, wo) at wavelengths `nm` (shape (k,) for every pair, or (..., k), one set per
+    /// pair): float32 (..., k), the pairs' shape as in `eval`.
     /// Spectral channels are interpolated; analytic models use their spectral data; RGB
     /// channels become a spectrum of their colour (`brdftab.rgb_basis`). A
     /// wavelength must be finite and > 0 (the library's rule, as for `wavelengths=`): any
@@ -199,7 +203,8 @@ impl PyBrdf {
         guard(|| self.eval_spectral_pairs(py, wi, wo, nm))
     }
 
-    /// The density (1/sr, solid angle) with which `sample(wo, u)` draws wi: float64 (n,).
+    /// The density (1/sr, solid angle) with which `sample(wo, u)` draws wi: float64 of the
+    /// pairs' shape (as in `eval`; 0-d for one pair).
     fn pdf(
         &self,
         py: Python<'_>,
@@ -209,17 +214,18 @@ impl PyBrdf {
         guard(|| self.pdf_pairs(py, wi, wo))
     }
 
-    /// Draws wi for each wo from uniform numbers u in [0, 1)² (shape (n, 2)); returns
-    /// (wi (n, 3) float64, pdf (n,) float64, weight (n, c) float32) with
+    /// Draws wi for each wo (..., 3) from uniform numbers u in [0, 1)² (..., 2), their leading
+    /// shapes broadcast as in `eval`; returns (wi (..., 3) float64, pdf (...) float64, weight
+    /// (..., c) float32) with
     /// weight = f_r cos θi / pdf (`brdftab sample`'s conventions). Where no direction can be
     /// drawn (wo below the horizon, NaN, infinite or zero) wi, pdf and weight are 0; `u`
     /// outside [0, 1) (NaN included) is a `ValueError`.
     ///
-    /// `nm` (wavelengths in nm, shape (k,) or (n, k)): the weights at those wavelengths,
-    /// (n, k), instead of the channels — for a smooth draw f_r from `eval_spectral`, for a
+    /// `nm` (wavelengths in nm, shape (k,) or (..., k)): the weights at those wavelengths,
+    /// (..., k), instead of the channels — for a smooth draw f_r from `eval_spectral`, for a
     /// delta draw (a mirror) the lobe's reflectance at each wavelength over its `pdf` (the
     /// probability of choosing that lobe, 1 for a mirror alone); the draws are those without
-    /// `nm`. `delta=True`: a fourth array, bool (n,), true where the draw is a delta lobe's (a
+    /// `nm`. `delta=True`: a fourth array, bool (...), true where the draw is a delta lobe's (a
     /// mirror term of a sum: its pdf is then the probability of choosing that lobe,
     /// not a density, and `pdf(wi, wo)` does not contain it) — what a renderer's multiple
     /// importance sampling needs to tell the two apart.
@@ -240,7 +246,7 @@ impl PyBrdf {
 
     /// Directional albedo ∫ f_r cos θo dωo at incidence angles θ′ (radians, in [0, π/2): light
     /// above the horizon; else ValueError naming theta):
-    /// float64 (k, c) (or (c,) for a scalar θ′). A closed form where the model has one, else
+    /// float64 of θ′'s shape and then c ((k, c) for k angles, (c,) for a scalar θ′). A closed form where the model has one, else
     /// adaptive quadrature: 1e-6 relative for models, 1e-4 for tables and measured data.
     fn albedo(&self, py: Python<'_>, theta: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
         guard(|| self.albedo_curve(py, theta))

@@ -51,10 +51,9 @@ impl PyBrdf {
         wi: &Bound<'_, PyAny>,
         wo: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyAny>> {
-        let (a, b) = (Rows::<DVec3>::new(wi, "wi")?, Rows::<DVec3>::new(wo, "wo")?);
+        let (a, b) = arrays::pair_rows::<DVec3, DVec3>(wi, "wi", wo, "wo")?;
         let p = Pairs::new(&a, "wi", &b, "wo")?;
-        let shape: &[usize] = if p.single { &[] } else { &[p.n] };
-        let out = arrays::zeros::<f64>(py, shape)?;
+        let out = arrays::zeros::<f64>(py, &p.shape(&[]))?;
         let mut w = out.readwrite();
         let o = w
             .as_slice_mut()
@@ -73,18 +72,14 @@ impl PyBrdf {
         wo: &Bound<'_, PyAny>,
         u: &Bound<'_, PyAny>,
     ) -> PyResult<Py<PyTuple>> {
-        let (a, b) = (Rows::<DVec3>::new(wo, "wo")?, Rows::<DVec2>::new(u, "u")?);
+        let (a, b) = arrays::pair_rows::<DVec3, DVec2>(wo, "wo", u, "u")?;
         check_u(&b)?;
         let p = Pairs::new(&a, "wo", &b, "u")?;
         let (n, c) = (p.n, self.c());
-        let (s3, s1, sc): (&[usize], &[usize], &[usize]) = match p.single {
-            true => (&[3], &[], &[c]),
-            false => (&[n, 3], &[n], &[n, c]),
-        };
         let (wi, pdf, weight) = (
-            arrays::zeros::<f64>(py, s3)?,
-            arrays::zeros::<f64>(py, s1)?,
-            arrays::zeros::<f32>(py, sc)?,
+            arrays::zeros::<f64>(py, &p.shape(&[3]))?,
+            arrays::zeros::<f64>(py, &p.shape(&[]))?,
+            arrays::zeros::<f32>(py, &p.shape(&[c]))?,
         );
         let (mut wi_w, mut pdf_w, mut w_w) = (wi.readwrite(), pdf.readwrite(), weight.readwrite());
         let slice_err = |e: numpy::NotContiguousError| Error::new_err(e.to_string());
@@ -152,24 +147,17 @@ impl PyBrdf {
         nm: Option<&Bound<'_, PyAny>>,
         want_delta: bool,
     ) -> PyResult<Py<PyTuple>> {
-        use numpy::PyUntypedArrayMethods;
-        let (a, b) = (Rows::<DVec3>::new(wo, "wo")?, Rows::<DVec2>::new(u, "u")?);
+        let (a, b) = arrays::pair_rows::<DVec3, DVec2>(wo, "wo", u, "u")?;
         check_u(&b)?;
         let p = Pairs::new(&a, "wo", &b, "u")?;
         let (n, c) = (p.n, self.c());
-        let l = nm.map(|x| arrays::f64_array(x, "nm")).transpose()?;
-        let (k, per_row) = match l.as_ref().map(|l| l.shape().to_vec()) {
-            None => (c, false),
-            Some(s) => match s.as_slice() {
-                [k] => (*k, false),
-                [m, k] if *m == n => (*k, true),
-                s => {
-                    return Err(PyValueError::new_err(format!(
-                        "nm: expected shape (k,) or ({n}, k), got {}",
-                        arrays::shape_str(s)
-                    )));
-                }
-            },
+        let (k, per_row, l) = match nm {
+            None => (c, false, None),
+            Some(x) => {
+                let (k, per_row, l) =
+                    arrays::wavelength_rows(arrays::f64_array(x, "nm")?, &p.lead)?;
+                (k, per_row, Some(l))
+            }
         };
         let lv = l.as_ref().map(|l| l.as_array());
         if n > 0
@@ -181,15 +169,11 @@ impl PyBrdf {
                 "nm: {x} is not a wavelength (a finite number of nm > 0)"
             )));
         }
-        let (s3, s1, sk): (&[usize], &[usize], &[usize]) = match p.single {
-            true => (&[3], &[], &[k]),
-            false => (&[n, 3], &[n], &[n, k]),
-        };
         let (wi, pdf, weight, delta) = (
-            arrays::zeros::<f64>(py, s3)?,
-            arrays::zeros::<f64>(py, s1)?,
-            arrays::zeros::<f32>(py, sk)?,
-            arrays::zeros::<bool>(py, s1)?,
+            arrays::zeros::<f64>(py, &p.shape(&[3]))?,
+            arrays::zeros::<f64>(py, &p.shape(&[]))?,
+            arrays::zeros::<f32>(py, &p.shape(&[k]))?,
+            arrays::zeros::<bool>(py, &p.shape(&[]))?,
         );
         let (mut wi_w, mut pdf_w, mut w_w, mut d_w) = (
             wi.readwrite(),
