@@ -28,7 +28,7 @@ use std::process::ExitCode;
 
 /// Tabulated BRDFs: analytic models, dense compressed tables, measured data.
 #[derive(Parser)]
-#[command(name = "brdftab", version, about, long_about = None)]
+#[command(name = "brdftab", version, long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

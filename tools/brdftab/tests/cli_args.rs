@@ -71,6 +71,21 @@ fn library_argument_errors_name_the_flag_or_value_the_user_typed() {
 }
 
 #[test]
+fn the_top_level_help_says_what_the_tool_does() {
+    // The `Cli` doc comment, not the tools crate's Cargo description ("The brdftab application:
+    // the `brdftab` CLI, the preview renderer, ..."), which a bare `about` put there.
+    let o = brdftab(&["--help"]);
+    assert!(o.ok, "{}", o.stderr);
+    assert!(
+        o.stdout.starts_with(
+            "Tabulated BRDFs: analytic models, dense compressed tables, measured data\n"
+        ),
+        "{}",
+        o.stdout
+    );
+}
+
+#[test]
 fn usage_says_what_is_required() {
     let o = brdftab(&["bake", "--help"]);
     assert!(o.ok, "{}", o.stderr);
