@@ -9,8 +9,9 @@
 //! - [`progress`]: the library's progress reports as an indicatif bar on a terminal;
 //! - [`report`]: the accuracy suite, the measured-table benchmark and their plots;
 //! - [`rng`]: the tools' random numbers;
-//! - [`text`]: the CLI's text input and output — lines of numbers from stdin (`eval`, `pdf`,
-//!   `sample`) and writes to stdout that fail instead of panicking on a closed pipe;
+//! - [`text`]: the CLI's text input and output — lines of numbers from stdin (`eval` and
+//!   `pdf`; `sample` takes its view as `--wo`) and writes to stdout that fail instead of
+//!   panicking on a closed pipe;
 //! - [`view`]: the `brdftab view` server (the BRDF explorer in the browser).
 
 // `!(x > 0.0)` rejects NaN together with non-positive values, as in the core library.

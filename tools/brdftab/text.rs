@@ -1,4 +1,4 @@
-//! Lines of numbers, as the CLI's `eval`, `pdf` and `sample` read them from stdin.
+//! Lines of numbers, as the CLI's `eval` and `pdf` read them from stdin.
 //!
 //! The format is shared by every host that pipes direction pairs through text: one record per
 //! line, numbers separated by white space, blank lines and `#` comments skipped. Errors name the
