@@ -14,8 +14,10 @@
 //! - [`tabulated`]: [`TabulatedBrdf`], the `Brdf` over a table — every chunk in memory, or loaded
 //!   on first touch through a [`ChunkLoader`];
 //! - [`presets`]: `small`, `medium`, `large` grids with measured accuracy;
-//! - [`raw`]: a minimal JSON-header + f32 file (stop-gap until the store's format is wired in);
-//! - [`sampling`]: importance sampling of tables (tabulated equal-area CDFs of f_r·cos θi).
+//! - [`raw`]: a minimal JSON-header + f32 file, uncompressed (`convert`'s output for a name that
+//!   is not `.btdb`, `DB#NAME`, `.bsdf` or `.binary`; the compressed format is [`crate::store`]);
+//! - [`sampling`]: importance sampling of tables ([`TableSampler`]: conditional half-vector
+//!   densities of f_r·cos θi, drawn with alias tables).
 //!
 //! Values are stored λ innermost: the values of one node for every channel are contiguous, so
 //! one set of angular interpolation weights serves all channels.
