@@ -18,7 +18,8 @@ use crate::spectrum::Value;
 pub struct FitSettings {
     /// Parameters to fit, paths into the spec with optional bounds:
     /// `terms[1].m,terms[0].kd=0:0.3,n=2:500:log` (or a list). Default: every numeric parameter,
-    /// within physical bounds (kd ≤ 1.2/π, ks ≤ 1.5, m and α 0.01–1.5, n 1–10⁴, σ ≤ 1.5).
+    /// within physical bounds (kd ≤ 1.2/π, ks ≤ 1.5 — the Phong family's 1e-3–10⁴ —, m and α
+    /// 0.01–1.5, n 1–10⁴, σ ≤ 1.5).
     #[cfg_attr(feature = "clap", arg(long))]
     pub params: Option<Names>,
     /// Residuals in log space, ln(1 + f cos θi) (compresses specular peaks).
