@@ -76,7 +76,8 @@ pub struct BakeRequest {
     pub force: bool,
     /// The codec (quantization, its tolerance, zstd level).
     pub codec: Codec,
-    /// The table's name (default: the output file's stem).
+    /// The table's name (default: the output file's stem); a [`BakeTarget::Db`] names its
+    /// table itself.
     pub name: Option<String>,
     /// Samples per stored axis and cell (box prefilter; 1 = node values).
     pub supersample: usize,

@@ -62,7 +62,7 @@ pub struct BakeSettings {
     #[cfg_attr(feature = "clap", arg(long))]
     pub exhaustive: bool,
     /// Table name inside the file (default: the output file's stem, or the input's for
-    /// `convert`).
+    /// `convert`; `DB#NAME` names it itself).
     #[cfg_attr(feature = "clap", arg(long))]
     pub name: Option<String>,
     /// Samples per axis and cell, 1..=64 (box prefilter for very sharp lobes; default 1).
