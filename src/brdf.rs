@@ -191,8 +191,8 @@ pub trait Brdf: Send + Sync {
     }
 
     /// Evaluates many pairs: `out[k * c .. (k + 1) * c]` receives `f_r(wi[k], wo[k])` where `c` is
-    /// the channel count. Batches of 16 384 pairs or more run on rayon's threads; tables
-    /// override this for throughput.
+    /// the channel count. Batches of [`crate::batch::PARALLEL`] (16 384) pairs or more run on
+    /// the library's pool ([`crate::par`]); tables override this for throughput.
     ///
     /// # Panics
     ///
