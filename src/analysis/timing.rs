@@ -6,8 +6,11 @@
 //! `eval`, 4.5–5.5× a batch) would be fast only on the benchmark's own inputs.
 //!
 //! The machines this runs on are shared, so each figure comes with its CPU-time twin (Linux
-//! schedstat; `None` elsewhere): wall-clock time alone says more about the neighbours than about
-//! the code. Medians over the repeats.
+//! schedstat): wall-clock time alone says more about the neighbours than about the code. Medians
+//! over the repeats. A CPU-time figure is NaN where it is unknown: off Linux, and for a run the
+//! clock does not resolve — schedstat's runtime advances at scheduler events (ticks of a few ms),
+//! so a repeat that shows none was shorter than that, and no figure is better than 0 ns or an
+//! infinite rate.
 
 use std::time::Instant;
 
@@ -47,13 +50,15 @@ pub struct LookupTiming {
     pub ns_per_pdf_single_thread: f64,
     /// Median over the rounds of one `sample` / one `eval` (each round times both).
     pub sample_over_eval: f64,
-    /// Samples per second of CPU time of `sample_batch` on the same views (per core).
+    /// Samples per second of CPU time of `sample_batch` on the same views (per core; NaN where
+    /// unknown).
     pub samples_per_s_batch_per_core_cpu_time: f64,
     /// Wall-clock ns per `eval` on one thread of the same pairs as renderers hold them: each
     /// direction rounded to f32 and normalized there (unit only to f32 precision), in the same
     /// rounds as the exact pairs.
     pub ns_per_lookup_f32_directions: f64,
-    /// Lookups per second of CPU time of `eval_batch` on those f32 pairs (per core).
+    /// Lookups per second of CPU time of `eval_batch` on those f32 pairs (per core; NaN where
+    /// unknown).
     pub lookups_per_s_batch_f32_directions_per_core_cpu_time: f64,
 }
 
@@ -108,9 +113,7 @@ pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTim
         }
         let eval_ns = t.elapsed().as_secs_f64() * 1e9 / n;
         single.push(eval_ns);
-        if let (Some(a0), Some(a1)) = (cpu, thread_cpu_ns()) {
-            single_cpu.push((a1 - a0) as f64 / n);
-        }
+        single_cpu.push(cpu_ns(cpu, thread_cpu_ns()).map(|d| d / n));
         std::hint::black_box(&out);
         let t = Instant::now();
         for (k, o) in out.chunks_exact_mut(c).enumerate() {
@@ -136,17 +139,13 @@ pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTim
         let (t, cpu) = (Instant::now(), process_cpu_ns());
         src.eval_batch(&wi, &wo, &mut out);
         batch.push(n / t.elapsed().as_secs_f64());
-        if let (Some(a0), Some(a1)) = (cpu, process_cpu_ns()) {
-            // Per core of CPU time: independent of how busy the machine is and of how many
-            // threads `eval_batch` used.
-            batch_cpu.push(n / ((a1 - a0) as f64 * 1e-9));
-        }
+        // Per core of CPU time: independent of how busy the machine is and of how many
+        // threads `eval_batch` used.
+        batch_cpu.push(cpu_ns(cpu, process_cpu_ns()).map(|d| n / (d * 1e-9)));
         std::hint::black_box(&out);
         let cpu = process_cpu_ns();
         src.eval_batch(&fi, &fo, &mut out);
-        if let (Some(a0), Some(a1)) = (cpu, process_cpu_ns()) {
-            batch_f32.push(n / ((a1 - a0) as f64 * 1e-9));
-        }
+        batch_f32.push(cpu_ns(cpu, process_cpu_ns()).map(|d| n / (d * 1e-9)));
         std::hint::black_box(&out);
     }
     let (mut swi, mut spdf) = (vec![DVec3::ZERO; pairs], vec![0.0; pairs]);
@@ -159,9 +158,7 @@ pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTim
             weight: &mut out,
         };
         src.sample_batch(&wo, &u, out);
-        if let (Some(a0), Some(a1)) = (cpu, process_cpu_ns()) {
-            sample_batch.push(n / ((a1 - a0) as f64 * 1e-9));
-        }
+        sample_batch.push(cpu_ns(cpu, process_cpu_ns()).map(|d| n / (d * 1e-9)));
         std::hint::black_box(&swi);
     }
     Ok(LookupTiming {
@@ -170,22 +167,41 @@ pub fn lookups(src: &dyn Brdf, pairs: usize, repeats: usize) -> Result<LookupTim
         channels: c,
         repeats,
         ns_per_lookup_single_thread: median(&mut single),
-        cpu_ns_per_lookup_single_thread: median(&mut single_cpu),
+        cpu_ns_per_lookup_single_thread: median_known(&single_cpu),
         lookups_per_s_batch: median(&mut batch),
-        lookups_per_s_batch_per_core_cpu_time: median(&mut batch_cpu),
+        lookups_per_s_batch_per_core_cpu_time: median_known(&batch_cpu),
         threads: crate::par::threads(),
         ns_per_sample_single_thread: median(&mut sample),
         ns_per_pdf_single_thread: median(&mut pdf),
         sample_over_eval: median(&mut ratio),
-        samples_per_s_batch_per_core_cpu_time: median(&mut sample_batch),
+        samples_per_s_batch_per_core_cpu_time: median_known(&sample_batch),
         ns_per_lookup_f32_directions: median(&mut single_f32),
-        lookups_per_s_batch_f32_directions_per_core_cpu_time: median(&mut batch_f32),
+        lookups_per_s_batch_f32_directions_per_core_cpu_time: median_known(&batch_f32),
     })
 }
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(|x, y| x.total_cmp(y));
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// The median of CPU-time figures, NaN unless every repeat has one: a repeat the clock did not
+/// resolve makes the others no more than ticks counted over a run of similar length.
+fn median_known(v: &[Option<f64>]) -> f64 {
+    match v.iter().copied().collect::<Option<Vec<f64>>>() {
+        Some(mut known) => median(&mut known),
+        None => f64::NAN,
+    }
+}
+
+/// The CPU ns between two clock readings, `None` where a reading is missing or the clock did not
+/// advance (or went back: a thread of the process that ended between the readings took its time
+/// with it).
+fn cpu_ns(a0: Option<u64>, a1: Option<u64>) -> Option<f64> {
+    match a1?.checked_sub(a0?) {
+        Some(d) if d > 0 => Some(d as f64),
+        _ => None,
+    }
 }
 
 /// CPU time of the calling thread in ns (Linux `/proc/thread-self/schedstat`).
@@ -223,5 +239,28 @@ mod tests {
         assert!(t.sample_over_eval > 0.0);
         assert!(t.ns_per_lookup_f32_directions > 0.0);
         assert!(lookups(m.as_ref(), 0, 3).is_err());
+    }
+
+    #[test]
+    fn a_cpu_time_the_clock_does_not_resolve_is_unknown_not_zero_or_infinite() {
+        // schedstat's runtime advances at scheduler events, not per instruction: ten lookups
+        // take no CPU time it can see. That is no figure (NaN), not "0.0 ns CPU time" or an
+        // infinite rate per core (what `brdftab bench --pairs 2000` printed).
+        let m = crate::spec::ModelSpec::parse(r#"{"model": "lambert", "kd": 0.5}"#)
+            .unwrap()
+            .build(&crate::Channels::Rgb)
+            .unwrap();
+        let t = lookups(m.as_ref(), 10, 3).unwrap();
+        for (name, x) in [
+            ("single", t.cpu_ns_per_lookup_single_thread),
+            ("batch", t.lookups_per_s_batch_per_core_cpu_time),
+            ("sample batch", t.samples_per_s_batch_per_core_cpu_time),
+            (
+                "f32 batch",
+                t.lookups_per_s_batch_f32_directions_per_core_cpu_time,
+            ),
+        ] {
+            assert!(x.is_nan() || (x.is_finite() && x > 0.0), "{name}: {x}");
+        }
     }
 }
