@@ -32,7 +32,7 @@ use brdftab_tools::text::print_out;
 #[derive(Args)]
 pub struct DemoArgs {
     /// Print only the plausibility table of the lecture's models.
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["out", "preset", "rgl", "quick"])]
     plausibility: bool,
     /// Output directory (created).
     #[arg(long, default_value = "demo-out")]
@@ -66,13 +66,13 @@ struct Source {
 /// Runs the demo.
 pub fn demo(a: DemoArgs) -> Result<()> {
     let t0 = Instant::now();
+    let preset = a.preset.as_deref().map(str::parse::<Preset>).transpose();
+    let preset = preset.map_err(|e| flag_named(e, "--preset"))?;
     plausibility_table()?;
     eprintln!("[{:.1} s] plausibility table", t0.elapsed().as_secs_f64());
     if a.plausibility {
         return Ok(());
     }
-    let preset = a.preset.as_deref().map(str::parse::<Preset>).transpose();
-    let preset = preset.map_err(|e| flag_named(e, "--preset"))?;
     std::fs::create_dir_all(&a.out).map_err(|e| Error::io(&a.out, e))?;
     let out = a.out.canonicalize().map_err(|e| Error::io(&a.out, e))?;
     let db = out.join("demo.btdb");

@@ -182,6 +182,22 @@ fn flags_of_another_mode_are_refused_not_ignored() {
     );
     assert!(slice(&["--kind", "halfdiff", "--phi-d", "30"]).ok);
     assert!(slice(&["--kind", "polar", "--theta-in", "30", "--phi-in", "10"]).ok);
+    // `demo --plausibility` bakes nothing: the bake's flags were ignored (`--preset huge`
+    // exited 0), and a bad preset was refused only after the plausibility table was printed.
+    for extra in [
+        &["--preset", "small"][..],
+        &["--preset", "huge"],
+        &["--quick"],
+        &["--rgl", "data/rgl"],
+        &["--out", &d.file("demo")],
+    ] {
+        let o = brdftab(&[&["demo", "--plausibility"][..], extra].concat());
+        refused(&o, &["--plausibility", extra[0]]);
+    }
+    refused(
+        &brdftab(&["demo", "--preset", "huge", "--out", &d.file("demo")]),
+        &["`--preset`", "huge"],
+    );
 }
 
 #[test]
