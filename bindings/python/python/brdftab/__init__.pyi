@@ -98,7 +98,8 @@ class Brdf:
         of choosing that lobe; `pdf()` does not contain them)."""
     def albedo(self, theta: _ArrayLike) -> npt.NDArray[np.float64]:
         """Directional albedo at θ′ in radians, 0 ≤ θ′ < π/2 (light above the horizon; else
-        ValueError naming theta): float64 of θ′'s shape then c, (k, c) for k angles.
+        ValueError naming theta): float64 of θ′'s shape then c: (k, c) for k angles, (c,) for a
+        scalar θ′.
 
         A closed form where the model has one, else adaptive quadrature: 1e-6 relative for
         models, 1e-4 for tables and measured data.
