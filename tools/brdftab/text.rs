@@ -1,8 +1,9 @@
 //! Lines of numbers, as the CLI's `eval` and `pdf` read them from stdin.
 //!
 //! The format is shared by every host that pipes direction pairs through text: one record per
-//! line, numbers separated by white space, blank lines and `#` comments skipped. Errors name the
-//! input and the 1-based line.
+//! line, numbers separated by white space, blank lines and lines that start with `#` skipped (a
+//! `#` after a record's numbers is not a comment: that line is an error). Errors name the input
+//! and the 1-based line.
 
 use std::io::BufRead;
 
