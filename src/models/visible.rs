@@ -51,10 +51,14 @@ pub fn partner_dot(v: DVec3, h: DVec3) -> f64 {
 
 /// The density (solid angle) with which the visible-normal draw reflects unit `v` to direction
 /// `x`, on either side of the horizon (a fold's preimage below it): with H = normalize(x + v),
-/// D(H) cos α / (2 (⟨V,H⟩⁺ + ⟨V,H′⟩⁺)), where `d` gives D at cos α; 0 where H is below the
-/// horizon or faces away from `v`.
+/// D(H) cos α / (2 (⟨V,H⟩⁺ + ⟨V,H′⟩⁺)), where `d` gives D of the unnormalized half vector
+/// x + v (h_z > 0); 0 where H is below the horizon or faces away from `v`.
+///
+/// `d` takes the vector rather than cos α so that a narrow D can read tan² α as
+/// (h_x² + h_y²)/h_z²: from cos α, (1 − cos² α)/cos² α cancels to multiples of ~1e-16, which
+/// is all of a Beckmann lobe of m = 1e-8 (tan² α/m² then moved in steps of ~1).
 #[inline]
-pub fn density(x: DVec3, v: DVec3, d: impl FnOnce(f64) -> f64) -> f64 {
+pub fn density(x: DVec3, v: DVec3, d: impl FnOnce(DVec3) -> f64) -> f64 {
     let h = x + v;
     let hh = h.length_squared();
     if !(h.z > 0.0 && hh > 0.0) {
@@ -66,7 +70,7 @@ pub fn density(x: DVec3, v: DVec3, d: impl FnOnce(f64) -> f64) -> f64 {
     if !(a > 0.0) {
         return 0.0;
     }
-    d(cos_a) * cos_a / (2.0 * (a + partner_dot(v, h) * inv))
+    d(h) * cos_a / (2.0 * (a + partner_dot(v, h) * inv))
 }
 
 /// The azimuth φ′ ∈ (−π, π) of a V-cavity visible normal relative to the view's azimuth, drawn
