@@ -122,12 +122,24 @@ impl Phong {
         self.variant
     }
 
-    /// cos^n for cos > 0.
+    /// cos^n ψ for the angle ψ between the unit vectors `r` and `w` (0 where cos ψ ≤ 0).
+    ///
+    /// Taken from 1 − cos ψ = |r − w|²/2 rather than from r·w: a sharp lobe lives where
+    /// cos ψ is within 1/n of 1, and the dot product, rounded to ~1e-16 and off by the 2⁻⁴⁰ in
+    /// squared length that the library takes as unit ([`geometry::unit`]), moved cos^n ψ by
+    /// n · 1e-16 and up to n · 9e-13 (4e-5 at n = 1e8, half the peak again at n = 1e12). The
+    /// difference has neither error: for vectors of lengths 1 + ε it is 1 − cos ψ to relative
+    /// ε plus (ε₁ − ε₂)², and it is symmetric in `r` and `w` bit for bit (reciprocity).
     #[inline]
-    fn pow_n(&self, c: f64) -> f64 {
+    fn pow_cos(&self, r: DVec3, w: DVec3) -> f64 {
+        let d = 0.5 * (r - w).length_squared();
+        if !(d < 1.0) {
+            return 0.0;
+        }
         match self.n_int {
-            Some(i) => c.powi(i),
-            None => c.powf(self.n),
+            // (1 − d)ⁿ rounds 1 − d to ~1e-16, n · 1e-16 ≤ 7e-12 here.
+            Some(i) => (1.0 - d).powi(i),
+            None => (self.n * (-d).ln_1p()).exp(),
         }
     }
 
@@ -136,11 +148,7 @@ impl Phong {
     #[inline]
     fn lobe_over_x(&self, wi: DVec3, wo: DVec3) -> f64 {
         // cos ψ = ω · (2 (N·ω′) N − ω′) = reflect_z(ω′) · ω.
-        let cos_psi = geometry::reflect_z(wi).dot(wo);
-        if cos_psi.is_nan() || cos_psi <= 0.0 {
-            return 0.0;
-        }
-        let lobe = self.pow_n(cos_psi);
+        let lobe = self.pow_cos(geometry::reflect_z(wi), wo);
         if lobe == 0.0 {
             // cos^n ψ underflowed (a sharp lobe far from its axis) where X may have too (the
             // product and sqrt X at subnormal cosines): 0, not 0/0 (which `eval` saturated to
@@ -167,12 +175,7 @@ impl Phong {
     /// hemisphere around that axis), at any direction `wi`, above the horizon or not.
     #[inline]
     fn lobe_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        let cos_psi = geometry::reflect_z(wo).dot(wi);
-        if cos_psi > 0.0 {
-            self.lobe_norm * self.pow_n(cos_psi)
-        } else {
-            0.0
-        }
+        self.lobe_norm * self.pow_cos(geometry::reflect_z(wo), wi)
     }
 
     /// The density of [`Brdf::sample`] at a unit `wi` above the horizon: the lobe's at `wi` and
@@ -257,12 +260,15 @@ impl Brdf for Phong {
             return None;
         }
         // cos ψ = u₀^{1/(n+1)} has density (n + 1) cos^n ψ on [0, 1]. At u₀ = 0 the draw is
-        // on the lobe's rim, where that density is 0: its pdf would be rounding noise.
-        let cos_psi = u.x.powf(self.inv_n1);
+        // on the lobe's rim, where that density is 0: its pdf would be rounding noise. 1 − cos ψ
+        // = −expm1(ln u₀ / (n + 1)) and sin ψ = √((1 − cos ψ)(1 + cos ψ)) keep a sharp lobe's
+        // angle, which 1 − cos² ψ rounded to ~1e-16 (1e-4 of sin ψ at n = 1e12).
+        let d = -(u.x.ln() * self.inv_n1).exp_m1();
+        let cos_psi = 1.0 - d;
         if !(cos_psi > 0.0) {
             return None;
         }
-        let sin_psi = (1.0 - cos_psi * cos_psi).max(0.0).sqrt();
+        let sin_psi = (d * (2.0 - d)).max(0.0).sqrt();
         let (s, c) = crate::fastmath::sin_cos_2pi(u.y);
         let r = geometry::reflect_z(wo);
         let drawn = Frame::from_normal(r).to_world(DVec3::new(sin_psi * c, sin_psi * s, cos_psi));
@@ -468,5 +474,42 @@ mod tests {
         assert!(f.iter().all(|x| x.is_finite() && *x > 1e30), "{f:?}");
         assert!(Phong::reciprocal(Value::Grey(1.0), -1.0, &Channels::Rgb).is_err());
         assert!(Phong::reciprocal(Value::Grey(-1.0), 1.0, &Channels::Rgb).is_err());
+    }
+    /// cos^n ψ of a huge exponent from 1 − cos ψ = |reflect(ω′) − ω|²/2, not from the dot
+    /// product: cos ψ rounded to ~1e-16 and the 2⁻⁴⁰ in squared length that the library takes
+    /// as unit moved cos^n ψ by n · 1e-16 and up to n · 9e-13. At the peak, pairs of lengths
+    /// 1 ± 2e-13 read 0.50002 (n = 1e8), 0.502 (1e10) and 0.746 (1e12) for k_s = 0.5, and at
+    /// n = 1e12 a draw from a rescaled view had a density 1e-4 from the unit view's.
+    #[test]
+    fn huge_exponents_keep_the_peak_and_their_density() {
+        for variant in [PhongVariant::Reciprocal, PhongVariant::Original] {
+            for n in [1e8, 1e10, 1e12] {
+                let p = Phong::new(variant, Value::Grey(0.5), n, &Channels::Rgb).unwrap();
+                let wi = geometry::spherical(0.5, 0.3);
+                let wo = geometry::reflect_z(wi);
+                let peak = 0.5
+                    / if variant == PhongVariant::Original {
+                        wi.z
+                    } else {
+                        1.0
+                    };
+                for (a, b) in [(1.0, 1.0), (1.0 + 2e-13, 1.0), (1.0, 1.0 - 2e-13)] {
+                    let mut f = [0.0f32; 3];
+                    p.eval(wi * a, wo * b, &mut f);
+                    // f32 rounding of the value.
+                    assert!(
+                        (f[0] as f64 / peak - 1.0).abs() < 1e-7,
+                        "{variant:?} n = {n:e}, lengths {a}, {b}: {} vs {peak}",
+                        f[0]
+                    );
+                }
+                if n == 1e12 {
+                    let opts = crate::testkit::Contract::default();
+                    if let Err(v) = crate::testkit::check_contract(&p, &opts) {
+                        panic!("{variant:?} n = {n:e}:\n{}", v.join("\n"));
+                    }
+                }
+            }
+        }
     }
 }
