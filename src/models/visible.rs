@@ -1,9 +1,10 @@
 //! Visible normals of a V-cavity surface: the importance sampler of microfacet-style lobes whose
-//! normal distribution D is isotropic (Cook-Torrance's Beckmann, Blinn-Phong's cosine power).
+//! normal distribution D is isotropic (Cook-Torrance's Beckmann; Blinn-Phong still draws its
+//! half vector from D cos α and refuses the draws that reflect below the horizon).
 //!
 //! Why a module: drawing the half vector H from D(H) cos α, as these models used to, ignores the
 //! view: at grazing views much of the draw faces away from V or reflects below the horizon and
-//! is refused (a third of the draws at 85° for Cook-Torrance and Blinn-Phong), and what is kept
+//! is refused (a third of the draws at 85° for Cook-Torrance), and what is kept
 //! carries weights that spread by V·H / cos α. The V-cavity model (Heitz & d'Eon 2014, and the
 //! masking term of Cook-Torrance itself) makes a surface of cavities with facets H and H′ (H turned
 //! by π about N); V sees H with probability ⟨V,H⟩⁺ / (⟨V,H⟩⁺ + ⟨V,H′⟩⁺). Drawing the visible
