@@ -148,9 +148,9 @@ impl Brdf for Mirror {
 /// `out` flag is false) and the relative index becomes 1/η.
 ///
 /// **Radiance convention.** The weight is the lecture's k_t = 1 − F with **no** (η_t/η_i)²
-/// factor (η_t the index on the side of the sampled `wi`, η_i that on the side of `wo`: the
-/// factor a radiance-tracking renderer applies when its camera path crosses from `wo`'s side
-/// into `wi`'s): the sample carries the fraction of energy (and of importance) transmitted, which is
+/// factor (light crosses from `wi`'s side, index η_i, into `wo`'s, index η_t; radiance L/η² is
+/// what an interface conserves, so the radiance reaching `wo` is (η_t/η_i)² (1 − F) that of
+/// `wi`): the sample carries the fraction of energy (and of importance) transmitted, which is
 /// the same in both directions. A renderer that tracks radiance across an interface and wants the
 /// radiance compression of a ray entering a denser medium must apply that factor itself. Because
 /// of this the model is not declared reciprocal (the radiance BTDF of a real interface is only
