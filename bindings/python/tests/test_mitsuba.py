@@ -803,3 +803,79 @@ def test_a_scene_file_names_its_material_as_it_would_for_measured(rgl, tmp_path,
         assert np.all(a > 0)
     with pytest.raises(Exception, match="not both"):
         mi.load_dict({"type": "brdftab", "source": "a.bsdf", "filename": "a.bsdf"})
+
+
+def _calls(variant, b, ctx, wi, wo, u):
+    """eval, pdf, eval_pdf and sample of ``b`` at one pair, as numpy arrays."""
+    si = mi.SurfaceInteraction3f() if variant.startswith("scalar") else dr.zeros(
+        mi.SurfaceInteraction3f, 1)
+    wi, wo, u = ([float(x) for x in v] for v in (wi, wo, u))
+    si.wi, v, u2 = mi.Vector3f(*wi), mi.Vector3f(*wo), mi.Point2f(*u)
+    e, p = b.eval_pdf(ctx, si, v)
+    bs, w = b.sample(ctx, si, 0.5, u2)
+    return dict(eval=np.array(b.eval(ctx, si, v)).ravel(), pdf=np.array(b.pdf(ctx, si, v)).ravel(),
+                eval_pdf=np.concatenate([np.array(e).ravel(), np.array(p).ravel()]),
+                sample=np.concatenate([np.array(bs.pdf).ravel(), np.array(w).ravel()]))
+
+
+@pytest.mark.parametrize("variant", ["scalar_rgb", "llvm_ad_rgb"])
+def test_a_context_that_excludes_the_component_gets_nothing(variant):
+    """A ``BSDFContext`` whose type mask or component leaves out the plugin's one component
+    (glossy reflection for GGX) got the full BSDF, where Mitsuba's own plugins (``measured``,
+    ``roughconductor``) give zeros: eval, pdf, eval_pdf and sample."""
+    use(variant)
+    F = mi.BSDFFlags
+    b = mi.load_dict({"type": "brdftab", "source": GGX_SPEC, "preset": "small", "cache": False})
+    wi, wo, u = [0.3, 0.1, 0.948683], [-0.3, 0.0, 0.953939], [0.3, 0.6]
+    full = _calls(variant, b, mi.BSDFContext(), wi, wo, u)
+    assert all(np.all(v > 0) for v in full.values())
+    other = mi.BSDFContext()
+    other.component = 1
+    for ctx in [mi.BSDFContext(mi.TransportMode.Radiance, F.DiffuseReflection),
+                mi.BSDFContext(mi.TransportMode.Radiance, F.DeltaReflection), other]:
+        got = _calls(variant, b, ctx, wi, wo, u)
+        assert all(not np.any(v) for v in got.values()), (ctx, got)
+    for ctx in [mi.BSDFContext(mi.TransportMode.Radiance, F.GlossyReflection),
+                mi.BSDFContext(mi.TransportMode.Radiance, F.GlossyReflection | F.DiffuseReflection)]:
+        got = _calls(variant, b, ctx, wi, wo, u)
+        for k, v in full.items():
+            np.testing.assert_array_equal(got[k], v)
+
+
+PHONG_ORIGINAL = '{"model": "phong", "ks": 0.5, "n": 20}'  # k_s cos^n ψ / cos θ′: not reciprocal
+
+
+@pytest.mark.parametrize("variant", ["scalar_rgb", "llvm_ad_rgb"])
+def test_importance_transport_evaluates_the_adjoint(variant):
+    """In importance transport (a light tracer: ``ptracer``) ``si.wi`` points towards the light's
+    side of the path, so for a source that is not reciprocal the plugin must give the adjoint,
+    f(wo, si.wi) cos θo, for ``path`` and ``ptracer`` to render one material. It gave
+    f(si.wi, wo) cos θo in both modes (the original Phong's 1 / cos θ′ on the wrong side)."""
+    use(variant)
+    b = mi.load_dict({"type": "brdftab", "source": PHONG_ORIGINAL, "preset": "small",
+                      "cache": False})
+    a = np.array([0.8, 0.0, 0.6])      # θ 53°
+    c = np.array([-0.75, 0.1, 0.6538])  # near a's mirror image, θ 49°
+    c /= np.linalg.norm(c)
+    rad = mi.BSDFContext(mi.TransportMode.Radiance)
+    imp = mi.BSDFContext(mi.TransportMode.Importance)
+    f_rad = _calls(variant, b, rad, c, a, [0.5, 0.5])["eval"] / a[2]
+    f_imp = _calls(variant, b, imp, a, c, [0.5, 0.5])["eval"] / c[2]
+    # The same f_r at the same pair, read with the roles the mode gives the directions.
+    np.testing.assert_allclose(f_imp, f_rad, rtol=1e-6)
+    f_swapped = _calls(variant, b, rad, a, c, [0.5, 0.5])["eval"] / c[2]
+    # 1 / cos θ′ of the two directions: 0.6538 / 0.6 apart, far from equal.
+    assert np.all(np.abs(f_swapped / f_imp - 1) > 0.05)
+    # A draw's weight in importance transport is its eval over its pdf.
+    for u in ([0.2, 0.7], [0.6, 0.1], [0.9, 0.9]):
+        got = _calls(variant, b, imp, a, c, u)
+        if variant.startswith("scalar"):
+            si = mi.SurfaceInteraction3f()
+        else:
+            si = dr.zeros(mi.SurfaceInteraction3f, 1)
+        si.wi = mi.Vector3f(*[float(x) for x in a])
+        bs, w = b.sample(imp, si, 0.5, mi.Point2f(*u))
+        e = np.array(b.eval(imp, si, bs.wo)).ravel()
+        pdf = float(np.array(bs.pdf).ravel()[0])
+        assert pdf > 0
+        np.testing.assert_allclose(np.array(w).ravel(), e / pdf, rtol=1e-5)

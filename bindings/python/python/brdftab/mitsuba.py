@@ -25,7 +25,14 @@ material is baked once, not at every scene load) and ``cache_dir``.
 Conventions are those of Mitsuba's ``measured`` plugin: ``si.wi`` is brdftab's ``wi`` (towards
 the light in brdftab's words; the tensor's incident axes for RGL data), Mitsuba's ``wo`` is
 brdftab's ``wo``; ``eval`` returns f_r · cos θ(wo); front side only (so a source that transmits
-— a refractor — is refused: use Mitsuba's ``dielectric``).
+— a refractor — is refused: use Mitsuba's ``dielectric``). In importance transport
+(``BSDFContext(TransportMode.Importance)``, a light tracer such as ``ptracer``) ``eval`` and
+``sample``'s weight are the adjoint, f_r(wo, si.wi) · cos θ(wo), so ``path`` and ``ptracer``
+render one material also for a source that is not reciprocal (the sampler and ``pdf`` are the
+same in both modes). The plugin is one component (index 0) with the source's lobe flags: a
+context whose type mask or component leaves it out gets zeros, as from Mitsuba's plugins (for
+``eval``/``pdf`` its smooth lobes count, for ``sample`` any of them: a sum's draw is not split
+by lobe).
 
 - Scalar variants (``scalar_rgb``, ``scalar_spectral``) call the library for every query (the
   native source: RGL files evaluate with their own adaptive parameterization, as Mitsuba's
@@ -281,6 +288,29 @@ class _Common:
         self.m_flags = flags
         self.delta = self.brdf.flags["delta"]
 
+    def _enabled(self, ctx, smooth):
+        """Whether ``ctx`` (its type mask and component index) asks for the plugin's one
+        component, as Mitsuba's plugins check it (``ctx.is_enabled``): for ``eval`` and ``pdf``
+        (``smooth``) its smooth lobes, for ``sample`` any of its lobes. A context that leaves it
+        out gets zeros, not the whole BSDF."""
+        import mitsuba as mi
+
+        F = mi.BSDFFlags
+        lobes = int(self.m_flags) & ~(int(F.FrontSide) | int(F.BackSide))
+        if smooth:
+            lobes &= int(F.Smooth)
+        # `BSDFContext::is_enabled(lobes, 0)`, by hand: its Python binding takes one flag, not
+        # a union of them.
+        return bool(int(ctx.type_mask) & lobes) and int(ctx.component) in (0, 2**32 - 1)
+
+    @staticmethod
+    def _adjoint(ctx):
+        """Whether ``ctx`` is importance transport (a light tracer: ``si.wi`` points to the
+        light's side of the path), where the plugin gives the adjoint BSDF f(wo, si.wi)."""
+        import mitsuba as mi
+
+        return ctx.mode == mi.TransportMode.Importance
+
     def to_string(self):
         """``BrdftabBSDF[source=..., <the source's description>]`` (Mitsuba's ``str``)."""
         return f"BrdftabBSDF[source={self.source!r}, {self.brdf.describe()}]"
@@ -323,17 +353,23 @@ class ScalarBrdftabBSDF(_Common):
         wi, wo = self._vec(si.wi), self._vec(wo)
         if self.delta or not (wi[2] > 0 and wo[2] > 0) or not active:
             return mi.Spectrum(0.0)
+        if not self._enabled(ctx, True):
+            return mi.Spectrum(0.0)
         cos_o = wo[2] / math.sqrt(wo[0] ** 2 + wo[1] ** 2 + wo[2] ** 2)
         if not cos_o > 0:
             # A NaN or infinite component of wo (the library's f_r is 0 for it, but 0 · NaN is
             # NaN): 0, the NaN rule of every host.
             return mi.Spectrum(0.0)
+        if self._adjoint(ctx):
+            return self._f(wo, wi, si) * cos_o
         return self._f(wi, wo, si) * cos_o
 
     def pdf(self, ctx, si, wo, active=True):
         """The density of :meth:`sample` drawing wo given ``si.wi`` (0 for a delta source)."""
         wi, wo = self._vec(si.wi), self._vec(wo)
         if self.delta or not (wi[2] > 0 and wo[2] > 0) or not active:
+            return 0.0
+        if not self._enabled(ctx, True):
             return 0.0
         # Mitsuba's wo is drawn given si.wi: brdftab's sampler draws its `wi` given its `wo`,
         # so it is asked with the roles swapped (see `sample`).
@@ -351,7 +387,7 @@ class ScalarBrdftabBSDF(_Common):
         bs = mi.BSDFSample3f()
         wi = self._vec(si.wi)
         u = [min(float(sample2[0]), 0.99999994), min(float(sample2[1]), 0.99999994)]
-        if not (wi[2] > 0) or not active:
+        if not (wi[2] > 0) or not active or not self._enabled(ctx, False):
             return bs, mi.Spectrum(0.0)
         # A spectral variant asks for the weights at the path's wavelengths (a mirror's
         # reflectance lives only in its sample); `delta` tells a delta lobe's draw (a mirror, or
@@ -1195,21 +1231,24 @@ class JitBrdftabBSDF(_Common):
         return dr.if_stmt(args=tuple(args), cond=active, true_fn=lambda *a: on(*a, None),
                           false_fn=lambda *a: off(*a, None), label="brdftab")
 
-    def _value(self, wi, wo, lam, active):
-        """f_r cos θo (0 where not ``active``)."""
+    def _value(self, wi, wo, lam, active, adjoint=False):
+        """f_r cos θo (0 where not ``active``); ``adjoint``: f_r(wo, wi) cos θo (importance
+        transport)."""
         import drjit as dr
 
-        return dr.select(active, self._f(wi, wo, lam, active) * dr.normalize(wo).z, 0.0)
+        f = self._f(wo, wi, lam, active) if adjoint else self._f(wi, wo, lam, active)
+        return dr.select(active, f * dr.normalize(wo).z, 0.0)
 
     def eval(self, ctx, si, wo, active=True):
         """f_r · cos θ(wo) from the table (0 below either horizon)."""
         import mitsuba as mi
 
         active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
-        if self.delta:
+        if self.delta or not self._enabled(ctx, True):
             return mi.Spectrum(0.0)
+        adjoint = self._adjoint(ctx)
         return self._when(active, si, (si.wi, wo, active),
-                          lambda wi, wo, a, lam: self._value(wi, wo, lam, a),
+                          lambda wi, wo, a, lam: self._value(wi, wo, lam, a, adjoint),
                           lambda wi, wo, a, lam: mi.Spectrum(0.0))
 
     def _pdf(self, wi, wo, active):
@@ -1222,7 +1261,7 @@ class JitBrdftabBSDF(_Common):
         import mitsuba as mi
 
         active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
-        if self.delta:
+        if self.delta or not self._enabled(ctx, True):
             return mi.Float(0.0)
         return self._when(active, si, (si.wi, wo, active),
                           lambda wi, wo, a, lam: self._pdf(wi, wo, a),
@@ -1233,10 +1272,11 @@ class JitBrdftabBSDF(_Common):
         import mitsuba as mi
 
         active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
-        if self.delta:
+        if self.delta or not self._enabled(ctx, True):
             return mi.Spectrum(0.0), mi.Float(0.0)
+        adjoint = self._adjoint(ctx)
         return self._when(active, si, (si.wi, wo, active),
-                          lambda wi, wo, a, lam: (self._value(wi, wo, lam, a),
+                          lambda wi, wo, a, lam: (self._value(wi, wo, lam, a, adjoint),
                                                   self._pdf(wi, wo, a)),
                           lambda wi, wo, a, lam: (mi.Spectrum(0.0), mi.Float(0.0)))
 
@@ -1247,11 +1287,14 @@ class JitBrdftabBSDF(_Common):
         import mitsuba as mi
 
         active = mi.Bool(active) & (si.wi.z > 0)
+        if not self._enabled(ctx, False):
+            return dr.zeros(mi.BSDFSample3f), mi.Spectrum(0.0)
+        adjoint = self._adjoint(ctx)
 
         def on(wi, u, a, lam):
             wo, pdf = self.sampler.sample(dr.normalize(wi), u, a)
             ok = a & (wo.z > 0) & (pdf > 0)
-            value = self._value(wi, wo, lam, ok)
+            value = self._value(wi, wo, lam, ok, adjoint)
             return wo, pdf, dr.select(ok, value / dr.maximum(pdf, 1e-20), 0.0)
 
         def off(wi, u, a, lam):

@@ -68,7 +68,9 @@ class ScalarBrdftabBSDF(_Common):
 
     def __init__(self, props: Any) -> None: ...
     def eval(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> Any:
-        """f_r · cos θ(wo) (Mitsuba's `eval`; 0 below either horizon and for a delta source)."""
+        """f_r · cos θ(wo) (Mitsuba's `eval`; 0 below either horizon and for a delta source).
+        In importance transport the adjoint, f_r(wo, si.wi) · cos θ(wo); 0 for a context whose
+        type mask or component leaves out the plugin's one component."""
     def pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> Any:
         """The density of `sample` drawing wo given `si.wi` (0 for a delta source)."""
     def eval_pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> tuple[Any, Any]:
@@ -96,7 +98,9 @@ class JitBrdftabBSDF(_Common):
     """The `cache_dir` property."""
     def __init__(self, props: Any) -> None: ...
     def eval(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> Any:
-        """f_r · cos θ(wo) from the table (0 below either horizon)."""
+        """f_r · cos θ(wo) from the table (0 below either horizon).
+        In importance transport the adjoint, f_r(wo, si.wi) · cos θ(wo); 0 for a context whose
+        type mask or component leaves out the plugin's one component."""
     def pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> Any:
         """The density of `sample` drawing wo given `si.wi`."""
     def eval_pdf(self, ctx: Any, si: Any, wo: Any, active: Any = True) -> tuple[Any, Any]:
