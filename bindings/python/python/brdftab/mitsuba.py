@@ -32,7 +32,10 @@ render one material also for a source that is not reciprocal (the sampler and ``
 same in both modes). The plugin is one component (index 0) with the source's lobe flags: a
 context whose type mask or component leaves it out gets zeros, as from Mitsuba's plugins (for
 ``eval``/``pdf`` its smooth lobes count, for ``sample`` any of them: a sum's draw is not split
-by lobe).
+by lobe). In a polarized variant the plugin is a depolarizer (f_r cos θo in the Mueller
+matrix's first entry, as Mitsuba's ``measured`` and ``diffuse``: a source says nothing of
+polarization); in a monochrome variant (``llvm_ad_mono``) an RGB source is read as its
+luminance, as Mitsuba reads RGB inputs there.
 
 - Scalar variants (``scalar_rgb``, ``scalar_spectral``) call the library for every query (the
   native source: RGL files evaluate with their own adaptive parameterization, as Mitsuba's
@@ -304,6 +307,26 @@ class _Common:
         return bool(int(ctx.type_mask) & lobes) and int(ctx.component) in (0, 2**32 - 1)
 
     @staticmethod
+    def _unpolarized(value):
+        """The variant's ``UnpolarizedSpectrum`` of ``value`` (the source's channels: R, G, B, or
+        the path's wavelengths in a spectral variant); in a monochrome variant the RGB value's
+        luminance, as Mitsuba reads RGB inputs there."""
+        import mitsuba as mi
+
+        if mi.is_monochromatic:
+            return mi.UnpolarizedSpectrum(mi.luminance(mi.Color3f(*value)))
+        return mi.UnpolarizedSpectrum(value)
+
+    @staticmethod
+    def _spectrum(value):
+        """The variant's ``Spectrum`` of an unpolarized value: in a polarized variant (whose
+        Spectrum is a Mueller matrix) a depolarizer, as Mitsuba's ``measured`` and ``diffuse``
+        give — the source says nothing of polarization."""
+        import mitsuba as mi
+
+        return mi.depolarizer(value) if mi.is_polarized else value
+
+    @staticmethod
     def _adjoint(ctx):
         """Whether ``ctx`` is importance transport (a light tracer: ``si.wi`` points to the
         light's side of the path), where the plugin gives the adjoint BSDF f(wo, si.wi)."""
@@ -339,8 +362,8 @@ class ScalarBrdftabBSDF(_Common):
 
         if self.spectral:
             nm = [float(x) for x in si.wavelengths]
-            return mi.Spectrum(self.brdf.eval_spectral(wi, wo, nm).tolist())
-        return mi.Spectrum(self.brdf.eval(wi, wo).tolist())
+            return self._unpolarized(self.brdf.eval_spectral(wi, wo, nm).tolist())
+        return self._unpolarized(self.brdf.eval(wi, wo).tolist())
 
     @staticmethod
     def _vec(v):
@@ -360,9 +383,8 @@ class ScalarBrdftabBSDF(_Common):
             # A NaN or infinite component of wo (the library's f_r is 0 for it, but 0 · NaN is
             # NaN): 0, the NaN rule of every host.
             return mi.Spectrum(0.0)
-        if self._adjoint(ctx):
-            return self._f(wo, wi, si) * cos_o
-        return self._f(wi, wo, si) * cos_o
+        f = self._f(wo, wi, si) if self._adjoint(ctx) else self._f(wi, wo, si)
+        return self._spectrum(f * cos_o)
 
     def pdf(self, ctx, si, wo, active=True):
         """The density of :meth:`sample` drawing wo given ``si.wi`` (0 for a delta source)."""
@@ -405,7 +427,7 @@ class ScalarBrdftabBSDF(_Common):
             # Mitsuba's BSDFs with a delta component report it; the weight is the library's.
             bs.pdf = pdf
             bs.sampled_type = mi.UInt32(+mi.BSDFFlags.DeltaReflection)
-            return bs, mi.Spectrum(w.tolist())
+            return bs, self._spectrum(self._unpolarized(w.tolist()))
         bs.pdf = pdf
         # A smooth draw: the smooth lobes' flags (a sum's mirror term is not what drew it, and a
         # Delta bit would tell the integrator to skip multiple importance sampling).
@@ -413,7 +435,7 @@ class ScalarBrdftabBSDF(_Common):
         bs.sampled_type = mi.UInt32(+self.m_flags & ~not_drawn)
         # The weight is recomputed from eval: exact also for sources that are not reciprocal.
         value = self.eval(ctx, si, bs.wo)
-        return bs, value / pdf
+        return bs, value * (1.0 / pdf)
 
     def traverse(self, callback):
         """Nothing to expose: a scalar variant evaluates the source, which holds no values."""
@@ -1188,7 +1210,7 @@ class JitBrdftabBSDF(_Common):
 
         f = self.table.lookup(wi, wo, active)
         if not self.spectral:
-            return mi.Spectrum(f[0], f[1], f[2])
+            return self._unpolarized([f[0], f[1], f[2]])
         wl = self.table.wavelengths
         if wl is None:
             # An RGB table in a spectral variant: the library's reading of RGB channels at a
@@ -1206,7 +1228,7 @@ class JitBrdftabBSDF(_Common):
                                 dr.gather(mi.Float, self._basis[k], j + 1), t)
                     v = v + w * f[k]
                 out.append(v)
-            return mi.Spectrum(out)
+            return mi.UnpolarizedSpectrum(out)
         out = []
         for i in range(len(lam)):
             x = lam[i]
@@ -1215,7 +1237,7 @@ class JitBrdftabBSDF(_Common):
                 t = (x - wl[k]) / (wl[k + 1] - wl[k])
                 v = dr.select((x > wl[k]) & (x <= wl[k + 1]), dr.lerp(f[k], f[k + 1], t), v)
             out.append(v)
-        return mi.Spectrum(out)
+        return mi.UnpolarizedSpectrum(out)
 
     def _when(self, active, si, args, on, off):
         """``on(*args, lam)`` where ``active``, ``off(*args, lam)`` elsewhere (``lam``: the
@@ -1233,7 +1255,7 @@ class JitBrdftabBSDF(_Common):
 
     def _value(self, wi, wo, lam, active, adjoint=False):
         """f_r cos θo (0 where not ``active``); ``adjoint``: f_r(wo, wi) cos θo (importance
-        transport)."""
+        transport). Unpolarized: :meth:`_spectrum` makes it the variant's Spectrum."""
         import drjit as dr
 
         f = self._f(wo, wi, lam, active) if adjoint else self._f(wi, wo, lam, active)
@@ -1247,9 +1269,13 @@ class JitBrdftabBSDF(_Common):
         if self.delta or not self._enabled(ctx, True):
             return mi.Spectrum(0.0)
         adjoint = self._adjoint(ctx)
-        return self._when(active, si, (si.wi, wo, active),
-                          lambda wi, wo, a, lam: self._value(wi, wo, lam, a, adjoint),
-                          lambda wi, wo, a, lam: mi.Spectrum(0.0))
+        # Unpolarized inside the branch, the variant's Spectrum outside: a Mueller matrix
+        # returned from a symbolic branch made Dr.Jit's LLVM backend emit invalid IR
+        # ("Instruction does not dominate all uses") in llvm_ad_spectral_polarized.
+        return self._spectrum(self._when(
+            active, si, (si.wi, wo, active),
+            lambda wi, wo, a, lam: self._value(wi, wo, lam, a, adjoint),
+            lambda wi, wo, a, lam: mi.UnpolarizedSpectrum(0.0)))
 
     def _pdf(self, wi, wo, active):
         import drjit as dr
@@ -1275,10 +1301,12 @@ class JitBrdftabBSDF(_Common):
         if self.delta or not self._enabled(ctx, True):
             return mi.Spectrum(0.0), mi.Float(0.0)
         adjoint = self._adjoint(ctx)
-        return self._when(active, si, (si.wi, wo, active),
-                          lambda wi, wo, a, lam: (self._value(wi, wo, lam, a, adjoint),
-                                                  self._pdf(wi, wo, a)),
-                          lambda wi, wo, a, lam: (mi.Spectrum(0.0), mi.Float(0.0)))
+        value, pdf = self._when(active, si, (si.wi, wo, active),
+                                lambda wi, wo, a, lam: (self._value(wi, wo, lam, a, adjoint),
+                                                        self._pdf(wi, wo, a)),
+                                lambda wi, wo, a, lam: (mi.UnpolarizedSpectrum(0.0),
+                                                        mi.Float(0.0)))
+        return self._spectrum(value), pdf
 
     def sample(self, ctx, si, sample1, sample2, active=True):
         """A ``BSDFSample3f`` and its weight f_r · cos θ(wo) / pdf, drawn by the library's
@@ -1298,9 +1326,10 @@ class JitBrdftabBSDF(_Common):
             return wo, pdf, dr.select(ok, value / dr.maximum(pdf, 1e-20), 0.0)
 
         def off(wi, u, a, lam):
-            return mi.Vector3f(0.0), mi.Float(0.0), mi.Spectrum(0.0)
+            return mi.Vector3f(0.0), mi.Float(0.0), mi.UnpolarizedSpectrum(0.0)
 
         wo, pdf, weight = self._when(active, si, (si.wi, sample2, active), on, off)
+        weight = self._spectrum(weight)
         bs = dr.zeros(mi.BSDFSample3f)
         bs.wo = wo
         bs.pdf = pdf
