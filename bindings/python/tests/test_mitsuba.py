@@ -943,3 +943,24 @@ def test_a_monochrome_variant_reads_the_luminance():
     lum = np.array([0.212671, 0.715160, 0.072169])
     for got, rgb in ((e, rgb_e), (w, rgb_w)):
         np.testing.assert_allclose(got.ravel(), lum @ rgb.reshape(3), rtol=1e-6)
+
+
+@pytest.mark.parametrize("variant", ["scalar_rgb", "llvm_ad_rgb"])
+def test_errors_name_the_property(variant):
+    """``source: 3`` said the property was "required" (it was given, as an integer);
+    ``filename: 3.5`` was read as the file "3.5"; a missing file's error did not say which
+    property named it. Each now names the property and what was wrong with it."""
+    use(variant)
+    for key, bad, kind in [("source", 3, "int"), ("filename", 3.5, "float"),
+                           ("source", True, "bool")]:
+        with pytest.raises(Exception, match=f"brdftab plugin: `{key}` must be a string, got "
+                                            f"{kind}"):
+            mi.load_dict({"type": "brdftab", key: bad})
+    with pytest.raises(Exception, match="brdftab plugin: `filename` 'no-such-file.bsdf': "
+                                        ".*no-such-file.bsdf"):
+        mi.load_dict({"type": "brdftab", "filename": "no-such-file.bsdf"})
+    with pytest.raises(Exception, match="brdftab plugin: `source` "):
+        mi.load_dict({"type": "brdftab", "source": '{"model": "nope"}'})
+    # The process goes on: a good material loads after the errors.
+    mi.load_dict({"type": "brdftab", "source": '{"model": "lambert", "kd": 0.5}',
+                  "preset": "small", "cache": False})

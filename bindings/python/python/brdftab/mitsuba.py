@@ -254,25 +254,44 @@ class _Common:
         if src is not None and filename is not None:
             raise ValueError("brdftab plugin: give `source` or `filename`, not both")
         # `filename`: what a scene written for Mitsuba's `measured` says (one word changed).
-        src = str(filename) if filename is not None else src
-        if not isinstance(src, str) or not src:
+        key, src = ("filename", filename) if filename is not None else ("source", src)
+        if src is None:
             raise ValueError(
                 "brdftab plugin: the string property `source` (or `filename`) is required"
             )
+        if isinstance(src, os.PathLike):
+            src = os.fspath(src)
+        if not isinstance(src, str):
+            # Named as given: `filename: 3.5` was read as the file "3.5", `source: 3` said the
+            # property was missing.
+            raise ValueError(
+                f"brdftab plugin: `{key}` must be a string, got {type(src).__name__} {src!r}"
+            )
+        if not src.strip():
+            raise ValueError(f"brdftab plugin: `{key}` is empty")
+        given = src
         src = _resolve(src)
-        given = [k for k in ("preset", "grid") if _prop(props, k) is not None]
-        if given and brdftab_kind(src) == "table":
+        try:
+            kind = brdftab_kind(src)
+        except brdftab.Error as e:
+            raise brdftab.Error(f"brdftab plugin: `{key}` {given!r}: {e}") from e
+        bake = [k for k in ("preset", "grid") if _prop(props, k) is not None]
+        if bake and kind == "table":
             # The JIT variants baked the table again from itself (a resample) where the scalar
             # ones read it as stored: one scene, two materials. Refused in both.
             raise ValueError(
-                f"brdftab plugin: {src} is a table, evaluated as it is stored; `{given[0]}` "
+                f"brdftab plugin: {src} is a table, evaluated as it is stored; `{bake[0]}` "
                 "chooses the table a non-table source is baked on (bake the table again with "
                 "brdftab.bake to change its grid)"
             )
         self.source = src
         self.interp = str(_prop(props, "interp", "auto"))
         self.spectral = mi.is_spectral
-        self.brdf = brdftab.open(src, interp=self.interp)
+        try:
+            self.brdf = brdftab.open(src, interp=self.interp)
+        except brdftab.Error as e:
+            # Which property named what (a file not found beside the scene, a bad spec).
+            raise brdftab.Error(f"brdftab plugin: `{key}` {given!r}: {e}") from e
         if self.brdf.flags["transmission"]:
             # Every draw of a refractor lies below the surface, where this front-side BRDF
             # plugin gives nothing: it rendered black.
