@@ -19,18 +19,19 @@ impl Wavelengths {
 }
 
 impl std::str::FromStr for Wavelengths {
-    type Err = Error;
+    type Err = BadValue;
 
-    /// `400,500,600`.
-    fn from_str(s: &str) -> Result<Wavelengths> {
+    /// `400,500,600`. The error names no field (a `BadValue`): `--wavelengths abc` said
+    /// "invalid value 'abc' for '--wavelengths': invalid argument `wavelengths`: …".
+    fn from_str(s: &str) -> std::result::Result<Wavelengths, BadValue> {
         let nm = s
             .split(',')
             .map(|x| {
-                x.trim().parse::<f64>().map_err(|_| {
-                    Error::arg("wavelengths", format!("`{}` is not a number", x.trim()))
-                })
+                x.trim()
+                    .parse::<f64>()
+                    .map_err(|_| BadValue(format!("`{}` is not a number", x.trim())))
             })
-            .collect::<Result<Vec<_>>>()?;
+            .collect::<std::result::Result<Vec<_>, BadValue>>()?;
         Ok(Wavelengths(nm))
     }
 }
@@ -50,8 +51,8 @@ enum NumbersOrText {
 }
 
 impl TryFrom<NumbersOrText> for Wavelengths {
-    type Error = Error;
-    fn try_from(v: NumbersOrText) -> Result<Wavelengths> {
+    type Error = BadValue;
+    fn try_from(v: NumbersOrText) -> std::result::Result<Wavelengths, BadValue> {
         match v {
             NumbersOrText::Numbers(n) => Ok(Wavelengths(n)),
             NumbersOrText::Text(s) => s.parse(),

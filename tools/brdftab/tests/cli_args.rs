@@ -64,6 +64,11 @@ fn library_argument_errors_name_the_flag_or_value_the_user_typed() {
         &brdftab(&["eval", LAMBERT, "--interp", "bogus"]),
         &["`--interp`"],
     );
+    // A value clap parses names its flag once: `--wavelengths abc` also said "invalid
+    // argument `wavelengths`" after clap's "for '--wavelengths'".
+    let o = brdftab(&["eval", LAMBERT, "--wavelengths", "400,abc"]);
+    refused(&o, &["--wavelengths", "`abc` is not a number"]);
+    assert_eq!(o.stderr.matches("wavelengths").count(), 1, "{}", o.stderr);
     // `bench --pairs 0` spoke of "repeats", which is no flag.
     let o = brdftab(&["bench", LAMBERT, "--pairs", "0"]);
     refused(&o, &["`--pairs`"]);
