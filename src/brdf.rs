@@ -586,14 +586,34 @@ fn flagged_blocks(
             }
         }
     };
-    // At least one weight a pair in the block sizes, so that zero wavelengths still split by
-    // pairs (their weight blocks are then empty).
-    let ww = width.max(1);
-    if n >= PARALLEL {
+    if width == 0 {
+        // No weights (zero wavelengths): `chunks_mut` of the empty weights yields no block at
+        // all, and zipped with it nothing would be drawn; each block of pairs gets no weights.
+        fn none<'a>(_: ()) -> &'a mut [f32] {
+            &mut []
+        }
+        if n >= PARALLEL {
+            crate::par::install(|| {
+                wi.par_chunks_mut(BLOCK)
+                    .zip(pdf.par_chunks_mut(BLOCK))
+                    .zip(rayon::iter::repeat_n((), n.div_ceil(BLOCK)).map(none))
+                    .zip(delta.par_chunks_mut(BLOCK))
+                    .enumerate()
+                    .for_each(go)
+            });
+        } else {
+            wi.chunks_mut(BLOCK)
+                .zip(pdf.chunks_mut(BLOCK))
+                .zip(std::iter::repeat(()).map(none))
+                .zip(delta.chunks_mut(BLOCK))
+                .enumerate()
+                .for_each(go);
+        }
+    } else if n >= PARALLEL {
         crate::par::install(|| {
             wi.par_chunks_mut(BLOCK)
                 .zip(pdf.par_chunks_mut(BLOCK))
-                .zip(weight.par_chunks_mut(BLOCK * ww))
+                .zip(weight.par_chunks_mut(BLOCK * width))
                 .zip(delta.par_chunks_mut(BLOCK))
                 .enumerate()
                 .for_each(go)
@@ -601,7 +621,7 @@ fn flagged_blocks(
     } else {
         wi.chunks_mut(BLOCK)
             .zip(pdf.chunks_mut(BLOCK))
-            .zip(weight.chunks_mut(BLOCK * ww))
+            .zip(weight.chunks_mut(BLOCK * width))
             .zip(delta.chunks_mut(BLOCK))
             .enumerate()
             .for_each(go);
@@ -823,5 +843,40 @@ mod tests {
             }
         }
         assert!(deltas > 0);
+    }
+
+    /// With no wavelengths, `sample_flagged_at` still draws: the directions, pdfs and flags of
+    /// `sample_flagged` (one pair, and across the parallel path's blocks). It drew nothing, and
+    /// left wi and pdf as they were, when the empty weights gave no block to zip with.
+    #[test]
+    fn sampling_at_no_wavelengths_still_draws() {
+        let sum = crate::spec::ModelSpec::parse(
+            r#"{"model": "sum", "terms": [{"model": "ggx", "alpha": 0.3},
+                {"model": "mirror", "fresnel": {"conductor": "Au"}}]}"#,
+        )
+        .unwrap()
+        .build(&Channels::Rgb)
+        .unwrap();
+        for n in [1, PARALLEL + BLOCK / 2 + 3] {
+            let wo = dirs(n);
+            let u: Vec<DVec2> = (0..n)
+                .map(|k| DVec2::new((k % 97) as f64 / 97.0, (k % 89) as f64 / 89.0))
+                .collect();
+            let (mut ai, mut ap, mut ad) = (vec![DVec3::NAN; n], vec![-1.0; n], vec![true; n]);
+            let out = SampleOut {
+                wi: &mut ai,
+                pdf: &mut ap,
+                weight: &mut [],
+            };
+            sample_flagged_at(sum.as_ref(), &wo, &u, &[], out, &mut ad);
+            let (mut bi, mut bp, mut bd) = (vec![DVec3::NAN; n], vec![-1.0; n], vec![true; n]);
+            let out = SampleOut {
+                wi: &mut bi,
+                pdf: &mut bp,
+                weight: &mut vec![0.0; 3 * n],
+            };
+            sample_flagged(sum.as_ref(), &wo, &u, out, &mut bd);
+            assert_eq!((ai, ap, ad), (bi, bp, bd), "{n} pairs");
+        }
     }
 }

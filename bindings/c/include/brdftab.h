@@ -95,11 +95,12 @@ int brdftab_sample_delta(const brdftab_brdf *b, size_t n, const double *wo, cons
  * files), its channels otherwise (wavelength channels interpolated; RGB through a
  * colour-preserving basis: the spectrum's CIE 1931 / D65 sRGB is the source's RGB). For
  * renderers that draw their wavelengths per path (pbrt-v4). Tables, MERL and RGL files look
- * each pair up once for all k wavelengths. */
+ * each pair up once for all k wavelengths. With k = 0, nm and f may be NULL. */
 int brdftab_eval_spectral(const brdftab_brdf *b, size_t n, const double *wi, const double *wo,
                           size_t k, const double *nm, float *f);
 /* brdftab_sample_delta with the weights at the k wavelengths nm (weight: n x k), a mirror's
- * reflectance at each of them for its draws. */
+ * reflectance at each of them for its draws. With k = 0, nm and weight may be NULL (wi, pdf and
+ * delta are still drawn). */
 int brdftab_sample_spectral(const brdftab_brdf *b, size_t n, const double *wo, const double *u,
                             size_t k, const double *nm, double *wi, double *pdf, float *weight,
                             unsigned char *delta);

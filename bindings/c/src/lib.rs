@@ -469,7 +469,12 @@ unsafe fn flagged_args<'a>(
     let u = unsafe { slice(u as *const DVec2, n, "u") }?;
     let wi = unsafe { slice_mut(wi as *mut DVec3, n, "wi") }?;
     let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
-    let weight = unsafe { slice_mut(weight, times(n, width, "weight")?, "weight") }?;
+    // No wavelengths (brdftab_sample_spectral with k = 0), no weights: `weight` may be NULL, as
+    // `nm` may and as brdftab_eval_spectral's `f` may.
+    let weight = match width {
+        0 => &mut [][..],
+        _ => unsafe { slice_mut(weight, times(n, width, "weight")?, "weight") }?,
+    };
     let flags = unsafe { slice_mut(delta, n, "delta") }?;
     // Zeroed first, the bytes are valid `bool`s (false); the library writes 0 or 1.
     flags.fill(0);

@@ -93,6 +93,22 @@ static void non_finite_directions(const brdftab_brdf *b) {
     CHECK(is_zero(swi, 3) && spdf == 0 && is_zero(fd, c), "no sample for a NaN u");
 }
 
+/* No wavelengths (k = 0): nm and the values may be NULL in both spectral calls (the header),
+ * and sample_spectral still draws what sample_delta draws. */
+static void no_wavelengths(const brdftab_brdf *b) {
+    double wi[3] = {0.3, 0.1, 0.9}, wo[3] = {-0.2, 0.3, 0.8}, u[2] = {0.3, 0.4};
+    double swi[3] = {7, 7, 7}, pdf = -1, dwi[3], dpdf;
+    float w[16];
+    unsigned char d = 7, dd;
+    CHECK(brdftab_eval_spectral(b, 1, wi, wo, 0, NULL, NULL) == 0,
+          "eval_spectral with k = 0 and f NULL succeeds");
+    CHECK(brdftab_sample_spectral(b, 1, wo, u, 0, NULL, swi, &pdf, NULL, &d) == 0,
+          "sample_spectral with k = 0 and weight NULL succeeds");
+    CHECK(brdftab_sample_delta(b, 1, wo, u, dwi, &dpdf, w, &dd) == 0, "sample_delta");
+    CHECK(memcmp(swi, dwi, sizeof swi) == 0 && pdf == dpdf && d == dd,
+          "sample_spectral with k = 0 draws what sample_delta draws");
+}
+
 /* A corrupt chunk met lazily: -1 with the checksum error, and the handle stays failed. */
 static void corrupt_table(const char *path) {
     brdftab_brdf *b = brdftab_open(path); /* lazy: the open succeeds */
@@ -167,6 +183,7 @@ int main(int argc, char **argv) {
     }
     overflowing_counts(b);
     non_finite_directions(b);
+    no_wavelengths(b);
     brdftab_close(b);
     corrupt_table(argv[2]);
     table_names(argv[2]);
