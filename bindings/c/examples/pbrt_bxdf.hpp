@@ -7,6 +7,10 @@
 //
 // Conventions agree: pbrt's wo (to the viewer) and wi (to the light) are brdftab's wo and wi, in
 // the shading frame with z the normal; f() is f_r without the cosine; Sample_f draws wi given wo.
+// pbrt-v4's BxDFs are two-sided (MeasuredBxDF, ConductorBxDF, DiffuseBxDF): seen from below
+// (wo.z < 0) the surface reflects as from above, mirrored through the tangent plane. brdftab's
+// functions are front-side only (f_r = 0, no sample for wo below the horizon), so the adapter
+// flips a back-side pair (wo, wi) -> (-wo, -wi) before calling them, as pbrt's MeasuredBxDF does.
 #pragma once
 
 #include <array>
@@ -21,7 +25,11 @@ using Float = float;
 
 struct Vector3f {
     Float x, y, z;
+    Vector3f operator-() const { return {-x, -y, -z}; }
 };
+
+/// pbrt's SameHemisphere: both directions on one side of the surface.
+inline bool SameHemisphere(Vector3f a, Vector3f b) { return a.z * b.z > 0; }
 
 /// RGB stand-in for pbrt's SampledSpectrum.
 struct SampledSpectrum {
@@ -72,18 +80,22 @@ public:
     }
 
     SampledSpectrum f(Vector3f wo, Vector3f wi) const {
-        if (wo.z <= 0 || wi.z <= 0) return {};  // front side only, as pbrt's measured BxDF
+        if (!SameHemisphere(wo, wi)) return {};  // reflection only
+        if (wo.z < 0) wo = -wo, wi = -wi;        // two-sided, as pbrt's MeasuredBxDF
         float v[3];
         b_->eval(to(wi), to(wo), v);
         return {{v[0], v[1], v[2]}};
     }
 
     std::optional<BSDFSample> Sample_f(Vector3f wo, Float /*uc*/, std::array<Float, 2> u) const {
-        if (wo.z <= 0) return std::nullopt;
+        if (wo.z == 0) return std::nullopt;
+        // Two-sided: a back-side wo samples the front's lobe at -wo, and the draw flips back.
+        const bool flip = wo.z < 0;
         float w[3];
-        brdftab::Sample s = b_->sample(to(wo), u[0], u[1], w);
+        brdftab::Sample s = b_->sample(to(flip ? -wo : wo), u[0], u[1], w);
         if (!(s.pdf > 0) || !(s.wi.z > 0)) return std::nullopt;
         Vector3f wi{Float(s.wi.x), Float(s.wi.y), Float(s.wi.z)};
+        if (flip) wi = -wi;
         if (s.delta) {
             // pbrt's specular sample: f = weight · pdf / |cos θi|, so that f |cos θi| / pdf is the
             // library's weight (the lobe's reflectance over the probability of choosing it).
@@ -96,7 +108,8 @@ public:
     }
 
     Float PDF(Vector3f wo, Vector3f wi) const {
-        if (wo.z <= 0 || wi.z <= 0) return 0;
+        if (!SameHemisphere(wo, wi)) return 0;
+        if (wo.z < 0) wo = -wo, wi = -wi;
         return Float(b_->pdf(to(wi), to(wo)));
     }
 
