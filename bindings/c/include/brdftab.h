@@ -127,6 +127,14 @@ char *brdftab_fit(const char *source, const char *model, const char *settings_js
 void brdftab_free_string(char *s);
 /* The version of the library, e.g. "0.1.0" (static). */
 const char *brdftab_version(void);
+/* The version of this header (the crate's, as brdftab_version() and brdftab.pc): for
+ * compile-time checks (#if BRDFTAB_VERSION_MINOR >= 2) and for comparing against
+ * brdftab_version() at run time, where a program built against one header may load another
+ * library. */
+#define BRDFTAB_VERSION_MAJOR 0
+#define BRDFTAB_VERSION_MINOR 1
+#define BRDFTAB_VERSION_PATCH 0
+#define BRDFTAB_VERSION "0.1.0"
 
 #ifdef __cplusplus
 }

@@ -397,6 +397,36 @@ fn the_header_declares_exactly_the_exported_functions() {
     assert!(declared.len() >= 11, "{declared:?}");
 }
 
+/// The header's version macros, the pkg-config file's `Version` and the library's
+/// `brdftab_version()` are the crate's version (hostile_test.c compares the macros with the
+/// library at run time).
+#[test]
+fn the_header_and_the_pkg_config_file_carry_the_crates_version() {
+    let version = env!("CARGO_PKG_VERSION");
+    let header = std::fs::read_to_string(Path::new(CRATE).join("include/brdftab.h")).unwrap();
+    let define = |name: &str| {
+        header
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("#define {name} ")))
+            .unwrap_or_else(|| panic!("brdftab.h: no `#define {name}`"))
+            .trim()
+            .to_owned()
+    };
+    assert_eq!(define("BRDFTAB_VERSION"), format!("\"{version}\""));
+    let parts: Vec<&str> = version.split('.').collect();
+    for (name, part) in ["MAJOR", "MINOR", "PATCH"].iter().zip(&parts) {
+        assert_eq!(&define(&format!("BRDFTAB_VERSION_{name}")), part, "{name}");
+    }
+    let pc = std::fs::read_to_string(Path::new(CRATE).join("brdftab.pc.in")).unwrap();
+    assert!(
+        pc.lines().any(|l| l == format!("Version: {version}")),
+        "{pc}"
+    );
+    // SAFETY: brdftab_version returns a static NUL-terminated string.
+    let lib = unsafe { std::ffi::CStr::from_ptr(brdftab_c::brdftab_version()) };
+    assert_eq!(lib.to_str().unwrap(), version);
+}
+
 /// The header alone compiles without a warning as strict C99 and C++17 (and C89: it uses no
 /// `//` comment, no `inline`, no declaration after a statement).
 #[test]

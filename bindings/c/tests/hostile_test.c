@@ -181,6 +181,12 @@ int main(int argc, char **argv) {
         fprintf(stderr, "error: %s\n", brdftab_last_error());
         return 1;
     }
+    /* The header's version is the library's (both are the crate's). */
+    char v[64];
+    snprintf(v, sizeof v, "%d.%d.%d", BRDFTAB_VERSION_MAJOR, BRDFTAB_VERSION_MINOR,
+             BRDFTAB_VERSION_PATCH);
+    CHECK(strcmp(v, BRDFTAB_VERSION) == 0 && strcmp(BRDFTAB_VERSION, brdftab_version()) == 0,
+          "BRDFTAB_VERSION_* and BRDFTAB_VERSION are brdftab_version()");
     overflowing_counts(b);
     non_finite_directions(b);
     no_wavelengths(b);
