@@ -58,7 +58,9 @@ typedef struct brdftab_open_options {
 brdftab_brdf *brdftab_open(const char *source);
 /* The same with options (opts NULL = defaults). */
 brdftab_brdf *brdftab_open_with(const char *source, const brdftab_open_options *opts);
-/* This thread's last failure, "" if none; valid until this thread's next brdftab call. */
+/* This thread's last failure, "" if none; valid until this thread's next brdftab call. Calls
+ * from exit handlers (atexit, C++ static destructors, thread-exit destructors) work, but after
+ * the thread's storage is destroyed no message is kept: this returns a fixed note saying so. */
 const char *brdftab_last_error(void);
 /* Closes a handle; NULL is a no-op. */
 void brdftab_close(brdftab_brdf *b);

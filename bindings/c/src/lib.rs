@@ -75,15 +75,23 @@ thread_local! {
     static LAST_ERROR: RefCell<Option<CString>> = const { RefCell::new(None) };
 }
 
+/// What [`brdftab_last_error`] returns once this thread's [`LAST_ERROR`] is destroyed.
+const NO_MESSAGE: &CStr =
+    c"no message: called after this thread's storage was destroyed (an atexit handler, a static destructor or a thread-exit destructor)";
+
+/// Keeps `msg` as this thread's last error. A call made after the thread's storage is destroyed
+/// (from an `atexit` handler, a C++ static destructor, another library's thread-exit
+/// destructor) has nowhere to keep it: its -1 stands alone ([`NO_MESSAGE`]) — `with` would
+/// panic there, and a panic outside the guard aborts the host.
 fn set_error(msg: &str) {
     let c = CString::new(msg.replace('\0', " ")).unwrap_or_default();
-    LAST_ERROR.with(|e| *e.borrow_mut() = Some(c));
+    let _ = LAST_ERROR.try_with(|e| *e.borrow_mut() = Some(c));
 }
 
 /// Empties the last error; allocates nothing, and writes nothing when it is already empty (the
-/// common case).
+/// common case). Nothing either once the thread's storage is destroyed ([`set_error`]).
 fn clear_error() {
-    LAST_ERROR.with(|e| {
+    let _ = LAST_ERROR.try_with(|e| {
         if e.borrow().is_some() {
             *e.borrow_mut() = None;
         }
@@ -277,10 +285,13 @@ pub unsafe extern "C" fn brdftab_open_with(
 }
 
 /// This thread's last failure, `""` if the last call succeeded. Valid until this thread's next
-/// brdftab call.
+/// brdftab call. After the thread's storage is destroyed (calls from exit handlers), a fixed
+/// note ([`NO_MESSAGE`]).
 #[unsafe(no_mangle)]
 pub extern "C" fn brdftab_last_error() -> *const c_char {
-    LAST_ERROR.with(|e| e.borrow().as_deref().unwrap_or(c"").as_ptr())
+    LAST_ERROR
+        .try_with(|e| e.borrow().as_deref().unwrap_or(c"").as_ptr())
+        .unwrap_or(NO_MESSAGE.as_ptr())
 }
 
 /// Closes a handle; NULL is a no-op.
