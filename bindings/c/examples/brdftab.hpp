@@ -35,6 +35,13 @@ struct Vec3 {
 };
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 must be three packed doubles");
 
+namespace detail {
+/// An array of Vec3 as the C ABI's doubles. Not `&v->x`: that is a member access through a null
+/// pointer (undefined) for an empty std::vector's data(), which an empty batch passes.
+inline const double *xyz(const Vec3 *v) { return reinterpret_cast<const double *>(v); }
+inline double *xyz(Vec3 *v) { return reinterpret_cast<double *>(v); }
+}  // namespace detail
+
 /// One sample of Brdf::sample. `delta`: drawn from a delta lobe (a mirror, or a sum's mirror
 /// term): `pdf` is then the probability of choosing that lobe, and the weight its reflectance
 /// over it.
@@ -81,13 +88,13 @@ public:
 
     /// f_r (no cosine) for n pairs; f holds n * channels() floats.
     void eval(std::size_t n, const Vec3 *wi, const Vec3 *wo, float *f) const {
-        detail::check(brdftab_eval(h_, n, &wi->x, &wo->x, f));
+        detail::check(brdftab_eval(h_, n, detail::xyz(wi), detail::xyz(wo), f));
     }
     /// f_r for one pair into f[channels()].
     void eval(const Vec3 &wi, const Vec3 &wo, float *f) const { eval(1, &wi, &wo, f); }
     /// pdf(wi | wo) for n pairs.
     void pdf(std::size_t n, const Vec3 *wi, const Vec3 *wo, double *p) const {
-        detail::check(brdftab_pdf(h_, n, &wi->x, &wo->x, p));
+        detail::check(brdftab_pdf(h_, n, detail::xyz(wi), detail::xyz(wo), p));
     }
     double pdf(const Vec3 &wi, const Vec3 &wo) const {
         double p = 0.0;
@@ -97,12 +104,13 @@ public:
     /// Draws wi for n given wo from u (n x 2 in [0,1)^2); weight = f cos(theta_i) / pdf.
     void sample(std::size_t n, const Vec3 *wo, const double *u, Vec3 *wi, double *p,
                 float *weight) const {
-        detail::check(brdftab_sample(h_, n, &wo->x, u, &wi->x, p, weight));
+        detail::check(brdftab_sample(h_, n, detail::xyz(wo), u, detail::xyz(wi), p, weight));
     }
     /// The same with each draw's delta flag (delta: n bytes, 1 for a delta lobe's draw).
     void sample(std::size_t n, const Vec3 *wo, const double *u, Vec3 *wi, double *p,
                 float *weight, unsigned char *delta) const {
-        detail::check(brdftab_sample_delta(h_, n, &wo->x, u, &wi->x, p, weight, delta));
+        detail::check(brdftab_sample_delta(h_, n, detail::xyz(wo), u, detail::xyz(wi), p, weight,
+                                                 delta));
     }
     Sample sample(const Vec3 &wo, double u0, double u1, float *weight) const {
         double u[2] = {u0, u1};

@@ -397,6 +397,32 @@ fn the_header_declares_exactly_the_exported_functions() {
     assert!(declared.len() >= 11, "{declared:?}");
 }
 
+/// The C++ wrapper takes empty batches from empty `std::vector`s (whose `data()` may be
+/// nullptr): under UBSan, `&wi->x` on nullptr was a member access through a null pointer.
+#[test]
+fn the_cpp_wrapper_takes_empty_batches_from_empty_vectors() {
+    let dir = TempDir::new("c-wrapper");
+    let exe = dir.join("wrapper_test");
+    let src = Path::new(CRATE).join("tests/wrapper_test.cpp");
+    let ubsan = ["-fsanitize=undefined", "-fno-sanitize-recover=undefined"];
+    // The sanitizer where the compiler links it (gcc and clang on Linux), else the plain build.
+    let probe = dir.join("probe.cpp");
+    std::fs::write(&probe, "int main() { return 0; }\n").unwrap();
+    let has_ubsan = Command::new("g++")
+        .args(ubsan)
+        .arg(&probe)
+        .arg("-o")
+        .arg(dir.join("probe"))
+        .status()
+        .is_ok_and(|s| s.success());
+    let mut extra = vec!["-std=c++17", "-Wextra", "-pedantic"];
+    if has_ubsan {
+        extra.extend(ubsan);
+    }
+    compile("g++", &extra, &src, &exe);
+    assert_eq!(run(&mut Command::new(&exe)).trim(), "ok");
+}
+
 /// The header's version macros, the pkg-config file's `Version` and the library's
 /// `brdftab_version()` are the crate's version (hostile_test.c compares the macros with the
 /// library at run time).
