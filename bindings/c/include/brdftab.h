@@ -29,7 +29,10 @@
  * NaN: a direction with a NaN or infinite component, or a zero vector, is not an error: f_r and
  * pdf are 0 for it and sample gives wi = 0, pdf = 0, weight = 0 (as the library does); a NaN
  * in u, or a u outside [0, 1), gives no sample either. A theta outside [0, pi/2) in brdftab_albedo (NaN included) is an
- * error (-1).
+ * error (-1). A direction a hair above the horizon is a direction: where a lobe grows like
+ * 1/cos theta (Ward, measured RGL data) its f_r or sample weight there can be huge, FLT_MAX or
+ * +inf (for cos theta_o below about 1e-38), never NaN or negative: clamp a path's throughput
+ * if such directions reach these calls.
  * Thread safety: eval, pdf, sample and albedo may run concurrently on one handle.
  */
 #ifndef BRDFTAB_H
