@@ -51,7 +51,7 @@ struct Sample {
     bool delta;
 };
 
-/// An open BRDF (move-only). eval/pdf/sample/albedo may be called from several threads at once.
+/// An open BRDF (move-only). Its const methods may be called from several threads at once.
 class Brdf {
 public:
     /// Opens any SOURCE (spec JSON, .json, table, DB#NAME, MERL .binary, RGL .bsdf).

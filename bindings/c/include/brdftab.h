@@ -33,7 +33,9 @@
  * 1/cos theta (Ward, measured RGL data) its f_r or sample weight there can be huge, FLT_MAX or
  * +inf (for cos theta_o below about 1e-38), never NaN or negative: clamp a path's throughput
  * if such directions reach these calls.
- * Thread safety: eval, pdf, sample and albedo may run concurrently on one handle.
+ * Thread safety: every call on a handle (eval, pdf, the sample and spectral calls, albedo,
+ * channels, flags, channel_name) may run concurrently from any number of threads; only
+ * brdftab_close must not overlap another call on that handle.
  */
 #ifndef BRDFTAB_H
 #define BRDFTAB_H

@@ -47,8 +47,9 @@ pub use request::*;
 const _: () = assert!(std::mem::size_of::<DVec3>() == 24 && std::mem::align_of::<DVec3>() == 8);
 const _: () = assert!(std::mem::size_of::<DVec2>() == 16 && std::mem::align_of::<DVec2>() == 8);
 
-/// An open BRDF. Opaque to C; `eval`, `pdf`, `sample` and `albedo` may run concurrently on one
-/// handle from any number of threads.
+/// An open BRDF. Opaque to C; every call but `brdftab_close` (the evaluations, samplers,
+/// spectral calls, albedo and the queries) may run concurrently on one handle from any number
+/// of threads.
 pub struct brdftab_brdf {
     brdf: Box<dyn Brdf + Send + Sync>,
     names: Vec<CString>,
