@@ -397,6 +397,31 @@ fn the_header_declares_exactly_the_exported_functions() {
     assert!(declared.len() >= 11, "{declared:?}");
 }
 
+/// Eight threads on one fresh handle (a lazily decoding table, a measured file, a sum with a
+/// mirror) give what one thread gives on another handle, bit for bit; each thread's last error
+/// is its own (tests/threads_test.c).
+#[test]
+fn calls_from_many_threads_on_one_handle_agree_with_one_thread() {
+    let dir = TempDir::new("c-threads");
+    let exe = dir.join("threads_test");
+    compile(
+        "cc",
+        &["-std=c11"],
+        &Path::new(CRATE).join("tests/threads_test.c"),
+        &exe,
+    );
+    let table = bake_table(dir.path());
+    let rgl = brdftab::measured::data::rgl_dir().expect("the RGL files ship in data/rgl");
+    let paper = rgl.join("paper_white_rgb.bsdf");
+    for src in [
+        &table[..],
+        paper.to_str().unwrap(),
+        r#"{"model":"sum","terms":[{"model":"lambert","kd":0.05},{"model":"mirror","fresnel":{"conductor":"Au"}}]}"#,
+    ] {
+        run(Command::new(&exe).arg(src));
+    }
+}
+
 /// The C++ wrapper takes empty batches from empty `std::vector`s (whose `data()` may be
 /// nullptr): under UBSan, `&wi->x` on nullptr was a member access through a null pointer.
 #[test]
