@@ -13,7 +13,8 @@
  *   - brdftab_eval returns f_r in 1/sr, NOT multiplied by a cosine;
  *   - brdftab_sample draws wi for a given wo; weight = f_r * cos(theta_i) / pdf;
  *   - arrays are pair-major: wi, wo are n x 3 doubles (x, y, z), u is n x 2, f and weight are
- *     n x channels floats.
+ *     n x channels floats; an output array must not overlap an input or another output (no
+ *     sampling wi in place over wo: copy wo first).
  * Every int-returning function returns 0 on success and -1 on failure, with the reason in
  * brdftab_last_error() (per thread). n = 0 succeeds whatever the pointers; a NULL handle or
  * array with n > 0 fails, and so does an n whose arrays would exceed PTRDIFF_MAX bytes (or
