@@ -117,7 +117,9 @@ fn classify_name(source: &str) -> SourceKind {
 pub struct OpenOptions {
     /// Interpolation of tables; `None` (the default) chooses per table
     /// ([`TabulatedBrdf::default_interp`]: nearest on tables of MERL cells, linear otherwise).
-    /// Measured and analytic sources ignore it.
+    /// A MERL file is a table of cells: linear opens it as its table on the MERL grid
+    /// ([`crate::measured::MerlBrdf::to_table`]) with linear lookups. RGL files and analytic
+    /// sources ignore it.
     pub interp: Option<Interp>,
     /// Channels to evaluate: `None` keeps the source's own (RGB for model specs, the file's for
     /// RGL files). Model specs evaluate their spectral data at these wavelengths; RGL files
@@ -258,7 +260,16 @@ pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send
             let channels = opts.channels.clone().unwrap_or(Channels::Rgb);
             spec(source)?.build(&channels)
         }
-        SourceKind::Merl => fixed_channels(Box::new(crate::measured::MerlBrdf::open(source)?)),
+        SourceKind::Merl => {
+            let merl = crate::measured::MerlBrdf::open(source)?;
+            // The file is a table of cells: a linear lookup asked for is the one its table on
+            // the MERL grid gives (auto and nearest: the reader's cell, as `MerlBrdf` reads it).
+            fixed_channels(if opts.interp == Some(Interp::Linear) {
+                Box::new(TabulatedBrdf::from_table(merl.to_table()).with_interp(Interp::Linear))
+            } else {
+                Box::new(merl)
+            })
+        }
         SourceKind::Rgl => match &opts.channels {
             Some(c) => Ok(Box::new(crate::measured::RglBrdf::open_with_channels(
                 source, c,

@@ -546,3 +546,41 @@ fn a_spectral_source_written_to_merl_keeps_its_colour() {
         }
     }
 }
+
+/// `interp` of a MERL file: linear is its table on the MERL grid looked up linearly (it was
+/// ignored: a MERL file read by cell whatever was asked); auto and nearest are the reader's cell.
+#[test]
+fn a_merl_file_opened_for_linear_lookups_interpolates_its_cells() {
+    use brdftab::source::{OpenOptions, open_with};
+    use brdftab::table::{Interp, TabulatedBrdf};
+    let dir = TempDir::new("merl-interp");
+    let path = dir.path().join("random.binary");
+    let data = random_data(21);
+    write_file(&path, [90, 90, 180], &data);
+    let src = path.to_str().unwrap();
+    let m = MerlBrdf::from_raw("random", data).unwrap();
+    let lin_table = TabulatedBrdf::from_table(m.to_table()).with_interp(Interp::Linear);
+    let linear = open_with(src, &OpenOptions::new().interp(Interp::Linear)).unwrap();
+    let nearest = open_with(src, &OpenOptions::new().interp(Interp::Nearest)).unwrap();
+    let auto = open_with(src, &OpenOptions::new()).unwrap();
+    let mut rng = Pcg32::new(22);
+    let (mut differ, mut f) = (0, [[0f32; 3]; 5]);
+    for _ in 0..2000 {
+        let wi = brdftab::geometry::uniform_hemisphere(rng.next_dvec2());
+        let wo = brdftab::geometry::uniform_hemisphere(rng.next_dvec2());
+        linear.eval(wi, wo, &mut f[0]);
+        lin_table.eval(wi, wo, &mut f[1]);
+        nearest.eval(wi, wo, &mut f[2]);
+        auto.eval(wi, wo, &mut f[3]);
+        m.eval(wi, wo, &mut f[4]);
+        assert_eq!(f[0], f[1], "linear: {wi} {wo}");
+        assert_eq!(f[2], f[4], "nearest: {wi} {wo}");
+        assert_eq!(f[3], f[4], "auto: {wi} {wo}");
+        differ += usize::from(f[0] != f[4]);
+    }
+    // Random cells: a linear lookup blends neighbours that differ almost everywhere.
+    assert!(
+        differ > 1900,
+        "linear differs from the cell value at {differ} of 2000 pairs"
+    );
+}

@@ -13,8 +13,8 @@ use crate::source::OpenOptions;
 #[serde(default)]
 #[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct OpenSettings {
-    /// Interpolation of tables: auto (default: nearest on tables of MERL cells, which a MERL
-    /// reader looks up by cell, linear otherwise), nearest or linear.
+    /// Interpolation of tables and MERL files: auto (default: nearest on tables of MERL cells and
+    /// MERL files, which a MERL reader looks up by cell, linear otherwise), nearest or linear.
     #[cfg_attr(feature = "clap", arg(long))]
     pub interp: Option<String>,
     /// Wavelengths in nm (`400,500,600`) instead of the source's channels (model specs and RGL
