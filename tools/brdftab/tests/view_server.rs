@@ -124,3 +124,36 @@ fn the_start_line_counts_its_materials() {
     );
     assert_eq!(get_json(&v, "/api/materials").as_array().unwrap().len(), 2);
 }
+
+#[test]
+fn a_slow_figure_asked_for_by_many_clients_at_once_is_computed_once() {
+    // The page asks for a material's albedo, plausibility and error figures on every click,
+    // each taking seconds on a large table: requests arriving while the first computes used to
+    // compute it again each (25 at once took 13 s for a figure of 1.7 s), and the cores were
+    // busy with copies.
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::{Arc, Barrier};
+    let reg = Arc::new(brdftab_tools::view::Registry::open(&[LAMBERT.to_owned()]).unwrap());
+    let (calls, n) = (Arc::new(AtomicUsize::new(0)), 8);
+    let start = Arc::new(Barrier::new(n));
+    let threads: Vec<_> = (0..n)
+        .map(|_| {
+            let (reg, calls, start) = (reg.clone(), calls.clone(), start.clone());
+            std::thread::spawn(move || {
+                start.wait();
+                reg.cached("albedo:0".into(), || {
+                    calls.fetch_add(1, Ordering::SeqCst);
+                    std::thread::sleep(Duration::from_millis(300));
+                    "slow".into()
+                })
+            })
+        })
+        .collect();
+    for t in threads {
+        assert_eq!(t.join().unwrap().as_str(), "slow");
+    }
+    assert_eq!(calls.load(Ordering::SeqCst), 1);
+    // Another key is its own figure, computed while nothing else waits.
+    let other = reg.cached("albedo:1".into(), || "other".into());
+    assert_eq!((other.as_str(), calls.load(Ordering::SeqCst)), ("other", 1));
+}

@@ -10,7 +10,7 @@
 
 use std::collections::HashMap;
 use std::path::Path;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use brdftab::measured::merl::sha256_file;
 use brdftab::source::{OpenOptions, SourceKind, classify};
@@ -37,7 +37,9 @@ pub struct Material {
 pub struct Registry {
     /// The materials in command-line order (a database's tables in file order).
     pub materials: Vec<Material>,
-    cache: Mutex<HashMap<String, Arc<String>>>,
+    /// One cell per key, made under the lock and filled outside it: requests for a figure
+    /// still being computed wait for that computation instead of starting their own.
+    cache: Mutex<HashMap<String, Arc<OnceLock<Arc<String>>>>>,
 }
 
 impl Registry {
@@ -66,16 +68,16 @@ impl Registry {
         self.materials.get(id)
     }
 
-    /// The value cached under `key`, computing it with `f` the first time.
+    /// The value cached under `key`, computing it with `f` the first time. Concurrent
+    /// requests for one key compute it once: the others wait for that value (the page asks for
+    /// a material's albedo and error figures again on every click, each taking seconds). Other
+    /// keys are computed meanwhile; a computation that panics leaves the key empty.
     pub fn cached(&self, key: String, f: impl FnOnce() -> String) -> Arc<String> {
-        if let Some(v) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
-            return v;
-        }
-        let v = Arc::new(f());
-        if let Ok(mut c) = self.cache.lock() {
-            c.insert(key, v.clone());
-        }
-        v
+        let cell = match self.cache.lock() {
+            Ok(mut c) => c.entry(key).or_default().clone(),
+            Err(_) => Arc::new(OnceLock::new()),
+        };
+        cell.get_or_init(|| Arc::new(f())).clone()
     }
 }
 
