@@ -146,3 +146,40 @@ fn albedos_count_delta_lobes_as_brdftab_albedo_does() {
         assert_eq!(p["energy_conserving"], want <= 1.0 + 1e-3, "{spec}: {p}");
     }
 }
+
+#[test]
+fn a_spectral_table_is_compared_with_its_spec_at_its_own_wavelengths() {
+    // A spec baked at 7 wavelengths: its source opened in RGB beside it made the error figures
+    // "7 vs 3 channels" (the page showed "–") and the source's curves another colour's.
+    let d = TempDir::new("view-spectral");
+    let db = d.file("s.btdb");
+    let gold = r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#;
+    let r = brdftab(&[
+        "db",
+        "add",
+        &db,
+        gold,
+        "--name",
+        "gold",
+        "--preset",
+        "small",
+        "--wavelengths",
+        "400,450,500,550,600,650,700",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let v = start(&[&db]);
+    let c = get_json(&v, "/api/compare?m=0");
+    assert!(c["error"].is_null(), "{c}");
+    // The small preset's table of this model is within 2 % (`brdftab demo --preset small`).
+    assert!(c["rel_rmse"].as_f64().unwrap() < 0.05, "{c}");
+    let (table, source) = (
+        get_json(&v, "/api/polar?m=0&n=8"),
+        get_json(&v, "/api/polar?m=0&of=source&n=8"),
+    );
+    assert_eq!(source["f"].as_array().unwrap().len(), 7, "{source}");
+    // The same luminance, up to the table's error near the peak.
+    let (a, b) = (nums(&table, "y"), nums(&source, "y"));
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x - y).abs() <= 0.05 * max(&b), "{a:?} {b:?}");
+    }
+}

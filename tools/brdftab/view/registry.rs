@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use brdftab::measured::merl::sha256_file;
 use brdftab::source::{OpenOptions, SourceKind, classify};
 use brdftab::store::{db, info, tables};
-use brdftab::{Brdf, Error, Result};
+use brdftab::{Brdf, Channels, Error, Result};
 use serde_json::{Value, json};
 
 /// An opened BRDF shared between the server's threads.
@@ -161,7 +161,7 @@ fn material(
         info["provenance"] = s["source"].clone();
         let dir = Path::new(brdftab::store::name::path_of(source)).parent();
         let note;
-        (paired, measured_source, note) = provenance_source(&s["source"], dir);
+        (paired, measured_source, note) = provenance_source(&s["source"], dir, brdf.channels());
         if let Some(n) = note {
             info["source_note"] = json!(n);
         }
@@ -179,11 +179,19 @@ fn material(
 /// recorded name in the table's directory (the provenance keeps the file name only) whose
 /// SHA-256 is the recorded one. Whether it is measured rides along, and why a file of that name
 /// was not paired.
-fn provenance_source(p: &Value, dir: Option<&Path>) -> (Option<Shared>, bool, Option<String>) {
+///
+/// The source is opened at the table's `channels`, as it was baked (`--wavelengths`): a spec
+/// opened in RGB beside a spectral table compared 3 channels with 7 ("7 vs 3 channels").
+fn provenance_source(
+    p: &Value,
+    dir: Option<&Path>,
+    channels: &Channels,
+) -> (Option<Shared>, bool, Option<String>) {
+    let opts = OpenOptions::new().channels(channels.clone());
+    let open = |s: &str| brdftab::open_with(s, &opts).ok().map(Arc::from);
     match p["kind"].as_str() {
         Some("model") => {
-            let spec = p["spec"].to_string();
-            let opened = brdftab::open(&spec).ok().map(Arc::from);
+            let opened = open(&p["spec"].to_string());
             (opened, false, None)
         }
         Some("measured") => {
@@ -199,9 +207,7 @@ fn provenance_source(p: &Value, dir: Option<&Path>) -> (Option<Shared>, bool, Op
             };
             let recorded = p["sha256"].as_str().unwrap_or_default();
             match sha256_file(path) {
-                Ok(sha) if sha.eq_ignore_ascii_case(recorded) => {
-                    (brdftab::open(path).ok().map(Arc::from), true, None)
-                }
+                Ok(sha) if sha.eq_ignore_ascii_case(recorded) => (open(path), true, None),
                 Ok(_) => (
                     None,
                     true,
