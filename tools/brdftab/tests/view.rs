@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use brdftab::testkit::TempDir;
 use common::brdftab;
-use common::viewer::{database, enc, get, get_json, send, start};
+use common::viewer::{database, enc, get, get_json, send, send_raw, start};
 
 #[test]
 fn materials_and_views_of_a_database() {
@@ -222,7 +222,11 @@ fn requests_cannot_reach_beyond_the_materials_named_at_start() {
     let post = format!(
         "POST /api/materials HTTP/1.1\r\nHost: 127.0.0.1:{p}\r\nContent-Length: 2\r\n\r\n{{}}"
     );
-    assert_eq!(send(p, post.as_bytes()).0, 405);
+    let refused = send_raw(p, post.as_bytes());
+    assert!(refused.starts_with("HTTP/1.1 405"), "{refused}");
+    // A 405 names the methods that are served (RFC 9110 §15.5.6); it named none.
+    let head = refused.split("\r\n\r\n").next().unwrap();
+    assert!(head.contains("\r\nAllow: GET, HEAD\r\n"), "{head}");
     let long = format!(
         "GET /api/polar?m=0&x={} HTTP/1.1\r\nHost: 127.0.0.1:{p}\r\n\r\n",
         "a".repeat(64 * 1024)

@@ -221,14 +221,20 @@ fn reason(status: u16) -> &'static str {
 }
 
 /// Writes `r` (with no body for `HEAD`) and the headers every response carries: no caching, no
-/// sniffing, no framing, and a content security policy that allows nothing from elsewhere.
+/// sniffing, no framing, and a content security policy that allows nothing from elsewhere. A 405
+/// says which methods are served (`Allow`, which RFC 9110 §15.5.6 requires of it).
 pub fn write_response(
     stream: &mut impl Write,
     r: &Response,
     head_only: bool,
 ) -> std::io::Result<()> {
+    let allow = if r.status == 405 {
+        "Allow: GET, HEAD\r\n"
+    } else {
+        ""
+    };
     let head = format!(
-        "HTTP/1.1 {} {}\r\nContent-Type: {}\r\nContent-Length: {}\r\nConnection: close\r\n\
+        "HTTP/1.1 {} {}\r\nContent-Type: {}\r\nContent-Length: {}\r\n{allow}Connection: close\r\n\
          Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\nX-Frame-Options: DENY\r\n\
          Referrer-Policy: no-referrer\r\nContent-Security-Policy: default-src 'self'; \
          img-src 'self' data: blob:; style-src 'self'; connect-src 'self'; frame-ancestors 'none'\r\n\r\n",

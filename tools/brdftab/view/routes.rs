@@ -38,7 +38,7 @@ pub fn handle(reg: &Registry, hosts: &[String], req: &Request) -> Response {
         return Response::error(403, "unexpected Host header");
     }
     if req.method != "GET" && req.method != "HEAD" {
-        return Response::error(405, "only GET is served");
+        return Response::error(405, "only GET and HEAD are served");
     }
     let (path, params) = match security::split_target(target) {
         Ok(x) => x,

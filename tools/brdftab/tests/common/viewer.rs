@@ -46,15 +46,20 @@ pub fn start(args: &[&str]) -> Viewer {
     Viewer { child, port, line }
 }
 
-/// Sends `raw` as is and returns (status, body).
-pub fn send(port: u16, raw: &[u8]) -> (u16, String) {
+/// Sends `raw` as is and returns the whole response, head and body.
+pub fn send_raw(port: u16, raw: &[u8]) -> String {
     let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
     s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
     // The server may answer (and close) before it has read an oversized request whole.
     let _ = s.write_all(raw);
     let mut out = Vec::new();
     let _ = s.read_to_end(&mut out);
-    let text = String::from_utf8_lossy(&out).into_owned();
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Sends `raw` as is and returns (status, body).
+pub fn send(port: u16, raw: &[u8]) -> (u16, String) {
+    let text = send_raw(port, raw);
     let status = text
         .split(' ')
         .nth(1)
