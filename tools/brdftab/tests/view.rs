@@ -227,6 +227,18 @@ fn requests_cannot_reach_beyond_the_materials_named_at_start() {
     // A 405 names the methods that are served (RFC 9110 §15.5.6); it named none.
     let head = refused.split("\r\n\r\n").next().unwrap();
     assert!(head.contains("\r\nAllow: GET, HEAD\r\n"), "{head}");
+    // A parameter given twice has no one meaning: it was answered for the first, silently.
+    for target in [
+        "/api/polar?m=0&theta_i=30&theta_i=60",
+        "/api/polar?m=0&m=1",
+        "/api/polar?m=0&of=source&of=table",
+    ] {
+        let (status, body) = get(&v, target);
+        assert!(
+            status == 400 && body.contains("more than once"),
+            "{target}: {status} {body}"
+        );
+    }
     let long = format!(
         "GET /api/polar?m=0&x={} HTTP/1.1\r\nHost: 127.0.0.1:{p}\r\n\r\n",
         "a".repeat(64 * 1024)

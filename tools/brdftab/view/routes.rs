@@ -42,7 +42,7 @@ pub fn handle(reg: &Registry, hosts: &[String], req: &Request) -> Response {
     }
     let (path, params) = match security::split_target(target) {
         Ok(x) => x,
-        Err(e) => return Response::error(400, e),
+        Err(e) => return Response::error(400, &e),
     };
     if let Some((_, ty, body)) = ASSETS.iter().find(|(p, _, _)| *p == path) {
         return Response {

@@ -71,22 +71,28 @@ pub fn effective<'a>(
 pub type Params = Vec<(String, String)>;
 
 /// A request target split into its path and decoded query parameters, or why it is refused.
-pub fn split_target(target: &str) -> Result<(&str, Params), &'static str> {
+/// A parameter given twice is refused: `theta_i=30&theta_i=60` (a URL edited by appending) has
+/// no one meaning, and answering for either value would be a silent guess.
+pub fn split_target(target: &str) -> Result<(&str, Params), String> {
     let (path, query) = target.split_once('?').unwrap_or((target, ""));
     if !path.starts_with('/')
         || path.contains('%')
         || path.contains('\\')
         || path.split('/').any(|seg| seg == ".." || seg == ".")
     {
-        return Err("bad path");
+        return Err("bad path".into());
     }
-    let mut params = Vec::new();
+    let mut params: Params = Vec::new();
     for pair in query.split('&').filter(|p| !p.is_empty()) {
         if params.len() == MAX_PARAMS {
-            return Err("too many query parameters");
+            return Err("too many query parameters".into());
         }
         let (k, v) = pair.split_once('=').unwrap_or((pair, ""));
-        params.push((decode(k)?, decode(v)?));
+        let k = decode(k)?;
+        if params.iter().any(|(n, _)| *n == k) {
+            return Err(format!("{k}: given more than once"));
+        }
+        params.push((k, decode(v)?));
     }
     Ok((path, params))
 }
