@@ -85,6 +85,7 @@ def main():
         server, url = start_server(a.brdftab, db, [GLAZED, '{"model": "lambert", "kd": 0.3}'])
         try:
             check_delta_and_four_curves(driver, url)
+            check_spheres_of_four(driver, url)
         finally:
             if driver is not None:
                 driver.quit()
@@ -263,6 +264,19 @@ def check_delta_and_four_curves(driver, url):
     assert "on=1" not in driver.current_url, driver.current_url
     errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
     assert not errors, f"console errors: {errors}"
+
+
+
+def check_spheres_of_four(driver, url):
+    """Four materials against their sources show every sphere (the panel showed the first six
+    images: two materials were missing)."""
+    wait = WebDriverWait(driver, 30)
+    driver.get("about:blank")
+    driver.get(url.split("#")[0] + "#m=0,1,2,3&src=1")
+    # The two tables with their sources and differences, the two specs alone.
+    wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sphere image")) == 8)
+    labels = [t.text for t in driver.find_elements(By.CSS_SELECTOR, "#sphere text")]
+    assert sum("source" in t for t in labels) == 4 and labels[-2:] == ["sum", "lambert"], labels
 
 
 if __name__ == "__main__":

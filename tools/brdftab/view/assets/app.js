@@ -143,18 +143,19 @@ async function fastViews() {
 function sphereView(size) {
   const q = `lt=${state.lt}&lp=${state.lp}&size=${size}&exposure=${Math.pow(2, state.ev)}`;
   return view("sphere", q, (list, got) => {
-    // Each material, then its source and their difference when shown.
-    const images = [];
+    // Each material, then its source and their difference when shown: one group each.
+    const groups = [];
     list.forEach((e, k) => {
       if (e.sourceOf !== undefined) return;
-      images.push({ ...got[k], color: e.color, label: e.label });
+      const group = [{ ...got[k], color: e.color, label: e.label }];
+      groups.push(group);
       const s = e.id === undefined ? -1 : list.findIndex((o) => o.sourceOf === e.id);
       if (s < 0) return;
-      images.push({ ...got[s], color: e.color, label: list[s].label });
+      group.push({ ...got[s], color: e.color, label: list[s].label });
       const diff = got[k].rgb.map((x, i) => Math.min(255, 4 * Math.abs(x - got[s].rgb[i])));
-      images.push({ size, rgb: diff, color: e.color, label: "|table − source| ×4" });
+      group.push({ size, rgb: diff, color: e.color, label: "|table − source| ×4" });
     });
-    spherePanel($("sphere"), images.slice(0, 6));
+    spherePanel($("sphere"), groups);
   });
 }
 

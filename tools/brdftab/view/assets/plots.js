@@ -200,23 +200,29 @@ function lobePlot(svg, lobes, view) {
   }
 }
 
-// Lit spheres: RGB bytes from the server, one image per entry, with a label.
-function spherePanel(svg, images) {
+// Lit spheres: RGB bytes from the server, one image per entry, with a label. `groups` holds
+// each material's images (itself, or itself, its source and their difference): three a row
+// when every group is one image, else a row per group. The panel grows to its rows (four
+// materials against their sources are twelve images; it used to show the first six).
+function spherePanel(svg, groups) {
   clear(svg);
-  images.forEach((im, k) => {
-    const c = document.createElement("canvas");
-    c.width = c.height = im.size;
+  const single = groups.every((g) => g.length === 1);
+  const rows = single ? [] : groups;
+  if (single) for (let k = 0; k < groups.length; k += 3) rows.push(groups.slice(k, k + 3).flat());
+  svg.setAttribute("viewBox", `0 0 440 ${Math.max(2, rows.length) * 118 + 4}`);
+  rows.forEach((row, r) => row.forEach((im, c) => {
+    const cv = document.createElement("canvas");
+    cv.width = cv.height = im.size;
     const data = new ImageData(im.size, im.size);
     for (let p = 0; p < im.size * im.size; p++) {
       data.data.set([im.rgb[3 * p], im.rgb[3 * p + 1], im.rgb[3 * p + 2], 255], 4 * p);
     }
-    c.getContext("2d").putImageData(data, 0, 0);
-    // Up to three a row: a table, its source, their difference.
-    const x = 4 + (k % 3) * 145, y = 4 + Math.floor(k / 3) * 118;
-    el("image", { x, y, width: 100, height: 100, href: c.toDataURL() }, svg);
+    cv.getContext("2d").putImageData(data, 0, 0);
+    const x = 4 + c * 145, y = 4 + r * 118;
+    el("image", { x, y, width: 100, height: 100, href: cv.toDataURL() }, svg);
     el("rect", { x, y: y + 102, width: 100, height: 3, fill: im.color }, svg);
     text(svg, x, y + 114, im.label.slice(0, 24));
-  });
+  }));
 }
 
 // Download buttons (SVG, PNG) on each plot's panel.
