@@ -86,6 +86,7 @@ def main():
         try:
             check_delta_and_four_curves(driver, url)
             check_spheres_of_four(driver, url)
+            check_a_late_report(driver, url)
         finally:
             if driver is not None:
                 driver.quit()
@@ -277,6 +278,29 @@ def check_spheres_of_four(driver, url):
     wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sphere image")) == 8)
     labels = [t.text for t in driver.find_elements(By.CSS_SELECTOR, "#sphere text")]
     assert sum("source" in t for t in labels) == 4 and labels[-2:] == ["sum", "lambert"], labels
+
+
+def check_a_late_report(driver, url):
+    """A report that answers after a newer one (its figures took seconds) does not replace it
+    with materials no longer selected."""
+    wait = WebDriverWait(driver, 30)
+    rows = lambda d: [r.text for r in d.find_elements(By.CSS_SELECTOR, "#report tr")][1:]
+    driver.get("about:blank")
+    driver.get(url.split("#")[0] + "#m=0")
+    wait.until(lambda d: len(rows(d)) == 1 and "…" not in rows(d)[0])
+    # Material 1's plausibility answers 1.5 s late; it is selected, then deselected at once.
+    driver.execute_script("""
+        const orig = getJSON;
+        window.getJSON = (p) => (p.startsWith("/api/plausibility?m=1")
+          ? new Promise((r) => setTimeout(r, 1500)).then(() => orig(p)) : orig(p));""")
+    items = driver.find_elements(By.CSS_SELECTOR, "#materials li")
+    items[1].click()
+    time.sleep(0.3)
+    driver.find_elements(By.CSS_SELECTOR, "#materials li")[1].click()
+    time.sleep(2.5)
+    assert len(rows(driver)) == 1 and rows(driver)[0].startswith("gold"), rows(driver)
+    errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+    assert not errors, f"console errors: {errors}"
 
 
 if __name__ == "__main__":

@@ -2,13 +2,19 @@
 // reciprocal, energy; against a table's source, the error figures).
 "use strict";
 
+// The newest report asked for: an older one that answers later (its figures took seconds to
+// compute) is dropped, or it would show materials no longer selected.
+let reportGen = 0;
+
 async function report() {
+  const g = ++reportGen;
   const list = entries().filter((e) => e.sourceOf === undefined);
   const rows = await Promise.all(list.map(async (e) => {
     const p = await getJSON(`/api/plausibility?${e.q}`).catch(() => null);
     const m = e.id !== undefined && materials[e.id].has_source ? await getJSON(`/api/compare?m=${e.id}`).catch(() => null) : null;
     return { e, p, m };
   }));
+  if (g !== reportGen) return;
   // Built as DOM nodes, not HTML text: the page's CSP allows no inline style attributes.
   const table = document.createElement("table");
   const row = (cells, head) => {
