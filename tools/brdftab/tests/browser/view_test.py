@@ -185,12 +185,21 @@ def check_scales(driver):
         const ys = xs.map((t) => (Math.abs(t) > 89 ? 1e14 : 0.3));
         polarPlot($("polar"), [{x: xs, y: ys, color: "#000"}], {log: false, thetaI: 30, label: ""});
         const polar = [...$("polar").querySelectorAll("text")].map((t) => t.textContent).find((t) => t.startsWith("scale"));
+        const rings = (log) => {
+          polarPlot($("polar"), [{x: xs, y: ys, color: "#000"}], {log, thetaI: 30, label: ""});
+          return [...$("polar").querySelectorAll("text.ring")].map((t) => t.textContent).join(" ");
+        };
+        window.ringLabels = [rings(false), rings(true)];
         const n = 10, theta = Array.from({length: n}, (_, k) => 4.5 + 9 * k);
         const y = Array.from({length: n * n}, (_, k) => (k % n === n - 1 || k >= n * (n - 1) ? 1 : 0.01));
         heatmap($("slice"), n, y, {signed: true, theta, label: ""});
         return [polar, [...$("slice").querySelectorAll("text")].map((t) => t.textContent).join(" | ")];""")
     assert legend[0].startswith("scale 0.300; 2 grazing samples clipped"), legend
     assert "scale ±0.0100" in legend[1] and "19 cells clipped" in legend[1], legend
+    # The polar plot's rings say their values: quarters of the scale, or decades on a log scale
+    # (they said nothing, and a log plot's rings read as quarters).
+    rings = driver.execute_script("return window.ringLabels;")
+    assert rings == ["0.075 0.15 0.22 0.30", "3.0e-4 3.0e-3 0.030 0.30"], rings
 
 
 def check_hash_and_errors(driver, wait, url):

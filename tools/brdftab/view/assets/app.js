@@ -103,8 +103,12 @@ function polarSeries() {
   return series;
 }
 
+// What the plots of f_r show: the luminance Y of each material's colour (RGB, or a spectrum
+// projected), not one channel.
+const quantity = () => (state.cos ? "f_r cos θo" : "f_r") + ", luminance Y (1/sr)";
+
 function drawPolar() {
-  polarPlot($("polar"), polarSeries(), { log: state.scale === "log", thetaI: state.ti, label: state.cos ? "f_r cos θo" : "f_r (1/sr)" });
+  polarPlot($("polar"), polarSeries(), { log: state.scale === "log", thetaI: state.ti, label: quantity() });
 }
 
 function drawLobe() {
@@ -115,7 +119,7 @@ function drawLobe() {
     const d = a.v.y.map((f, k) => Math.abs(f - b.v.y[k]));
     lobes.push({ nt: a.v.nt, np: a.v.np, theta: a.v.theta_o, color: a.e.color, dash: "1 2", width: 0.4, r: weigh(a.v, d) });
   }
-  lobePlot($("lobe"), lobes, { yaw: state.yaw, pitch: state.pitch, log: state.scale === "log", thetaI: state.ti });
+  lobePlot($("lobe"), lobes, { yaw: state.yaw, pitch: state.pitch, log: state.scale === "log", thetaI: state.ti, label: quantity() });
 }
 
 async function fastViews() {
@@ -173,7 +177,7 @@ function sliceView() {
       const src = got[s].y;
       const d = v.y.map((f, k) => (f - src[k]) / Math.max(Math.abs(src[k]), 1e-5));
       heatmap($("slice"), v.n, d, { signed: true, theta: v.theta, label: `${a.label}: (table − source) / source` });
-    } else heatmap($("slice"), v.n, v.y, { log, theta: v.theta, label: a.label });
+    } else heatmap($("slice"), v.n, v.y, { log, theta: v.theta, label: `${a.label}: f_r, luminance Y (1/sr)` });
   });
 }
 

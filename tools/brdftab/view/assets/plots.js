@@ -67,8 +67,11 @@ function polarPlot(svg, series, opts) {
   const cx = 210, cy = 220, R = 195;
   const keep = (t) => Math.abs(t) <= Math.max(SCALE_DEG, opts.thetaI);
   const sc = robustScale(series, keep), s = scaler(sc.max, opts.log);
+  // Each ring says its value: a quarter of the scale apart, or a decade apart on the log scale.
   for (const f of [0.25, 0.5, 0.75, 1]) {
     el("path", { d: `M${cx - R * f},${cy} A${R * f},${R * f} 0 0 1 ${cx + R * f},${cy}`, fill: "none", stroke: "#ddd" }, svg);
+    const v = opts.log ? sc.max * Math.pow(10, 4 * (f - 1)) : sc.max * f;
+    text(svg, cx + R * f - 10, cy + 12, v >= 0.01 && v < 1e4 ? v.toPrecision(2) : v.toExponential(1), { "font-size": 8, class: "ring" });
   }
   for (let a = -90; a <= 90; a += 30) {
     const r = (a * Math.PI) / 180;
@@ -179,6 +182,7 @@ function lobePlot(svg, lobes, view) {
   };
   axis(1, 0, 0, "x"); axis(0, 1, 0, "y"); axis(0, 0, 1, "n");
   text(svg, 4, 12, (view.log ? "log, " : "") + scaleNote(sc, "grazing samples"));
+  if (view.label) text(svg, 4, 24, view.label);
   for (const l of lobes) {
     const pt = (i, j) => {
       const t = (l.theta[i] * Math.PI) / 180, p = (2 * Math.PI * j) / l.np, r = s(l.r[i * l.np + j]);
