@@ -86,6 +86,7 @@ def main():
         try:
             check_delta_and_four_curves(driver, url)
             check_spheres_of_four(driver, url)
+            check_a_narrow_window(driver, url)
             check_a_late_report(driver, url)
         finally:
             if driver is not None:
@@ -287,6 +288,25 @@ def check_spheres_of_four(driver, url):
     wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sphere image")) == 8)
     labels = [t.text for t in driver.find_elements(By.CSS_SELECTOR, "#sphere text")]
     assert sum("source" in t for t in labels) == 4 and labels[-2:] == ["sum", "lambert"], labels
+
+
+def check_a_narrow_window(driver, url):
+    """In a narrow window (a phone, half a screen) every panel fits the page's width: beside
+    the material list they had less than their width and ran off the right edge."""
+    wait = WebDriverWait(driver, 30)
+    driver.set_window_size(480, 900)
+    try:
+        driver.get("about:blank")
+        driver.get(url.split("#")[0] + "#m=0")
+        wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#polar polyline"))
+        width, overflow = driver.execute_script("""
+            const w = document.documentElement.clientWidth;
+            const right = [...document.querySelectorAll(".panel, #controls, aside")]
+              .map((e) => e.getBoundingClientRect().right);
+            return [w, Math.max(...right) - w];""")
+        assert overflow <= 0.5, f"the panels run {overflow:.0f} px past a {width} px page"
+    finally:
+        driver.set_window_size(1500, 1000)
 
 
 def check_a_late_report(driver, url):
