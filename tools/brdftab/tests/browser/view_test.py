@@ -14,12 +14,14 @@ Needs Debian's `chromium` and `chromium-driver` and the `selenium` package.
 """
 
 import argparse
+import json
 import os
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
+import urllib.parse
 
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
@@ -87,6 +89,7 @@ def main():
             check_delta_and_four_curves(driver, url)
             check_spheres_of_four(driver, url)
             check_a_narrow_window(driver, url)
+            check_a_colour_slider(driver, url)
             check_a_late_report(driver, url)
         finally:
             if driver is not None:
@@ -307,6 +310,22 @@ def check_a_narrow_window(driver, url):
         assert overflow <= 0.5, f"the panels run {overflow:.0f} px past a {width} px page"
     finally:
         driver.set_window_size(1500, 1000)
+
+
+def check_a_colour_slider(driver, url):
+    """A slider on an RGB value scales the colour, keeping its hue (it set a grey)."""
+    wait = WebDriverWait(driver, 30)
+    driver.get("about:blank")
+    driver.get(url.split("#")[0] + "#m=0&spec=" + urllib.parse.quote(
+        '{"model": "lambert", "kd": [0.1, 0.2, 0.4]}'))
+    wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#params input[type=range]"))
+    slider = driver.find_element(By.CSS_SELECTOR, "#params input[type=range]")
+    for _ in range(20):
+        slider.send_keys(Keys.ARROW_LEFT)
+    kd = json.loads(driver.find_element(By.ID, "spec-json").get_attribute("value"))["kd"]
+    assert isinstance(kd, list) and len(kd) == 3, kd
+    # 20 steps of 1/400 down from 0.4; the hue's ratios 1 : 2 : 4 kept.
+    assert abs(kd[2] - 0.35) < 1e-9 and abs(kd[0] * 4 - kd[2]) < 1e-9 and abs(kd[1] * 2 - kd[2]) < 1e-9, kd
 
 
 def check_a_late_report(driver, url):

@@ -41,8 +41,11 @@ function buildParams(spec) {
     label.textContent = p.name;
     if (["number", "radians", "value"].includes(p.kind)) {
       const r = sliderRange(p.name, p.kind);
-      let v = spec[p.name];
-      if (Array.isArray(v)) v = v[0];
+      // A colour (an RGB triple) keeps its hue: the slider sets its largest component and
+      // scales the others with it (it used to set the value to a grey of its first).
+      const rgb = Array.isArray(spec[p.name]) && spec[p.name].every(Number.isFinite) ? spec[p.name] : null;
+      const top = rgb ? Math.max(...rgb) : 0;
+      let v = rgb ? top : spec[p.name];
       if (typeof v !== "number") v = p.default !== null && Number.isFinite(+p.default) ? +p.default : r.min;
       const input = Object.assign(document.createElement("input"), { type: "range", min: r.min, max: r.max, step: (r.max - r.min) / 400 });
       input.value = r.log ? Math.log10(Math.max(v, 1)) : v;
@@ -51,7 +54,8 @@ function buildParams(spec) {
       input.addEventListener("input", () => {
         const x = r.log ? Math.round(Math.pow(10, +input.value)) : +input.value;
         out.textContent = x.toPrecision(3);
-        specChanged(Object.assign(JSON.parse(state.spec), { [p.name]: x }));
+        const value = rgb && top > 0 ? rgb.map((c) => (c * x) / top) : x;
+        specChanged(Object.assign(JSON.parse(state.spec), { [p.name]: value }));
       });
       label.append(input, out);
     } else if (p.kind === "fresnel" || (p.kind && p.kind.choice)) {
