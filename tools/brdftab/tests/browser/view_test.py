@@ -90,6 +90,7 @@ def main():
             check_spheres_of_four(driver, url)
             check_a_narrow_window(driver, url)
             check_a_colour_slider(driver, url)
+            check_a_spec_that_is_not_an_object(driver, url)
             check_a_late_report(driver, url)
         finally:
             if driver is not None:
@@ -326,6 +327,23 @@ def check_a_colour_slider(driver, url):
     assert isinstance(kd, list) and len(kd) == 3, kd
     # 20 steps of 1/400 down from 0.4; the hue's ratios 1 : 2 : 4 kept.
     assert abs(kd[2] - 0.35) < 1e-9 and abs(kd[0] * 4 - kd[2]) < 1e-9 and abs(kd[1] * 2 - kd[2]) < 1e-9, kd
+
+
+def check_a_spec_that_is_not_an_object(driver, url):
+    """`null` typed in the spec editor is not a spec: it is refused there, and a URL holding it
+    (the editor wrote one) still opens (the page stopped at a TypeError and drew nothing)."""
+    wait = WebDriverWait(driver, 30)
+    driver.get("about:blank")
+    driver.get(url.split("#")[0] + "#m=0&spec=null&on=1")
+    wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#polar polyline"))
+    assert not driver.find_element(By.ID, "spec-on").is_selected()
+    editor = driver.find_element(By.ID, "spec-json")
+    editor.clear()
+    editor.send_keys("null")
+    wait.until(lambda d: "JSON object" in d.find_element(By.ID, "spec-error").text)
+    assert "spec=null" not in driver.current_url, driver.current_url
+    errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+    assert not errors, f"console errors: {errors}"
 
 
 def check_a_late_report(driver, url):

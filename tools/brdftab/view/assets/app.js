@@ -249,8 +249,17 @@ function bind() {
     specChanged(JSON.parse(state.spec));
   });
   $("spec-json").addEventListener("input", () => {
-    try { const s = JSON.parse($("spec-json").value); $("spec-error").textContent = ""; state.spec = JSON.stringify(s); buildParams(s); specChanged(s); }
-    catch { $("spec-error").textContent = "not JSON yet"; }
+    const s = parseSpec($("spec-json").value);
+    if (!s) {
+      let json = true;
+      try { JSON.parse($("spec-json").value); } catch { json = false; }
+      $("spec-error").textContent = json ? 'a spec is a JSON object: {"model": ...}' : "not JSON yet";
+      return;
+    }
+    $("spec-error").textContent = "";
+    state.spec = JSON.stringify(s);
+    buildParams(s);
+    specChanged(s);
   });
   // Drag on the lobe rotates it; drag on the sphere moves the light.
   drag($("lobe"), (dx, dy) => { state.yaw += dx * 0.01; state.pitch = Math.min(Math.PI, Math.max(0, state.pitch + dy * 0.01)); drawLobe(); }, writeHash);
@@ -283,7 +292,12 @@ async function main() {
   for (const m of models) $("model").add(new Option(m.name, m.name));
   readHash();
   if (!location.hash) state.sel = [0];
-  loadSpec(state.spec || models.find((m) => m.name === "cook_torrance").example);
+  // A URL's spec that is not one (`spec=null`, which the editor used to write) is dropped:
+  // it stopped the page before it drew anything.
+  if (!loadSpec(state.spec)) {
+    state.on = false;
+    loadSpec(models.find((m) => m.name === "cook_torrance").example);
+  }
   bind();
   redrawAll();
   window.addEventListener("hashchange", () => {

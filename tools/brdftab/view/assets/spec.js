@@ -17,13 +17,24 @@ function sliderRange(name, kind) {
   return { min: 0, max: 1, log: false };
 }
 
+// The spec `json` holds if it is a JSON object, else null: `null`, `1` or `"x"` is JSON but
+// not a spec.
+function parseSpec(json) {
+  try {
+    const s = JSON.parse(json);
+    return s !== null && typeof s === "object" && !Array.isArray(s) ? s : null;
+  } catch { return null; }
+}
+
+// Shows spec `json` in the editor; false (and nothing changed) if it is not a spec.
 function loadSpec(json) {
-  let spec;
-  try { spec = JSON.parse(json); } catch { return; }
+  const spec = parseSpec(json);
+  if (!spec) return false;
   state.spec = JSON.stringify(spec);
   $("spec-json").value = state.spec;
   $("model").value = spec.model;
   buildParams(spec);
+  return true;
 }
 
 function buildParams(spec) {
