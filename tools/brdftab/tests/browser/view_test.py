@@ -198,11 +198,15 @@ def check_scales(driver):
         const n = 10, theta = Array.from({length: n}, (_, k) => 4.5 + 9 * k);
         const y = Array.from({length: n * n}, (_, k) => (k % n === n - 1 || k >= n * (n - 1) ? 1 : 0.01));
         heatmap($("slice"), n, y, {signed: true, theta, label: ""});
+        window.sliceTicks = [...$("slice").querySelectorAll("text.tick")].map((t) => t.textContent);
         return [polar, [...$("slice").querySelectorAll("text")].map((t) => t.textContent).join(" | ")];""")
     assert legend[0].startswith("scale 0.300; 2 grazing samples clipped"), legend
     assert "scale ±0.0100" in legend[1] and "19 cells clipped" in legend[1], legend
     # The polar plot's rings say their values: quarters of the scale, or decades on a log scale
     # (they said nothing, and a log plot's rings read as quarters).
+    # The slice's axes say their range (they said only "θh →" and "θd ↑").
+    ticks = driver.execute_script("return window.sliceTicks;")
+    assert ticks == ["0°", "90°", "0°", "90°"], ticks
     rings = driver.execute_script("return window.ringLabels;")
     assert rings == ["0.075 0.15 0.22 0.30", "3.0e-4 3.0e-3 0.030 0.30"], rings
 

@@ -156,6 +156,10 @@ function heatmap(svg, n, y, opts) {
   }
   text(svg, L + S / 2 - 10, T + S + 12, "θh →");
   text(svg, 2, T + S / 2, "θd ↑");
+  // Both axes run over [0°, 90°] (the cells' edges; `opts.theta` are their centres).
+  for (const [x, y, s] of [[L - 2, T + S + 12, "0°"], [L + S - 14, T + S + 12, "90°"], [12, T + S, "0°"], [8, T + 8, "90°"]]) {
+    text(svg, x, y, s, { class: "tick" });
+  }
   text(svg, L, T + S + 26, opts.label);
   const [scale, clip] = scaleNote(sc, "cells", opts.signed ? "±" : "").split("; ");
   text(svg, L, T + S + 39, (opts.log ? "log, " : "") + (opts.signed ? "red +, blue −, " : "") + scale);
