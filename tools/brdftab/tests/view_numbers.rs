@@ -183,3 +183,46 @@ fn a_spectral_table_is_compared_with_its_spec_at_its_own_wavelengths() {
         assert!((x - y).abs() <= 0.05 * max(&b), "{a:?} {b:?}");
     }
 }
+
+#[test]
+fn a_view_shows_the_channel_asked_for() {
+    // The views drew the luminance only: gold's red and blue Fresnel, a blue plastic's colour
+    // could not be seen one by one. `ch=r|g|b` shows a linear sRGB component (an RGB
+    // material's own channel), `ch=y` (the default) the luminance.
+    let spec = r#"{"model": "lambert", "kd": [0.1, 0.2, 0.4]}"#;
+    let v = start(&[spec]);
+    let f = get_json(&v, "/api/polar?m=0&n=4");
+    for (k, ch) in ["r", "g", "b"].iter().enumerate() {
+        let one: Vec<f64> = f["f"][k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        for view in [
+            format!("/api/polar?m=0&n=4&ch={ch}"),
+            format!("/api/lobe?m=0&nt=2&np=3&ch={ch}"),
+            format!("/api/slice?m=0&n=2&ch={ch}"),
+        ] {
+            let y = nums(&get_json(&v, &view), "y");
+            assert!(
+                y.iter().all(|&x| (x - one[0]).abs() < 1e-7),
+                "{view}: {y:?}"
+            );
+        }
+        let a = get_json(&v, &format!("/api/albedo?m=0&ch={ch}"));
+        let (y, kd) = (nums(&a, "y"), [0.1, 0.2, 0.4][k]);
+        // The lecture's Lambert: f_r = kd, albedo π kd at every angle.
+        assert!(
+            y.iter()
+                .all(|&x| (x - std::f64::consts::PI * kd).abs() < 1e-4),
+            "{ch}: {y:?}"
+        );
+    }
+    let y = nums(&get_json(&v, "/api/polar?m=0&n=4&ch=y"), "y");
+    let lum = 0.2126 * 0.1 + 0.7152 * 0.2 + 0.0722 * 0.4;
+    assert!(y.iter().all(|&x| (x - lum).abs() < 1e-7), "{y:?}");
+    assert_eq!(nums(&get_json(&v, "/api/polar?m=0&n=4"), "y"), y);
+    let (status, body) = common::viewer::get(&v, "/api/albedo?m=0&ch=x");
+    assert!(status == 400 && body.contains("ch:"), "{status} {body}");
+}

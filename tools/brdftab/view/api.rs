@@ -11,7 +11,7 @@ use brdftab::analysis::plausibility;
 use brdftab::spectrum::Channels;
 use serde_json::json;
 
-use super::eval;
+use super::eval::{self, Channel};
 use super::http::Response;
 use super::registry::{Registry, Shared};
 use super::security::inline_spec;
@@ -37,6 +37,16 @@ impl Query {
                 400,
                 &format!("{k}: expected a number in [{lo}, {hi}]"),
             )),
+        }
+    }
+
+    /// The channel a view shows (`ch=y|r|g|b`, the luminance when absent).
+    fn channel(&self) -> Result<Channel, Response> {
+        match self.get("ch") {
+            None => Ok(Channel::Y),
+            Some(v) => {
+                Channel::parse(v).ok_or_else(|| Response::error(400, "ch: expected y, r, g or b"))
+            }
         }
     }
 
@@ -121,30 +131,30 @@ fn answer(brdf: &dyn brdftab::Brdf, body: String) -> Result<Response, Response> 
     Ok(Response::json(body))
 }
 
-/// `/api/polar?theta_i=DEG&n=N`.
+/// `/api/polar?theta_i=DEG&n=N&ch=C`.
 pub fn polar(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let t = target(reg, q)?;
     let ti = q.num("theta_i", 30.0, 0.0, 89.9)?;
     let n = q.count("n", 181, 2, 2001)?;
-    let body = eval::polar(t.brdf.as_ref(), ti, n).to_string();
+    let body = eval::polar(t.brdf.as_ref(), ti, n, q.channel()?).to_string();
     answer(t.brdf.as_ref(), body)
 }
 
-/// `/api/lobe?theta_i=DEG&nt=N&np=N`.
+/// `/api/lobe?theta_i=DEG&nt=N&np=N&ch=C`.
 pub fn lobe(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let t = target(reg, q)?;
     let ti = q.num("theta_i", 30.0, 0.0, 89.9)?;
     let nt = q.count("nt", 24, 2, 96)?;
     let np = q.count("np", 48, 3, 192)?;
-    let body = eval::lobe(t.brdf.as_ref(), ti, nt, np).to_string();
+    let body = eval::lobe(t.brdf.as_ref(), ti, nt, np, q.channel()?).to_string();
     answer(t.brdf.as_ref(), body)
 }
 
-/// `/api/slice?n=N`.
+/// `/api/slice?n=N&ch=C`.
 pub fn slice(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let t = target(reg, q)?;
     let n = q.count("n", 64, 2, 256)?;
-    let body = eval::slice(t.brdf.as_ref(), n).to_string();
+    let body = eval::slice(t.brdf.as_ref(), n, q.channel()?).to_string();
     answer(t.brdf.as_ref(), body)
 }
 
@@ -164,7 +174,7 @@ fn cached_view(
     reg: &Registry,
     q: &Query,
     what: &str,
-    f: fn(&(dyn brdftab::Brdf + Sync)) -> String,
+    f: impl FnOnce(&(dyn brdftab::Brdf + Sync)) -> String,
 ) -> Result<Response, Response> {
     let t = target(reg, q)?;
     let body = match t.key {
@@ -176,9 +186,11 @@ fn cached_view(
     answer(t.brdf.as_ref(), body)
 }
 
-/// `/api/albedo`: the albedo curve.
+/// `/api/albedo?ch=C`: the albedo curve.
 pub fn albedo(reg: &Registry, q: &Query) -> Result<Response, Response> {
-    cached_view(reg, q, "albedo", |b| eval::albedo(b).to_string())
+    let ch = q.channel()?;
+    let what = format!("albedo-{}", ch.name());
+    cached_view(reg, q, &what, |b| eval::albedo(b, ch).to_string())
 }
 
 /// `/api/plausibility`: positivity, reciprocity and energy conservation (the demo's quick
@@ -289,7 +301,7 @@ mod tests {
     #[test]
     fn a_source_that_failed_answers_its_error_not_its_zeros() {
         let failed = Failed(Channels::Rgb);
-        let body = eval::polar(&failed, 30.0, 5).to_string();
+        let body = eval::polar(&failed, 30.0, 5, Channel::Y).to_string();
         let r = answer(&failed, body).unwrap_err();
         assert_eq!(r.status, 500);
         assert!(String::from_utf8_lossy(&r.body).contains("checksum"));
@@ -297,7 +309,7 @@ mod tests {
             .unwrap()
             .build(&Channels::Rgb)
             .unwrap();
-        let body = eval::polar(lambert.as_ref(), 30.0, 5).to_string();
+        let body = eval::polar(lambert.as_ref(), 30.0, 5, Channel::Y).to_string();
         assert_eq!(answer(lambert.as_ref(), body).unwrap().status, 200);
     }
 
@@ -317,7 +329,7 @@ mod tests {
         );
         for (b, want) in [(&smooth, false), (&mirror, true), (&sum, true)] {
             assert_eq!(
-                eval::polar(b.as_ref(), 30.0, 5)["delta"],
+                eval::polar(b.as_ref(), 30.0, 5, Channel::Y)["delta"],
                 want,
                 "{}",
                 b.describe()

@@ -1,9 +1,9 @@
 //! The numbers behind each view, computed from any `&dyn Brdf` in one batched evaluation each.
 //!
 //! Angles arrive in degrees (the page's units) and are turned into directions here; every
-//! result is plain arrays the page draws. A view's luminance `y` (Rec. 709 weights of linear
-//! sRGB) is what one curve or one surface shows; the per-channel values ride along where the
-//! page can use them. A spectral material is seen as a spectral renderer shows it: its channels'
+//! result is plain arrays the page draws. What one curve or one surface shows, `y`, is the
+//! [`Channel`] the page asks for: the luminance (Rec. 709 weights of linear sRGB) or one of the
+//! linear sRGB components; the per-channel values ride along where the page can use them. A spectral material is seen as a spectral renderer shows it: its channels'
 //! spectrum projected to linear sRGB ([`brdftab::colour::srgb_weights`]), so its sphere has its
 //! colour and its luminance is the photometric one (CIE ȳ), not the channels' plain mean.
 //!
@@ -32,6 +32,38 @@ fn eval_pairs(brdf: &dyn Brdf, wi: &[DVec3], wo: &[DVec3]) -> Vec<f32> {
         }
     }
     out
+}
+
+/// What a curve or surface of a view shows of a material's colour.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Channel {
+    /// The luminance Y.
+    #[default]
+    Y,
+    /// The linear sRGB red component (a spectrum's projection, unclipped).
+    R,
+    /// The linear sRGB green component.
+    G,
+    /// The linear sRGB blue component.
+    B,
+}
+
+impl Channel {
+    /// `y`, `r`, `g` or `b`.
+    pub fn parse(s: &str) -> Option<Channel> {
+        match s {
+            "y" => Some(Channel::Y),
+            "r" => Some(Channel::R),
+            "g" => Some(Channel::G),
+            "b" => Some(Channel::B),
+            _ => None,
+        }
+    }
+
+    /// Its name in a request and a cache key.
+    pub fn name(self) -> &'static str {
+        ["y", "r", "g", "b"][self as usize]
+    }
 }
 
 /// How a material's channels are seen: linear sRGB as they are, or a spectrum's projection.
@@ -73,19 +105,24 @@ impl Seen {
         self.project(f).map(|v| v.max(0.0) as f32)
     }
 
-    /// The luminance: Y of the unclipped linear sRGB (Rec. 709 weights; for a spectrum, the
-    /// photometric luminance).
-    fn luminance(&self, f: &[f32]) -> f32 {
+    /// Channel `ch` of the unclipped linear sRGB; the luminance is its Y (Rec. 709 weights;
+    /// for a spectrum, the photometric luminance).
+    fn component(&self, f: &[f32], ch: Channel) -> f32 {
         let c = self.project(f);
-        (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]) as f32
+        match ch {
+            Channel::Y => (0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]) as f32,
+            Channel::R => c[0] as f32,
+            Channel::G => c[1] as f32,
+            Channel::B => c[2] as f32,
+        }
     }
 }
 
-/// The luminance of each pair of an interleaved result.
-fn luminances(brdf: &dyn Brdf, f: &[f32]) -> Vec<f32> {
+/// Channel `ch` of each pair of an interleaved result.
+fn components(brdf: &dyn Brdf, f: &[f32], ch: Channel) -> Vec<f32> {
     let c = brdf.channels().len().max(1);
     let seen = Seen::new(brdf.channels());
-    f.chunks(c).map(|p| seen.luminance(p)).collect()
+    f.chunks(c).map(|p| seen.component(p, ch)).collect()
 }
 
 /// The centre of cell `k` of `n` equal cells over [`lo`, `hi`].
@@ -95,7 +132,7 @@ fn centre(k: usize, n: usize, lo: f64, hi: f64) -> f64 {
 
 /// The in-plane polar curve: light at θi on the −x side, the viewer at the centres of `n` cells
 /// of θo ∈ [−90°, 90°] in the plane of incidence (positive θo towards the mirror direction).
-pub fn polar(brdf: &dyn Brdf, theta_i_deg: f64, n: usize) -> Value {
+pub fn polar(brdf: &dyn Brdf, theta_i_deg: f64, n: usize, ch: Channel) -> Value {
     let wi = geometry::spherical(theta_i_deg.to_radians(), std::f64::consts::PI);
     let thetas: Vec<f64> = (0..n).map(|k| centre(k, n, -90.0, 90.0)).collect();
     let wo: Vec<DVec3> = thetas
@@ -110,7 +147,7 @@ pub fn polar(brdf: &dyn Brdf, theta_i_deg: f64, n: usize) -> Value {
     let per_channel: Vec<Vec<f32>> = (0..c)
         .map(|ch| f.iter().skip(ch).step_by(c).copied().collect())
         .collect();
-    json!({ "theta_o": thetas, "y": luminances(brdf, &f), "f": per_channel, "delta": has_delta(brdf) })
+    json!({ "theta_o": thetas, "y": components(brdf, &f, ch), "channel": ch.name(), "f": per_channel, "delta": has_delta(brdf) })
 }
 
 /// Whether `brdf` has a delta lobe (a mirror or refractor, alone or as a term of a sum): f_r
@@ -120,10 +157,10 @@ pub fn has_delta(brdf: &dyn Brdf) -> bool {
     f.delta || f.lobes.delta
 }
 
-/// The lobe for light at (θi, φ = 180°): the luminance of f_r over the outgoing hemisphere on an
+/// The lobe for light at (θi, φ = 180°): channel `ch` of f_r over the outgoing hemisphere on an
 /// `nt` × `np` grid of (θo at the centres of `nt` cells of [0°, 90°], φo ∈ [0°, 360°)), row by
 /// row; `theta_o` lists the rows' angles.
-pub fn lobe(brdf: &dyn Brdf, theta_i_deg: f64, nt: usize, np: usize) -> Value {
+pub fn lobe(brdf: &dyn Brdf, theta_i_deg: f64, nt: usize, np: usize, ch: Channel) -> Value {
     let wi = geometry::spherical(theta_i_deg.to_radians(), std::f64::consts::PI);
     let rows: Vec<f64> = (0..nt).map(|i| centre(i, nt, 0.0, 90.0)).collect();
     let mut wo = Vec::with_capacity(nt * np);
@@ -136,12 +173,12 @@ pub fn lobe(brdf: &dyn Brdf, theta_i_deg: f64, nt: usize, np: usize) -> Value {
         }
     }
     let f = eval_pairs(brdf, &vec![wi; wo.len()], &wo);
-    json!({ "nt": nt, "np": np, "theta_o": rows, "y": luminances(brdf, &f) })
+    json!({ "nt": nt, "np": np, "theta_o": rows, "y": components(brdf, &f, ch), "channel": ch.name() })
 }
 
-/// The MERL-style θh × θd slice at φd = 90°: `n` × `n` luminances, θh along rows' columns
+/// The MERL-style θh × θd slice at φd = 90°: `n` × `n` values of channel `ch`, θh along rows' columns
 /// (`y[d * n + h]`), both angles at the centres of `n` cells of [0°, 90°] (`theta`).
-pub fn slice(brdf: &dyn Brdf, n: usize) -> Value {
+pub fn slice(brdf: &dyn Brdf, n: usize, ch: Channel) -> Value {
     let angles: Vec<f64> = (0..n).map(|k| centre(k, n, 0.0, 90.0)).collect();
     let mut wi = Vec::with_capacity(n * n);
     let mut wo = Vec::with_capacity(n * n);
@@ -158,7 +195,7 @@ pub fn slice(brdf: &dyn Brdf, n: usize) -> Value {
         }
     }
     let f = eval_pairs(brdf, &wi, &wo);
-    json!({ "n": n, "theta": angles, "y": luminances(brdf, &f) })
+    json!({ "n": n, "theta": angles, "y": components(brdf, &f, ch), "channel": ch.name() })
 }
 
 /// A sphere seen from +z (orthographic) under a distant light from (θ, φ) measured from the view
@@ -211,7 +248,7 @@ pub fn sphere(
 /// The directional albedo at θ′ = 0°, 5°, ..., 85°, 89° (azimuth 0) per channel and its
 /// luminance: the library's [`Brdf::albedo`], as `brdftab albedo` gives it (closed forms where a
 /// model has one, delta lobes' reflectance, the bounded quadrature of data).
-pub fn albedo(brdf: &(dyn Brdf + Sync)) -> Value {
+pub fn albedo(brdf: &(dyn Brdf + Sync), ch: Channel) -> Value {
     let mut deg: Vec<f64> = (0..18).map(|k| 5.0 * k as f64).collect();
     deg.push(89.0);
     let a: Vec<Vec<f64>> = brdftab::par::install(|| {
@@ -227,10 +264,10 @@ pub fn albedo(brdf: &(dyn Brdf + Sync)) -> Value {
         .iter()
         .map(|row| {
             let f: Vec<f32> = row.iter().map(|&x| x as f32).collect();
-            seen.luminance(&f) as f64
+            seen.component(&f, ch) as f64
         })
         .collect();
-    json!({ "theta": deg, "y": y, "a": a })
+    json!({ "theta": deg, "y": y, "a": a, "channel": ch.name() })
 }
 
 #[cfg(test)]
@@ -265,7 +302,10 @@ mod tests {
         assert!(a.iter().any(|x| x.as_i64().unwrap() > 100));
         // A flat spectrum's luminance is its value (the photometric weights sum to 1).
         let grey = build(r#"{"model": "lambert", "kd": 0.2}"#, &ch);
-        for y in polar(grey.as_ref(), 30.0, 8)["y"].as_array().unwrap() {
+        for y in polar(grey.as_ref(), 30.0, 8, Channel::Y)["y"]
+            .as_array()
+            .unwrap()
+        {
             assert!((y.as_f64().unwrap() - 0.2).abs() < 1e-6, "{y}");
         }
     }

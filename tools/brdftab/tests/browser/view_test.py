@@ -91,6 +91,7 @@ def main():
             check_a_narrow_window(driver, url)
             check_a_colour_slider(driver, url)
             check_a_spec_that_is_not_an_object(driver, url)
+            check_a_channel(driver, url)
             check_a_late_report(driver, url)
         finally:
             if driver is not None:
@@ -348,6 +349,21 @@ def check_a_spec_that_is_not_an_object(driver, url):
     assert "spec=null" not in driver.current_url, driver.current_url
     errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
     assert not errors, f"console errors: {errors}"
+
+
+def check_a_channel(driver, url):
+    """The channel chosen (here blue) is what the plots show and say, and the URL keeps it."""
+    wait = WebDriverWait(driver, 30)
+    driver.get("about:blank")
+    driver.get(url.split("#")[0] + "#m=0")
+    wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#polar polyline"))
+    Select(driver.find_element(By.ID, "channel")).select_by_value("b")
+    label = lambda d: " ".join(t.text for t in d.find_elements(By.CSS_SELECTOR, "#polar text"))
+    wait.until(lambda d: "f_r, B (1/sr)" in label(d) and "ch=b" in d.current_url)
+    driver.get("about:blank")
+    driver.get(url.split("#")[0] + "#m=0&ch=b")
+    wait.until(lambda d: "f_r, B (1/sr)" in label(d))
+    assert Select(driver.find_element(By.ID, "channel")).first_selected_option.get_attribute("value") == "b"
 
 
 def check_a_late_report(driver, url):

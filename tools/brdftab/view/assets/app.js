@@ -4,7 +4,10 @@
 
 const $ = (id) => document.getElementById(id);
 // What a hash that does not name a setting means.
-const DEFAULTS = { ti: 30, scale: "linear", cos: false, src: false, lt: 40, lp: 135, ev: 0, yaw: -0.7, pitch: 1.05 };
+const DEFAULTS = { ti: 30, scale: "linear", ch: "y", cos: false, src: false, lt: 40, lp: 135, ev: 0, yaw: -0.7, pitch: 1.05 };
+// The channels a view can show: the luminance, or a linear sRGB component (a spectrum's
+// projection).
+const CHANNELS = { y: "luminance Y", r: "R", g: "G", b: "B" };
 const state = Object.assign({ sel: [], spec: "", on: false }, DEFAULTS);
 // The settings with a slider: a hash value is clamped to its range and step.
 const SLIDERS = { ti: "theta-i", lt: "light-theta", lp: "light-phi", ev: "exposure" };
@@ -38,6 +41,7 @@ function readHash() {
   if (num("yaw") !== null) state.yaw = num("yaw");
   if (num("pitch") !== null) state.pitch = Math.min(Math.PI, Math.max(0, num("pitch")));
   if (h.has("scale")) state.scale = h.get("scale") === "log" ? "log" : "linear";
+  if (h.has("ch") && Object.hasOwn(CHANNELS, h.get("ch"))) state.ch = h.get("ch");
   state.cos = h.get("cos") === "1";
   state.src = h.get("src") === "1";
   if (h.has("spec")) state.spec = h.get("spec");
@@ -49,6 +53,7 @@ function writeHash() {
   const h = [`m=${state.sel.join(",")}`];
   for (const k of ["ti", "scale", "lt", "lp", "ev"]) h.push(`${k}=${state[k]}`);
   h.push(`yaw=${state.yaw.toFixed(2)}`, `pitch=${state.pitch.toFixed(2)}`);
+  if (state.ch !== "y") h.push(`ch=${state.ch}`);
   if (state.cos) h.push("cos=1");
   if (state.src) h.push("src=1");
   if (state.spec) h.push("spec=" + encodeURIComponent(state.spec));
@@ -103,12 +108,12 @@ function polarSeries() {
   return series;
 }
 
-// What the plots of f_r show: the luminance Y of each material's colour (RGB, or a spectrum
-// projected), not one channel.
-const quantity = () => (state.cos ? "f_r cos θo" : "f_r") + ", luminance Y (1/sr)";
+// What the plots of f_r show: the chosen channel of each material's colour (RGB, or a
+// spectrum projected).
+const quantity = (cos) => (cos ? "f_r cos θo" : "f_r") + `, ${CHANNELS[state.ch]} (1/sr)`;
 
 function drawPolar() {
-  polarPlot($("polar"), polarSeries(), { log: state.scale === "log", thetaI: state.ti, label: quantity() });
+  polarPlot($("polar"), polarSeries(), { log: state.scale === "log", thetaI: state.ti, label: quantity(state.cos) });
 }
 
 function drawLobe() {
@@ -119,12 +124,12 @@ function drawLobe() {
     const d = a.v.y.map((f, k) => Math.abs(f - b.v.y[k]));
     lobes.push({ nt: a.v.nt, np: a.v.np, theta: a.v.theta_o, color: a.e.color, dash: "1 2", width: 0.4, r: weigh(a.v, d) });
   }
-  lobePlot($("lobe"), lobes, { yaw: state.yaw, pitch: state.pitch, log: state.scale === "log", thetaI: state.ti, label: quantity() });
+  lobePlot($("lobe"), lobes, { yaw: state.yaw, pitch: state.pitch, log: state.scale === "log", thetaI: state.ti, label: quantity(state.cos) });
 }
 
 async function fastViews() {
   const t0 = performance.now();
-  const p = view("polar", `theta_i=${state.ti}&n=180`, (list, got) => {
+  const p = view("polar", `theta_i=${state.ti}&n=180&ch=${state.ch}`, (list, got) => {
     data.polar = list.map((e, k) => ({ e, v: got[k] }));
     // A mirror or refraction lobe is a delta: f_r has none of it, the albedo has it all.
     const delta = list.filter((e, k) => got[k].delta).map((e) => e.label);
@@ -132,7 +137,7 @@ async function fastViews() {
       ? `${delta.join(", ")}: the delta (mirror/refraction) lobe is not drawn; the albedo counts it` : "";
     drawPolar();
   });
-  const l = view("lobe", `theta_i=${state.ti}&nt=19&np=36`, (list, got) => {
+  const l = view("lobe", `theta_i=${state.ti}&nt=19&np=36&ch=${state.ch}`, (list, got) => {
     data.lobe = list.map((e, k) => ({ e, v: got[k] }));
     drawLobe();
   });
@@ -166,7 +171,7 @@ function sphereView(size) {
 // The slice of the first selected material (a map cannot overlay); with "table vs its source",
 // its relative difference to its source.
 function sliceView() {
-  return view("slice", "n=64", (list, got) => {
+  return view("slice", `n=64&ch=${state.ch}`, (list, got) => {
     const log = state.scale === "log";
     if (!got.length || list[0].sourceOf !== undefined) return clear($("slice"));
     const a = list[0], s = a.id === undefined ? -1 : list.findIndex((o) => o.sourceOf === a.id);
@@ -177,19 +182,19 @@ function sliceView() {
       const src = got[s].y;
       const d = v.y.map((f, k) => (f - src[k]) / Math.max(Math.abs(src[k]), 1e-5));
       heatmap($("slice"), v.n, d, { signed: true, theta: v.theta, label: `${a.label}: (table − source) / source` });
-    } else heatmap($("slice"), v.n, v.y, { log, theta: v.theta, label: `${a.label}: f_r, luminance Y (1/sr)` });
+    } else heatmap($("slice"), v.n, v.y, { log, theta: v.theta, label: `${a.label}: ${quantity(false)}` });
   });
 }
 
 function albedoView() {
-  return view("albedo", "", (list, got) => {
+  return view("albedo", `ch=${state.ch}`, (list, got) => {
     const items = list.map((e, k) => ({ e, v: got[k] }));
     const series = items.map(({ e, v }) => ({ x: v.theta, y: v.y, color: e.color, dash: e.dash }));
     // The difference of each table and its source, thin.
     for (const [a, b] of withSource(items)) {
       series.push({ x: a.v.theta, y: a.v.y.map((f, k) => Math.abs(f - b.v.y[k])), color: a.e.color, dash: "1 2", width: 1 });
     }
-    linePlot($("albedo"), series, { x0: 0, x1: 90, dx: 15, xlabel: "θ′ (luminance)" });
+    linePlot($("albedo"), series, { x0: 0, x1: 90, dx: 15, xlabel: `θ′ (${state.ch === "y" ? "luminance" : CHANNELS[state.ch]})` });
   });
 }
 
@@ -213,6 +218,7 @@ function syncControls() {
   for (const [k, id] of Object.entries(SLIDERS)) $(id).value = state[k];
   $("theta-i-val").textContent = `${state.ti}°`;
   $("scale").value = state.scale;
+  $("channel").value = state.ch;
   $("cosine").checked = state.cos;
   $("vs-source").checked = state.src;
   $("spec-on").checked = state.on;
@@ -229,6 +235,7 @@ function bind() {
   range("light-phi", "lp", (drag) => sphereView(drag ? 48 : 128));
   range("exposure", "ev", (drag) => sphereView(drag ? 48 : 128));
   $("scale").addEventListener("change", () => { state.scale = $("scale").value; writeHash(); drawPolar(); drawLobe(); sliceView(); });
+  $("channel").addEventListener("change", () => { state.ch = $("channel").value; writeHash(); fastViews(); sliceView(); albedoView(); });
   $("cosine").addEventListener("change", () => { state.cos = $("cosine").checked; writeHash(); drawPolar(); drawLobe(); });
   $("vs-source").addEventListener("change", () => { state.src = $("vs-source").checked; redrawAll(); });
   $("spec-on").addEventListener("change", () => {
