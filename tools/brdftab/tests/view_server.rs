@@ -76,17 +76,26 @@ fn a_refused_spec_path_is_never_looked_up() {
     let log = d.file("trace.txt");
     let probe = d.file("probe.btdb#x");
     let bin = env!("CARGO_BIN_EXE_brdftab");
+    // The server runs as a shell that says its pid and execs it: killing strace detaches its
+    // tracee, which served on (an orphan `brdftab view` left by every run of this test).
     let mut child = std::process::Command::new("strace")
-        .args(["-f", "-e", "trace=%file", "-o", &log, bin, "view", LAMBERT])
-        .args(["--port", "0"])
+        .args(["-f", "-e", "trace=%file", "-o", &log, "sh", "-c"])
+        .args([
+            "echo $$; exec \"$0\" \"$@\"",
+            bin,
+            "view",
+            LAMBERT,
+            "--port",
+            "0",
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    let mut line = String::new();
-    std::io::BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
+    let mut out = std::io::BufReader::new(child.stdout.take().unwrap());
+    let (mut pid, mut line) = (String::new(), String::new());
+    out.read_line(&mut pid).unwrap();
+    out.read_line(&mut line).unwrap();
     let port: u16 = line
         .split("http://127.0.0.1:")
         .nth(1)
@@ -97,8 +106,18 @@ fn a_refused_spec_path_is_never_looked_up() {
         enc(&probe)
     );
     let (status, body) = common::viewer::send(port, req.as_bytes());
+    let killed = std::process::Command::new("kill")
+        .args(["-9", pid.trim()])
+        .status();
     let _ = child.kill();
     let _ = child.wait();
+    assert!(killed.is_ok_and(|s| s.success()), "pid {pid:?}");
+    // The server is gone, not serving on as an orphan.
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while TcpStream::connect(("127.0.0.1", port)).is_ok() {
+        assert!(Instant::now() < deadline, "the traced server still serves");
+        std::thread::sleep(Duration::from_millis(50));
+    }
     assert!(
         status == 400 && body.contains("only inline"),
         "{status} {body}"
