@@ -21,13 +21,16 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result, excerpt};
 
-/// Refuses `path` unless it is a regular file (after following symlinks). A path that does not
-/// exist passes: the open that follows reports it with its own error.
+/// Refuses `path` unless it is a regular file (after following symlinks). Every reader asks
+/// this before its open, so a file that is missing is reported here, in the same words whatever
+/// reads it (a table, a database, a MERL or RGL file, a spec, an `.npy`): an
+/// [`Error::NotFound`] `PATH: no such file`; a path that cannot be looked up (a directory on
+/// the way without permission) is an [`Error::Io`] naming it.
 pub fn require_regular(path: impl AsRef<Path>) -> Result<()> {
     let path = path.as_ref();
     let m = match std::fs::metadata(path) {
         Ok(m) => m,
-        Err(_) => return Ok(()),
+        Err(e) => return Err(read_error(path, e)),
     };
     if m.is_file() {
         return Ok(());
@@ -37,6 +40,20 @@ pub fn require_regular(path: impl AsRef<Path>) -> Result<()> {
         excerpt(&path.display().to_string()),
         kind_name(&m.file_type())
     )))
+}
+
+/// The error of a file that could not be read: a missing file is an [`Error::NotFound`] `PATH:
+/// no such file` (also a path through a file, `x.btdb/y`), anything else an [`Error::Io`]
+/// naming the path.
+pub fn read_error(path: &Path, e: std::io::Error) -> Error {
+    use std::io::ErrorKind::{NotADirectory, NotFound};
+    match e.kind() {
+        NotFound | NotADirectory => Error::NotFound(format!(
+            "{}: no such file",
+            excerpt(&path.display().to_string())
+        )),
+        _ => Error::io(path, e),
+    }
 }
 
 /// True when `path` is a regular file (after following symlinks); checked without opening it.
@@ -300,11 +317,17 @@ mod tests {
     }
 
     #[test]
-    fn directories_are_refused_and_missing_files_pass() {
+    fn directories_are_refused_and_missing_files_are_not_found() {
         let d = std::env::temp_dir();
         let e = require_regular(&d).unwrap_err().to_string();
         assert!(e.contains("a directory"), "{e}");
-        assert!(require_regular(d.join("brdftab-no-such-file.btdb")).is_ok());
+        let missing = d.join("brdftab-no-such-file.btdb");
+        let e = require_regular(&missing).unwrap_err();
+        assert!(matches!(e, Error::NotFound(_)), "{e}");
+        assert_eq!(
+            e.to_string(),
+            format!("not found: {}: no such file", missing.display())
+        );
     }
 
     #[cfg(unix)]

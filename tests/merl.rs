@@ -319,7 +319,7 @@ fn wrong_size_and_dims_are_typed_errors() {
     // Missing file.
     assert!(matches!(
         MerlBrdf::open(dir.join("none.binary")),
-        Err(Error::Io { .. })
+        Err(Error::NotFound(_))
     ));
 }
 

@@ -122,6 +122,22 @@ pub fn file_info_at(path: &str, name: Option<&str>) -> Result<Value> {
     }))
 }
 
+/// Renders an `info` report as the text `brdftab info` prints.
+pub type TextFn = fn(&Value) -> String;
+
+/// What `info` reports of a table SOURCE that is no measured file, with the function that
+/// renders it as text: a brdftab file or `DB#NAME` ([`file_info`], [`file_text`]) or a raw
+/// table ([`raw_info`], [`raw_text`]). A `DB#NAME` is a database's table even when DB is
+/// missing, so that the error names DB (not a raw file `DB#NAME`).
+pub fn table_file_info(source: &str) -> Result<(Value, TextFn)> {
+    let (path, name) = db::split_source(source)?;
+    if name.is_some() || super::tables::is_store_file(path) {
+        Ok((file_info(source)?, file_text))
+    } else {
+        Ok((raw_info(source)?, raw_text))
+    }
+}
+
 /// What `info` reports of a raw table file (`format` = `raw`).
 pub fn raw_info(path: &str) -> Result<Value> {
     let t = Table::open_raw(path)?;

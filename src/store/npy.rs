@@ -109,7 +109,8 @@ impl NpyReader<std::io::BufReader<std::fs::File>> {
     /// Opens the `.npy` file at `path` and reads its header.
     ///
     /// # Errors
-    /// [`Error::Io`] when the file cannot be read, [`Error::Format`] (file, field, byte offset)
+    /// [`Error::NotFound`] when the file is missing, [`Error::Io`] when it cannot be read,
+    /// [`Error::Format`] (file, field, byte offset)
     /// for what [`NpyReader::new`] refuses.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
@@ -973,7 +974,7 @@ mod tests {
         assert!(e.contains("a.npy") && e.contains("truncated"), "{e}");
         assert!(matches!(
             read_f32(d.join("none.npy")),
-            Err(Error::Io { .. })
+            Err(Error::NotFound(_))
         ));
         assert!(read_f32(d.path()).is_err());
     }

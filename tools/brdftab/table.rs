@@ -2,7 +2,7 @@
 //! `measured::info` say it; this prints).
 
 use brdftab::Result;
-use brdftab::store::{db, info, tables};
+use brdftab::store::info;
 use clap::Args;
 
 use crate::source;
@@ -26,10 +26,7 @@ pub fn info(a: InfoArgs) -> Result<()> {
     let (v, text): (_, fn(&serde_json::Value) -> String) = match source::kind(&a.file) {
         Merl | Rgl if !a.json => return print_out(&measured::describe(&a.file)?),
         Merl | Rgl => (measured::info(&a.file)?, |_| String::new()),
-        _ if tables::is_store_file(db::split_source(&a.file)?.0) => {
-            (info::file_info(&a.file)?, info::file_text)
-        }
-        _ => (info::raw_info(&a.file)?, info::raw_text),
+        _ => info::table_file_info(&a.file)?,
     };
     if a.json {
         let json = serde_json::to_string_pretty(&v).unwrap_or_default();

@@ -100,3 +100,52 @@ fn export_flags_agree_with_what_export_does() {
     // The .npy of a table needs a .npy name too.
     refused(&brdftab(&["export", &t, "--npy", &t]), &["`--npy`", ".npy"]);
 }
+
+/// A missing input was "not found: x.btdb: no such file" to `eval` but "x.btdb: No such file or
+/// directory (os error 2)" to `info`, `db`, `export`, `check` (and `x.btdb#t: ...` to `info`,
+/// naming a file that nobody asked for). Every command and every kind of file now say it alike,
+/// from the library's one check before every open.
+#[test]
+fn a_missing_input_is_reported_alike_by_every_command() {
+    let d = TempDir::new("io-missing");
+    let (btdb, bsdf, binary, json, npy) = (
+        d.file("m.btdb"),
+        d.file("m.bsdf"),
+        d.file("m.binary"),
+        d.file("m.json"),
+        d.file("m.npy"),
+    );
+    let table = format!("{btdb}#t");
+    let out = d.file("o.btdb");
+    let like = d.file("like.btdb");
+    assert!(brdftab(&["bake", LAMBERT, "-o", &like, "--preset", "small"]).ok);
+    let runs: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["eval", &btdb], &btdb),
+        (vec!["eval", &table], &btdb),
+        (vec!["eval", &bsdf], &bsdf),
+        (vec!["eval", &binary], &binary),
+        (vec!["eval", &json], &json),
+        (vec!["info", &btdb], &btdb),
+        (vec!["info", &table], &btdb),
+        (vec!["info", &bsdf], &bsdf),
+        (vec!["info", &binary], &binary),
+        (vec!["db", "list", &btdb], &btdb),
+        (vec!["db", "verify", &btdb], &btdb),
+        (vec!["db", "rm", &btdb, "t"], &btdb),
+        (vec!["export", &table, "--npy", &npy], &btdb),
+        (vec!["check", &bsdf], &bsdf),
+        (vec!["albedo", &table], &btdb),
+        (vec!["bake", &binary, "-o", &out], &binary),
+        (vec!["convert", &bsdf, &out], &bsdf),
+        (vec!["import", &npy, "--like", &like, "-o", &out], &npy),
+    ];
+    for (args, file) in runs {
+        let o = common::brdftab_with_stdin(&args, "0 0 1 0 0 1\n");
+        refused(&o, &[]);
+        assert_eq!(
+            o.stderr,
+            format!("error: not found: {file}: no such file\n"),
+            "{args:?}"
+        );
+    }
+}
