@@ -167,17 +167,21 @@ pub fn write_table(
     w.finish()
 }
 
-/// Removes table `name`. Errors with [`Error::NotFound`] if absent.
+/// Removes table `name`. Errors with [`Error::NotFound`] if it or the database is absent
+/// (naming the tables the database holds).
 pub fn remove(path: impl AsRef<Path>, name: &str) -> Result<()> {
     let user = path.as_ref(); // the name errors give
     let path = &crate::files::resolve_links(user)?;
+    // A missing database is reported before the lock, which would leave its lock file behind.
+    crate::files::require_regular(user)?;
     let _lock = lock(path)?;
     let s = Store::open(path)?;
     if !s.tables().iter().any(|t| t.name == name) {
-        return Err(Error::NotFound(format!(
-            "table `{name}` in {}",
-            user.display()
-        )));
+        return Err(super::no_table(
+            &user.display().to_string(),
+            name,
+            s.tables(),
+        ));
     }
     let mut w = Writer::create(path)?;
     for e in s.tables().iter().filter(|e| e.name != name) {

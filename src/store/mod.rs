@@ -108,6 +108,16 @@ impl std::fmt::Debug for Store {
     }
 }
 
+/// The error of a table `name` that the database `container` (its `tables`) does not hold: the
+/// same words for every reader and for `db::remove`, with the names it holds.
+pub(crate) fn no_table(container: &str, name: &str, tables: &[TocEntry]) -> Error {
+    let names: Vec<&str> = tables.iter().map(|t| t.name.as_str()).collect();
+    Error::NotFound(match names.is_empty() {
+        true => format!("table `{name}` in {container} (it holds no table)"),
+        false => format!("table `{name}` in {container} (has: {})", names.join(", ")),
+    })
+}
+
 impl Store {
     /// Opens a file with default options.
     pub fn open(path: impl AsRef<Path>) -> Result<Store> {
@@ -206,14 +216,7 @@ impl Store {
             .iter()
             .enumerate()
             .find(|(_, t)| t.name == name)
-            .ok_or_else(|| {
-                let names: Vec<&str> = self.toc.tables.iter().map(|t| t.name.as_str()).collect();
-                Error::NotFound(format!(
-                    "table `{name}` in {} (has: {})",
-                    self.name,
-                    names.join(", ")
-                ))
-            })?;
+            .ok_or_else(|| no_table(&self.name, name, &self.toc.tables))?;
         self.table_at(i, e)
     }
 

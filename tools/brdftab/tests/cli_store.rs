@@ -236,3 +236,39 @@ fn info_of_an_empty_database_says_it_holds_no_tables() {
     );
     assert!(!r.stdout.contains("smaller than f32"), "{}", r.stdout);
 }
+
+/// `db rm` of a table that is not there said only `not found: table `x` in DB` where every
+/// reader (`eval DB#x`, `info`, `export`) lists the tables DB holds; and `db rm` on a database
+/// that does not exist created its lock file `.DB.lock` before failing, litter beside a file
+/// that was never there.
+#[test]
+fn db_rm_names_what_the_database_holds_and_leaves_nothing_behind() {
+    let d = TempDir::new("cli-store-rm");
+    let db = d.file("lib.btdb");
+    let lambert = r#"{"model": "lambert", "kd": 0.5}"#;
+    let r = brdftab(&[
+        "db", "add", &db, lambert, "--name", "white", "--preset", "small",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let missing = format!("error: not found: table `nope` in {db} (has: white)\n");
+    let r = brdftab(&["db", "rm", &db, "nope"]);
+    assert_eq!((r.code, r.stderr.as_str()), (1, missing.as_str()));
+    let r = brdftab_with_stdin(&["eval", &format!("{db}#nope")], "0 0 1 0 0 1\n");
+    assert_eq!((r.code, r.stderr.as_str()), (1, missing.as_str()));
+    let r = brdftab(&["db", "rm", &db, "white"]);
+    assert!(r.ok, "{}", r.stderr);
+    let r = brdftab(&["db", "rm", &db, "white"]);
+    let empty = format!("error: not found: table `white` in {db} (it holds no table)\n");
+    assert_eq!((r.code, r.stderr.as_str()), (1, empty.as_str()));
+
+    let gone = d.file("gone.btdb");
+    let r = brdftab(&["db", "rm", &gone, "white"]);
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert!(r.stderr.contains("gone.btdb: no such file"), "{}", r.stderr);
+    let left: Vec<_> = std::fs::read_dir(d.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|f| f.contains("gone"))
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}
