@@ -10,7 +10,7 @@ use clap::Args;
 #[derive(Args)]
 pub struct ExportArgs {
     /// The table: a brdftab file, or `DB#NAME`.
-    file: String,
+    source: String,
     /// Write the dense table as .npy (shape = stored grid dims + channels, float32): the stored
     /// quantity as `info` names it (f_r, f_r cos θo or f_r cos θi cos θo; before a calibration).
     #[arg(long)]
@@ -43,7 +43,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     if let Some(out) = &a.exr {
         brdftab_tools::output::check(out, "--exr", &["exr"])?;
     }
-    let (path, name) = db::split_source(&a.file)?;
+    let (path, name) = db::split_source(&a.source)?;
     let s = Store::open(path)?;
     let t = match name {
         Some(n) => s.table(n)?,

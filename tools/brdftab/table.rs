@@ -13,7 +13,7 @@ use brdftab_tools::text::print_out;
 pub struct InfoArgs {
     /// A brdftab file (`FILE.btdb`, or one table of it as `DB#NAME`), a raw table file, a MERL
     /// `.binary` or an RGL `.bsdf`.
-    file: String,
+    source: String,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -23,10 +23,10 @@ pub struct InfoArgs {
 pub fn info(a: InfoArgs) -> Result<()> {
     use brdftab::measured::info as measured;
     use source::Kind::{Merl, Rgl};
-    let (v, text): (_, fn(&serde_json::Value) -> String) = match source::kind(&a.file) {
-        Merl | Rgl if !a.json => return print_out(&measured::describe(&a.file)?),
-        Merl | Rgl => (measured::info(&a.file)?, |_| String::new()),
-        _ => info::table_file_info(&a.file)?,
+    let (v, text): (_, fn(&serde_json::Value) -> String) = match source::kind(&a.source) {
+        Merl | Rgl if !a.json => return print_out(&measured::describe(&a.source)?),
+        Merl | Rgl => (measured::info(&a.source)?, |_| String::new()),
+        _ => info::table_file_info(&a.source)?,
     };
     if a.json {
         let json = serde_json::to_string_pretty(&v).unwrap_or_default();

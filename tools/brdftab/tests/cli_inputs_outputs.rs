@@ -149,3 +149,33 @@ fn a_missing_input_is_reported_alike_by_every_command() {
         );
     }
 }
+
+/// `info` and `export` named their SOURCE by the library's setting, `source`, where every other
+/// command says `SOURCE` (the name their usage line shows): `export 'x.btdb#'` said "invalid
+/// argument `source`", `eval 'x.btdb#'` "invalid argument `SOURCE`".
+#[test]
+fn every_command_names_its_source_alike() {
+    let d = TempDir::new("io-source-name");
+    let t = d.file("t.btdb");
+    assert!(brdftab(&["bake", LAMBERT, "-o", &t, "--preset", "small"]).ok);
+    let empty = format!("{t}#");
+    let npy = d.file("t.npy");
+    for args in [
+        vec!["eval", &empty],
+        vec!["info", &empty],
+        vec!["export", &empty, "--npy", &npy],
+    ] {
+        let o = common::brdftab_with_stdin(&args, "0 0 1 0 0 1\n");
+        refused(
+            &o,
+            &["invalid argument `SOURCE`", "no table name after `#`"],
+        );
+    }
+    let o = brdftab(&["export", "--help"]);
+    assert!(
+        o.stdout
+            .contains("Usage: brdftab export [OPTIONS] <SOURCE>"),
+        "{}",
+        o.stdout
+    );
+}
