@@ -53,6 +53,9 @@ impl BakeRequest {
         {
             db::refuse_duplicate(path, &name)?;
         }
+        if let BakeTarget::File(path) = target {
+            db::refuse_dropping_tables(path)?;
+        }
         let src = self.open_source()?;
         let t0 = Instant::now();
         // A model the medium preset misses is baked as the request with an error target would

@@ -100,6 +100,7 @@ pub fn save_table(
         }
         t => {
             let path = t.path().to_owned();
+            store::db::refuse_dropping_tables(&path)?;
             let name = settings.name.clone().unwrap_or_else(|| bake::stem(&path));
             tables::save_file(&path, &name, source, table, codec)?;
             (path, name)

@@ -70,6 +70,34 @@ pub fn refuse_duplicate(path: impl AsRef<Path>, name: &str) -> Result<()> {
     }
 }
 
+/// Refuses to write a one-table file over `path` when it is a database of several tables: `bake
+/// x -o lib.btdb` replaced a library of materials with one table, silently, where `convert x
+/// lib.btdb` adds a table to it. A file that is no database, or one of a single table (a
+/// table file baked before), is replaced as any output is. Checked before the work.
+///
+/// # Errors
+/// [`Error::InvalidArgument`] naming `output`.
+pub fn refuse_dropping_tables(path: impl AsRef<Path>) -> Result<()> {
+    let path = path.as_ref();
+    let Some(s) = crate::files::is_regular(path)
+        .then(|| Store::open(path).ok())
+        .flatten()
+    else {
+        return Ok(());
+    };
+    match s.tables().len() {
+        n @ 2.. => Err(Error::arg(
+            "output",
+            format!(
+                "{0} is a database of {n} tables: a one-table file written there would drop \
+                 them all (write {0}#NAME to add a table, or remove the file first)",
+                path.display()
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Copies table `e` of `from` into `w` without decoding (checksums are checked on the way).
 fn copy_table(from: &Store, e: &TocEntry, w: &mut Writer) -> Result<()> {
     let t = from.table(&e.name)?;

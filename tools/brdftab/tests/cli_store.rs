@@ -272,3 +272,57 @@ fn db_rm_names_what_the_database_holds_and_leaves_nothing_behind() {
         .collect();
     assert!(left.is_empty(), "left behind: {left:?}");
 }
+
+/// `bake SOURCE -o lib.btdb` over a database of several tables replaced the whole library with
+/// one table, silently (`convert SOURCE lib.btdb` adds a table instead); `import -o lib.btdb`
+/// too. A database of several tables is now refused as such an output, before the work; a
+/// one-table file is still replaced as any output is.
+#[test]
+fn a_one_table_file_is_not_written_over_a_database() {
+    let d = TempDir::new("cli-store-over-db");
+    let db = d.file("lib.btdb");
+    let spec = |kd: f64| format!(r#"{{"model": "lambert", "kd": {kd}}}"#);
+    for (name, kd) in [("white", 0.5), ("grey", 0.2)] {
+        let r = brdftab(&[
+            "db",
+            "add",
+            &db,
+            &spec(kd),
+            "--name",
+            name,
+            "--preset",
+            "small",
+        ]);
+        assert!(r.ok, "{}", r.stderr);
+    }
+    let before = std::fs::read(&db).unwrap();
+    let r = brdftab(&["bake", &spec(0.1), "-o", &db, "--preset", "small"]);
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert_eq!(
+        r.stderr,
+        format!(
+            "error: invalid argument `--output`: {db} is a database of 2 tables: a one-table \
+             file written there would drop them all (write {db}#NAME to add a table, or remove \
+             the file first)\n"
+        )
+    );
+    let npy = d.file("white.npy");
+    let white = format!("{db}#white");
+    assert!(brdftab(&["export", &white, "--npy", &npy]).ok);
+    let r = brdftab(&["import", &npy, "--like", &white, "-o", &db]);
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("is a database of 2 tables"),
+        "{}",
+        r.stderr
+    );
+    assert_eq!(std::fs::read(&db).unwrap(), before, "the database changed");
+    // One table: a file baked before is replaced.
+    let one = d.file("one.btdb");
+    for kd in [0.1, 0.3] {
+        let r = brdftab(&["bake", &spec(kd), "-o", &one, "--preset", "small"]);
+        assert!(r.ok, "{}", r.stderr);
+    }
+    let r = brdftab_with_stdin(&["eval", &one], "0 0 1 0 0 1\n");
+    assert!(r.stdout.starts_with("3e-1 "), "{}", r.stdout);
+}
