@@ -235,6 +235,14 @@ pub fn resolve_links(path: &Path) -> Result<PathBuf> {
     ))
 }
 
+/// An output `path` that can be written: [`check_output`], and its directory exists
+/// ([`check_dir`]). What a database's writers check before any work (and before a lock file
+/// is made beside it).
+pub fn check_writable(path: &Path) -> Result<()> {
+    check_output(path)?;
+    check_dir(path, &parent(path))
+}
+
 /// An output's directory must exist (checked up front: the error then names `path`).
 pub fn check_dir(path: &Path, dir: &Path) -> Result<()> {
     match std::fs::metadata(dir) {

@@ -24,9 +24,9 @@ pub struct Lock {
 /// link's is its target's.
 pub fn lock(path: &Path) -> Result<Lock> {
     let path = &crate::files::resolve_links(path)?;
-    // A database is written through a new file renamed over it: a pipe or a device there is
-    // refused before the lock, in output terms.
-    crate::files::check_output(path)?;
+    // A database is written through a new file renamed over it: a pipe or a device there, or
+    // a directory that is not one, is refused before the lock, in output terms.
+    crate::files::check_writable(path)?;
     let name = path
         .file_name()
         .ok_or_else(|| Error::arg("DB", format!("{} has no file name", path.display())))?
@@ -35,7 +35,6 @@ pub fn lock(path: &Path) -> Result<Lock> {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    crate::files::check_dir(path, &dir)?;
     let lp = dir.join(format!(".{name}.lock"));
     let f = File::options()
         .create(true)
@@ -61,6 +60,9 @@ fn existing(path: &Path) -> Result<Option<Store>> {
 /// seconds to minutes) rather than at its end. A database not created yet holds no name.
 pub fn refuse_duplicate(path: impl AsRef<Path>, name: &str) -> Result<()> {
     let path = path.as_ref();
+    // What the write at the end would refuse (`x.btdb/lib.btdb` read as "Not a directory (os
+    // error 20)"), before the work.
+    crate::files::check_writable(&crate::files::resolve_links(path)?)?;
     match existing(path)? {
         Some(s) if s.tables().iter().any(|t| t.name == name) => Err(Error::Duplicate {
             container: path.display().to_string(),

@@ -22,13 +22,17 @@ pub fn check(path: impl AsRef<Path>, flag: &str, exts: &[&str]) -> Result<()> {
         ));
     }
     match path.parent() {
+        // A file on the way (`lib.btdb/x.png`) is not a directory that does not exist.
         Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => Err(Error::arg(
             flag,
-            format!(
-                "{}: directory {} does not exist",
-                path.display(),
-                dir.display()
-            ),
+            match dir.exists() {
+                true => format!("{}: {} is not a directory", path.display(), dir.display()),
+                false => format!(
+                    "{}: directory {} does not exist",
+                    path.display(),
+                    dir.display()
+                ),
+            },
         )),
         _ => Ok(()),
     }
@@ -44,6 +48,14 @@ mod tests {
         assert!(check("a.jpg", "-o", &["png", "exr"]).is_err());
         assert!(check("a", "-o", &["exr"]).is_err());
         assert!(check("/no/such/dir/a.exr", "-o", &["exr"]).is_err());
+        let file = std::env::current_exe().unwrap();
+        let e = check(file.join("a.exr"), "-o", &["exr"])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.ends_with(&format!("{} is not a directory", file.display())),
+            "{e}"
+        );
         let e = check("a.png", "--exr", &["exr"]).unwrap_err().to_string();
         assert!(e.contains("--exr") && e.contains(".exr"), "{e}");
     }

@@ -179,3 +179,29 @@ fn every_command_names_its_source_alike() {
         o.stdout
     );
 }
+
+/// An output under a path whose directory part is a file (`t.btdb/x.png`): `db add` said
+/// "Not a directory (os error 20)", `render` and `export` that the directory "does not exist"
+/// (it does: it is a file), `bake` that it "is not a directory". All say the last now, before
+/// any work.
+#[test]
+fn an_output_under_a_file_says_that_it_is_not_a_directory() {
+    let d = TempDir::new("io-under-file");
+    let t = d.file("t.btdb");
+    assert!(brdftab(&["bake", LAMBERT, "-o", &t, "--preset", "small"]).ok);
+    let under = |f: &str| format!("{t}/{f}");
+    let (db, png, npy) = (under("lib.btdb"), under("x.png"), under("x.npy"));
+    for args in [
+        vec![
+            "db", "add", &db, LAMBERT, "--name", "w", "--preset", "small",
+        ],
+        vec!["bake", LAMBERT, "-o", &db, "--preset", "small"],
+        vec!["render", LAMBERT, "-o", &png, "--size", "8x8", "--spp", "1"],
+        vec!["export", &t, "--npy", &npy],
+    ] {
+        let o = brdftab(&args);
+        refused(&o, &[&format!("{t} is not a directory")]);
+        assert!(!o.stderr.contains("baked"), "{args:?}: {}", o.stderr);
+        assert_eq!(o.stderr.lines().count(), 1, "{}", o.stderr);
+    }
+}
