@@ -2,6 +2,8 @@
 //! error's field (`max_depth`) named as the flag (`--max-depth`) — the library's errors name
 //! settings, never flags (DESIGN: one request layer), so the CLI translates them.
 
+use std::process::ExitCode;
+
 use clap::{ArgMatches, Command};
 
 /// The names of the subcommand that ran, outermost first (`["db", "add"]`).
@@ -39,4 +41,77 @@ pub fn as_typed(e: brdftab::Error, cmd: &Command, path: &[String]) -> brdftab::E
         None => name,
     };
     brdftab::Error::InvalidArgument { name, msg }
+}
+
+/// `--help` and `--version` print to stdout and succeed; every usage error prints one line
+/// `error: ...` on stderr and exits 1, like every other error ([`one_line`]).
+pub fn clap_exit(e: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            // Help into a closed pipe (`brdftab --help | head -1`) is still a success.
+            let _ = crate::text::print_out(&e.to_string());
+            ExitCode::SUCCESS
+        }
+        // clap's message is the whole help of the command that lacks its subcommand.
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            let help = e.to_string();
+            let usage = help.lines().find(|l| l.starts_with("Usage:"));
+            let usage = usage.map(|u| u.replacen("Usage:", "; usage:", 1));
+            eprintln!(
+                "error: a subcommand is required{} (see --help)",
+                usage.unwrap_or_default()
+            );
+            ExitCode::from(1)
+        }
+        _ => {
+            eprintln!("{}", one_line(&e.to_string()));
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// A clap usage error (`error: MSG`, then indented lines — the missing arguments, a tip —,
+/// the usage line and a pointer to `--help`, with blank lines between) as the one line
+/// `error: MSG ...; tip: ...; usage: ...` every error of the CLI is: a script reads the first
+/// line of stderr, and a user still gets the tip and the usage.
+pub fn one_line(msg: &str) -> String {
+    let mut out = String::from("error:");
+    let msg = msg.trim_start().strip_prefix("error:").unwrap_or(msg);
+    for line in msg.lines().map(str::trim).filter(|l| !l.is_empty()) {
+        if line.starts_with("For more information") {
+            continue;
+        }
+        let (sep, line) = match line.strip_prefix("Usage:") {
+            Some(u) => ("; usage:", u),
+            None if line.starts_with("tip:") => (";", line),
+            None => ("", line),
+        };
+        out.push_str(sep);
+        out.push(' ');
+        out.push_str(line.trim());
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn usage_errors_are_one_line() {
+        let msg = "error: unexpected argument '-o' found\n\n  tip: to pass '-o' as a value, use \
+                   '-- -o'\n\nUsage: brdftab export [OPTIONS] <SOURCE>\n\nFor more information, \
+                   try '--help'.\n";
+        assert_eq!(
+            super::one_line(msg),
+            "error: unexpected argument '-o' found; tip: to pass '-o' as a value, use '-- -o'; \
+             usage: brdftab export [OPTIONS] <SOURCE>"
+        );
+        let msg = "error: the following required arguments were not provided:\n  --name <NAME>\n\n\
+                   Usage: brdftab db add --name <NAME> <DB> <SOURCE>\n";
+        assert_eq!(
+            super::one_line(msg),
+            "error: the following required arguments were not provided: --name <NAME>; usage: \
+             brdftab db add --name <NAME> <DB> <SOURCE>"
+        );
+    }
 }

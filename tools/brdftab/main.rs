@@ -22,7 +22,7 @@ mod table;
 #[path = "view.rs"]
 mod view;
 
-use brdftab_tools::args::{as_typed, subcommand_path};
+use brdftab_tools::args::{as_typed, clap_exit, subcommand_path};
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -144,30 +144,5 @@ fn hint(e: &brdftab::Error) -> &'static str {
         brdftab::Error::Duplicate { .. } => " (use --replace)",
         brdftab::Error::Symmetry { .. } => " (use --force to bake anyway, or --symmetry none)",
         _ => "",
-    }
-}
-
-/// `--help` and `--version` print to stdout and succeed; every usage error prints
-/// `error: ...` on stderr and exits 1, like every other error.
-fn clap_exit(e: clap::Error) -> ExitCode {
-    use clap::error::ErrorKind;
-    match e.kind() {
-        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
-            // Help into a closed pipe (`brdftab --help | head -1`) is still a success.
-            let _ = brdftab_tools::text::print_out(&e.to_string());
-            ExitCode::SUCCESS
-        }
-        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
-            eprint!("error: a subcommand is required\n\n{e}");
-            ExitCode::from(1)
-        }
-        _ => {
-            let msg = e.to_string();
-            match msg.strip_prefix("error: ") {
-                Some(rest) => eprint!("error: {rest}"),
-                None => eprint!("error: {msg}"),
-            }
-            ExitCode::from(1)
-        }
     }
 }

@@ -259,3 +259,48 @@ fn bench_measured_prints_no_line_that_looks_like_an_error() {
         &["`--pairs`"],
     );
 }
+
+/// A usage error was clap's block — `error: ...`, a blank line, the usage, `For more
+/// information, try '--help'.` — where every other error of the CLI is one line `error: ...`
+/// that a script can read. Now one line too, keeping clap's message, its tip and the usage.
+#[test]
+fn usage_errors_are_one_line() {
+    let out = "x.btdb";
+    for (args, needles) in [
+        (
+            vec![
+                "bake", LAMBERT, "-o", out, "--preset", "small", "--preset", "large",
+            ],
+            &[
+                "'--preset <PRESET>' cannot be used multiple times",
+                "usage: brdftab bake",
+            ][..],
+        ),
+        (
+            vec!["db", "add", "lib.btdb", LAMBERT],
+            &["required arguments were not provided: --name <NAME>"][..],
+        ),
+        (
+            vec!["export", "t.btdb", "-o", "t.npy"],
+            &["unexpected argument '-o'", "tip:"][..],
+        ),
+        (
+            vec!["db", "list", "x.btdb", "--json", "--json"],
+            &["'--json' cannot be used"][..],
+        ),
+        (
+            vec!["db"],
+            &["a subcommand is required", "usage: brdftab db <COMMAND>"][..],
+        ),
+        (vec![], &["a subcommand is required"][..]),
+        (
+            vec!["bake", LAMBERT, "-o", out, "--calibrate", "maybe"],
+            &["invalid value 'maybe'", "[possible values: true, false]"][..],
+        ),
+    ] {
+        let o = brdftab(&args);
+        refused(&o, needles);
+        assert_eq!(o.stderr.lines().count(), 1, "{args:?}: {}", o.stderr);
+        assert!(!o.stderr.contains("For more information"), "{}", o.stderr);
+    }
+}
