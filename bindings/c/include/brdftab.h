@@ -52,8 +52,8 @@ typedef struct brdftab_brdf brdftab_brdf;
 
 /* Options of brdftab_open_with; zero-initialized means the defaults. */
 typedef struct brdftab_open_options {
-    int interp;               /* tables: 0 auto (default: nearest on tables of MERL cells,
-                                 linear otherwise), 1 nearest, 2 linear */
+    int interp;               /* tables and MERL files: 0 auto (default: nearest on MERL
+                                 cells, linear otherwise), 1 nearest, 2 linear */
     size_t n_wavelengths;     /* 0 keeps the source's channels */
     const double *wavelengths; /* nm, strictly increasing (model specs, RGL files) */
     int eager;                /* non-zero: decode every table chunk at open */
