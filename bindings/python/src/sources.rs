@@ -14,9 +14,13 @@ use crate::errors::{guard, lib_err, unlocked};
 use crate::values::{channels_of, ser, text_arg, to_py};
 
 /// Opens SOURCE (a spec, table, `DB#NAME`, MERL `.binary` or RGL `.bsdf`) as a `Brdf`.
+///
+/// The GIL is released while the source is read (an eager table decodes every chunk: half a
+/// second for a large preset's table).
 #[pyfunction]
 #[pyo3(signature = (source, *, interp = "auto", wavelengths = None, eager = true))]
 pub(crate) fn open(
+    py: Python<'_>,
     source: &Bound<'_, PyAny>,
     interp: &str,
     wavelengths: Option<&Bound<'_, PyAny>>,
@@ -24,7 +28,8 @@ pub(crate) fn open(
 ) -> PyResult<PyBrdf> {
     guard(|| {
         let source = text_arg(source, "source")?;
-        PyBrdf::open(&source, interp, channels_of(wavelengths)?, eager)
+        let channels = channels_of(wavelengths)?;
+        unlocked(py, || PyBrdf::open(&source, interp, channels, eager))?
     })
 }
 
@@ -32,6 +37,7 @@ pub(crate) fn open(
 #[pyfunction]
 #[pyo3(signature = (source, interp, wavelengths, eager = true))]
 pub(crate) fn _reopen(
+    py: Python<'_>,
     source: &str,
     interp: &str,
     wavelengths: Option<Vec<f64>>,
@@ -42,7 +48,7 @@ pub(crate) fn _reopen(
             .map(Channels::wavelengths)
             .transpose()
             .map_err(lib_err)?;
-        PyBrdf::open(source, interp, ch, eager)
+        unlocked(py, || PyBrdf::open(source, interp, ch, eager))?
     })
 }
 
@@ -61,8 +67,8 @@ pub(crate) fn check(
             channels: channels_of(wavelengths)?,
             ..OpenOptions::default()
         };
-        let brdf = brdftab::open_with(source, &opts).map_err(lib_err)?;
         let report = unlocked(py, || {
+            let brdf = brdftab::open_with(source, &opts)?;
             brdftab::analysis::plausibility::check(
                 brdf.as_ref(),
                 &brdftab::analysis::plausibility::Options::default(),
@@ -74,17 +80,17 @@ pub(crate) fn check(
 }
 
 /// What `brdftab info --json` reports of a brdftab file (`FILE`), one table (`DB#NAME`) or a
-/// measured file (MERL `.binary`, RGL `.bsdf`).
+/// measured file (MERL `.binary`, RGL `.bsdf`). The GIL is released while the file is read.
 #[pyfunction]
 pub(crate) fn info(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
     guard(|| {
         let source = text_arg(source, "source")?;
         let source = source.as_str();
         use brdftab::SourceKind;
-        let v = match brdftab::classify(source) {
+        let v = unlocked(py, || match brdftab::classify(source) {
             SourceKind::Merl | SourceKind::Rgl => brdftab::measured::info::info(source),
             _ => brdftab::store::info::file_info(source),
-        };
+        })?;
         to_py(py, &v.map_err(lib_err)?)
     })
 }
