@@ -177,10 +177,14 @@ impl PyTable {
     /// The table as a `brdftab.Brdf` (in memory: a copy of its values), looked up with
     /// `interp` ("auto": nearest on a grid of MERL cells, linear otherwise; "nearest";
     /// "linear"), as `brdftab.open` of the saved table would. It has no SOURCE to reopen:
-    /// it does not pickle, and `table(**options)` does not bake it again.
+    /// it does not pickle, and `table(**options)` does not bake it again. Like the node
+    /// methods below, it runs with the GIL released (a large table: a quarter of a second).
     #[pyo3(signature = (interp = "auto"))]
-    fn open(&self, interp: &str) -> PyResult<PyBrdf> {
-        guard(|| PyBrdf::from_table(self.table.clone(), interp))
+    fn open(&self, py: Python<'_>, interp: &str) -> PyResult<PyBrdf> {
+        guard(|| {
+            let t = &self.table;
+            unlocked(py, || PyBrdf::from_table(t.clone(), interp))?
+        })
     }
 
     /// The coordinates of every stored node, in radians: float64 shaped like `values` with
@@ -189,8 +193,12 @@ impl PyTable {
     /// φo the azimuth difference), flat (nodes × 4) for a packed table.
     fn node_angles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         guard(|| {
-            let angles = self.table.grid().stored_node_angles();
-            node_array(py, &self.table, angles.into_iter().flatten().collect(), 4)
+            let grid = self.table.grid();
+            let angles = unlocked(py, || {
+                let a = grid.stored_node_angles();
+                a.into_iter().flatten().collect()
+            })?;
+            node_array(py, &self.table, angles, 4)
         })
     }
 
@@ -202,12 +210,15 @@ impl PyTable {
     fn node_directions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
         guard(|| {
             let grid = self.table.grid();
-            let (mut wi, mut wo) = (Vec::new(), Vec::new());
-            for c in grid.stored_node_angles() {
-                let (i, o) = brdftab::table::node_pair(grid.param(), c);
-                wi.extend(i.to_array());
-                wo.extend(o.to_array());
-            }
+            let (wi, wo) = unlocked(py, || {
+                let (mut wi, mut wo) = (Vec::new(), Vec::new());
+                for c in grid.stored_node_angles() {
+                    let (i, o) = brdftab::table::node_pair(grid.param(), c);
+                    wi.extend(i.to_array());
+                    wo.extend(o.to_array());
+                }
+                (wi, wo)
+            })?;
             let wi = node_array(py, &self.table, wi, 3)?;
             let wo = node_array(py, &self.table, wo, 3)?;
             PyTuple::new(py, [wi, wo])
