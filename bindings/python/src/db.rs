@@ -20,7 +20,7 @@ pub(crate) fn db_names(path: &str) -> PyResult<Vec<String>> {
     })
 }
 
-/// Checks a table name against the library's rule ([`brdftab::store::name::check`]):
+/// Checks a table name against the library's rule (the one the CLI and the C ABI apply):
 /// `ValueError` naming `name` for an empty name or one with `#`, `/` or a control character.
 #[pyfunction]
 pub(crate) fn _check_table_name(name: &str) -> PyResult<()> {

@@ -33,8 +33,8 @@ fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyA
 }
 
 /// Bakes SOURCE into OUTPUT: a `.btdb` file, or `DB#NAME` (a table of a database). The
-/// keywords are the fields of [`BakeSettings`] (the CLI's `bake` flags, snake_cased). Returns
-/// what `brdftab info --json OUTPUT` reports.
+/// keywords are the CLI's `bake` flags, snake_cased (`preset`, `grid`, `codec`, ...; the
+/// fields of the library's `BakeSettings`). Returns what `brdftab info --json OUTPUT` reports.
 #[pyfunction]
 #[pyo3(signature = (source, output, **options))]
 pub(crate) fn bake(
@@ -74,7 +74,7 @@ pub(crate) fn _check_bake_options(
 }
 
 /// The table of SOURCE baked with `options` (the keywords of `bake`), from the cache of baked
-/// tables or baked into it now ([`brdftab::cache`]): keyed by the source's content, the
+/// tables or baked into it now (the library's `cache` module): keyed by the source's content, the
 /// settings and the library's version, in `cache_dir` (default `$BRDFTAB_CACHE_DIR`, else
 /// `$XDG_CACHE_HOME/brdftab`, else `~/.cache/brdftab`). Safe under concurrent calls from many
 /// processes. `refresh=True` bakes again (for a cached file that failed to open). Returns
@@ -101,9 +101,10 @@ pub(crate) fn bake_cached(
     })
 }
 
-/// Converts SOURCE into OUTPUT as `brdftab convert` does ([`request::convert`]): an RGL
-/// `.bsdf`, a MERL `.binary`, `DB#NAME`, a `.btdb` file (a table named after the input) or a raw
-/// table. The keywords are the fields of [`ConvertSettings`].
+/// Converts SOURCE into OUTPUT as `brdftab convert` does: an RGL `.bsdf`, a MERL `.binary`,
+/// `DB#NAME`, a `.btdb` file (a table named after the input) or a raw table. The keywords are
+/// the CLI's `convert` flags, snake_cased: those of `bake` and `pairs`, `interp`, `resolution`,
+/// `theta_i`, `phi_i`, `ndf_resolution` (the fields of the library's `ConvertSettings`).
 #[pyfunction]
 #[pyo3(signature = (source, output, **options))]
 pub(crate) fn convert(
@@ -170,7 +171,9 @@ pub(crate) fn convert(
 }
 
 /// Fits `model` (a name such as "ggx", a sum "lambert+ggx", or a JSON spec) to SOURCE; returns
-/// the dict of `brdftab fit --json`. The keywords are the fields of [`FitSettings`].
+/// the dict of `brdftab fit --json`. The keywords are the CLI's `fit` flags, snake_cased
+/// (`params`, `starts`, `pairs`, `max_theta_deg`, ...; the fields of the library's
+/// `FitSettings`).
 #[pyfunction]
 #[pyo3(signature = (source, model, **options))]
 pub(crate) fn fit(

@@ -88,7 +88,7 @@ impl PyTable {
 
     /// The table as a GPU or JIT host evaluates it, for lookups with `interp` ("linear",
     /// "nearest", or "auto": the table's default, nearest on a grid of MERL cells): the
-    /// library's device layout (`brdftab::table::device`), a dict with
+    /// library's device layout (Rust `brdftab::table::device`), a dict with
     /// "version" (refuse any other than the one you implement), "kind" ("kernel" or "grid"),
     /// "channels", "channel_names", "quantity", "calibration" (None or its factors), "kernel"
     /// and "grid" (None or dicts of the layout's fields, each with its float32 "values").

@@ -6,6 +6,7 @@ name of the stubs. (That each stub's signature matches the runtime is mypy's `st
 import ast
 import inspect
 import pathlib
+import re
 
 import brdftab
 import brdftab.mitsuba
@@ -84,3 +85,39 @@ def test_the_stubs_name_what_the_runtime_exports():
         if isinstance(n, ast.Assign) and any(getattr(t, "id", None) == "__all__" for t in n.targets)
     )
     assert stub_all == brdftab.__all__
+
+
+# Rustdoc's link syntax, which PyO3 copies from a Rust doc comment into the docstring that
+# `help()` shows: [`Foo`], [`Foo`](crate::bar), [text](self::x), [Foo], [foo::bar].
+RUSTDOC_LINK = re.compile(
+    r"\[`[^`\n]+`\]|\]\((?:crate|self|super)::|\[(?:[A-Z]\w*|\w+(?:::\w+)+)\](?![\[(])"
+)
+
+
+def _rustdoc_links(doc):
+    return [m.group(0) for m in RUSTDOC_LINK.finditer(doc or "")]
+
+
+def test_docstrings_read_as_python_docs_not_rustdoc():
+    """What `help(brdftab.X)` shows carries no rustdoc link syntax (the extension's docstrings
+    are its Rust doc comments): `bake`, `convert`, `fit` and `bake_cached` showed
+    [`BakeSettings`], [`request::convert`], [`FitSettings`] and [`brdftab::cache`]."""
+    found = []
+    for mod in [*MODULES, brdftab._native]:
+        found += [(mod.__name__, x) for x in _rustdoc_links(mod.__doc__)]
+        for n in dir(mod):
+            obj = getattr(mod, n)
+            if callable(obj) and getattr(obj, "__module__", None) in ("brdftab._native", "brdftab"):
+                found += [(f"{mod.__name__}.{n}", x) for x in _rustdoc_links(obj.__doc__)]
+    for qual, obj in _runtime_members():
+        fn = obj.__func__ if isinstance(obj, (staticmethod, classmethod)) else obj
+        found += [(qual, x) for x in _rustdoc_links(getattr(fn, "__doc__", None))]
+    for stub in ["__init__.pyi", "mitsuba.pyi"]:
+        tree = ast.parse((PKG / stub).read_text(encoding="utf-8"))
+        found += [(stub, x) for x in _rustdoc_links(ast.get_docstring(tree))]
+        found += [(f"{stub}: {q}", x) for q, node in _stub_defs(tree)
+                  for x in _rustdoc_links(ast.get_docstring(node))]
+    assert not found, f"rustdoc link syntax in docstrings: {sorted(set(found))}"
+    assert _rustdoc_links("see [`Foo`](crate::bar), [a table](self::t), [Foo] and [a::b]") == [
+        "[`Foo`]", "](self::", "[Foo]", "[a::b]"]
+    assert _rustdoc_links('`grid["stored_shape"] + [c]`, ["R", "G", "B"], [0, 1)') == []

@@ -259,13 +259,13 @@ impl PyBrdf {
         guard(|| self.table_device_layout(py))
     }
 
-    /// The node densities of the library's importance sampler (`brdftab.table.SamplingNodes`
-    /// in Rust): {"version": 3, "linear", "nx", "ny", "nt", "np", "isotropic", "data": float32
-    /// array (nt·np, ny, nx), "alias": {...}} — g(s, y) of f_r cos θ over the half-vector square
-    /// (s → θh = (π/2)(a s + (1 − a) s²), a = "linear", y → φh = 2π y − π relative to the conditioning
-    /// direction's azimuth) at nt conditioning nodes uniform in t = sqrt(1 − cos θ) (times np
+    /// The node densities of the library's importance sampler (Rust
+    /// `brdftab::table::SamplingNodes`): {"version": 3, "linear", "nx", "ny", "nt", "np",
+    /// "isotropic", "data": float32 array (nt·np, ny, nx), "alias": {...}} — g(s, y) of f_r cos θ
+    /// over the half-vector square (s → θh = (π/2)(a s + (1 − a) s²), a = "linear", y → φh =
+    /// 2π y − π relative to the conditioning direction's azimuth) at nt conditioning nodes uniform in t = sqrt(1 − cos θ) (times np
     /// over φ for anisotropic sources), and the library's constant-time draw of them
-    /// (`brdftab.table.AliasTables`): {"other_bits", "pdf": float32 (nt·np, ny, nx)
+    /// (Rust `brdftab::table::AliasTables`): {"other_bits", "pdf": float32 (nt·np, ny, nx)
     /// normalized, "strips": uint32 (nt·np, 2(ny − 1)), "cells": uint32 (nt·np, ny, nx − 1)}.
     /// `adjoint=True` conditions on wi and weights by cos θo (Mitsuba's convention: draw wo
     /// given wi). For hosts that sample on a device (the Mitsuba plugin).
@@ -282,7 +282,8 @@ impl PyBrdf {
         guard(|| self.sampling_nodes_dict(py, adjoint, theta_h, phi_h, theta_o, phi_o))
     }
 
-    /// The resolution the library samples this source at (`SamplingResolution::for_source`):
+    /// The resolution the library samples this source at (Rust
+    /// `brdftab::table::SamplingResolution::for_source`):
     /// {"theta_h", "phi_h", "theta_o", "phi_o"} for `sampling_nodes` — twice the θh nodes for
     /// a peak at normal incidence too sharp for 64, half again the views and φh nodes for a
     /// lobe that changes shape between the grazing views faster than they follow (the Phong
