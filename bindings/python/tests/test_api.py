@@ -308,6 +308,23 @@ def test_database(tmp_path):
     assert pickle.loads(pickle.dumps(db)).names() == ["shiny"]
 
 
+def test_a_database_path_is_a_str_or_a_pathlike_of_one(tmp_path, monkeypatch):
+    """Database(path) took str(path) of anything: Database(b"m.btdb").add(...) wrote a file
+    named "b'm.btdb'", Database(3) a file "3". Now it refuses what `open` and `bake` refuse,
+    naming the argument; and `source(name)` checks the name as add, open and remove do."""
+    monkeypatch.chdir(tmp_path)
+    for bad, match in [(b"m.btdb", "path: expected a str"), (3, "path: expected a str"),
+                       (None, "path: expected a str"), (_BytesPath("m.btdb"), "path: a bytes")]:
+        with pytest.raises(TypeError, match=match):
+            brdftab.Database(bad).add(LAMBERT, "a", preset="small")
+    assert not list(tmp_path.iterdir())
+    assert brdftab.Database(pathlib.Path("m.btdb")).path == "m.btdb"
+    with pytest.raises(ValueError, match="name"):
+        brdftab.Database("m.btdb").source("a#b")
+    with pytest.raises(TypeError, match="name"):
+        brdftab.Database("m.btdb").source(3)
+
+
 def test_table_names_follow_the_librarys_rule(tmp_path):
     """An empty name, `DB#` with nothing after the `#`, and names with control characters were
     stored as given (a table named "\\0", a file named `n.btdb#`); the library's one rule

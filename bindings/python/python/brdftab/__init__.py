@@ -62,7 +62,9 @@ class Database:
     """
 
     def __init__(self, path):
-        self.path = str(path)
+        # A str or an os.PathLike of one, as every SOURCE and OUTPUT (str() of anything else
+        # made a path of its repr: Database(b"m.btdb") wrote a file named "b'm.btdb'").
+        self.path = _path_arg(path, "path")
 
     def __repr__(self):
         return f"brdftab.Database({self.path!r})"
@@ -113,11 +115,23 @@ class Database:
 
     def source(self, name):
         """The SOURCE string of table NAME (``DB#NAME``), e.g. for worker processes."""
+        _check_name(name)
         return f"{self.path}#{name}"
 
     def info(self):
         """What ``brdftab info --json DB`` reports: the file and every table."""
         return _native.info(self.path)
+
+
+def _path_arg(path, what):
+    """A path argument as the extension takes one: a str, or an os.PathLike whose path is a
+    str; anything else is a TypeError naming `what`."""
+    if isinstance(path, (str, _os.PathLike)):
+        p = _os.fspath(path)
+        if isinstance(p, str):
+            return p
+        raise TypeError(f"{what}: a bytes path is not supported; pass a str")
+    raise TypeError(f"{what}: expected a str or an os.PathLike, got {type(path).__name__}")
 
 
 def _check_name(name):
