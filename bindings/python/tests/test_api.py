@@ -522,6 +522,12 @@ def test_bad_arguments():
         brdftab.bake(LAMBERT, "/tmp/never.btdb", supersample=65)
     with pytest.raises(ValueError, match="max_theta_deg"):
         brdftab.fit(LAMBERT, "lambert", max_theta_deg=100)
+    # A negative node count names its argument (it was an OverflowError "can't convert
+    # negative int to unsigned", naming none); numpy integers are counts too.
+    for k in ["theta_h", "phi_h", "theta_o", "phi_o"]:
+        with pytest.raises(ValueError, match=f"{k}: -1 is not a node count"):
+            b.sampling_nodes(**{k: -1})
+    assert b.sampling_nodes(theta_h=np.int64(8), phi_h=8, theta_o=4, phi_o=1)["ny"] == 8
     # one-pair evaluation does not leak state between bad and good calls
     assert b.eval([0, 0, 1], [0, 0, 1]).tolist() == pytest.approx([0.1, 0.2, 0.3])
 

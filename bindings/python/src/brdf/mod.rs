@@ -263,23 +263,36 @@ impl PyBrdf {
     /// `brdftab::table::SamplingNodes`): {"version": 3, "linear", "nx", "ny", "nt", "np",
     /// "isotropic", "data": float32 array (nt·np, ny, nx), "alias": {...}} — g(s, y) of f_r cos θ
     /// over the half-vector square (s → θh = (π/2)(a s + (1 − a) s²), a = "linear", y → φh =
-    /// 2π y − π relative to the conditioning direction's azimuth) at nt conditioning nodes uniform in t = sqrt(1 − cos θ) (times np
-    /// over φ for anisotropic sources), and the library's constant-time draw of them
+    /// 2π y − π relative to the conditioning direction's azimuth) at nt conditioning nodes
+    /// uniform in t = sqrt(1 − cos θ) (times np over φ for anisotropic sources), and the
+    /// library's constant-time draw of them
     /// (Rust `brdftab::table::AliasTables`): {"other_bits", "pdf": float32 (nt·np, ny, nx)
     /// normalized, "strips": uint32 (nt·np, 2(ny − 1)), "cells": uint32 (nt·np, ny, nx − 1)}.
     /// `adjoint=True` conditions on wi and weights by cos θo (Mitsuba's convention: draw wo
-    /// given wi). For hosts that sample on a device (the Mitsuba plugin).
+    /// given wi). For hosts that sample on a device (the Mitsuba plugin). A negative count is
+    /// a `ValueError` naming it.
     #[pyo3(signature = (adjoint=false, theta_h=64, phi_h=64, theta_o=32, phi_o=16))]
     fn sampling_nodes(
         &self,
         py: Python<'_>,
         adjoint: bool,
-        theta_h: usize,
-        phi_h: usize,
-        theta_o: usize,
-        phi_o: usize,
+        theta_h: i64,
+        phi_h: i64,
+        theta_o: i64,
+        phi_o: i64,
     ) -> PyResult<Py<PyAny>> {
-        guard(|| self.sampling_nodes_dict(py, adjoint, theta_h, phi_h, theta_o, phi_o))
+        // Signed here: pyo3's refusal of a negative `usize` is an OverflowError that does not
+        // name the argument.
+        let count = |x: i64, name: &str| {
+            usize::try_from(x).map_err(|_| {
+                pyo3::exceptions::PyValueError::new_err(format!(
+                    "{name}: {x} is not a node count (an integer >= 0)"
+                ))
+            })
+        };
+        let (th, ph) = (count(theta_h, "theta_h")?, count(phi_h, "phi_h")?);
+        let (to, po) = (count(theta_o, "theta_o")?, count(phi_o, "phi_o")?);
+        guard(|| self.sampling_nodes_dict(py, adjoint, th, ph, to, po))
     }
 
     /// The resolution the library samples this source at (Rust
