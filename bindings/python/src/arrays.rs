@@ -390,6 +390,10 @@ pub(crate) fn wavelength_rows<'py>(
             let flat = nm.as_any().call_method1("reshape", ((n, k),))?;
             Ok((k, true, flat.extract()?))
         }
+        _ if lead.is_empty() => Err(PyValueError::new_err(format!(
+            "nm: expected shape (k,) (the k wavelengths of the one pair), got {}",
+            shape_str(nm.shape())
+        ))),
         _ => {
             let per_pair: Vec<String> = lead.iter().map(|d| d.to_string()).collect();
             Err(PyValueError::new_err(format!(

@@ -204,5 +204,12 @@ def test_leading_shapes_broadcast_as_numpy_broadcasts():
         b.eval(np.zeros((3, 4)), dirs(3))
     with pytest.raises(ValueError, match=r"nm: expected shape \(k,\) or \(4, 5, k\)"):
         b.eval_spectral(dirs(4, 5), dirs(5), np.full((5, 2), 550.0))
+    # One pair takes one set (k,): the message said "(k,) or (, k)".
+    for nm in (np.full((1, 2), 550.0), 550.0):
+        for call in (lambda: b.eval_spectral([0, 0, 1], [0, 0, 1], nm),
+                     lambda: b.sample([0, 0, 1], [0.5, 0.5], nm=nm)):
+            with pytest.raises(ValueError, match=r"nm: expected shape \(k,\) \(the k wavelengths "
+                                                 r"of the one pair\), got"):
+                call()
     with pytest.raises(ValueError, match="u: expected shape"):
         b.sample(dirs(2), np.zeros(3))
