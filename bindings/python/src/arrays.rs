@@ -72,9 +72,13 @@ fn real_array<'py, T: Element>(
             )));
         }
     }
+    // In C order: what every caller reads (rows in place, values in C order); converting a
+    // Fortran-order or strided array keeping its layout made `Rows` copy it a second time.
     let np = py.import("numpy")?;
+    let kw = pyo3::types::PyDict::new(py);
+    kw.set_item("order", "C")?;
     let arr = np
-        .call_method1("asarray", (obj, dtype))
+        .call_method("asarray", (obj, dtype), Some(&kw))
         .map_err(|e| PyTypeError::new_err(format!("{name}: not an array of real numbers ({e})")))?;
     arr.extract::<PyReadonlyArrayDyn<'py, T>>()
         .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))

@@ -5,6 +5,7 @@ wrong and none aborts the interpreter."""
 
 import subprocess
 import sys
+import tracemalloc
 
 import numpy as np
 import pytest
@@ -213,3 +214,26 @@ def test_leading_shapes_broadcast_as_numpy_broadcasts():
                 call()
     with pytest.raises(ValueError, match="u: expected shape"):
         b.sample(dirs(2), np.zeros(3))
+
+
+def test_an_array_converted_for_a_call_is_copied_once():
+    """A Fortran-order or strided array of another dtype is converted once into C-order
+    float64. (A Fortran-order float32 `wi` was converted keeping its order, then copied again
+    into C order: two n×3 float64 copies at once, a peak of 48 bytes a pair; now one copy and
+    the float32 output, 36.)"""
+    b = brdftab.open(GGX)
+    n = 200_000
+    wi = np.random.default_rng(8).normal(size=(n, 3))
+    wi[:, 2] = np.abs(wi[:, 2])
+    for a in (np.asfortranarray(wi.astype(np.float32)), np.asfortranarray(wi.astype(np.int64)),
+              wi.astype(np.float16)[::-1]):
+        tracemalloc.start()
+        try:
+            tracemalloc.reset_peak()
+            f = b.eval(a, [0, 0, 1])
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        assert f.shape == (n, 3)
+        # one float64 copy (24 bytes a pair) and the float32 output (12): 36; two copies: 48
+        assert peak < 42 * n, f"{a.dtype}: {peak / n:.0f} bytes a pair"
