@@ -71,10 +71,12 @@ impl Table {
     }
 
     /// [`Table::with_values`] of an array of `shape` (`data` in C order): flat (the stored
-    /// layout) or shaped by the stored axes and the channels (`grid.stored_shape() + [c]`, what
-    /// [`Table::view`] and the `.npy` export give) — for a packed layout (an `inout` reciprocal
-    /// table stores a triangle of its θ axes) the whole rectangle, whose unstored nodes are
-    /// ignored (the export writes NaN there).
+    /// layout), `[nodes, c]` (the same order, a row of channels per stored node, as the nodes
+    /// of [`Grid::stored_node_angles`] come: a source evaluated at them) or shaped by the
+    /// stored axes and the channels (`grid.stored_shape() + [c]`, what [`Table::view`] and the
+    /// `.npy` export give) — for a packed layout (an `inout` reciprocal table stores a triangle
+    /// of its θ axes) the whole rectangle, whose unstored nodes are ignored (the export writes
+    /// NaN there).
     ///
     /// # Errors
     /// [`Error::InvalidArgument`] naming `values`: a shape that is neither, `data` not of the
@@ -158,7 +160,11 @@ fn form(grid: &Grid, shape: &[usize], len: usize) -> Result<Form> {
             Form::Stored
         });
     }
-    if shape == [grid.stored_values()] {
+    // Flat, or one row of channels a stored node (the stored order: what a host gets by
+    // evaluating a source at the nodes `stored_node_angles` lists, packed or not).
+    let c = l.channels.max(1);
+    let rows = [grid.stored_values() / c, c];
+    if shape == [grid.stored_values()] || shape == rows {
         return Ok(Form::Stored);
     }
     let packed = if l.packed {
@@ -170,7 +176,8 @@ fn form(grid: &Grid, shape: &[usize], len: usize) -> Result<Form> {
         "values",
         format!(
             "an array of shape {shape:?} does not fit the grid: it stores an array of shape \
-             {rect:?} (its stored axes and channels{packed}), or {} values flat",
+             {rect:?} (its stored axes and channels{packed}), {rows:?} (a row of channels a \
+             stored node) or {} values flat",
             grid.stored_values()
         ),
     ))
@@ -421,6 +428,15 @@ mod tests {
             .with_array(&[t.values().len()], t.values().to_vec())
             .unwrap();
         assert_eq!(flat.values(), t.values());
+        // A row of channels per stored node, as a source evaluated at the stored nodes gives.
+        let nodes = t.grid().stored_node_angles().len();
+        let rows = t.with_array(&[nodes, 3], t.values().to_vec()).unwrap();
+        assert_eq!(rows.values(), t.values());
+        let e = refused(t.with_array(&[3, nodes], t.values().to_vec())).to_string();
+        assert!(
+            e.contains(&format!("[{nodes}, 3] (a row of channels")),
+            "{e}"
+        );
         // Node [2, 0, 1, 0] lies below the diagonal (not stored); [2, 0, 3, 0] is stored.
         let at = |idx: [usize; 4]| ((idx[0] * n1 + idx[1]) * n2 + idx[2]) * n3 + idx[3];
         assert!(t.node([2, 0, 1, 0]).is_none() && t.node([2, 0, 3, 0]).is_some());

@@ -109,7 +109,9 @@ impl PyTable {
     /// The same table — grid (stored layout, symmetry, quantity, albedo calibration) — holding
     /// `values`: any array-like of real numbers shaped as `values` is (the stored axes and
     /// channels; for a packed table the flat values, or the rectangle `brdftab export --npy`
-    /// writes, whose unstored nodes are ignored) or flat, converted to float32 in C order.
+    /// writes, whose unstored nodes are ignored), flat, or (nodes, c) — a row per stored node,
+    /// as `eval(*node_directions())` gives for a packed table — converted to float32 in C
+    /// order.
     /// The values are the stored quantity before the albedo calibration, as `values` gives
     /// them; negative values mark unmeasured nodes in a table of f_r (lookups read 0 there).
     /// `calibration=False` drops the grid's albedo calibration (for another material's values

@@ -183,6 +183,11 @@ def test_node_directions_are_where_the_bake_sampled(options):
     inside = (wi[:, 2] > 1e-3) & (wo[:, 2] > 1e-3)
     assert inside.sum() > len(inside) // 3
     np.testing.assert_array_equal(src.eval(wi[inside], wo[inside]), v[inside])
+    # A source evaluated at the nodes goes back in as it comes out, (nodes, c) for a packed
+    # table (refused before: only flat or the rectangle were taken), and equals it flat.
+    f = src.eval(*t.node_directions())
+    assert np.array_equal(t.with_values(f).values, t.with_values(f.reshape(-1)).values)
+    assert np.array_equal(t.with_values(f.reshape(-1, 3)).values, t.with_values(f).values)
     if t.grid["param"] == "halfdiff":
         # θh is the angle of wi + wo from the normal, θd the angle of wi from it.
         h = wi + wo

@@ -155,8 +155,10 @@ class Table:
     def with_values(self, values: _ArrayLike, *, calibration: bool = True) -> Table:
         """The same table (grid: stored layout, symmetry, quantity, albedo calibration) holding
         `values`: any array-like of real numbers the size of `values` — shaped as it is (stored
-        axes + channels), flat, or for a packed table the rectangle `brdftab export --npy`
-        writes (unstored nodes ignored) — converted to float32 in C order. Values are the stored
+        axes + channels), flat, (nodes, c) (a row per stored node, as
+        `eval(*node_directions())` gives for a packed table), or for a packed table the
+        rectangle `brdftab export --npy` writes (unstored nodes ignored) — converted to float32
+        in C order. Values are the stored
         quantity before the calibration, as `values` gives them; negative values mark unmeasured
         nodes of an f_r table (lookups read 0). `calibration=False` drops the grid's albedo
         calibration (for another material's values on this grid). A wrong size or shape, or a
