@@ -60,7 +60,17 @@ fn real_array<'py, T: Element>(
                 .unwrap_or_default()
         )));
     }
+    let np = py.import("numpy")?;
+    let not_real =
+        |e: PyErr| PyTypeError::new_err(format!("{name}: not an array of real numbers ({e})"));
+    let mut obj = obj.clone();
     if let Ok(dt) = obj.getattr("dtype") {
+        if dt.getattr("kind").is_err() {
+            // Another library's dtype (a torch tensor's `torch.float32` has no numpy `kind`,
+            // and was refused as if not real): numpy's view of the object says what it holds.
+            obj = np.call_method1("asarray", (&obj,)).map_err(not_real)?;
+        }
+        let dt = obj.getattr("dtype")?;
         let kind: String = dt
             .getattr("kind")
             .and_then(|k| k.extract())
@@ -74,12 +84,11 @@ fn real_array<'py, T: Element>(
     }
     // In C order: what every caller reads (rows in place, values in C order); converting a
     // Fortran-order or strided array keeping its layout made `Rows` copy it a second time.
-    let np = py.import("numpy")?;
     let kw = pyo3::types::PyDict::new(py);
     kw.set_item("order", "C")?;
     let arr = np
-        .call_method("asarray", (obj, dtype), Some(&kw))
-        .map_err(|e| PyTypeError::new_err(format!("{name}: not an array of real numbers ({e})")))?;
+        .call_method("asarray", (&obj, dtype), Some(&kw))
+        .map_err(not_real)?;
     arr.extract::<PyReadonlyArrayDyn<'py, T>>()
         .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))
 }

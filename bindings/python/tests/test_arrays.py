@@ -237,3 +237,33 @@ def test_an_array_converted_for_a_call_is_copied_once():
         assert f.shape == (n, 3)
         # one float64 copy (24 bytes a pair) and the float32 output (12): 36; two copies: 48
         assert peak < 42 * n, f"{a.dtype}: {peak / n:.0f} bytes a pair"
+
+
+class _ForeignTensor:
+    """An array of another library (a CPU torch tensor): numpy reads it through `__array__`,
+    and its `dtype` is that library's (`torch.float32`), not numpy's."""
+
+    def __init__(self, a):
+        self.a = np.asarray(a)
+        self.dtype = f"torch.{self.a.dtype}"
+        self.shape = self.a.shape
+
+    def __array__(self, dtype=None, copy=None):
+        return self.a if dtype is None else self.a.astype(dtype)
+
+
+def test_an_array_of_another_library_is_read_as_numpy_reads_it():
+    """Anything numpy reads as real numbers is an array argument: a tensor whose dtype is not
+    numpy's was a TypeError ("expected real numbers, got an array of dtype torch.float32"); a
+    complex one stays a TypeError, its imaginary part not dropped."""
+    b = brdftab.open(GGX)
+    want = b.eval(WI, WO)
+    for dt in (np.float32, np.float64, np.int64):
+        x = WI.astype(dt) if dt != np.int64 else np.array([[0, 0, 1]] * 3)
+        got = b.eval(_ForeignTensor(x), WO)
+        np.testing.assert_array_equal(got, b.eval(x, WO))
+    np.testing.assert_array_equal(b.eval(_ForeignTensor(WI), _ForeignTensor(WO)), want)
+    np.testing.assert_array_equal(b.albedo(_ForeignTensor(THETA)), b.albedo(THETA))
+    with pytest.raises(TypeError, match=r"wi: expected real numbers, got an array of dtype "
+                                        r"complex128"):
+        b.eval(_ForeignTensor(WI.astype(complex)), WO)
