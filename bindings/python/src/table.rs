@@ -239,6 +239,16 @@ impl PyTable {
         2
     }
 
+    /// The object itself: a `Table` is immutable (`copy.copy` raised "cannot pickle").
+    fn __copy__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+
+    /// The object itself (immutable, as `__copy__`).
+    fn __deepcopy__(slf: Py<Self>, _memo: &Bound<'_, PyAny>) -> Py<Self> {
+        slf
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<brdftab.Table {}: {}>",

@@ -198,3 +198,24 @@ def test_node_directions_are_where_the_bake_sampled(options):
     else:
         np.testing.assert_allclose(np.arccos(wi[:, 2]), a[:, 0], atol=1e-9)
         np.testing.assert_allclose(np.arccos(wo[:, 2]), a[:, 2], atol=1e-9)
+
+
+def test_copies_of_immutable_objects_are_the_objects(tmp_path):
+    """`copy.copy`/`deepcopy` of a `Brdf` reopened its source from disk (an in-memory table's
+    raised "cannot pickle"), of a `Table` raised "cannot pickle": both are immutable, so a copy
+    is the object itself, as for a tuple; a container of them deep-copies."""
+    import copy
+
+    path = tmp_path / "g.btdb"
+    brdftab.bake(GGX, path, preset="small")
+    b = brdftab.open(path)
+    t = b.table()
+    m = t.open()
+    for x in (b, t, m):
+        assert copy.copy(x) is x and copy.deepcopy(x) is x
+    d = copy.deepcopy({"brdf": b, "table": t, "memory": m})
+    assert d["brdf"] is b and d["table"] is t and d["memory"] is m
+    path.unlink()  # nothing is reopened
+    assert copy.deepcopy(b) is b
+    with pytest.raises(TypeError, match="pickle"):
+        pickle.dumps(m)

@@ -38,7 +38,7 @@ class Brdf:
     either byte order, any strides; complex, object and string dtypes are a TypeError). A
     numpy.ma masked array with masked entries is a ValueError (fill or drop them first); one
     without is read as its data. A result beyond memory is numpy's MemoryError. Pickles by its
-    source and options."""
+    source and options; `copy.copy` and `copy.deepcopy` give the object itself (immutable)."""
 
     def device_layout(self) -> dict[str, Any]:
         """A table SOURCE's device layout for its interpolation (`Table.device_layout`), the
@@ -129,6 +129,8 @@ class Brdf:
         (Rust ``brdftab::table::AliasTables``); adjoint=True conditions on wi (Mitsuba's
         convention)."""
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
+    def __copy__(self) -> Brdf: ...
+    def __deepcopy__(self, memo: Any, /) -> Brdf: ...
 
 @final
 class Table:
@@ -136,7 +138,9 @@ class Table:
     λ innermost; flat when packed), `grid` describes it. The values are the stored quantity
     (`info(...)["tables"][k]["quantity"]`: "fr", "fr_cos_out" or "fr_cos_cos", i.e. f_r, f_r cos θo
     or f_r cos θi cos θo), before any albedo calibration (`"calibrated"`) a lookup applies.
-    Edited values go back in with `with_values`; `save` writes the table, `open` looks it up."""
+    Edited values go back in with `with_values`; `save` writes the table, `open` looks it up.
+    Immutable: `copy.copy` and `copy.deepcopy` give the object itself; it does not pickle
+    (`save` it)."""
     @property
     def values(self) -> npt.NDArray[np.float32]:
         """float32 values shaped by the stored axes and the channels (grid["stored_shape"] +
@@ -198,6 +202,8 @@ class Table:
         """Yields values, then grid: `values, grid = b.table()`."""
     def __len__(self) -> int:
         """2 (values and grid)."""
+    def __copy__(self) -> Table: ...
+    def __deepcopy__(self, memo: Any, /) -> Table: ...
 
 def open(
     source: str | PathLike[str],

@@ -27,7 +27,7 @@ use crate::values::{ser, wavelengths_of};
 /// pointing away from the surface; `wi` is the direction to the light, `wo` to the viewer.
 /// Array arguments are anything numpy reads as real numbers; a `numpy.ma` masked array with
 /// masked entries is a `ValueError` (fill or drop them first). Pickles by its source and
-/// options.
+/// options; `copy.copy` and `copy.deepcopy` give the object itself (it is immutable).
 #[pyclass(name = "Brdf", module = "brdftab", frozen)]
 pub(crate) struct PyBrdf {
     inner: Arc<dyn Brdf + Send + Sync>,
@@ -320,6 +320,17 @@ impl PyBrdf {
     #[pyo3(signature = (**options))]
     fn table(&self, py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<PyTable> {
         guard(|| self.decoded_table(py, options))
+    }
+
+    /// The object itself: a `Brdf` is immutable (`copy.copy` reopened the source from disk,
+    /// and refused an in-memory table's).
+    fn __copy__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+
+    /// The object itself (immutable, as `__copy__`).
+    fn __deepcopy__(slf: Py<Self>, _memo: &Bound<'_, PyAny>) -> Py<Self> {
+        slf
     }
 
     fn __reduce__(&self, py: Python<'_>) -> PyResult<Py<PyTuple>> {
