@@ -239,7 +239,7 @@ impl PyTable {
         2
     }
 
-    /// The object itself: a `Table` is immutable (`copy.copy` raised "cannot pickle").
+    /// The object itself: a `Table` is immutable.
     fn __copy__(slf: Py<Self>) -> Py<Self> {
         slf
     }

@@ -322,8 +322,7 @@ impl PyBrdf {
         guard(|| self.decoded_table(py, options))
     }
 
-    /// The object itself: a `Brdf` is immutable (`copy.copy` reopened the source from disk,
-    /// and refused an in-memory table's).
+    /// The object itself: a `Brdf` is immutable (nothing is reopened from disk).
     fn __copy__(slf: Py<Self>) -> Py<Self> {
         slf
     }
