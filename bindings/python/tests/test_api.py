@@ -306,6 +306,11 @@ def test_database(tmp_path):
     with pytest.raises(ValueError, match="name"):  # the name's rule, as add and open apply it
         db.remove("a#b")
     assert pickle.loads(pickle.dumps(db)).names() == ["shiny"]
+    # A handle on a path, as pathlib.Path: a pickled copy, or another handle on the same path,
+    # is equal (they were unequal: identity) and hashes alike.
+    same = pickle.loads(pickle.dumps(db))
+    assert same == db == brdftab.Database(str(tmp_path / "m.btdb")) and hash(same) == hash(db)
+    assert db != brdftab.Database(tmp_path / "other.btdb") and db != str(tmp_path / "m.btdb")
 
 
 def test_a_database_path_is_a_str_or_a_pathlike_of_one(tmp_path, monkeypatch):

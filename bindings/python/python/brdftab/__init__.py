@@ -72,6 +72,15 @@ class Database:
     def __reduce__(self):
         return (Database, (self.path,))
 
+    def __eq__(self, other):
+        # A handle on a path, as a pathlib.Path: equal when the paths are (a pickled copy too).
+        if not isinstance(other, Database):
+            return NotImplemented
+        return self.path == other.path
+
+    def __hash__(self):
+        return hash((Database, self.path))
+
     def names(self):
         """The table names, in file order."""
         return _native.db_names(self.path)
