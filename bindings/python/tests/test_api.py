@@ -99,6 +99,14 @@ def test_sample_at_wavelengths_and_its_delta_flags():
         assert one[2].shape == (3,) and one[3].shape == ()
         per_row = b.sample(wo, u, nm=np.tile(lam, (400, 1)))
         np.testing.assert_array_equal(per_row[2], w2)
+        # no wavelengths (k = 0), one set or one per row: the same draws, empty weights (per
+        # row they were all (0, 0, 0) with pdf 0)
+        for nm in (np.zeros(0), np.zeros((400, 0))):
+            wi0, pdf0, w0, d0 = b.sample(wo, u, nm=nm, delta=True)
+            assert w0.shape == (400, 0)
+            np.testing.assert_array_equal(wi0, wi)
+            np.testing.assert_array_equal(pdf0, pdf)
+            np.testing.assert_array_equal(d0, delta)
     with pytest.raises(ValueError, match="nm"):
         b.sample(wo, u, nm=[500.0, float("nan")])
     with pytest.raises(ValueError, match="nm"):

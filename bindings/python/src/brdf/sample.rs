@@ -245,7 +245,17 @@ impl PyBrdf {
                     }
                 }
             };
+            // With no wavelengths the weights are empty, yet every block must still draw: its
+            // weight chunks come from a stand-in of one (unused) value a pair.
             let kw = k.max(1);
+            let mut stand_in = Vec::new();
+            let w_s = match k {
+                0 => {
+                    stand_in.resize(n, 0.0f32);
+                    stand_in.as_mut_slice()
+                }
+                _ => w_s,
+            };
             if n >= brdftab::batch::PARALLEL {
                 brdftab::par::install(|| {
                     wi_s.par_chunks_mut(BLOCK)
