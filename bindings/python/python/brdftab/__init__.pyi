@@ -212,8 +212,9 @@ def open(
     wavelengths: _Wavelengths = None,
     eager: bool = True,
 ) -> Brdf:
-    """Opens SOURCE. interp: "auto" (nearest on tables of MERL cells, linear otherwise),
-    "nearest" or "linear"."""
+    """Opens SOURCE. interp: "auto" (nearest on tables of MERL cells and MERL files, linear
+    otherwise), "nearest" or "linear" (a MERL file: its cells interpolated; an RGL file or a
+    model: no effect)."""
 def rgb_basis(nm: _ArrayLike) -> npt.NDArray[np.float64]:
     """The weights of R, G, B at wavelengths `nm` (nm; result shape: nm's + (3,)): RGB data
     (r, g, b) at a wavelength is r w[0] + g w[1] + b w[2], as `Brdf.eval_spectral` reads an RGB
