@@ -287,7 +287,7 @@ pub unsafe extern "C" fn brdftab_open_with(
 
 /// This thread's last failure, `""` if the last call succeeded. Valid until this thread's next
 /// brdftab call. After the thread's storage is destroyed (calls from exit handlers), a fixed
-/// note ([`NO_MESSAGE`]).
+/// note saying so.
 #[unsafe(no_mangle)]
 pub extern "C" fn brdftab_last_error() -> *const c_char {
     LAST_ERROR
