@@ -211,6 +211,7 @@ fn channel_names(c: &Channels, n: usize) -> Vec<String> {
 }
 
 /// Writes a 2D slice as OpenEXR, channels as EXR channels, f32 or f16 (`half`), ZIP-compressed.
+/// With `half`, a finite value beyond f16's range (±65504) is an error, not an infinite pixel.
 pub fn exr(
     table: &StoredTable,
     s: &Slice,
@@ -223,6 +224,25 @@ pub fn exr(
     let nc = *table.header().shape.last().unwrap_or(&1) as usize;
     if w == 0 || ht == 0 {
         return Err(crate::Error::arg("slice", "empty slice"));
+    }
+    if half {
+        // f16 holds ±65504 at most: a larger value (a grazing or sharp lobe's f_r) became inf.
+        if let Some(i) = v
+            .iter()
+            .position(|&x| x.is_finite() && f16::from_f32(x).is_infinite())
+        {
+            let (px, c) = (i / nc, i % nc);
+            return Err(crate::Error::arg(
+                "half",
+                format!(
+                    "value {} at x = {}, y = {} (channel {c}) is beyond the half float range \
+                     (±65504): write the slice as f32",
+                    v[i],
+                    px % w,
+                    px / w
+                ),
+            ));
+        }
     }
     let names = channel_names(&table.header().channels, nc);
     let list: Vec<AnyChannel<FlatSamples>> = (0..nc)

@@ -23,7 +23,7 @@ pub struct ExportArgs {
     /// ignored); without them, the others at index 0.
     #[arg(long, requires = "exr")]
     slice: Option<String>,
-    /// Write EXR channels as half floats instead of f32.
+    /// Write EXR channels as half floats instead of f32 (refused when a value exceeds ±65504).
     #[arg(long, requires = "exr")]
     half: bool,
 }
@@ -90,6 +90,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
 fn named(e: Error, flag: &str) -> Error {
     match e {
         Error::InvalidArgument { name, msg } if name == "output" => Error::arg(flag, msg),
+        Error::InvalidArgument { name, msg } if name == "half" => Error::arg("--half", msg),
         e => e,
     }
 }

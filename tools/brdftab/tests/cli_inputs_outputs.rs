@@ -101,6 +101,39 @@ fn export_flags_agree_with_what_export_does() {
     refused(&brdftab(&["export", &t, "--npy", &t]), &["`--npy`", ".npy"]);
 }
 
+/// `export --half` wrote a value beyond f16's ±65504 (the peak of a sharp lobe) as an infinite
+/// pixel without a word; it is refused, and the f32 slice holds the value.
+#[test]
+fn export_half_refuses_values_beyond_f16() {
+    let d = TempDir::new("io-export-half");
+    let t = d.file("sharp.btdb");
+    let sharp = r#"{"model": "cook_torrance", "m": 0.05}"#;
+    assert!(brdftab(&["bake", sharp, "-o", &t, "--preset", "small"]).ok);
+    // x = θd, y = θh: row 0 is the θh node nearest the peak.
+    let (h, f) = (d.file("h.exr"), d.file("f.exr"));
+    refused(
+        &brdftab(&["export", &t, "--exr", &h, "--slice", "2,0", "--half"]),
+        &["`--half`", "65504", "f32"],
+    );
+    assert!(!std::path::Path::new(&h).exists());
+    let o = brdftab(&["export", &t, "--exr", &f, "--slice", "2,0"]);
+    assert!(o.ok, "{}", o.stderr);
+    let img = brdftab_tools::preview::read_exr(&f).unwrap();
+    let max = img.data.iter().fold(0.0f32, |m, &x| m.max(x));
+    assert!(max > 65504.0 && max.is_finite(), "{max}");
+    // A slice within the range (θd × φd at the last θh node) is written as half floats still.
+    let o = brdftab(&[
+        "export",
+        &t,
+        "--exr",
+        &h,
+        "--slice",
+        "2,3:31,0,0,0",
+        "--half",
+    ]);
+    assert!(o.ok, "{}", o.stderr);
+}
+
 /// A missing input was "not found: x.btdb: no such file" to `eval` but "x.btdb: No such file or
 /// directory (os error 2)" to `info`, `db`, `export`, `check` (and `x.btdb#t: ...` to `info`,
 /// naming a file that nobody asked for). Every command and every kind of file now say it alike,
