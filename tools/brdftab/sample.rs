@@ -14,7 +14,6 @@ use std::io::Write;
 use brdftab::{Error, Result};
 use brdftab_tools::rng::Rng;
 use clap::Args;
-use glam::DVec3;
 
 /// Arguments of `brdftab sample`.
 #[derive(Args)]
@@ -47,29 +46,14 @@ pub struct PdfArgs {
     open: brdftab::request::OpenSettings,
 }
 
-fn parse_wo(s: &str) -> Result<DVec3> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|_| Error::arg("--wo", format!("`{s}`: expected X,Y,Z")))?;
-    match v[..] {
-        [x, y, z] => Ok(DVec3::new(x, y, z)),
-        _ => Err(Error::arg(
-            "--wo",
-            format!("`{s}`: expected 3 numbers X,Y,Z"),
-        )),
-    }
-}
-
 fn out_err(e: std::io::Error) -> Error {
     Error::io("stdout", e)
 }
 
 /// Draws `count` directions for `wo` and prints `wix wiy wiz pdf w_1 .. w_c`.
 pub fn sample(a: SampleArgs) -> Result<()> {
+    let wo = brdftab_tools::text::parse_direction(&a.wo, "--wo")?;
     let brdf = brdftab::request::open(&a.source, &a.open)?;
-    let wo = parse_wo(&a.wo)?;
     let c = brdf.channels().len();
     let mut w = vec![0.0f32; c];
     let mut rng = Rng::new(a.seed);

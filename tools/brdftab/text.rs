@@ -82,6 +82,28 @@ pub fn for_each_pair(
     Ok(())
 }
 
+/// A direction typed as one argument, `X,Y,Z` (need not be normalized; `sample --wo`): three
+/// finite numbers, not all zero. A NaN, infinite or zero vector is an error naming `flag` — it
+/// was taken, and every draw for it silently printed nothing.
+pub fn parse_direction(s: &str, flag: &str) -> Result<DVec3> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| Error::arg(flag, format!("`{s}`: expected X,Y,Z")))?;
+    let [x, y, z] = v[..] else {
+        return Err(Error::arg(flag, format!("`{s}`: expected 3 numbers X,Y,Z")));
+    };
+    let d = DVec3::new(x, y, z);
+    if !d.is_finite() || d == DVec3::ZERO {
+        return Err(Error::arg(
+            flag,
+            format!("`{s}` is not a direction: three finite numbers, not all zero"),
+        ));
+    }
+    Ok(d)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -105,5 +127,19 @@ mod tests {
         let e = parse_numbers::<2>("1 x", "in", 7).unwrap_err();
         assert!(e.to_string().contains("line 7") && e.to_string().contains("`x`"));
         assert!(parse_numbers::<2>("1 2 3", "in", 1).is_err());
+    }
+
+    #[test]
+    fn a_direction_argument_is_finite_and_not_zero() {
+        assert_eq!(
+            parse_direction(" 0.3, 0,1", "--wo").unwrap(),
+            DVec3::new(0.3, 0.0, 1.0)
+        );
+        // Not normalized, so any finite scale (the sampler normalizes it).
+        assert!(parse_direction("1e300,0,1e300", "--wo").is_ok());
+        for bad in ["nan,0,1", "0,0,0", "inf,0,1", "0,-0,0", "1,2", "a,b,c"] {
+            let e = parse_direction(bad, "--wo").unwrap_err().to_string();
+            assert!(e.contains("--wo") && e.contains(bad), "{bad}: {e}");
+        }
     }
 }

@@ -186,6 +186,18 @@ fn sample_rejects_a_bad_wo() {
     let r = brdftab(&["sample", LAMBERT, "--wo", "1,2"]);
     assert_eq!(r.code, 1);
     assert!(r.stderr.contains("--wo"), "{}", r.stderr);
+    // Not a direction: it printed nothing with status 0, as if every draw had missed.
+    for wo in ["nan,0,1", "0,0,0", "0,inf,1"] {
+        let r = brdftab(&["sample", LAMBERT, &format!("--wo={wo}")]);
+        assert_eq!(r.code, 1, "{wo}: {}", r.stdout);
+        assert!(
+            r.stderr.starts_with("error: ")
+                && r.stderr.contains("--wo")
+                && r.stderr.lines().count() == 1,
+            "{}",
+            r.stderr
+        );
+    }
     // Below the horizon: no direction can be drawn, nothing is printed.
     let r = brdftab(&["sample", LAMBERT, "--wo", "0,0,-1"]);
     assert_eq!(r.code, 0);
