@@ -50,7 +50,31 @@ pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
             .memory_bytes(isotropic),
         "quantity": quantity.name(),
         "calibrated": calibrated,
+        "axes": grid.as_ref().map(axes_json),
     }))
+}
+
+/// Where the stored nodes sit, axis by axis in the stored shape's order (the `.npy` export's
+/// axes): name, mapping, node placement and every node's angle in degrees — so values
+/// exported by `export --npy` can be placed without the library.
+fn axes_json(g: &crate::table::Grid) -> Value {
+    let mut names = g.param().axis_names();
+    // An isotropic `inout` table stores φi = 0 only and φo as the difference φo − φi.
+    if g.param() == crate::table::Param::InOut && g.symmetry().isotropic {
+        names[3] = "phi_o_minus_phi_i";
+    }
+    g.stored_axes()
+        .iter()
+        .zip(names)
+        .map(|(a, name)| {
+            json!({
+                "name": name,
+                "mapping": a.mapping.label(),
+                "nodes": a.nodes,
+                "degrees": (0..a.size).map(|i| a.node(i).to_degrees()).collect::<Vec<_>>(),
+            })
+        })
+        .collect()
 }
 
 /// The resolution of the sampler the table `t` builds when opened with its default lookup

@@ -134,6 +134,50 @@ fn export_half_refuses_values_beyond_f16() {
     assert!(o.ok, "{}", o.stderr);
 }
 
+/// `export --npy` wrote the stored values, but nothing the CLI prints said where the nodes sit:
+/// `info --json` lists every stored axis's node angles (the .npy's axes, in order). Checked
+/// against the closed forms of the small halfdiff preset: θh = 90°·((i + ½)/n)² (Sqrt,
+/// centres), θd = acos(1 − (i + ½)/n) (Cos, centres), φd = i·360°/64 (folded to 0..90°).
+#[test]
+fn info_json_places_the_exported_nodes() {
+    let d = TempDir::new("io-info-axes");
+    let t = d.file("ct.btdb");
+    let ct = r#"{"model": "cook_torrance", "m": 0.3}"#;
+    assert!(brdftab(&["bake", ct, "-o", &t, "--preset", "small"]).ok);
+    let o = brdftab(&["info", &t, "--json"]);
+    assert!(o.ok, "{}", o.stderr);
+    let v: serde_json::Value = serde_json::from_str(&o.stdout).unwrap();
+    let table = &v["tables"][0];
+    let axes = table["axes"].as_array().expect("axes");
+    let shape = table["shape"].as_array().unwrap();
+    assert_eq!(axes.len() + 1, shape.len());
+    let deg = |a: usize| -> Vec<f64> {
+        let v = axes[a]["degrees"].as_array().unwrap();
+        assert_eq!(v.len() as u64, shape[a].as_u64().unwrap(), "axis {a}");
+        v.iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    let names: Vec<&str> = axes.iter().map(|a| a["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["theta_h", "phi_h", "theta_d", "phi_d"]);
+    let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+    let (th, td, fd) = (deg(0), deg(2), deg(3));
+    let n = th.len() as f64;
+    for (i, x) in th.iter().enumerate() {
+        let u = (i as f64 + 0.5) / n;
+        assert!(close(*x, 90.0 * u * u), "θh {i}: {x}");
+    }
+    let n = td.len() as f64;
+    for (i, x) in td.iter().enumerate() {
+        let u = (i as f64 + 0.5) / n;
+        assert!(close(*x, (1.0 - u).acos().to_degrees()), "θd {i}: {x}");
+    }
+    for (i, x) in fd.iter().enumerate() {
+        assert!(close(*x, i as f64 * 360.0 / 64.0), "φd {i}: {x}");
+    }
+    assert!(close(*fd.last().unwrap(), 90.0));
+    assert_eq!(axes[0]["mapping"], "Sqrt");
+    assert_eq!(axes[2]["nodes"], "centers");
+}
+
 /// A missing input was "not found: x.btdb: no such file" to `eval` but "x.btdb: No such file or
 /// directory (os error 2)" to `info`, `db`, `export`, `check` (and `x.btdb#t: ...` to `info`,
 /// naming a file that nobody asked for). Every command and every kind of file now say it alike,

@@ -227,7 +227,8 @@ def info(source: str | PathLike[str]) -> dict[str, Any]:
     """What `brdftab info --json` reports of a table file (or, for DB#NAME, of one table): "file", "format", "bytes", "ratio_to_f32"
     and "tables", one dict per table with "name", "source", "parameterization", "symmetry",
     "channels", "units", "codec", "tool", "shape", "values", "chunks", "bytes", "ratio_to_f32",
-    "sampling_bytes", "quantity" (what the stored values are) and "calibrated". Of a measured
+    "sampling_bytes", "quantity" (what the stored values are), "calibrated" and "axes" (per stored
+    axis in shape order: "name", "mapping", "nodes" and every node's angle in "degrees"). Of a measured
     file (MERL .binary, RGL .bsdf): "file", "format" ("merl" or "rgl"), "bytes", "channels",
     "sha256", and MERL "material", "dims", "unmeasured", "cells" or RGL "description", "kind",
     "isotropic", "reduction", "phi_i", "theta_i", "resolution", "vndf_resolution", "fields"."""
