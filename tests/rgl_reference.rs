@@ -495,3 +495,52 @@ fn sampler_passes_chi_square() {
         }
     }
 }
+
+/// A hand-edited file whose angles or microfacet fields leave their domain is an error naming
+/// the field, not a file that reads as zeros or as one clamped slice.
+#[test]
+fn fields_outside_their_domain_are_errors() {
+    let edit = |field: &'static str, f: fn(usize, f32) -> f32| {
+        rebuild("paper_white_rgb.bsdf", move |n, d, s, b| {
+            let b = if n == field {
+                (b.chunks(4).enumerate())
+                    .flat_map(|(i, c)| {
+                        f(i, f32::from_le_bytes(c.try_into().unwrap())).to_le_bytes()
+                    })
+                    .collect()
+            } else {
+                b
+            };
+            Some((d, s.to_vec(), b))
+        })
+    };
+    let cases: [(&str, fn(usize, f32) -> f32); 6] = [
+        ("theta_i", |_, v| v.to_degrees()),
+        ("phi_i", |_, v| v + 4.0),
+        ("ndf", |_, _| 0.0),
+        ("ndf", |i, v| if i == 7 { -v } else { v }),
+        ("sigma", |_, _| 0.0),
+        ("sigma", |i, v| if i == 3 { -v } else { v }),
+    ];
+    for (field, f) in cases {
+        let t = TensorFile::from_bytes("x.bsdf", edit(field, f)).unwrap();
+        match RglBrdf::from_tensor(&t, None) {
+            Ok(b) => {
+                let mut out = [0f32; 3];
+                b.eval(dir(30.0, 0.0), dir(30.0, 180.0), &mut out);
+                panic!("{field}: accepted, evaluates to {out:?}");
+            }
+            Err(e) => assert!(
+                matches!(e, brdftab::Error::Format { .. }) && e.to_string().contains(field),
+                "{field}: {e}"
+            ),
+        }
+    }
+    // σ may vanish at the horizon (the last column): such a file still opens.
+    let t = TensorFile::from_bytes(
+        "x.bsdf",
+        edit("sigma", |i, v| if i % 128 == 127 { 0.0 } else { v }),
+    )
+    .unwrap();
+    RglBrdf::from_tensor(&t, None).unwrap();
+}

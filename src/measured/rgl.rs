@@ -242,8 +242,23 @@ impl RglBrdf {
             }
             Ok(v)
         };
-        let phi_i = params("phi_i")?;
-        let theta_i = params("theta_i")?;
+        // Angles in radians within their domain: θi ∈ [0, π/2], φi ∈ [−π, π] (a file written in
+        // degrees would otherwise be read as one clamped slice, silently wrong).
+        let within = |name: &str, v: Vec<f32>, lo: f64, hi: f64| -> Result<Vec<f32>> {
+            const SLACK: f64 = 1e-4;
+            match v
+                .iter()
+                .find(|&&x| !(lo - SLACK..=hi + SLACK).contains(&(x as f64)))
+            {
+                Some(x) => Err(tf.error(
+                    field(name)?,
+                    format!("{x} is outside [{lo:.6}, {hi:.6}] (radians)"),
+                )),
+                None => Ok(v),
+            }
+        };
+        let phi_i = within("phi_i", params("phi_i")?, -PI, PI)?;
+        let theta_i = within("theta_i", params("theta_i")?, 0.0, FRAC_PI_2)?;
         let (np, nt) = (phi_i.len(), theta_i.len());
 
         let plane2 = |name: &str| -> Result<Planes> {
@@ -263,6 +278,24 @@ impl RglBrdf {
         };
         let ndf = plane2("ndf")?;
         let sigma = plane2("sigma")?;
+        // D ≥ 0 with ∫ D cos θ dω = 1, and σ(ω) ≥ cos θ > 0 below the horizon (the last column,
+        // θ = π/2, may be 0): otherwise the Jacobian ndf / 4σ is negative, infinite or 0 and
+        // every lookup would silently read 0.
+        if let Some(v) = ndf.data.iter().find(|&&v| v < 0.0) {
+            return Err(tf.error(field("ndf")?, format!("negative density {v}")));
+        }
+        if ndf.data.iter().all(|&v| v == 0.0) {
+            return Err(tf.error(field("ndf")?, "is 0 everywhere, not a distribution"));
+        }
+        let last = |i: usize| i % sigma.nx == sigma.nx - 1;
+        if let Some((_, v)) =
+            (sigma.data.iter().enumerate()).find(|&(i, &v)| v < 0.0 || (v == 0.0 && !last(i)))
+        {
+            return Err(tf.error(
+                field("sigma")?,
+                format!("{v} where a projected area must be positive"),
+            ));
+        }
 
         let vf = field("vndf")?;
         let vs = tf.expect_ndim(vf, 4)?.to_vec();
