@@ -483,6 +483,10 @@ fn decode(dtype: Dtype, b: &[u8]) -> f64 {
     }
 }
 
+/// The alignment of every field's data in a written file: 8 bytes, so that a reader which maps
+/// the file and reads an `f32`/`f64` field in place reads aligned memory.
+pub const ALIGN: u64 = 8;
+
 /// Builds a tensor file in memory: add fields, then [`TensorWriter::to_bytes`].
 #[derive(Debug, Default, Clone)]
 pub struct TensorWriter {
@@ -514,8 +518,11 @@ impl TensorWriter {
         self.raw(name, Dtype::U8, shape, data.to_vec())
     }
 
-    /// Serializes: header first, then the fields' data in order.
+    /// Serializes: header first, then the fields' data in order, each starting at a multiple
+    /// of [`ALIGN`] bytes (zero padding between), as Mitsuba's `tensor_io.write` and the
+    /// published files lay them out.
     pub fn to_bytes(&self) -> Vec<u8> {
+        let align = |x: u64| x.div_ceil(ALIGN) * ALIGN;
         let mut header = Vec::new();
         header.extend_from_slice(MAGIC);
         header.extend_from_slice(&[1, 0]);
@@ -526,7 +533,7 @@ impl TensorWriter {
                 .iter()
                 .map(|(n, _, s, _)| 2 + n.len() + 2 + 1 + 8 + 8 * s.len())
                 .sum::<usize>();
-        let mut offset = header_len as u64;
+        let mut offset = align(header_len as u64);
         for (name, dtype, shape, data) in &self.fields {
             header.extend_from_slice(&(name.len() as u16).to_le_bytes());
             header.extend_from_slice(name.as_bytes());
@@ -536,9 +543,10 @@ impl TensorWriter {
             for d in shape {
                 header.extend_from_slice(&d.to_le_bytes());
             }
-            offset += data.len() as u64;
+            offset = align(offset + data.len() as u64);
         }
         for (_, _, _, data) in &self.fields {
+            header.resize(align(header.len() as u64) as usize, 0);
             header.extend_from_slice(data);
         }
         header
