@@ -500,7 +500,8 @@ fn sampler_passes_chi_square() {
 /// the field, not a file that reads as zeros or as one clamped slice.
 #[test]
 fn fields_outside_their_domain_are_errors() {
-    let edit = |field: &'static str, f: fn(usize, f32) -> f32| {
+    type Edit = fn(usize, f32) -> f32;
+    let edit = |field: &'static str, f: Edit| {
         rebuild("paper_white_rgb.bsdf", move |n, d, s, b| {
             let b = if n == field {
                 (b.chunks(4).enumerate())
@@ -514,7 +515,7 @@ fn fields_outside_their_domain_are_errors() {
             Some((d, s.to_vec(), b))
         })
     };
-    let cases: [(&str, fn(usize, f32) -> f32); 6] = [
+    let cases: [(&str, Edit); 6] = [
         ("theta_i", |_, v| v.to_degrees()),
         ("phi_i", |_, v| v + 4.0),
         ("ndf", |_, _| 0.0),
