@@ -240,6 +240,9 @@ pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send
             format!("{source:?}: an empty SOURCE or path (expected a spec, a file or DB#NAME)"),
         ));
     }
+    if let Some(c) = &opts.channels {
+        c.validate()?;
+    }
     // Stat before any open: a FIFO, socket, device or directory is refused at once.
     // `x.btdb#` or a control character in NAME is an argument error, not a path to stat.
     if crate::files::source_file(source).is_some() {

@@ -645,6 +645,7 @@ impl ModelSpec {
     /// Builds the model for `channels` (validating first).
     pub fn build(&self, channels: &Channels) -> Result<Box<dyn Brdf + Send + Sync>> {
         self.validate()?;
+        channels.validate()?;
         build(self, channels)
     }
 }

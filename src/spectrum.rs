@@ -40,36 +40,21 @@ impl Channels {
     /// A spectral channel set; checks that the wavelengths are finite, positive, strictly
     /// increasing, and at most [`MAX_CHANNELS`].
     pub fn wavelengths(nm: Vec<f64>) -> Result<Self> {
-        if nm.is_empty() {
-            return Err(Error::arg(
-                "wavelengths",
-                "at least one wavelength is needed",
-            ));
-        }
-        if nm.len() > MAX_CHANNELS {
-            return Err(Error::arg(
-                "wavelengths",
-                format!("{} wavelengths given, at most {MAX_CHANNELS}", nm.len()),
-            ));
-        }
-        for (i, &w) in nm.iter().enumerate() {
-            if !is_wavelength(w) {
-                return Err(Error::arg(
-                    "wavelengths",
-                    format!(
-                        "{w} (item {} of the list) is not a wavelength (a finite number of nm > 0)",
-                        i + 1
-                    ),
-                ));
-            }
-            if i > 0 && w <= nm[i - 1] {
-                return Err(Error::arg(
-                    "wavelengths",
-                    "wavelengths must be strictly increasing",
-                ));
-            }
-        }
+        check_wavelengths(&nm)?;
         Ok(Channels::Wavelengths(nm))
+    }
+
+    /// Checks a channel set built directly from its public variant
+    /// (`Channels::Wavelengths(vec![])`) as [`Channels::wavelengths`] checks its list. Every
+    /// door that takes a caller's channels — [`crate::spec::ModelSpec::build`],
+    /// [`crate::open_with`], a bake ([`crate::BakeRequest`], and the source a bake samples) —
+    /// calls it: an empty, NaN, unordered or oversized list made models of no channels and
+    /// wrote tables a database could no longer read.
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            Channels::Rgb => Ok(()),
+            Channels::Wavelengths(nm) => check_wavelengths(nm),
+        }
     }
 
     /// `n` wavelengths evenly spaced from `start` to `end` nm inclusive.
@@ -397,6 +382,41 @@ impl std::str::FromStr for Channels {
             .collect::<Result<Vec<_>>>()?;
         Channels::wavelengths(nm)
     }
+}
+
+/// The rules of [`Channels::wavelengths`]: 1..=[`MAX_CHANNELS`] finite positive wavelengths,
+/// strictly increasing.
+fn check_wavelengths(nm: &[f64]) -> Result<()> {
+    if nm.is_empty() {
+        return Err(Error::arg(
+            "wavelengths",
+            "at least one wavelength is needed",
+        ));
+    }
+    if nm.len() > MAX_CHANNELS {
+        return Err(Error::arg(
+            "wavelengths",
+            format!("{} wavelengths given, at most {MAX_CHANNELS}", nm.len()),
+        ));
+    }
+    for (i, &w) in nm.iter().enumerate() {
+        if !is_wavelength(w) {
+            return Err(Error::arg(
+                "wavelengths",
+                format!(
+                    "{w} (item {} of the list) is not a wavelength (a finite number of nm > 0)",
+                    i + 1
+                ),
+            ));
+        }
+        if i > 0 && w <= nm[i - 1] {
+            return Err(Error::arg(
+                "wavelengths",
+                "wavelengths must be strictly increasing",
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

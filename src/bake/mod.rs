@@ -117,6 +117,9 @@ impl BakeRequest {
                 format!("{t}: expected a finite tolerance ≥ 0"),
             ));
         }
+        if let Some(c) = &self.channels {
+            c.validate()?;
+        }
         if self.supersample == 0 {
             return Err(crate::Error::arg(
                 "supersample",

@@ -77,11 +77,15 @@ pub struct BakeStats {
 }
 
 /// Checks the source against the grid: channel count and declared symmetry.
-/// Refuses a source with a delta lobe — a mirror or refractor, alone or as a term of a sum:
+/// Refuses a source whose channels are not a valid set
+/// ([`Channels::validate`](crate::spectrum::Channels::validate)), and one with a delta lobe — a
+/// mirror or refractor, alone or as a term of a sum:
 /// a table (or an RGL or MERL file) holds f_r values, which a Dirac delta has none of, so its
 /// table would silently lack the lobe (a sum's smooth terms alone, or zeros). Every bake and
 /// conversion checks this before any work.
 pub fn tabulable(brdf: &dyn Brdf) -> Result<()> {
+    // A `Brdf` of a caller's own may declare channels no table can hold (none, NaN nm).
+    brdf.channels().validate()?;
     let f = brdf.flags();
     match (f.delta, f.lobes.delta) {
         (true, _) => Err(Error::Unsupported(

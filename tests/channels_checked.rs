@@ -1,0 +1,119 @@
+//! A channel set built from its public variant (`Channels::Wavelengths(vec![])`) is checked at
+//! every door that takes one, as `Channels::wavelengths` checks its list: an empty list built
+//! a model of no channels, and a bake with it wrote a table that made the whole database
+//! unreadable (`db list`, `verify`, opening its other tables).
+
+use brdftab::bake::{BakeRequest, BakeTarget};
+use brdftab::table::presets::Preset;
+use brdftab::testkit::TempDir;
+use brdftab::{Brdf, Channels, Error, Flags, ModelSpec, OpenOptions, Silent};
+use glam::DVec3;
+
+const LAMBERT: &str = r#"{"model": "lambert", "kd": 0.5}"#;
+
+/// Channel sets `Channels::wavelengths` refuses.
+fn bad() -> Vec<Channels> {
+    vec![
+        Channels::Wavelengths(vec![]),
+        Channels::Wavelengths(vec![0.0]),
+        Channels::Wavelengths(vec![f64::NAN, 500.0]),
+        Channels::Wavelengths(vec![600.0, 500.0]),
+        Channels::Wavelengths((0..65).map(|i| 400.0 + i as f64).collect()),
+    ]
+}
+
+fn is_wavelengths_arg(e: &Error) -> bool {
+    matches!(e, Error::InvalidArgument { name, .. } if name == "wavelengths")
+}
+
+#[test]
+fn validate_agrees_with_the_constructor() {
+    for c in bad() {
+        let Channels::Wavelengths(nm) = &c else {
+            unreachable!()
+        };
+        assert!(Channels::wavelengths(nm.clone()).is_err());
+        assert!(c.validate().is_err(), "{c:?}");
+    }
+    assert!(Channels::Rgb.validate().is_ok());
+    assert!(
+        Channels::linspace(400.0, 700.0, 64)
+            .unwrap()
+            .validate()
+            .is_ok()
+    );
+}
+
+#[test]
+fn models_and_opens_refuse_bad_channels() {
+    let spec = ModelSpec::parse(LAMBERT).unwrap();
+    for c in bad() {
+        let e = spec.build(&c).unwrap_err();
+        assert!(is_wavelengths_arg(&e), "{c:?}: {e}");
+        let opts = OpenOptions {
+            channels: Some(c.clone()),
+            ..OpenOptions::default()
+        };
+        let e = brdftab::open_with(LAMBERT, &opts).unwrap_err();
+        assert!(is_wavelengths_arg(&e), "{c:?}: {e}");
+    }
+}
+
+#[test]
+fn a_bad_bake_leaves_the_database_readable() {
+    let d = TempDir::new("channels-checked");
+    let db = d.file("m.btdb");
+    BakeRequest::new(LAMBERT)
+        .preset(Preset::Small)
+        .run(&BakeTarget::db(&db, "good"))
+        .unwrap();
+    for (k, c) in bad().into_iter().enumerate() {
+        let e = BakeRequest::new(LAMBERT)
+            .preset(Preset::Small)
+            .channels(c.clone())
+            .run(&BakeTarget::db(&db, &format!("bad{k}")))
+            .unwrap_err();
+        assert!(is_wavelengths_arg(&e), "{c:?}: {e}");
+    }
+    let names: Vec<String> = brdftab::store::db::list(&db)
+        .unwrap()
+        .into_iter()
+        .map(|(t, _)| t.name)
+        .collect();
+    assert_eq!(names, ["good"]);
+    brdftab::store::db::verify(&db).unwrap();
+}
+
+/// A `Brdf` of a caller's own that declares the channels it is given.
+struct Own(Channels);
+
+impl Brdf for Own {
+    fn channels(&self) -> &Channels {
+        &self.0
+    }
+    fn eval(&self, _wi: DVec3, _wo: DVec3, out: &mut [f32]) {
+        out.fill(0.1);
+    }
+    fn flags(&self) -> Flags {
+        Flags::SMOOTH_SYMMETRIC
+    }
+    fn describe(&self) -> String {
+        "own".into()
+    }
+}
+
+#[test]
+fn a_bake_of_an_own_brdf_refuses_bad_channels() {
+    for c in bad() {
+        let e = BakeRequest::new("{}")
+            .preset(Preset::Small)
+            .table_of(&Own(c.clone()), &Silent)
+            .unwrap_err();
+        assert!(is_wavelengths_arg(&e), "{c:?}: {e}");
+    }
+    let (t, _) = BakeRequest::new("{}")
+        .preset(Preset::Small)
+        .table_of(&Own(Channels::Rgb), &Silent)
+        .unwrap();
+    assert!(t.values().iter().all(|&v| (v - 0.1).abs() < 1e-3));
+}
