@@ -117,3 +117,26 @@ fn a_bake_of_an_own_brdf_refuses_bad_channels() {
         .unwrap();
     assert!(t.values().iter().all(|&v| (v - 0.1).abs() < 1e-3));
 }
+
+#[test]
+fn a_grid_refuses_bad_channels() {
+    use brdftab::table::grid::{Grid, Mapping, Param};
+    use brdftab::table::symmetry::Symmetry;
+    let grid = |c: Channels| {
+        Grid::with_sizes(
+            Param::InOut,
+            [4, 8, 4, 8],
+            [Mapping::Uniform, Mapping::Uniform],
+            c,
+            Symmetry::NONE,
+        )
+    };
+    for c in bad() {
+        // A grid of no channels made `Table::from_fn` panic (a chunk size of 0).
+        let e = grid(c.clone()).unwrap_err();
+        assert!(is_wavelengths_arg(&e), "{c:?}: {e}");
+    }
+    let t =
+        brdftab::table::Table::from_fn(grid(Channels::Rgb).unwrap(), "ones", |_, _, o| o.fill(1.0));
+    assert_eq!(t.values().len(), 4 * 8 * 4 * 8 * 3);
+}

@@ -549,7 +549,8 @@ impl From<Grid> for GridRepr {
 impl Grid {
     /// A grid from its full axes `[θ1, φ1, θ2, φ2]` (see the table in the module docs).
     ///
-    /// Requirements (checked): every size ≥ 1 and the grid at most 2^40 values; φ axes uniform
+    /// Requirements (checked): valid channels ([`Channels::validate`]: a grid of no channels
+    /// made `Table::from_fn` panic); every size ≥ 1 and the grid at most 2^40 values; φ axes uniform
     /// with `cell_start` nodes; φ1 of size 1 only when isotropic (it then counts as φ2's size in
     /// [`Grid::full_values`]); folded φ axes need an even size (a multiple of 4 when
     /// `halfdiff` φd is folded by both reciprocity and bilateral symmetry); `inout` reciprocity
@@ -560,6 +561,7 @@ impl Grid {
         channels: Channels,
         symmetry: Symmetry,
     ) -> Result<Grid> {
+        channels.validate()?;
         let name = param.axis_names();
         for (k, a) in axes.iter().enumerate() {
             if a.size == 0 {
