@@ -140,3 +140,62 @@ fn a_grid_refuses_bad_channels() {
         brdftab::table::Table::from_fn(grid(Channels::Rgb).unwrap(), "ones", |_, _, o| o.fill(1.0));
     assert_eq!(t.values().len(), 4 * 8 * 4 * 8 * 3);
 }
+
+#[test]
+fn model_constructors_refuse_bad_channels() {
+    use brdftab::fresnel::FresnelSpec;
+    use brdftab::models::{
+        blinn_phong::BlinnPhong, cook_torrance::CookTorrance, ggx::Ggx, lambert::Lambert,
+        mirror::Mirror, mirror::Refractor, oren_nayar::OrenNayar, phong::Phong, ward::Ward,
+    };
+    use brdftab::spectrum::Value;
+    type Built = brdftab::Result<Box<dyn Brdf + Send + Sync>>;
+    fn boxed<B: Brdf + Send + Sync + 'static>(b: brdftab::Result<B>) -> Built {
+        b.map(|b| Box::new(b) as Box<dyn Brdf + Send + Sync>)
+    }
+    let g = || Value::Grey(0.5);
+    let au = FresnelSpec::Conductor("Au".into());
+    let ctors: Vec<(&str, Box<dyn Fn(&Channels) -> Built>)> = vec![
+        ("lambert", Box::new(|c| boxed(Lambert::new(g(), c)))),
+        ("phong", Box::new(|c| boxed(Phong::original(g(), 20.0, c)))),
+        (
+            "blinn_phong",
+            Box::new(|c| boxed(BlinnPhong::new(g(), 20.0, c))),
+        ),
+        (
+            "oren_nayar",
+            Box::new(|c| boxed(OrenNayar::new(g(), 0.3, c))),
+        ),
+        ("ward", Box::new(|c| boxed(Ward::new(g(), 0.2, 0.3, c)))),
+        (
+            "cook_torrance",
+            Box::new(|c| boxed(CookTorrance::new(0.3, g(), &au, c))),
+        ),
+        (
+            "ggx",
+            Box::new(|c| boxed(Ggx::isotropic(0.3, g(), au.clone(), c))),
+        ),
+        ("mirror", Box::new(|c| boxed(Mirror::new(&au, c)))),
+        (
+            "refractor",
+            Box::new(|c| boxed(Refractor::new(Value::Grey(1.5), c))),
+        ),
+    ];
+    for (name, ctor) in &ctors {
+        for c in bad() {
+            // 65 channels built a model whose `sample_wavelengths` (a buffer of 64 weights)
+            // panicked; none built a model of no channels.
+            let e = ctor(&c)
+                .err()
+                .unwrap_or_else(|| panic!("{name} built with {c:?}"));
+            assert!(is_wavelengths_arg(&e), "{name} {c:?}: {e}");
+        }
+        let m = ctor(&Channels::linspace(400.0, 700.0, 64).unwrap()).unwrap();
+        let v = m.eval_wavelength(DVec3::new(0.3, 0.0, 0.9), DVec3::new(-0.3, 0.0, 0.9), 550.0);
+        assert!(v.is_finite() && v >= 0.0, "{name}: {v}");
+        let mut w = [0.0f32; 2];
+        let wo = DVec3::new(0.3, 0.1, 0.9);
+        let s = m.sample_wavelengths(wo, glam::DVec2::new(0.3, 0.6), &[450.0, 650.0], &mut w);
+        assert!(s.is_some(), "{name}");
+    }
+}

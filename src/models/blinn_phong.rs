@@ -59,6 +59,7 @@ pub struct BlinnPhong {
 impl BlinnPhong {
     /// A Blinn-Phong lobe with specular coefficient `ks` and exponent `n` ≥ 0.
     pub fn new(ks: Value, n: f64, channels: &Channels) -> Result<Self> {
+        channels.validate()?;
         ks.validate("ks", 0.0)?;
         if !(n.is_finite() && n >= 0.0) {
             return Err(Error::spec("n", format!("{n} must be a finite number ≥ 0")));

@@ -100,6 +100,7 @@ struct Geometry {
 impl CookTorrance {
     /// A Cook-Torrance model with Beckmann roughness `m` (> 0), scale `ks` (≥ 0) and Fresnel term.
     pub fn new(m: f64, ks: Value, fresnel: &FresnelSpec, channels: &Channels) -> Result<Self> {
+        channels.validate()?;
         if !m.is_finite() || m <= 0.0 {
             return Err(crate::Error::spec(
                 "m",

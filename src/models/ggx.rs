@@ -76,6 +76,7 @@ impl Ggx {
         fresnel: FresnelSpec,
         channels: &Channels,
     ) -> Result<Self> {
+        channels.validate()?;
         for (name, a) in [("alpha_x", alpha_x), ("alpha_y", alpha_y)] {
             if !(a.is_finite() && a > 0.0) {
                 return Err(Error::spec(

@@ -24,6 +24,7 @@ pub struct Lambert {
 impl Lambert {
     /// A Lambert model with diffuse coefficient `kd` (the BRDF value; albedo kd·π).
     pub fn new(kd: Value, channels: &Channels) -> Result<Self> {
+        channels.validate()?;
         kd.validate("kd", 0.0)?;
         let kd32: Vec<f32> = kd.resolve(channels).iter().map(|&x| x as f32).collect();
         Ok(Lambert {

@@ -50,6 +50,7 @@ pub struct Mirror {
 impl Mirror {
     /// A mirror whose reflectance k_r is the Fresnel term `fresnel` (`FresnelSpec::None`: k_r = 1).
     pub fn new(fresnel: &FresnelSpec, channels: &Channels) -> Result<Self> {
+        channels.validate()?;
         Ok(Mirror {
             channels: channels.clone(),
             fresnel: Fresnel::new(fresnel, channels, "fresnel")?,
@@ -170,6 +171,7 @@ pub struct Refractor {
 impl Refractor {
     /// A refractor of relative index `eta` (> 0) per channel.
     pub fn new(eta: Value, channels: &Channels) -> Result<Self> {
+        channels.validate()?;
         eta.validate("eta", 0.0)?;
         if eta.numbers().iter().any(|&x| x <= 0.0) {
             return Err(crate::Error::spec("eta", "must be > 0"));

@@ -47,6 +47,7 @@ impl OrenNayar {
     /// An Oren-Nayar surface with diffuse coefficient `kd` (as in Lambert) and slope-angle
     /// deviation `sigma` ≥ 0 in radians.
     pub fn new(kd: Value, sigma: f64, channels: &Channels) -> Result<Self> {
+        channels.validate()?;
         kd.validate("kd", 0.0)?;
         if !(sigma.is_finite() && sigma >= 0.0) {
             return Err(Error::spec(

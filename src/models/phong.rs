@@ -77,6 +77,7 @@ pub struct Phong {
 impl Phong {
     /// A Phong-family model with specular coefficient `ks` (≥ 0) and exponent `n` (≥ 0).
     pub fn new(variant: PhongVariant, ks: Value, n: f64, channels: &Channels) -> Result<Self> {
+        channels.validate()?;
         ks.validate("ks", 0.0)?;
         if !n.is_finite() || n < 0.0 {
             return Err(crate::Error::spec(

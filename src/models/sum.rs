@@ -83,14 +83,9 @@ impl Sum {
         weights: Option<Vec<f64>>,
         channels: &Channels,
     ) -> Result<Self> {
+        channels.validate()?;
         if terms.is_empty() {
             return Err(Error::spec("terms", "a sum needs at least one term"));
-        }
-        if channels.len() > MAX_CHANNELS {
-            return Err(Error::arg(
-                "channels",
-                format!("{} channels, at most {MAX_CHANNELS}", channels.len()),
-            ));
         }
         if terms.len() > MAX_TERMS {
             return Err(Error::spec(

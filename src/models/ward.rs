@@ -55,6 +55,7 @@ pub struct Ward {
 impl Ward {
     /// A Ward lobe with specular reflectance `ks` (ρ_s) and roughness `alpha_x`, `alpha_y` > 0.
     pub fn new(ks: Value, alpha_x: f64, alpha_y: f64, channels: &Channels) -> Result<Self> {
+        channels.validate()?;
         ks.validate("ks", 0.0)?;
         for (name, a) in [("alpha_x", alpha_x), ("alpha_y", alpha_y)] {
             if !(a.is_finite() && a > 0.0) {
