@@ -71,7 +71,7 @@ fn a_bad_bake_leaves_the_database_readable() {
         let e = BakeRequest::new(LAMBERT)
             .preset(Preset::Small)
             .channels(c.clone())
-            .run(&BakeTarget::db(&db, &format!("bad{k}")))
+            .run(&BakeTarget::db(&db, format!("bad{k}")))
             .unwrap_err();
         assert!(is_wavelengths_arg(&e), "{c:?}: {e}");
     }
@@ -150,12 +150,13 @@ fn model_constructors_refuse_bad_channels() {
     };
     use brdftab::spectrum::Value;
     type Built = brdftab::Result<Box<dyn Brdf + Send + Sync>>;
+    type Ctor<'a> = Box<dyn Fn(&Channels) -> Built + 'a>;
     fn boxed<B: Brdf + Send + Sync + 'static>(b: brdftab::Result<B>) -> Built {
         b.map(|b| Box::new(b) as Box<dyn Brdf + Send + Sync>)
     }
     let g = || Value::Grey(0.5);
     let au = FresnelSpec::Conductor("Au".into());
-    let ctors: Vec<(&str, Box<dyn Fn(&Channels) -> Built>)> = vec![
+    let ctors: Vec<(&str, Ctor<'_>)> = vec![
         ("lambert", Box::new(|c| boxed(Lambert::new(g(), c)))),
         ("phong", Box::new(|c| boxed(Phong::original(g(), 20.0, c)))),
         (
