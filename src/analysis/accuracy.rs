@@ -164,16 +164,7 @@ pub fn compare_region(
             format!("{} vs {} channels", approx.channels().len(), c),
         ));
     }
-    if pairs.checked_mul(c).is_none_or(|n| n > MAX_SAMPLES) {
-        return Err(Error::arg(
-            "pairs",
-            format!(
-                "{pairs} pairs × {c} channels: at most {MAX_SAMPLES} samples are compared \
-                 ({} pairs of {c} channels)",
-                MAX_SAMPLES / c.max(1)
-            ),
-        ));
-    }
+    check_pairs(pairs, c)?;
     let blocks = pairs.div_ceil(BLOCK);
     // Per block: (Σ w err² per channel, Σ w ref² per channel, Σ w f² and Σ w without the
     // cosines, samples (|err|, |f|, wi, wo)).
@@ -260,6 +251,22 @@ pub fn compare_region(
         max_rel_at: at,
         per_channel: (0..c).map(|k| ratio(e2[k], r2[k])).collect(),
     })
+}
+
+/// The bound of [`compare_region`]'s work, checked before it (a bake checks it before it writes
+/// anything): `pairs` × `c` channels at most [`MAX_SAMPLES`].
+pub(crate) fn check_pairs(pairs: usize, c: usize) -> Result<()> {
+    if pairs.checked_mul(c).is_none_or(|n| n > MAX_SAMPLES) {
+        return Err(Error::arg(
+            "pairs",
+            format!(
+                "{pairs} pairs × {c} channels: at most {MAX_SAMPLES} samples are compared \
+                 ({} pairs of {c} channels)",
+                MAX_SAMPLES / c.max(1)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

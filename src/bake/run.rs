@@ -57,6 +57,11 @@ impl BakeRequest {
             db::refuse_dropping_tables(path)?;
         }
         let src = self.open_source()?;
+        // The accuracy report's bound, before the table is written: a request over it wrote
+        // the table (replacing an old one) and then failed.
+        if self.accuracy_pairs > 0 {
+            crate::analysis::accuracy::check_pairs(self.accuracy_pairs, src.channels().len())?;
+        }
         let t0 = Instant::now();
         // A model the medium preset misses is baked as the request with an error target would
         // be (the whole path: calibrated, built whole), or gets the check's calibrated table;
