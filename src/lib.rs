@@ -60,6 +60,7 @@ pub mod table;
 pub mod testkit;
 
 pub use bake::{BakeReport, BakeRequest, BakeTarget, GridChoice};
+pub use batch::SampleOut;
 pub use brdf::{BakeSource, Brdf, BrdfSample, Flags, Lobes};
 pub use error::{Error, Result};
 pub use progress::{Progress, Silent};
@@ -67,7 +68,7 @@ pub use source::{OpenOptions, SourceKind, classify, open, open_with};
 pub use spec::ModelSpec;
 pub use spectrum::{Channels, Value};
 pub use table::presets::Preset;
-pub use table::{Interp, TabulatedBrdf};
+pub use table::{Grid, Interp, Table, TabulatedBrdf};
 
 /// The README's code examples, compiled and run as doctests.
 #[cfg(doctest)]
