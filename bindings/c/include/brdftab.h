@@ -88,6 +88,10 @@ const char *brdftab_channel_name(const brdftab_brdf *b, size_t i);
 int brdftab_eval(const brdftab_brdf *b, size_t n, const double *wi, const double *wo, float *f);
 /* pdf(wi | wo) of brdftab_sample for n pairs. */
 int brdftab_pdf(const brdftab_brdf *b, size_t n, const double *wi, const double *wo, double *pdf);
+/* Both of the same n pairs in one call (multiple importance sampling): f (n x channels) as
+ * brdftab_eval, pdf (n) as brdftab_pdf; f and pdf must not overlap. */
+int brdftab_eval_pdf(const brdftab_brdf *b, size_t n, const double *wi, const double *wo,
+                     float *f, double *pdf);
 /* Draws wi for each wo from u in [0,1)^2: wi (n x 3), pdf (n), weight (n x channels). A pair
  * with no sample gets wi = 0, pdf = 0, weight = 0. */
 int brdftab_sample(const brdftab_brdf *b, size_t n, const double *wo, const double *u,

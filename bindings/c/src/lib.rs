@@ -412,6 +412,42 @@ pub unsafe extern "C" fn brdftab_pdf(
     })
 }
 
+/// f_r and pdf(wi | wo) of the same `n` pairs in one call, what multiple importance sampling
+/// asks at every light sample (`f` as [`brdftab_eval`] writes it, `pdf` as [`brdftab_pdf`]);
+/// for one pair the source's `eval_pdf`, which shares the work where the model can (a
+/// microfacet model's half vector and D). 0 on success, -1 on failure.
+///
+/// # Safety
+/// With n > 0: `wi`, `wo` point to 3n doubles, `f` to n·channels floats, `pdf` to n doubles,
+/// neither output overlapping another array.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_eval_pdf(
+    b: *const brdftab_brdf,
+    n: usize,
+    wi: *const f64,
+    wo: *const f64,
+    f: *mut f32,
+    pdf: *mut f64,
+) -> c_int {
+    guard(|| {
+        if n == 0 {
+            return Ok(());
+        }
+        // SAFETY (all): the header's contract on sizes; NULL and alignment are checked.
+        let (b, wi, wo) = unsafe { pair_args(b, n, wi, wo) }?;
+        let f = unsafe { slice_mut(f, times(n, b.names.len(), "f")?, "f") }?;
+        let pdf = unsafe { slice_mut(pdf, n, "pdf") }?;
+        match n {
+            1 => pdf[0] = b.brdf.eval_pdf(wi[0], wo[0], f),
+            _ => {
+                b.brdf.eval_batch(wi, wo, f);
+                b.brdf.pdf_batch(wi, wo, pdf);
+            }
+        }
+        healthy(b)
+    })
+}
+
 /// Draws `wi` for each of `n` given `wo` from uniforms `u` (n × 2 in [0, 1)²): `wi` (n × 3),
 /// `pdf` (n) and `weight` (n × channels, f cos θi / pdf). A pair with no sample (wo below the
 /// horizon, a zero lobe) gets wi = (0, 0, 0), pdf = 0 and weight 0. For a delta source (mirror,

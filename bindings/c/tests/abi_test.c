@@ -106,6 +106,30 @@ int main(int argc, char **argv) {
     CHECK(brdftab_pdf(b, n, wi, wo, pdf) == 0, "pdf");
     CHECK(brdftab_sample(b, n, wo, u, swi, spdf, w) == 0, "sample");
     {
+        /* eval_pdf: the batch is eval's and pdf's values exactly; one pair is the source's
+         * eval_pdf (shared work, the same math: f32 rounding of f, f64 of the pdf). */
+        float *f2 = malloc(n * c * sizeof(float));
+        double *p2 = malloc(n * sizeof(double));
+        CHECK(brdftab_eval_pdf(b, n, wi, wo, f2, p2) == 0, "eval_pdf");
+        for (size_t k = 0; k < n; k++) {
+            CHECK(p2[k] == pdf[k], "eval_pdf's batch pdf is pdf's");
+            for (size_t i = 0; i < c; i++) CHECK(f2[k * c + i] == f[k * c + i], "eval_pdf's batch f is eval's");
+        }
+        for (size_t k = 0; k < n; k++) {
+            float f1[64];
+            double p1;
+            CHECK(brdftab_eval_pdf(b, 1, wi + 3 * k, wo + 3 * k, f1, &p1) == 0, "eval_pdf of one pair");
+            CHECK(fabs(p1 - pdf[k]) <= 1e-12 * pdf[k], "eval_pdf of one pair: pdf");
+            for (size_t i = 0; i < c; i++)
+                CHECK(fabs(f1[i] - f[k * c + i]) <= 4e-7f * fabs(f[k * c + i]), "eval_pdf of one pair: f");
+        }
+        CHECK(brdftab_eval_pdf(b, 1, wi, wo, f2, NULL) == -1, "NULL pdf of eval_pdf");
+        CHECK(brdftab_eval_pdf(b, 1, wi, wo, NULL, p2) == -1, "NULL f of eval_pdf");
+        CHECK(brdftab_eval_pdf(b, 0, NULL, NULL, NULL, NULL) == 0, "eval_pdf n = 0");
+        free(f2);
+        free(p2);
+    }
+    {
         /* u outside [0, 1) has no sample, like a NaN in u (u = -3 drew one before). */
         double wo1[3] = {0.3, 0.0, 0.95}, bad[4][2] = {{-3.0, 0.5}, {1.5, 0.2}, {1.0, 0.0}, {0.5, 0.25}};
         double wi1[3], p1;

@@ -167,6 +167,12 @@ fn the_c_test_program_agrees_with_the_rust_api() {
         dir.path(),
         r#"{"model":"lambert","kd":[0.1,0.2,0.3]}"#,
     );
+    // A microfacet model: its one-pair `eval_pdf` shares the half vector and D.
+    check_source(
+        &exe,
+        dir.path(),
+        r#"{"model":"ggx","alpha":0.3,"fresnel":{"conductor":"Cu"}}"#,
+    );
     let rgl = brdftab::measured::data::rgl_dir().expect("the RGL files ship in data/rgl");
     check_source(
         &exe,
