@@ -27,6 +27,7 @@ from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
+from selenium.common.exceptions import StaleElementReferenceException
 from selenium.webdriver.support.ui import Select, WebDriverWait
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "..", ".."))
@@ -37,6 +38,20 @@ PLASTIC = ('{"model": "sum", "terms": [{"model": "lambert", "kd": [0.05, 0.12, 0
 
 GLAZED = ('{"model": "sum", "terms": [{"model": "lambert", "kd": 0.2}, '
           '{"model": "mirror", "fresnel": {"schlick": 0.04}}]}')
+
+
+def waiter(driver):
+    """A 30 s wait that retries a condition which met an element the page has
+    just redrawn (the panels replace their SVG children on every update)."""
+    return WebDriverWait(driver, 30, ignored_exceptions=(StaleElementReferenceException,))
+
+
+def texts(driver, css):
+    """The text of every element `css` selects, read in one script: the panels redraw their
+    SVG while a test reads it, and an element fetched before a redraw is stale after it."""
+    return driver.execute_script(
+        "return [...document.querySelectorAll(arguments[0])]"
+        ".map((e) => (e.innerText ?? e.textContent).trim());", css)
 
 
 def run(cmd):
@@ -102,7 +117,7 @@ def main():
 
 
 def check(driver, url, screenshot):
-    wait = WebDriverWait(driver, 30)
+    wait = waiter(driver)
     driver.get(url)
     wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#materials li")) == 2)
     wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#polar polyline"))
@@ -265,7 +280,7 @@ def check_ggx_sliders(driver, wait):
 def check_delta_and_four_curves(driver, url):
     """A material with a mirror lobe says that no plot of f_r shows it; with four materials
     selected the spec waits for a free place instead of dropping one of them."""
-    wait = WebDriverWait(driver, 30)
+    wait = waiter(driver)
     driver.get("about:blank")
     driver.get(url.split("#")[0] + "#m=2")
     wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#materials li")) == 4)
@@ -290,19 +305,19 @@ def check_delta_and_four_curves(driver, url):
 def check_spheres_of_four(driver, url):
     """Four materials against their sources show every sphere (the panel showed the first six
     images: two materials were missing)."""
-    wait = WebDriverWait(driver, 30)
+    wait = waiter(driver)
     driver.get("about:blank")
     driver.get(url.split("#")[0] + "#m=0,1,2,3&src=1")
     # The two tables with their sources and differences, the two specs alone.
     wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sphere image")) == 8)
-    labels = [t.text for t in driver.find_elements(By.CSS_SELECTOR, "#sphere text")]
+    labels = texts(driver, "#sphere text")
     assert sum("source" in t for t in labels) == 4 and labels[-2:] == ["sum", "lambert"], labels
 
 
 def check_a_narrow_window(driver, url):
     """In a narrow window (a phone, half a screen) every panel fits the page's width: beside
     the material list they had less than their width and ran off the right edge."""
-    wait = WebDriverWait(driver, 30)
+    wait = waiter(driver)
     driver.set_window_size(480, 900)
     try:
         driver.get("about:blank")
@@ -320,7 +335,7 @@ def check_a_narrow_window(driver, url):
 
 def check_a_colour_slider(driver, url):
     """A slider on an RGB value scales the colour, keeping its hue (it set a grey)."""
-    wait = WebDriverWait(driver, 30)
+    wait = waiter(driver)
     driver.get("about:blank")
     driver.get(url.split("#")[0] + "#m=0&spec=" + urllib.parse.quote(
         '{"model": "lambert", "kd": [0.1, 0.2, 0.4]}'))
@@ -337,7 +352,7 @@ def check_a_colour_slider(driver, url):
 def check_a_spec_that_is_not_an_object(driver, url):
     """`null` typed in the spec editor is not a spec: it is refused there, and a URL holding it
     (the editor wrote one) still opens (the page stopped at a TypeError and drew nothing)."""
-    wait = WebDriverWait(driver, 30)
+    wait = waiter(driver)
     driver.get("about:blank")
     driver.get(url.split("#")[0] + "#m=0&spec=null&on=1")
     wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#polar polyline"))
@@ -353,12 +368,12 @@ def check_a_spec_that_is_not_an_object(driver, url):
 
 def check_a_channel(driver, url):
     """The channel chosen (here blue) is what the plots show and say, and the URL keeps it."""
-    wait = WebDriverWait(driver, 30)
+    wait = waiter(driver)
     driver.get("about:blank")
     driver.get(url.split("#")[0] + "#m=0")
     wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#polar polyline"))
     Select(driver.find_element(By.ID, "channel")).select_by_value("b")
-    label = lambda d: " ".join(t.text for t in d.find_elements(By.CSS_SELECTOR, "#polar text"))
+    label = lambda d: " ".join(texts(d, "#polar text"))
     wait.until(lambda d: "f_r, B (1/sr)" in label(d) and "ch=b" in d.current_url)
     driver.get("about:blank")
     driver.get(url.split("#")[0] + "#m=0&ch=b")
@@ -369,8 +384,8 @@ def check_a_channel(driver, url):
 def check_a_late_report(driver, url):
     """A report that answers after a newer one (its figures took seconds) does not replace it
     with materials no longer selected."""
-    wait = WebDriverWait(driver, 30)
-    rows = lambda d: [r.text for r in d.find_elements(By.CSS_SELECTOR, "#report tr")][1:]
+    wait = waiter(driver)
+    rows = lambda d: texts(d, "#report tr")[1:]
     driver.get("about:blank")
     driver.get(url.split("#")[0] + "#m=0")
     wait.until(lambda d: len(rows(d)) == 1 and "…" not in rows(d)[0])
