@@ -65,6 +65,7 @@ fuzz_target!(|data: &[u8]| {
         CString::new(file.to_str().expect("utf-8 temp path")).expect("no NUL")
     };
     let opts = brdftab_open_options {
+        size: 0,
         interp: (mode >> 4 & 1) as i32,
         n_wavelengths: 0,
         wavelengths: std::ptr::null(),

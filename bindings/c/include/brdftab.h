@@ -50,8 +50,14 @@ extern "C" {
 /* An open BRDF (opaque). */
 typedef struct brdftab_brdf brdftab_brdf;
 
-/* Options of brdftab_open_with; zero-initialized means the defaults. */
+/* Options of brdftab_open_with; zero-initialized means the defaults.
+ * The struct may grow in later versions without breaking programs built against this header:
+ * `size` is sizeof(brdftab_open_options) as the program's header defines it, or 0 for this
+ * first layout (so a zero-initialized struct stays valid in every version, any later field at
+ * its default). A library older than the program's header accepts the larger struct when the
+ * fields it does not know are all zero, and fails the open otherwise. */
 typedef struct brdftab_open_options {
+    size_t size;              /* sizeof(brdftab_open_options), or 0 for this first layout */
     int interp;               /* tables and MERL files: 0 auto (default: nearest on MERL
                                  cells, linear otherwise), 1 nearest, 2 linear */
     size_t n_wavelengths;     /* 0 keeps the source's channels */

@@ -56,8 +56,16 @@ pub struct brdftab_brdf {
 }
 
 /// Options of [`brdftab_open_with`]. Zero-initialized means the defaults.
+///
+/// The struct can grow without breaking programs built against an older header: `size` says
+/// how many bytes the caller's struct has (the extensible-struct rule of Linux's `openat2` and
+/// `clone3`). 0 stands for this first layout, so a zero-initialized struct stays valid in every
+/// later version, with any later field at its default. A caller larger than the library knows
+/// is accepted when its extra bytes are all zero (fields it left at their defaults).
 #[repr(C)]
 pub struct brdftab_open_options {
+    /// `sizeof(brdftab_open_options)` in the caller's header, or 0 for this first layout.
+    pub size: usize,
     /// Table interpolation: 0 auto (default: nearest on tables of MERL cells, linear otherwise),
     /// 1 nearest, 2 linear.
     pub interp: c_int,
@@ -210,6 +218,36 @@ unsafe fn text<'a>(p: *const c_char, what: &str) -> Result<&'a str, String> {
         .map_err(|_| format!("`{what}` is not valid UTF-8"))
 }
 
+/// Checks the caller's `size` against this library's layout (see [`brdftab_open_options`]).
+///
+/// # Safety
+/// `opts` points to a valid struct of at least `max(size, size_of::<brdftab_open_options>())`
+/// readable bytes (the caller's contract).
+unsafe fn check_size(opts: *const brdftab_open_options) -> Result<(), String> {
+    let known = std::mem::size_of::<brdftab_open_options>();
+    // SAFETY: `size` is the first field of a valid struct.
+    let size = unsafe { (*opts).size };
+    if size == 0 || size == known {
+        return Ok(());
+    }
+    if size < known {
+        return Err(format!(
+            "options size {size}: expected 0 or sizeof(brdftab_open_options) ({known})"
+        ));
+    }
+    // SAFETY: the caller's struct has `size` readable bytes; bytes past our layout are read.
+    let extra = unsafe { std::slice::from_raw_parts(opts.cast::<u8>().add(known), size - known) };
+    match extra.iter().position(|&b| b != 0) {
+        None => Ok(()),
+        Some(i) => Err(format!(
+            "options size {size}: byte {} is set, a field this library ({}) does not know; \
+             link the brdftab the program's header comes from",
+            known + i,
+            env!("CARGO_PKG_VERSION")
+        )),
+    }
+}
+
 /// The library's open options of a C options struct.
 fn open_options(opts: &brdftab_open_options) -> Result<OpenOptions, String> {
     let interp = match opts.interp {
@@ -272,16 +310,21 @@ pub unsafe extern "C" fn brdftab_open(source: *const c_char) -> *mut brdftab_brd
 /// Opens SOURCE with options (`opts` NULL = defaults). NULL on failure.
 ///
 /// # Safety
-/// `source` is NULL or a NUL-terminated string; `opts` is NULL or points to a valid struct.
+/// `source` is NULL or a NUL-terminated string; `opts` is NULL or points to a valid struct
+/// whose `size` bytes (this layout's when 0) are readable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn brdftab_open_with(
     source: *const c_char,
     opts: *const brdftab_open_options,
 ) -> *mut brdftab_brdf {
-    // SAFETY: the caller promises NULL or a valid struct.
-    let opts = unsafe { opts.as_ref() };
     open_impl(source, || {
-        opts.map_or(Ok(OpenOptions::default()), open_options)
+        if opts.is_null() {
+            return Ok(OpenOptions::default());
+        }
+        // SAFETY: the caller promises a valid struct of `size` bytes (or this layout's).
+        unsafe { check_size(opts) }?;
+        // SAFETY: as above; the first layout's fields are all there.
+        open_options(unsafe { &*opts })
     })
 }
 

@@ -69,6 +69,34 @@ int main(int argc, char **argv) {
     CHECK(brdftab_open(NULL) == NULL && strlen(brdftab_last_error()) > 0, "NULL source");
     CHECK(brdftab_open("{\"model\": \"no_such_model\"}") == NULL, "unknown model");
 
+    /* The options struct's size: 0 (this first layout) and sizeof open; a size smaller than the
+     * first layout fails; a later header's larger struct opens while its new fields are zero
+     * and fails, naming the byte, once one is set (a field this library cannot honour). */
+    {
+        const char *lam = "{\"model\": \"lambert\", \"kd\": 0.5}";
+        brdftab_open_options o = {0};
+        brdftab_brdf *h = brdftab_open_with(lam, &o);
+        CHECK(h != NULL, "size 0: the first layout");
+        brdftab_close(h);
+        o.size = sizeof o;
+        h = brdftab_open_with(lam, &o);
+        CHECK(h != NULL, "size = sizeof(brdftab_open_options)");
+        brdftab_close(h);
+        o.size = 8;
+        CHECK(brdftab_open_with(lam, &o) == NULL && strstr(brdftab_last_error(), "size 8"),
+              "a size smaller than the first layout");
+        struct later { brdftab_open_options o; double added; } big;
+        memset(&big, 0, sizeof big);
+        big.o.size = sizeof big;
+        h = brdftab_open_with(lam, &big.o);
+        CHECK(h != NULL, "a later header's struct with its new field at zero");
+        brdftab_close(h);
+        big.added = 1.0;
+        CHECK(brdftab_open_with(lam, &big.o) == NULL &&
+                  strstr(brdftab_last_error(), "does not know") != NULL,
+              "a later header's field set");
+    }
+
     brdftab_brdf *b = brdftab_open(argv[1]);
     if (!b) {
         fprintf(stderr, "error: %s\n", brdftab_last_error());
@@ -211,7 +239,7 @@ int main(int argc, char **argv) {
         /* brdftab_eval_spectral / brdftab_sample_spectral at wavelengths of the call: what a
          * handle opened at those wavelengths gives at its channels. */
         double nm[3] = {450.0, 531.5, 690.0}, nan_nm[2] = {500.0, NAN};
-        brdftab_open_options at = {0, 3, nm, 0};
+        brdftab_open_options at = {.n_wavelengths = 3, .wavelengths = nm};
         const char *ggx = "{\"model\": \"ggx\", \"alpha\": 0.3, \"fresnel\": {\"conductor\": \"Au\"}}";
         const char *gold = "{\"model\": \"mirror\", \"fresnel\": {\"conductor\": \"Au\"}}";
         brdftab_brdf *g = brdftab_open(ggx), *g3 = brdftab_open_with(ggx, &at);

@@ -143,7 +143,7 @@ static void corrupt_table(const char *path) {
               strstr(brdftab_last_error(), "checksum"),
           "sample_delta on a failed handle");
     brdftab_close(b);
-    brdftab_open_options eager = {0, 0, NULL, 1};
+    brdftab_open_options eager = {.eager = 1};
     CHECK(brdftab_open_with(path, &eager) == NULL && strstr(brdftab_last_error(), "checksum"),
           "an eager open of a corrupt table fails");
 }

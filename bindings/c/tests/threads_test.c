@@ -42,7 +42,7 @@ static void *work(void *arg) {
     /* This thread's error is its own: a message naming what this thread did wrong. */
     char want[32];
     snprintf(want, sizeof want, "interp %d", 3 + t);
-    brdftab_open_options bad = {3 + t, 0, NULL, 0};
+    brdftab_open_options bad = {.interp = 3 + t};
     if (brdftab_open_with("{\"model\": \"lambert\"}", &bad) != NULL ||
         strncmp(brdftab_last_error(), want, strlen(want)) != 0)
         failures[t]++;
