@@ -181,8 +181,9 @@ pub fn demo(a: DemoArgs) -> Result<()> {
          relative to the stored values as plain f32;\nrel RMSE: relative RMSE of f_r cos θi cos θo of \
          the table read back from the database vs its source (50k random pairs over the whole hemisphere;\nmeasured rows (rgl_*): with both directions within 80° of the normal, as `brdftab bench --measured`, since their f_r grows like 1/cos θo at grazing — see BENCHMARKS.md;\nweighted by cos θi alone the RMS is infinite for measured data, Ward and Cook-Torrance);\nalbedo: max \
          relative albedo error at θ′ = 0, 30, 60, 80° (measured rows: 2°, not 0°, where their reader is discontinuous; the accuracy suite's, floored at 1e-3 of the largest albedo); pos/rec/energy: plausibility of the stored \
-         table (y = yes, N = no;\nmeasured data is not reciprocal, and the lecture's Lambert \
-         kd = 0.5 is not energy conserving).\n",
+         table (y = yes, N = no;\nmeasured data is not reciprocal, satin_rosaline's own file \
+         reflects more than it receives past 75° (`brdftab check` on it: albedo up to 1.16), and \
+         the lecture's Lambert kd = 0.5 is not energy conserving).\n",
     )?;
 
     if !fidelity_rows.is_empty() {
