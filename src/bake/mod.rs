@@ -85,8 +85,10 @@ pub struct BakeRequest {
     pub channels: Option<Channels>,
     /// Random pairs for the accuracy report of the written table against its source (0 = none).
     pub accuracy_pairs: usize,
-    /// Interpolation of the accuracy report.
-    pub accuracy_interp: Interp,
+    /// Interpolation of the accuracy report (`None`: the table's own,
+    /// [`Interp::default_for`] its grid — nearest on MERL cells, linear otherwise — as every
+    /// host opens it).
+    pub accuracy_interp: Option<Interp>,
     /// Pick the smallest adaptive grid whose table meets this error (relative RMSE of
     /// f_r cos θi cos θo within 80°; [`crate::table::target`]) instead of fixed node counts.
     /// Applies to adaptive grids: RGL files by default, any isotropic bilateral source with
@@ -143,7 +145,7 @@ impl BakeRequest {
             supersample: 1,
             channels: None,
             accuracy_pairs: 0,
-            accuracy_interp: Interp::Linear,
+            accuracy_interp: None,
             target_error: None,
             quantity: None,
             calibrate: true,

@@ -11,7 +11,7 @@ use crate::progress::{Progress, Silent, Stage};
 use crate::source;
 use crate::spectrum::Channels;
 use crate::store::{TableHeader, Writer, db, tables};
-use crate::table::{Grid, Quantity, Table, TabulatedBrdf, bake_chunks};
+use crate::table::{Grid, Interp, Quantity, Table, TabulatedBrdf, bake_chunks};
 
 use super::BakeRequest;
 use super::choices::BakeTarget;
@@ -153,8 +153,11 @@ impl BakeRequest {
             let tab = match table {
                 Some(t) => TabulatedBrdf::from_table(t),
                 None => crate::store::tables::open_brdf_at(target.path(), Some(&name), false)?,
-            }
-            .with_interp(self.accuracy_interp);
+            };
+            let interp = self
+                .accuracy_interp
+                .unwrap_or_else(|| Interp::default_for(tab.grid()));
+            let tab = tab.with_interp(interp);
             report.accuracy = Some(Accuracy::measure(&tab, src.as_ref(), self.accuracy_pairs)?);
         }
         Ok(report)

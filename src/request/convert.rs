@@ -25,7 +25,9 @@ pub struct ConvertSettings {
     /// Random pairs for the reported accuracy (default 200 000; 0 skips it).
     #[cfg_attr(feature = "clap", arg(long))]
     pub pairs: Option<usize>,
-    /// Interpolation for the reported accuracy of a table: nearest or linear (default).
+    /// Interpolation for the reported accuracy of a table: auto (default: the table's own, as
+    /// every host opens it — nearest on a table of MERL cells, linear otherwise), nearest or
+    /// linear.
     #[cfg_attr(feature = "clap", arg(long))]
     pub interp: Option<String>,
     /// .bsdf output: reflectance table resolution N (default 64, or 128 where 64 stays past the
@@ -112,9 +114,7 @@ pub fn convert(
         }
         _ => {
             req.accuracy_pairs = pairs;
-            if let Some(i) = &settings.interp {
-                req.accuracy_interp = i.parse()?;
-            }
+            req.accuracy_interp = accuracy_interp(settings.interp.as_deref())?;
             let replace = settings.bake.replace;
             let target = match BakeTarget::parse(output, None, replace)? {
                 BakeTarget::File(path) => BakeTarget::Db {
@@ -128,11 +128,23 @@ pub fn convert(
                 t => t,
             };
             let report = req.run_with(&target, progress)?;
-            Ok(ConvertOutput::Table {
-                report,
-                interp: req.accuracy_interp,
-            })
+            let interp = req
+                .accuracy_interp
+                .unwrap_or_else(|| Interp::default_for(&report.grid));
+            Ok(ConvertOutput::Table { report, interp })
         }
+    }
+}
+
+/// The `interp` setting of a conversion's accuracy report: `None` (auto, the default) for the
+/// table's own interpolation.
+fn accuracy_interp(s: Option<&str>) -> Result<Option<Interp>> {
+    match s.map(|s| s.trim().to_ascii_lowercase()) {
+        None => Ok(None),
+        Some(s) if s == "auto" => Ok(None),
+        Some(s) => s.parse().map(Some).map_err(|_| {
+            crate::error::Error::arg("interp", format!("`{s}`: expected auto, nearest or linear"))
+        }),
     }
 }
 

@@ -168,6 +168,64 @@ fn merl_to_table_to_merl_keeps_every_cell() {
     assert_same_file(&data, &b, F32_REL);
 }
 
+/// The relative RMSE of `convert`'s accuracy line (`accuracy vs native (INTERP, N pairs):
+/// relative RMSE of f_r cos θi cos θo X, max relative Y`), with the interpolation it names.
+fn reported_accuracy(stdout: &str) -> (String, f64) {
+    let line = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("accuracy vs native ("))
+        .unwrap_or_else(|| panic!("no accuracy line in {stdout}"));
+    let interp = line.split('(').nth(1).unwrap().split(',').next().unwrap();
+    let rmse = line
+        .split("cos θo ")
+        .nth(1)
+        .and_then(|r| r.split(',').next())
+        .and_then(|x| x.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no relative RMSE in {line}"));
+    (interp.to_owned(), rmse)
+}
+
+/// `convert a.binary t.btdb` copies the cells, and every host opens such a table nearest by
+/// default (`interp` auto): its accuracy report measures that lookup, exact to f32 rounding.
+/// It measured a linear lookup whatever the table, which no host does by default, and printed
+/// 2.6 % and a max relative error of 9258 for a table of a Cook-Torrance file's own cells; and
+/// `--interp auto`, which every other command takes, was refused.
+#[test]
+fn converting_merl_cells_reports_the_lookup_hosts_use() {
+    let dir = TempDir::new("merlrt-acc");
+    let a = dir.join("a.binary");
+    issue_file(&a);
+    let a = a.to_str().unwrap();
+    for (i, extra) in [&[][..], &["--interp", "auto"][..]].iter().enumerate() {
+        let t = dir.join(format!("t{i}.btdb"));
+        let mut args = vec!["convert", a, t.to_str().unwrap(), "--codec", "f32"];
+        args.extend_from_slice(&["--pairs", "20000"]);
+        args.extend_from_slice(extra);
+        let r = common::brdftab(&args);
+        assert!(r.ok, "{args:?}: {}", r.stderr);
+        let (interp, rmse) = reported_accuracy(&r.stdout);
+        assert_eq!(interp, "Nearest", "{}", r.stdout);
+        // The f32 table holds each cell's f32 value, the file's reader returns the same f32:
+        // equal but for the f64 arithmetic of the comparison (F32_REL is a bound per value).
+        assert!(rmse <= 2.0 * F32_REL, "{}", r.stdout);
+    }
+    // Asked for, the linear lookup is still what is measured: it blends the random cells.
+    let t = dir.join("lin.btdb");
+    let r = common::brdftab(&[
+        "convert",
+        a,
+        t.to_str().unwrap(),
+        "--pairs",
+        "20000",
+        "--interp",
+        "linear",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let (interp, rmse) = reported_accuracy(&r.stdout);
+    assert_eq!(interp, "Linear", "{}", r.stdout);
+    assert!(rmse > 1e-2, "{}", r.stdout);
+}
+
 /// What a lookup makes of the unmeasured cells: 0 at them (nearest), a blend towards 0 next to
 /// them (linear), never a negative value.
 #[test]
