@@ -11,12 +11,12 @@ use brdftab_tools::text::print_out;
 /// Arguments of `brdftab bench`.
 #[derive(Args)]
 pub struct BenchArgs {
-    /// The source: a table file or a model spec (not with --measured).
+    /// Any SOURCE: a spec, a table (`FILE.btdb`, `DB#NAME`), a MERL or RGL file (not with --measured).
     #[arg(required_unless_present = "measured", conflicts_with = "measured")]
     source: Option<String>,
-    /// Instead of one source: bake every RGL `.bsdf` file of DIR (default: the shipped
-    /// data/rgl) with the defaults and compare each table with the file's own evaluation in
-    /// the same run — error, bytes, resident memory, ns per lookup, batch rate.
+    /// Instead of one source: bake every RGL `.bsdf` file of DIR (default: $BRDFTAB_RGL_DIR,
+    /// else the shipped data/rgl) with the defaults and compare each table with the file's own
+    /// evaluation in the same run — error, bytes, resident memory, ns per lookup, batch rate.
     #[arg(long, value_name = "DIR", num_args = 0..=1, default_missing_value = "")]
     measured: Option<String>,
     /// Number of random pairs.

@@ -115,6 +115,18 @@ fn usage_says_what_is_required() {
     let d = TempDir::new("args-db-name");
     let o = brdftab(&["db", "add", &d.file("lib.btdb"), LAMBERT]);
     refused(&o, &["--name <NAME>"]);
+    // `bench` times any SOURCE (its help said a table or a spec, but RGL and MERL files and
+    // `DB#NAME` are timed too, as BENCHMARKS.md does) and says where --measured looks first.
+    let o = brdftab(&["bench", "--help"]);
+    assert!(o.ok, "{}", o.stderr);
+    assert!(
+        o.stdout
+            .contains("Any SOURCE: a spec, a table (`FILE.btdb`, `DB#NAME`), a MERL or RGL")
+            && o.stdout
+                .contains("(default: $BRDFTAB_RGL_DIR, else the shipped data/rgl)"),
+        "{}",
+        o.stdout
+    );
     // `bench` times SOURCE or, with --measured, the RGL files: not both.
     let o = brdftab(&["bench", LAMBERT, "--measured", "/no/such/dir"]);
     refused(&o, &["--measured"]);
