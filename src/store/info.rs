@@ -208,9 +208,25 @@ pub fn raw_text(v: &Value) -> String {
 
 /// [`list`] as the table `brdftab db list` prints: one line per table.
 pub fn list_text(rows: &[Value]) -> String {
+    use unicode_width::UnicodeWidthStr;
+    // The name column is as wide as the widest name on a terminal (a CJK character takes two
+    // cells, a combining accent none), at least 24: `{:<24}` counted chars and a long or wide
+    // name pushed its row's other columns out of line.
+    let name_of = |r: &Value| r["name"].as_str().unwrap_or("").to_owned();
+    let width = rows
+        .iter()
+        .map(|r| name_of(r).width())
+        .max()
+        .unwrap_or(0)
+        .max(24);
+    let pad = |s: &str| format!("{s}{}", " ".repeat(width - s.width().min(width)));
     let mut o = format!(
-        "{:<24} {:<8} {:>12} {:>12} {:>7}  grid\n",
-        "name", "codec", "values", "bytes", "ratio"
+        "{} {:<8} {:>12} {:>12} {:>7}  grid\n",
+        pad("name"),
+        "codec",
+        "values",
+        "bytes",
+        "ratio"
     );
     for r in rows {
         let shape = r["shape"]
@@ -224,8 +240,8 @@ pub fn list_text(rows: &[Value]) -> String {
             .unwrap_or_default();
         let _ = writeln!(
             o,
-            "{:<24} {:<8} {:>12} {:>12} {:>6.1}x  {} {} {}",
-            r["name"].as_str().unwrap_or(""),
+            "{} {:<8} {:>12} {:>12} {:>6.1}x  {} {} {}",
+            pad(&name_of(r)),
             r["codec"]["quant"].as_str().unwrap_or(""),
             r["values"].as_u64().unwrap_or(0),
             r["bytes"].as_u64().unwrap_or(0),
@@ -304,4 +320,35 @@ pub fn file_text(v: &Value) -> String {
         );
     }
     o
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use unicode_width::UnicodeWidthStr;
+
+    #[test]
+    fn list_columns_stay_aligned_with_long_and_wide_names() {
+        // A 34-cell CJK name and a 40-character one pushed their rows' columns right of the
+        // header's (`{:<24}` pads by chars, and not at all past 24).
+        let names = [
+            "c",
+            "日本語の長い名前のテーブル名前です",
+            &"n".repeat(40),
+            "é",
+        ];
+        let rows: Vec<Value> = names
+            .iter()
+            .map(|n| json!({"name": n, "codec": {"quant": "log16"}, "values": 1, "bytes": 1}))
+            .collect();
+        let text = list_text(&rows);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), names.len() + 1);
+        let column = |line: &str, word: &str| line[..line.find(word).unwrap()].width();
+        let codec_at = column(lines[0], "codec");
+        assert_eq!(codec_at, 41, "{text}");
+        for l in &lines[1..] {
+            assert_eq!(column(l, "log16"), codec_at, "{text}");
+        }
+    }
 }

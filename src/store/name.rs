@@ -6,7 +6,8 @@
 //! same words. It depends on nothing but the error type, so the file helpers
 //! (`files`) and the store share it without an import circle.
 //!
-//! A table name is non-empty and holds no `#` (it ends the path of `DB#NAME`), no `/` (a
+//! A table name holds a character other than white space (an empty or blank name is invisible
+//! in `db list`), and no `#` (it ends the path of `DB#NAME`), no `/` (a
 //! `DB#NAME` whose name part has a `/` is read as a path with a `#` in a directory, so such a
 //! table could be written but never opened by name) and no control character (NUL, tab,
 //! newline, ...: invisible or cut short in listings, C strings and terminals).
@@ -32,6 +33,8 @@ use crate::error::{Error, Result};
 pub fn check(field: &str, name: &str) -> Result<()> {
     let bad = if name.is_empty() {
         Some("is empty")
+    } else if name.chars().all(char::is_whitespace) {
+        Some("is only white space")
     } else if name.contains('#') {
         Some("contains `#`")
     } else if name.contains('/') {
@@ -46,8 +49,8 @@ pub fn check(field: &str, name: &str) -> Result<()> {
         Some(why) => Err(Error::arg(
             field,
             format!(
-                "table name {name:?} {why}: a table name is non-empty, without `#`, `/` or \
-                 control characters"
+                "table name {name:?} {why}: a table name has a character other than white \
+                 space, and no `#`, `/` or control characters"
             ),
         )),
     }
@@ -101,6 +104,18 @@ mod tests {
             Error::InvalidArgument { name, .. } => name,
             e => panic!("not an argument error: {e}"),
         }
+    }
+
+    #[test]
+    fn blank_names_are_refused_as_empty_ones() {
+        // `bake -o 'db.btdb#   '` wrote a table `db list` showed as an empty column.
+        for name in [" ", "   ", "\u{3000}", " \u{a0} "] {
+            let e = check("name", name).unwrap_err();
+            assert!(e.to_string().contains("white space"), "{name:?}: {e}");
+            assert_eq!(field_of(e), "name", "{name:?}");
+            assert!(parse_source("output", &format!("db.btdb#{name}")).is_err());
+        }
+        check("name", " padded ").unwrap();
     }
 
     #[test]
