@@ -35,6 +35,17 @@ impl BakeRequest {
         crate::files::check_output(&crate::files::resolve_links(Path::new(target.path()))?)?;
         self.refuse_overwrite(target)?;
         let name = match (target, &self.name) {
+            // `DB#NAME` with another `name` setting: which one the user meant is unknown, and
+            // taking either silently wrote a table the other road could not find.
+            (BakeTarget::Db { name, .. }, Some(n)) if n != name => {
+                return Err(Error::arg(
+                    "name",
+                    format!(
+                        "{n:?} conflicts with the output's table name {name:?} (DB#NAME names \
+                         the table itself: drop the name setting or make them agree)"
+                    ),
+                ));
+            }
             (BakeTarget::Db { name, .. }, _) => name.clone(),
             (_, Some(n)) => n.clone(),
             (t, None) => stem(t.path()),

@@ -198,6 +198,32 @@ mod tests {
     }
 
     #[test]
+    fn a_name_setting_that_contradicts_db_name_is_refused_before_any_write() {
+        // `bake(src, "db.btdb#c", name="d")` wrote table `c` and dropped `d` without a word.
+        let d = crate::testkit::TempDir::new("request_bake_name_conflict");
+        let db = d.join("db.btdb").to_str().unwrap().to_owned();
+        let spec = r#"{"model": "lambert", "kd": 0.5}"#;
+        let with_name = |n: &str| BakeSettings {
+            name: Some(n.into()),
+            preset: Some("small".into()),
+            ..Default::default()
+        };
+        let out = format!("{db}#c");
+        let e = bake(spec, &out, &with_name("d"), &crate::progress::Silent).unwrap_err();
+        match e {
+            Error::InvalidArgument { ref name, ref msg } => {
+                assert_eq!(name, "name");
+                assert!(msg.contains("\"d\"") && msg.contains("\"c\""), "{msg}");
+            }
+            e => panic!("{e}"),
+        }
+        assert!(!d.join("db.btdb").exists(), "nothing is written");
+        // The same name twice is no conflict.
+        let r = bake(spec, &out, &with_name("c"), &crate::progress::Silent).unwrap();
+        assert_eq!(r.name, "c");
+    }
+
+    #[test]
     fn defaults_are_the_requests_defaults_and_bad_values_name_their_field() {
         let spec = r#"{"model": "lambert", "kd": 0.5}"#;
         let d = BakeSettings::default().request(spec).unwrap();

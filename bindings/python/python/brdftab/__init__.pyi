@@ -255,7 +255,9 @@ def bake(
     replace: bool = ...,
 ) -> dict[str, Any]:
     """Bakes SOURCE into OUTPUT (a .btdb file or DB#NAME); the keywords are the CLI's bake flags,
-    snake_cased, validated by the library's request layer. Returns `brdftab info --json`."""
+    snake_cased, validated by the library's request layer. `name` names a .btdb file's table;
+    with DB#NAME it may only repeat NAME (another name is an error). Returns `brdftab info
+    --json`."""
 def bake_cached(
     source: str | PathLike[str],
     cache_dir: str | PathLike[str] | None = None,
