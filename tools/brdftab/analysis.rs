@@ -2,7 +2,7 @@
 
 use brdftab::analysis::{albedo, plausibility};
 use brdftab::{Error, Result};
-use brdftab_tools::text::print_out;
+use brdftab_tools::text::{print_out, shortest};
 use clap::Args;
 
 /// Arguments of `brdftab albedo`.
@@ -51,7 +51,7 @@ pub fn albedo(a: AlbedoArgs) -> Result<()> {
     let mut text = String::new();
     for (t, row) in thetas.iter().zip(curve) {
         let vals: Vec<String> = row.iter().map(|&x| sig7(x)).collect();
-        text += &format!("{t} {}\n", vals.join(" "));
+        text += &format!("{} {}\n", shortest(*t), vals.join(" "));
     }
     print_out(&text)
 }
@@ -82,7 +82,10 @@ fn parse_degrees(s: &str) -> Result<Vec<f64>> {
             if !(0.0..90.0).contains(&t) {
                 return Err(Error::arg(
                     "--theta",
-                    format!("{t}° is outside [0°, 90°): the albedo is defined for light above the horizon"),
+                    format!(
+                        "{}° is outside [0°, 90°): the albedo is defined for light above the horizon",
+                        shortest(t)
+                    ),
                 ));
             }
             Ok(t)

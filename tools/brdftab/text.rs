@@ -104,6 +104,17 @@ pub fn parse_direction(s: &str, flag: &str) -> Result<DVec3> {
     Ok(d)
 }
 
+/// `x` as typed (its shortest round-trip form), in exponent form when the plain form runs to
+/// more than 16 characters (`1e-300`, not `0.000…1` with 300 zeros; `1e300`).
+pub fn shortest(x: f64) -> String {
+    let plain = x.to_string();
+    if plain.len() > 16 {
+        format!("{x:e}")
+    } else {
+        plain
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -141,6 +141,21 @@ fn albedo_is_for_light_above_the_horizon() {
 }
 
 #[test]
+fn albedo_prints_tiny_and_huge_numbers_in_exponent_form() {
+    // `--theta 1e-300` printed the angle as 0.000…0001 (302 characters), and `--theta 1e300`
+    // refused it with a 301-digit number.
+    let o = brdftab(&["albedo", LAMBERT, "--theta", "1e-300,12.5"]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let lines: Vec<&str> = o.stdout.lines().collect();
+    assert!(lines[0].starts_with("1e-300 "), "{}", o.stdout);
+    assert!(lines[1].starts_with("12.5 "), "{}", o.stdout);
+    assert!(lines.iter().all(|l| l.len() < 60), "{}", o.stdout);
+    let o = brdftab(&["albedo", LAMBERT, "--theta", "1e300"]);
+    assert_error(&o, "1e300°");
+    assert!(o.stderr.len() < 200, "{}", o.stderr);
+}
+
+#[test]
 fn a_polar_slice_is_for_light_above_the_horizon() {
     // The incidence was clamped into [0°, 90°]: 120 and -5 drew the 90° and 0° slices silently.
     let dir = TempDir::new("cli-slice-theta");
