@@ -250,6 +250,48 @@ fn npy_and_exr_exports() {
     assert!(export::slice(&t, &export::Slice::parse("0,1:0,0,99", 3).unwrap(), None).is_err());
 }
 
+/// `export --half` wrote values below f16's smallest subnormal as 0 without a word (it refuses
+/// those above 65504): the export now counts them. And the EXR was written in place (`to_file`
+/// truncated the old file first), so a kill mid-write left a truncated file and another hard
+/// link saw the new bytes: now a temporary file is renamed over it, as every other output.
+#[test]
+fn exr_half_counts_values_flushed_to_zero_and_replaces_the_file_atomically() {
+    let d = TempDir::new("store-exr-half");
+    let p = d.join("t.btdb");
+    let mut data = lobe(SHAPE, 0.0);
+    let [_, b, c] = SHAPE;
+    for k in 0..c {
+        // Row y = 0 of the slice (nodes [0, 4, k]): 1e-9 < 2^-25, written as 0 in f16.
+        data[((4 * c) + k) * 3..][..3].fill(1e-9);
+        // Row y = 1 (nodes [1, 4, k]): 1e-7 is an f16 subnormal, not 0.
+        data[((b + 4) * c + k) * 3..][..3].fill(1e-7);
+    }
+    let h = header("a", SHAPE, Quant::F32);
+    let n = data.len() / SHAPE[0];
+    db::put(&p, h, true, |w| {
+        for ch in data.chunks(n) {
+            w.chunk(ch)?;
+        }
+        Ok(())
+    })
+    .unwrap();
+    let s = Store::open(&p).unwrap();
+    let t = s.table("a").unwrap();
+    let sl = export::Slice::parse("2,0:0,4", 3).unwrap();
+    let (out, keep) = (d.join("a.exr"), d.join("keep.exr"));
+    std::fs::write(&out, b"old").unwrap();
+    std::fs::hard_link(&out, &keep).unwrap();
+    assert_eq!(export::exr(&t, &sl, None, &out, true).unwrap(), 20 * 3);
+    assert_eq!(std::fs::read(&keep).unwrap(), b"old");
+    assert!(std::fs::metadata(&out).unwrap().len() > 100);
+    assert_eq!(export::exr(&t, &sl, None, &out, false).unwrap(), 0);
+    // No temporary file is left beside it.
+    let names: Vec<_> = (std::fs::read_dir(d.path()).unwrap())
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(!names.iter().any(|n| n.contains(".tmp.")), "{names:?}");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input.
 

@@ -210,15 +210,19 @@ fn channel_names(c: &Channels, n: usize) -> Vec<String> {
     }
 }
 
-/// Writes a 2D slice as OpenEXR, channels as EXR channels, f32 or f16 (`half`), ZIP-compressed.
-/// With `half`, a finite value beyond f16's range (±65504) is an error, not an infinite pixel.
+/// Writes a 2D slice as OpenEXR, channels as EXR channels, f32 or f16 (`half`), ZIP-compressed,
+/// replacing `out` atomically (a temporary file renamed into place, as the other outputs).
+/// With `half`, a finite value beyond f16's range (±65504) is an error, not an infinite pixel;
+/// a value nearer 0 than half of f16's smallest subnormal (2⁻²⁴ ≈ 6e-8) is written as 0, as
+/// f16 must, and counted: the returned number (0 without `half`) says how many nonzero values
+/// became 0, so a caller can tell a dark tail that vanished from one that was 0.
 pub fn exr(
     table: &StoredTable,
     s: &Slice,
     offset: NodeOffset<'_>,
     out: impl AsRef<Path>,
     half: bool,
-) -> Result<()> {
+) -> Result<usize> {
     use exr::prelude::*;
     let (w, ht, v) = slice(table, s, offset)?;
     let nc = *table.header().shape.last().unwrap_or(&1) as usize;
@@ -244,6 +248,13 @@ pub fn exr(
             ));
         }
     }
+    let flushed = if half {
+        (v.iter())
+            .filter(|&&x| x != 0.0 && f16::from_f32(x) == f16::ZERO)
+            .count()
+    } else {
+        0
+    };
     let names = channel_names(&table.header().channels, nc);
     let list: Vec<AnyChannel<FlatSamples>> = (0..nc)
         .map(|c| {
@@ -264,8 +275,14 @@ pub fn exr(
     );
     let path = out.as_ref();
     crate::files::refuse_input(path, &[table.file()])?;
+    // Encoded in memory (a slice is small) and written as every other output is, through a
+    // temporary file renamed into place: `to_file` truncated the old file first, so a kill or
+    // a full disk mid-write left a truncated EXR.
+    let mut bytes = std::io::Cursor::new(Vec::new());
     Image::from_layer(layer)
         .write()
-        .to_file(path)
-        .map_err(|e| crate::Error::io(path, std::io::Error::other(e.to_string())))
+        .to_buffered(&mut bytes)
+        .map_err(|e| crate::Error::io(path, std::io::Error::other(e.to_string())))?;
+    crate::files::write_atomic(path, bytes.get_ref())?;
+    Ok(flushed)
 }

@@ -67,6 +67,18 @@ use format::{ChunkEntry, Superblock, Toc};
 pub use format::{Source, TableHeader, TocEntry};
 pub use writer::Writer;
 
+/// Writes `bytes` to `path` the way every output of the crate is written: into a temporary file
+/// beside it, renamed over `path` once complete, so a reader (or a kill mid-write) never sees a
+/// truncated file and another hard link to the old file keeps the old contents. A `path` that
+/// is a symbolic link is written where it points. For hosts writing an image or any other
+/// output of their own.
+///
+/// # Errors
+/// [`Error::Io`] naming `path`; the temporary file is removed.
+pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    crate::files::write_atomic(path, bytes)
+}
+
 use crate::codec;
 use crate::error::{Error, Result, Section};
 

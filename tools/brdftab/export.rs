@@ -23,7 +23,8 @@ pub struct ExportArgs {
     /// ignored); without them, the others at index 0.
     #[arg(long, requires = "exr")]
     slice: Option<String>,
-    /// Write EXR channels as half floats instead of f32 (refused when a value exceeds ±65504).
+    /// Write EXR channels as half floats instead of f32 (refused when a value exceeds ±65504;
+    /// values below f16's smallest subnormal, 6e-8, become 0 and are counted in a note).
     #[arg(long, requires = "exr")]
     half: bool,
 }
@@ -80,8 +81,13 @@ pub fn run(a: ExportArgs) -> Result<()> {
         );
     }
     if let (Some(out), Some(sl)) = (&a.exr, &sl) {
-        export::exr(&t, sl, off_ref, out, a.half).map_err(|e| named(e, "--exr"))?;
+        let zeros = export::exr(&t, sl, off_ref, out, a.half).map_err(|e| named(e, "--exr"))?;
         eprintln!("wrote {out} (stored values: {stored})");
+        if zeros > 0 {
+            eprintln!(
+                "note: {zeros} values below f16's smallest subnormal (6e-8) were written as 0"
+            );
+        }
     }
     Ok(())
 }

@@ -16,8 +16,6 @@
 //! Why log scale for false colour: BRDF values and render differences span decades (a glossy
 //! peak is 10³ times the diffuse floor), and a linear map shows only the peak.
 
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::Path;
 
 use brdftab::error::{Error, Result};
@@ -321,10 +319,14 @@ pub fn write_exr(img: &Image, path: impl AsRef<Path>, precision: ExrPrecision) -
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(list),
     );
+    // In memory, then a temporary file renamed into place (`to_file` truncated the old file
+    // first: a kill mid-write left a truncated image).
+    let mut bytes = std::io::Cursor::new(Vec::new());
     exr::prelude::Image::from_layer(layer)
         .write()
-        .to_file(path)
-        .map_err(|e| exr_error(path, e))
+        .to_buffered(&mut bytes)
+        .map_err(|e| exr_error(path, e))?;
+    brdftab::store::write_file_atomic(path, bytes.get_ref())
 }
 
 /// Reads the first layer of an OpenEXR file at full resolution, all channels, as f32.
@@ -454,8 +456,8 @@ pub fn write_png(img: &Image, path: impl AsRef<Path>, exposure: f32) -> Result<(
         u32::try_from(img.width).map_err(|_| too_large(path))?,
         u32::try_from(img.height).map_err(|_| too_large(path))?,
     );
-    let file = File::create(path).map_err(|e| Error::io(path, e))?;
-    let mut enc = png::Encoder::new(BufWriter::new(file), w, h);
+    let mut file = Vec::new();
+    let mut enc = png::Encoder::new(&mut file, w, h);
     enc.set_color(color);
     enc.set_depth(png::BitDepth::Eight);
     enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
@@ -465,7 +467,9 @@ pub fn write_png(img: &Image, path: impl AsRef<Path>, exposure: f32) -> Result<(
     };
     let mut writer = enc.write_header().map_err(png_err)?;
     writer.write_image_data(&bytes).map_err(png_err)?;
-    writer.finish().map_err(png_err)
+    writer.finish().map_err(png_err)?;
+    // Replaced atomically, as every other output.
+    brdftab::store::write_file_atomic(path, &file)
 }
 
 fn too_large(path: &Path) -> Error {
@@ -661,6 +665,7 @@ pub fn false_color(img: &Image, opts: &FalseColor) -> (Image, String) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs::File;
 
     /// `name` in a fresh scratch directory, removed when the returned guard drops.
     fn tmp(name: &str) -> (brdftab::testkit::TempDir, std::path::PathBuf) {
@@ -727,6 +732,24 @@ mod tests {
         assert!(read_exr(&p).is_err()); // not there yet
         std::fs::write(&p, b"not an exr file at all").unwrap();
         assert!(read_exr(&p).is_err());
+    }
+
+    #[test]
+    fn images_replace_the_file_and_leave_another_hard_link_alone() {
+        // `to_file` / `File::create` truncated the old file and wrote into it: a kill mid-write
+        // left a truncated image, and another hard link to it saw the half-written bytes.
+        let (dir, _) = tmp("x");
+        let img = Image::new(4, 3, 3);
+        for name in ["out.exr", "out.png"] {
+            let (out, keep) = (dir.join(name), dir.join(format!("keep-{name}")));
+            std::fs::write(&out, b"old contents").unwrap();
+            std::fs::hard_link(&out, &keep).unwrap();
+            write_auto(&img, &out, 0.0).unwrap();
+            assert_eq!(std::fs::read(&keep).unwrap(), b"old contents", "{name}");
+            assert_ne!(std::fs::read(&out).unwrap(), b"old contents", "{name}");
+        }
+        // No temporary file is left beside them.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4);
     }
 
     #[test]
