@@ -38,7 +38,8 @@ pub struct ConvertSettings {
     /// where the written file is farthest from the source; 8 = the RGL database's spacing).
     #[cfg_attr(feature = "clap", arg(long))]
     pub theta_i: Option<usize>,
-    /// .bsdf output: number of incident azimuths φi (default 1 if isotropic, else 17).
+    /// .bsdf output: number of incident azimuths φi (default 1 if isotropic — the only count an
+    /// isotropic source takes —, else 17; 3 or more).
     #[cfg_attr(feature = "clap", arg(long))]
     pub phi_i: Option<usize>,
     /// .bsdf output: NDF, σ and VNDF grid resolution (default 128).

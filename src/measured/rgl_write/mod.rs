@@ -146,8 +146,9 @@ pub struct Options {
     /// parameterization (which fixes them).
     pub theta_i: Option<usize>,
     /// Number of incident azimuths: `None` = 1 for isotropic sources, 17 otherwise. 1 writes an
-    /// isotropic file (φi = 0); 3 or more an anisotropic one (evenly over [−π, π]). 2 is not
-    /// allowed (readers take ≤ 2 azimuths as isotropic).
+    /// isotropic file (φi = 0), and is the only value an isotropic source takes; 3 or more an
+    /// anisotropic one (evenly over [−π, π]), for anisotropic sources. 2 is not allowed
+    /// (readers take ≤ 2 azimuths as isotropic).
     pub phi_i: Option<usize>,
     /// Resolution of the NDF, σ and VNDF warp grids along each axis, 4..=1024; `None`: 128.
     pub ndf_resolution: Option<usize>,
@@ -329,6 +330,18 @@ impl Options {
                 "phi_i",
                 format!(
                     "{n_phi} incident azimuths: 1 (isotropic) or 3..=360 (anisotropic) are allowed"
+                ),
+            ));
+        }
+        // More azimuths for an isotropic source only repeat it: n_phi times the bytes, and the
+        // anisotropic layout's even elevations in place of the placed ones (a GGX α = 0.3 file
+        // with 4 φi: 4× the bytes, whole-hemisphere error 7.3 % against 0.41 % with 1).
+        if n_phi > 1 && source_isotropic {
+            return Err(Error::arg(
+                "phi_i",
+                format!(
+                    "the source is isotropic: {n_phi} incident azimuths would repeat it {n_phi} \
+                     times and lose the elevations placed for it (leave it unset, or 1)"
                 ),
             ));
         }
