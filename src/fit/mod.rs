@@ -181,13 +181,37 @@ impl FitResult {
     /// One line per parameter whose value ended at a bound (`kd = [..] ended at a bound of
     /// 0..0.38 (...)`): the data pushed against it, and a wider `--params` range may fit
     /// better. What the CLI notes on stderr.
+    ///
+    /// A value held at a lower bound of 0 (a `kd` or `ks` of 0) is another case: the data
+    /// would take it below 0, which no bound may allow, so the note does not suggest wider
+    /// bounds. It says what this means: the source has no such term, or the model lacks
+    /// something the source has and the term was given up to make room. (A lambert+ggx fit to
+    /// the clear-coated RGL paint `cc_ibiza_sunset` ends with `kd = 0`, the true minimum of
+    /// the loss — scipy's bounded least squares on the same pairs agrees to 8 digits — because
+    /// its lobe has no Fresnel term for the clear coat's grazing rise; with `--fresnel schlick`
+    /// the diffuse term comes back, kd ≈ (0.13, 0.002, 0.05), and the RMSE falls from 0.55 to
+    /// 0.19.)
     pub fn bound_notes(&self) -> Vec<String> {
         (self.params.iter().filter(|p| p.at_bound))
             .map(|p| {
-                format!(
-                    "{} = {:?} ended at a bound of {}..{} (--params {}=LO:HI moves it)",
-                    p.path, p.value, p.bounds.lo, p.bounds.hi, p.path
-                )
+                let at_zero = p.bounds.lo == 0.0
+                    && (p.value.iter())
+                        .filter(|&&v| !(1e-3..=1.0 - 1e-3).contains(&p.bounds.to_unit(v)))
+                        .all(|&v| p.bounds.to_unit(v) < 0.5);
+                if at_zero {
+                    format!(
+                        "{} = {:?} ended at its lower bound 0: the data would take it below 0. \
+                         The source has no such term, or the model lacks something the source \
+                         has (a Fresnel term: --fresnel schlick; another lobe) and gave this \
+                         term up to make room",
+                        p.path, p.value
+                    )
+                } else {
+                    format!(
+                        "{} = {:?} ended at a bound of {}..{} (--params {}=LO:HI moves it)",
+                        p.path, p.value, p.bounds.lo, p.bounds.hi, p.path
+                    )
+                }
             })
             .collect()
     }

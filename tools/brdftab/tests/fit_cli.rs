@@ -43,6 +43,36 @@ fn a_value_at_a_bound_is_flagged_in_plain_output() {
     assert!(!r.stderr.contains("ended at a bound"), "{}", r.stderr);
 }
 
+/// A diffuse term the data pushes to 0 is not a bound to widen. lambert+ggx on the clear-coated
+/// `cc_ibiza_sunset` ends with kd = 0 (the true minimum of the loss: the lobe has no Fresnel
+/// rise); the note said `--params terms[0].kd=LO:HI moves it`, but no bound below 0 is valid.
+#[test]
+fn a_value_held_at_zero_is_not_sent_to_wider_bounds() {
+    let rgl = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../data/rgl/cc_ibiza_sunset_rgb.bsdf"
+    );
+    let r = brdftab(&[
+        "fit",
+        rgl,
+        "--model",
+        "lambert+ggx",
+        "--pairs",
+        "1000",
+        "--starts",
+        "2",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(
+        r.stderr
+            .contains("note: terms[0].kd = [0.0, 0.0, 0.0] ended at its lower bound 0")
+            && r.stderr.contains("--fresnel schlick"),
+        "{}",
+        r.stderr
+    );
+    assert!(!r.stderr.contains("terms[0].kd=LO:HI"), "{}", r.stderr);
+}
+
 #[test]
 fn fit_json_has_spec_rmse_and_starts() {
     let r = brdftab(&[
