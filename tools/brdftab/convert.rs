@@ -5,7 +5,7 @@ use brdftab::Result;
 use brdftab::request::{self, ConvertOutput, ConvertSettings};
 use clap::Args;
 
-use brdftab_tools::outln;
+use brdftab_tools::errln;
 use brdftab_tools::progress::Bar;
 
 /// Arguments of `brdftab convert`.
@@ -24,7 +24,7 @@ pub struct ConvertArgs {
 /// Converts between formats and prints what was written.
 pub fn convert(a: ConvertArgs) -> Result<()> {
     match request::convert(&a.input, &a.output, &a.settings, &Bar::values())? {
-        ConvertOutput::Merl(r) => outln!(
+        ConvertOutput::Merl(r) => errln!(
             "{}: {} on the MERL grid (90 × 90 × 180 cells: the mean of the source over each, or \
              its own cells when it is on that grid) in {:.2} s",
             r.output,
@@ -33,7 +33,7 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
         )?,
         ConvertOutput::Rgl(r) => {
             let f = &r.written.fields;
-            outln!(
+            errln!(
                 "{}: {} as an RGL tensor file ({} φi × {} θi, {n}×{n} table, {} bytes, {:.2} s)",
                 a.output,
                 r.source,
@@ -44,14 +44,14 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
                 n = f.n
             )?;
             if let Some(e) = r.error {
-                outln!(
+                errln!(
                     "  error vs source (read back, {} pairs within 80°): relative RMSE of f_r weighted by cos θi cos θo {:.3e}, max relative {:.3e}",
                     e.pairs,
                     e.rel_rmse,
                     e.max_rel
                 )?;
                 let f = &e.fidelity;
-                outln!(
+                errln!(
                     "  over the whole domain (f_r cos θi cos θo): whole hemisphere {:.2} %, grazing band (a direction past 80°) {:.2} %, worst albedo {:.2} % at {}° (channel {})",
                     100.0 * f.whole,
                     100.0 * f.grazing,
@@ -62,21 +62,21 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
             }
         }
         ConvertOutput::Table { report: r, interp } => {
-            outln!("{}: {}", r.output, r.source)?;
-            outln!(
+            errln!("{}: {}", r.output, r.source)?;
+            errln!(
                 "  grid: {} ({} values, {:.2} s)",
                 r.grid_line(),
                 r.values,
                 r.seconds
             )?;
             if let Some(acc) = r.accuracy {
-                outln!(
+                errln!(
                     "  accuracy vs native ({interp:?}, {} pairs): relative RMSE of f_r cos θi cos θo {:.3e}, max relative {:.3e}",
                     acc.pairs,
                     acc.rel_rmse,
                     acc.max_rel
                 )?;
-                outln!(
+                errln!(
                     "  within 80° of the normal (Ngan et al.'s cut; grazing f_r of measured data ∝ 1/cos θo): relative RMSE {:.3e}, max relative {:.3e}",
                     acc.rel_rmse_80,
                     acc.max_rel_80

@@ -1,7 +1,7 @@
 //! `slice`: a slice image of any SOURCE.
 
 use brdftab::{Brdf, Error, Result};
-use brdftab_tools::outln;
+use brdftab_tools::errln;
 use brdftab_tools::preview::slice;
 use clap::{Args, ValueEnum};
 
@@ -126,6 +126,6 @@ pub fn slice(a: SliceArgs) -> Result<()> {
         ),
     };
     let legend = slice::write(&img, channel, &a.output)?;
-    outln!("{}: {what}; {legend}", a.output)?;
+    errln!("{}: {what}; {legend}", a.output)?;
     Ok(())
 }

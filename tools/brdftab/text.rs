@@ -30,6 +30,16 @@ macro_rules! outln {
     };
 }
 
+/// `eprintln!` as an expression of type `Result<()>`, for the report of a command whose product
+/// is a file (DESIGN.md, "stdout and stderr"): where `outln!` would print the product itself.
+#[macro_export]
+macro_rules! errln {
+    ($($t:tt)*) => {{
+        eprintln!($($t)*);
+        Ok::<(), brdftab::Error>(())
+    }};
+}
+
 /// Parses a line of exactly `N` numbers; `None` for blank and `#` lines. `name` and `lineno`
 /// go into the error.
 pub fn parse_numbers<const N: usize>(

@@ -55,7 +55,7 @@ fn info_eval_slice_convert() {
         "32",
     ]);
     assert!(r.ok, "{}", r.stderr);
-    assert!(r.stdout.contains("log10") && png.exists(), "{}", r.stdout);
+    assert!(r.stderr.contains("log10") && png.exists(), "{}", r.stderr);
 
     let bin = dir.join("pw.binary");
     let r = brdftab(&["convert", &f, bin.to_str().unwrap()]);

@@ -20,35 +20,37 @@ fn convert_writes_bsdf_files_and_reports_their_error() {
     let spec = r#"{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}"#;
     let r = brdftab(&["convert", spec, out_s, "--pairs", "20000"]);
     assert!(r.ok, "{}", r.stderr);
-    // The elevations are placed per source (16 to 32), the table 64 × 64 or 128 × 128.
+    // The elevations are placed per source (16 to 32), the table 64 × 64 or 128 × 128. The
+    // report is on stderr (a command that writes a file reports there; DESIGN.md), stdout empty.
+    assert!(r.stdout.is_empty(), "{}", r.stdout);
     let layout = r
-        .stdout
+        .stderr
         .split("1 φi × ")
         .nth(1)
         .and_then(|t| t.split(" table").next())
-        .unwrap_or_else(|| panic!("no layout in {}", r.stdout));
+        .unwrap_or_else(|| panic!("no layout in {}", r.stderr));
     let (nt, n) = layout.split_once(" θi, ").expect("θi, N×N");
     let nt: usize = nt.parse().unwrap();
-    assert!((16..=32).contains(&nt), "{}", r.stdout);
-    assert!(n == "64×64" || n == "128×128", "{}", r.stdout);
+    assert!((16..=32).contains(&nt), "{}", r.stderr);
+    assert!(n == "64×64" || n == "128×128", "{}", r.stderr);
     let rmse: f64 = r
-        .stdout
+        .stderr
         .split("cos θi cos θo ")
         .nth(1)
         .and_then(|t| t.split(',').next())
         .and_then(|t| t.trim().parse().ok())
-        .unwrap_or_else(|| panic!("no error figure in {}", r.stdout));
-    assert!(rmse < 0.02, "{}", r.stdout);
+        .unwrap_or_else(|| panic!("no error figure in {}", r.stderr));
+    assert!(rmse < 0.02, "{}", r.stderr);
     // What the cap hides is printed too: the whole hemisphere, the band past 80°, the albedo.
     let band: f64 = r
-        .stdout
+        .stderr
         .split("grazing band (a direction past 80°) ")
         .nth(1)
         .and_then(|t| t.split(' ').next())
         .and_then(|t| t.parse().ok())
-        .unwrap_or_else(|| panic!("no grazing figure in {}", r.stdout));
-    assert!(band > 100.0 * rmse, "{}", r.stdout);
-    assert!(r.stdout.contains("whole hemisphere") && r.stdout.contains("worst albedo"));
+        .unwrap_or_else(|| panic!("no grazing figure in {}", r.stderr));
+    assert!(band > 100.0 * rmse, "{}", r.stderr);
+    assert!(r.stderr.contains("whole hemisphere") && r.stderr.contains("worst albedo"));
     let r = brdftab(&["info", out_s]);
     assert!(
         r.ok && r.stdout.contains("rgb") && r.stdout.contains(&format!("φi 1 × θi {nt}")),
@@ -69,9 +71,9 @@ fn convert_writes_bsdf_files_and_reports_their_error() {
         "0",
     ]);
     assert!(
-        r.ok && r.stdout.contains("1 φi × 8 θi, 32×32 table"),
+        r.ok && r.stderr.contains("1 φi × 8 θi, 32×32 table"),
         "{}{}",
-        r.stdout,
+        r.stderr,
         r.stderr
     );
     let paper = rgl_dir().join("paper_white_rgb.bsdf");
@@ -84,9 +86,9 @@ fn convert_writes_bsdf_files_and_reports_their_error() {
         "20000",
     ]);
     assert!(
-        r.ok && r.stdout.contains("1 φi × 8 θi, 32×32 table"),
+        r.ok && r.stderr.contains("1 φi × 8 θi, 32×32 table"),
         "{}{}",
-        r.stdout,
+        r.stderr,
         r.stderr
     );
 
