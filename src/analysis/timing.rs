@@ -35,7 +35,9 @@ pub struct LookupTiming {
     pub repeats: usize,
     /// Wall-clock ns per `eval` on one thread.
     pub ns_per_lookup_single_thread: f64,
-    /// CPU ns per `eval` on one thread (NaN where unknown).
+    /// CPU ns per `eval` on one thread (NaN where unknown: no CPU clock, as where
+    /// `/proc/thread-self/schedstat` reads 0 in some containers; `null` in JSON, `unknown` in
+    /// `brdftab bench`'s text).
     pub cpu_ns_per_lookup_single_thread: f64,
     /// Lookups per wall-clock second of `eval_batch`.
     pub lookups_per_s_batch: f64,

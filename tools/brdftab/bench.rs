@@ -6,7 +6,7 @@ use brdftab::analysis::timing;
 use brdftab::{Error, Result};
 use clap::Args;
 
-use brdftab_tools::text::print_out;
+use brdftab_tools::text::{or_unknown, print_out};
 
 /// Arguments of `brdftab bench`.
 #[derive(Args)]
@@ -119,20 +119,24 @@ pub fn bench(a: BenchArgs) -> Result<()> {
         );
         let _ = writeln!(
             o,
-            "single:  {ns:.1} ns per lookup wall, {ns_cpu:.1} ns CPU time (median of {r}, one thread)"
+            "single:  {ns:.1} ns per lookup wall, {} ns CPU time (median of {r}, one thread)",
+            or_unknown(ns_cpu, 1)
         );
         let _ = writeln!(
             o,
-            "batch:   {:.2} M lookups/s wall (eval_batch, up to {} threads), {:.2} M/s per core of CPU time (median of {r})",
+            "batch:   {:.2} M lookups/s wall (eval_batch, up to {} threads), {} M/s per core of CPU time (median of {r})",
             t.lookups_per_s_batch / 1e6,
             t.threads,
-            t.lookups_per_s_batch_per_core_cpu_time / 1e6
+            or_unknown(t.lookups_per_s_batch_per_core_cpu_time / 1e6, 2)
         );
         let _ = writeln!(
             o,
-            "f32:     {:.1} ns per lookup wall, {:.2} M/s per core batch: the same pairs rounded to f32 as renderers pass them (median of {r})",
+            "f32:     {:.1} ns per lookup wall, {} M/s per core batch: the same pairs rounded to f32 as renderers pass them (median of {r})",
             t.ns_per_lookup_f32_directions,
-            t.lookups_per_s_batch_f32_directions_per_core_cpu_time / 1e6
+            or_unknown(
+                t.lookups_per_s_batch_f32_directions_per_core_cpu_time / 1e6,
+                2
+            )
         );
         let _ = writeln!(
             o,
@@ -146,8 +150,8 @@ pub fn bench(a: BenchArgs) -> Result<()> {
         );
         let _ = writeln!(
             o,
-            "sample batch: {:.2} M samples/s per core of CPU time (sample_batch on the same views, median of {r})",
-            t.samples_per_s_batch_per_core_cpu_time / 1e6
+            "sample batch: {} M samples/s per core of CPU time (sample_batch on the same views, median of {r})",
+            or_unknown(t.samples_per_s_batch_per_core_cpu_time / 1e6, 2)
         );
     }
     print_out(&o)

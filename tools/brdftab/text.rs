@@ -114,6 +114,17 @@ pub fn parse_direction(s: &str, flag: &str) -> Result<DVec3> {
     Ok(d)
 }
 
+/// `x` with `prec` decimals, or `unknown` where it is NaN: the CPU-time figures of `bench` are NaN
+/// where no CPU clock can be read (`/proc/.../schedstat` reads 0 in some containers), and
+/// printed `NaN ns CPU time` as if it were a measurement.
+pub fn or_unknown(x: f64, prec: usize) -> String {
+    if x.is_nan() {
+        "unknown".into()
+    } else {
+        format!("{x:.prec$}")
+    }
+}
+
 /// `x` as typed (its shortest round-trip form), in exponent form when the plain form runs to
 /// more than 16 characters (`1e-300`, not `0.000…1` with 300 zeros; `1e300`).
 pub fn shortest(x: f64) -> String {
@@ -128,6 +139,14 @@ pub fn shortest(x: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_unknown_figure_is_not_printed_as_nan() {
+        assert_eq!(or_unknown(f64::NAN, 1), "unknown");
+        assert_eq!(or_unknown(f64::NAN / 1e6, 2), "unknown");
+        assert_eq!(or_unknown(12.345, 1), "12.3");
+        assert_eq!(or_unknown(224.774, 2), "224.77");
+    }
 
     #[test]
     fn pairs_skip_comments_and_errors_name_the_line() {
