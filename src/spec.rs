@@ -209,7 +209,8 @@ pub struct ModelInfo {
 }
 
 impl ModelInfo {
-    /// The parameters as one line, e.g. `ks: Value ≥ 0, n: number ≥ 0`.
+    /// The parameters as one line, e.g. `ks: Value ≥ 0, n: number ≥ 0`, then the model's rule
+    /// after a semicolon.
     pub fn params_line(&self) -> String {
         let mut v: Vec<String> = self
             .params
@@ -237,10 +238,11 @@ impl ModelInfo {
                 format!("{}: {kind}{bound}{default}", p.name)
             })
             .collect();
+        let mut line = v.join(", ");
         if let Some(r) = self.rule {
-            v.push(format!("({r})"));
+            line += &format!("; {r}");
         }
-        v.join(", ")
+        line
     }
 }
 
@@ -806,6 +808,16 @@ mod tests {
         let e = ModelSpec::parse(r#"{"model": "ggx", "alpha": 0.1, "alpha_x": 0.2}"#).unwrap_err();
         assert!(e.to_string().contains("alpha"), "{e}");
         assert!(MODELS[9].params_line().contains("alpha_x: number > 0"));
+        // The rule follows the parameters after a semicolon (it was ", (rule)").
+        let sum = MODELS
+            .iter()
+            .find(|m| m.name == "sum")
+            .unwrap()
+            .params_line();
+        assert!(
+            sum.ends_with("= all 1; at least one term; one weight per term"),
+            "{sum}"
+        );
     }
 
     /// Every number at either end of [`crate::spectrum::NUMBER_RANGE`] evaluates to finite

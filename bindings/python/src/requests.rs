@@ -34,7 +34,9 @@ fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyA
 
 /// Bakes SOURCE into OUTPUT: a `.btdb` file, or `DB#NAME` (a table of a database). The
 /// keywords are the CLI's `bake` flags, snake_cased (`preset`, `grid`, `codec`, ...; the
-/// fields of the library's `BakeSettings`). Returns what `brdftab info --json OUTPUT` reports.
+/// fields of the library's `BakeSettings`). `name` names a `.btdb` file's table; with `DB#NAME`
+/// it may only repeat NAME (another name is an error). Returns what `brdftab info --json OUTPUT`
+/// reports.
 #[pyfunction]
 #[pyo3(signature = (source, output, **options))]
 pub(crate) fn bake(
