@@ -172,6 +172,11 @@ pub trait Brdf: Send + Sync {
     /// interpolated linearly between wavelength channels (constant outside them), RGB through the
     /// colour-preserving basis of [`crate::colour`]; analytic models with spectral parameters
     /// override it to use their spectral data directly.
+    ///
+    /// `nm` must be a wavelength ([`crate::spectrum::is_wavelength`]: finite, > 0): at anything
+    /// else every source returns NaN, whatever the directions (this method and
+    /// [`Brdf::eval_at_wavelengths`] cannot fail; the Python and C hosts refuse such wavelengths
+    /// with an error), rather than an end channel's value, which passed NaN or 0 nm off as data.
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
         let mut buf = [0.0f32; MAX_CHANNELS];
         let n = self.channels().len().min(MAX_CHANNELS);
@@ -323,7 +328,8 @@ pub trait Brdf: Send + Sync {
     ///
     /// The default interpolates a delta draw's channel weights as `eval_wavelength`'s default
     /// interpolates channels; the delta models (and sums holding them) override it with their
-    /// spectral data. `weight` must hold `nm.len()` values.
+    /// spectral data. `weight` must hold `nm.len()` values; a weight at a non-wavelength is NaN
+    /// (as [`Brdf::eval_wavelength`]'s value).
     ///
     /// # Example
     /// ```

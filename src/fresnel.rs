@@ -570,8 +570,12 @@ impl Fresnel {
         }
     }
 
-    /// F at wavelength `nm` from the spectral data.
+    /// F at wavelength `nm` from the spectral data; NaN at a non-wavelength
+    /// ([`crate::spectrum::is_wavelength`]).
     pub fn eval_at(&self, cos_i: f64, nm: f64) -> f64 {
+        if !crate::spectrum::is_wavelength(nm) {
+            return f64::NAN;
+        }
         match self {
             Fresnel::None => 1.0,
             Fresnel::Conductor { n_spec, k_spec, .. } => {

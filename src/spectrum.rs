@@ -100,7 +100,9 @@ impl Channels {
 
     /// How channel data gives a value at wavelength `nm`: for wavelengths, linear interpolation
     /// between the two channels around `nm` (the nearest end channel outside them); for RGB, the
-    /// colour-preserving basis [`crate::colour::rgb_basis_at`].
+    /// colour-preserving basis [`crate::colour::rgb_basis_at`]. At a non-wavelength (NaN, ±∞,
+    /// ≤ 0 nm: not [`is_wavelength`]) the weights are NaN, so the mix is NaN rather than an end
+    /// channel's value passed off as data.
     #[inline]
     pub fn mix_at(&self, nm: f64) -> ChannelMix {
         match self {
@@ -110,6 +112,12 @@ impl Channels {
             },
             Channels::Wavelengths(w) => {
                 let (i0, i1, t) = lerp_sorted(w, nm, |k| k);
+                if t.is_nan() {
+                    return ChannelMix {
+                        index: [i0; 3],
+                        weight: [f64::NAN; 3],
+                    };
+                }
                 ChannelMix {
                     index: [i0, i1, i1],
                     weight: [1.0 - t, t, 0.0],
@@ -124,7 +132,7 @@ impl Channels {
 pub struct ChannelMix {
     /// The channels read.
     pub index: [usize; 3],
-    /// Their weights (≥ 0, summing to 1).
+    /// Their weights (≥ 0, summing to 1; NaN at a non-wavelength).
     pub weight: [f64; 3],
 }
 
@@ -144,18 +152,33 @@ impl ChannelMix {
 }
 
 /// Whether `nm` can be a wavelength: finite and positive. The rule of
-/// [`Channels::wavelengths`], and of every wavelength a host evaluates at.
+/// [`Channels::wavelengths`], and of every wavelength a host evaluates at: the Python and C
+/// hosts refuse anything else with an error; in Rust, where [`crate::Brdf::eval_wavelength`]
+/// and its kin cannot fail, every source gives NaN there (never an end channel's value, which
+/// passed a NaN or 0 nm off as data).
+#[inline]
 pub fn is_wavelength(nm: f64) -> bool {
     nm.is_finite() && nm > 0.0
 }
 
+/// The neighbours of `nm` in the increasing list `w` and the weight of the upper one; the
+/// weight is NaN at a non-wavelength ([`is_wavelength`]). Checked only at the ends, where a
+/// non-wavelength lands (NaN fails every comparison, ∞ and ≤ 0 fall outside any list).
 fn lerp_sorted(w: &[f64], nm: f64, map: impl Fn(usize) -> usize) -> (usize, usize, f64) {
     let n = w.len();
     if n == 1 || nm.is_nan() || nm <= w[0] {
-        return (map(0), map(0), 0.0);
+        return (
+            map(0),
+            map(0),
+            if is_wavelength(nm) { 0.0 } else { f64::NAN },
+        );
     }
     if nm >= w[n - 1] {
-        return (map(n - 1), map(n - 1), 0.0);
+        return (
+            map(n - 1),
+            map(n - 1),
+            if is_wavelength(nm) { 0.0 } else { f64::NAN },
+        );
     }
     let k = w.partition_point(|&x| x <= nm).clamp(1, n - 1);
     let t = (nm - w[k - 1]) / (w[k] - w[k - 1]);
@@ -183,9 +206,10 @@ pub enum Value {
 
 impl Value {
     /// The value at wavelength `nm` (RGB values through the colour-preserving basis,
-    /// [`Channels::mix_at`]).
+    /// [`Channels::mix_at`]); NaN at a non-wavelength ([`is_wavelength`]), a grey value too.
     pub fn at(&self, nm: f64) -> f64 {
         match self {
+            Value::Grey(_) if !is_wavelength(nm) => f64::NAN,
             Value::Grey(v) => *v,
             Value::Rgb(rgb) => Channels::Rgb.mix_at(nm).apply(|i| rgb[i]),
             Value::Spectral {
@@ -477,6 +501,41 @@ mod tests {
             ch.mix_at(500.0).apply(|i| [f64::INFINITY, 3.0, 5.0][i]),
             3.0
         );
+    }
+
+    #[test]
+    fn a_non_wavelength_has_no_value() {
+        // NaN, ±∞, 0 and negative nm are not wavelengths: NaN, never an end channel's value.
+        let ch = Channels::wavelengths(vec![400.0, 500.0]).unwrap();
+        let spectral = Value::Spectral {
+            wavelengths: vec![400.0, 500.0],
+            values: vec![1.0, 3.0],
+        };
+        for nm in [
+            f64::NAN,
+            0.0,
+            -0.0,
+            -450.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ] {
+            assert!(ch.mix_at(nm).apply(|i| [1.0, 3.0][i]).is_nan(), "{nm}");
+            assert!(
+                Channels::Rgb.mix_at(nm).apply(|i| [0.2; 3][i]).is_nan(),
+                "{nm}"
+            );
+            for v in [
+                Value::Grey(0.5),
+                Value::Rgb([0.1, 0.2, 0.3]),
+                spectral.clone(),
+            ] {
+                assert!(v.at(nm).is_nan(), "{v:?} at {nm}");
+            }
+        }
+        // The ends of real wavelengths are held, as before.
+        assert_eq!(ch.mix_at(1e-300).apply(|i| [1.0, 3.0][i]), 1.0);
+        assert_eq!(ch.mix_at(1e300).apply(|i| [1.0, 3.0][i]), 3.0);
+        assert_eq!(Value::Grey(0.5).at(1e-300), 0.5);
     }
 
     #[test]

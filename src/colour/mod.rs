@@ -241,17 +241,20 @@ fn solve6(mut a: [[f64; 6]; 6], mut b: [f64; 6]) -> [f64; 6] {
 
 /// Weights (R, G, B) of the RGB basis spectra at `nm`: RGB data (r, g, b) at this wavelength is
 /// `r w[0] + g w[1] + b w[2]`. The weights are ≥ 0 and sum to 1; they are interpolated linearly
-/// between 1 nm points and held at their end values outside [`RANGE_NM`] (NaN gives the short
-/// end's).
+/// between 1 nm points and held at their end values outside [`RANGE_NM`]. At a non-wavelength
+/// (NaN, ±∞, ≤ 0 nm: not a finite number of nm > 0, the rule of `spectrum::is_wavelength`) they
+/// are NaN: RGB data read there is NaN, not the violet or red end's colour passed off as data.
 #[inline]
 pub fn rgb_basis_at(nm: f64) -> [f64; 3] {
     let b = &tables().basis;
     let u = nm - RANGE_NM.0;
-    if !(u > 0.0) {
-        return b[0];
-    }
-    if u >= (N - 1) as f64 {
-        return b[N - 1];
+    if !(u > 0.0) || u >= (N - 1) as f64 {
+        // Only here can a non-wavelength land (NaN fails `u > 0`, ∞ and ≤ 0 are outside).
+        // `spectrum::is_wavelength`, written out: `spectrum` builds on this module.
+        if !(nm.is_finite() && nm > 0.0) {
+            return [f64::NAN; 3];
+        }
+        return if u > 0.0 { b[N - 1] } else { b[0] };
     }
     let i = u as usize;
     let t = u - i as f64;
@@ -388,7 +391,7 @@ mod tests {
                 );
             }
         }
-        for nm in [300.0, 360.0, 444.4, 555.0, 700.0, 900.0, f64::NAN] {
+        for nm in [1e-300, 300.0, 360.0, 444.4, 555.0, 700.0, 900.0, 1e300] {
             let b = rgb_basis_at(nm);
             assert!((0.3 * b[0] + 0.3 * b[1] + 0.3 * b[2] - 0.3).abs() < 1e-15);
         }

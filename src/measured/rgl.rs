@@ -43,7 +43,7 @@ use super::tensor::{Dtype, Field, TensorFile};
 use crate::brdf::{BakeSource, Brdf, Flags};
 use crate::error::{Error, Result};
 use crate::geometry;
-use crate::spectrum::{ChannelMix, Channels, MAX_CHANNELS};
+use crate::spectrum::{ChannelMix, Channels, MAX_CHANNELS, is_wavelength};
 use crate::table::sampling::TableSampler;
 pub(crate) use crate::table::warp2d::{Corners, Planes, Warp};
 use crate::table::warp2d::{NO_PARAMS, bilinear};
@@ -719,6 +719,9 @@ impl Brdf for RglBrdf {
     }
 
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        if !is_wavelength(nm) {
+            return f64::NAN; // not a wavelength: no value (Channels::mix_at)
+        }
         let mix = match &self.wavelengths {
             Some(wl) => spectral_mix(wl, nm),
             None => Channels::Rgb.mix_at(nm),
@@ -735,10 +738,16 @@ impl Brdf for RglBrdf {
     /// them (the inversion is most of a lookup's cost).
     fn eval_at_wavelengths(&self, wi: DVec3, wo: DVec3, nm: &[f64], out: &mut [f32]) {
         let Some((sample, k, scale, cos_o)) = self.prepare(wi, wo) else {
-            out.iter_mut().take(nm.len()).for_each(|o| *o = 0.0);
+            for (o, &x) in out.iter_mut().zip(nm) {
+                *o = if is_wavelength(x) { 0.0 } else { f32::NAN };
+            }
             return;
         };
         for (o, &x) in out.iter_mut().zip(nm) {
+            if !is_wavelength(x) {
+                *o = f32::NAN;
+                continue;
+            }
             let mix = match &self.wavelengths {
                 Some(wl) => spectral_mix(wl, x),
                 None => Channels::Rgb.mix_at(x),

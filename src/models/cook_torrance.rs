@@ -222,6 +222,9 @@ impl Brdf for CookTorrance {
     }
 
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        if !crate::spectrum::is_wavelength(nm) {
+            return f64::NAN; // not a wavelength: no value (Channels::mix_at)
+        }
         match self.geometry(wi, wo) {
             Some(g) => self.ks_spec.at(nm) * g.dg * self.fresnel.eval_at(g.l_dot_h, nm),
             None => 0.0,

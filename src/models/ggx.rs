@@ -314,6 +314,9 @@ impl Brdf for Ggx {
     }
 
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        if !crate::spectrum::is_wavelength(nm) {
+            return f64::NAN; // not a wavelength: no value (Channels::mix_at)
+        }
         match self.lobe(wi, wo) {
             Some(lobe) => self.ks_spec.at(nm) * lobe.dg * self.fresnel.eval_at(lobe.l_dot_h, nm),
             None => 0.0,

@@ -52,6 +52,9 @@ impl Brdf for Lambert {
     }
 
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        if !crate::spectrum::is_wavelength(nm) {
+            return f64::NAN; // not a wavelength: no value (Channels::mix_at)
+        }
         if geometry::upper_pair(wi, wo).is_some() {
             self.kd_spec.at(nm)
         } else {

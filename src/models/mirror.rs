@@ -75,8 +75,12 @@ impl Brdf for Mirror {
         out[..self.channels.len()].fill(0.0);
     }
 
-    fn eval_wavelength(&self, _wi: DVec3, _wo: DVec3, _nm: f64) -> f64 {
-        0.0
+    fn eval_wavelength(&self, _wi: DVec3, _wo: DVec3, nm: f64) -> f64 {
+        if crate::spectrum::is_wavelength(nm) {
+            0.0
+        } else {
+            f64::NAN
+        }
     }
 
     fn flags(&self) -> Flags {
@@ -221,8 +225,12 @@ impl Brdf for Refractor {
         out[..self.channels.len()].fill(0.0);
     }
 
-    fn eval_wavelength(&self, _wi: DVec3, _wo: DVec3, _nm: f64) -> f64 {
-        0.0
+    fn eval_wavelength(&self, _wi: DVec3, _wo: DVec3, nm: f64) -> f64 {
+        if crate::spectrum::is_wavelength(nm) {
+            0.0
+        } else {
+            f64::NAN
+        }
     }
 
     fn flags(&self) -> Flags {
@@ -287,7 +295,10 @@ impl Brdf for Refractor {
         let s = self.sample(wo, u, &mut buf[..self.channels.len()])?;
         let cos = geometry::unit(wo)?.z;
         for (w, &x) in weight.iter_mut().zip(nm) {
-            *w = (1.0 - fresnel::dielectric(cos, self.eta_spec.at(x))) as f32;
+            *w = match crate::spectrum::is_wavelength(x) {
+                true => (1.0 - fresnel::dielectric(cos, self.eta_spec.at(x))) as f32,
+                false => f32::NAN,
+            };
         }
         Some(s)
     }

@@ -99,6 +99,9 @@ impl Brdf for OrenNayar {
     }
 
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        if !crate::spectrum::is_wavelength(nm) {
+            return f64::NAN; // not a wavelength: no value (Channels::mix_at)
+        }
         match crate::geometry::upper_pair(wi, wo) {
             Some((wi, wo)) => self.kd_spec.at(nm) * self.factor(wi, wo),
             None => 0.0,

@@ -566,6 +566,9 @@ impl Brdf for Sum {
     }
 
     fn eval_wavelength(&self, wi: DVec3, wo: DVec3, nm: f64) -> f64 {
+        if !crate::spectrum::is_wavelength(nm) {
+            return f64::NAN; // also with every weight 0
+        }
         self.terms
             .iter()
             .zip(&self.weights)

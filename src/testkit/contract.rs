@@ -271,8 +271,58 @@ fn at_wavelengths(brdf: &dyn Brdf, pairs: &[(DVec3, DVec3)], log: &mut Log) {
     }
 }
 
+/// At a non-wavelength (NaN, ±∞, 0, < 0 nm) `eval_wavelength`, `eval_at_wavelengths` and the
+/// weights of `sample_wavelengths` are NaN, on pairs of every kind ([`Brdf::eval_wavelength`]):
+/// never a value a renderer could take for data.
+fn at_non_wavelengths(brdf: &dyn Brdf, pairs: &[(DVec3, DVec3)], log: &mut Log) {
+    let bad = [
+        f64::NAN,
+        0.0,
+        -0.0,
+        -550.0,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    let mut out = [0.0f32; 7];
+    for (k, &(a, b)) in pairs.iter().enumerate().take(50) {
+        let (wi, wo) = match k % 5 {
+            0 => (a, DVec3::new(b.x, b.y, -b.z)),
+            _ => (a, b),
+        };
+        // One real wavelength among them keeps its value.
+        let nm = [bad[0], bad[1], bad[2], 550.0, bad[3], bad[4], bad[5]];
+        brdf.eval_at_wavelengths(wi, wo, &nm, &mut out);
+        for (j, &x) in nm.iter().enumerate() {
+            let f = brdf.eval_wavelength(wi, wo, x);
+            if x == 550.0 {
+                if out[j].to_bits() != (f as f32).to_bits() {
+                    log.fail("non-wavelength", || {
+                        format!("({wi}, {wo}) at 550 nm among non-wavelengths: {}", out[j])
+                    });
+                }
+            } else if !f.is_nan() || !out[j].is_nan() {
+                log.fail("non-wavelength", || {
+                    format!(
+                        "({wi}, {wo}) at {x} nm: eval_wavelength {f}, eval_at_wavelengths {} \
+                         (NaN expected)",
+                        out[j]
+                    )
+                });
+            }
+        }
+        let u = DVec2::new((k as f64 + 0.5) / 50.0, 0.37);
+        let mut w = [0.0f32; 6];
+        if brdf.sample_wavelengths(b, u, &bad, &mut w).is_some() && w.iter().any(|v| !v.is_nan()) {
+            log.fail("non-wavelength", || {
+                format!("sample_wavelengths({b}, {u}) weights {w:?} at {bad:?} (NaN expected)")
+            });
+        }
+    }
+}
+
 fn batches(brdf: &dyn Brdf, opts: &Contract, pairs: &[(DVec3, DVec3)], log: &mut Log) {
     at_wavelengths(brdf, pairs, log);
+    at_non_wavelengths(brdf, pairs, log);
     let c = brdf.channels().len();
     let (wi, wo): (Vec<DVec3>, Vec<DVec3>) = pairs
         .iter()

@@ -15,6 +15,8 @@
 //!   (whose squares under- or overflow), gives what the unit direction gives: f_r, pdf and the
 //!   sample;
 //! - **batches**: `eval_batch` gives what `eval` gives, pair by pair;
+//! - **wavelengths**: `eval_at_wavelengths` gives what `eval_wavelength` gives, and at a
+//!   non-wavelength (NaN, ±∞, ≤ 0 nm) both, and `sample_wavelengths`' weights, are NaN;
 //! - **sampling**: a sample's pdf is `pdf(wi, wo)`, its weight is f_r cos θi / pdf, the fused
 //!   `eval_pdf` agrees with both, and sampled directions are unit and above the horizon (a delta
 //!   lobe: samples marked delta with finite weights).
