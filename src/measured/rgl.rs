@@ -61,14 +61,14 @@ fn warp_of(planes: Planes, file: &TensorFile, field: &Field) -> Result<Warp> {
 /// Interval index `i` (clamped to [0, n−2]) with `values[i]` ≤ x, and the weight of `i + 1`
 /// (clamped to [0, 1]). A single value gives (0, 0) — no interpolation.
 #[inline]
-fn param_weight(values: &[f32], x: f64) -> (usize, usize, f64) {
+fn param_weight<T: Copy + Into<f64>>(values: &[T], x: f64) -> (usize, usize, f64) {
     let n = values.len();
     if n < 2 {
         return (0, 0, 0.0);
     }
-    let count = values.partition_point(|&v| v as f64 <= x);
+    let count = values.partition_point(|&v| v.into() <= x);
     let i = count.saturating_sub(1).min(n - 2);
-    let (p0, p1) = (values[i] as f64, values[i + 1] as f64);
+    let (p0, p1) = (values[i].into(), values[i + 1].into());
     let w = ((x - p0) / (p1 - p0)).clamp(0.0, 1.0);
     (i, i + 1, w)
 }
@@ -77,9 +77,8 @@ fn param_weight(values: &[f32], x: f64) -> (usize, usize, f64) {
 /// per texel (`slices × 3 × ny × nx`): what a spectral renderer's pixel shows of each measured
 /// spectrum, read linearly between the file's wavelengths as everywhere. Negative values (noise
 /// in dark channels) are clipped first, as the reader clips what it interpolates.
-fn project_to_rgb(table: &Planes, wavelengths: &[f32]) -> Planes {
-    let nm: Vec<f64> = wavelengths.iter().map(|&x| x as f64).collect();
-    let w = crate::colour::srgb_weights(&nm);
+fn project_to_rgb(table: &Planes, nm: &[f64]) -> Planes {
+    let w = crate::colour::srgb_weights(nm);
     let (n, plane) = (nm.len(), table.plane_len());
     let slices = table.data.len() / (n * plane).max(1);
     let mut data = vec![0f32; slices * 3 * plane];
@@ -111,8 +110,16 @@ fn project_to_rgb(table: &Planes, wavelengths: &[f32]) -> Planes {
     }
 }
 
+/// A file's wavelength (stored as f32) as the number written: the shortest decimal that reads
+/// back as the same f32 (400.1, not 400.1000061035156, which named the channel
+/// `400.1000061035156nm` and made `wavelengths` differ from what the writer was given). Strictly
+/// increasing f32s stay strictly increasing, and each still rounds to its f32.
+fn decimal_nm(x: f32) -> f64 {
+    x.to_string().parse().unwrap_or(x as f64)
+}
+
 /// The file's spectral channels read at `nm`: linear between the two around it.
-fn spectral_mix(wavelengths: &[f32], nm: f64) -> ChannelMix {
+fn spectral_mix(wavelengths: &[f64], nm: f64) -> ChannelMix {
     let (c0, c1, t) = param_weight(wavelengths, nm);
     ChannelMix {
         index: [c0, c1, c1],
@@ -168,8 +175,9 @@ pub struct RglBrdf {
     luminance: Option<Warp>,
     /// Reflectance: slices × file channels × ny × nx.
     table: Planes,
-    /// File channels: 3 for RGB, else the wavelengths (nm) of `spectra`.
-    wavelengths: Option<Vec<f32>>,
+    /// File channels: 3 for RGB, else the wavelengths (nm) of `spectra`, as written
+    /// ([`decimal_nm`]).
+    wavelengths: Option<Vec<f64>>,
     /// Per output channel: the file channels it reads and their weights.
     out_map: Vec<ChannelMix>,
     /// A spectral file asked for RGB: each texel's spectrum projected to linear sRGB
@@ -359,7 +367,10 @@ impl RglBrdf {
             if wl.is_empty() || wl.windows(2).any(|w| w[1] <= w[0]) || wl[0] <= 0.0 {
                 return Err(tf.error(wf, "wavelengths must be positive and strictly increasing"));
             }
-            (f, Some(wl))
+            (
+                f,
+                Some(wl.into_iter().map(decimal_nm).collect::<Vec<f64>>()),
+            )
         } else {
             return Err(Error::format(
                 tf.file_name(),
@@ -418,12 +429,8 @@ impl RglBrdf {
         let channels = match (channels, &wavelengths) {
             (Some(c), _) => c.clone(),
             (None, None) => Channels::Rgb,
-            (None, Some(wl)) if wl.len() <= MAX_CHANNELS => {
-                Channels::wavelengths(wl.iter().map(|&x| x as f64).collect())?
-            }
-            (None, Some(wl)) => {
-                Channels::linspace(wl[0] as f64, wl[wl.len() - 1] as f64, MAX_CHANNELS)?
-            }
+            (None, Some(wl)) if wl.len() <= MAX_CHANNELS => Channels::wavelengths(wl.clone())?,
+            (None, Some(wl)) => Channels::linspace(wl[0], wl[wl.len() - 1], MAX_CHANNELS)?,
         };
         let rgb_of_spectra = match (&channels, &wavelengths) {
             (Channels::Rgb, Some(wl)) => Some(project_to_rgb(&table, wl)),

@@ -214,6 +214,43 @@ fn spectral_source_writes_spectra_and_wavelengths() {
 }
 
 #[test]
+fn a_spectral_files_wavelengths_read_back_as_written() {
+    // 400.1 nm is stored as the f32 400.1000061…: the reader used to name the channel
+    // `400.1000061035156nm` and report that wavelength, not the one written.
+    let nm = vec![400.1, 550.3, 700.7];
+    let ch = Channels::wavelengths(nm.clone()).unwrap();
+    let src = model(CT_GOLD, &ch);
+    let o = Options {
+        theta_i: Some(4),
+        resolution: Some(16),
+        ..Options::default()
+    };
+    let f = encode(&*src, &o, &Silent).unwrap();
+    let t = TensorFile::from_bytes("mem.bsdf", f.to_bytes()).unwrap();
+    let back = RglBrdf::from_tensor(&t, None).unwrap();
+    assert_eq!(back.channels(), &ch);
+    assert_eq!(back.channels().names(), ["400.1nm", "550.3nm", "700.7nm"]);
+    assert!(
+        back.summary().kind.contains("400.1–700.7 nm"),
+        "{}",
+        back.summary().kind
+    );
+    // Each channel is the file's value at its wavelength, exactly.
+    let (wi, wo) = (
+        glam::DVec3::new(0.3, 0.1, 0.9),
+        glam::DVec3::new(-0.2, 0.1, 0.95),
+    );
+    let mut v = [0.0f32; 3];
+    back.eval(wi, wo, &mut v);
+    let mut at = [0.0f32; 3];
+    back.eval_at_wavelengths(wi, wo, &nm, &mut at);
+    assert_eq!(v, at);
+    assert!(v.iter().all(|&x| x > 0.0), "{v:?}");
+    // Re-encoded in its own parameterization, it is still the same channels.
+    assert!(same_channels(&f.wavelengths, back.channels()));
+}
+
+#[test]
 fn anisotropic_source_writes_several_azimuths() {
     let src = model(
         r#"{"model": "sum", "terms": [{"model": "lambert", "kd": 0.1}, {"model": "ggx", "alpha_x": 0.2, "alpha_y": 0.5}]}"#,
