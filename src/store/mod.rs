@@ -470,10 +470,13 @@ impl StoredTable {
         Ok(v)
     }
 
-    /// Decodes the whole table (all chunks in parallel), outermost axis first.
+    /// Decodes the whole table (all chunks in parallel), outermost axis first. The vector has
+    /// room for [`Packed::PAD`](crate::table::kernel::Packed::PAD) values more, so that a
+    /// table's one-array kernel keeps it without a copy.
     pub fn read_all(&self) -> Result<Vec<f32>> {
         let total = self.index.iter().map(|e| e.values as usize).sum();
-        let mut out = vec![0.0f32; total];
+        let mut out = Vec::with_capacity(total + crate::table::kernel::Packed::PAD);
+        out.resize(total, 0.0f32);
         let mut parts = Vec::with_capacity(self.index.len());
         let mut rest = out.as_mut_slice();
         for e in &self.index {

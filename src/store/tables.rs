@@ -259,16 +259,12 @@ pub fn open_brdf_at(
         None => store.single()?,
     };
     if eager {
-        use rayon::prelude::*;
-        let chunks: Vec<Vec<f32>> = crate::par::install(|| {
-            (0..t.chunk_count())
-                .into_par_iter()
-                .map(|i| t.decode_chunk(i))
-                .collect::<Result<_>>()
-        })?;
+        // Decoded in parallel into one array, which the table (and an exact kernel) keeps: the
+        // chunks decoded apart and then concatenated held the table three times over.
+        let grid = t.grid()?;
         let table = Table::new(
-            t.grid()?,
-            chunks.concat(),
+            grid,
+            t.read_all()?,
             format!("table `{}` from {path}", t.header().name),
         )?;
         return Ok(crate::table::TabulatedBrdf::from_table(table));

@@ -130,8 +130,9 @@ impl TabulatedBrdf {
                 _ => OnceLock::from(Arc::<[f32]>::from(&*v)),
             });
         }
+        // The table's own array becomes an exact kernel's (no second copy of it).
         let packed = match &kernel {
-            Some(k) => OnceLock::from(Packed::for_kernel(k, &values)),
+            Some(k) => OnceLock::from(Packed::for_kernel_owned(k, values)),
             None => OnceLock::new(),
         };
         TabulatedBrdf {
@@ -356,7 +357,8 @@ impl TabulatedBrdf {
     #[cold]
     fn load_packed(&self) -> Packed {
         let l = self.grid.layout();
-        let mut all = Vec::with_capacity(l.len());
+        // Room for the padding: an exact kernel keeps this array as it is.
+        let mut all = Vec::with_capacity(l.len() + Packed::PAD);
         for a in 0..l.chunk_count() {
             if let Some(c) = self.chunks[a].get() {
                 if c.len() != l.chunk_len(a) {
@@ -378,7 +380,7 @@ impl TabulatedBrdf {
             }
         }
         match &self.kernel {
-            Some(k) => Packed::for_kernel(k, &all),
+            Some(k) => Packed::for_kernel_owned(k, all),
             None => Packed::empty(),
         }
     }

@@ -85,14 +85,26 @@ impl Packed {
 
     /// `values` as they are (f32; non-finite ones become 0).
     pub fn exact(values: &[f32]) -> Packed {
-        let full = values
-            .iter()
-            .map(|&v| if v.is_finite() { v } else { 0.0 })
-            .chain(std::iter::repeat_n(0.0, PACK_PAD))
-            .collect();
+        let mut v = Vec::with_capacity(values.len() + PACK_PAD);
+        v.extend_from_slice(values);
+        Packed::exact_owned(v)
+    }
+
+    /// [`Packed::exact`] of values the caller gives up, kept in their own allocation: a table's
+    /// one array is not copied into a second (the first lookup of a 70 MB table peaked at
+    /// twice its size, an eager open at three times).
+    pub fn exact_owned(mut values: Vec<f32>) -> Packed {
+        for v in &mut values {
+            if !v.is_finite() {
+                *v = 0.0;
+            }
+        }
+        // Exactly the padding more: a doubled capacity would be shrunk (copied) into the box.
+        values.reserve_exact(PACK_PAD);
+        values.extend_from_slice(&[0.0; PACK_PAD]);
         Packed {
             bits: Box::new([]),
-            full,
+            full: values.into_boxed_slice(),
             unscale: 1.0,
         }
     }
@@ -105,6 +117,20 @@ impl Packed {
             Packed::new(values)
         }
     }
+
+    /// [`Packed::for_kernel`] of values the caller gives up: exact values keep their allocation
+    /// ([`Packed::exact_owned`]; reserve [`Packed::PAD`] more for no reallocation).
+    pub fn for_kernel_owned(kernel: &Kernel, values: Vec<f32>) -> Packed {
+        if kernel.exact_values() {
+            Packed::exact_owned(values)
+        } else {
+            Packed::new(&values)
+        }
+    }
+
+    /// The zeros after the values: a vector given to [`Packed::exact_owned`] with this much
+    /// spare capacity is not reallocated.
+    pub const PAD: usize = PACK_PAD;
 
     /// No values (a table that could not be loaded: every lookup gives 0).
     pub fn empty() -> Packed {

@@ -1,0 +1,137 @@
+//! What reading a stored table costs in memory, measured by a counting allocator: a table
+//! opened (lazily then looked up, or eagerly) is held once, not two or three times over while
+//! it loads.
+//!
+//! The allocator counts every thread (an eager open decodes on the library's pool), so the
+//! tests of this file take turns on one lock.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+
+use brdftab::codec::{Codec, Quant};
+use brdftab::store::{Source, tables};
+use brdftab::table::{Grid, Mapping, Param, Symmetry, Table};
+use brdftab::testkit::TempDir;
+use brdftab::{Brdf, Channels};
+use glam::DVec3;
+
+/// The system allocator, counting live bytes, their peak and every byte ever allocated.
+struct Counting;
+
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+static TOTAL: AtomicUsize = AtomicUsize::new(0);
+
+fn added(n: usize) {
+    let live = LIVE.fetch_add(n, Relaxed) + n;
+    PEAK.fetch_max(live, Relaxed);
+    TOTAL.fetch_add(n, Relaxed);
+}
+
+// SAFETY: every call is forwarded to `System` unchanged; only counters are added.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        added(l.size());
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn alloc_zeroed(&self, l: Layout) -> *mut u8 {
+        added(l.size());
+        unsafe { System.alloc_zeroed(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        LIVE.fetch_sub(l.size(), Relaxed);
+        unsafe { System.dealloc(p, l) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, new: usize) -> *mut u8 {
+        // Counted as the old block and the new one alive together, as a copy would hold them.
+        added(new);
+        LIVE.fetch_sub(l.size(), Relaxed);
+        unsafe { System.realloc(p, l, new) }
+    }
+}
+
+#[global_allocator]
+static A: Counting = Counting;
+
+static TURN: Mutex<()> = Mutex::new(());
+
+/// The bytes `f` allocated in all (`TOTAL`) and its peak of live bytes above those live before.
+fn measure<T>(f: impl FnOnce() -> T) -> (T, usize, usize) {
+    let base = LIVE.load(Relaxed);
+    PEAK.store(base, Relaxed);
+    let total = TOTAL.load(Relaxed);
+    let out = f();
+    let peak = PEAK.load(Relaxed) - base;
+    (out, TOTAL.load(Relaxed) - total, peak)
+}
+
+/// A database `db.btdb` holding table `t`: 64×128×91 stored nodes × 3 channels (2.2 M values,
+/// 8.9 MB as f32) on a grid the one-array kernel reads exact (sqrt θh, cos θd: the presets'
+/// mappings), f32 codec. Returns the path and the number of values.
+fn database(d: &TempDir) -> (String, usize) {
+    let g = Grid::with_sizes(
+        Param::HalfDiff,
+        [64, 360, 128, 360],
+        [Mapping::Sqrt, Mapping::Cos],
+        Channels::Rgb,
+        Symmetry {
+            isotropic: true,
+            reciprocal: true,
+            bilateral: true,
+        },
+    )
+    .unwrap();
+    assert!(
+        brdftab::table::kernel::Kernel::new(&g).is_some_and(|k| k.exact_values()),
+        "the grid of this test is one the exact kernel reads"
+    );
+    let t = Table::from_fn(g, "test", |_, a, out| {
+        for (c, o) in out.iter_mut().enumerate() {
+            *o = (1.0 + a[0].cos() * 3.0 + a[2].sin() + a[3].cos()) as f32 * (1.0 + c as f32);
+        }
+    });
+    let n = t.values().len();
+    let p = d.file("db.btdb");
+    let codec = Codec {
+        quant: Quant::F32,
+        level: 1,
+        ..Codec::default()
+    };
+    let src = Source::Other {
+        description: "fn".into(),
+    };
+    tables::save(&p, "t", src, &t, codec, false).unwrap();
+    (p, n)
+}
+
+#[test]
+fn an_opened_table_is_held_once_while_it_loads() {
+    let _turn = TURN.lock().unwrap_or_else(|p| p.into_inner());
+    let d = TempDir::new("mem-open");
+    let (p, n) = database(&d);
+    let bytes = 4 * n;
+    let source = format!("{p}#t");
+    let (wi, wo) = (DVec3::new(0.3, 0.1, 0.9), DVec3::new(-0.2, 0.4, 0.8));
+    // The table, one array of it, plus a chunk being decoded (1/64 of it) and small things.
+    let bound = bytes + bytes / 8;
+    let mut peaks = Vec::new();
+    for eager in [false, true] {
+        let (v, _, peak) = measure(|| {
+            let b = tables::open_brdf(&source, eager).unwrap();
+            let mut out = [0f32; 3];
+            b.eval(wi, wo, &mut out);
+            b.health().unwrap();
+            (b, out)
+        });
+        assert!(v.1[0] > 0.0, "{:?}", v.1);
+        peaks.push((eager, peak));
+        drop(v);
+    }
+    // Before: 2.0× the table lazily (the chunks gathered, then copied into the kernel's
+    // array), 3× eagerly (the chunks decoded apart, concatenated, then copied).
+    assert!(
+        peaks.iter().all(|&(_, p)| p < bound),
+        "(eager, peak bytes) {peaks:?} for a table of {bytes} bytes (bound {bound})"
+    );
+}
