@@ -1,6 +1,6 @@
-//! What reading a stored table costs in memory, measured by a counting allocator: a table
-//! opened (lazily then looked up, or eagerly) is held once, not two or three times over while
-//! it loads.
+//! What reading a stored table costs in memory, measured by a counting allocator: listing a
+//! database decodes nothing, and a table opened (lazily then looked up, or eagerly) is held
+//! once, not two or three times over while it loads.
 //!
 //! The allocator counts every thread (an eager open decodes on the library's pool), so the
 //! tests of this file take turns on one lock.
@@ -10,7 +10,7 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 
 use brdftab::codec::{Codec, Quant};
-use brdftab::store::{Source, tables};
+use brdftab::store::{Source, info, tables};
 use brdftab::table::{Grid, Mapping, Param, Symmetry, Table};
 use brdftab::testkit::TempDir;
 use brdftab::{Brdf, Channels};
@@ -103,6 +103,29 @@ fn database(d: &TempDir) -> (String, usize) {
     };
     tables::save(&p, "t", src, &t, codec, false).unwrap();
     (p, n)
+}
+
+#[test]
+fn listing_a_database_decodes_no_chunk() {
+    let _turn = TURN.lock().unwrap_or_else(|p| p.into_inner());
+    let d = TempDir::new("mem-list");
+    let (p, n) = database(&d);
+    let (rows, total, _) = measure(|| info::list(&p).unwrap());
+    assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0]["values"].as_u64(), Some(n as u64));
+    // The header, index and axes are a few kB; the table is 4n bytes, and sizing its sampler
+    // (what the rows held before) decoded all of it and built a sampler of 1 MB.
+    assert!(
+        total < n,
+        "db list allocated {total} bytes for a table of {} bytes",
+        4 * n
+    );
+    // `info` of the table still sizes the sampler.
+    let one = info::table_info(&p, "t").unwrap();
+    assert!(
+        one["sampling_bytes"].as_u64().is_some_and(|b| b > 0),
+        "{one}"
+    );
 }
 
 #[test]

@@ -4,7 +4,8 @@
 //! entry of the table it wrote, and the Python package hands them out as dicts — so the keys are
 //! an interface: `name`, `source`, `parameterization`, `symmetry`, `channels`, `units`, `codec`,
 //! `tool`, `shape`, `values`, `chunks`, `bytes`, `ratio_to_f32`, `sampling_bytes` (the importance
-//! sampler's structure, built in memory on the first `sample`/`pdf`), `quantity` (what the
+//! sampler's structure, built in memory on the first `sample`/`pdf`; not in [`list`]'s rows,
+//! which read no chunk), `quantity` (what the
 //! stored values are: `fr`, `fr_cos_out` or `fr_cos_cos`, [`crate::table::Quantity::name`]) and
 //! `calibrated` (whether lookups multiply them by an albedo calibration's k_in(θi) k_out(θo))
 //! per table; `file`, `format`, `bytes`, `ratio_to_f32`, `tables` per file. The last two say
@@ -20,6 +21,14 @@ use crate::table::{Quantity, SamplingResolution, Table};
 
 /// The summary of table `name` of an open store.
 pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
+    summary(s, name, true)
+}
+
+/// The summary of table `name`, with `sampling_bytes` when `sampling` (which builds the
+/// table's importance sampler to size it: 0.1 s for the smallest table, and every chunk of a
+/// table with a one-array kernel decoded); without it, what the header and index say and
+/// nothing decoded.
+fn summary(s: &Store, name: &str, sampling: bool) -> Result<Value> {
     let t = s.table(name)?;
     let h = t.header();
     let bytes = t.compressed_bytes();
@@ -32,7 +41,7 @@ pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
         .is_some_and(|g| crate::table::Interp::default_for(g) == crate::table::Interp::Nearest);
     let quantity = grid.as_ref().map_or(Quantity::Fr, |g| g.quantity());
     let calibrated = grid.as_ref().is_some_and(|g| g.calibration().is_some());
-    Ok(json!({
+    let mut v = json!({
         "name": h.name,
         "source": h.source,
         "parameterization": h.parameterization,
@@ -46,12 +55,16 @@ pub fn table_summary(s: &Store, name: &str) -> Result<Value> {
         "chunks": t.chunk_count(),
         "bytes": bytes,
         "ratio_to_f32": (h.values as f64 * 4.0) / (bytes.max(1) as f64),
-        "sampling_bytes": sampling_resolution(&t, grid.as_ref(), isotropic, cells)
-            .memory_bytes(isotropic),
         "quantity": quantity.name(),
         "calibrated": calibrated,
         "axes": grid.as_ref().map(axes_json),
-    }))
+    });
+    if sampling {
+        v["sampling_bytes"] = sampling_resolution(&t, grid.as_ref(), isotropic, cells)
+            .memory_bytes(isotropic)
+            .into();
+    }
+    Ok(v)
 }
 
 /// Where the stored nodes sit, axis by axis in the stored shape's order (the `.npy` export's
@@ -103,12 +116,16 @@ pub fn table_info(path: &str, name: &str) -> Result<Value> {
     table_summary(&Store::open(path)?, name)
 }
 
-/// The summaries of every table of the file at `path`, in file order.
+/// The summaries of every table of the file at `path`, in file order (`brdftab db list`):
+/// what each table's header and chunk index say, without `sampling_bytes` and with no chunk
+/// decoded. (Sizing each table's sampler made `db list` of a database of 1,000 tables of
+/// 576 values take 94 s, and decoded every chunk of every table with a one-array kernel:
+/// [`table_summary`] and `info` report it.)
 pub fn list(path: &str) -> Result<Vec<Value>> {
     let s = Store::open(path)?;
     s.tables()
         .iter()
-        .map(|e| table_summary(&s, &e.name))
+        .map(|e| summary(&s, &e.name, false))
         .collect()
 }
 
