@@ -475,6 +475,57 @@ fn absurd_dimensions_and_invalid_json_are_refused_before_allocating() {
     assert!(matches!(open_err(d.path(), &m), Error::Format { .. }));
 }
 
+/// A table whose index claims 51.5 GB of values (256 chunks of 50 M values, each within what
+/// zstd could expand its 1,536 bytes to) in a file of 400 kB: reading it whole (`read_all`,
+/// `to_table`, an eager open) is an error naming the file — it allocated the whole claim before
+/// decoding a chunk, and aborted the process ("memory allocation failed") where that was more
+/// than the machine's memory.
+#[test]
+fn a_table_claiming_more_values_than_memory_is_an_error_when_read_whole() {
+    use brdftab::store::tables;
+    use brdftab::table::{Grid, Mapping, Param, Symmetry};
+    let d = TempDir::new("store-claim");
+    let p = d.join("claim.btdb");
+    let none = Symmetry {
+        isotropic: false,
+        reciprocal: false,
+        bilateral: false,
+    };
+    let g = Grid::with_sizes(
+        Param::HalfDiff,
+        [256; 4],
+        [Mapping::Sqrt, Mapping::Uniform],
+        Channels::Rgb,
+        none,
+    )
+    .unwrap();
+    let src = Source::Other {
+        description: "a claim".into(),
+    };
+    let h = TableHeader::for_grid("claim", src, &g, Codec::default());
+    assert_eq!(h.values, 3 << 32);
+    let per = h.values / 256;
+    let mut w = Writer::create(&p).unwrap();
+    w.begin_table(h).unwrap();
+    for i in 0..256 {
+        w.encoded_chunk(&[i as u8; 1536], per).unwrap();
+    }
+    w.end_table().unwrap();
+    w.finish().unwrap();
+    let s = Store::open(&p).unwrap();
+    let t = s.table("claim").unwrap();
+    t.grid().unwrap(); // header, index and grid agree: only the chunks tell
+    let eager = tables::open_brdf(&format!("{}#claim", p.display()), true);
+    for e in [
+        t.read_all().map(drop).unwrap_err(),
+        t.to_table().map(drop).unwrap_err(),
+        eager.map(drop).unwrap_err(),
+    ] {
+        assert!(matches!(e, Error::Format { .. }), "{e}");
+        assert!(e.to_string().contains("claim.btdb"), "{e}");
+    }
+}
+
 /// The in-repo substitute for a fuzzer (nightly is not available for `cargo fuzz`): thousands of
 /// random mutations — byte flips, overwrites, truncations, splices — of a real database must
 /// each give an error, never a panic or an accepted file.

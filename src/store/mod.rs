@@ -470,26 +470,43 @@ impl StoredTable {
         Ok(v)
     }
 
-    /// Decodes the whole table (all chunks in parallel), outermost axis first. The vector has
-    /// room for [`Packed::PAD`](crate::table::kernel::Packed::PAD) values more, so that a
-    /// table's one-array kernel keeps it without a copy.
+    /// Decodes the whole table (chunks in parallel, a few at a time), outermost axis first. The
+    /// vector has room for [`Packed::PAD`](crate::table::kernel::Packed::PAD) values more, so
+    /// that a table's one-array kernel keeps it without a copy.
+    ///
+    /// The table's size is the file's word until its chunks decode: it is reserved fallibly (a
+    /// size beyond memory is an error, not an abort) and filled as chunks decode, so a file that
+    /// claims more than its chunks hold fails at its first chunk, having touched little of it.
     pub fn read_all(&self) -> Result<Vec<f32>> {
-        let total = self.index.iter().map(|e| e.values as usize).sum();
-        let mut out = Vec::with_capacity(total + crate::table::kernel::Packed::PAD);
-        out.resize(total, 0.0f32);
-        let mut parts = Vec::with_capacity(self.index.len());
-        let mut rest = out.as_mut_slice();
-        for e in &self.index {
-            let (a, b) = rest.split_at_mut(e.values as usize);
-            parts.push(a);
-            rest = b;
+        let total: usize = self.index.iter().map(|e| e.values as usize).sum();
+        let mut out = Vec::new();
+        if out
+            .try_reserve_exact(total + crate::table::kernel::Packed::PAD)
+            .is_err()
+        {
+            return Err(Error::format(
+                &self.file,
+                Some(&format!("table `{}` values", self.header.name)),
+                None,
+                format!(
+                    "{total} values ({:.1} GB of f32) do not fit in memory",
+                    total as f64 * 4e-9
+                ),
+            ));
         }
-        crate::par::install(|| {
-            parts.into_par_iter().enumerate().try_for_each(|(i, dst)| {
-                let b = self.raw_chunk(i)?;
-                codec::decode_into(b, dst).map_err(|e| self.in_chunk(e, i))
-            })
-        })?;
+        let window = 2 * crate::par::threads().max(1);
+        for first in (0..self.index.len()).step_by(window) {
+            let last = (first + window).min(self.index.len());
+            let decoded: Vec<Vec<f32>> = crate::par::install(|| {
+                (first..last)
+                    .into_par_iter()
+                    .map(|i| self.decode_chunk(i))
+                    .collect::<Result<_>>()
+            })?;
+            for v in decoded {
+                out.extend_from_slice(&v);
+            }
+        }
         Ok(out)
     }
 
