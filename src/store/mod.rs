@@ -494,7 +494,11 @@ impl StoredTable {
                 ),
             ));
         }
-        let window = 2 * crate::par::threads().max(1);
+        // Chunks decoded at a time: enough for the pool, but at most a 32nd of the table (each
+        // held twice while it decodes, the payload and the values) on a machine of many cores.
+        let window = (2 * crate::par::threads())
+            .min(self.index.len() / 32)
+            .max(1);
         for first in (0..self.index.len()).step_by(window) {
             let last = (first + window).min(self.index.len());
             let decoded: Vec<Vec<f32>> = crate::par::install(|| {
