@@ -323,6 +323,104 @@ fn wrong_size_and_dims_are_typed_errors() {
     ));
 }
 
+/// A file of the wrong size names the byte where it ends (and what is missing from there) or
+/// where its surplus begins, read from disk or from memory alike (the error had no offset).
+#[test]
+fn a_file_of_the_wrong_size_names_where_it_ends() {
+    let dir = TempDir::new("merl-size");
+    let p = dir.join("cut.binary");
+    let data = vec![0.5f64; 3 * SAMPLES];
+    let full = 12 + 8 * 3 * SAMPLES as u64;
+    for (len, parts) in [
+        (
+            8012u64,
+            vec![
+                "at byte 8012",
+                "channel R, sample 1000",
+                "header says 90 × 90 × 180",
+            ],
+        ),
+        (
+            full - 8,
+            vec![
+                "at byte 34992004",
+                "channel B, sample 1457999",
+                "this one has 34992004",
+            ],
+        ),
+        (
+            full + 5,
+            vec!["at byte 34992012", "5 bytes after the last sample"],
+        ),
+        (7, vec!["at byte 7", "truncated in the header"]),
+    ] {
+        let mut b = Vec::new();
+        for d in [90i32, 90, 180] {
+            b.extend_from_slice(&d.to_le_bytes());
+        }
+        for v in &data {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        b.resize(len as usize, 0);
+        std::fs::write(&p, &b).unwrap();
+        let e = MerlBrdf::open(&p).unwrap_err();
+        assert!(matches!(e, Error::Format { .. }), "{e}");
+        let s = e.to_string();
+        assert!(s.contains("cut.binary"), "{s}");
+        for part in parts {
+            assert!(s.contains(part), "{part:?} not in {s}");
+        }
+        if len >= 12 {
+            let s = MerlBrdf::from_bytes("mem", &b).unwrap_err().to_string();
+            assert!(s.contains(&format!("at byte {}", len.min(full))), "{s}");
+        }
+    }
+}
+
+/// ±∞ and values that overflow f32 once scaled are corrupt samples: an error naming the file,
+/// the channel and the byte, as NaN is (they were read, and the cells they hold evaluated to ∞,
+/// which `check` did not see either when its pairs missed them).
+#[test]
+fn infinite_or_overflowing_samples_are_errors_with_their_offset() {
+    let dir = TempDir::new("merl-inf");
+    let p = dir.join("inf.binary");
+    let base = vec![1.0; 3 * SAMPLES];
+    for (k, v, what, channel) in [
+        (2 * SAMPLES + 4321, f64::INFINITY, "+∞", "B"),
+        (100, f64::NEG_INFINITY, "−∞", "R"),
+        (SAMPLES + 200, 1e300, "beyond f32", "G"),
+        (SAMPLES + 201, -1e300, "beyond f32", "G"),
+    ] {
+        let mut d = base.clone();
+        d[k] = v;
+        write_file(&p, [90, 90, 180], &d);
+        let e = MerlBrdf::open(&p).unwrap_err();
+        assert!(matches!(e, Error::Format { .. }), "{e}");
+        let s = e.to_string();
+        for part in [
+            "inf.binary".to_owned(),
+            format!("field `{channel}`"),
+            format!("at byte {}", 12 + 8 * k),
+            format!("sample {}", k % SAMPLES),
+            what.to_owned(),
+        ] {
+            assert!(s.contains(&part), "{part:?} not in {s}");
+        }
+        let e = MerlBrdf::from_raw("x", d).unwrap_err().to_string();
+        assert!(
+            e.contains(what) && e.contains(&format!("channel {channel}")),
+            "{e}"
+        );
+    }
+    // The bounds: −1 (unmeasured) and the largest value whose f_r is an f32 are data.
+    let mut d = base.clone();
+    d[7] = -1.0;
+    d[8] = f32::MAX as f64 * 0.999 * 1500.0;
+    let m = MerlBrdf::from_raw("x", d).unwrap();
+    assert!(!m.is_valid(0, 0, 7));
+    assert!(m.cell(0, 0, 8)[0].is_finite() && m.cell(0, 0, 8)[0] > 3e38);
+}
+
 #[test]
 fn embedded_manifest_matches_tsv() {
     let path = brdftab::measured::data::merl_file("merl_expected_files.tsv")

@@ -29,6 +29,10 @@
 //! them through [`MerlBrdf::is_valid`], and evaluates them as 0, as the reference reader's clamp
 //! does.
 //!
+//! A sample no lookup can use — NaN, ±∞, or finite but beyond f32 once scaled to f_r — is a
+//! corrupt file: [`MerlBrdf::open`] fails naming its channel and byte offset (it would otherwise
+//! evaluate to ∞ in the cells it holds).
+//!
 //! A table of the file on [`Grid::merl`](crate::table::Grid::merl) ([`MerlBrdf::to_table`], or
 //! a bake on that grid, which copies the cells through [`BakeSource::stored_node`]) keeps them too, as
 //! negative values (−1 × scale), so MERL → table → MERL gives the file back (to f32 precision,
@@ -210,27 +214,12 @@ impl MerlBrdf {
         let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
         if meta.len() != FILE_SIZE {
             // Read the header anyway (if present) for a more helpful message.
-            let hint = std::fs::File::open(path)
-                .ok()
-                .and_then(|mut f| {
-                    use std::io::Read;
-                    let mut h = [0u8; 12];
-                    f.read_exact(&mut h).ok().map(|_| h)
-                })
-                .map(|h| {
-                    let d = dims(&h);
-                    format!(" (header says {} × {} × {})", d[0], d[1], d[2])
-                })
-                .unwrap_or_default();
-            return Err(Error::format(
-                &file,
-                None,
-                None,
-                format!(
-                    "a MERL file has {FILE_SIZE} bytes, this one has {}{hint}",
-                    meta.len()
-                ),
-            ));
+            let header = std::fs::File::open(path).ok().and_then(|mut f| {
+                use std::io::Read;
+                let mut h = [0u8; 12];
+                f.read_exact(&mut h).ok().map(|_| dims(&h))
+            });
+            return Err(size_error(&file, meta.len(), header));
         }
         let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
         Self::from_bytes(file, &bytes)
@@ -261,26 +250,18 @@ impl MerlBrdf {
             ));
         }
         if bytes.len() as u64 != FILE_SIZE {
-            return Err(Error::format(
-                &name,
-                None,
-                Some(bytes.len().min(FILE_SIZE as usize) as u64),
-                format!(
-                    "a MERL file has {FILE_SIZE} bytes, this one has {}",
-                    bytes.len()
-                ),
-            ));
+            return Err(size_error(&name, bytes.len() as u64, None));
         }
         let data: Vec<f64> = bytes[12..]
             .chunks_exact(8)
             .map(|b| f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]))
             .collect();
-        if let Some(k) = data.iter().position(|v| v.is_nan()) {
+        if let Some((k, why)) = bad_sample(&data) {
             return Err(Error::format(
                 &name,
-                Some(["R", "G", "B"][k / SAMPLES]),
+                Some(CHANNEL_NAMES[k / SAMPLES]),
                 Some(12 + 8 * k as u64),
-                format!("sample {} is NaN", k % SAMPLES),
+                format!("sample {} {why}", k % SAMPLES),
             ));
         }
         Ok(MerlBrdf {
@@ -306,6 +287,16 @@ impl MerlBrdf {
             return Err(Error::arg(
                 "data",
                 format!("{} values, expected 3 × {SAMPLES}", data.len()),
+            ));
+        }
+        if let Some((k, why)) = bad_sample(&data) {
+            return Err(Error::arg(
+                "data",
+                format!(
+                    "channel {} sample {} {why}",
+                    CHANNEL_NAMES[k / SAMPLES],
+                    k % SAMPLES
+                ),
             ));
         }
         Ok(MerlBrdf {
@@ -400,6 +391,58 @@ impl MerlBrdf {
             out.copy_from_slice(&self.stored_cell(idx[0], idx[2], idx[3]));
         })
     }
+}
+
+/// The error of a file of `len` bytes, not [`FILE_SIZE`]: at the byte where it ends (and the
+/// channel and sample missing from there) or where its surplus begins; `header` the dimensions
+/// it says, when read.
+fn size_error(file: &str, len: u64, header: Option<[i32; 3]>) -> Error {
+    let hint = header
+        .map(|d| format!(" (header says {} × {} × {})", d[0], d[1], d[2]))
+        .unwrap_or_default();
+    let (offset, what) = if len < 12 {
+        (len, "truncated in the header".to_owned())
+    } else if len < FILE_SIZE {
+        let k = ((len - 12) / 8) as usize;
+        let ch = CHANNEL_NAMES[k / SAMPLES];
+        (
+            len,
+            format!("truncated in channel {ch}, sample {}", k % SAMPLES),
+        )
+    } else {
+        (
+            FILE_SIZE,
+            format!("{} bytes after the last sample", len - FILE_SIZE),
+        )
+    };
+    Error::format(
+        file,
+        None,
+        Some(offset),
+        format!("a MERL file has {FILE_SIZE} bytes, this one has {len}{hint}: {what}"),
+    )
+}
+
+/// The channels of the file, in order.
+const CHANNEL_NAMES: [&str; 3] = ["R", "G", "B"];
+
+/// The first stored value no lookup can use, and why: NaN, ±∞, or finite but beyond f32 once
+/// scaled to f_r (the lookups' precision), where it would become ∞ — a corrupt file, which
+/// would otherwise evaluate to ∞ in the cells it touches. Negative finite values are the
+/// database's "unmeasured" marker and pass.
+fn bad_sample(data: &[f64]) -> Option<(usize, String)> {
+    data.iter().enumerate().find_map(|(k, &v)| {
+        let scaled = v * SCALE[k / SAMPLES];
+        if v.is_nan() {
+            Some((k, "is NaN".to_owned()))
+        } else if v.is_infinite() {
+            Some((k, format!("is {}", if v > 0.0 { "+∞" } else { "−∞" })))
+        } else if !(scaled as f32).is_finite() {
+            Some((k, format!("is {v:e}, beyond f32 once scaled to f_r")))
+        } else {
+            None
+        }
+    })
 }
 
 fn dims(h: &[u8]) -> [i32; 3] {
