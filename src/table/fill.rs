@@ -15,8 +15,9 @@
 //! on [`Grid::merl`], a table on its own grid), the stored value verbatim, including cells whose
 //! centre lies below the horizon and negative markers of unmeasured cells; with
 //! `supersample = k > 1` it is the mean of k^d stratified, jittered samples over the node's cell
-//! (d = stored angular axes of size > 1, cell = ±½ node spacing, [i, i+1) for
-//! [`Nodes::CellStart`](super::Nodes)) — a box prefilter for lobes narrower than a cell.
+//! (d = stored angular axes of size > 1, cell = ±½ node spacing, which on a
+//! [`Nodes::CellStart`](super::Nodes) axis is the node's own cell [i/n, (i+1)/n) of u) — a box
+//! prefilter for lobes narrower than a cell.
 
 use rayon::prelude::*;
 use std::time::Instant;
@@ -300,15 +301,14 @@ fn eval_node(
         }
         return;
     }
-    // Stratified jittered samples over the node's cell on every axis of size > 1.
+    // Stratified jittered samples over the node's cell on every axis of size > 1: ±½ in node
+    // index on every placement. (On a `CellStart` axis node i sits at the centre of cell i, so
+    // ±½ *is* cell i, [i/n, (i+1)/n) of u: `coord` adds the half; sampling [i, i + 1) had
+    // averaged cells i and i + 1, half each, on a MERL grid.)
     let active: Vec<usize> = (0..4).filter(|&d| axes[d].size > 1).collect();
     let cell = |d: usize| -> (f64, f64) {
         let i = idx[d] as f64;
-        if axes[d].nodes == Nodes::CellStart {
-            (i, i + 1.0)
-        } else {
-            (i - 0.5, i + 0.5)
-        }
+        (i - 0.5, i + 0.5)
     };
     let c = out.len().min(MAX_CHANNELS);
     let mut acc = [0.0f64; MAX_CHANNELS];
@@ -330,9 +330,8 @@ fn eval_node(
             let n = ax.size as f64;
             let t = match (ax.periodic, ax.nodes) {
                 (true, _) => t,
-                (false, Nodes::Centers) => t.clamp(-0.5, n - 0.5),
+                (false, Nodes::Centers | Nodes::CellStart) => t.clamp(-0.5, n - 0.5),
                 (false, Nodes::Edges) => t.clamp(0.0, n - 1.0),
-                (false, Nodes::CellStart) => t.clamp(0.0, n),
             };
             coords[d] = ax.coord(t);
         }
