@@ -518,6 +518,18 @@ fn a_model_baked_on_the_merl_grid_keeps_its_phi_d_cells() {
     }
 }
 
+/// The MERL grid is halfdiff: asked for with `inout` it is an error, not a halfdiff table
+/// baked anyway (and, for a MERL file, resampled instead of copied).
+#[test]
+fn the_merl_grid_with_inout_is_an_error() {
+    use brdftab::{BakeRequest, GridChoice, progress::Silent, table::Param};
+    let mut req = BakeRequest::new(r#"{"model": "lambert", "kd": 0.3}"#).grid(GridChoice::Merl);
+    req.param = Some(Param::InOut);
+    let e = req.table(&Silent).unwrap_err();
+    assert!(matches!(e, Error::InvalidArgument { .. }), "{e}");
+    assert!(e.to_string().contains("MERL grid is halfdiff"), "{e}");
+}
+
 #[test]
 fn embedded_manifest_matches_tsv() {
     let path = brdftab::measured::data::merl_file("merl_expected_files.tsv")

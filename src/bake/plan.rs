@@ -298,7 +298,15 @@ impl BakeRequest {
             return adaptive::adaptive_grid(src, sym, &self.adaptive_options(src, nodes));
         }
         match self.grid {
-            GridChoice::Merl => Grid::merl(ch).with_symmetry(sym),
+            GridChoice::Merl => {
+                if self.param.is_some_and(|p| p != Param::HalfDiff) {
+                    return Err(Error::arg(
+                        "param",
+                        "the MERL grid is halfdiff (θh, θd, φd cells)",
+                    ));
+                }
+                Grid::merl(ch).with_symmetry(sym)
+            }
             GridChoice::Sizes(s) => {
                 let p = self.param.unwrap_or(Param::HalfDiff);
                 let m = match p {
