@@ -26,8 +26,9 @@
 //!
 //! Negative stored values (the database uses −1) mark cells that were never measured (mostly at
 //! grazing θd). [`MerlBrdf`] keeps them as stored — writing a file back is bit-exact — exposes
-//! them through [`MerlBrdf::is_valid`], and evaluates them as 0, as the reference reader's clamp
-//! does.
+//! them through [`MerlBrdf::is_valid`], and evaluates them as 0: no reflectance is negative. (The
+//! reference reader, `BRDFRead.cpp`, returns the scaled negative value and prints "Below
+//! horizon.".)
 //!
 //! A sample no lookup can use — NaN, ±∞, or finite but beyond f32 once scaled to f_r — is a
 //! corrupt file: [`MerlBrdf::open`] fails naming its channel and byte offset (it would otherwise
