@@ -212,7 +212,7 @@ impl ModelInfo {
     /// The parameters as one line, e.g. `ks: Value ≥ 0, n: number ≥ 0`, then the model's rule
     /// after a semicolon.
     pub fn params_line(&self) -> String {
-        let mut v: Vec<String> = self
+        let v: Vec<String> = self
             .params
             .iter()
             .map(|p| {
