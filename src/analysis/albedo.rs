@@ -78,16 +78,45 @@ pub fn incidence(theta: f64) -> crate::Result<DVec3> {
     Ok(geometry::spherical(theta, 0.0))
 }
 
+/// The incident direction of polar angle `theta` and azimuth `phi` (radians, φ′ measured from the
+/// local x axis, the tangent along which an anisotropic model's α_x runs): [`incidence`] turned
+/// about the normal. `theta` follows [`incidence`]'s rule; a `phi` that is not finite is an
+/// [`Error::InvalidArgument`](crate::Error::InvalidArgument) naming `phi`.
+///
+/// The albedo of an anisotropic source depends on the light's azimuth as well as on θ′: GGX with
+/// α = (0.01, 1) reflects 0.517 of the light at θ′ = 89° from φ′ = 0 and 0.904 from φ′ = 0.3.
+pub fn incidence_at(theta: f64, phi: f64) -> crate::Result<DVec3> {
+    incidence(theta)?;
+    if !phi.is_finite() {
+        return Err(crate::Error::arg(
+            "phi",
+            format!("{phi} is not a finite azimuth (radians)"),
+        ));
+    }
+    Ok(geometry::spherical(theta, phi))
+}
+
 /// The albedo a(θ) at incidence angles `thetas` (radians, azimuth φ = 0) per channel, using
 /// [`Brdf::albedo`] (so closed forms are used where a model has one): `curve[k][channel]`.
 ///
 /// Every angle must lie in [0, π/2) ([`incidence`]), or the whole curve is an
 /// [`Error::InvalidArgument`](crate::Error::InvalidArgument) naming `theta`.
 pub fn albedo_curve<B: Brdf + ?Sized>(brdf: &B, thetas: &[f64]) -> crate::Result<Vec<Vec<f64>>> {
+    albedo_curve_at(brdf, thetas, 0.0)
+}
+
+/// [`albedo_curve`] for light at azimuth `phi` (radians from the local x axis, [`incidence_at`]),
+/// which matters for anisotropic sources only.
+pub fn albedo_curve_at<B: Brdf + ?Sized>(
+    brdf: &B,
+    thetas: &[f64],
+    phi: f64,
+) -> crate::Result<Vec<Vec<f64>>> {
     let c = brdf.channels().len().min(MAX_CHANNELS);
+    incidence_at(0.0, phi)?;
     let dirs = thetas
         .iter()
-        .map(|&t| incidence(t))
+        .map(|&t| incidence_at(t, phi))
         .collect::<crate::Result<Vec<_>>>()?;
     Ok(dirs
         .into_iter()
@@ -584,6 +613,46 @@ mod tests {
             quadrature(&l, wi, &mut a);
             assert_eq!(a, [0.0; 3], "{wi}");
         }
+    }
+
+    /// The albedo of an anisotropic model depends on the light's azimuth: hosts asked for
+    /// azimuth 0 only (GGX α = (0.01, 1) at 89°: 0.517 there, 0.904 from φ′ = 0.3). Light at
+    /// φ′ = π/2 on (α_x, α_y) is light at φ′ = 0 on (α_y, α_x), each integral to 1e-6.
+    #[test]
+    fn the_albedo_curve_takes_the_lights_azimuth() {
+        let spec = |ax: f64, ay: f64| {
+            crate::open(&format!(
+                r#"{{"model":"ggx","alpha_x":{ax},"alpha_y":{ay}}}"#
+            ))
+            .unwrap()
+        };
+        let (b, turned) = (spec(0.01, 1.0), spec(1.0, 0.01));
+        let thetas = [
+            0.0,
+            45f64.to_radians(),
+            80f64.to_radians(),
+            89f64.to_radians(),
+        ];
+        let at = albedo_curve_at(&*b, &thetas, FRAC_PI_2).unwrap();
+        let want = albedo_curve(&*turned, &thetas).unwrap();
+        for (a, w) in at.iter().zip(&want) {
+            assert!(rel(a[0], w[0]) < 5e-6, "{} vs {}", a[0], w[0]);
+        }
+        assert_eq!(
+            albedo_curve_at(&*b, &thetas, 0.0).unwrap(),
+            albedo_curve(&*b, &thetas).unwrap()
+        );
+        let a89 = albedo_curve_at(&*b, &[89f64.to_radians()], 0.3).unwrap()[0][0];
+        assert!((a89 - 0.904).abs() < 2e-3, "{a89}");
+        for phi in [f64::NAN, f64::INFINITY] {
+            let e = albedo_curve_at(&*b, &[], phi).unwrap_err();
+            assert!(
+                matches!(&e, crate::Error::InvalidArgument { name, .. } if name == "phi"),
+                "{e}"
+            );
+        }
+        let w = incidence_at(0.5, 0.25).unwrap();
+        assert!((w - geometry::spherical(0.5, 0.25)).length() == 0.0);
     }
 
     #[test]

@@ -19,6 +19,15 @@ pub struct AlbedoArgs {
         allow_hyphen_values = true
     )]
     theta: String,
+    /// Azimuth φ′ of the light in degrees from the local x axis, along which an anisotropic
+    /// model's α_x runs (the albedo of an anisotropic source depends on it).
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        value_name = "DEG",
+        allow_hyphen_values = true
+    )]
+    phi: f64,
     #[command(flatten)]
     open: brdftab::request::OpenSettings,
 }
@@ -43,10 +52,12 @@ pub fn albedo(a: AlbedoArgs) -> Result<()> {
     let radians: Vec<f64> = thetas.iter().map(|t| t.to_radians()).collect();
     // The library's rule, [0, π/2) in radians; `parse_degrees` has said it in degrees already,
     // unless a degree just below 90 rounded to π/2.
-    let curve = albedo::albedo_curve(&*brdf, &radians).map_err(|e| match e {
-        Error::InvalidArgument { msg, .. } => Error::arg("--theta", msg),
-        e => e,
-    })?;
+    let curve =
+        albedo::albedo_curve_at(&*brdf, &radians, a.phi.to_radians()).map_err(|e| match e {
+            Error::InvalidArgument { name, msg } if name == "phi" => Error::arg("--phi", msg),
+            Error::InvalidArgument { msg, .. } => Error::arg("--theta", msg),
+            e => e,
+        })?;
     brdf.health()?;
     let mut text = String::new();
     for (t, row) in thetas.iter().zip(curve) {

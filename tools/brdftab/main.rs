@@ -58,7 +58,7 @@ enum Command {
     Slice(slice::SliceArgs),
     /// Convert between formats (MERL .binary, RGL .bsdf, tables).
     Convert(convert::ConvertArgs),
-    /// Directional albedo a(θ′) per channel: one line `theta a_1 a_2 ...` per angle.
+    /// Directional albedo a(θ′) per channel (light at azimuth `--phi`, default 0): one line `theta a_1 a_2 ...` per angle.
     Albedo(analysis::AlbedoArgs),
     /// Physical plausibility: positivity, reciprocity, energy conservation.
     Check(analysis::CheckArgs),

@@ -156,6 +156,36 @@ fn albedo_prints_tiny_and_huge_numbers_in_exponent_form() {
 }
 
 #[test]
+fn albedo_takes_the_lights_azimuth() {
+    // The albedo was that of light from azimuth 0 only: GGX α = (0.01, 1) reflects 0.517 at
+    // θ′ = 89° from there, 0.904 from φ′ = 0.3 rad. φ′ = 90° on (α_x, α_y) is φ′ = 0 on
+    // (α_y, α_x), each integral to 1e-6 (printed to 7 digits).
+    let aniso = r#"{"model":"ggx","alpha_x":0.01,"alpha_y":1}"#;
+    let turned = r#"{"model":"ggx","alpha_x":1,"alpha_y":0.01}"#;
+    let run = |args: &[&str]| {
+        let o = brdftab(args);
+        assert_eq!(o.code, 0, "{}", o.stderr);
+        numbers(o.stdout.trim())
+    };
+    let at = run(&["albedo", aniso, "--theta", "0,80,89", "--phi", "90"]);
+    let want = run(&["albedo", turned, "--theta", "0,80,89"]);
+    for (a, w) in at.iter().zip(&want) {
+        assert!((a - w).abs() <= 5e-6 * w.abs(), "{a} vs {w}");
+    }
+    let a = run(&[
+        "albedo",
+        aniso,
+        "--theta",
+        "89",
+        "--phi",
+        "17.188733853924695",
+    ]);
+    assert!((a[1] - 0.904).abs() < 2e-3, "{a:?}");
+    let o = brdftab(&["albedo", aniso, "--phi", "nan"]);
+    assert_error(&o, "--phi");
+}
+
+#[test]
 fn a_polar_slice_is_for_light_above_the_horizon() {
     // The incidence was clamped into [0°, 90°]: 120 and -5 drew the 90° and 0° slices silently.
     let dir = TempDir::new("cli-slice-theta");

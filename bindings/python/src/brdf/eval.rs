@@ -95,6 +95,7 @@ impl PyBrdf {
         &self,
         py: Python<'_>,
         theta: &Bound<'_, PyAny>,
+        phi: f64,
     ) -> PyResult<Py<PyAny>> {
         let a = arrays::f64_array(theta, "theta")?;
         // Read in place and written into the numpy result, allocated (or refused by numpy)
@@ -103,9 +104,11 @@ impl PyBrdf {
         let c = self.c();
         // One row of c per angle, in the angles' shape (a number: (c,)).
         let out = arrays::zeros::<f64>(py, &[a.shape(), &[c]].concat())?;
-        use brdftab::analysis::albedo::incidence;
+        use brdftab::analysis::albedo::incidence_at;
+        // The azimuth is checked even when there is no angle.
+        incidence_at(0.0, phi).map_err(lib_err)?;
         for &x in t.iter() {
-            incidence(x).map_err(lib_err)?;
+            incidence_at(x, phi).map_err(lib_err)?;
         }
         let mut w = out.readwrite();
         let o = w
@@ -115,7 +118,7 @@ impl PyBrdf {
         // What `albedo::albedo_curve` computes, angle by angle into the result.
         unlocked(py, || {
             for (row, &x) in o.chunks_exact_mut(c.max(1)).zip(t.iter()) {
-                if let Ok(wi) = incidence(x) {
+                if let Ok(wi) = incidence_at(x, phi) {
                     brdf.albedo(wi, row);
                 }
             }
