@@ -120,10 +120,11 @@ public:
         s.delta = d != 0;
         return s;
     }
-    /// Directional albedo at incidence theta (radians), one value per channel.
-    std::vector<double> albedo(double theta) const {
+    /// Directional albedo at incidence theta and azimuth phi (radians, phi from the local x
+    /// axis), one value per channel.
+    std::vector<double> albedo(double theta, double phi = 0.0) const {
         std::vector<double> a(channels());
-        detail::check(brdftab_albedo(h_, theta, a.data()));
+        detail::check(brdftab_albedo_at(h_, theta, phi, a.data()));
         return a;
     }
     /// The C handle, for calls the wrapper does not cover.

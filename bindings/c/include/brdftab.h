@@ -127,6 +127,10 @@ int brdftab_sample_spectral(const brdftab_brdf *b, size_t n, const double *wo, c
  * form where the model has one, else adaptive quadrature: 1e-6 relative for models, 1e-4 for
  * tables and measured data). */
 int brdftab_albedo(const brdftab_brdf *b, double theta, double *albedo);
+/* The same for light at azimuth phi (radians, from the local x axis, alpha_x's direction;
+ * brdftab_albedo is phi = 0): an anisotropic source's albedo depends on it. A non-finite phi
+ * is -1. */
+int brdftab_albedo_at(const brdftab_brdf *b, double theta, double phi, double *albedo);
 /* The request layer: settings as a JSON object with the field names of the CLI's flags and
  * Python's keywords (e.g. {"target_error": 0.005, "codec": "f16"}); NULL or "" = defaults; an
  * unknown field is an error. */

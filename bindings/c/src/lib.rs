@@ -721,6 +721,30 @@ pub unsafe extern "C" fn brdftab_albedo(
     })
 }
 
+/// [`brdftab_albedo`] for light at polar angle `theta` and azimuth `phi` (radians, from the local
+/// x axis, α_x's direction): an anisotropic source reflects a different share of light from each
+/// azimuth. A non-finite `phi` is -1, as a `theta` outside [0, π/2) is
+/// ([`brdftab::analysis::albedo::incidence_at`]).
+///
+/// # Safety
+/// `albedo` points to `brdftab_channels(b)` doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn brdftab_albedo_at(
+    b: *const brdftab_brdf,
+    theta: f64,
+    phi: f64,
+    albedo: *mut f64,
+) -> c_int {
+    guard(|| {
+        // SAFETY (both): the header's contract; NULL and alignment are checked.
+        let b = unsafe { handle(b) }?;
+        let out = unsafe { slice_mut(albedo, b.names.len(), "albedo") }?;
+        let wi = brdftab::analysis::albedo::incidence_at(theta, phi).map_err(|e| e.to_string())?;
+        b.brdf.albedo(wi, out);
+        healthy(b)
+    })
+}
+
 /// Panics inside the boundary's guard and returns its result (-1): what a bug in the library
 /// would do. For the tests of the quiet panic hook only; not part of the C ABI (not exported).
 #[doc(hidden)]

@@ -125,6 +125,27 @@ int main(int argc, char **argv) {
     CHECK(strstr(brdftab_last_error(), "horizon") != NULL, "the horizon named in the error");
     CHECK(brdftab_albedo(b, nextafter(BRDFTAB_PI / 2.0, 0.0), alb) == 0, "just below pi/2");
     CHECK(brdftab_albedo(NULL, 0.5, alb) == -1, "NULL albedo handle");
+    /* Light from an azimuth: phi = 0 is brdftab_albedo; GGX (0.01, 1) from phi = pi/2 is
+     * (1, 0.01) from phi = 0 (each integral to 1e-6); a non-finite phi is -1 naming phi. */
+    {
+        brdftab_brdf *an = brdftab_open("{\"model\": \"ggx\", \"alpha_x\": 0.01, \"alpha_y\": 1}");
+        brdftab_brdf *tu = brdftab_open("{\"model\": \"ggx\", \"alpha_x\": 1, \"alpha_y\": 0.01}");
+        CHECK(an && tu, "anisotropic GGX handles");
+        double a0[3], a1[3], at[3], want[3];
+        CHECK(brdftab_albedo(an, 1.2, a0) == 0 && brdftab_albedo_at(an, 1.2, 0.0, a1) == 0,
+              "albedo_at phi = 0");
+        CHECK(memcmp(a0, a1, sizeof a0) == 0, "albedo_at phi = 0 is brdftab_albedo");
+        CHECK(brdftab_albedo_at(an, 1.2, BRDFTAB_PI / 2.0, at) == 0 &&
+                  brdftab_albedo(tu, 1.2, want) == 0,
+              "albedo_at phi = pi/2");
+        int near = 1;
+        for (int i = 0; i < 3; i++) near &= fabs(at[i] - want[i]) <= 5e-6 * want[i];
+        CHECK(near && fabs(at[0] - a0[0]) > 1e-2 * a0[0], "an anisotropic albedo turns with phi");
+        CHECK(brdftab_albedo_at(an, 1.2, NAN, at) == -1 && strstr(brdftab_last_error(), "phi"),
+              "a NaN phi");
+        brdftab_close(an);
+        brdftab_close(tu);
+    }
     CHECK(brdftab_eval(b, 0, NULL, NULL, NULL) == 0, "n = 0");
     CHECK(brdftab_eval(NULL, 0, NULL, NULL, NULL) == 0, "n = 0, NULL handle");
     CHECK(brdftab_sample(b, 0, NULL, NULL, NULL, NULL, NULL) == 0, "sample n = 0");
