@@ -168,13 +168,13 @@ fn merl_to_table_to_merl_keeps_every_cell() {
     assert_same_file(&data, &b, F32_REL);
 }
 
-/// The relative RMSE of `convert`'s accuracy line (`accuracy vs native (INTERP, N pairs):
+/// The relative RMSE of `convert`'s accuracy line on stderr (`accuracy vs native (INTERP, N pairs):
 /// relative RMSE of f_r cos θi cos θo X, max relative Y`), with the interpolation it names.
-fn reported_accuracy(stdout: &str) -> (String, f64) {
-    let line = stdout
+fn reported_accuracy(stderr: &str) -> (String, f64) {
+    let line = stderr
         .lines()
         .find(|l| l.trim_start().starts_with("accuracy vs native ("))
-        .unwrap_or_else(|| panic!("no accuracy line in {stdout}"));
+        .unwrap_or_else(|| panic!("no accuracy line in {stderr}"));
     let interp = line.split('(').nth(1).unwrap().split(',').next().unwrap();
     let rmse = line
         .split("cos θo ")
@@ -203,11 +203,11 @@ fn converting_merl_cells_reports_the_lookup_hosts_use() {
         args.extend_from_slice(extra);
         let r = common::brdftab(&args);
         assert!(r.ok, "{args:?}: {}", r.stderr);
-        let (interp, rmse) = reported_accuracy(&r.stdout);
-        assert_eq!(interp, "Nearest", "{}", r.stdout);
+        let (interp, rmse) = reported_accuracy(&r.stderr);
+        assert_eq!(interp, "Nearest", "{}", r.stderr);
         // The f32 table holds each cell's f32 value, the file's reader returns the same f32:
         // equal but for the f64 arithmetic of the comparison (F32_REL is a bound per value).
-        assert!(rmse <= 2.0 * F32_REL, "{}", r.stdout);
+        assert!(rmse <= 2.0 * F32_REL, "{}", r.stderr);
     }
     // Asked for, the linear lookup is still what is measured: it blends the random cells.
     let t = dir.join("lin.btdb");
@@ -221,9 +221,9 @@ fn converting_merl_cells_reports_the_lookup_hosts_use() {
         "linear",
     ]);
     assert!(r.ok, "{}", r.stderr);
-    let (interp, rmse) = reported_accuracy(&r.stdout);
-    assert_eq!(interp, "Linear", "{}", r.stdout);
-    assert!(rmse > 1e-2, "{}", r.stdout);
+    let (interp, rmse) = reported_accuracy(&r.stderr);
+    assert_eq!(interp, "Linear", "{}", r.stderr);
+    assert!(rmse > 1e-2, "{}", r.stderr);
 }
 
 /// What a lookup makes of the unmeasured cells: 0 at them (nearest), a blend towards 0 next to
