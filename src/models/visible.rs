@@ -65,13 +65,18 @@ pub fn density(x: DVec3, v: DVec3, d: impl FnOnce(DVec3) -> f64) -> f64 {
     if !(h.z > 0.0 && hh > 0.0) {
         return 0.0;
     }
-    let inv = 1.0 / hh.sqrt();
+    let len = hh.sqrt();
+    let inv = 1.0 / len;
     let cos_a = h.z * inv;
-    let a = v.dot(h) * inv;
+    // ⟨V,H⟩ = |x + v| / 2 for unit x, v, and the partner's ⟨V,H′⟩ = 2 v_z h_z / |h| − ⟨V,H⟩:
+    // as dot products both cancelled at a grazing view, where terms ~ 0.1 leave ~ 1e-8, and the
+    // density of a direction moved by rounding changed by 30 %.
+    let a = 0.5 * len;
     if !(a > 0.0) {
         return 0.0;
     }
-    d(h) * cos_a / (2.0 * (a + partner_dot(v, h) * inv))
+    let partner = (2.0 * v.z * cos_a - a).max(0.0);
+    d(h) * cos_a / (2.0 * (a + partner))
 }
 
 /// The azimuth φ′ ∈ (−π, π) of a V-cavity visible normal relative to the view's azimuth, drawn

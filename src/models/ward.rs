@@ -232,10 +232,13 @@ impl Brdf for Ward {
         let Some((wi, wo)) = geometry::upper_pair(wi, wo) else {
             return 0.0;
         };
-        let Some(h) = geometry::normalize(wi + wo) else {
+        let s = wi + wo;
+        let Some(h) = geometry::normalize(s) else {
             return 0.0;
         };
-        let wo_h = wo.dot(h);
+        // wo·h = |wi + wo| / 2 for unit wi, wo, here as h·s (terms of one sign): `wo.dot(h)`
+        // cancelled at a grazing view where h is nearly perpendicular to wo's azimuth.
+        let wo_h = 0.5 * h.dot(s);
         if wo_h <= 0.0 {
             return 0.0;
         }

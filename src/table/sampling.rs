@@ -603,8 +603,12 @@ impl TableSampler {
         if !(h.z > 0.0 && l2 > 0.0 && l2.is_finite()) {
             return 0.0;
         }
-        let inv_l = 1.0 / l2.sqrt();
-        let dot = wol.dot(h) * inv_l;
+        let l = l2.sqrt();
+        let inv_l = 1.0 / l;
+        // wo·ĥ = |wi + wo| / 2 for unit wi, wo: as `wol.dot(h)` it cancelled where ĥ is nearly
+        // perpendicular to wo's azimuth at a grazing view (wo·ĥ ~ 1e-8 from terms ~ 0.1), and
+        // the density of a direction moved by rounding jumped by orders of magnitude.
+        let dot = 0.5 * l;
         if !(dot > 0.0) {
             return 0.0;
         }
