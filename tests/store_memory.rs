@@ -158,3 +158,55 @@ fn an_opened_table_is_held_once_while_it_loads() {
         "(eager, peak bytes) {peaks:?} for a table of {bytes} bytes (bound {bound})"
     );
 }
+
+/// A raw table file (`table::raw`) of `lambert.raw`'s header with the θh axis given `size`,
+/// followed by `values` f32 zeros. Found by fuzzing (session 40, `raw` target): the reader
+/// built the grid of the header's word before checking it against the values that follow.
+fn raw_with_theta_size(size: &str, values: usize) -> Vec<u8> {
+    let header = format!(
+        r#"{{"format":1,"grid":{{"param":"halfdiff","theta1":{{"size":{size},"mapping":"sqrt","nodes":"centers"}},"phi1":{{"size":1,"mapping":"uniform","nodes":"edges"}},"theta2":{{"size":2,"mapping":"uniform","nodes":"centers"}},"phi2":{{"size":4,"mapping":"uniform","nodes":"edges"}},"channels":"rgb","symmetry":{{"isotropic":true,"reciprocal":true,"bilateral":true}}}},"description":"lambert kd=0.5","values":24}}"#
+    );
+    let mut b = b"BRDFTAB-RAW\n".to_vec();
+    b.extend_from_slice(&(header.len() as u64).to_le_bytes());
+    b.extend_from_slice(header.as_bytes());
+    b.resize(b.len() + 4 * values, 0);
+    b
+}
+
+#[test]
+fn a_raw_tables_header_cannot_make_its_reader_allocate_beyond_the_file() {
+    let _turn = TURN.lock().unwrap_or_else(|p| p.into_inner());
+    let d = TempDir::new("mem-raw");
+    let p = d.join("t.raw");
+    // The honest file (2 × 1 × 2 × 2 stored nodes × 3 channels) opens.
+    std::fs::write(&p, raw_with_theta_size("2", 24)).unwrap();
+    assert_eq!(Table::open_raw(&p).unwrap().values().len(), 24);
+    // θh of 20 million nodes over the same 24 values: the grid's layout alone held a start
+    // per node (160 MB), allocated before the values were counted. Opening a file of under
+    // 1 kB reads it (1 kB), parses a header of a few hundred bytes and refuses: a few kB in
+    // all, far below the 1 MiB allowed here.
+    for size in [
+        "20000000",
+        "1099511627776",
+        "4611686018427387904",
+        "-1",
+        "1e300",
+    ] {
+        let bytes = raw_with_theta_size(size, 24);
+        assert!(bytes.len() < 1024);
+        std::fs::write(&p, &bytes).unwrap();
+        let (r, _, peak) = measure(|| Table::open_raw(&p));
+        assert!(
+            peak < 1 << 20,
+            "θh size {size}: the reader's peak was {peak} bytes"
+        );
+        let e = r.expect_err("a grid larger than the file's values");
+        assert!(
+            matches!(
+                e,
+                brdftab::Error::Format { .. } | brdftab::Error::Json { .. }
+            ),
+            "{e}"
+        );
+    }
+}

@@ -647,6 +647,32 @@ fn raw_file_round_trips() {
     assert!(matches!(Table::open_raw(&p), Err(Error::Format { .. })));
 }
 
+/// Axis sizes whose product overflows are the grid's "more than 2^40 values" error: the check
+/// ran after the layout was built, which reserved a start per θ1 node (`capacity overflow` at
+/// 2^61 and above) and multiplied the sizes unchecked. Found by fuzzing (session 40).
+#[test]
+fn grid_sizes_whose_product_overflows_are_an_error() {
+    for sizes in [
+        [1 << 62, 4, 1 << 62, 4],
+        [1 << 61, 1, 2, 4],
+        [4, 1 << 32, 1 << 32, 1 << 33],
+    ] {
+        for param in [Param::HalfDiff, Param::InOut] {
+            let r = Grid::with_sizes(
+                param,
+                sizes,
+                [Mapping::Uniform, Mapping::Uniform],
+                Channels::Rgb,
+                Symmetry::NONE,
+            );
+            assert!(
+                matches!(&r, Err(Error::InvalidArgument { .. })),
+                "{param:?} {sizes:?}: {r:?}"
+            );
+        }
+    }
+}
+
 /// The two-phase batch path (prepare, prefetch, gather) is bit-identical to single lookups for
 /// every layout it covers and falls back for the others, with invalid pairs mixed in and a
 /// count that is not a multiple of the group size.

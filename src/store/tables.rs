@@ -138,8 +138,7 @@ impl StoredTable {
             .unwrap_or(0)
             .saturating_mul(4)
             .saturating_add(4);
-        let mut sizes = Vec::new();
-        collect_sizes(&h.grid, &mut sizes);
+        let sizes = crate::table::grid::json_sizes(&h.grid);
         if let Some(s) = sizes.iter().find(|&&s| s > max) {
             return Err(bad(format!(
                 "axis size {s} does not fit the stored shape {:?}",
@@ -177,21 +176,6 @@ impl StoredTable {
     pub fn to_table(&self) -> Result<Table> {
         let grid = self.grid()?;
         Table::new(grid, self.read_all()?, self.header().name.clone())
-    }
-}
-
-fn collect_sizes(v: &serde_json::Value, out: &mut Vec<u64>) {
-    match v {
-        serde_json::Value::Object(m) => {
-            for (k, x) in m {
-                if k == "size" {
-                    out.push(x.as_u64().unwrap_or(u64::MAX));
-                }
-                collect_sizes(x, out);
-            }
-        }
-        serde_json::Value::Array(a) => a.iter().for_each(|x| collect_sizes(x, out)),
-        _ => {}
     }
 }
 

@@ -546,6 +546,29 @@ impl From<Grid> for GridRepr {
     }
 }
 
+/// Every `size` in a grid's JSON, at any depth (`u64::MAX` for one that is not a number): what
+/// a reader bounds by the values its file holds before it builds the grid
+/// ([`Grid::new`] holds one offset per θ1 node, so a size is an allocation).
+pub(crate) fn json_sizes(v: &serde_json::Value) -> Vec<u64> {
+    fn walk(v: &serde_json::Value, out: &mut Vec<u64>) {
+        match v {
+            serde_json::Value::Object(m) => {
+                for (k, x) in m {
+                    if k == "size" {
+                        out.push(x.as_u64().unwrap_or(u64::MAX));
+                    }
+                    walk(x, out);
+                }
+            }
+            serde_json::Value::Array(a) => a.iter().for_each(|x| walk(x, out)),
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    walk(v, &mut out);
+    out
+}
+
 impl Grid {
     /// A grid from its full axes `[θ1, φ1, θ2, φ2]` (see the table in the module docs).
     ///
@@ -593,6 +616,26 @@ impl Grid {
                     ),
                 ));
             }
+        }
+        // The grid's size before anything is built from it (the layout holds a start per θ1
+        // node): a hostile size in a file's header is this error, not an overflow, a panic or
+        // an allocation of its size.
+        let p1_full = if axes[1].size == 1 {
+            axes[3].size
+        } else {
+            axes[1].size
+        };
+        let full = [
+            axes[0].size,
+            p1_full,
+            axes[2].size,
+            axes[3].size,
+            channels.len(),
+        ]
+        .iter()
+        .try_fold(1u64, |acc, &n| acc.checked_mul(n as u64));
+        if full.is_none_or(|n| n > 1 << 40) {
+            return Err(Error::arg("grid", "more than 2^40 values"));
         }
         let [t1, p1, t2, p2] = &axes;
         if p1.size == 1 && !symmetry.isotropic && p2.size > 1 {
@@ -694,9 +737,6 @@ impl Grid {
             stored,
             layout,
         };
-        if g.full_values() > 1 << 40 {
-            return Err(Error::arg("grid", "more than 2^40 values"));
-        }
         Ok(g)
     }
 

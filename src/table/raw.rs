@@ -123,9 +123,15 @@ impl Table {
     /// Reads a raw table file.
     pub fn open_raw(path: impl AsRef<Path>) -> Result<Table> {
         let path = path.as_ref();
-        let name = path.display().to_string();
         crate::files::require_regular(path)?;
         let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        Table::from_raw_bytes(&path.display().to_string(), &bytes)
+    }
+
+    /// Reads a raw table file held in memory (`name` is used in error messages): what
+    /// [`Table::open_raw`] runs on the file's bytes, and the fuzz target's entry.
+    pub fn from_raw_bytes(name: &str, bytes: &[u8]) -> Result<Table> {
+        let name = name.to_owned();
         if bytes.len() < 20 || &bytes[..12] != MAGIC {
             return Err(Error::format(
                 &name,
@@ -146,10 +152,30 @@ impl Table {
                     format!("{hl} exceeds the file"),
                 )
             })? as usize;
-        let h: Header = serde_json::from_slice(&bytes[20..end]).map_err(|e| Error::Json {
+        let json = |e| Error::Json {
             context: name.clone(),
             source: e,
-        })?;
+        };
+        let v: serde_json::Value = serde_json::from_slice(&bytes[20..end]).map_err(json)?;
+        // The values the file holds bound every axis before the grid is built (a folded axis
+        // stores a quarter of its nodes, plus one): a size in a header of a few hundred bytes
+        // was an allocation of that size (2^40: the process aborted; 2e8: 1.6 GB and 5 s
+        // before the size check below refused it).
+        let held = (bytes.len() - end) as u64 / 4;
+        let max = held.saturating_mul(4).saturating_add(4);
+        if let Some(s) = v
+            .get("grid")
+            .map(crate::table::grid::json_sizes)
+            .and_then(|sizes| sizes.into_iter().find(|&s| s > max))
+        {
+            return Err(Error::format(
+                &name,
+                Some("grid"),
+                Some(20),
+                format!("axis size {s} does not fit the {held} values the file holds"),
+            ));
+        }
+        let h: Header = serde_json::from_value(v).map_err(json)?;
         if h.format != 1 {
             return Err(Error::format(
                 &name,
