@@ -573,3 +573,36 @@ fn written_fields_are_aligned_as_the_published_files() {
     let offsets = |t: &TensorFile| t.fields().iter().map(|f| f.offset).collect::<Vec<_>>();
     assert_eq!(offsets(&written), offsets(&published));
 }
+
+/// Re-encoding a file the reader accepts (`convert x.bsdf y.bsdf`: the file's own
+/// parameterization, the file as the source) either writes a file the reader accepts or is an
+/// error. `tests/data/fuzz_bsdf_luminance_overflow.bsdf` (9,043 bytes: the `bsdf` fuzz target's
+/// crash `crash-c04d9de8…`, session 40) stores values near f32's largest: each finite, and its
+/// own luminance field valid, but the luminance the writer computes from them integrates to
+/// inf, and the writer wrote a file the reader refuses ("slice 2 integrates to inf").
+#[test]
+fn a_reencoded_file_reads_back_or_is_an_error() {
+    use brdftab::measured::rgl_write::{Options, Parameterization, encode};
+    let p = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/fuzz_bsdf_luminance_overflow.bsdf"
+    );
+    let t = TensorFile::open(p).unwrap();
+    let src = RglBrdf::from_tensor(&t, None).expect("the reader accepts the input");
+    let opts = Options {
+        parameterization: Some(Parameterization::from_tensor(&t).unwrap()),
+        ..Options::default()
+    };
+    match encode(&src, &opts, &brdftab::Silent) {
+        Ok(f) => {
+            let back = TensorFile::from_bytes("out.bsdf", f.to_bytes()).unwrap();
+            if let Err(e) = RglBrdf::from_tensor(&back, None) {
+                panic!("the writer wrote a file the reader refuses: {e}");
+            }
+        }
+        Err(e) => assert!(
+            matches!(e, brdftab::Error::InvalidArgument { .. }),
+            "an error naming the source: {e}"
+        ),
+    }
+}

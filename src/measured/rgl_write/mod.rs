@@ -462,14 +462,32 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
         .description
         .clone()
         .unwrap_or_else(|| format!("brdftab: {}", brdf.describe()));
-    Ok(fields_of(
+    let fields = fields_of(
         description,
         &layout,
         &ndf,
         warps.data,
         values,
         brdf.channels(),
-    ))
+    );
+    // The luminance must be a density the readers can build their warp of: values near f32's
+    // largest, each finite, summed to inf (session 40's fuzzing: a file the reader accepts,
+    // re-encoded, was written and then refused by the reader).
+    let planes = crate::table::warp2d::Planes {
+        nx: layout.n,
+        ny: layout.n,
+        data: fields.luminance.clone(),
+    };
+    if let Err((s, total)) = crate::table::warp2d::Warp::build(planes) {
+        return Err(Error::arg(
+            "source",
+            format!(
+                "the luminance of slice {s} integrates to {total}: the source's values are too \
+                 large for a .bsdf file"
+            ),
+        ));
+    }
+    Ok(fields)
 }
 
 /// The fields of a file of `layout` from its parts (the luminance computed from the values).
