@@ -4,8 +4,9 @@
 //! entry of the table it wrote, and the Python package hands them out as dicts — so the keys are
 //! an interface: `name`, `source`, `parameterization`, `symmetry`, `channels`, `units`, `codec`,
 //! `tool`, `shape`, `values`, `chunks`, `bytes`, `ratio_to_f32`, `sampling_bytes` (the importance
-//! sampler's structure, built in memory on the first `sample`/`pdf`; not in [`list`]'s rows,
-//! which read no chunk), `quantity` (what the
+//! sampler's structure, built in memory on the first `sample`/`pdf`; reported of one table —
+//! `DB#NAME`, a file of one table — only: sizing it builds the sampler, so neither [`list`]'s
+//! rows nor [`file_info`] of a database of several tables hold it), `quantity` (what the
 //! stored values are: `fr`, `fr_cos_out` or `fr_cos_cos`, [`crate::table::Quantity::name`]) and
 //! `calibrated` (whether lookups multiply them by an albedo calibration's k_in(θi) k_out(θo))
 //! per table; `file`, `format`, `bytes`, `ratio_to_f32`, `tables` per file. The last two say
@@ -120,7 +121,7 @@ pub fn table_info(path: &str, name: &str) -> Result<Value> {
 /// what each table's header and chunk index say, without `sampling_bytes` and with no chunk
 /// decoded. (Sizing each table's sampler made `db list` of a database of 1,000 tables of
 /// 576 values take 94 s, and decoded every chunk of every table with a one-array kernel:
-/// [`table_summary`] and `info` report it.)
+/// [`table_summary`] and `info` of one table report it.)
 pub fn list(path: &str) -> Result<Vec<Value>> {
     let s = Store::open(path)?;
     s.tables()
@@ -136,16 +137,20 @@ pub fn file_info(source: &str) -> Result<Value> {
 }
 
 /// [`file_info`] of the brdftab file at `path`, taken as a path (never split at a `#`): table
-/// `name`, or every table for `None`.
+/// `name`, or every table for `None`. `sampling_bytes` is reported of one table (`name`, or a
+/// file holding one table): sizing a sampler builds it (0.1 s for the smallest table, every
+/// chunk of a one-array table decoded), and `info` of a database of 1,000 small tables took
+/// 94 s (session 39). A database of several tables is reported as [`list`] reads it.
 pub fn file_info_at(path: &str, name: Option<&str>) -> Result<Value> {
     let s = Store::open(path)?;
     let names: Vec<String> = match name {
         Some(n) => vec![n.to_owned()],
         None => s.tables().iter().map(|e| e.name.clone()).collect(),
     };
+    let sampling = names.len() == 1;
     let tables: Vec<Value> = names
         .iter()
-        .map(|n| table_summary(&s, n))
+        .map(|n| summary(&s, n, sampling))
         .collect::<Result<_>>()?;
     // The file's ratio compares the whole file with every table it holds, also when one table
     // is asked for (`DB#NAME`): against that table alone it read "0.6x smaller than f32".
@@ -313,11 +318,10 @@ pub fn file_text(v: &Value) -> String {
             t["bytes"],
             t["ratio_to_f32"].as_f64().unwrap_or(0.0)
         );
-        let _ = writeln!(
-            o,
-            "  sampling: {} bytes in memory once sampled",
-            t["sampling_bytes"]
-        );
+        let _ = match t.get("sampling_bytes") {
+            Some(b) => writeln!(o, "  sampling: {b} bytes in memory once sampled"),
+            None => writeln!(o, "  sampling: sized for one table at a time (DB#NAME)"),
+        };
         let stores = match t["quantity"].as_str() {
             Some("fr_cos_cos") => "f_r cos θi cos θo (lookups divide by both cosines)",
             Some("fr_cos_out") => "f_r cos θo (lookups divide by cos θo)",

@@ -128,7 +128,9 @@ class Database:
         return f"{self.path}#{name}"
 
     def info(self):
-        """What ``brdftab info --json DB`` reports: the file and every table."""
+        """What ``brdftab info --json DB`` reports: the file and every table, read from their
+        headers and indexes (no ``sampling_bytes`` for a database of several tables: that is
+        ``info(db.source(name))``'s, one table's)."""
         return _native.info(self.path)
 
 

@@ -230,7 +230,8 @@ def info(source: str | PathLike[str]) -> dict[str, Any]:
     """What `brdftab info --json` reports of a table file (or, for DB#NAME, of one table): "file", "format", "bytes", "ratio_to_f32"
     and "tables", one dict per table with "name", "source", "parameterization", "symmetry",
     "channels", "units", "codec", "tool", "shape", "values", "chunks", "bytes", "ratio_to_f32",
-    "sampling_bytes", "quantity" (what the stored values are), "calibrated" and "axes" (per stored
+    "sampling_bytes" (of one table — DB#NAME, a file of one table — only: sizing it builds
+    the sampler), "quantity" (what the stored values are), "calibrated" and "axes" (per stored
     axis in shape order: "name", "mapping", "nodes" and every node's angle in "degrees"). Of a measured
     file (MERL .binary, RGL .bsdf): "file", "format" ("merl" or "rgl"), "bytes", "channels",
     "sha256", and MERL "material", "dims", "unmeasured", "cells" or RGL "description", "kind",
@@ -338,4 +339,6 @@ class Database:
     def source(self, name: str) -> str:
         """The SOURCE string of table NAME ("DB#NAME"), e.g. for worker processes."""
     def info(self) -> dict[str, Any]:
-        """What `brdftab info --json DB` reports: the file and every table."""
+        """What `brdftab info --json DB` reports: the file and every table, read from their
+        headers and indexes (no "sampling_bytes" for a database of several tables: that is
+        `info(db.source(name))`'s, one table's)."""
