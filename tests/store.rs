@@ -526,6 +526,75 @@ fn a_table_claiming_more_values_than_memory_is_an_error_when_read_whole() {
     }
 }
 
+/// A claim of 68.7 GB (2^34 values less a few, the most a header may hold: 16,384 chunks of 1 M
+/// values, each within what zstd could expand its 40 bytes to) by a table whose grid has the
+/// one-array kernel (halfdiff, isotropic and bilateral, warped axes), opened lazily: its first
+/// lookup gathers every chunk into one array, which reserved the whole claim unguarded and
+/// aborted the process ("memory allocation failed") before decoding a chunk. Now it is an
+/// error as the eager read's is: the lookup gives 0 and `health` names the file.
+#[test]
+fn a_one_array_table_claiming_more_values_than_memory_fails_its_first_lookup() {
+    use brdftab::Brdf;
+    use brdftab::table::adaptive::grid_with_warps;
+    use brdftab::table::kernel::Kernel;
+    use brdftab::table::warp::{Warp, WarpVar};
+    use brdftab::table::{Grid, Symmetry};
+    use glam::DVec3;
+    let d = TempDir::new("store-claim-lazy");
+    let p = d.join("claim.btdb");
+    let sym = Symmetry {
+        isotropic: true,
+        reciprocal: false,
+        bilateral: true,
+    };
+    let warps = [
+        Warp::identity(WarpVar::SqrtSine),
+        Warp::identity(WarpVar::HalfPower),
+        Warp::identity(WarpVar::PseudoAngle),
+    ];
+    // The claim's grid: 16,384 θh × 174,760 θd × 2 φd nodes, RGB (within the grid's 2^40
+    // values over the full domain). The library bakes no grid that large; the header says so.
+    let small = grid_with_warps(Channels::Rgb, sym, [2, 2, 2], warps).unwrap();
+    let mut j = serde_json::to_value(&small).unwrap();
+    for (axis, size) in [
+        ("theta1", 16384),
+        ("phi1", 2),
+        ("theta2", 174760),
+        ("phi2", 2),
+    ] {
+        j[axis]["size"] = size.into();
+    }
+    let g: Grid = serde_json::from_value(j).unwrap();
+    assert!(
+        Kernel::new(&g).is_some(),
+        "a grid the one-array kernel reads"
+    );
+    let src = Source::Other {
+        description: "a claim".into(),
+    };
+    let h = TableHeader::for_grid("claim", src, &g, Codec::default());
+    assert_eq!(h.values, 16384 * 174760 * 6);
+    let per = h.values / 16384;
+    let mut w = Writer::create(&p).unwrap();
+    w.begin_table(h).unwrap();
+    for i in 0..16384 {
+        w.encoded_chunk(&[i as u8; 40], per).unwrap();
+    }
+    w.end_table().unwrap();
+    w.finish().unwrap();
+    let b = brdftab::store::tables::open_brdf(&format!("{}#claim", p.display()), false).unwrap();
+    let mut out = [1f32; 3];
+    b.eval(
+        DVec3::new(0.3, 0.1, 0.9),
+        DVec3::new(-0.2, 0.4, 0.8),
+        &mut out,
+    );
+    assert_eq!(out, [0.0; 3]);
+    let e = b.health().unwrap_err();
+    assert!(matches!(e, Error::Format { .. }), "{e}");
+    assert!(e.to_string().contains("claim.btdb"), "{e}");
+}
+
 /// The in-repo substitute for a fuzzer (nightly is not available for `cargo fuzz`): thousands of
 /// random mutations — byte flips, overwrites, truncations, splices — of a real database must
 /// each give an error, never a panic or an accepted file.

@@ -354,11 +354,29 @@ impl TabulatedBrdf {
     /// All chunks in one packed array (tables with a kernel), decoded on first use (without
     /// keeping the f32 chunks); empty when a chunk could not be loaded (the error is recorded,
     /// lookups give 0).
+    ///
+    /// The array's size is the file's word until its chunks decode: it is reserved fallibly,
+    /// as [`StoredTable::read_all`](crate::store::StoredTable::read_all) reserves an eager
+    /// open's (a size beyond memory is an error, not an abort), and filled as chunks decode,
+    /// so a file that claims more than its chunks hold fails at its first chunk.
     #[cold]
     fn load_packed(&self) -> Packed {
         let l = self.grid.layout();
+        let mut all = Vec::new();
         // Room for the padding: an exact kernel keeps this array as it is.
-        let mut all = Vec::with_capacity(l.len() + Packed::PAD);
+        if all.try_reserve_exact(l.len() + Packed::PAD).is_err() {
+            self.record_failure(Error::format(
+                &self.description,
+                Some("values"),
+                None,
+                format!(
+                    "{} values ({:.1} GB of f32) do not fit in memory",
+                    l.len(),
+                    l.len() as f64 * 4e-9
+                ),
+            ));
+            return Packed::empty();
+        }
         for a in 0..l.chunk_count() {
             if let Some(c) = self.chunks[a].get() {
                 if c.len() != l.chunk_len(a) {
