@@ -1,8 +1,8 @@
 //! `slice`: a slice image of any SOURCE.
 
 use brdftab::{Brdf, Error, Result};
-use brdftab_tools::errln;
 use brdftab_tools::preview::slice;
+use brdftab_tools::{errln, text::shortest};
 use clap::{Args, ValueEnum};
 
 /// Which slice to draw.
@@ -100,7 +100,7 @@ pub fn slice(a: SliceArgs) -> Result<()> {
                     "--theta-in",
                     format!(
                         "{}° is outside [0°, 90°): the light must be above the horizon",
-                        theta_in
+                        shortest(theta_in)
                     ),
                 )
             })?;
@@ -113,16 +113,17 @@ pub fn slice(a: SliceArgs) -> Result<()> {
         // An isotropic BRDF is the same at every φh; an anisotropic one shows its φh = 0 slice.
         SliceKind::Halfdiff if brdf.flags().isotropic => format!(
             "f_r, x = θh 0..90°, y = θd 0..90° (top to bottom), φd = {}°",
-            phi_d
+            shortest(phi_d)
         ),
         SliceKind::Halfdiff => format!(
             "f_r, x = θh 0..90°, y = θd 0..90° (top to bottom), φd = {}°, φh = 0° (anisotropic: \
              the half vector in the x–z plane)",
-            phi_d
+            shortest(phi_d)
         ),
         SliceKind::Polar => format!(
             "f_r·cos θo over the outgoing hemisphere (radius ∝ θo, +x right, +y up), θi = {}°, φi = {}°",
-            theta_in, phi_in
+            shortest(theta_in),
+            shortest(phi_in)
         ),
     };
     let legend = slice::write(&img, channel, &a.output)?;

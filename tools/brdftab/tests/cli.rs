@@ -185,6 +185,34 @@ fn albedo_takes_the_lights_azimuth() {
     assert_error(&o, "--phi");
 }
 
+/// The angles a slice's legend and errors echo are printed as `albedo` prints its angles
+/// (`text::shortest`): 1e-300° read as "0.000…1" with 300 zeros and 1e300° as 301 digits.
+#[test]
+fn a_slice_echoes_its_angles_in_their_shortest_form() {
+    let dir = TempDir::new("cli-slice-echo");
+    let png = dir.join("s.png");
+    let png = png.to_str().unwrap();
+    let base = ["slice", LAMBERT, "-o", png, "--size", "8"];
+    let polar = [
+        &base[..],
+        &["--kind=polar", "--theta-in=1e-300", "--phi-in=1e300"],
+    ]
+    .concat();
+    let o = brdftab(&polar);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("θi = 1e-300°, φi = 1e300°"),
+        "{}",
+        o.stderr
+    );
+    let o = brdftab(&[&base[..], &["--kind=halfdiff", "--phi-d=1e-300"]].concat());
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(o.stderr.contains("φd = 1e-300°"), "{}", o.stderr);
+    let o = brdftab(&[&base[..], &["--kind=polar", "--theta-in=1e300"]].concat());
+    assert_error(&o, "1e300° is outside [0°, 90°)");
+    assert!(!o.stderr.contains("000000"), "{}", o.stderr);
+}
+
 #[test]
 fn a_polar_slice_is_for_light_above_the_horizon() {
     // The incidence was clamped into [0°, 90°]: 120 and -5 drew the 90° and 0° slices silently.
