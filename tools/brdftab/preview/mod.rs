@@ -3,8 +3,9 @@
 //! - [`image`]: the [`Image`] type and its files (EXR, PNG), tone mapping, false colour;
 //! - [`scene`]: a unit sphere (optionally on a grey ground) under a smooth procedural sky or an
 //!   EXR lat-long map, with an optional point or spherical light, seen by a pinhole camera;
+//! - [`options`]: [`RenderOptions`], what a render is asked for, and its checks;
 //! - [`path`]: the path tracer (MIS between light sampling and `Brdf::sample`) and the
-//!   direct-lighting "lit sphere" mode, [`RenderOptions`] and [`render`];
+//!   direct-lighting "lit sphere" mode, [`render`];
 //! - [`compare`](mod@compare): relative RMSE between renders and false-colour difference images.
 //!
 //! ```
@@ -20,6 +21,7 @@
 
 pub mod compare;
 pub mod image;
+pub mod options;
 pub mod path;
 pub mod sampler;
 pub mod scene;
@@ -30,5 +32,6 @@ pub use image::{
     ExrPrecision, FalseColor, Image, colormap, false_color, read_exr, write_auto, write_exr,
     write_png,
 };
-pub use path::{EnvChoice, LightChoice, Mode, RenderOptions, Sampling, render};
+pub use options::{EnvChoice, LightChoice, Mode, RenderOptions, Sampling};
+pub use path::render;
 pub use scene::{Environment, Light, Scene};

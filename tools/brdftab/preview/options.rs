@@ -1,0 +1,223 @@
+//! What a render is asked for: [`RenderOptions`] and its choices, checked before any pixel is
+//! rendered.
+
+use std::sync::Arc;
+
+use super::scene::{Environment, Light, Scene};
+use brdftab::error::{Error, Result};
+
+/// What to compute.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mode {
+    /// Full path tracing (up to `max_depth` bounces).
+    #[default]
+    Path,
+    /// Direct lighting only ("lit sphere"): one bounce.
+    Lit,
+}
+
+/// Which sampling strategies reach the emitters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Sampling {
+    /// Light sampling and `Brdf::sample`, combined with the power heuristic.
+    #[default]
+    Mis,
+    /// `Brdf::sample` only (no light sampling; point lights are then invisible).
+    BrdfOnly,
+    /// Light sampling only for emitters; BRDF samples still continue paths but count emitters
+    /// they hit only after delta lobes.
+    LightOnly,
+    /// Light sampling and cosine-hemisphere sampling, MIS-combined: the sampled directions do not
+    /// depend on the material, so two materials rendered with the same seed see the same
+    /// directions and their difference is nearly free of noise (Russian roulette aside). Delta
+    /// lobes still use `Brdf::sample`.
+    Fixed,
+}
+
+/// The environment of the scene.
+#[derive(Debug, Clone, Default)]
+pub enum EnvChoice {
+    /// The smooth procedural sky ([`Environment::sky`]).
+    #[default]
+    Sky,
+    /// Constant radiance (the furnace).
+    Constant([f32; 3]),
+    /// No environment light.
+    Black,
+    /// A given environment (e.g. loaded from an EXR lat-long map).
+    Map(Arc<Environment>),
+}
+
+/// The extra light of the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum LightChoice {
+    /// None.
+    #[default]
+    None,
+    /// [`Light::default_point`].
+    Point,
+    /// [`Light::default_area`].
+    Area,
+    /// A given light.
+    Custom(Light),
+}
+
+/// A name from `choices` (`(name, value)`), or an argument error naming `what` and the choices.
+fn choose<T: Clone>(what: &str, s: &str, choices: &[(&str, T)]) -> Result<T> {
+    let t = s.trim().to_ascii_lowercase();
+    match choices.iter().find(|(n, _)| *n == t) {
+        Some((_, v)) => Ok(v.clone()),
+        None => {
+            let names: Vec<&str> = choices.iter().map(|c| c.0).collect();
+            Err(Error::arg(
+                what,
+                format!("`{s}`: expected {}", names.join(", ")),
+            ))
+        }
+    }
+}
+
+impl Mode {
+    /// Parses `path` or `lit`.
+    pub fn parse(s: &str) -> Result<Mode> {
+        choose("mode", s, &[("path", Mode::Path), ("lit", Mode::Lit)])
+    }
+}
+
+impl Sampling {
+    /// Parses `mis`, `brdf`, `light` or `fixed`.
+    pub fn parse(s: &str) -> Result<Sampling> {
+        let c = [
+            ("mis", Sampling::Mis),
+            ("brdf", Sampling::BrdfOnly),
+            ("light", Sampling::LightOnly),
+            ("fixed", Sampling::Fixed),
+        ];
+        choose("sampling", s, &c)
+    }
+}
+
+impl EnvChoice {
+    /// Parses `sky`, `white` (constant 1, the furnace), `none`, or a lat-long `.exr` file.
+    pub fn parse(s: &str) -> Result<EnvChoice> {
+        if s.to_ascii_lowercase().ends_with(".exr") {
+            return Ok(EnvChoice::Map(Arc::new(Environment::from_exr(s)?)));
+        }
+        let c = [
+            ("sky", EnvChoice::Sky),
+            ("white", EnvChoice::Constant([1.0; 3])),
+            ("none", EnvChoice::Black),
+        ];
+        choose("env", s, &c).map_err(|e| match e {
+            Error::InvalidArgument { name, msg } => {
+                Error::arg(name, format!("{msg} or a .exr file"))
+            }
+            e => e,
+        })
+    }
+}
+
+impl LightChoice {
+    /// Parses `none`, `point` or `area`.
+    pub fn parse(s: &str) -> Result<LightChoice> {
+        let c = [
+            ("none", LightChoice::None),
+            ("point", LightChoice::Point),
+            ("area", LightChoice::Area),
+        ];
+        choose("light", s, &c)
+    }
+}
+
+/// Everything a render needs besides the material.
+#[derive(Debug, Clone)]
+pub struct RenderOptions {
+    /// Image width in pixels.
+    pub width: usize,
+    /// Image height in pixels.
+    pub height: usize,
+    /// Samples per pixel.
+    pub spp: usize,
+    /// Seed: same seed, same image, bit for bit, whatever the thread count.
+    pub seed: u64,
+    /// Maximum number of surface interactions per path (1 = direct lighting only).
+    pub max_depth: usize,
+    /// Path tracing or direct lighting.
+    pub mode: Mode,
+    /// Sampling strategies.
+    pub sampling: Sampling,
+    /// The environment.
+    pub env: EnvChoice,
+    /// The extra light.
+    pub light: LightChoice,
+    /// Whether a diffuse grey ground plane (albedo 0.5) is under the sphere.
+    pub ground: bool,
+    /// Exposure in stops for PNG output (not applied to the returned image).
+    pub exposure: f32,
+    /// Number of threads (`None` = rayon's global pool).
+    pub threads: Option<usize>,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 256,
+            height: 256,
+            spp: 64,
+            seed: 0,
+            max_depth: 8,
+            mode: Mode::Path,
+            sampling: Sampling::Mis,
+            env: EnvChoice::Sky,
+            light: LightChoice::None,
+            ground: false,
+            exposure: 0.0,
+            threads: None,
+        }
+    }
+}
+
+impl RenderOptions {
+    /// Builds the scene these options describe.
+    pub fn scene(&self) -> Scene {
+        let env = match &self.env {
+            EnvChoice::Sky => Environment::sky(),
+            EnvChoice::Constant(c) => Environment::constant(*c),
+            EnvChoice::Black => Environment::black(),
+            EnvChoice::Map(e) => (**e).clone(),
+        };
+        let light = match self.light {
+            LightChoice::None => None,
+            LightChoice::Point => Some(Light::default_point()),
+            LightChoice::Area => Some(Light::default_area()),
+            LightChoice::Custom(l) => Some(l),
+        };
+        Scene::new(env, light, self.ground)
+    }
+
+    /// Checks the options before any work: every refusal names the field.
+    pub(crate) fn validate(&self) -> Result<()> {
+        let bad = |name: &str, msg: &str| {
+            Err(Error::InvalidArgument {
+                name: name.into(),
+                msg: msg.into(),
+            })
+        };
+        if self.width == 0 || self.height == 0 {
+            return bad("size", "width and height must be positive");
+        }
+        if self.width.saturating_mul(self.height) > 1 << 28 {
+            return bad("size", "image too large");
+        }
+        if self.spp == 0 || self.spp > 1 << 20 {
+            return bad("spp", "samples per pixel must be in 1..=1048576");
+        }
+        if self.max_depth == 0 {
+            return bad("max_depth", "must be at least 1");
+        }
+        if self.threads == Some(0) {
+            return bad("threads", "must be at least 1");
+        }
+        Ok(())
+    }
+}
