@@ -43,9 +43,9 @@ pub struct RenderArgs {
     /// Put the sphere on a diffuse grey ground plane.
     #[arg(long)]
     ground: bool,
-    /// Sampling: mis (light + BRDF sampling), brdf, light, or fixed (light + cosine sampling:
-    /// material-independent directions). Default: mis, but fixed with --compare, so that both
-    /// sources see the same directions and the difference shows the materials, not the noise.
+    /// Sampling: mis (light + BRDF sampling), brdf (no point light), light, or fixed (light +
+    /// cosine sampling: material-independent directions). Default: mis, but fixed with --compare,
+    /// so both sources see the same directions and the difference shows materials, not noise.
     #[arg(long)]
     sampling: Option<String>,
     /// Exposure in stops for PNG output.

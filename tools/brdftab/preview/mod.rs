@@ -3,7 +3,7 @@
 //! - [`image`]: the [`Image`] type and its files (EXR, PNG), tone mapping, false colour;
 //! - [`scene`]: a unit sphere (optionally on a grey ground) under a smooth procedural sky or an
 //!   EXR lat-long map, with an optional point or spherical light, seen by a pinhole camera;
-//! - [`options`]: [`RenderOptions`], what a render is asked for, and its checks;
+//! - [`options`]: [`RenderOptions`], what a render is asked for, and its limits;
 //! - [`path`]: the path tracer (MIS between light sampling and `Brdf::sample`) and the
 //!   direct-lighting "lit sphere" mode, [`render`];
 //! - [`compare`](mod@compare): relative RMSE between renders and false-colour difference images.
@@ -32,6 +32,9 @@ pub use image::{
     ExrPrecision, FalseColor, Image, colormap, false_color, read_exr, write_auto, write_exr,
     write_png,
 };
-pub use options::{EnvChoice, LightChoice, Mode, RenderOptions, Sampling};
+pub use options::{
+    EnvChoice, LightChoice, MAX_PIXELS, MAX_SAMPLE_BYTES, MAX_THREADS, Mode, RenderOptions,
+    Sampling,
+};
 pub use path::render;
 pub use scene::{Environment, Light, Scene};

@@ -1,8 +1,10 @@
 //! What a render is asked for: [`RenderOptions`] and its choices, checked before any pixel is
-//! rendered.
+//! rendered (sizes, samples, threads and the memory they take, combinations that would drop
+//! a light the user asked for).
 
 use std::sync::Arc;
 
+use super::sampler::STRATIFIED_PAIRS;
 use super::scene::{Environment, Light, Scene};
 use brdftab::error::{Error, Result};
 
@@ -129,6 +131,22 @@ impl LightChoice {
     }
 }
 
+/// The largest image [`render`](crate::preview::render) accepts, in pixels (8192 × 8192). The
+/// CLI's peak memory is about 28 bytes a pixel for one render (the tiles' results, the image,
+/// the encoder's copy: 477 MB at 4096 × 4096) and 85 for `--compare` (two images, the pair, the
+/// difference: 1.42 GB), so the 2²⁸ pixels once allowed (16384 × 16384) asked for ~23 GB and
+/// ended in an out-of-memory abort rather than an error; 2²⁶ is at most ~5.7 GB.
+pub const MAX_PIXELS: usize = 1 << 26;
+
+/// The most threads a render starts: its 16-pixel tiles give no more threads work than there
+/// are cores, and an unbounded count (100000) asked the system for that many threads first.
+pub const MAX_THREADS: usize = 1024;
+
+/// The most memory the per-thread sample tables may hold together: each thread keeps
+/// `STRATIFIED_PAIRS` × spp sample pairs of 16 bytes for the pixel it renders (218 MB at the
+/// largest spp), so 2²⁰ spp on 64 threads asked for 14 GB.
+pub const MAX_SAMPLE_BYTES: usize = 4 << 30;
+
 /// Everything a render needs besides the material.
 #[derive(Debug, Clone)]
 pub struct RenderOptions {
@@ -206,8 +224,15 @@ impl RenderOptions {
         if self.width == 0 || self.height == 0 {
             return bad("size", "width and height must be positive");
         }
-        if self.width.saturating_mul(self.height) > 1 << 28 {
-            return bad("size", "image too large");
+        let pixels = self.width.saturating_mul(self.height);
+        if pixels > MAX_PIXELS {
+            return Err(Error::InvalidArgument {
+                name: "size".into(),
+                msg: format!(
+                    "{}×{} is {pixels} pixels; at most {MAX_PIXELS} (8192×8192)",
+                    self.width, self.height
+                ),
+            });
         }
         if self.spp == 0 || self.spp > 1 << 20 {
             return bad("spp", "samples per pixel must be in 1..=1048576");
@@ -218,6 +243,123 @@ impl RenderOptions {
         if self.threads == Some(0) {
             return bad("threads", "must be at least 1");
         }
+        if self.threads.is_some_and(|n| n > MAX_THREADS) {
+            return bad("threads", "must be at most 1024");
+        }
+        let workers = self.threads.unwrap_or_else(brdftab::par::threads);
+        let bytes = (workers.saturating_mul(self.spp)).saturating_mul(STRATIFIED_PAIRS * 16);
+        if bytes > MAX_SAMPLE_BYTES {
+            let name = if self.threads.is_some() {
+                "threads"
+            } else {
+                "spp"
+            };
+            return Err(Error::InvalidArgument {
+                name: name.into(),
+                msg: format!(
+                    "{} samples per pixel on {workers} threads hold {:.1} GB of sample values \
+                     (at most {:.1} GB): use fewer samples or threads",
+                    self.spp,
+                    bytes as f64 / 1e9,
+                    MAX_SAMPLE_BYTES as f64 / 1e9
+                ),
+            });
+        }
+        // BRDF sampling never finds a point: the image would lack the light asked for.
+        let point = matches!(
+            self.light,
+            LightChoice::Point | LightChoice::Custom(Light::Point { .. })
+        );
+        if point && self.sampling == Sampling::BrdfOnly {
+            return bad(
+                "light",
+                "a point light is reached only by light sampling; sampling `brdf` renders \
+                 without it (use `mis`, `light` or `fixed`, or an area light)",
+            );
+        }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tiny() -> RenderOptions {
+        RenderOptions {
+            width: 24,
+            height: 24,
+            spp: 16,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn a_point_light_that_brdf_sampling_cannot_reach_is_refused() {
+        let opts = |light, sampling| RenderOptions {
+            light,
+            sampling,
+            ..tiny()
+        };
+        let e = opts(LightChoice::Point, Sampling::BrdfOnly)
+            .validate()
+            .unwrap_err();
+        assert!(
+            matches!(&e, Error::InvalidArgument { name, .. } if name == "light"),
+            "{e}"
+        );
+        let custom = LightChoice::Custom(Light::default_point());
+        assert!(opts(custom, Sampling::BrdfOnly).validate().is_err());
+        assert!(
+            opts(LightChoice::Area, Sampling::BrdfOnly)
+                .validate()
+                .is_ok()
+        );
+        assert!(
+            opts(LightChoice::Point, Sampling::LightOnly)
+                .validate()
+                .is_ok()
+        );
+    }
+
+    #[test]
+    fn thread_counts_and_sample_tables_beyond_the_limits_are_refused() {
+        let opts = |threads, spp| RenderOptions {
+            threads: Some(threads),
+            spp,
+            ..tiny()
+        };
+        assert!(opts(MAX_THREADS, 64).validate().is_ok());
+        assert!(opts(8, 1 << 20).validate().is_ok());
+        for (threads, spp) in [(MAX_THREADS + 1, 1), (100_000, 64), (64, 1 << 20)] {
+            let e = opts(threads, spp).validate().unwrap_err();
+            assert!(
+                matches!(&e, Error::InvalidArgument { name, .. } if name == "threads"),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
+    fn sizes_beyond_the_pixel_limit_are_refused_before_rendering() {
+        let size = |width, height| RenderOptions {
+            width,
+            height,
+            ..tiny()
+        };
+        assert!(size(8192, 8192).validate().is_ok());
+        assert!(size(1 << 26, 1).validate().is_ok());
+        for (w, h) in [
+            (16384, 16384),
+            (8193, 8192),
+            ((1 << 26) + 1, 1),
+            (usize::MAX, 2),
+        ] {
+            let e = size(w, h).validate().unwrap_err();
+            assert!(
+                matches!(&e, Error::InvalidArgument { name, .. } if name == "size"),
+                "{e}"
+            );
+        }
     }
 }

@@ -184,6 +184,11 @@ fn flags_of_another_mode_are_refused_not_ignored() {
     // The lit sphere's one bounce does sample (light, BRDF or both): --sampling is used.
     let o = render(&["--mode", "lit", "--sampling", "brdf"]);
     assert!(o.ok, "{}", o.stderr);
+    // ... but BRDF sampling never reaches a point light: the image lacked the light asked for.
+    refused(
+        &render(&["--light", "point", "--sampling", "brdf"]),
+        &["`--light`", "point light"],
+    );
     let slice = |extra: &[&str]| {
         let args = ["slice", LAMBERT, "-o", &png, "--size", "8"];
         brdftab(&[&args[..], extra].concat())
