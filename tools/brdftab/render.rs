@@ -34,7 +34,7 @@ pub struct RenderArgs {
     #[arg(long)]
     max_depth: Option<usize>,
     /// Environment: `sky` (smooth procedural), `white` (constant 1, the furnace), `none`, or a
-    /// lat-long FILE.exr (z up: row 0 = zenith).
+    /// lat-long FILE.exr as pbrt-v3 reads it (z up: row 0 = zenith, φ = 2πu from +x to +y).
     #[arg(long, default_value = "sky")]
     env: String,
     /// Extra light: none, point or area (a small spherical light).

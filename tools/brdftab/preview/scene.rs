@@ -9,7 +9,10 @@
 //! Environments are lat-long tables, looked up with the nearest texel, so radiance is piecewise
 //! constant and importance sampling by luminance × sin θ is exact up to the luminance weighting
 //! (pbrt's `ImageInfiniteLight` approach). Row 0 is the zenith (+z), the last row the nadir;
-//! column u covers azimuth φ = 2πu measured from +x towards +y. The default [`Environment::sky`] is
+//! column u covers azimuth φ = 2πu measured from +x towards +y — pbrt-v3's layout; Mitsuba 3's
+//! `envmap` (y up, u = atan2(x, −z)/2π) shows the same file mirrored, and renders this scene's
+//! lighting with the columns flipped and `to_world` taking its (x, y, z) to world (−z, −x, y)
+//! (`bindings/python/bench/render_vs_mitsuba.py`). The default [`Environment::sky`] is
 //! deliberately smooth — a blue-white gradient, a broad warm "sun" lobe (σ ≈ 7°) and a dim ground
 //! colour below the horizon — so that renders converge quickly and two renders can be compared
 //! at a low noise floor.
