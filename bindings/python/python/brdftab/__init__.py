@@ -82,7 +82,8 @@ class Database:
         return hash((Database, self.path))
 
     def names(self):
-        """The table names, in file order."""
+        """The table names, in file order (the table of contents; :meth:`info` reads each
+        table)."""
         return _native.db_names(self.path)
 
     def __contains__(self, name):
