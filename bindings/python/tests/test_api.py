@@ -339,6 +339,19 @@ def test_database(tmp_path):
     assert db != brdftab.Database(tmp_path / "other.btdb") and db != str(tmp_path / "m.btdb")
 
 
+def test_a_database_has_a_length_and_iterates_over_its_names(tmp_path):
+    """`len(db)` and `for name in db` are the tables, as `names()` lists them (a Database had
+    `in` but neither); a database not created yet holds none, as `in` says."""
+    db = brdftab.Database(tmp_path / "m.btdb")
+    assert len(db) == 0 and list(db) == [] and not db
+    db.add(LAMBERT, "matte", preset="small")
+    db.add(GGX, "shiny", preset="small")
+    assert len(db) == 2 and list(db) == ["matte", "shiny"] == db.names()
+    assert [db.open(n).source for n in db] == [db.source("matte"), db.source("shiny")]
+    db.remove("matte")
+    assert len(db) == 1 and list(db) == ["shiny"]
+
+
 def test_a_database_path_is_a_str_or_a_pathlike_of_one(tmp_path, monkeypatch):
     """Database(path) took str(path) of anything: Database(b"m.btdb").add(...) wrote a file
     named "b'm.btdb'", Database(3) a file "3". Now it refuses what `open` and `bake` refuse,

@@ -54,7 +54,8 @@ __all__ = [
 
 
 class Database:
-    """A brdftab database: many named tables in one ``.btdb`` file.
+    """A brdftab database: many named tables in one ``.btdb`` file. ``len(db)``, ``name in db``
+    and ``for name in db`` are its tables' names (none for a file not created yet).
 
     >>> db = brdftab.Database("materials.btdb")            # doctest: +SKIP
     >>> db.add('{"model": "lambert", "kd": 0.5}', "matte")  # doctest: +SKIP
@@ -86,11 +87,22 @@ class Database:
         table)."""
         return _native.db_names(self.path)
 
-    def __contains__(self, name):
+    def _names(self):
         # A database that does not exist yet holds no table (``add`` creates it).
         if not _os.path.exists(self.path):
-            return False
-        return name in self.names()
+            return []
+        return self.names()
+
+    def __contains__(self, name):
+        return name in self._names()
+
+    def __len__(self):
+        return len(self._names())
+
+    def __iter__(self):
+        # The names as the file holds them now: adding or removing tables while iterating
+        # changes the file, not this list.
+        return iter(self._names())
 
     def add(self, source, name, *, replace=False, **options):
         """Bakes SOURCE into table NAME (the database is created if absent); takes the keywords

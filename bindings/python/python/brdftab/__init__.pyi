@@ -310,7 +310,8 @@ def fit(
 
 class Database:
     """A brdftab database: many named tables in one .btdb file. Pickles by its path; equal to
-    another Database of the same path."""
+    another Database of the same path. len(db), name in db and for name in db are its tables'
+    names (none for a file not created yet)."""
 
     path: str
     def __init__(self, path: Union[str, PathLike[str]]) -> None: ...
@@ -320,7 +321,9 @@ class Database:
     def __hash__(self) -> int: ...
     def names(self) -> list[str]:
         """The table names, in file order (the table of contents; `info` reads each table)."""
-    def __contains__(self, name: str) -> bool: ...
+    def __contains__(self, name: object) -> bool: ...
+    def __len__(self) -> int: ...
+    def __iter__(self) -> Iterator[str]: ...
     def add(
         self, source: str | PathLike[str], name: str, *, replace: bool = False, **options: Any
     ) -> dict[str, Any]:
