@@ -28,6 +28,9 @@ use crate::values::{ser, wavelengths_of};
 /// Array arguments are anything numpy reads as real numbers; a `numpy.ma` masked array with
 /// masked entries is a `ValueError` (fill or drop them first). Pickles by its source and
 /// options; `copy.copy` and `copy.deepcopy` give the object itself (it is immutable).
+/// `eval`, `pdf` and `sample` run with the GIL released and to their end, as numpy's ufuncs
+/// do: Ctrl-C raises KeyboardInterrupt when the call returns (10^7 pairs: seconds); `albedo`
+/// stops between angles.
 #[pyclass(name = "Brdf", module = "brdftab", frozen)]
 pub(crate) struct PyBrdf {
     inner: Arc<dyn Brdf + Send + Sync>,
@@ -249,7 +252,8 @@ impl PyBrdf {
     /// local x axis, along which an anisotropic model's α_x runs; default 0; not finite:
     /// ValueError naming phi):
     /// float64 of θ′'s shape and then c ((k, c) for k angles, (c,) for a scalar θ′). A closed form where the model has one, else
-    /// adaptive quadrature: 1e-6 relative for models, 1e-4 for tables and measured data.
+    /// adaptive quadrature: 1e-6 relative for models, 1e-4 for tables and measured data (a
+    /// tenth of a second an angle for an RGL file; Ctrl-C stops the curve between angles).
     /// The azimuth matters for anisotropic sources only (GGX α = (0.01, 1) at θ′ = 89°: 0.517
     /// at phi = 0, 0.904 at phi = 0.3).
     #[pyo3(signature = (theta, phi=0.0))]
