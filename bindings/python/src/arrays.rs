@@ -7,8 +7,10 @@
 //! is `#[repr(C)]` of three f64, as the C ABI reads `double[n][3]`); a C-contiguous float32
 //! array — what Mitsuba, PyTorch and most renderers' buffers hold — is read in place too, each
 //! block of rows widened to f64 as the block is evaluated (the same values numpy's `astype`
-//! gives, without an n-sized float64 copy before the call); anything else — a strided view,
-//! integers, a list — is converted by numpy once. Results are written straight into the numpy
+//! gives, without an n-sized float64 copy before the call); a float64 `(n, W)` array at other
+//! strides — Fortran order (`np.array([x, y, z]).T`), reversed (`a[::-1]`), every other row, the
+//! first columns of a wider array — is read in place too, each block of rows gathered as it is
+//! evaluated; anything else — an N-d strided view, integers, a list — is converted by numpy once. Results are written straight into the numpy
 //! arrays returned, with the GIL released, so a large call's memory is its output.
 
 use brdftab::batch::{BLOCK, blocks};
@@ -130,8 +132,8 @@ pub(crate) fn shape_str(shape: &[usize]) -> String {
 
 /// Rows of `W` numbers, `(..., W)` (one row: `(W,)`), as `T` (`T` = `DVec3` or `DVec2`):
 /// float64 borrowed in place as `[T]` when C-contiguous and aligned, float32 borrowed in place
-/// when C-contiguous (widened block by block: [`Rows::rows`]), anything else converted or
-/// copied once.
+/// when C-contiguous (widened block by block: [`View::rows`]), 2-d float64 borrowed in place at
+/// other strides (gathered block by block), anything else converted or copied once.
 pub(crate) struct Rows<'py, T> {
     /// Keeps the numpy array (and its read borrow) alive while `ptr` or `narrow` is used.
     _array: Held<'py>,
@@ -140,6 +142,8 @@ pub(crate) struct Rows<'py, T> {
     ptr: *const T,
     /// Rows in place as `W` f32 each (float32), or null.
     narrow: *const f32,
+    /// Rows in place at any strides (a 2-d float64 array that is not C-contiguous), or `None`.
+    strided: Option<Strided>,
     len: usize,
     /// The input's leading shape (its shape without the last axis; `[]` for one row `(W,)`).
     pub lead: Vec<usize>,
@@ -193,6 +197,54 @@ fn narrow_rows<'py>(obj: &Bound<'py, PyAny>, w: usize) -> Option<PyReadonlyArray
     (shaped && a.is_c_contiguous()).then_some(a)
 }
 
+/// A 2-d float64 array's numbers where they are: entry (i, j) at `ptr + i·row + j·col` (strides
+/// in elements, either sign).
+#[derive(Clone, Copy)]
+pub(crate) struct Strided {
+    ptr: *const f64,
+    row: isize,
+    col: isize,
+}
+
+// SAFETY: a `Strided` only reads the numbers of a numpy array that its `Rows` keeps alive and
+// read-borrowed, as the `&[f64]` and `&[f32]` views of the other layouts do.
+unsafe impl Send for Strided {}
+unsafe impl Sync for Strided {}
+
+impl Strided {
+    /// `a` (shape `(n, w)`, not C-contiguous) in place, or `None` where its strides are not
+    /// whole float64 steps or its data is misaligned (then it is copied).
+    fn of(a: &PyReadonlyArrayDyn<'_, f64>) -> Option<Strided> {
+        use numpy::PyArrayMethods;
+        let e = std::mem::size_of::<f64>() as isize;
+        let (rs, cs) = match a.strides() {
+            &[r, c] if r % e == 0 && c % e == 0 => (r / e, c / e),
+            _ => return None,
+        };
+        let ptr = a.data() as *const f64;
+        ptr.is_aligned().then_some(Strided {
+            ptr,
+            row: rs,
+            col: cs,
+        })
+    }
+
+    /// Row `i` as `T` (`i` below the array's row count).
+    fn row<T: Row>(&self, i: usize) -> T {
+        let mut x = [0.0; 4];
+        for (j, x) in x.iter_mut().enumerate().take(T::W) {
+            // SAFETY: (i, j) is within the array's shape, so its offset from `ptr` (numpy's
+            // pointer to entry (0, 0)) is within its buffer, which `Rows` keeps alive.
+            *x = unsafe {
+                *self
+                    .ptr
+                    .offset(i as isize * self.row + j as isize * self.col)
+            };
+        }
+        T::from(&x[..T::W])
+    }
+}
+
 impl<'py, T: Row> Rows<'py, T> {
     /// Reads `obj` as rows of `T::W` numbers; wrong shapes are a `ValueError` naming `name`.
     pub(crate) fn new(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Self> {
@@ -204,6 +256,7 @@ impl<'py, T: Row> Rows<'py, T> {
             return Ok(Rows {
                 narrow: flat.as_ptr(),
                 ptr: std::ptr::null(),
+                strided: None,
                 owned: Vec::new(),
                 len: flat.len() / w,
                 lead: a.shape()[..a.ndim() - 1].to_vec(),
@@ -220,8 +273,23 @@ impl<'py, T: Row> Rows<'py, T> {
                 )));
             }
         };
+        if !a.is_c_contiguous()
+            && a.ndim() == 2
+            && let Some(st) = Strided::of(&a)
+        {
+            // `(n, W)` at other strides: read in place, block by block.
+            return Ok(Rows {
+                len: a.shape()[0],
+                lead,
+                _array: Held::F64 { _a: a },
+                owned: Vec::new(),
+                ptr: std::ptr::null(),
+                narrow: std::ptr::null(),
+                strided: Some(st),
+            });
+        }
         if !a.is_c_contiguous() {
-            // A strided view (or Fortran order): one copy, by numpy.
+            // An N-d strided view: one copy, by numpy.
             let np = obj.py().import("numpy")?;
             a = np
                 .call_method1("ascontiguousarray", (a.as_any(),))?
@@ -253,6 +321,7 @@ impl<'py, T: Row> Rows<'py, T> {
             owned,
             ptr,
             narrow: std::ptr::null(),
+            strided: None,
             len,
             lead,
         })
@@ -263,10 +332,14 @@ impl<'py, T: Row> Rows<'py, T> {
         self.len
     }
 
-    /// The rows as they are held: `[T]` or float32 numbers (shared across threads).
+    /// The rows as they are held: `[T]`, float32 numbers or float64 at strides (shared across
+    /// threads).
     pub(crate) fn view(&self) -> View<'_, T> {
         if !self.owned.is_empty() {
             return View::Wide(&self.owned);
+        }
+        if let Some(s) = self.strided {
+            return View::Strided(s, self.len);
         }
         if !self.narrow.is_null() {
             // SAFETY: `narrow` points to `len * W` f32 of the C-contiguous array kept alive
@@ -289,11 +362,13 @@ impl<'py, T: Row> Rows<'py, T> {
     }
 }
 
-/// [`Rows`] as held: rows of `T` (float64 in place, or a copy), or float32 numbers in place.
+/// [`Rows`] as held: rows of `T` (float64 in place, or a copy), float32 numbers in place, or
+/// `len` rows of float64 in place at strides.
 #[derive(Clone, Copy)]
 pub(crate) enum View<'a, T> {
     Wide(&'a [T]),
     Narrow(&'a [f32]),
+    Strided(Strided, usize),
 }
 
 impl<'a, T: Row> View<'a, T> {
@@ -302,6 +377,7 @@ impl<'a, T: Row> View<'a, T> {
         match self {
             View::Wide(x) => x.len(),
             View::Narrow(x) => x.len() / T::W,
+            View::Strided(_, n) => *n,
         }
     }
 
@@ -310,10 +386,15 @@ impl<'a, T: Row> View<'a, T> {
         match self {
             View::Wide(x) => x[i],
             View::Narrow(x) => T::from_f32(&x[i * T::W..(i + 1) * T::W]),
+            View::Strided(x, n) => {
+                assert!(i < *n, "row {i} of {n}");
+                x.row(i)
+            }
         }
     }
 
-    /// The `k` rows from `s` on: in place, or widened from float32 into `buf`.
+    /// The `k` rows from `s` on: in place, or widened from float32 (gathered from strides)
+    /// into `buf`.
     fn rows<'s>(&self, s: usize, k: usize, buf: &'s mut Vec<T>) -> &'s [T]
     where
         'a: 's,
@@ -324,6 +405,12 @@ impl<'a, T: Row> View<'a, T> {
                 let w = T::W;
                 buf.clear();
                 buf.extend(x[s * w..(s + k) * w].chunks_exact(w).map(T::from_f32));
+                buf
+            }
+            View::Strided(x, n) => {
+                assert!(s + k <= n, "rows {s}..{} of {n}", s + k);
+                buf.clear();
+                buf.extend((s..s + k).map(|i| x.row::<T>(i)));
                 buf
             }
         }

@@ -30,8 +30,12 @@ def table(tmp_path_factory):
     return brdftab.open(str(p))
 
 
-@pytest.mark.parametrize("layout", ["fortran", "strided", "float32", "misaligned", "list"])
+@pytest.mark.parametrize("layout", ["fortran", "strided", "reversed", "rows", "packed",
+                                    "float32", "misaligned", "list"])
 def test_every_layout_gives_the_contiguous_result(table, layout):
+    """Read in place (C order, Fortran order, columns of a wider array, reversed, every other
+    row, float32), or copied once (strides of no whole float64, a misaligned buffer, a list):
+    the numbers of the C-ordered float64 array, for eval, pdf and sample alike."""
     wi, wo = upper(N, 1), upper(N, 2)
     ref = table.eval(wi, wo)
 
@@ -39,9 +43,21 @@ def test_every_layout_gives_the_contiguous_result(table, layout):
         if layout == "fortran":
             return np.asfortranarray(a)
         if layout == "strided":
-            b = np.zeros((a.shape[0], 5))
-            b[:, 1:4] = a
-            return b[:, 1:4]
+            w = a.shape[1]
+            b = np.zeros((a.shape[0], w + 2))
+            b[:, 1:w + 1] = a
+            return b[:, 1:w + 1]
+        if layout == "reversed":
+            return np.ascontiguousarray(a[::-1])[::-1]
+        if layout == "rows":
+            b = np.zeros((2 * a.shape[0], a.shape[1]))
+            b[1::2] = a
+            return b[1::2]
+        if layout == "packed":
+            b = np.zeros(a.shape[0], dtype=[("tag", "u1"), ("v", "f8", a.shape[1])])
+            b["v"] = a
+            assert b["v"].strides[0] % 8 != 0
+            return b["v"]
         if layout == "float32":
             return a.astype(np.float32)
         if layout == "misaligned":
@@ -60,6 +76,11 @@ def test_every_layout_gives_the_contiguous_result(table, layout):
         np.testing.assert_array_equal(got, ref)
     np.testing.assert_array_equal(table.pdf(convert(wi), convert(wo)), table.pdf(
         np.asarray(convert(wi), np.float64), np.asarray(convert(wo), np.float64)))
+    u = np.random.default_rng(3).random((N, 2))
+    for got, want in zip(table.sample(convert(wo), convert(u)),
+                         table.sample(np.asarray(convert(wo), np.float64),
+                                      np.asarray(convert(u), np.float64))):
+        np.testing.assert_array_equal(got, want)
 
 
 def test_float32_arrays_read_in_place_give_their_float64_values(table):
@@ -173,7 +194,11 @@ n = 4_000_000
 rng = np.random.default_rng(1)
 wi = rng.normal(size=(n, 3)); wi[:, 2] = abs(wi[:, 2])
 wo = rng.normal(size=(n, 3)); wo[:, 2] = abs(wo[:, 2])
-wi, wo = wi.astype(sys.argv[2]), wo.astype(sys.argv[2])
+layout = {"fortran": np.asfortranarray, "reversed": lambda a: np.ascontiguousarray(a[::-1])[::-1]}
+if sys.argv[2] in layout:
+    wi, wo = layout[sys.argv[2]](wi), layout[sys.argv[2]](wo)
+else:
+    wi, wo = wi.astype(sys.argv[2]), wo.astype(sys.argv[2])
 b.eval(wi[:10], wo[:10])
 def status(key):
     for line in open("/proc/self/status"):
@@ -192,11 +217,12 @@ print(peak - rss - max(status("RssFile") - file0, 0), f.nbytes)
 """
 
 
-@pytest.mark.parametrize("dtype", ["float64", "float32"])
+@pytest.mark.parametrize("dtype", ["float64", "float32", "fortran", "reversed"])
 def test_a_large_eval_needs_about_its_output(tmp_path, dtype):
     """4e6 pairs (inputs 192 MB, result 48 MB): the process grows by the result, not by
     copies of the inputs (432 MB before the inputs were read in place; float32 inputs, 96 MB,
-    grew it by their float64 copies, 192 MB, before they were read in place). Measured in a fresh
+    grew it by their float64 copies, 192 MB, before they were read in place; Fortran-ordered
+    and reversed float64 inputs by their C-ordered copies, 192 MB, too). Measured in a fresh
     process, whatever ran before in this one: the peak below stands for earlier tests (the
     Mitsuba plugin's, a large batch) that left this process with a high-water mark above the
     child's."""
