@@ -23,7 +23,12 @@ fn main() -> brdftab::Result<()> {
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
-            "--pairs" => pairs = args.next().and_then(|s| s.parse().ok()).unwrap_or(pairs),
+            "--pairs" => {
+                pairs = args.next().and_then(|s| s.parse().ok()).unwrap_or_else(|| {
+                    eprintln!("error: --pairs takes a whole number");
+                    std::process::exit(1)
+                })
+            }
             "--keep" => keep = args.next().map(Into::into),
             _ => sources.push(a),
         }

@@ -128,8 +128,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let q = args.next().unwrap_or_default();
                 quantity = Some(Quantity::from_name(&q).ok_or(format!("unknown quantity {q}"))?);
             }
-            "--pairs" => pairs = args.next().and_then(|s| s.parse().ok()).unwrap_or(pairs),
-            "--target" => target = args.next().and_then(|s| s.parse().ok()),
+            "--pairs" => pairs = args.next().unwrap_or_default().parse()?,
+            "--target" => {
+                let e: brdftab::request::ErrorTarget = args.next().unwrap_or_default().parse()?;
+                target = Some(e.0);
+            }
             "--preset" => preset = Some(args.next().unwrap_or_default().parse()?),
             "--azimuths" => per_azimuth = true,
             "--table" => table_file = args.next(),

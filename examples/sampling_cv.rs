@@ -183,7 +183,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
-            "--samples" => samples = args.next().and_then(|s| s.parse().ok()).unwrap_or(samples),
+            "--samples" => samples = args.next().unwrap_or_default().parse()?,
             "--native-only" => table = false,
             "--wrap" => wrap = true,
             "--midway" => mid = true,

@@ -45,9 +45,19 @@ fn main() -> brdftab::Result<()> {
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
-            "--pairs" => pairs = it.next().and_then(|s| s.parse().ok()).unwrap_or(pairs),
+            "--pairs" => {
+                pairs = it.next().and_then(|s| s.parse().ok()).unwrap_or_else(|| {
+                    eprintln!("error: --pairs takes a whole number");
+                    std::process::exit(1)
+                })
+            }
             "--only" => only = it.next().cloned(),
-            "--seeds" => seeds = it.next().and_then(|s| s.parse().ok()).unwrap_or(1),
+            "--seeds" => {
+                seeds = it.next().and_then(|s| s.parse().ok()).unwrap_or_else(|| {
+                    eprintln!("error: --seeds takes a whole number");
+                    std::process::exit(1)
+                })
+            }
             p => presets.push(p.parse::<Preset>()?),
         }
     }
