@@ -9,7 +9,8 @@
 //! rows nor [`file_info`] of a database of several tables hold it), `quantity` (what the
 //! stored values are: `fr`, `fr_cos_out` or `fr_cos_cos`, [`crate::table::Quantity::name`]) and
 //! `calibrated` (whether lookups multiply them by an albedo calibration's k_in(θi) k_out(θo))
-//! per table; `file`, `format`, `bytes`, `ratio_to_f32`, `tables` per file. The last two say
+//! per table; `file`, `format`, `bytes`, `ratio_to_f32`, `table_count` (the tables the file
+//! holds, also when `tables` reports one of them) and `tables` per file. The last two say
 //! how the raw values (`export`, Python's `Table.values`) become f_r.
 
 use std::fmt::Write as _;
@@ -164,6 +165,7 @@ pub fn file_info_at(path: &str, name: Option<&str>) -> Result<Value> {
         "format": "btdb",
         "bytes": s.file_len(),
         "ratio_to_f32": values as f64 * 4.0 / s.file_len().max(1) as f64,
+        "table_count": s.tables().len(),
         "tables": tables,
     }))
 }
@@ -280,13 +282,19 @@ pub fn list_text(rows: &[Value]) -> String {
 pub fn file_text(v: &Value) -> String {
     let tables = v["tables"].as_array().cloned().unwrap_or_default();
     let str_of = |t: &Value, k: &str| t[k].as_str().unwrap_or("").to_owned();
+    // The file's tables, not the ones reported: `DB#NAME` reports one of several.
+    let count = v["table_count"].as_u64().unwrap_or(tables.len() as u64);
+    let shown = if (tables.len() as u64) < count {
+        format!(", {} shown", tables.len())
+    } else {
+        String::new()
+    };
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "file:    {} (brdftab format, {} table{})",
+        "file:    {} (brdftab format, {count} table{}{shown})",
         str_of(v, "file"),
-        tables.len(),
-        if tables.len() == 1 { "" } else { "s" }
+        if count == 1 { "" } else { "s" }
     );
     if tables.is_empty() {
         // No values to compare with (it read "0.0x smaller than f32").
@@ -347,6 +355,20 @@ pub fn file_text(v: &Value) -> String {
 mod tests {
     use super::*;
     use unicode_width::UnicodeWidthStr;
+
+    #[test]
+    fn the_header_counts_the_files_tables_not_the_ones_reported() {
+        // `info DB#NAME` of a database of two tables said "1 table".
+        let row = json!({"name": "a", "codec": {"quant": "f32"}, "values": 1, "bytes": 1});
+        let one_of_two = json!({"file": "x.btdb", "bytes": 9, "table_count": 2, "tables": [row]});
+        let text = file_text(&one_of_two);
+        assert!(
+            text.contains("(brdftab format, 2 tables, 1 shown)"),
+            "{text}"
+        );
+        let whole = json!({"file": "x.btdb", "bytes": 9, "table_count": 1, "tables": [row]});
+        assert!(file_text(&whole).contains("(brdftab format, 1 table)"));
+    }
 
     #[test]
     fn list_columns_stay_aligned_with_long_and_wide_names() {

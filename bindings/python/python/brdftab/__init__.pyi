@@ -232,8 +232,8 @@ def rgb_basis(nm: _ArrayLike) -> npt.NDArray[np.float64]:
 def check(source: str | PathLike[str], *, wavelengths: _Wavelengths = None) -> dict[str, Any]:
     """The plausibility report of SOURCE as a dict with the keys of `brdftab check --json`."""
 def info(source: str | PathLike[str]) -> dict[str, Any]:
-    """What `brdftab info --json` reports of a table file (or, for DB#NAME, of one table): "file", "format", "bytes", "ratio_to_f32"
-    and "tables", one dict per table with "name", "source", "parameterization", "symmetry",
+    """What `brdftab info --json` reports of a table file (or, for DB#NAME, of one table): "file", "format", "bytes", "ratio_to_f32",
+    "table_count" (the tables the file holds) and "tables", one dict per table with "name", "source", "parameterization", "symmetry",
     "channels", "units", "codec", "tool", "shape", "values", "chunks", "bytes", "ratio_to_f32",
     "sampling_bytes" (of one table — DB#NAME, a file of one table — only: sizing it builds
     the sampler), "quantity" (what the stored values are), "calibrated" and "axes" (per stored
