@@ -140,6 +140,19 @@ pub fn bake_cached(
     dir: Option<&Path>,
     refresh: bool,
 ) -> Result<Cached> {
+    bake_cached_with(source, settings, dir, refresh, &crate::progress::Silent)
+}
+
+/// [`bake_cached`], reporting the bake's stages to `progress` (which may stop it:
+/// [`Progress::cancelled`](crate::progress::Progress::cancelled); the cache is then left
+/// without the table).
+pub fn bake_cached_with(
+    source: &str,
+    settings: &BakeSettings,
+    dir: Option<&Path>,
+    refresh: bool,
+    progress: &dyn crate::progress::Progress,
+) -> Result<Cached> {
     let dir = match dir {
         Some(d) => d.to_path_buf(),
         None => default_dir()?,
@@ -160,7 +173,7 @@ pub fn bake_cached(
     let mut s = settings.clone();
     s.replace = true;
     let out = path.to_string_lossy();
-    crate::request::bake(source, &out, &s, &crate::progress::Silent)?;
+    crate::request::bake(source, &out, &s, progress)?;
     Ok(Cached { path, hit: false })
 }
 

@@ -126,6 +126,11 @@ pub enum Error {
     /// A named entry does not exist (a table in a database, a metal, ...).
     #[error("not found: {0}")]
     NotFound(String),
+
+    /// The host asked the operation to stop ([`crate::progress::Progress::cancelled`]); a file
+    /// it was writing is left as it was.
+    #[error("cancelled")]
+    Cancelled,
 }
 
 /// One of the symmetries a BRDF may have, as [`Error::Symmetry`] names it.
@@ -313,6 +318,7 @@ impl Error {
             Error::Encode { msg } => Error::Encode { msg: msg.clone() },
             Error::Unsupported(m) => Error::Unsupported(m.clone()),
             Error::NotFound(m) => Error::NotFound(m.clone()),
+            Error::Cancelled => Error::Cancelled,
         }
     }
 }

@@ -100,7 +100,8 @@ impl BakeRequest {
         let (mut table, r) = {
             let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
             let set = |done: u64, _total: u64| progress.set(done);
-            let opts = self.bake_options(&set, force);
+            let cancel = || progress.cancelled();
+            let opts = self.bake_options(&set, &cancel, force);
             crate::table::bake(bake_src, &grid, &opts)?
         };
         // A lazily read table source whose chunk failed gave zeros: refuse them.
@@ -120,6 +121,7 @@ impl BakeRequest {
     pub(super) fn bake_options<'a>(
         &self,
         set: crate::table::fill::Progress<'a>,
+        cancel: &'a (dyn Fn() -> bool + Sync),
         force: bool,
     ) -> BakeOptions<'a> {
         BakeOptions {
@@ -127,6 +129,7 @@ impl BakeRequest {
             force,
             tolerance: self.symmetry_tolerance,
             progress: Some(set),
+            cancel: Some(cancel),
             ..BakeOptions::default()
         }
     }

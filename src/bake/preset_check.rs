@@ -152,9 +152,11 @@ impl BakeRequest {
         let grid = Preset::Medium
             .grid(Some(Param::HalfDiff), sym, src.channels().clone())?
             .with_quantity(quantity)?;
+        let cancel = || progress.cancelled();
         let opts = BakeOptions {
             tolerance: self.symmetry_tolerance,
             force: self.force || self.symmetry == SymmetryChoice::Declared,
+            cancel: Some(&cancel),
             ..BakeOptions::default()
         };
         let (preset, stats) = crate::table::bake(src, &grid, &opts)?;

@@ -103,6 +103,7 @@ impl BakeRequest {
         if let BakeTarget::Merl(path) = target {
             let t0 = Instant::now();
             let merl = crate::measured::MerlBrdf::from_brdf_with(src.as_ref(), progress);
+            crate::progress::check(progress)?;
             src.health()?;
             merl.write(path)?;
             let mut report =
@@ -211,7 +212,8 @@ impl BakeRequest {
         let header = TableHeader::for_grid(name.to_owned(), provenance, &grid, self.codec);
         let _stage = Stage::begin(progress, "baking", grid.stored_values() as u64);
         let set = |done: u64, _total: u64| progress.set(done);
-        let opts = self.bake_options(&set, force);
+        let cancel = || progress.cancelled();
+        let opts = self.bake_options(&set, &cancel, force);
         let mut baked = None;
         let mut write = |w: &mut Writer| -> Result<()> {
             baked = Some(bake_chunks(bake_src, &grid, &opts, |i, v| {

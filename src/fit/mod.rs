@@ -409,6 +409,7 @@ pub fn fit_with_progress(
     // A source that failed while it was read (a corrupt table chunk) gave zeros: fitting
     // them would return a black material.
     source.health()?;
+    let cancel = || progress.cancelled();
     let problem = Problem {
         base: base.clone(),
         params: &params,
@@ -420,6 +421,7 @@ pub fn fit_with_progress(
         t: DVector::zeros(0),
         iterations: Cell::new(0),
         evaluations: Cell::new(0),
+        cancel: &cancel,
     };
 
     // Start positions.
@@ -472,6 +474,7 @@ pub fn fit_with_progress(
         problem.evaluations.set(0);
         let (p, report) = lm.minimize(problem);
         problem = p;
+        crate::progress::check(progress)?;
         // The objective as LM reports it may belong to a rejected step; recompute at the end point.
         let end = problem.model_values(&problem.t);
         let (objective, rmse) = match &end {
@@ -609,6 +612,9 @@ struct Problem<'a> {
     t: DVector<f64>,
     iterations: Cell<usize>,
     evaluations: Cell<usize>,
+    /// The host's request to stop ([`crate::progress::Progress::cancelled`]): the model's
+    /// values are then `None`, which ends the optimizer's start at its next evaluation.
+    cancel: &'a (dyn Fn() -> bool + Sync),
 }
 
 /// Central-difference step in the free variables.
@@ -629,6 +635,9 @@ impl Problem<'_> {
     /// Transformed model values f̂ cos θi at `t`, or `None` if the model cannot be built.
     fn model_values(&self, t: &DVector<f64>) -> Option<Vec<f64>> {
         self.evaluations.set(self.evaluations.get() + 1);
+        if (self.cancel)() {
+            return None;
+        }
         let spec = self.spec_at(t).ok()?;
         spec.validate().ok()?;
         let mut terms = Vec::new();

@@ -86,7 +86,9 @@ impl MerlBrdf {
 
     /// [`MerlBrdf::from_brdf`], reporting the θh rows done (of 90) to `progress` as a stage
     /// `"resampling on the MERL grid"` (a file from a measurement takes seconds: 54 evaluations
-    /// per cell).
+    /// per cell). A cancelled `progress` ([`Progress::cancelled`]) stops it within a row of
+    /// θd: the cells not reached are then 0, and the caller returns
+    /// [`crate::Error::Cancelled`] rather than use them.
     pub fn from_brdf_with(brdf: &dyn Brdf, progress: &dyn Progress) -> Self {
         let _stage = Stage::begin(progress, "resampling on the MERL grid", RES_THETA_H as u64);
         let done = AtomicUsize::new(0);
@@ -103,6 +105,9 @@ impl MerlBrdf {
                 .enumerate()
                 .for_each(|(ith, chunk)| {
                     for itd in 0..RES_THETA_D {
+                        if progress.cancelled() {
+                            return;
+                        }
                         for ipd in 0..RES_PHI_D {
                             let hd = cell_center(ith, itd, ipd);
                             let cell = &mut chunk[ipd + RES_PHI_D * itd];

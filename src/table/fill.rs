@@ -52,6 +52,8 @@ pub struct BakeOptions<'a> {
     pub memory_budget: usize,
     /// Called after every chunk.
     pub progress: Option<Progress<'a>>,
+    /// Asked before every row of values: true stops the bake with [`Error::Cancelled`].
+    pub cancel: Option<&'a (dyn Fn() -> bool + Sync)>,
 }
 
 impl Default for BakeOptions<'_> {
@@ -62,6 +64,7 @@ impl Default for BakeOptions<'_> {
             tolerance: symmetry::DEFAULT_TOLERANCE,
             memory_budget: 64 << 20,
             progress: None,
+            cancel: None,
         }
     }
 }
@@ -162,6 +165,7 @@ pub fn bake_chunks(
     let mut buf: Vec<f32> = Vec::new();
     let mut a = 0;
     let n0 = layout.chunk_count();
+    let cancelled = || opts.cancel.is_some_and(|c| c());
     while a < n0 {
         // Group chunks a..e up to the budget.
         let mut e = a + 1;
@@ -186,6 +190,10 @@ pub fn bake_chunks(
                     .with_min_len(8)
                     .enumerate()
                     .for_each(|(gr, row)| {
+                        // A cancelled bake skips its remaining rows (one per thread finishes).
+                        if cancelled() {
+                            return;
+                        }
                         let k = row_starts.partition_point(|&s| s <= gr) - 1;
                         let chunk = a + k;
                         let (p, b) = layout.row_node(chunk, gr - row_starts[k]);
@@ -209,12 +217,18 @@ pub fn bake_chunks(
                     })
             });
         }
+        if cancelled() {
+            return Err(Error::Cancelled);
+        }
         let mut off = 0;
         let mut done = layout.chunk_range(a).start as u64;
         for k in a..e {
             let l = layout.chunk_len(k);
             if let Some(h) = horizon.as_mut() {
                 h.fill(k, &mut buf[off..off + l]);
+            }
+            if cancelled() {
+                return Err(Error::Cancelled);
             }
             sink(k, &buf[off..off + l])?;
             off += l;

@@ -178,13 +178,16 @@ pub fn search(
         adaptive::grid_with_warps(src.channels().clone(), symmetry, nodes, warps.clone())
             .and_then(|g| g.with_quantity(adaptive_opts.quantity))
     };
+    let cancel = || progress.cancelled();
     let bake_opts = BakeOptions {
         force,
+        cancel: Some(&cancel),
         ..BakeOptions::default()
     };
     let mut tried = Vec::new();
     let mut score_of = |k: usize| -> Result<f64> {
         let [h, d, p] = LADDER[k];
+        crate::progress::check(progress)?;
         progress.note(&format!("{h}x{d}x{p}"));
         let (mut t, _) = bake(src, &grid_of(LADDER[k])?, &bake_opts)?;
         if let Some(a) = albedo {

@@ -373,7 +373,7 @@ pub(crate) enum View<'a, T> {
 
 impl<'a, T: Row> View<'a, T> {
     /// Number of rows.
-    fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         match self {
             View::Wide(x) => x.len(),
             View::Narrow(x) => x.len() / T::W,
@@ -382,7 +382,7 @@ impl<'a, T: Row> View<'a, T> {
     }
 
     /// Row `i` (< `len`).
-    fn row(&self, i: usize) -> T {
+    pub(crate) fn row(&self, i: usize) -> T {
         match self {
             View::Wide(x) => x[i],
             View::Narrow(x) => T::from_f32(&x[i * T::W..(i + 1) * T::W]),

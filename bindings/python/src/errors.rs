@@ -41,6 +41,61 @@ pub(crate) fn unlocked<T: Send>(py: Python<'_>, f: impl FnOnce() -> T + Send) ->
         .map_err(panic_err)
 }
 
+/// How long [`interruptible`] (and `Brdf.albedo`) leave the GIL released between checks for a
+/// pending signal.
+pub(crate) const SLICE: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// A [`brdftab::progress::Progress`] that reports nothing and asks the work to stop once
+/// [`interruptible`] has seen a signal's exception.
+struct Stop(std::sync::atomic::AtomicBool);
+
+impl brdftab::progress::Progress for Stop {
+    fn cancelled(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
+/// [`unlocked`] for work that can stop: `f` runs on a thread of its own with a progress whose
+/// `cancelled` the library asks between units of work, while this thread waits with the GIL
+/// released and handles pending signals every [`SLICE`]. When a handler raises (Ctrl-C:
+/// `KeyboardInterrupt`), the work is asked to stop, waited for (the library returns
+/// `Error::Cancelled` within a unit of work per thread, leaving files as they were) and the
+/// exception is raised. Without it, a bake of minutes ran to its end with Ctrl-C pending.
+pub(crate) fn interruptible<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce(&dyn brdftab::progress::Progress) -> T + Send,
+) -> PyResult<T> {
+    use std::sync::mpsc::{RecvTimeoutError, channel};
+    let stop = Stop(std::sync::atomic::AtomicBool::new(false));
+    let stop = &stop;
+    std::thread::scope(|s| {
+        let (tx, rx) = channel();
+        s.spawn(move || {
+            let r = brdftab::host::catch_quietly(|| brdftab::par::install(|| f(stop)));
+            let _ = tx.send(r);
+        });
+        // The receiver moves into each wait and back (it may not be shared between threads).
+        let mut rx = rx;
+        loop {
+            let (r, back) = py.detach(move || (rx.recv_timeout(SLICE), rx));
+            rx = back;
+            match r {
+                Ok(r) => return r.map_err(panic_err),
+                Err(RecvTimeoutError::Disconnected) => {
+                    return Err(panic_err("the work's thread ended without a result".into()));
+                }
+                Err(RecvTimeoutError::Timeout) => {}
+            }
+            if let Err(e) = py.check_signals() {
+                stop.0.store(true, std::sync::atomic::Ordering::Relaxed);
+                // Its result (an error or a finished operation) gives way to the exception.
+                let _ = py.detach(move || rx.recv());
+                return Err(e);
+            }
+        }
+    })
+}
+
 /// Runs a batch call of `n` pairs: with the GIL released for the whole call unless it is one
 /// pair (where releasing costs more than the lookup). The library's batch functions go to its
 /// pool themselves.

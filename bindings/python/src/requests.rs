@@ -1,6 +1,7 @@
 //! The request layer's long calls ([`brdftab::request`]): `bake`, `bake_cached`, `convert` and
-//! `fit`, whose keyword arguments are the fields of its settings, run with the GIL released;
-//! each returns a dict (what the CLI's `--json` prints).
+//! `fit`, whose keyword arguments are the fields of its settings, run with the GIL released
+//! and stop at Ctrl-C (`KeyboardInterrupt`, [`interruptible`]); each returns a dict (what the
+//! CLI's `--json` prints).
 //!
 //! Why a module: the functions that take `**options` as settings and write files or fit
 //! models, with the dicts of their reports.
@@ -9,7 +10,7 @@ use brdftab::request::{self, BakeSettings, ConvertOutput, ConvertSettings, FitSe
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{guard, lib_err, unlocked};
+use crate::errors::{guard, interruptible, lib_err};
 use crate::values::{ser, settings_of, text_arg, to_py};
 
 fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyAny>> {
@@ -36,7 +37,7 @@ fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyA
 /// keywords are the CLI's `bake` flags, snake_cased (`preset`, `grid`, `codec`, ...; the
 /// fields of the library's `BakeSettings`). `name` names a `.btdb` file's table; with `DB#NAME`
 /// it may only repeat NAME (another name is an error). Returns what `brdftab info --json OUTPUT`
-/// reports.
+/// reports. Ctrl-C stops it (KeyboardInterrupt; OUTPUT is left as it was).
 #[pyfunction]
 #[pyo3(signature = (source, output, **options))]
 pub(crate) fn bake(
@@ -49,10 +50,8 @@ pub(crate) fn bake(
         let (source, output) = (text_arg(source, "source")?, text_arg(output, "output")?);
         let (source, output) = (source.as_str(), output.as_str());
         let settings: BakeSettings = settings_of(options)?;
-        let r = unlocked(py, || {
-            request::bake(source, output, &settings, &brdftab::progress::Silent)
-        })?
-        .map_err(lib_err)?;
+        let r =
+            interruptible(py, |p| request::bake(source, output, &settings, p))?.map_err(lib_err)?;
         report_dict(py, &r)
     })
 }
@@ -80,7 +79,8 @@ pub(crate) fn _check_bake_options(
 /// settings and the library's version, in `cache_dir` (default `$BRDFTAB_CACHE_DIR`, else
 /// `$XDG_CACHE_HOME/brdftab`, else `~/.cache/brdftab`). Safe under concurrent calls from many
 /// processes. `refresh=True` bakes again (for a cached file that failed to open). Returns
-/// `{"path": str, "hit": bool}`; open the table with `brdftab.open(path)`.
+/// `{"path": str, "hit": bool}`; open the table with `brdftab.open(path)`. Ctrl-C stops the bake
+/// (KeyboardInterrupt; nothing is cached).
 #[pyfunction]
 #[pyo3(signature = (source, cache_dir=None, refresh=false, **options))]
 pub(crate) fn bake_cached(
@@ -94,8 +94,8 @@ pub(crate) fn bake_cached(
         let source = text_arg(source, "source")?;
         let source = source.as_str();
         let settings: BakeSettings = settings_of(options)?;
-        let c = unlocked(py, || {
-            brdftab::cache::bake_cached(source, &settings, cache_dir.as_deref(), refresh)
+        let c = interruptible(py, |p| {
+            brdftab::cache::bake_cached_with(source, &settings, cache_dir.as_deref(), refresh, p)
         })?
         .map_err(lib_err)?;
         let v = serde_json::json!({"path": c.path.to_string_lossy(), "hit": c.hit});
@@ -106,7 +106,8 @@ pub(crate) fn bake_cached(
 /// Converts SOURCE into OUTPUT as `brdftab convert` does: an RGL `.bsdf`, a MERL `.binary`,
 /// `DB#NAME`, a `.btdb` file (a table named after the input) or a raw table. The keywords are
 /// the CLI's `convert` flags, snake_cased: those of `bake` and `pairs`, `interp`, `resolution`,
-/// `theta_i`, `phi_i`, `ndf_resolution` (the fields of the library's `ConvertSettings`).
+/// `theta_i`, `phi_i`, `ndf_resolution` (the fields of the library's `ConvertSettings`). Ctrl-C
+/// stops it (KeyboardInterrupt; OUTPUT is left as it was).
 #[pyfunction]
 #[pyo3(signature = (source, output, **options))]
 pub(crate) fn convert(
@@ -119,10 +120,8 @@ pub(crate) fn convert(
         let (source, output) = (text_arg(source, "source")?, text_arg(output, "output")?);
         let (source, output) = (source.as_str(), output.as_str());
         let settings: ConvertSettings = settings_of(options)?;
-        let out = unlocked(py, || {
-            request::convert(source, output, &settings, &brdftab::progress::Silent)
-        })?
-        .map_err(lib_err)?;
+        let out = interruptible(py, |p| request::convert(source, output, &settings, p))?
+            .map_err(lib_err)?;
         let d = match out {
             ConvertOutput::Merl(r) => serde_json::json!({
                 "output": r.output,
@@ -175,7 +174,7 @@ pub(crate) fn convert(
 /// Fits `model` (a name such as "ggx", a sum "lambert+ggx", or a JSON spec) to SOURCE; returns
 /// the dict of `brdftab fit --json`. The keywords are the CLI's `fit` flags, snake_cased
 /// (`params`, `starts`, `pairs`, `max_theta_deg`, ...; the fields of the library's
-/// `FitSettings`).
+/// `FitSettings`). Ctrl-C stops it (KeyboardInterrupt).
 #[pyfunction]
 #[pyo3(signature = (source, model, **options))]
 pub(crate) fn fit(
@@ -188,10 +187,8 @@ pub(crate) fn fit(
         let source = text_arg(source, "source")?;
         let source = source.as_str();
         let settings: FitSettings = settings_of(options)?;
-        let result = unlocked(py, || {
-            request::fit(source, model, &settings, &brdftab::progress::Silent)
-        })?
-        .map_err(lib_err)?;
+        let result =
+            interruptible(py, |p| request::fit(source, model, &settings, p))?.map_err(lib_err)?;
         ser(py, &result)
     })
 }

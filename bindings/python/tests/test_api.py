@@ -633,3 +633,84 @@ def test_ctrl_c_stops_an_albedo_curve(paper):
     assert what == "interrupted", r.stdout + r.stderr
     # One angle of an RGL file takes ~0.1 s on one core: 5 s leaves room for a loaded machine.
     assert float(after) < 5.0, r.stdout
+
+
+INTERRUPTED_CALL = r"""
+import os, signal, sys, threading, time, brdftab
+op, rgl, out = sys.argv[1:]
+ggx = '{"model": "ggx", "alpha": 0.1}'
+call = {
+    "bake": lambda: brdftab.bake(ggx, out, preset="large"),
+    "bake_cached": lambda: brdftab.bake_cached(ggx, cache_dir=out, preset="large"),
+    "convert": lambda: brdftab.convert(ggx, out),
+    "fit": lambda: brdftab.fit(rgl, "ggx", starts=8, pairs=200_000),
+}[op]
+threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+t0 = time.perf_counter()
+try:
+    call()
+    print("finished", time.perf_counter() - t0 - 0.3)
+except KeyboardInterrupt:
+    print("interrupted", time.perf_counter() - t0 - 0.3)
+"""
+
+
+@pytest.mark.parametrize("op", ["bake", "bake_cached", "convert", "fit"])
+def test_ctrl_c_stops_a_bake_a_conversion_and_a_fit(rgl, tmp_path, op):
+    """Ctrl-C (SIGINT) during `bake`, `bake_cached`, `convert` or `fit` raises
+    KeyboardInterrupt within a second, and a bake or conversion leaves no file. They ran to
+    their end with the signal pending (uninterrupted on one machine: the large preset's bake
+    3.8 s, the .bsdf conversion 2.5 s, the fit 11 s); now the library is asked to stop
+    (`Progress::cancelled`) when the waiting thread, which takes the GIL back every 50 ms,
+    sees the signal. Bound: that 50 ms, then one unit of work per thread — a row of a bake's
+    values (~1 ms), an incident slice of the .bsdf writer (measured interrupts: up to 0.25 s
+    after the signal), an evaluation of the model over the fit's 200,000 pairs (~20 ms) —
+    with 4× room for a loaded machine."""
+    out = tmp_path / {"bake": "t.btdb", "bake_cached": "cache", "convert": "t.bsdf",
+                      "fit": "unused"}[op]
+    r = subprocess.run([sys.executable, "-c", INTERRUPTED_CALL, op,
+                        str(rgl / "cc_ibiza_sunset_rgb.bsdf"), str(out)],
+                       capture_output=True, text=True, timeout=600)
+    what, after = r.stdout.split()
+    assert what == "interrupted", r.stdout + r.stderr
+    assert float(after) < 1.0, r.stdout
+    if op == "bake_cached":
+        assert not list(out.glob("*.btdb")), list(out.iterdir())
+    else:
+        assert not out.exists()
+
+
+def test_sample_checks_u_with_the_gil_released():
+    """`sample` reads its `u` rows for the [0, 1)² check with the GIL released, as it draws:
+    another thread runs during the whole call. The check held the GIL: 10^7 rows (the last
+    outside the square, so the call is the check alone) kept every other Python thread
+    waiting for the call's 55–60 ms. Here the other thread's timestamps must span at least
+    half of the call (its largest gap was 8–12 ms, Python's switch interval being 5 ms)."""
+    import threading
+    import time
+
+    b = brdftab.open('{"model": "lambert", "kd": 0.5}')
+    n = 10_000_000
+    u = np.full((n, 2), 0.5)
+    u[-1, 0] = 1.0
+    stamps, running, stop = [], threading.Event(), threading.Event()
+
+    def other():
+        running.set()
+        while not stop.is_set():
+            stamps.append(time.perf_counter())
+
+    t = threading.Thread(target=other)
+    t.start()
+    running.wait()
+    try:
+        t0 = time.perf_counter()
+        with pytest.raises(ValueError, match=f"row {n - 1}"):
+            b.sample([0.0, 0.0, 1.0], u)
+        t1 = time.perf_counter()
+    finally:
+        stop.set()
+        t.join()
+    s = np.array(stamps)
+    inside = s[(s > t0) & (s < t1)]
+    assert len(inside) > 1 and inside[-1] - inside[0] >= 0.5 * (t1 - t0), (len(inside), t1 - t0)

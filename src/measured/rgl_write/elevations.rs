@@ -175,6 +175,7 @@ pub fn place(
     };
     loop {
         progress.set(theta.len() as u64);
+        crate::progress::check(progress)?;
         let fl = floors(&theta, &at);
         let (fig, floor) = figures(&iv, &fl);
         let done = Placement {

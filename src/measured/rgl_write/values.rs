@@ -155,6 +155,7 @@ pub fn sample(
         (0..total)
         .into_par_iter()
         .map(|s| {
+            crate::progress::check(progress)?;
             let (p, t) = (s / nt, s % nt);
             let wi = incident(layout, p, t);
             let wi_eval = geometry::spherical(

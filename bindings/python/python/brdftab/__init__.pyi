@@ -266,7 +266,7 @@ def bake(
     """Bakes SOURCE into OUTPUT (a .btdb file or DB#NAME); the keywords are the CLI's bake flags,
     snake_cased, validated by the library's request layer. `name` names a .btdb file's table;
     with DB#NAME it may only repeat NAME (another name is an error). Returns `brdftab info
-    --json`."""
+    --json`. Ctrl-C stops it (KeyboardInterrupt; OUTPUT is left as it was)."""
 def bake_cached(
     source: str | PathLike[str],
     cache_dir: str | PathLike[str] | None = None,
@@ -275,7 +275,8 @@ def bake_cached(
 ) -> dict[str, Any]:
     """The table of SOURCE baked with `options` (the keywords of `bake`), from the cache of
     baked tables (keyed by the source's content, the settings and the library's version) or
-    baked into it now. Returns {"path": str, "hit": bool}."""
+    baked into it now. Returns {"path": str, "hit": bool}. Ctrl-C stops the bake
+    (KeyboardInterrupt; nothing is cached)."""
 def convert(
     source: str | PathLike[str],
     output: str | PathLike[str],
@@ -293,7 +294,8 @@ def convert(
     of `bake` plus these; returns {"output", "format", "source", ...}. For a .bsdf, "error" is
     the file read back against SOURCE: "rel_rmse" and "max_rel" within 80°, then "whole"
     (hemisphere), "grazing" (a direction past 80°) and "albedo" (the worst directional albedo
-    error: "worst", "theta_deg", "channel", ...), relative, or None with pairs=0."""
+    error: "worst", "theta_deg", "channel", ...), relative, or None with pairs=0. Ctrl-C stops
+    it (KeyboardInterrupt; OUTPUT is left as it was)."""
 def fit(
     source: str | PathLike[str],
     model: str,
@@ -311,7 +313,8 @@ def fit(
     max_iterations: int | None = ...,
 ) -> dict[str, Any]:
     """Fits `model` (a name such as "ggx", a sum "lambert+ggx", or a JSON spec) to SOURCE; the
-    keywords are the CLI's fit flags, snake_cased. Returns the dict of `brdftab fit --json`."""
+    keywords are the CLI's fit flags, snake_cased. Returns the dict of `brdftab fit --json`.
+    Ctrl-C stops it (KeyboardInterrupt)."""
 
 class Database:
     """A brdftab database: many named tables in one .btdb file. Pickles by its path; equal to

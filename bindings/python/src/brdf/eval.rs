@@ -120,7 +120,7 @@ impl PyBrdf {
         // Ctrl-C stops a curve of many angles within a slice and an angle (it ran to the end:
         // 2,000 angles of an RGL file, 190 s), and a closed form's microsecond angles still run
         // a slice per release.
-        const SLICE: std::time::Duration = std::time::Duration::from_millis(50);
+        use crate::errors::SLICE;
         let mut angles = o.chunks_exact_mut(c.max(1)).zip(t.iter()).peekable();
         while angles.peek().is_some() {
             unlocked(py, || {
