@@ -9,9 +9,9 @@
 //! `cargo run --release --example bsdf_fidelity -- [--pairs N] [--keep DIR] SOURCE...`
 //! (`--keep DIR` leaves the written files there; otherwise they go to a temporary directory).
 //! Environment: `THETA_I=n` and `RES=n` write n elevations or an n × n table instead of the
-//! defaults; `AGAINST=SOURCE` judges every written file against that source instead of its own
+//! defaults (`PHI_I=n`: n incident azimuths, `NDF_RES=n`: n × n warps); `AGAINST=SOURCE` judges every written file against that source instead of its own
 //! (a table of an RGL file, written as `.bsdf`, against the file); `BINS=1` also prints the
-//! relative RMSE of f_r cos θi cos θo per (θi, θo) band.
+//! relative RMSE of f_r cos θi cos θo per (θi, θo) band, `GRID=1` the incident directions written.
 
 use brdftab::analysis::fidelity::{self, FidelityOptions};
 use brdftab::measured::rgl_write;
@@ -55,8 +55,27 @@ fn main() -> brdftab::Result<()> {
         if let Some(n) = std::env::var("RES").ok().and_then(|v| v.parse().ok()) {
             wopts.resolution = Some(n);
         }
+        if let Some(n) = std::env::var("PHI_I").ok().and_then(|v| v.parse().ok()) {
+            wopts.phi_i = Some(n);
+        }
+        if let Some(n) = std::env::var("NDF_RES").ok().and_then(|v| v.parse().ok()) {
+            wopts.ndf_resolution = Some(n);
+        }
         let w = rgl_write::write(src.as_ref(), &path, &wopts, &brdftab::progress::Silent)?;
         let secs = t0.elapsed().as_secs_f64();
+        if std::env::var("GRID").is_ok() {
+            let deg = |v: &[f32]| -> Vec<String> {
+                v.iter().map(|x| format!("{:.1}", x.to_degrees())).collect()
+            };
+            eprintln!(
+                "{s}: {} φi {:?}, {} θi {:?}, N = {}",
+                w.fields.phi_i.len(),
+                deg(&w.fields.phi_i),
+                w.fields.theta_i.len(),
+                deg(&w.fields.theta_i),
+                w.fields.n
+            );
+        }
         let back = brdftab::measured::RglBrdf::open(&path)?;
         if std::env::var("BINS").is_ok() {
             bins(&back, src.as_ref());

@@ -39,7 +39,8 @@ pub struct ConvertSettings {
     #[cfg_attr(feature = "clap", arg(long))]
     pub theta_i: Option<usize>,
     /// .bsdf output: number of incident azimuths φi (default 1 if isotropic — the only count an
-    /// isotropic source takes —, else 17; 3 or more).
+    /// isotropic source takes —, else placed with the elevations where the written file is
+    /// farthest from the source, from 9, within 32 MiB; given: 3 or more, evenly, with 16 θi).
     #[cfg_attr(feature = "clap", arg(long))]
     pub phi_i: Option<usize>,
     /// .bsdf output: NDF, σ and VNDF grid resolution (default 128).

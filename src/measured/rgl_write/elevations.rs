@@ -28,7 +28,7 @@ use std::f64::consts::{PI, TAU};
 
 use super::ndf::Ndf;
 use super::{Layout, Progress, values, warps};
-use crate::analysis::fidelity::mirror_albedo;
+use crate::analysis::fidelity::{Turned, mirror_albedo};
 use crate::brdf::Brdf;
 use crate::error::Result;
 use crate::geometry;
@@ -65,7 +65,7 @@ pub const IMPROVABLE: f64 = 0.1;
 pub const MIN_STEP: f64 = 0.25 * PI / 180.0;
 
 /// Pairs drawn per interval and step.
-const PAIRS: usize = 3000;
+pub(super) const PAIRS: usize = 3000;
 
 /// Angle of the cone about the mirror direction that half the pairs are drawn in (radians):
 /// a sharp lobe is then seen on every step, not by lottery.
@@ -76,15 +76,15 @@ const CONE: f64 = 20.0 * PI / 180.0;
 /// incidences, and the worst albedo error at the whole degrees inside it (its middle when
 /// there are none). For one elevation alone (θi exactly there) the same per unit solid angle.
 #[derive(Debug, Clone, Copy, Default)]
-struct Errors {
-    err: [f64; 3],
-    reference: [f64; 3],
-    albedo: f64,
+pub(super) struct Errors {
+    pub(super) err: [f64; 3],
+    pub(super) reference: [f64; 3],
+    pub(super) albedo: f64,
 }
 
 /// The four figures divided by their bars, and the part of each that splitting cannot lower:
 /// what the slices themselves give.
-fn figures(iv: &[Errors], floors: &[Errors]) -> ([f64; 4], [f64; 4]) {
+pub(super) fn figures(iv: &[Errors], floors: &[Errors]) -> ([f64; 4], [f64; 4]) {
     let (mut fig, mut floor) = ([0.0; 4], [0.0; 4]);
     for (k, bar) in BARS.iter().enumerate().take(3) {
         let e: f64 = iv.iter().map(|i| i.err[k]).sum();
@@ -103,7 +103,12 @@ fn figures(iv: &[Errors], floors: &[Errors]) -> ([f64; 4], [f64; 4]) {
 /// The slice-limited errors of the interval between elevations `ta` and `tb`: the mean of the
 /// two slices' densities over the interval's solid angle, the larger albedo error.
 fn floor_of(a: &Errors, b: &Errors, ta: f64, tb: f64) -> Errors {
-    let measure = TAU * (ta.cos() - tb.cos());
+    floor_over(a, b, TAU * (ta.cos() - tb.cos()))
+}
+
+/// The slice-limited errors of a cell of solid angle `measure` between two slices (or rows of
+/// slices) whose densities are `a` and `b`.
+pub(super) fn floor_over(a: &Errors, b: &Errors, measure: f64) -> Errors {
     let mut out = Errors::default();
     for k in 0..3 {
         out.err[k] = measure * 0.5 * (a.err[k] + b.err[k]);
@@ -114,10 +119,10 @@ fn floor_of(a: &Errors, b: &Errors, ta: f64, tb: f64) -> Errors {
 }
 
 /// One elevation's encoded slices (every azimuth): VNDF densities, values and validity.
-struct Slice {
-    vndf: Vec<f32>,
-    values: Vec<f32>,
-    valid: Vec<bool>,
+pub(super) struct Slice {
+    pub(super) vndf: Vec<f32>,
+    pub(super) values: Vec<f32>,
+    pub(super) valid: Vec<bool>,
 }
 
 /// What [`place`] chose and measured.
@@ -163,10 +168,19 @@ pub fn place(
     let _stage = crate::progress::Stage::begin(progress, "placing elevations", max as u64);
     let mut file = reader(brdf, ndf, base, &theta, &mut cache)?;
     let mut at: Vec<Errors> = (0..theta.len())
-        .map(|k| measure(&file, brdf, theta[k], theta[k], k as u64))
+        .map(|k| measure(&file, brdf, theta[k], theta[k], &WHOLE_CIRCLE, k as u64))
         .collect();
     let mut iv: Vec<Errors> = (0..theta.len() - 1)
-        .map(|k| measure(&file, brdf, theta[k], theta[k + 1], 100 + k as u64))
+        .map(|k| {
+            measure(
+                &file,
+                brdf,
+                theta[k],
+                theta[k + 1],
+                &WHOLE_CIRCLE,
+                100 + k as u64,
+            )
+        })
         .collect();
     let floors = |theta: &[f64], at: &[Errors]| -> Vec<Errors> {
         (0..theta.len() - 1)
@@ -207,9 +221,9 @@ pub fn place(
         theta.insert(j + 1, mid);
         file = reader(brdf, ndf, base, &theta, &mut cache)?;
         let seed = theta.len() as u64 * 1000;
-        at.insert(j + 1, measure(&file, brdf, mid, mid, seed));
-        let left = measure(&file, brdf, theta[j], mid, seed + 1);
-        let right = measure(&file, brdf, mid, theta[j + 2], seed + 2);
+        at.insert(j + 1, measure(&file, brdf, mid, mid, &WHOLE_CIRCLE, seed));
+        let left = measure(&file, brdf, theta[j], mid, &WHOLE_CIRCLE, seed + 1);
+        let right = measure(&file, brdf, mid, theta[j + 2], &WHOLE_CIRCLE, seed + 2);
         iv.splice(j..=j, [left, right]);
     }
 }
@@ -272,20 +286,57 @@ fn reader(
     RglBrdf::from_tensor(&tf, None)
 }
 
-/// Measures the file against the source for incident elevations in (`a`, `b`) (radians).
-fn measure(file: &dyn Brdf, src: &dyn Brdf, a: f64, b: f64, seed: u64) -> Errors {
+/// Which incident azimuths a measurement draws and where it turns the light for the albedo.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Azimuths {
+    /// Incident azimuths are drawn uniformly in [`from`, `to`] (radians); `from == to`: that
+    /// azimuth alone.
+    pub(super) from: f64,
+    /// The end of the range.
+    pub(super) to: f64,
+    /// The light's azimuth of the albedo (radians).
+    pub(super) light: f64,
+    /// The albedo quadrature's azimuths about the mirror direction and Gauss-Legendre nodes
+    /// per segment ([`mirror_albedo`]).
+    pub(super) rule: [usize; 2],
+}
+
+/// Every incident azimuth, the albedo at the light's azimuth 0 (an isotropic source's).
+const WHOLE_CIRCLE: Azimuths = Azimuths {
+    from: 0.0,
+    to: TAU,
+    light: 0.0,
+    rule: [128, 8],
+};
+
+/// Measures the file against the source for incident elevations in (`a`, `b`) (radians) and
+/// azimuths `az`: error and reference integrated over that range of incidences, or per unit
+/// solid angle where the range is a single elevation or azimuth.
+pub(super) fn measure(
+    file: &dyn Brdf,
+    src: &dyn Brdf,
+    a: f64,
+    b: f64,
+    az: &Azimuths,
+    seed: u64,
+) -> Errors {
     let c = src.channels().len().min(MAX_CHANNELS);
     let cap = super::report::MAX_THETA.cos();
     let (ca, cb) = (a.cos(), b.cos());
-    // One elevation alone: densities per unit solid angle of incidences.
-    let measure = if a == b { 1.0 } else { TAU * (ca - cb) };
+    // One elevation or one azimuth alone: densities per unit solid angle of incidences.
+    let measure = if a == b || az.from == az.to {
+        1.0
+    } else {
+        (az.to - az.from) * (ca - cb)
+    };
     let cone_pdf = 1.0 / (TAU * (1.0 - CONE.cos()));
     let mut rng = Pcg32::with_stream(seed, 0x0e1e);
     let mut out = Errors::default();
     let (mut fa, mut fb) = ([0.0f32; MAX_CHANNELS], [0.0f32; MAX_CHANNELS]);
     for s in 0..PAIRS {
         let ci = ca - (ca - cb) * (s as f64 + rng.next_f64()) / PAIRS as f64;
-        let wi = geometry::spherical(ci.clamp(0.0, 1.0).acos(), TAU * rng.next_f64());
+        let phi = az.from + (az.to - az.from) * rng.next_f64();
+        let wi = geometry::spherical(ci.clamp(0.0, 1.0).acos(), phi);
         let wo = if s % 2 == 0 {
             let z = rng.next_f64();
             geometry::spherical(z.acos(), TAU * rng.next_f64())
@@ -329,9 +380,10 @@ fn measure(file: &dyn Brdf, src: &dyn Brdf, a: f64, b: f64, seed: u64) -> Errors
     if degrees.is_empty() {
         degrees.push(0.5 * (lo + hi));
     }
+    let (file, src) = (Turned(file, az.light), Turned(src, az.light));
     for deg in degrees.into_iter().filter(|d| (0.0..=89.0).contains(d)) {
-        let x = mirror_albedo(file, deg.to_radians(), 128, 8);
-        let y = mirror_albedo(src, deg.to_radians(), 128, 8);
+        let x = mirror_albedo(&file, deg.to_radians(), az.rule[0], az.rule[1]);
+        let y = mirror_albedo(&src, deg.to_radians(), az.rule[0], az.rule[1]);
         for ch in 0..c {
             out.albedo = out
                 .albedo

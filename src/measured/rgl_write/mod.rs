@@ -29,11 +29,14 @@
 //! wrong"): an isotropic source's incident elevations are placed by [`elevations`] — from 16
 //! even in cos θi, split where the file's own reader is farthest from the source over the whole
 //! domain, up to 32 within [`PLACED_BYTES`] — at N = 64, or at N = 128 when a figure stays past
-//! its bar, 128 does better and 16 elevations of it fit the budget; an anisotropic source keeps
-//! 16 elevations even in cos θi at N = 64 (its error lies in the interpolation over azimuths)
-//! and gets 17 φi evenly over [−π, π] (no symmetry reduction assumed), an isotropic one φi = 0.
-//! Warps are 128 × 128, NDF and σ on 128 elevations (2 identical azimuth rows when isotropic,
-//! 64 rows over [−π, π] otherwise). One fixed spacing served no source over the whole domain:
+//! its bar, 128 does better and 16 elevations of it fit the budget; an anisotropic source's
+//! azimuths and elevations are placed together by [`azimuths`] — from 9 φi evenly over [−π, π]
+//! (no symmetry reduction assumed) and 16 θi even in cos θi, split where the file is farthest
+//! from the source, at N = 64 on 64 × 64 warps ([`GRID_VNDF`]) within [`PLACED_BYTES`] (its
+//! error lies mostly in the interpolation over azimuths, which no count that fits brings
+//! within the grazing band's bar: BENCHMARKS.md "Anisotropic files placed over azimuths and
+//! elevations"); an isotropic source gets φi = 0. Warps are otherwise 128 × 128, NDF and σ on
+//! 128 elevations (2 identical azimuth rows when isotropic, 64 rows over [−π, π] otherwise). One fixed spacing served no source over the whole domain:
 //! 16 elevations even in cos θi left a Lambertian's grazing band 6.3 % off and Cook-Torrance
 //! gold's albedo 4.5 % off at 89°; even in θi, a Cook-Torrance's grazing band 10 %. A given
 //! count of elevations (`theta_i`) is even in cos θi as before. The published files' layout
@@ -73,6 +76,7 @@
 //! NaN or infinite values, is an [`Error::InvalidArgument`]; invalid cells of MERL files evaluate
 //! as 0 in the source and are written as 0.
 
+pub mod azimuths;
 pub mod container;
 pub mod elevations;
 pub mod ndf;
@@ -120,14 +124,26 @@ fn most_elevations(layout: &Layout, nch: usize) -> usize {
     (PLACED_BYTES / elevation_bytes(layout, nch)).clamp(elevations::START, elevations::MAX)
 }
 
+/// The most slices (incident directions) an anisotropic file of `layout` with `nch` channels
+/// may have within [`PLACED_BYTES`].
+fn most_slices(layout: &Layout, nch: usize) -> usize {
+    PLACED_BYTES / (elevation_bytes(layout, nch) / layout.phi_i.len())
+}
+
 /// Bytes of one incident elevation of `layout` (every azimuth) for `nch` channels.
 fn elevation_bytes(layout: &Layout, nch: usize) -> usize {
     4 * layout.phi_i.len() * ((nch + 1) * layout.n * layout.n + layout.vndf[0] * layout.vndf[1])
 }
 
-/// The number of incident elevations of anisotropic sources (even in cos θi); isotropic ones
-/// get theirs placed ([`elevations`]).
+/// The number of incident elevations of an anisotropic source given its count of azimuths
+/// (even in cos θi); otherwise elevations are placed ([`elevations`], [`azimuths`]).
 pub const DEFAULT_THETA_I: usize = 16;
+
+/// Rows and columns of an anisotropic file's VNDF slices when its azimuths and elevations are
+/// placed ([`azimuths::place`]): 64 × 64 leaves [`PLACED_BYTES`] room for 409 RGB slices at
+/// N = 64, against 256 at 128 × 128, and the interpolation over azimuths is where such a file's
+/// error is (the NDF and σ keep 128 columns).
+pub const GRID_VNDF: usize = 64;
 
 /// The most f32 values a written file may hold (1 GiB), so that no option allocates without bound.
 pub const MAX_FLOATS: usize = 1 << 28;
@@ -141,16 +157,19 @@ pub struct Options {
     /// parameterization's own.
     pub resolution: Option<usize>,
     /// Number of incident elevations θi (from 0 to 90°), 2..=256; `None`: placed per source
-    /// ([`elevations::place`], 16 to 32) when it is isotropic, else [`DEFAULT_THETA_I`]. 8 gives
+    /// ([`elevations::place`], 16 to 32, when it is isotropic; [`azimuths::place`] with its
+    /// azimuths when it is not and `phi_i` is `None`), else [`DEFAULT_THETA_I`]. 8 gives
     /// the database's spacing, other counts are even in cos θi. Must be `None` with a
     /// parameterization (which fixes them).
     pub theta_i: Option<usize>,
-    /// Number of incident azimuths: `None` = 1 for isotropic sources, 17 otherwise. 1 writes an
+    /// Number of incident azimuths: `None` = 1 for isotropic sources; for anisotropic ones
+    /// placed with the elevations ([`azimuths::place`]) when `theta_i` is `None`, else 17. 1 writes an
     /// isotropic file (φi = 0), and is the only value an isotropic source takes; 3 or more an
     /// anisotropic one (evenly over [−π, π]), for anisotropic sources. 2 is not allowed
     /// (readers take ≤ 2 azimuths as isotropic).
     pub phi_i: Option<usize>,
-    /// Resolution of the NDF, σ and VNDF warp grids along each axis, 4..=1024; `None`: 128.
+    /// Resolution of the NDF, σ and VNDF warp grids along each axis, 4..=1024; `None`: 128
+    /// (the VNDF warps [`GRID_VNDF`] when an anisotropic source's azimuths are placed).
     pub ndf_resolution: Option<usize>,
     /// The `description` field (default: the source's description).
     pub description: Option<String>,
@@ -384,6 +403,15 @@ impl Options {
 /// incident directions done to `progress` ([`Silent`](crate::progress::Silent) for none).
 pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Result<Fields> {
     let mut layout = opts.layout(brdf.flags().isotropic)?;
+    // An anisotropic source's azimuths and elevations are placed together unless either is
+    // given, on GRID_VNDF² warps unless those are given.
+    let gridding = opts.parameterization.is_none()
+        && opts.theta_i.is_none()
+        && opts.phi_i.is_none()
+        && !layout.isotropic;
+    if gridding && opts.ndf_resolution.is_none() {
+        layout.vndf = [GRID_VNDF; 2];
+    }
     let nch = brdf.channels().len();
     if nch == 0 {
         return Err(Error::arg("source", "the source has no channels"));
@@ -397,7 +425,12 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
     } else {
         layout.theta_i.len()
     };
-    let slices = layout.phi_i.len() * nt;
+    let slices = if gridding {
+        // The grid placement starts from, whether it fits the budget or not.
+        most_slices(&layout, nch).max(azimuths::START_PHI * elevations::START)
+    } else {
+        layout.phi_i.len() * nt
+    };
     let floats = slices * ((nch + 1) * layout.n * layout.n + layout.vndf[0] * layout.vndf[1]);
     if floats > MAX_FLOATS {
         return Err(Error::arg(
@@ -416,9 +449,6 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
         }
         None => {
             let ndf = ndf::recover(brdf, &layout)?;
-            // Anisotropic files interpolate over 17 azimuths as well, and that is where their
-            // error is: placing elevations changed none of their figures (Lambert + GGX
-            // α = (0.2, 0.5): grazing band 4.0 → 3.8 % on the pair rule) for 2.3× the bytes.
             if placing {
                 let max = most_elevations(&layout, nch);
                 let mut placed = elevations::place(brdf, &ndf, &layout, max, progress)?;
@@ -441,6 +471,15 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
                     }
                 }
                 layout.theta_i = placed.theta_i;
+            }
+            // Anisotropic files interpolate over azimuths as well, and that is where most of
+            // their error is: placing elevations alone changed none of their figures (Lambert +
+            // GGX α = (0.2, 0.5): grazing band 4.0 → 3.8 % on the pair rule) for 2.3× the bytes.
+            if gridding {
+                let (placed, phi_i) =
+                    azimuths::place(brdf, &ndf, &layout, most_slices(&layout, nch), progress)?;
+                layout.theta_i = placed.theta_i;
+                layout.phi_i = phi_i;
             }
             let warps = warps::vndf(&ndf, &layout)?;
             (ndf, warps)

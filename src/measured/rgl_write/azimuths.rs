@@ -1,0 +1,409 @@
+//! Where an anisotropic file's incident azimuths and elevations go: placed together where the
+//! file's own reader is farthest from the source.
+//!
+//! An anisotropic `.bsdf` file stores slices on a product grid of incident azimuths φi and
+//! elevations θi, and its readers (brdftab's, Mitsuba 3's `measured`, pbrt-v4's
+//! `MeasuredBxDF`) find the interval around a direction's φi and θi by binary search over the
+//! stored values and interpolate linearly in both: neither needs to be even, provided the
+//! azimuths run from −π to π (the readers derive a symmetry reduction from their span, and
+//! pbrt-v4 takes none but 1). Unlike an isotropic file, whose half vectors are stored relative
+//! to φi, an anisotropic file's are absolute: two slices a step apart in φi store, at one point
+//! of their warps, the same half vector for incidences a step apart, so the outgoing directions
+//! they were evaluated at differ, most near the horizon. That interpolation, not the one over
+//! θi, is where an anisotropic file's error is (BENCHMARKS.md "Anisotropic files placed over
+//! azimuths and elevations").
+//!
+//! [`place`] extends [`elevations::place`] to the grid: from
+//! [`START_PHI`] azimuths evenly over [−π, π] and [`elevations::START`] elevations even in
+//! cos θi, it writes the file in memory, reads it back and measures every cell (an azimuth
+//! interval × an elevation interval), every elevation over each azimuth interval and every
+//! azimuth over each elevation interval, with the figures of `elevations` (the light of the
+//! cell's albedo at its middle azimuth). The figure farthest past its bar, where more slices
+//! can lower it, decides: of splitting an elevation interval (a slice per azimuth) or an
+//! azimuth interval (a slice per elevation), the one whose error above its slices' is largest
+//! per slice added is split in the middle. It stops when no figure qualifies or when no split
+//! fits `max_slices`.
+
+use std::collections::HashMap;
+use std::f64::consts::PI;
+
+use rayon::prelude::*;
+
+use super::elevations::{
+    self, Azimuths, Errors, IMPROVABLE, MARGIN, MIN_STEP, Placement, Slice, figures, floor_over,
+    measure,
+};
+use super::ndf::Ndf;
+use super::{Layout, Progress, values, warps};
+use crate::brdf::Brdf;
+use crate::error::Result;
+use crate::measured::RglBrdf;
+use crate::measured::tensor::TensorFile;
+use crate::progress::Silent;
+
+/// Azimuths placement starts from (evenly over [−π, π], both ends included: 8 intervals).
+pub const START_PHI: usize = 9;
+
+/// The albedo quadrature of the measurements (azimuths about the mirror direction, nodes per
+/// segment): a quarter of the evaluations of the isotropic placement's, which measures far
+/// fewer cells.
+const ALBEDO_RULE: [usize; 2] = [64, 4];
+
+/// The closest two azimuths may be (radians).
+pub const MIN_PHI_STEP: f64 = 0.5 * PI / 180.0;
+
+/// The incident azimuths `n` evenly over [−π, π] (both ends).
+pub fn even_azimuths(n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|k| -PI + 2.0 * PI * k as f64 / (n - 1) as f64)
+        .collect()
+}
+
+/// One measurement to make: elevations (`a`, `b`) and azimuths `az`.
+#[derive(Clone, Copy)]
+struct Job {
+    a: f64,
+    b: f64,
+    az: Azimuths,
+    seed: u64,
+}
+
+/// The grid and what was measured on it.
+struct Grid {
+    phi: Vec<f64>,
+    theta: Vec<f64>,
+    /// Cells, `[azimuth interval][elevation interval]`.
+    cell: Vec<Vec<Errors>>,
+    /// Each elevation over each azimuth interval, `[azimuth interval][elevation]`.
+    at_theta: Vec<Vec<Errors>>,
+    /// Each azimuth over each elevation interval, `[azimuth][elevation interval]`.
+    at_phi: Vec<Vec<Errors>>,
+}
+
+impl Grid {
+    fn cell_job(&self, i: usize, j: usize, seed: u64) -> Job {
+        let (pa, pb) = (self.phi[i], self.phi[i + 1]);
+        Job {
+            a: self.theta[j],
+            b: self.theta[j + 1],
+            az: Azimuths {
+                from: pa,
+                to: pb,
+                light: 0.5 * (pa + pb),
+                rule: ALBEDO_RULE,
+            },
+            seed,
+        }
+    }
+    fn at_theta_job(&self, i: usize, j: usize, seed: u64) -> Job {
+        let (pa, pb) = (self.phi[i], self.phi[i + 1]);
+        Job {
+            a: self.theta[j],
+            b: self.theta[j],
+            az: Azimuths {
+                from: pa,
+                to: pb,
+                light: 0.5 * (pa + pb),
+                rule: ALBEDO_RULE,
+            },
+            seed,
+        }
+    }
+    fn at_phi_job(&self, i: usize, j: usize, seed: u64) -> Job {
+        let p = self.phi[i];
+        Job {
+            a: self.theta[j],
+            b: self.theta[j + 1],
+            az: Azimuths {
+                from: p,
+                to: p,
+                light: p,
+                rule: ALBEDO_RULE,
+            },
+            seed,
+        }
+    }
+    /// Solid angle of cell (`i`, `j`).
+    fn area(&self, i: usize, j: usize) -> f64 {
+        (self.phi[i + 1] - self.phi[i]) * (self.theta[j].cos() - self.theta[j + 1].cos())
+    }
+    /// The slice-limited errors of cell (`i`, `j`) along elevations and along azimuths.
+    fn floors(&self, i: usize, j: usize) -> (Errors, Errors) {
+        let area = self.area(i, j);
+        (
+            floor_over(&self.at_theta[i][j], &self.at_theta[i][j + 1], area),
+            floor_over(&self.at_phi[i][j], &self.at_phi[i + 1][j], area),
+        )
+    }
+}
+
+/// Runs `jobs` on the file in parallel.
+fn run(file: &RglBrdf, src: &dyn Brdf, jobs: &[Job]) -> Vec<Errors> {
+    crate::par::install(|| {
+        jobs.par_iter()
+            .map(|j| measure(file, src, j.a, j.b, &j.az, j.seed))
+            .collect()
+    })
+}
+
+/// Chooses the incident azimuths and elevations of an anisotropic `brdf` (at most
+/// `max_slices` slices), with `base` giving every other part of the layout. Returns the
+/// placement (its `theta_i`) and the azimuths.
+pub fn place(
+    brdf: &dyn Brdf,
+    ndf: &Ndf,
+    base: &Layout,
+    max_slices: usize,
+    progress: &dyn Progress,
+) -> Result<(Placement, Vec<f32>)> {
+    let nt0 = elevations::START;
+    let mut g = Grid {
+        phi: even_azimuths(START_PHI),
+        theta: (0..nt0)
+            .map(|k| (1.0 - k as f64 / (nt0 - 1) as f64).clamp(0.0, 1.0).acos())
+            .collect(),
+        cell: Vec::new(),
+        at_theta: Vec::new(),
+        at_phi: Vec::new(),
+    };
+    let mut cache: HashMap<(u64, u64), Slice> = HashMap::new();
+    let _stage = crate::progress::Stage::begin(
+        progress,
+        "placing azimuths and elevations",
+        max_slices as u64,
+    );
+    let mut file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache)?;
+    let (np, nt) = (g.phi.len(), g.theta.len());
+    let mut seed = 1u64;
+    let mut next_seed = || {
+        seed += 1;
+        seed
+    };
+    let jobs: Vec<Job> = (0..np - 1)
+        .flat_map(|i| (0..nt - 1).map(move |j| (i, j)))
+        .map(|(i, j)| g.cell_job(i, j, next_seed()))
+        .collect();
+    let r = run(&file, brdf, &jobs);
+    g.cell = r.chunks(nt - 1).map(<[Errors]>::to_vec).collect();
+    let jobs: Vec<Job> = (0..np - 1)
+        .flat_map(|i| (0..nt).map(move |j| (i, j)))
+        .map(|(i, j)| g.at_theta_job(i, j, next_seed()))
+        .collect();
+    let r = run(&file, brdf, &jobs);
+    g.at_theta = r.chunks(nt).map(<[Errors]>::to_vec).collect();
+    let jobs: Vec<Job> = (0..np)
+        .flat_map(|i| (0..nt - 1).map(move |j| (i, j)))
+        .map(|(i, j)| g.at_phi_job(i, j, next_seed()))
+        .collect();
+    let r = run(&file, brdf, &jobs);
+    g.at_phi = r.chunks(nt - 1).map(<[Errors]>::to_vec).collect();
+    loop {
+        let (np, nt) = (g.phi.len(), g.theta.len());
+        progress.set((np * nt) as u64);
+        let (mut cells, mut floors) = (Vec::new(), Vec::new());
+        for i in 0..np - 1 {
+            for j in 0..nt - 1 {
+                let (ft, fp) = g.floors(i, j);
+                let mut f = ft;
+                for k in 0..3 {
+                    f.err[k] = ft.err[k].min(fp.err[k]);
+                }
+                f.albedo = ft.albedo.min(fp.albedo);
+                cells.push(g.cell[i][j]);
+                floors.push(f);
+            }
+        }
+        let (mut fig, floor) = figures(&cells, &floors);
+        // The albedo with the light at a stored azimuth is what a renderer sees there too (the
+        // fidelity report's φ′ = 0 is one): more elevations lower it.
+        let at_nodes = (g.at_phi.iter().flatten()).fold(0.0, |m: f64, e| m.max(e.albedo));
+        fig[3] = fig[3].max(at_nodes / elevations::BARS[3]);
+        let done = || {
+            (
+                Placement {
+                    theta_i: g.theta.iter().map(|&t| t as f32).collect(),
+                    figures: fig,
+                    floors: floor,
+                },
+                g.phi.iter().map(|&p| p as f32).collect::<Vec<f32>>(),
+            )
+        };
+        let Some(worst) = (0..4)
+            .filter(|&k| fig[k] > MARGIN && fig[k] - floor[k] > IMPROVABLE * fig[k])
+            .max_by(|&a, &b| fig[a].total_cmp(&fig[b]))
+        else {
+            return Ok(done());
+        };
+        let excess = |e: &Errors, f: &Errors| match worst {
+            3 => e.albedo - f.albedo,
+            k => e.err[k] - f.err[k],
+        };
+        // Per slice added: an elevation adds one per azimuth, an azimuth one per elevation.
+        let by_theta = (0..nt - 1)
+            .filter(|&j| {
+                g.theta[j + 1] - g.theta[j] > 2.0 * MIN_STEP && (nt + 1) * np <= max_slices
+            })
+            .map(|j| {
+                let gains = (0..np - 1).map(|i| {
+                    let mut e = g.cell[i][j];
+                    e.albedo = (e.albedo)
+                        .max(g.at_phi[i][j].albedo)
+                        .max(g.at_phi[i + 1][j].albedo);
+                    excess(&e, &g.floors(i, j).0)
+                });
+                let gain = if worst == 3 {
+                    gains.fold(0.0, f64::max)
+                } else {
+                    gains.sum()
+                };
+                (gain / np as f64, j)
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0));
+        let by_phi = (0..np - 1)
+            .filter(|&i| {
+                g.phi[i + 1] - g.phi[i] > 2.0 * MIN_PHI_STEP && (np + 1) * nt <= max_slices
+            })
+            .map(|i| {
+                let gains = (0..nt - 1).map(|j| excess(&g.cell[i][j], &g.floors(i, j).1));
+                let gain = if worst == 3 {
+                    gains.fold(0.0, f64::max)
+                } else {
+                    gains.sum()
+                };
+                (gain / nt as f64, i)
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0));
+        let split_theta = match (by_theta, by_phi) {
+            (None, None) => return Ok(done()),
+            (Some((gt, j)), Some((gp, i))) => {
+                if gt >= gp {
+                    Ok(j)
+                } else {
+                    Err(i)
+                }
+            }
+            (Some((_, j)), None) => Ok(j),
+            (None, Some((_, i))) => Err(i),
+        };
+        match split_theta {
+            Ok(j) => {
+                let mid = 0.5 * (g.theta[j] + g.theta[j + 1]);
+                g.theta.insert(j + 1, mid);
+                file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache)?;
+                let mut jobs = Vec::new();
+                for i in 0..np - 1 {
+                    jobs.push(g.cell_job(i, j, next_seed()));
+                    jobs.push(g.cell_job(i, j + 1, next_seed()));
+                    jobs.push(g.at_theta_job(i, j + 1, next_seed()));
+                }
+                for i in 0..np {
+                    jobs.push(g.at_phi_job(i, j, next_seed()));
+                    jobs.push(g.at_phi_job(i, j + 1, next_seed()));
+                }
+                let r = run(&file, brdf, &jobs);
+                for i in 0..np - 1 {
+                    g.cell[i].splice(j..=j, [r[3 * i], r[3 * i + 1]]);
+                    g.at_theta[i].insert(j + 1, r[3 * i + 2]);
+                }
+                let o = 3 * (np - 1);
+                for i in 0..np {
+                    g.at_phi[i].splice(j..=j, [r[o + 2 * i], r[o + 2 * i + 1]]);
+                }
+            }
+            Err(i) => {
+                let mid = 0.5 * (g.phi[i] + g.phi[i + 1]);
+                g.phi.insert(i + 1, mid);
+                file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache)?;
+                let mut jobs = Vec::new();
+                for k in [i, i + 1] {
+                    for j in 0..nt - 1 {
+                        jobs.push(g.cell_job(k, j, next_seed()));
+                    }
+                    for j in 0..nt {
+                        jobs.push(g.at_theta_job(k, j, next_seed()));
+                    }
+                }
+                for j in 0..nt - 1 {
+                    jobs.push(g.at_phi_job(i + 1, j, next_seed()));
+                }
+                let r = run(&file, brdf, &jobs);
+                let row = (nt - 1) + nt;
+                let (left, right) = (&r[..row], &r[row..2 * row]);
+                g.cell
+                    .splice(i..=i, [left[..nt - 1].to_vec(), right[..nt - 1].to_vec()]);
+                g.at_theta
+                    .splice(i..=i, [left[nt - 1..].to_vec(), right[nt - 1..].to_vec()]);
+                g.at_phi.insert(i + 1, r[2 * row..].to_vec());
+            }
+        }
+    }
+}
+
+/// The file of `base` with azimuths `phi` and elevations `theta`, read back by brdftab's RGL
+/// reader; slices not in `cache` are encoded (in parallel) and kept there.
+fn reader(
+    brdf: &dyn Brdf,
+    ndf: &Ndf,
+    base: &Layout,
+    phi: &[f64],
+    theta: &[f64],
+    cache: &mut HashMap<(u64, u64), Slice>,
+) -> Result<RglBrdf> {
+    let nch = brdf.channels().len();
+    let n = base.n;
+    let plane = n * n;
+    let vplane = base.vndf[0] * base.vndf[1];
+    let missing: Vec<(f64, f64)> = phi
+        .iter()
+        .flat_map(|&p| theta.iter().map(move |&t| (p, t)))
+        .filter(|(p, t)| !cache.contains_key(&(p.to_bits(), t.to_bits())))
+        .collect();
+    let encoded = crate::par::install(|| {
+        missing
+            .par_iter()
+            .map(|&(p, t)| {
+                let layout = Layout {
+                    theta_i: vec![t as f32],
+                    phi_i: vec![p as f32],
+                    ..base.clone()
+                };
+                let w = warps::vndf(ndf, &layout)?;
+                let v = values::sample(brdf, ndf, &w, &layout, None, &Silent)?;
+                let valid = super::container::unpack_bits(&v.valid, plane);
+                Ok((
+                    (p.to_bits(), t.to_bits()),
+                    Slice {
+                        vndf: w.data,
+                        values: v.data,
+                        valid,
+                    },
+                ))
+            })
+            .collect::<Result<Vec<_>>>()
+    })?;
+    cache.extend(encoded);
+    let (np, nt) = (phi.len(), theta.len());
+    let mut vndf = Vec::with_capacity(np * nt * vplane);
+    let mut data = Vec::with_capacity(np * nt * nch * plane);
+    let mut valid = Vec::with_capacity(np * nt * plane);
+    for &p in phi {
+        for &t in theta {
+            let s = &cache[&(p.to_bits(), t.to_bits())];
+            vndf.extend_from_slice(&s.vndf);
+            data.extend_from_slice(&s.values);
+            valid.extend_from_slice(&s.valid);
+        }
+    }
+    let layout = Layout {
+        theta_i: theta.iter().map(|&t| t as f32).collect(),
+        phi_i: phi.iter().map(|&p| p as f32).collect(),
+        ..base.clone()
+    };
+    let values = super::Values {
+        data,
+        valid: super::container::pack_bits(&valid),
+    };
+    let fields = super::fields_of(String::new(), &layout, ndf, vndf, values, brdf.channels());
+    let tf = TensorFile::from_bytes("(placing azimuths)", fields.to_bytes())?;
+    RglBrdf::from_tensor(&tf, None)
+}
