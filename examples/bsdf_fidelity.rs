@@ -11,7 +11,9 @@
 //! Environment: `THETA_I=n` and `RES=n` write n elevations or an n × n table instead of the
 //! defaults (`PHI_I=n`: n incident azimuths, `NDF_RES=n`: n × n warps); `AGAINST=SOURCE` judges every written file against that source instead of its own
 //! (a table of an RGL file, written as `.bsdf`, against the file); `BINS=1` also prints the
-//! relative RMSE of f_r cos θi cos θo per (θi, θo) band, `GRID=1` the incident directions written.
+//! relative RMSE of f_r cos θi cos θo per (θi, θo) band, `GRID=1` the incident directions written, `TURN=deg` measures
+//! both turned by deg about the normal (the albedo with the light at azimuth deg, the rule's
+//! pairs turned with it).
 
 use brdftab::analysis::fidelity::{self, FidelityOptions};
 use brdftab::measured::rgl_write;
@@ -84,7 +86,12 @@ fn main() -> brdftab::Result<()> {
             Ok(a) => brdftab::open(&a)?,
             Err(_) => brdftab::open(s)?,
         };
-        let f = fidelity::measure(&back, against.as_ref(), &opts)?;
+        let turn = std::env::var("TURN")
+            .ok()
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(0.0)
+            .to_radians();
+        let f = fidelity::measure(&Turned(&back, turn), &Turned(against.as_ref(), turn), &opts)?;
         let p = f.percents();
         println!(
             "| {s} | {} | {secs:.1} | {:.2} % | {:.2} % | {:.2} % | {:.2} / {:.2} / {:.2} % | {:.2} % at {}° (ch {}, {:.4} vs {:.4}) |",
@@ -106,6 +113,26 @@ fn main() -> brdftab::Result<()> {
         let _ = std::fs::remove_dir_all(&tmp);
     }
     Ok(())
+}
+
+/// A BRDF with both directions turned by an angle about the normal (`TURN`).
+struct Turned<'a>(&'a dyn brdftab::Brdf, f64);
+
+impl brdftab::Brdf for Turned<'_> {
+    fn channels(&self) -> &brdftab::spectrum::Channels {
+        self.0.channels()
+    }
+    fn eval(&self, wi: glam::DVec3, wo: glam::DVec3, out: &mut [f32]) {
+        let (s, c) = self.1.sin_cos();
+        let turn = |v: glam::DVec3| glam::DVec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
+        self.0.eval(turn(wi), turn(wo), out)
+    }
+    fn flags(&self) -> brdftab::brdf::Flags {
+        self.0.flags()
+    }
+    fn describe(&self) -> String {
+        self.0.describe()
+    }
 }
 
 fn bins(a: &dyn brdftab::Brdf, r: &dyn brdftab::Brdf) {
