@@ -48,7 +48,7 @@ pub struct RenderArgs {
     /// so both sources see the same directions and the difference shows materials, not noise.
     #[arg(long)]
     sampling: Option<String>,
-    /// Exposure in stops for PNG output.
+    /// Exposure in stops: the linear values × 2^EV, in the PNG's encoding and the EXR alike.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f32,
     /// Render a second SOURCE with the same seed; write OUT as the side-by-side pair

@@ -479,8 +479,11 @@ fn too_large(path: &Path) -> Error {
     }
 }
 
-/// Writes `img` to `path`, choosing the format by extension: `.exr` (f32) or `.png` (with
-/// `exposure`, see [`write_png`]).
+/// Writes `img` to `path`, choosing the format by extension: `.exr` (f32) or `.png` (see
+/// [`write_png`]). Both scale the linear values by 2^`exposure` (stops), as pbrt-v4's
+/// `imgtool convert --exposure` does for every format: an EXR holds the radiance × 2^exposure
+/// (exactly the radiance at exposure 0), a PNG its sRGB encoding. (The EXR ignored the
+/// exposure until session 41.)
 pub fn write_auto(img: &Image, path: impl AsRef<Path>, exposure: f32) -> Result<()> {
     let path = path.as_ref();
     match path
@@ -489,6 +492,14 @@ pub fn write_auto(img: &Image, path: impl AsRef<Path>, exposure: f32) -> Result<
         .map(str::to_ascii_lowercase)
         .as_deref()
     {
+        Some("exr") if exposure != 0.0 => {
+            let k = exposure.exp2();
+            let scaled = Image {
+                data: img.data.iter().map(|v| v * k).collect(),
+                ..img.clone()
+            };
+            write_exr(&scaled, path, ExrPrecision::F32)
+        }
         Some("exr") => write_exr(img, path, ExrPrecision::F32),
         Some("png") => write_png(img, path, exposure),
         _ => Err(Error::InvalidArgument {
@@ -750,6 +761,23 @@ mod tests {
         }
         // No temporary file is left beside them.
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4);
+    }
+
+    #[test]
+    fn exposure_scales_the_exr_too() {
+        // `render --exposure 1 -o x.exr` wrote the unscaled radiance: the flag was ignored.
+        let mut img = Image::new(3, 2, 3);
+        img.pixel_mut(0, 0).copy_from_slice(&[0.25, 1.5, 3.0]);
+        img.pixel_mut(2, 1).copy_from_slice(&[1e-3, 0.0, 7.0]);
+        let (_dir, p) = tmp("exposed.exr");
+        for ev in [0.0f32, 1.0, -2.0, 0.5] {
+            write_auto(&img, &p, ev).unwrap();
+            let back = read_exr(&p).unwrap();
+            let k = ev.exp2();
+            // f32 in and out; a product of two f32 rounded once, as the writer does.
+            let want: Vec<f32> = img.data.iter().map(|v| v * k).collect();
+            assert_eq!(back.data, want, "exposure {ev}");
+        }
     }
 
     #[test]

@@ -170,7 +170,7 @@ pub struct RenderOptions {
     pub light: LightChoice,
     /// Whether a diffuse grey ground plane (albedo 0.5) is under the sphere.
     pub ground: bool,
-    /// Exposure in stops for PNG output (not applied to the returned image).
+    /// Exposure in stops for the written file, PNG or EXR (not applied to the returned image).
     pub exposure: f32,
     /// Number of threads (`None` = rayon's global pool).
     pub threads: Option<usize>,

@@ -29,6 +29,36 @@ fn render_writes_png_and_exr() {
 }
 
 #[test]
+fn exposure_scales_an_exr_output() {
+    // The EXR ignored `--exposure` (session 41): the same render at +1 and -1 stop must hold
+    // exactly twice and half the values of the render at 0 (same seed: the same image).
+    let dir = TempDir::new("render-cli-exposure");
+    let render = |ev: &str| {
+        let out = dir.join(format!("e{ev}.exr"));
+        let r = brdftab(&[
+            "render",
+            r#"{"model":"lambert","kd":0.2}"#,
+            "--size",
+            "8x6",
+            "--spp",
+            "2",
+            "--exposure",
+            ev,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(r.ok, "{}", r.stderr);
+        brdftab_tools::preview::read_exr(&out).unwrap().data
+    };
+    let base = render("0");
+    assert!(base.iter().any(|&v| v > 0.0));
+    for (ev, k) in [("1", 2.0f32), ("-1", 0.5)] {
+        let want: Vec<f32> = base.iter().map(|v| v * k).collect();
+        assert_eq!(render(ev), want, "--exposure {ev}");
+    }
+}
+
+#[test]
 fn compare_with_itself_is_zero_and_writes_diff() {
     let dir = TempDir::new("render-cli-compare");
     let out = dir.join("cmp.png");
