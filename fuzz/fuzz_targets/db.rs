@@ -6,8 +6,9 @@
 //! On 1 input in 2 (by the input's hash) the store itself is opened eagerly
 //! (`StoreOptions::eager`: every chunk of a table decoded when it is opened).
 //!
-//! The sampler is built at the small resolution the `table` target picks (its cost, not a
-//! different code path); tables over 2^22 values are skipped (the fuzzer's time).
+//! The sampler is built at `SamplingResolution::coarse()` (its cost, not a different code
+//! path; what `info`'s sizing starts from too in this `cfg(fuzzing)` build); tables over 2^22
+//! values are skipped (the fuzzer's time).
 #![no_main]
 
 #[path = "common.rs"]
@@ -31,13 +32,7 @@ fuzz_target!(|data: &[u8]| {
         }
         let Ok(table) = t.to_table() else { continue };
         let mut b = TabulatedBrdf::from_table(table);
-        b.set_sampling_resolution(&SamplingResolution {
-            theta_h: 3,
-            phi_h: 2,
-            theta_o: 2,
-            phi_o: 1,
-            floor: 0.005,
-        });
+        b.set_sampling_resolution(&SamplingResolution::coarse());
         common::exercise(&b);
         assert!(b.health().is_ok(), "a table decoded whole must stay healthy");
     }

@@ -433,9 +433,15 @@ impl TableSampler {
     /// predicted weights miss a bar between the conditioning views
     /// ([`TableSampler::view_excess`] > 1), [`SamplingResolution::finer_views`] when those do
     /// better by a tenth. Costs a build and the prediction (about 150 k evaluations and
-    /// densities), twice for a source that gets the finer views.
+    /// densities), twice for a source that gets the finer views. A `cfg(fuzzing)` build (the
+    /// fuzz targets) starts from [`SamplingResolution::coarse`] instead: the same decisions on
+    /// a few dozen nodes.
     pub fn for_source(brdf: &dyn Brdf, isotropic: bool, nearest: bool) -> TableSampler {
-        let mut res = SamplingResolution::for_lookup(isotropic, nearest);
+        let mut res = if cfg!(fuzzing) {
+            SamplingResolution::coarse()
+        } else {
+            SamplingResolution::for_lookup(isotropic, nearest)
+        };
         if !isotropic {
             return TableSampler::build(brdf, false, &res);
         }
