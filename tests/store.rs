@@ -104,6 +104,69 @@ fn every_codec_round_trips_through_a_file() {
 }
 
 #[test]
+fn database_rename_keeps_the_table_and_its_place() {
+    let d = TempDir::new("store-db-rename");
+    let p = d.join("db.btdb");
+    add(&p, "a", Quant::F16, 0.0);
+    add(&p, "b", Quant::F32, 1.0);
+    add(&p, "c", Quant::F16, 2.0);
+    let before = Store::open(&p).unwrap();
+    let names = || {
+        let s = Store::open(&p).unwrap();
+        s.tables()
+            .iter()
+            .map(|e| e.name.clone())
+            .collect::<Vec<_>>()
+    };
+    db::rename(&p, "b", "gold").unwrap();
+    assert_eq!(names(), ["a", "gold", "c"]);
+    let s = Store::open(&p).unwrap();
+    // The values and every other header field are the old table's, bit for bit.
+    let (old_t, new_t) = (before.table("b").unwrap(), s.table("gold").unwrap());
+    assert_eq!(new_t.read_all().unwrap(), old_t.read_all().unwrap());
+    let mut h = old_t.header().clone();
+    h.name = "gold".into();
+    assert_eq!(new_t.header(), &h);
+    assert_eq!(db::verify(&p).unwrap(), 3 * SHAPE[0]);
+    assert!(matches!(s.table("b"), Err(Error::NotFound(_))));
+    let file = p.to_str().unwrap();
+    let bytes = std::fs::read(&p).unwrap();
+
+    // A taken NEW (`old` itself too), a missing OLD or database, a NEW the name rule refuses:
+    // each an error naming the database or the argument, the file untouched.
+    for (old, new) in [("a", "c"), ("a", "a")] {
+        match db::rename(&p, old, new) {
+            Err(Error::Duplicate { container, name }) => {
+                assert_eq!((container.as_str(), name.as_str()), (file, new))
+            }
+            r => panic!("{old} -> {new}: {r:?}"),
+        }
+    }
+    match db::rename(&p, "b", "x") {
+        Err(e @ Error::NotFound(_)) => {
+            let e = e.to_string();
+            assert!(
+                e.contains(file) && e.contains("`b`") && e.contains("gold"),
+                "{e}"
+            )
+        }
+        r => panic!("{r:?}"),
+    }
+    for bad in ["", "x#y", "x/y", "x\ny"] {
+        match db::rename(&p, "a", bad) {
+            Err(Error::InvalidArgument { name, .. }) => assert_eq!(name, "name", "{bad:?}"),
+            r => panic!("{bad:?}: {r:?}"),
+        }
+    }
+    assert_eq!(std::fs::read(&p).unwrap(), bytes);
+    let missing = d.join("none.btdb");
+    let e = db::rename(&missing, "a", "b").unwrap_err();
+    assert!(matches!(e, Error::NotFound(_)), "{e}");
+    assert!(e.to_string().contains("none.btdb"), "{e}");
+    assert!(!missing.exists());
+}
+
+#[test]
 fn database_add_replace_remove_list_verify() {
     let d = TempDir::new("store-db");
     let p = d.join("db.btdb");

@@ -1,4 +1,4 @@
-//! Database operations on a brdftab file: add, replace, remove, list, get, verify.
+//! Database operations on a brdftab file: add, replace, remove, rename, list, get, verify.
 //!
 //! Every change writes a complete new file next to the old one (copying the other tables' chunks
 //! byte for byte, checksums checked, without decoding them), fsyncs it, renames it over the old
@@ -216,6 +216,48 @@ pub fn remove(path: impl AsRef<Path>, name: &str) -> Result<()> {
     let mut w = Writer::create(path)?;
     for e in s.tables().iter().filter(|e| e.name != name) {
         copy_table(&s, e, &mut w)?;
+    }
+    w.finish()
+}
+
+/// Renames table `old` to `new`: the table keeps its place among the others and its chunks
+/// byte for byte (checksums checked on the way), only its header's name changes; the database
+/// is rewritten atomically as by every other change. `new` must keep the table-name rule
+/// ([`super::name::check`]).
+///
+/// # Errors
+/// [`Error::NotFound`] naming the database when it or table `old` is absent (listing the
+/// tables it holds), [`Error::Duplicate`] naming the database when it holds a table `new`
+/// already (`old` itself included), [`Error::InvalidArgument`] (`name`) for a `new` the rule
+/// refuses — each before the database is rewritten.
+pub fn rename(path: impl AsRef<Path>, old: &str, new: &str) -> Result<()> {
+    super::name::check("name", new)?;
+    let user = path.as_ref(); // the name errors give
+    let path = &crate::files::resolve_links(user)?;
+    // A missing database is reported before the lock, which would leave its lock file behind.
+    crate::files::require_regular(user)?;
+    let _lock = lock(path)?;
+    let s = Store::open(path)?;
+    let container = user.display().to_string();
+    if !s.tables().iter().any(|t| t.name == old) {
+        return Err(super::no_table(&container, old, s.tables()));
+    }
+    if s.tables().iter().any(|t| t.name == new) {
+        let name = new.to_owned();
+        return Err(Error::Duplicate { container, name });
+    }
+    let mut w = Writer::create(path)?;
+    for e in s.tables() {
+        if e.name != old {
+            copy_table(&s, e, &mut w)?;
+            continue;
+        }
+        let t = s.table(old)?;
+        let mut header = t.header().clone();
+        header.name = new.to_owned();
+        w.begin_table(header)?;
+        copy_chunks(&t, &mut w)?;
+        w.end_table()?;
     }
     w.finish()
 }

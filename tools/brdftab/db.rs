@@ -1,4 +1,4 @@
-//! `db` subcommands (add, list, rm, verify): thin over `brdftab::store`.
+//! `db` subcommands (add, list, rm, rename, verify): thin over `brdftab::store`.
 
 use brdftab::bake::BakeTarget;
 use brdftab::store::{self, db};
@@ -23,6 +23,12 @@ enum DbCommand {
     List(ListArgs),
     /// Remove table NAME from DB.
     Rm(RmArgs),
+    /// Rename table OLD of DB to NEW (refused when DB holds a table NEW).
+    Rename {
+        db: String,
+        old: String,
+        new: String,
+    },
     /// Check every checksum and decode every chunk of DB.
     Verify(VerifyArgs),
 }
@@ -85,15 +91,11 @@ pub fn run(a: DbArgs) -> Result<()> {
         }
         DbCommand::List(a) => list(&a.db, a.json),
         DbCommand::Rm(a) => {
-            db::remove(&a.db, &a.name)?;
-            eprintln!("removed `{}` from {}", a.name, a.db);
-            Ok(())
+            db::remove(&a.db, &a.name).map(|()| eprintln!("removed `{}` from {}", a.name, a.db))
         }
-        DbCommand::Verify(a) => {
-            let n = db::verify(&a.db)?;
-            outln!("ok: {} ({n} chunks checked)", a.db)?;
-            Ok(())
-        }
+        DbCommand::Rename { db, old, new } => store::db::rename(&db, &old, &new)
+            .map(|()| eprintln!("renamed `{old}` to `{new}` in {db}")),
+        DbCommand::Verify(a) => outln!("ok: {} ({} chunks checked)", a.db, db::verify(&a.db)?),
     }
 }
 

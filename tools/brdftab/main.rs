@@ -42,7 +42,7 @@ enum Command {
     Models(models::ModelsArgs),
     /// Bake SOURCE into a dense (symmetry-reduced) table file.
     Bake(bake::BakeArgs),
-    /// Databases of named tables: add, list, rm, verify.
+    /// Databases of named tables: add, list, rm, rename, verify.
     Db(db::DbArgs),
     /// Export a stored table as .npy, or a 2D slice of it as EXR.
     Export(export::ExportArgs),
@@ -132,16 +132,16 @@ fn main() -> ExitCode {
         }
         Err(e) => {
             let e = as_typed(e, &command(), &path);
-            eprintln!("error: {e}{}", hint(&e));
+            eprintln!("error: {e}{}", hint(&e, &path));
             ExitCode::from(1)
         }
     }
 }
 
 /// The flags that get past an error: the library's messages name none, the CLI adds them here.
-fn hint(e: &brdftab::Error) -> &'static str {
+fn hint(e: &brdftab::Error, path: &[String]) -> &'static str {
     match e {
-        brdftab::Error::Duplicate { .. } => " (use --replace)",
+        brdftab::Error::Duplicate { .. } if path != ["db", "rename"] => " (use --replace)",
         brdftab::Error::Symmetry { .. } => " (use --force to bake anyway, or --symmetry none)",
         _ => "",
     }

@@ -1,5 +1,5 @@
 //! The database functions the pure-Python `brdftab.Database` wraps: list, check a name, remove,
-//! import a table.
+//! rename, import a table.
 //!
 //! Why a module: these manage the tables of a database file; they open no BRDF.
 
@@ -34,6 +34,13 @@ pub(crate) fn _check_table_name(name: &str) -> PyResult<()> {
 #[pyfunction]
 pub(crate) fn db_remove(py: Python<'_>, path: &str, name: &str) -> PyResult<()> {
     guard(|| unlocked(py, || brdftab::store::db::remove(path, name))?.map_err(lib_err))
+}
+
+/// Renames table `old` of database `path` to `new`, with the GIL released as `db_remove` does:
+/// the database is rewritten after waiting for its lock.
+#[pyfunction]
+pub(crate) fn db_rename(py: Python<'_>, path: &str, old: &str, new: &str) -> PyResult<()> {
+    guard(|| unlocked(py, || brdftab::store::db::rename(path, old, new))?.map_err(lib_err))
 }
 
 /// Adds the table of a single-table file's bytes (what `bake` writes to a `.btdb` path) to

@@ -42,6 +42,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sources::_source_kind, m)?)?;
     m.add_function(wrap_pyfunction!(db::db_names, m)?)?;
     m.add_function(wrap_pyfunction!(db::db_remove, m)?)?;
+    m.add_function(wrap_pyfunction!(db::db_rename, m)?)?;
     m.add_function(wrap_pyfunction!(db::_check_table_name, m)?)?;
     m.add_function(wrap_pyfunction!(db::db_import, m)?)?;
     m.add_function(wrap_pyfunction!(requests::bake, m)?)?;

@@ -341,6 +341,27 @@ def test_database(tmp_path):
     assert db != brdftab.Database(tmp_path / "other.btdb") and db != str(tmp_path / "m.btdb")
 
 
+def test_database_rename(tmp_path):
+    """`Database.rename(old, new)` (session 41): the table keeps its place and its values; a
+    taken or missing name is a brdftab.Error naming the database, a bad name a ValueError."""
+    db = brdftab.Database(tmp_path / "m.btdb")
+    db.add(LAMBERT, "matte", preset="small")
+    db.add(GGX, "shiny", preset="small")
+    before = db.open("matte").eval([0, 0, 1], [0.6, 0, 0.8])
+    db.rename("matte", "chalk")
+    assert db.names() == ["chalk", "shiny"]
+    np.testing.assert_array_equal(db.open("chalk").eval([0, 0, 1], [0.6, 0, 0.8]), before)
+    with pytest.raises(brdftab.Error, match=r"m\.btdb already holds a table `shiny`"):
+        db.rename("chalk", "shiny")
+    with pytest.raises(brdftab.Error, match=r"table `matte` in .*m\.btdb"):
+        db.rename("matte", "x")
+    with pytest.raises(ValueError, match="name"):
+        db.rename("chalk", "a/b")
+    with pytest.raises(brdftab.Error, match="none.btdb"):
+        brdftab.Database(tmp_path / "none.btdb").rename("a", "b")
+    assert db.names() == ["chalk", "shiny"]
+
+
 def test_a_database_has_a_length_and_iterates_over_its_names(tmp_path):
     """`len(db)` and `for name in db` are the tables, as `names()` lists them (a Database had
     `in` but neither); a database not created yet holds none, as `in` says."""

@@ -177,3 +177,12 @@ print(len(brdftab.Database({str(path)!r}).names()))
     except subprocess.TimeoutExpired:
         raise AssertionError("remove held the GIL while it waited for the lock") from None
     assert r.stdout.split() == ["19"], r.stdout + r.stderr
+    # `Database.rename` (session 41) waits for the lock as `remove` does.
+    code = code.replace('.remove("000" + "x" * 200_000)', '.rename("001" + "x" * 200_000, "one")')
+    code = code.replace("print(len(", "print(sorted(").replace(".names()))", ".names())[-1])")
+    try:
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                           timeout=60)
+    except subprocess.TimeoutExpired:
+        raise AssertionError("rename held the GIL while it waited for the lock") from None
+    assert r.stdout.split() == ["one"], r.stdout + r.stderr

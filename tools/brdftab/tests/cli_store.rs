@@ -273,6 +273,53 @@ fn db_rm_names_what_the_database_holds_and_leaves_nothing_behind() {
     assert!(left.is_empty(), "left behind: {left:?}");
 }
 
+/// `db rename DB OLD NEW` (session 41): the table is read under its new name with the same
+/// values; a taken NEW, a missing OLD and a missing DB are errors naming DB.
+#[test]
+fn db_rename_renames_and_refuses_taken_or_missing_names() {
+    let d = TempDir::new("cli-store-rename");
+    let db = d.file("lib.btdb");
+    for (spec, name) in [
+        (r#"{"model": "lambert", "kd": 0.5}"#, "white"),
+        (r#"{"model": "lambert", "kd": 0.1}"#, "grey"),
+    ] {
+        let r = brdftab(&["db", "add", &db, spec, "--name", name, "--preset", "small"]);
+        assert!(r.ok, "{}", r.stderr);
+    }
+    let eval = |name: &str| brdftab_with_stdin(&["eval", &format!("{db}#{name}")], "0 0 1 0 0 1\n");
+    let white = eval("white").stdout;
+    let r = brdftab(&["db", "rename", &db, "white", "snow"]);
+    assert!(r.ok, "{}", r.stderr);
+    assert_eq!(r.stderr, format!("renamed `white` to `snow` in {db}\n"));
+    assert_eq!(eval("snow").stdout, white);
+    let r = brdftab(&["db", "list", &db]);
+    assert!(
+        r.stdout.find("snow") < r.stdout.find("grey") && !r.stdout.contains("white"),
+        "{}",
+        r.stdout
+    );
+
+    let r = brdftab(&["db", "rename", &db, "snow", "grey"]);
+    let taken = format!("error: {db} already holds a table `grey`\n");
+    assert_eq!((r.code, r.stderr.as_str()), (1, taken.as_str()));
+    let r = brdftab(&["db", "rename", &db, "white", "x"]);
+    let missing = format!("error: not found: table `white` in {db} (has: snow, grey)\n");
+    assert_eq!((r.code, r.stderr.as_str()), (1, missing.as_str()));
+    let r = brdftab(&["db", "rename", &db, "snow", "a#b"]);
+    assert!(
+        r.code == 1 && r.stderr.contains("contains `#`"),
+        "{}",
+        r.stderr
+    );
+    let gone = d.file("gone.btdb");
+    let r = brdftab(&["db", "rename", &gone, "a", "b"]);
+    assert!(
+        r.code == 1 && r.stderr.contains("gone.btdb: no such file"),
+        "{}",
+        r.stderr
+    );
+}
+
 /// `bake SOURCE -o lib.btdb` over a database of several tables replaced the whole library with
 /// one table, silently (`convert SOURCE lib.btdb` adds a table instead); `import -o lib.btdb`
 /// too. A database of several tables is now refused as such an output, before the work; a

@@ -130,6 +130,15 @@ class Database:
         _check_name(name)
         _native.db_remove(self.path, name)
 
+    def rename(self, old, new):
+        """Renames table OLD to NEW; the table keeps its place and its stored bytes. The
+        database is rewritten atomically, after waiting for its lock with the GIL released.
+        :class:`Error` (not found) when the database or OLD is absent; :class:`Error` when the
+        database holds a table NEW already; ``ValueError`` for a name the rule refuses."""
+        _check_name(old)
+        _check_name(new)
+        _native.db_rename(self.path, old, new)
+
     def open(self, name, **options):
         """Opens table NAME as a :class:`Brdf` (keywords of :func:`open`)."""
         _check_name(name)

@@ -345,6 +345,10 @@ class Database:
         buffer is copied into bytes first (MemoryError if that does not fit)."""
     def remove(self, name: str) -> None:
         """Removes table NAME."""
+    def rename(self, old: str, new: str) -> None:
+        """Renames table OLD to NEW (its place and stored bytes kept; atomic, GIL released
+        while waiting for the lock). Error when OLD or the database is absent or NEW is
+        taken; ValueError for a name the rule refuses."""
     def open(self, name: str, **options: Any) -> Brdf:
         """Opens table NAME as a Brdf (the keywords of `open`)."""
     def source(self, name: str) -> str:
