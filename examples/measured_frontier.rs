@@ -39,7 +39,7 @@ fn main() -> brdftab::Result<()> {
     };
     let cap = 80f64.to_radians();
     for f in files.iter().filter(|f| f.to_string_lossy().contains(&only)) {
-        let src = brdftab::open(&f.to_string_lossy())?;
+        let src = brdftab::open(f)?;
         for s in &sizes {
             let opts = AdaptiveOptions {
                 nodes: *s,

@@ -258,7 +258,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 req = req.quantity(q);
             }
             req.run(&BakeTarget::file(out.to_string_lossy()))?;
-            let mut b = source::open_table(&out.to_string_lossy(), &Default::default())?;
+            let mut b = source::open_table(&out, &Default::default())?;
             if mid {
                 midway(&format!("{name} table"), &b, fixed);
                 continue;

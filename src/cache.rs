@@ -23,7 +23,7 @@
 //! use brdftab::cache;
 //! use brdftab::request::BakeSettings;
 //! let hit = cache::bake_cached("paper_white_rgb.bsdf", &BakeSettings::default(), None, false)?;
-//! let table = brdftab::open(&hit.path.to_string_lossy())?;
+//! let table = brdftab::open(&hit.path)?;
 //! # Ok::<(), brdftab::Error>(())
 //! ```
 
@@ -230,14 +230,14 @@ mod tests {
                 hit: true
             }
         );
-        let t = crate::open(&b.path.to_string_lossy()).unwrap();
+        let t = crate::open(&b.path).unwrap();
         let mut f = [0.0f32; 3];
         t.eval(glam::DVec3::Z, glam::DVec3::Z, &mut f);
         assert!((f[0] - 0.5).abs() < 1e-3, "Lambert: f_r = kd, {f:?}");
         std::fs::write(&a.path, b"not a table").unwrap();
         let c = bake_cached(SPEC, &small(), Some(d.path()), true).unwrap();
         assert!(!c.hit);
-        assert!(crate::open(&c.path.to_string_lossy()).is_ok());
+        assert!(crate::open(&c.path).is_ok());
         // One table; beside it only the writer's lock file, no temporary file.
         let mut names: Vec<String> = std::fs::read_dir(d.path())
             .unwrap()
@@ -267,7 +267,7 @@ mod tests {
         assert!(hits.iter().all(|c| c.path == hits[0].path));
         let baked = hits.iter().filter(|c| !c.hit).count();
         assert_eq!(baked, 1, "one bake, the others wait for it: {hits:?}");
-        assert!(crate::open(&hits[0].path.to_string_lossy()).is_ok());
+        assert!(crate::open(&hits[0].path).is_ok());
     }
 
     #[test]

@@ -101,21 +101,23 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
-/// The file a SOURCE string reads, if it names one: the path of `FILE`, `DB#NAME`, a `.json`
-/// spec file, a MERL or RGL file; `None` for inline JSON.
-pub fn source_file(source: &str) -> Option<&str> {
-    if source.trim_start().starts_with('{') {
+/// The file a SOURCE reads, if it names one: the path of `FILE`, `DB#NAME`, a `.json`
+/// spec file, a MERL or RGL file; `None` for inline JSON. A string the `DB#NAME` rule refuses
+/// is taken as a plain path (the open reports the error).
+pub fn source_file(source: &std::ffi::OsStr) -> Option<&Path> {
+    if crate::source::is_inline(source) {
         return None;
     }
-    Some(crate::store::name::path_of(source))
+    Some(crate::store::name::parse_input_os("source", source).map_or(Path::new(source), |(p, _)| p))
 }
 
-/// Refuses to write `output` when it is the file one of `inputs` (SOURCE strings or paths)
-/// reads: the write would replace the input with a resample of itself.
-pub fn refuse_input(output: &Path, inputs: &[&str]) -> Result<()> {
+/// Refuses to write `output` when it is the file one of `inputs` (SOURCEs or paths) reads:
+/// the write would replace the input with a resample of itself.
+pub fn refuse_input<S: AsRef<std::ffi::OsStr>>(output: &Path, inputs: &[S]) -> Result<()> {
     for input in inputs {
+        let input = input.as_ref();
         if let Some(f) = source_file(input)
-            && same_file(output, Path::new(f))
+            && same_file(output, f)
         {
             return Err(Error::arg(
                 "output",
@@ -123,7 +125,7 @@ pub fn refuse_input(output: &Path, inputs: &[&str]) -> Result<()> {
                     "{} is the input {}: writing it would replace the input while it is read \
                      (write to another file)",
                     output.display(),
-                    excerpt(input)
+                    excerpt(&input.to_string_lossy())
                 ),
             ));
         }

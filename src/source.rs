@@ -15,7 +15,13 @@
 //! Classification looks at the string ([`classify`]; for a string with a `#`, also whether a
 //! file of that whole name exists, as opening does); opening reads the file and reports a typed
 //! [`Error`] (missing file, bad magic, unknown model, ...) with the path in it.
+//!
+//! A SOURCE is an [`OsStr`] (`impl AsRef<OsStr>`: a `&str`, a `String`, a `Path`, an
+//! `OsString`): on Linux a file name is bytes, and a file whose name is not UTF-8 opens as any
+//! other (its `DB#NAME` too: the name after `#` is UTF-8, as every table name). Inline JSON is
+//! text. Errors show such a name lossily (U+FFFD for the bytes that are not UTF-8).
 
+use std::ffi::OsStr;
 use std::path::Path;
 
 use crate::brdf::Brdf;
@@ -68,13 +74,25 @@ impl SourceKind {
 /// assert_eq!(classify("paper_white_rgb.bsdf"), SourceKind::Rgl);
 /// assert_eq!(classify("materials.btdb#gold"), SourceKind::Table);
 /// ```
-pub fn classify(source: &str) -> SourceKind {
-    if source.trim_start().starts_with('{') {
+pub fn classify(source: impl AsRef<OsStr>) -> SourceKind {
+    let source = source.as_ref();
+    if is_inline(source) {
         return SourceKind::Spec;
     }
-    match crate::store::name::parse_input("source", source) {
+    match crate::store::name::parse_input_os("source", source) {
         Ok((_, Some(_))) => SourceKind::Table,
-        _ => classify_name(source),
+        _ => classify_name(source.as_encoded_bytes()),
+    }
+}
+
+/// Whether SOURCE is inline JSON: its first character after white space is `{`.
+pub(crate) fn is_inline(source: &OsStr) -> bool {
+    match source.to_str() {
+        Some(s) => s.trim_start().starts_with('{'),
+        None => source
+            .as_encoded_bytes()
+            .trim_ascii_start()
+            .starts_with(b"{"),
     }
 }
 
@@ -84,19 +102,20 @@ pub fn classify(source: &str) -> SourceKind {
 pub fn classify_output(output: &str) -> SourceKind {
     match crate::store::name::parse_source("output", output) {
         Ok((_, Some(_))) => SourceKind::Table,
-        _ => classify_name(output),
+        _ => classify_name(output.as_bytes()),
     }
 }
 
-/// By the string's form and extension only.
-fn classify_name(source: &str) -> SourceKind {
-    let s = source.trim_start();
-    let lower = s.to_ascii_lowercase();
-    if s.starts_with('{') || lower.ends_with(".json") {
+/// By the name's form and extension only (its bytes: the extensions are ASCII).
+fn classify_name(source: &[u8]) -> SourceKind {
+    let s = source.trim_ascii_start();
+    let ends =
+        |ext: &[u8]| s.len() >= ext.len() && s[s.len() - ext.len()..].eq_ignore_ascii_case(ext);
+    if s.starts_with(b"{") || ends(b".json") {
         SourceKind::Spec
-    } else if lower.ends_with(".binary") {
+    } else if ends(b".binary") {
         SourceKind::Merl
-    } else if lower.ends_with(".bsdf") {
+    } else if ends(b".bsdf") {
         SourceKind::Rgl
     } else {
         SourceKind::Table
@@ -226,18 +245,23 @@ impl OpenOptions {
 /// let material: Arc<dyn brdftab::Brdf> = shared.clone();
 /// # Ok::<(), brdftab::Error>(())
 /// ```
-pub fn open(source: &str) -> Result<Box<dyn Brdf + Send + Sync>> {
+pub fn open(source: impl AsRef<OsStr>) -> Result<Box<dyn Brdf + Send + Sync>> {
     open_with(source, &OpenOptions::default())
 }
 
 /// Opens SOURCE as `opts` say (see [`open`] for the kinds).
-pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send + Sync>> {
+pub fn open_with(
+    source: impl AsRef<OsStr>,
+    opts: &OpenOptions,
+) -> Result<Box<dyn Brdf + Send + Sync>> {
+    let source = source.as_ref();
+    let shown = source.to_string_lossy();
     // An empty SOURCE (or an empty path before `#NAME`) names nothing: it was "not found: : no
     // such file".
-    if source.trim().is_empty() || (source.starts_with('#') && !Path::new(source).exists()) {
+    if shown.trim().is_empty() || (shown.starts_with('#') && !Path::new(source).exists()) {
         return Err(Error::arg(
             "source",
-            format!("{source:?}: an empty SOURCE or path (expected a spec, a file or DB#NAME)"),
+            format!("{shown:?}: an empty SOURCE or path (expected a spec, a file or DB#NAME)"),
         ));
     }
     if let Some(c) = &opts.channels {
@@ -245,14 +269,14 @@ pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send
     }
     // Stat before any open: a FIFO, socket, device or directory is refused at once.
     // `x.btdb#` or a control character in NAME is an argument error, not a path to stat.
-    if crate::files::source_file(source).is_some() {
-        let (f, _) = crate::store::name::parse_input("source", source)?;
+    if !is_inline(source) {
+        let (f, _) = crate::store::name::parse_input_os("source", source)?;
         crate::files::require_regular(f)?;
     }
     let fixed_channels = |brdf: Box<dyn Brdf + Send + Sync>| match &opts.channels {
         Some(c) if c != brdf.channels() => Err(Error::Unsupported(format!(
             "{}: stored with channels {}; it cannot be evaluated at {}",
-            excerpt(source),
+            excerpt(&shown),
             brdf.channels().names().join(" "),
             c.names().join(" ")
         ))),
@@ -284,28 +308,33 @@ pub fn open_with(source: &str, opts: &OpenOptions) -> Result<Box<dyn Brdf + Send
 }
 
 /// Opens a table SOURCE (`FILE`, `DB#NAME` or a raw table) as a [`TabulatedBrdf`].
-pub fn open_table(source: &str, opts: &OpenOptions) -> Result<TabulatedBrdf> {
-    let path = crate::store::db::split_source(source)?.0;
+pub fn open_table(source: impl AsRef<OsStr>, opts: &OpenOptions) -> Result<TabulatedBrdf> {
+    let source = source.as_ref();
+    let (path, name) = crate::store::name::parse_input_os("source", source)?;
     crate::files::require_regular(path)?;
+    let shown = path.to_string_lossy();
     let brdf = if crate::store::tables::is_store_file(path) {
-        crate::store::tables::open_brdf(source, opts.eager)?
+        crate::store::tables::open_brdf_at(path, name, opts.eager)?
     } else if Table::is_raw(source) {
         TabulatedBrdf::from_table(Table::open_raw(source)?)
-    } else if !Path::new(path).exists() {
-        return Err(Error::NotFound(format!("{}: no such file", excerpt(path))));
+    } else if !path.exists() {
+        return Err(Error::NotFound(format!(
+            "{}: no such file",
+            excerpt(&shown)
+        )));
     } else if crate::measured::tensor::has_magic(path) {
         // Sources are told apart by name (`classify`); an RGL file under another name would
         // otherwise be "no RGL signature", which it has.
         return Err(Error::Unsupported(format!(
             "{}: an RGL tensor file (its signature) without the .bsdf name that RGL files are \
              opened by: give it a .bsdf name",
-            excerpt(path)
+            excerpt(&shown)
         )));
     } else {
         return Err(Error::Unsupported(format!(
             "{}: not a file brdftab can read (no brdftab, MERL or RGL signature, and not a \
              .json spec)",
-            excerpt(path)
+            excerpt(&shown)
         )));
     };
     let interp = opts.interp.unwrap_or_else(|| brdf.default_interp());
@@ -313,11 +342,18 @@ pub fn open_table(source: &str, opts: &OpenOptions) -> Result<TabulatedBrdf> {
 }
 
 /// Parses a spec SOURCE: inline JSON (starting with `{`) or a `.json` file.
-pub fn spec(source: &str) -> Result<ModelSpec> {
-    if source.trim_start().starts_with('{') {
-        ModelSpec::parse(source)
-    } else {
-        ModelSpec::from_file(source)
+pub fn spec(source: impl AsRef<OsStr>) -> Result<ModelSpec> {
+    let source = source.as_ref();
+    match source.to_str() {
+        Some(s) if is_inline(source) => ModelSpec::parse(s),
+        None if is_inline(source) => Err(Error::arg(
+            "source",
+            format!(
+                "{}: inline JSON that is not UTF-8",
+                excerpt(&source.to_string_lossy())
+            ),
+        )),
+        _ => ModelSpec::from_file(source),
     }
 }
 
@@ -335,12 +371,13 @@ pub fn parse_wavelengths(list: &str) -> Result<Channels> {
 
 /// The provenance a table baked from SOURCE records: the spec for models, the file's name and
 /// sha256 for measurements, the source's own description otherwise.
-pub fn provenance(source: &str, brdf: &dyn Brdf) -> Result<crate::store::Source> {
+pub fn provenance(source: impl AsRef<OsStr>, brdf: &dyn Brdf) -> Result<crate::store::Source> {
+    let source = source.as_ref();
     Ok(match classify(source) {
         SourceKind::Spec => crate::store::Source::model(&spec(source)?),
         SourceKind::Merl | SourceKind::Rgl => crate::store::Source::measured(source)?,
         SourceKind::Table => crate::store::Source::Other {
-            description: format!("{source}: {}", brdf.describe()),
+            description: format!("{}: {}", source.to_string_lossy(), brdf.describe()),
         },
     })
 }
@@ -425,7 +462,7 @@ mod tests {
         assert_eq!(classify("x.tbl"), SourceKind::Table);
         // A table of a database is a table whatever its name ends in.
         for kind in ["json", "binary", "bsdf"] {
-            assert_eq!(classify(&format!("db.btdb#t.{kind}")), SourceKind::Table);
+            assert_eq!(classify(format!("db.btdb#t.{kind}")), SourceKind::Table);
             assert_eq!(
                 classify_output(&format!("db.btdb#t.{kind}")),
                 SourceKind::Table

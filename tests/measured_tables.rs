@@ -23,7 +23,7 @@ fn bake_default(dir: &Path, file: &str) -> (String, brdftab::bake::BakeReport) {
         .join(format!("{file}.btdb"))
         .to_string_lossy()
         .into_owned();
-    let r = BakeRequest::new(rgl.to_string_lossy())
+    let r = BakeRequest::new(&rgl)
         .run(&BakeTarget::File(out.clone()))
         .unwrap();
     (out, r)
@@ -75,7 +75,7 @@ fn baked() -> &'static [Baked] {
 
 impl Baked {
     fn native(&self) -> Box<dyn Brdf + Send + Sync> {
-        source::open(&self.rgl.to_string_lossy()).unwrap()
+        source::open(&self.rgl).unwrap()
     }
     fn table(&self) -> brdftab::table::TabulatedBrdf {
         source::open_table(&self.table, &OpenOptions::default()).unwrap()

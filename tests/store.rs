@@ -578,7 +578,7 @@ fn a_table_claiming_more_values_than_memory_is_an_error_when_read_whole() {
     let s = Store::open(&p).unwrap();
     let t = s.table("claim").unwrap();
     t.grid().unwrap(); // header, index and grid agree: only the chunks tell
-    let eager = tables::open_brdf(&format!("{}#claim", p.display()), true);
+    let eager = tables::open_brdf(format!("{}#claim", p.display()), true);
     for e in [
         t.read_all().map(drop).unwrap_err(),
         t.to_table().map(drop).unwrap_err(),
@@ -645,7 +645,7 @@ fn a_one_array_table_claiming_more_values_than_memory_fails_its_first_lookup() {
     }
     w.end_table().unwrap();
     w.finish().unwrap();
-    let b = brdftab::store::tables::open_brdf(&format!("{}#claim", p.display()), false).unwrap();
+    let b = brdftab::store::tables::open_brdf(format!("{}#claim", p.display()), false).unwrap();
     let mut out = [1f32; 3];
     b.eval(
         DVec3::new(0.3, 0.1, 0.9),
@@ -850,8 +850,8 @@ fn stored_tables_evaluate_like_the_table_they_came_from() {
     )
     .unwrap();
     let reference = TabulatedBrdf::from_table(t);
-    let lazy = tables::open_brdf(&format!("{}#x", p.display()), false).unwrap();
-    let eager = tables::open_brdf(&format!("{}#x", p.display()), true).unwrap();
+    let lazy = tables::open_brdf(format!("{}#x", p.display()), false).unwrap();
+    let eager = tables::open_brdf(format!("{}#x", p.display()), true).unwrap();
     assert_eq!(lazy.loaded_chunks(), 0);
     let (wi, wo) = (DVec3::new(0.3, 0.1, 0.9), DVec3::new(-0.2, 0.4, 0.8));
     let (mut a, mut b, mut c) = ([0f32; 3], [0f32; 3], [0f32; 3]);
@@ -868,7 +868,7 @@ fn stored_tables_evaluate_like_the_table_they_came_from() {
         assert!(lazy.loaded_chunks() >= 1 && lazy.loaded_chunks() <= 2);
     }
     // A database with several tables needs a name.
-    let e = tables::open_brdf(&p.display().to_string(), false)
+    let e = tables::open_brdf(p.display().to_string(), false)
         .unwrap_err()
         .to_string();
     assert!(e.contains("#NAME"), "{e}");

@@ -137,7 +137,7 @@ fn info_of_a_whole_database_decodes_no_chunk() {
     let _turn = TURN.lock().unwrap_or_else(|p| p.into_inner());
     let d = TempDir::new("mem-info");
     let (p, n) = database(&d);
-    let t = tables::open_brdf(&format!("{p}#t"), true)
+    let t = tables::open_brdf(format!("{p}#t"), true)
         .unwrap()
         .to_table()
         .unwrap();

@@ -621,7 +621,7 @@ mod tests {
     #[test]
     fn the_albedo_curve_takes_the_lights_azimuth() {
         let spec = |ax: f64, ay: f64| {
-            crate::open(&format!(
+            crate::open(format!(
                 r#"{{"model":"ggx","alpha_x":{ax},"alpha_y":{ay}}}"#
             ))
             .unwrap()

@@ -62,8 +62,8 @@ use crate::table::{Interp, Param, Quantity, symmetry};
 /// log16 ≤ 1e-3 at zstd level 6).
 #[derive(Debug, Clone)]
 pub struct BakeRequest {
-    /// The SOURCE (see [`crate::source`]).
-    pub source: String,
+    /// The SOURCE (see [`crate::source`]: a file name need not be UTF-8).
+    pub source: std::ffi::OsString,
     /// The grid.
     pub grid: GridChoice,
     /// The parameterization (`None`: halfdiff).
@@ -132,9 +132,9 @@ impl BakeRequest {
     }
 
     /// A request with the defaults for `source`.
-    pub fn new(source: impl Into<String>) -> BakeRequest {
+    pub fn new(source: impl AsRef<std::ffi::OsStr>) -> BakeRequest {
         BakeRequest {
-            source: source.into(),
+            source: source.as_ref().to_owned(),
             grid: GridChoice::Default,
             param: None,
             symmetry: SymmetryChoice::Auto,

@@ -25,13 +25,14 @@ pub struct Converted {
 /// `.bsdf` source keeps its own layout unless `opts` change it, see
 /// [`rgl_write::Options::reuse_source_file`]) and, with `pairs > 0`, reports the written file's error.
 pub fn to_rgl(
-    source: &str,
+    source: impl AsRef<std::ffi::OsStr>,
     channels: Option<Channels>,
     output: &str,
     opts: &rgl_write::Options,
     pairs: usize,
     progress: &dyn Progress,
 ) -> Result<Converted> {
+    let source = source.as_ref();
     let open = OpenOptions {
         channels,
         ..Default::default()

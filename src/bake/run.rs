@@ -180,7 +180,7 @@ impl BakeRequest {
     /// database a `DB#NAME` source reads is fine (the source entry is kept as it is).
     fn refuse_overwrite(&self, target: &BakeTarget) -> Result<()> {
         if let BakeTarget::Db { name, .. } = target
-            && let Ok((_, Some(entry))) = db::split_source(&self.source)
+            && let Ok((_, Some(entry))) = crate::store::name::parse_input_os("source", &self.source)
             && entry != name
         {
             return Ok(());
@@ -245,8 +245,8 @@ impl BakeRequest {
 /// A file name's stem, the default name of a table (`table` when it has none). `path` is a
 /// path, not a `DB#NAME` (a SOURCE's file is [`crate::store::name::path_of`]); a `#` in the stem
 /// (a file named `scan#2.bsdf`), which a table name cannot hold, becomes `_`.
-pub fn stem(path: &str) -> String {
-    Path::new(path)
+pub fn stem(path: impl AsRef<Path>) -> String {
+    path.as_ref()
         .file_stem()
         .map(|s| s.to_string_lossy().replace('#', "_"))
         .unwrap_or_else(|| "table".into())
@@ -255,14 +255,18 @@ pub fn stem(path: &str) -> String {
 /// The default name of a table converted from SOURCE: the table's own name for `DB#NAME`, the
 /// model's name for an inline spec (`lambert`; not a stem of the JSON text, cut at its last
 /// `.`), else its file's [`stem`].
-pub fn source_stem(source: &str) -> String {
-    if source.trim_start().starts_with('{') {
-        return crate::spec::ModelSpec::parse(source)
+pub fn source_stem(source: impl AsRef<std::ffi::OsStr>) -> String {
+    let source = source.as_ref();
+    if let Some(s) = source.to_str()
+        && s.trim_start().starts_with('{')
+    {
+        return crate::spec::ModelSpec::parse(s)
             .map_or_else(|_| "table".into(), |s| s.name().to_owned());
     }
-    match crate::store::name::parse_input("source", source) {
+    match crate::store::name::parse_input_os("source", source) {
         Ok((_, Some(name))) => name.to_owned(),
-        _ => stem(crate::store::name::path_of(source)),
+        Ok((path, None)) => stem(path),
+        Err(_) => stem(Path::new(source)),
     }
 }
 
@@ -298,7 +302,7 @@ mod tests {
             .unwrap()
             .to_table()
             .unwrap();
-        let b = crate::source::open_table(&format!("{dbp}#ct"), &OpenOptions::default())
+        let b = crate::source::open_table(format!("{dbp}#ct"), &OpenOptions::default())
             .unwrap()
             .to_table()
             .unwrap();

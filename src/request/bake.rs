@@ -105,7 +105,7 @@ impl BakeSettings {
     ///
     /// # Errors
     /// [`Error::InvalidArgument`] naming the field.
-    pub fn request(&self, source: &str) -> Result<BakeRequest> {
+    pub fn request(&self, source: impl AsRef<std::ffi::OsStr>) -> Result<BakeRequest> {
         let grid = match (&self.grid, &self.preset) {
             (Some(g), _) => g.parse::<GridChoice>().map_err(|e| rename(e, "grid")),
             (None, Some(p)) => p.parse::<GridChoice>().map_err(|e| rename(e, "preset")),
@@ -161,7 +161,7 @@ impl BakeSettings {
 /// Invalid settings ([`Error::InvalidArgument`] naming the field), and whatever opening the
 /// source, baking and writing fail with.
 pub fn bake(
-    source: &str,
+    source: impl AsRef<std::ffi::OsStr>,
     output: &str,
     settings: &BakeSettings,
     progress: &dyn Progress,

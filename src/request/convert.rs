@@ -76,11 +76,12 @@ pub enum ConvertOutput {
 /// Invalid settings ([`crate::Error::InvalidArgument`] naming the field), and whatever opening
 /// the source and writing the output fail with.
 pub fn convert(
-    source: &str,
+    source: impl AsRef<std::ffi::OsStr>,
     output: &str,
     settings: &ConvertSettings,
     progress: &dyn Progress,
 ) -> Result<ConvertOutput> {
+    let source = source.as_ref();
     let mut req = settings.bake.request(source)?;
     let pairs = settings.pairs.unwrap_or(DEFAULT_PAIRS);
     // Checked before the bake, not after it: the comparison's own check (per channel count)

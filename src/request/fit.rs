@@ -136,7 +136,7 @@ impl FitSettings {
 /// # Errors
 /// Invalid settings or model, and whatever opening the source fails with.
 pub fn fit(
-    source: &str,
+    source: impl AsRef<std::ffi::OsStr>,
     model: &str,
     settings: &FitSettings,
     progress: &dyn Progress,

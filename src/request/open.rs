@@ -57,6 +57,9 @@ impl OpenSettings {
 }
 
 /// Opens SOURCE as `settings` say ([`crate::open_with`]).
-pub fn open(source: &str, settings: &OpenSettings) -> Result<Box<dyn Brdf + Send + Sync>> {
+pub fn open(
+    source: impl AsRef<std::ffi::OsStr>,
+    settings: &OpenSettings,
+) -> Result<Box<dyn Brdf + Send + Sync>> {
     crate::source::open_with(source, &settings.options()?)
 }

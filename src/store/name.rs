@@ -24,6 +24,7 @@
 //! `b.btdb` into the database `a`, the documented `DB#NAME` output, whatever exists — where a
 //! bake writes must not depend on which files happen to be there.
 
+use std::ffi::OsStr;
 use std::path::Path;
 
 use crate::error::{Error, Result};
@@ -65,17 +66,53 @@ pub fn parse_source<'a>(field: &str, source: &'a str) -> Result<(&'a str, Option
     match source.rsplit_once('#') {
         Some((_, n)) if n.contains('/') => Ok((source, None)),
         Some((p, n)) => {
-            if n.is_empty() {
-                return Err(Error::arg(
-                    field,
-                    format!("{source:?}: no table name after `#` (DB#NAME)"),
-                ));
-            }
-            check(field, n)?;
+            check_split(field, &format!("{source:?}"), n)?;
             Ok((p, Some(n)))
         }
         None => Ok((source, None)),
     }
+}
+
+/// The name of a `DB#NAME` split, `shown` being the whole string as errors quote it.
+fn check_split(field: &str, shown: &str, name: &str) -> Result<()> {
+    if name.is_empty() {
+        return Err(Error::arg(
+            field,
+            format!("{shown}: no table name after `#` (DB#NAME)"),
+        ));
+    }
+    check(field, name)
+}
+
+/// [`parse_input`] of a SOURCE that need not be UTF-8 (a file name on Linux is bytes): a UTF-8
+/// string goes through [`parse_input`] itself; another is split by the same rule on its bytes
+/// (the last `#`, unless what follows holds a `/`), the path part kept as the bytes it is and
+/// the name part required to be UTF-8, as every table name is. Errors show the string lossily.
+pub fn parse_input_os<'a>(field: &str, source: &'a OsStr) -> Result<(&'a Path, Option<&'a str>)> {
+    if let Some(s) = source.to_str() {
+        return parse_input(field, s).map(|(p, n)| (Path::new(p), n));
+    }
+    let whole = Ok((Path::new(source), None));
+    let bytes = source.as_encoded_bytes();
+    let Some(i) = bytes.iter().rposition(|&b| b == b'#') else {
+        return whole;
+    };
+    let name = &bytes[i + 1..];
+    if name.contains(&b'/') || std::fs::metadata(source).is_ok() {
+        return whole;
+    }
+    let shown = format!("{:?}", source.to_string_lossy());
+    let name = std::str::from_utf8(name).map_err(|_| {
+        Error::arg(
+            field,
+            format!("{shown}: the table name after `#` is not UTF-8 (DB#NAME)"),
+        )
+    })?;
+    check_split(field, &shown, name)?;
+    // SAFETY: `bytes` came from `as_encoded_bytes` and is cut immediately before an ASCII `#`,
+    // a valid UTF-8 substring, as `from_encoded_bytes_unchecked` requires.
+    let path = unsafe { OsStr::from_encoded_bytes_unchecked(&bytes[..i]) };
+    Ok((Path::new(path), Some(name)))
 }
 
 /// Splits a SOURCE that is read: the whole string when something exists on disk under it (a

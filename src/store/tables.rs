@@ -223,8 +223,11 @@ pub fn is_store_file(path: impl AsRef<Path>) -> bool {
 /// Opens `FILE` (a single-table file) or `DB#NAME` (a table of a database) as a lazily decoded
 /// [`TabulatedBrdf`](crate::table::TabulatedBrdf). With `eager`, every chunk is decoded now (in
 /// parallel) and checked.
-pub fn open_brdf(source: &str, eager: bool) -> Result<crate::table::TabulatedBrdf> {
-    let (path, name) = db::split_source(source)?;
+pub fn open_brdf(
+    source: impl AsRef<std::ffi::OsStr>,
+    eager: bool,
+) -> Result<crate::table::TabulatedBrdf> {
+    let (path, name) = super::name::parse_input_os("source", source.as_ref())?;
     open_brdf_at(path, name, eager)
 }
 
@@ -233,10 +236,11 @@ pub fn open_brdf(source: &str, eager: bool) -> Result<crate::table::TabulatedBrd
 /// writer that knows both (a bake reading back its output) opens, whatever `#` the path holds
 /// and whatever files lie beside it.
 pub fn open_brdf_at(
-    path: &str,
+    path: impl AsRef<Path>,
     name: Option<&str>,
     eager: bool,
 ) -> Result<crate::table::TabulatedBrdf> {
+    let path = path.as_ref();
     let store = super::Store::open(path)?;
     let t = match name {
         Some(n) => store.table(n)?,
@@ -249,7 +253,7 @@ pub fn open_brdf_at(
         let table = Table::new(
             grid,
             t.read_all()?,
-            format!("table `{}` from {path}", t.header().name),
+            format!("table `{}` from {}", t.header().name, path.display()),
         )?;
         return Ok(crate::table::TabulatedBrdf::from_table(table));
     }

@@ -14,7 +14,7 @@ use brdftab_tools::progress::Bar;
 #[derive(Args)]
 pub struct BakeArgs {
     /// The source: a model spec (inline JSON or .json), a table, a MERL or RGL file.
-    pub source: String,
+    pub source: std::ffi::OsString,
     /// Output table file (`.btdb`), or `DB#NAME`.
     #[arg(short, long)]
     pub output: String,

@@ -12,7 +12,7 @@ use brdftab_tools::progress::Bar;
 #[derive(Args)]
 pub struct ConvertArgs {
     /// Any SOURCE: a MERL `.binary`, an RGL `.bsdf`, a spec, a table.
-    input: String,
+    input: std::ffi::OsString,
     /// The output: an RGL `.bsdf` (loads in Mitsuba 3 and pbrt-v4), a MERL `.binary` (the
     /// source's mean over each MERL cell), a table database entry `DB#NAME` (or a
     /// `.btdb` file, named after the input), or a raw table file.

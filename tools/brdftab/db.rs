@@ -44,7 +44,7 @@ struct AddArgs {
     /// The database file.
     db: String,
     /// The source: a model spec (inline JSON or .json), a table, a MERL or RGL file.
-    source: String,
+    source: std::ffi::OsString,
     #[command(flatten)]
     bake: Box<BakeSettings>,
 }

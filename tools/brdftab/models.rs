@@ -12,7 +12,7 @@ use clap::Args;
 pub struct EvalArgs {
     /// Any SOURCE: a model spec (inline JSON starting with `{`, or a .json file), a table
     /// (`FILE.btdb`, `DB#NAME`), a MERL `.binary` or an RGL `.bsdf`.
-    source: String,
+    source: std::ffi::OsString,
     #[command(flatten)]
     open: brdftab::request::OpenSettings,
 }

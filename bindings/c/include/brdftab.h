@@ -66,7 +66,9 @@ typedef struct brdftab_open_options {
 } brdftab_open_options;
 
 /* Opens any SOURCE the brdftab CLI takes: a model spec as JSON text or a .json file, a table
- * file, DB#NAME (a table of a database), a MERL .binary, an RGL .bsdf. NULL on failure. */
+ * file, DB#NAME (a table of a database), a MERL .binary, an RGL .bsdf. NULL on failure. A
+ * path's bytes are taken as they are (on Unix a file name need not be UTF-8; JSON text must
+ * be), here and in every SOURCE argument below. */
 brdftab_brdf *brdftab_open(const char *source);
 /* The same with options (opts NULL = defaults). */
 brdftab_brdf *brdftab_open_with(const char *source, const brdftab_open_options *opts);

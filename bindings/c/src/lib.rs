@@ -218,6 +218,26 @@ unsafe fn text<'a>(p: *const c_char, what: &str) -> Result<&'a str, String> {
         .map_err(|_| format!("`{what}` is not valid UTF-8"))
 }
 
+/// A caller's SOURCE argument with its bytes as they are (`what` names it in errors): on Unix
+/// a file name is bytes, and one that is not UTF-8 opens as any other (inline JSON must still
+/// be UTF-8, which the library checks). Elsewhere it must be UTF-8.
+///
+/// # Safety
+/// `p` is NULL or a NUL-terminated string.
+unsafe fn source_text<'a>(p: *const c_char, what: &str) -> Result<&'a std::ffi::OsStr, String> {
+    if p.is_null() {
+        return Err(format!("`{what}` is NULL"));
+    }
+    // SAFETY: a non-NULL pointer is a NUL-terminated string (the caller's contract).
+    let s = unsafe { CStr::from_ptr(p) };
+    #[cfg(unix)]
+    return Ok(std::os::unix::ffi::OsStrExt::from_bytes(s.to_bytes()));
+    #[cfg(not(unix))]
+    s.to_str()
+        .map(std::ffi::OsStr::new)
+        .map_err(|_| format!("`{what}` is not valid UTF-8"))
+}
+
 /// Checks the caller's `size` against this library's layout (see [`brdftab_open_options`]).
 ///
 /// # Safety
@@ -282,7 +302,7 @@ fn open_impl(
     let mut out = std::ptr::null_mut();
     guard(|| {
         // SAFETY: the header's contract: NULL or a NUL-terminated string.
-        let source = unsafe { text(source, "source") }?;
+        let source = unsafe { source_text(source, "source") }?;
         let brdf = brdftab::open_with(source, &opts()?).map_err(|e| e.to_string())?;
         let names = brdf
             .channels()

@@ -8,7 +8,7 @@ use std::ffi::{CString, c_char, c_int};
 use brdftab::progress::Silent;
 use brdftab::request::{self, BakeSettings, ConvertSettings, FitSettings, OpenSettings};
 
-use crate::{brdftab_brdf, guard, open_impl, text};
+use crate::{brdftab_brdf, guard, open_impl, source_text, text};
 
 /// Settings from a nullable JSON string.
 ///
@@ -57,7 +57,7 @@ pub unsafe extern "C" fn brdftab_bake(
 ) -> c_int {
     guard(|| {
         // SAFETY (all three): the caller's contract.
-        let (source, output) = unsafe { (text(source, "source")?, text(output, "output")?) };
+        let (source, output) = unsafe { (source_text(source, "source")?, text(output, "output")?) };
         let s: BakeSettings = unsafe { settings(settings_json) }?;
         request::bake(source, output, &s, &Silent)
             .map(drop)
@@ -78,7 +78,7 @@ pub unsafe extern "C" fn brdftab_convert(
 ) -> c_int {
     guard(|| {
         // SAFETY (all three): the caller's contract.
-        let (source, output) = unsafe { (text(source, "source")?, text(output, "output")?) };
+        let (source, output) = unsafe { (source_text(source, "source")?, text(output, "output")?) };
         let s: ConvertSettings = unsafe { settings(settings_json) }?;
         request::convert(source, output, &s, &Silent)
             .map(drop)
@@ -101,7 +101,7 @@ pub unsafe extern "C" fn brdftab_fit(
     let mut out = std::ptr::null_mut();
     guard(|| {
         // SAFETY (all three): the caller's contract.
-        let (source, model) = unsafe { (text(source, "source")?, text(model, "model")?) };
+        let (source, model) = unsafe { (source_text(source, "source")?, text(model, "model")?) };
         let s: FitSettings = unsafe { settings(settings_json) }?;
         let r = request::fit(source, model, &s, &Silent).map_err(|e| e.to_string())?;
         let json = serde_json::to_string(&r).map_err(|e| e.to_string())?;

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{guard, interruptible, lib_err};
-use crate::values::{ser, settings_of, text_arg, to_py};
+use crate::values::{ser, settings_of, source_arg, text_arg, to_py};
 
 fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyAny>> {
     let info = if r.info.is_null() {
@@ -47,8 +47,8 @@ pub(crate) fn bake(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let (source, output) = (text_arg(source, "source")?, text_arg(output, "output")?);
-        let (source, output) = (source.as_str(), output.as_str());
+        let (source, output) = (source_arg(source, "source")?, text_arg(output, "output")?);
+        let (source, output) = (source.as_os_str(), output.as_str());
         let settings: BakeSettings = settings_of(options)?;
         let r =
             interruptible(py, |p| request::bake(source, output, &settings, p))?.map_err(lib_err)?;
@@ -117,8 +117,8 @@ pub(crate) fn convert(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let (source, output) = (text_arg(source, "source")?, text_arg(output, "output")?);
-        let (source, output) = (source.as_str(), output.as_str());
+        let (source, output) = (source_arg(source, "source")?, text_arg(output, "output")?);
+        let (source, output) = (source.as_os_str(), output.as_str());
         let settings: ConvertSettings = settings_of(options)?;
         let out = interruptible(py, |p| request::convert(source, output, &settings, p))?
             .map_err(lib_err)?;
@@ -184,11 +184,10 @@ pub(crate) fn fit(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let source = text_arg(source, "source")?;
-        let source = source.as_str();
+        let source = source_arg(source, "source")?;
         let settings: FitSettings = settings_of(options)?;
         let result =
-            interruptible(py, |p| request::fit(source, model, &settings, p))?.map_err(lib_err)?;
+            interruptible(py, |p| request::fit(&source, model, &settings, p))?.map_err(lib_err)?;
         ser(py, &result)
     })
 }

@@ -11,9 +11,11 @@ use pyo3::prelude::*;
 
 use crate::brdf::PyBrdf;
 use crate::errors::{guard, lib_err, unlocked};
-use crate::values::{channels_of, ser, text_arg, to_py};
+use crate::values::{channels_of, ser, source_arg, text_arg, to_py};
 
-/// Opens SOURCE (a spec, table, `DB#NAME`, MERL `.binary` or RGL `.bsdf`) as a `Brdf`.
+/// Opens SOURCE (a spec, table, `DB#NAME`, MERL `.binary` or RGL `.bsdf`) as a `Brdf`. A path
+/// is a `str`, `bytes` or an `os.PathLike` (`bake`, `convert`, `check` and `fit` take the same):
+/// a file name that is not UTF-8 opens as `bytes` or as the `str` `os.fsdecode` gives.
 ///
 /// The GIL is released while the source is read (an eager table decodes every chunk: half a
 /// second for a large preset's table).
@@ -27,7 +29,7 @@ pub(crate) fn open(
     eager: bool,
 ) -> PyResult<PyBrdf> {
     guard(|| {
-        let source = text_arg(source, "source")?;
+        let source = source_arg(source, "source")?;
         let channels = channels_of(wavelengths)?;
         unlocked(py, || PyBrdf::open(&source, interp, channels, eager))?
     })
@@ -38,17 +40,18 @@ pub(crate) fn open(
 #[pyo3(signature = (source, interp, wavelengths, eager = true))]
 pub(crate) fn _reopen(
     py: Python<'_>,
-    source: &str,
+    source: &Bound<'_, PyAny>,
     interp: &str,
     wavelengths: Option<Vec<f64>>,
     eager: bool,
 ) -> PyResult<PyBrdf> {
     guard(|| {
+        let source = source_arg(source, "source")?;
         let ch = wavelengths
             .map(Channels::wavelengths)
             .transpose()
             .map_err(lib_err)?;
-        unlocked(py, || PyBrdf::open(source, interp, ch, eager))?
+        unlocked(py, || PyBrdf::open(&source, interp, ch, eager))?
     })
 }
 
@@ -61,14 +64,13 @@ pub(crate) fn check(
     wavelengths: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let source = text_arg(source, "source")?;
-        let source = source.as_str();
+        let source = source_arg(source, "source")?;
         let opts = OpenOptions {
             channels: channels_of(wavelengths)?,
             ..OpenOptions::default()
         };
         let report = unlocked(py, || {
-            let brdf = brdftab::open_with(source, &opts)?;
+            let brdf = brdftab::open_with(&source, &opts)?;
             brdftab::analysis::plausibility::check(
                 brdf.as_ref(),
                 &brdftab::analysis::plausibility::Options::default(),

@@ -43,6 +43,37 @@ pub(crate) fn text_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<String> {
     )))
 }
 
+/// A SOURCE argument as the library takes one (session 41: a file name need not be UTF-8): a
+/// `str` (a spec, a path, `DB#NAME`), `bytes`, or an `os.PathLike` of either, as `os.fspath`
+/// gives them. A `str` is encoded as `os.fsencode` does, so a file name of undecodable bytes
+/// (which Python holds with surrogate escapes) reaches the library as those bytes; anything
+/// else is a `TypeError`. (A SOURCE that was not UTF-8 was a `ValueError`, bytes a `TypeError`.)
+pub(crate) fn source_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<std::ffi::OsString> {
+    use pyo3::types::{PyBytes, PyString};
+    let os = obj.py().import("os")?;
+    let path = if obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyBytes>() {
+        obj.clone()
+    } else if obj.hasattr("__fspath__")? {
+        os.call_method1("fspath", (obj,))?
+    } else {
+        return Err(PyTypeError::new_err(format!(
+            "{what}: expected a str, bytes or an os.PathLike, got {}",
+            obj.get_type().name()?
+        )));
+    };
+    let bytes = match path.is_instance_of::<PyString>() {
+        true => os.call_method1("fsencode", (path,))?,
+        false => path,
+    };
+    let bytes = bytes.downcast::<PyBytes>()?.as_bytes();
+    #[cfg(unix)]
+    return Ok(<std::ffi::OsStr as std::os::unix::ffi::OsStrExt>::from_bytes(bytes).to_owned());
+    #[cfg(not(unix))]
+    String::from_utf8(bytes.to_vec())
+        .map(Into::into)
+        .map_err(|_| PyValueError::new_err(format!("{what}: a path that is not UTF-8")))
+}
+
 /// `wavelengths=`: None, a comma-separated string, or a sequence of numbers (nm).
 pub(crate) fn channels_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Channels>> {
     let Some(o) = obj else { return Ok(None) };

@@ -283,13 +283,37 @@ def test_paths_may_be_pathlike(tmp_path, paper):
     assert conv["format"] == "table" and (tmp_path / "p.btdb").exists()
     with pytest.raises(TypeError, match="source"):
         brdftab.open(42)
-    with pytest.raises(TypeError, match="bytes"):
-        brdftab.open(_BytesPath(paper))
-    # a file name that is not UTF-8 (a str of surrogate escapes): said so, not "bytes"
-    name = os.fsdecode(b"m\xff.btdb")
-    for p in [name, pathlib.Path(name)]:
-        with pytest.raises(ValueError, match="not valid UTF-8"):
-            brdftab.open(p)
+    # bytes, and an os.PathLike of bytes, are paths as os.fspath gives them (session 41: they
+    # were a TypeError)
+    for p in [paper.encode(), _BytesPath(paper)]:
+        assert np.array_equal(brdftab.open(p).eval(wi, wo), brdftab.open(paper).eval(wi, wo))
+
+
+def test_a_source_whose_name_is_not_utf8(tmp_path):
+    """A file name of bytes that are not UTF-8 — as bytes, as a str of surrogate escapes
+    (`os.fsdecode`), as a pathlib.Path — opens, bakes and converts, and pickles (session 41: a
+    ValueError "not valid UTF-8"). Its `Brdf.source` is the `os.fsdecode` str; a missing one is
+    an error naming it lossily."""
+    raw = os.fsencode(tmp_path) + b"/caf\xe9.btdb"
+    brdftab.bake(LAMBERT, tmp_path / "t.btdb", preset="small")
+    os.rename(tmp_path / "t.btdb", raw)
+    wi, wo = upper(20, 5), upper(20, 6)
+    want = brdftab.open(LAMBERT).eval(wi, wo)
+    for p in [raw, os.fsdecode(raw), pathlib.Path(os.fsdecode(raw))]:
+        b = brdftab.open(p)
+        assert b.source == os.fsdecode(raw)
+        # a constant stored by log16: within its 1e-3
+        np.testing.assert_allclose(b.eval(wi, wo), want, rtol=1e-3)
+        np.testing.assert_array_equal(pickle.loads(pickle.dumps(b)).eval(wi, wo), b.eval(wi, wo))
+    out = tmp_path / "again.btdb"
+    brdftab.bake(raw, out, preset="small")
+    np.testing.assert_allclose(brdftab.open(out).eval(wi, wo), want, rtol=2e-3)
+    conv = brdftab.convert(os.fsdecode(raw), f"{tmp_path}/lib.btdb#m", pairs=0)
+    assert conv["format"] == "table"
+    np.testing.assert_allclose(brdftab.open(f"{tmp_path}/lib.btdb#m").eval(wi, wo), want,
+                               rtol=2e-3)
+    with pytest.raises(brdftab.Error, match="caf\ufffd-missing.btdb"):
+        brdftab.open(os.fsencode(tmp_path) + b"/caf\xe9-missing.btdb")
 
 
 def test_info_describes_measured_files_as_the_cli_does(cli, paper):
@@ -300,7 +324,7 @@ def test_info_describes_measured_files_as_the_cli_does(cli, paper):
 
 
 class _BytesPath:
-    """An os.PathLike whose path is bytes (not supported: sources are text)."""
+    """An os.PathLike whose path is bytes (a SOURCE may be one; a Database path may not)."""
 
     def __init__(self, p):
         self.p = str(p).encode()

@@ -293,11 +293,15 @@ impl Options {
     /// When `source` names a `.bsdf` file and no incident-direction or NDF-grid option is set,
     /// resample into the file's own parameterization (re-encoding: values land where they were
     /// stored); otherwise the options as they are.
-    pub fn reuse_source_file(mut self, source: &str) -> Result<Self> {
+    pub fn reuse_source_file(mut self, source: impl AsRef<std::ffi::OsStr>) -> Result<Self> {
+        let source = source.as_ref();
         let fixed = self.theta_i.is_none() && self.phi_i.is_none() && self.ndf_resolution.is_none();
         if fixed
             && self.parameterization.is_none()
-            && source.to_ascii_lowercase().ends_with(".bsdf")
+            && source
+                .as_encoded_bytes()
+                .to_ascii_lowercase()
+                .ends_with(b".bsdf")
         {
             self.parameterization = Some(Parameterization::from_file(source)?);
         }

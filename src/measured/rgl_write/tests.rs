@@ -143,7 +143,7 @@ fn reencoded_rgl_files_are_their_originals_tables() {
     for p in rgl_files() {
         let src = RglBrdf::open(&p).unwrap();
         let o = Options::default()
-            .reuse_source_file(&p.display().to_string())
+            .reuse_source_file(p.display().to_string())
             .unwrap();
         let (f, back, r) = roundtrip(&src, &o, PAIRS);
         let original = TensorFile::open(&p).unwrap();
@@ -162,7 +162,7 @@ fn another_source_in_a_files_parameterization_is_evaluated() {
     // (same N and channels) gets its own values, not the file's.
     let p = rgl_dir().join("paper_white_rgb.bsdf");
     let o = Options::default()
-        .reuse_source_file(&p.display().to_string())
+        .reuse_source_file(p.display().to_string())
         .unwrap();
     let lambert = model(r#"{"model": "lambert", "kd": 0.1}"#, &Channels::Rgb);
     let (f, _, r) = roundtrip(lambert.as_ref(), &o, PAIRS);
@@ -183,7 +183,7 @@ fn rgl_source_without_its_parameterization_is_recovered_by_power_iteration() {
         theta_i: Some(16),
         ..Options::default()
     }
-    .reuse_source_file(&p.display().to_string())
+    .reuse_source_file(p.display().to_string())
     .unwrap();
     assert!(o.parameterization.is_none());
     let (_, _, r) = roundtrip(&src, &o, PAIRS);

@@ -26,6 +26,9 @@ __all__ = [
 # Aliases of the stubs only (private: not names of the package).
 _ArrayLike = npt.ArrayLike
 _Wavelengths = Union[None, str, Sequence[float]]
+# A SOURCE: a str (a spec, a path, DB#NAME) or a path as os.fspath gives one, bytes included (a
+# file name need not be UTF-8).
+_Source = Union[str, bytes, PathLike[str], PathLike[bytes]]
 
 class Error(Exception):
     """An error of the brdftab library; the message is the library's."""
@@ -60,7 +63,8 @@ class Brdf:
         "lobes": {"diffuse", "glossy", "delta": bool}}."""
     @property
     def source(self) -> str:
-        """The SOURCE string this BRDF was opened from."""
+        """The SOURCE string this BRDF was opened from (a file name that is not UTF-8 as
+        os.fsdecode gives it)."""
     @property
     def interp(self) -> str:
         """The interpolation of a table ("linear" or "nearest"; with interp="auto", the one the
@@ -214,22 +218,22 @@ class Table:
     def __deepcopy__(self, memo: Any, /) -> Table: ...
 
 def open(
-    source: str | PathLike[str],
+    source: _Source,
     *,
     interp: str = "auto",
     wavelengths: _Wavelengths = None,
     eager: bool = True,
 ) -> Brdf:
-    """Opens SOURCE. interp: "auto" (nearest on tables of MERL cells and MERL files, linear
-    otherwise), "nearest" or "linear" (a MERL file: its cells interpolated; an RGL file or a
-    model: no effect)."""
+    """Opens SOURCE (a str, bytes or os.PathLike: a file name need not be UTF-8). interp:
+    "auto" (nearest on tables of MERL cells and MERL files, linear otherwise), "nearest" or
+    "linear" (a MERL file: its cells interpolated; an RGL file or a model: no effect)."""
 def rgb_basis(nm: _ArrayLike) -> npt.NDArray[np.float64]:
     """The weights of R, G, B at wavelengths `nm` (nm; result shape: nm's + (3,)): RGB data
     (r, g, b) at a wavelength is r w[0] + g w[1] + b w[2], as `Brdf.eval_spectral` reads an RGB
     source. Weights >= 0 summing to 1; the spectrum they make projects (CIE 1931 2°, D65,
     linear sRGB) to the RGB it came from, so colour survives a spectral renderer. A value that
     is not a wavelength (a finite number > 0) is a ValueError."""
-def check(source: str | PathLike[str], *, wavelengths: _Wavelengths = None) -> dict[str, Any]:
+def check(source: _Source, *, wavelengths: _Wavelengths = None) -> dict[str, Any]:
     """The plausibility report of SOURCE as a dict with the keys of `brdftab check --json`."""
 def info(source: str | PathLike[str]) -> dict[str, Any]:
     """What `brdftab info --json` reports of a table file (or, for DB#NAME, of one table): "file", "format", "bytes", "ratio_to_f32",
@@ -242,7 +246,7 @@ def info(source: str | PathLike[str]) -> dict[str, Any]:
     "sha256", and MERL "material", "dims", "unmeasured", "cells" or RGL "description", "kind",
     "isotropic", "reduction", "phi_i", "theta_i", "resolution", "vndf_resolution", "fields"."""
 def bake(
-    source: str | PathLike[str],
+    source: _Source,
     output: str | PathLike[str],
     *,
     preset: str | None = ...,
@@ -278,7 +282,7 @@ def bake_cached(
     baked into it now. Returns {"path": str, "hit": bool}. Ctrl-C stops the bake
     (KeyboardInterrupt; nothing is cached)."""
 def convert(
-    source: str | PathLike[str],
+    source: _Source,
     output: str | PathLike[str],
     *,
     pairs: int | None = ...,
@@ -297,7 +301,7 @@ def convert(
     error: "worst", "theta_deg", "channel", ...), relative, or None with pairs=0. Ctrl-C stops
     it (KeyboardInterrupt; OUTPUT is left as it was)."""
 def fit(
-    source: str | PathLike[str],
+    source: _Source,
     model: str,
     *,
     params: str | Sequence[str] | None = ...,

@@ -35,7 +35,7 @@ use crate::values::{ser, wavelengths_of};
 pub(crate) struct PyBrdf {
     inner: Arc<dyn Brdf + Send + Sync>,
     table: Option<Arc<TabulatedBrdf>>,
-    source: String,
+    source: std::ffi::OsString,
     /// The interpolation asked for: auto, nearest or linear.
     interp: String,
     wavelengths: Option<Vec<f64>>,
@@ -47,7 +47,7 @@ pub(crate) struct PyBrdf {
 
 impl PyBrdf {
     pub(crate) fn open(
-        source: &str,
+        source: &std::ffi::OsStr,
         interp: &str,
         channels: Option<Channels>,
         eager: bool,
@@ -89,7 +89,7 @@ impl PyBrdf {
             ..OpenSettings::default()
         };
         let opts = settings.options().map_err(lib_err)?;
-        let source = format!("<in-memory table: {}>", table.description());
+        let source = format!("<in-memory table: {}>", table.description()).into();
         let t = TabulatedBrdf::from_table(table);
         let i = opts.interp.unwrap_or_else(|| t.default_interp());
         let t = Arc::new(t.with_interp(i));
@@ -143,9 +143,9 @@ impl PyBrdf {
     }
 
     /// The SOURCE string this BRDF was opened from (`"<in-memory table: ...>"` for
-    /// `Table.open`).
+    /// `Table.open`); a file name that is not UTF-8 as `os.fsdecode` gives it.
     #[getter]
-    fn source(&self) -> String {
+    fn source(&self) -> std::ffi::OsString {
         self.source.clone()
     }
 
@@ -167,7 +167,7 @@ impl PyBrdf {
     fn __repr__(&self) -> String {
         format!(
             "<brdftab.Brdf {:?}: {}>",
-            self.source,
+            self.source.to_string_lossy(),
             self.inner.describe()
         )
     }
@@ -346,7 +346,7 @@ impl PyBrdf {
             return Err(pyo3::exceptions::PyTypeError::new_err(format!(
                 "cannot pickle {}: it has no SOURCE to reopen (Table.save it and \
                  brdftab.open the file)",
-                self.source
+                self.source.to_string_lossy()
             )));
         }
         let module = py.import("brdftab._native")?;

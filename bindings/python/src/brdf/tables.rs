@@ -31,7 +31,7 @@ impl PyBrdf {
                 return Err(Error::new_err(format!(
                     "{}: an in-memory table has no SOURCE to bake with options (Table.save it \
                      and brdftab.open the file)",
-                    self.source
+                    self.source.to_string_lossy()
                 )));
             }
             _ => {
@@ -53,7 +53,7 @@ impl PyBrdf {
         let Some(t) = &self.table else {
             return Err(Error::new_err(format!(
                 "{}: not a table (use Brdf.table(...).device_layout())",
-                self.source
+                self.source.to_string_lossy()
             )));
         };
         let t = t.clone();

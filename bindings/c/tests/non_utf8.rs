@@ -1,0 +1,86 @@
+//! The C ABI passes a SOURCE's bytes through unchanged (session 41): a file whose name is not
+//! UTF-8 opens, bakes and converts (`brdftab_open`, `brdftab_bake`, `brdftab_convert`; they
+//! returned NULL / -1 with "`source` is not valid UTF-8"), and a missing one is named lossily.
+#![cfg(unix)]
+
+use std::ffi::{CStr, CString, OsString};
+use std::os::unix::ffi::{OsStrExt, OsStringExt};
+use std::path::{Path, PathBuf};
+
+use brdftab::testkit::TempDir;
+use brdftab_c::*;
+
+fn c_path(p: &Path) -> CString {
+    CString::new(p.as_os_str().as_bytes()).unwrap()
+}
+
+fn last_error() -> String {
+    // SAFETY: a NUL-terminated string owned by this thread.
+    unsafe { CStr::from_ptr(brdftab_last_error()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// f_r at (wi, wo) = (0.6, 0, 0.8), z of SOURCE through the C ABI; `None` and the message on
+/// failure.
+fn eval(source: &CStr) -> Result<Vec<f32>, String> {
+    // SAFETY: valid NUL-terminated strings and arrays of the sizes given.
+    unsafe {
+        let b = brdftab_open(source.as_ptr());
+        if b.is_null() {
+            return Err(last_error());
+        }
+        let c = brdftab_channels(b);
+        let mut f = vec![0.0f32; c];
+        let (wi, wo) = ([0.6, 0.0, 0.8], [0.0, 0.0, 1.0]);
+        let r = brdftab_eval(b, 1, wi.as_ptr(), wo.as_ptr(), f.as_mut_ptr());
+        brdftab_close(b);
+        assert_eq!(r, 0, "{}", last_error());
+        Ok(f)
+    }
+}
+
+fn latin1(d: &TempDir, name: &str) -> PathBuf {
+    let mut b = b"caf\xe9-".to_vec();
+    b.extend_from_slice(name.as_bytes());
+    d.path().join(OsString::from_vec(b))
+}
+
+#[test]
+fn a_source_whose_name_is_not_utf8_opens_bakes_and_converts() {
+    let d = TempDir::new("c-non-utf8");
+    let spec = latin1(&d, "matte.json");
+    let json = r#"{"model": "lambert", "kd": [0.1, 0.2, 0.3]}"#;
+    std::fs::write(&spec, json).unwrap();
+    let want = eval(&CString::new(json).unwrap()).unwrap();
+    assert_eq!(eval(&c_path(&spec)).unwrap(), want);
+
+    let out = d.path().join("t.btdb");
+    let settings = CString::new(r#"{"preset": "small"}"#).unwrap();
+    // SAFETY: valid NUL-terminated strings.
+    let r = unsafe {
+        brdftab_bake(
+            c_path(&spec).as_ptr(),
+            c_path(&out).as_ptr(),
+            settings.as_ptr(),
+        )
+    };
+    assert_eq!(r, 0, "{}", last_error());
+    let table = latin1(&d, "t.btdb");
+    std::fs::rename(&out, &table).unwrap();
+    let from_table = eval(&c_path(&table)).unwrap();
+    // A constant: the log16 table holds it within 1e-3.
+    for (a, b) in from_table.iter().zip(&want) {
+        assert!((a - b).abs() <= 1e-3 * b, "{a} vs {b}");
+    }
+    let lib = d.path().join("lib.btdb");
+    let entry = CString::new(format!("{}#m", lib.display())).unwrap();
+    let pairs = CString::new(r#"{"pairs": 0}"#).unwrap();
+    // SAFETY: valid NUL-terminated strings.
+    let r = unsafe { brdftab_convert(c_path(&table).as_ptr(), entry.as_ptr(), pairs.as_ptr()) };
+    assert_eq!(r, 0, "{}", last_error());
+    assert!(eval(&entry).is_ok());
+
+    let e = eval(&c_path(&latin1(&d, "missing.btdb"))).unwrap_err();
+    assert!(e.contains("caf\u{FFFD}-missing.btdb"), "{e}");
+}
