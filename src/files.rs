@@ -105,7 +105,7 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 /// spec file, a MERL or RGL file; `None` for inline JSON. A string the `DB#NAME` rule refuses
 /// is taken as a plain path (the open reports the error).
 pub fn source_file(source: &std::ffi::OsStr) -> Option<&Path> {
-    if crate::source::is_inline(source) {
+    if crate::store::name::is_inline(source) {
         return None;
     }
     Some(crate::store::name::parse_input_os("source", source).map_or(Path::new(source), |(p, _)| p))

@@ -28,6 +28,7 @@ use crate::brdf::Brdf;
 use crate::error::{Error, Result, excerpt};
 use crate::spec::ModelSpec;
 use crate::spectrum::Channels;
+use crate::store::name::is_inline;
 use crate::table::{Interp, Table, TabulatedBrdf};
 
 /// What a SOURCE string names, judged from the string alone (see the module table).
@@ -82,17 +83,6 @@ pub fn classify(source: impl AsRef<OsStr>) -> SourceKind {
     match crate::store::name::parse_input_os("source", source) {
         Ok((_, Some(_))) => SourceKind::Table,
         _ => classify_name(source.as_encoded_bytes()),
-    }
-}
-
-/// Whether SOURCE is inline JSON: its first character after white space is `{`.
-pub(crate) fn is_inline(source: &OsStr) -> bool {
-    match source.to_str() {
-        Some(s) => s.trim_start().starts_with('{'),
-        None => source
-            .as_encoded_bytes()
-            .trim_ascii_start()
-            .starts_with(b"{"),
     }
 }
 

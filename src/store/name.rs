@@ -84,6 +84,18 @@ fn check_split(field: &str, shown: &str, name: &str) -> Result<()> {
     check(field, name)
 }
 
+/// Whether SOURCE is inline JSON rather than a path: its first character after white space is
+/// `{` (here, beside the `DB#NAME` rule, so that the file helpers and `source` share it).
+pub(crate) fn is_inline(source: &OsStr) -> bool {
+    match source.to_str() {
+        Some(s) => s.trim_start().starts_with('{'),
+        None => source
+            .as_encoded_bytes()
+            .trim_ascii_start()
+            .starts_with(b"{"),
+    }
+}
+
 /// [`parse_input`] of a SOURCE that need not be UTF-8 (a file name on Linux is bytes): a UTF-8
 /// string goes through [`parse_input`] itself; another is split by the same rule on its bytes
 /// (the last `#`, unless what follows holds a `/`), the path part kept as the bytes it is and
