@@ -81,47 +81,28 @@ struct Grid {
 }
 
 impl Grid {
+    /// The job over elevations `a`–`b` and azimuths `from`–`to` (the light midway).
+    fn job(a: f64, b: f64, from: f64, to: f64, seed: u64) -> Job {
+        let light = 0.5 * (from + to);
+        let az = Azimuths {
+            from,
+            to,
+            light,
+            rule: ALBEDO_RULE,
+        };
+        Job { a, b, az, seed }
+    }
     fn cell_job(&self, i: usize, j: usize, seed: u64) -> Job {
-        let (pa, pb) = (self.phi[i], self.phi[i + 1]);
-        Job {
-            a: self.theta[j],
-            b: self.theta[j + 1],
-            az: Azimuths {
-                from: pa,
-                to: pb,
-                light: 0.5 * (pa + pb),
-                rule: ALBEDO_RULE,
-            },
-            seed,
-        }
+        let (t, p) = (&self.theta, &self.phi);
+        Self::job(t[j], t[j + 1], p[i], p[i + 1], seed)
     }
     fn at_theta_job(&self, i: usize, j: usize, seed: u64) -> Job {
-        let (pa, pb) = (self.phi[i], self.phi[i + 1]);
-        Job {
-            a: self.theta[j],
-            b: self.theta[j],
-            az: Azimuths {
-                from: pa,
-                to: pb,
-                light: 0.5 * (pa + pb),
-                rule: ALBEDO_RULE,
-            },
-            seed,
-        }
+        let (t, p) = (&self.theta, &self.phi);
+        Self::job(t[j], t[j], p[i], p[i + 1], seed)
     }
     fn at_phi_job(&self, i: usize, j: usize, seed: u64) -> Job {
-        let p = self.phi[i];
-        Job {
-            a: self.theta[j],
-            b: self.theta[j + 1],
-            az: Azimuths {
-                from: p,
-                to: p,
-                light: p,
-                rule: ALBEDO_RULE,
-            },
-            seed,
-        }
+        let (t, p) = (&self.theta, &self.phi);
+        Self::job(t[j], t[j + 1], p[i], p[i], seed)
     }
     /// Solid angle of cell (`i`, `j`).
     fn area(&self, i: usize, j: usize) -> f64 {
