@@ -10,7 +10,7 @@ use clap::Args;
 pub struct AlbedoArgs {
     /// Any SOURCE: a model spec (inline JSON starting with `{`, or a .json file), a table
     /// (`FILE.btdb`, `DB#NAME`), a MERL `.binary` or an RGL `.bsdf`.
-    source: String,
+    source: std::ffi::OsString,
     /// Incidence angles θ′ in degrees, comma separated.
     #[arg(
         long,
@@ -37,7 +37,7 @@ pub struct AlbedoArgs {
 pub struct CheckArgs {
     /// Any SOURCE: a model spec (inline JSON starting with `{`, or a .json file), a table
     /// (`FILE.btdb`, `DB#NAME`), a MERL `.binary` or an RGL `.bsdf`.
-    source: String,
+    source: std::ffi::OsString,
     /// Print the report as one JSON object.
     #[arg(long)]
     json: bool,

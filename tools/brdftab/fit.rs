@@ -11,7 +11,7 @@ use brdftab_tools::outln;
 #[derive(Args)]
 pub struct FitArgs {
     /// The data to fit: a spec, table, MERL `.binary` or RGL `.bsdf` file.
-    source: String,
+    source: std::ffi::OsString,
     /// The model: a name (`ggx`, `reciprocal_phong`, ...), a sum of names
     /// (`lambert+cook_torrance`, `lambert+ggx`, `lambert+blinn_phong`, `lambert+ward`), or a JSON
     /// spec used as the first start.

@@ -19,7 +19,7 @@ use clap::Args;
 #[derive(Args)]
 pub struct SampleArgs {
     /// A spec, table, MERL or RGL SOURCE.
-    source: String,
+    source: std::ffi::OsString,
     /// The outgoing direction (towards the viewer) `X,Y,Z`; need not be normalized.
     #[arg(long, allow_hyphen_values = true)]
     wo: String,
@@ -41,7 +41,7 @@ pub struct SampleArgs {
 #[derive(Args)]
 pub struct PdfArgs {
     /// A spec, table, MERL or RGL SOURCE.
-    source: String,
+    source: std::ffi::OsString,
     #[command(flatten)]
     open: brdftab::request::OpenSettings,
 }

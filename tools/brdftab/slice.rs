@@ -18,7 +18,7 @@ pub enum SliceKind {
 #[derive(Args)]
 pub struct SliceArgs {
     /// Any SOURCE (spec, table, .binary, .bsdf).
-    source: String,
+    source: std::ffi::OsString,
     /// Output image: `.exr` (linear f32) or `.png` (log scale, viridis, colorbar).
     #[arg(short, long)]
     output: String,

@@ -1,5 +1,5 @@
-//! SOURCE arguments whose file names are not UTF-8 (session 41): `bake`, `convert`, `eval` and
-//! `db add` pass them to the library as the bytes they are (they were refused by the argument
+//! SOURCE arguments whose file names are not UTF-8 (session 41): `bake`, `convert`, `eval`,
+//! `db add`, `albedo`, `check`, `sample`, `pdf`, `slice` and `fit` pass them to the library as the bytes they are (they were refused by the argument
 //! parser: "invalid UTF-8 was detected in one or more arguments"), and errors show them
 //! lossily.
 #![cfg(unix)]
@@ -116,4 +116,52 @@ fn bake_convert_eval_and_db_add_take_a_source_whose_name_is_not_utf8() {
         "{}",
         r.stderr
     );
+}
+
+/// The other commands that read a SOURCE and nothing else: `albedo`, `check`, `sample`, `pdf`,
+/// `slice` and `fit` open a Lambertian spec file whose name is not UTF-8 (the argument parser
+/// refused it before: exit 2 with "invalid UTF-8"), and give what they give for the same
+/// file under a UTF-8 name.
+#[test]
+fn the_reading_commands_take_a_source_whose_name_is_not_utf8() {
+    let d = TempDir::new("cli-non-utf8-read");
+    let spec = r#"{"model": "lambert", "kd": 0.25}"#;
+    let (odd, plain) = (latin1(&d, "m.json"), d.path().join("m.json"));
+    std::fs::write(&odd, spec).unwrap();
+    std::fs::write(&plain, spec).unwrap();
+    let s = |x: &str| OsString::from(x);
+    let exr = d.path().join("slice.exr").to_string_lossy().into_owned();
+    let cases: [(&[&str], &str); 6] = [
+        (&["albedo", "@", "--theta", "0,60"], ""),
+        (&["check", "@"], ""),
+        (&["sample", "@", "--wo", "0.3,0,1", "--count", "2"], ""),
+        (&["pdf", "@"], "0 0 1 0.6 0 0.8\n"),
+        (&["slice", "@", "-o", &exr, "--size", "16"], ""),
+        (&["fit", "@", "--model", "lambert", "--starts", "1"], ""),
+    ];
+    for (args, stdin) in cases {
+        let with = |src: &PathBuf| -> Vec<OsString> {
+            let a = args.iter();
+            a.map(|&x| {
+                if x == "@" {
+                    src.clone().into_os_string()
+                } else {
+                    s(x)
+                }
+            })
+            .collect()
+        };
+        let (a, b) = (with(&odd), with(&plain));
+        let r = brdftab_os(&a.iter().map(|x| x.as_os_str()).collect::<Vec<_>>(), stdin);
+        let want = brdftab_os(&b.iter().map(|x| x.as_os_str()).collect::<Vec<_>>(), stdin);
+        assert!(want.ok, "{args:?}: {}", want.stderr);
+        assert!(r.ok, "{args:?}: exit {}: {}", r.code, r.stderr);
+        // Outputs that echo the source name show it lossily; the values agree.
+        let lossy = r.stdout.replace("caf\u{FFFD}-m.json", "m.json");
+        let want_out = want
+            .stdout
+            .replace(&d.path().to_string_lossy().to_string(), "");
+        let got_out = lossy.replace(&d.path().to_string_lossy().to_string(), "");
+        assert_eq!(got_out, want_out, "{args:?}");
+    }
 }
