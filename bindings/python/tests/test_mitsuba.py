@@ -255,6 +255,10 @@ def test_jit_eval_matches_measured_within_table_error(rgl, tmp_path, preset):
     assert err_plugin <= 1.05 * (err_table + err_native) + 1e-6
 
 
+# Views stop at 80°: beyond it mitsuba.chi2 refuses Mitsuba's own roughconductor and
+# roughplastic (their pdf's cell integrals read 1.13–1.25 at 89–89.999°, BENCHMARKS session 42);
+# the plugin's grazing draws are checked against the library's pdf instead
+# (test_jit_pdf_near_the_horizon_is_the_librarys).
 CHI2 = [
     ("RGL", {"preset": "small"}, [0.4, 0.1, 0.91]),
     # The default (adaptive) table, view within 2° of the normal: the pdf's cell integrals at
