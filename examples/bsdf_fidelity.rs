@@ -11,7 +11,8 @@
 //! Environment: `THETA_I=n` and `RES=n` write n elevations or an n × n table instead of the
 //! defaults (`PHI_I=n`: n incident azimuths, `NDF_RES=n`: n × n warps); `AGAINST=SOURCE` judges every written file against that source instead of its own
 //! (a table of an RGL file, written as `.bsdf`, against the file); `BINS=1` also prints the
-//! relative RMSE of f_r cos θi cos θo per (θi, θo) band, `GRID=1` the incident directions written, `TURN=deg` measures
+//! relative RMSE of f_r cos θi cos θo per (θi, θo) band (`BINS=phi`: per 30° of φi, of φo − φi
+//! and of the half vector's φm, within 80° and in the grazing band), `GRID=1` the incident directions written, `TURN=deg` measures
 //! both turned by deg about the normal (the albedo with the light at azimuth deg, the rule's
 //! pairs turned with it).
 
@@ -79,8 +80,10 @@ fn main() -> brdftab::Result<()> {
             );
         }
         let back = brdftab::measured::RglBrdf::open(&path)?;
-        if std::env::var("BINS").is_ok() {
-            bins(&back, src.as_ref());
+        match std::env::var("BINS").as_deref() {
+            Ok("phi") => phi_bins(&back, src.as_ref()),
+            Ok(_) => bins(&back, src.as_ref()),
+            Err(_) => {}
         }
         let against = match std::env::var("AGAINST") {
             Ok(a) => brdftab::open(&a)?,
@@ -181,5 +184,66 @@ fn bins(a: &dyn brdftab::Brdf, r: &dyn brdftab::Brdf) {
             );
         }
         println!();
+    }
+}
+
+/// Relative RMSE of f_r cos θi cos θo over random pairs binned by φi, by φo − φi and by the half
+/// vector's φm (12 bins of 30° centred on 0°, ±30°, …, 180°), within 80° and in the grazing band.
+fn phi_bins(a: &dyn brdftab::Brdf, r: &dyn brdftab::Brdf) {
+    const NB: usize = 12;
+    let cap = 80f64.to_radians().cos();
+    // [which angle][band][bin]
+    let mut num = [[[0.0f64; NB]; 2]; 3];
+    let mut den = [[[0.0f64; NB]; 2]; 3];
+    let mut st = 0x9E3779B97F4A7C15u64;
+    let mut next = move || {
+        st ^= st << 13;
+        st ^= st >> 7;
+        st ^= st << 17;
+        (st >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let bin = |phi: f64| {
+        let d = phi.to_degrees().rem_euclid(360.0);
+        (((d + 15.0) / 30.0).floor() as usize) % NB
+    };
+    let c = r.channels().len();
+    let (mut fa, mut fr) = (vec![0.0f32; c], vec![0.0f32; c]);
+    for _ in 0..1_000_000 {
+        let wi = brdftab::geometry::uniform_hemisphere(glam::DVec2::new(next(), next()));
+        let wo = brdftab::geometry::uniform_hemisphere(glam::DVec2::new(next(), next()));
+        a.eval(wi, wo, &mut fa);
+        r.eval(wi, wo, &mut fr);
+        let w = wi.z * wo.z;
+        let band = usize::from(wi.z < cap || wo.z < cap);
+        let pi = wi.y.atan2(wi.x);
+        let h = wi + wo;
+        let bins = [bin(pi), bin(wo.y.atan2(wo.x) - pi), bin(h.y.atan2(h.x))];
+        for ch in 0..c {
+            let (e, f) = (
+                ((fa[ch] - fr[ch]) as f64 * w).powi(2),
+                (fr[ch] as f64 * w).powi(2),
+            );
+            for (k, &b) in bins.iter().enumerate() {
+                num[k][band][b] += e;
+                den[k][band][b] += f;
+            }
+        }
+    }
+    print!("{:>17}", "bin centre (deg)");
+    for b in 0..NB {
+        print!(" {:>6}", (b as i64 * 30 + 180).rem_euclid(360) - 180);
+    }
+    println!();
+    for (k, name) in ["φi", "φo − φi", "φm"].iter().enumerate() {
+        for (band, bname) in ["within 80°", "grazing"].iter().enumerate() {
+            print!("{:>17}", format!("{name} {bname}"));
+            for b in 0..NB {
+                print!(
+                    " {:>5.2}%",
+                    100.0 * (num[k][band][b] / den[k][band][b]).sqrt()
+                );
+            }
+            println!();
+        }
     }
 }
