@@ -129,14 +129,16 @@ fn run(file: &RglBrdf, src: &dyn Brdf, jobs: &[Job]) -> Vec<Errors> {
 
 /// Chooses the incident azimuths and elevations of an anisotropic `brdf` (at most
 /// `max_slices` slices), with `base` giving every other part of the layout. Returns the
-/// placement (its `theta_i`) and the azimuths.
+/// placement (its `theta_i`), the azimuths, and the chosen grid's VNDF slices and values as
+/// placement encoded them (φi-major, the file's order), which are the file's: each slice is
+/// encoded alone, as [`warps::vndf`] and [`values::sample`] encode it in the whole layout.
 pub fn place(
     brdf: &dyn Brdf,
     ndf: &Ndf,
     base: &Layout,
     max_slices: usize,
     progress: &dyn Progress,
-) -> Result<(Placement, Vec<f32>)> {
+) -> Result<(Placement, Vec<f32>, Encoded)> {
     let nt0 = elevations::START;
     let mut g = Grid {
         phi: even_azimuths(START_PHI),
@@ -199,7 +201,7 @@ pub fn place(
         // fidelity report's φ′ = 0 is one): more elevations lower it.
         let at_nodes = (g.at_phi.iter().flatten()).fold(0.0, |m: f64, e| m.max(e.albedo));
         fig[3] = fig[3].max(at_nodes / elevations::BARS[3]);
-        let done = || {
+        let done = |cache: &HashMap<(u64, u64), Slice>| {
             (
                 Placement {
                     theta_i: g.theta.iter().map(|&t| t as f32).collect(),
@@ -207,13 +209,14 @@ pub fn place(
                     floors: floor,
                 },
                 g.phi.iter().map(|&p| p as f32).collect::<Vec<f32>>(),
+                encoded(&g.phi, &g.theta, cache),
             )
         };
         let Some(worst) = (0..4)
             .filter(|&k| fig[k] > MARGIN && fig[k] - floor[k] > IMPROVABLE * fig[k])
             .max_by(|&a, &b| fig[a].total_cmp(&fig[b]))
         else {
-            return Ok(done());
+            return Ok(done(&cache));
         };
         let excess = |e: &Errors, f: &Errors| match worst {
             3 => e.albedo - f.albedo,
@@ -255,7 +258,7 @@ pub fn place(
             })
             .max_by(|a, b| a.0.total_cmp(&b.0));
         let split_theta = match (by_theta, by_phi) {
-            (None, None) => return Ok(done()),
+            (None, None) => return Ok(done(&cache)),
             (Some((gt, j)), Some((gp, i))) => {
                 if gt >= gp {
                     Ok(j)
@@ -330,16 +333,13 @@ fn reader(
     theta: &[f64],
     cache: &mut HashMap<(u64, u64), Slice>,
 ) -> Result<RglBrdf> {
-    let nch = brdf.channels().len();
-    let n = base.n;
-    let plane = n * n;
-    let vplane = base.vndf[0] * base.vndf[1];
+    let plane = base.n * base.n;
     let missing: Vec<(f64, f64)> = phi
         .iter()
         .flat_map(|&p| theta.iter().map(move |&t| (p, t)))
         .filter(|(p, t)| !cache.contains_key(&(p.to_bits(), t.to_bits())))
         .collect();
-    let encoded = crate::par::install(|| {
+    let fresh = crate::par::install(|| {
         missing
             .par_iter()
             .map(|&(p, t)| {
@@ -362,29 +362,47 @@ fn reader(
             })
             .collect::<Result<Vec<_>>>()
     })?;
-    cache.extend(encoded);
-    let (np, nt) = (phi.len(), theta.len());
-    let mut vndf = Vec::with_capacity(np * nt * vplane);
-    let mut data = Vec::with_capacity(np * nt * nch * plane);
-    let mut valid = Vec::with_capacity(np * nt * plane);
-    for &p in phi {
-        for &t in theta {
-            let s = &cache[&(p.to_bits(), t.to_bits())];
-            vndf.extend_from_slice(&s.vndf);
-            data.extend_from_slice(&s.values);
-            valid.extend_from_slice(&s.valid);
-        }
-    }
+    cache.extend(fresh);
+    let Encoded { vndf, values } = encoded(phi, theta, cache);
     let layout = Layout {
         theta_i: theta.iter().map(|&t| t as f32).collect(),
         phi_i: phi.iter().map(|&p| p as f32).collect(),
         ..base.clone()
     };
-    let values = super::Values {
-        data,
-        valid: super::container::pack_bits(&valid),
-    };
     let fields = super::fields_of(String::new(), &layout, ndf, vndf, values, brdf.channels());
     let tf = TensorFile::from_bytes("(placing azimuths)", fields.to_bytes())?;
-    RglBrdf::from_tensor(&tf, None)
+    RglBrdf::from_tensor_unhashed(&tf)
+}
+
+/// The VNDF slices and values of a grid, in the file's order (φi-major).
+pub struct Encoded {
+    /// φi × θi × rows × columns.
+    pub vndf: Vec<f32>,
+    /// The values and their valid bits.
+    pub values: super::Values,
+}
+
+/// The grid `phi` × `theta` of slices in `cache` (every one of them there).
+fn encoded(phi: &[f64], theta: &[f64], cache: &HashMap<(u64, u64), Slice>) -> Encoded {
+    let slices: Vec<&Slice> = (phi.iter())
+        .flat_map(|&p| {
+            theta
+                .iter()
+                .map(move |&t| &cache[&(p.to_bits(), t.to_bits())])
+        })
+        .collect();
+    let valid: Vec<bool> = slices
+        .iter()
+        .flat_map(|s| s.valid.iter().copied())
+        .collect();
+    Encoded {
+        vndf: slices.iter().flat_map(|s| s.vndf.iter().copied()).collect(),
+        values: super::Values {
+            data: slices
+                .iter()
+                .flat_map(|s| s.values.iter().copied())
+                .collect(),
+            valid: super::container::pack_bits(&valid),
+        },
+    }
 }

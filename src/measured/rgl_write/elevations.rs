@@ -28,13 +28,14 @@ use std::f64::consts::{PI, TAU};
 
 use super::ndf::Ndf;
 use super::{Layout, Progress, values, warps};
-use crate::analysis::fidelity::{Turned, mirror_albedo};
+use crate::analysis::pair_rule::mirror_rule;
 use crate::brdf::Brdf;
 use crate::error::Result;
 use crate::geometry;
 use crate::measured::RglBrdf;
 use crate::measured::tensor::TensorFile;
 use crate::progress::Silent;
+use crate::quadrature::gauss_legendre;
 use crate::rng::Pcg32;
 use crate::spectrum::MAX_CHANNELS;
 
@@ -283,7 +284,7 @@ fn reader(
     };
     let fields = super::fields_of(String::new(), &layout, ndf, vndf, values, brdf.channels());
     let tf = TensorFile::from_bytes("(placing elevations)", fields.to_bytes())?;
-    RglBrdf::from_tensor(&tf, None)
+    RglBrdf::from_tensor_unhashed(&tf)
 }
 
 /// Which incident azimuths a measurement draws and where it turns the light for the albedo.
@@ -297,7 +298,7 @@ pub(super) struct Azimuths {
     /// The light's azimuth of the albedo (radians).
     pub(super) light: f64,
     /// The albedo quadrature's azimuths about the mirror direction and Gauss-Legendre nodes
-    /// per segment ([`mirror_albedo`]).
+    /// per segment ([`mirror_albedo`](crate::analysis::fidelity::mirror_albedo)).
     pub(super) rule: [usize; 2],
 }
 
@@ -380,10 +381,16 @@ pub(super) fn measure(
     if degrees.is_empty() {
         degrees.push(0.5 * (lo + hi));
     }
-    let (file, src) = (Turned(file, az.light), Turned(src, az.light));
+    let (gx, gw) = gauss_legendre(az.rule[1].max(1));
     for deg in degrees.into_iter().filter(|d| (0.0..=89.0).contains(d)) {
-        let x = mirror_albedo(&file, deg.to_radians(), az.rule[0], az.rule[1]);
-        let y = mirror_albedo(&src, deg.to_radians(), az.rule[0], az.rule[1]);
+        let (x, y) = albedos(
+            file,
+            src,
+            az.light,
+            deg.to_radians(),
+            az.rule[0],
+            (&gx, &gw),
+        );
         for ch in 0..c {
             out.albedo = out
                 .albedo
@@ -393,9 +400,74 @@ pub(super) fn measure(
     out
 }
 
+/// The directional albedos of `file` and `src` with the light at azimuth `light` (each turned by
+/// it, as [`Turned`](crate::analysis::fidelity::Turned) turns them) and at elevation `theta`: what
+/// [`mirror_albedo`](crate::analysis::fidelity::mirror_albedo) gives for each,
+/// to the bit (the same nodes, turned the same way, summed in the same order), from one walk of
+/// the rule and one turn of each node (session 42: this walk, and `Turned`'s sine and cosine
+/// of the light at every evaluation, were a fifth of an anisotropic file's placement).
+fn albedos(
+    file: &dyn Brdf,
+    src: &dyn Brdf,
+    light: f64,
+    theta: f64,
+    nphi: usize,
+    (gx, gw): (&[f64], &[f64]),
+) -> ([f64; MAX_CHANNELS], [f64; MAX_CHANNELS]) {
+    let c = src.channels().len().min(MAX_CHANNELS);
+    let (s, co) = light.sin_cos();
+    let turn = |v: glam::DVec3| {
+        if light == 0.0 {
+            v
+        } else {
+            glam::DVec3::new(co * v.x - s * v.y, s * v.x + co * v.y, v.z)
+        }
+    };
+    let (mut x, mut y) = ([0.0f64; MAX_CHANNELS], [0.0f64; MAX_CHANNELS]);
+    let (mut fa, mut fb) = ([0.0f32; MAX_CHANNELS], [0.0f32; MAX_CHANNELS]);
+    mirror_rule(theta, nphi.max(1), gx, gw, None, |wi, wo, w| {
+        let weight = w * wo.z;
+        let (ti, to) = (turn(wi), turn(wo));
+        file.eval(ti, to, &mut fa[..c]);
+        src.eval(ti, to, &mut fb[..c]);
+        for ch in 0..c {
+            x[ch] += weight * fa[ch] as f64;
+            y[ch] += weight * fb[ch] as f64;
+        }
+    });
+    (x, y)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn albedos_are_mirror_albedos_of_the_turned_brdfs_to_the_bit() {
+        // Placement's figures, hence the file's bytes, must not change with how the albedos
+        // are walked: one walk for both BRDFs gives each what `mirror_albedo` of `Turned`
+        // gives, with the light at 0 (no turn) and elsewhere.
+        use crate::analysis::fidelity::{Turned, mirror_albedo};
+        let path = &crate::measured::rgl_write::tests::rgl_files()[0];
+        let file = RglBrdf::open(path).unwrap();
+        let src = crate::open(
+            r#"{"model": "ggx", "alpha_x": 0.1, "alpha_y": 0.4, "fresnel": {"conductor": "Cu"}}"#,
+        )
+        .unwrap();
+        let (gx, gw) = gauss_legendre(4);
+        for light in [0.0, 1.3, -2.9] {
+            for deg in [1.0f64, 37.0, 89.0] {
+                let (x, y) = albedos(&file, &*src, light, deg.to_radians(), 64, (&gx, &gw));
+                let x0 = mirror_albedo(&Turned(&file, light), deg.to_radians(), 64, 4);
+                let y0 = mirror_albedo(&Turned(&*src, light), deg.to_radians(), 64, 4);
+                assert!(x[0] > 0.0 && y[0] > 0.0, "{light} {deg}: {x:?} {y:?}");
+                for ch in 0..3 {
+                    assert_eq!(x[ch].to_bits(), x0[ch].to_bits(), "{light} {deg} {ch}");
+                    assert_eq!(y[ch].to_bits(), y0[ch].to_bits(), "{light} {deg} {ch}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn figures_divide_by_the_bars_and_floors_cap_at_the_error() {

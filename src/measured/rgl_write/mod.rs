@@ -447,11 +447,11 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
             ),
         ));
     }
-    let (ndf, warps) = match &opts.parameterization {
+    let (ndf, warps, placed) = match &opts.parameterization {
         Some(p) => {
             let ndf = ndf::Ndf::given(p, layout.isotropic);
             let warps = warps::given(p, &layout)?;
-            (ndf, warps)
+            (ndf, warps, None)
         }
         None => {
             let ndf = ndf::recover(brdf, &layout)?;
@@ -482,13 +482,18 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
             // their error is: placing elevations alone changed none of their figures (Lambert +
             // GGX α = (0.2, 0.5): grazing band 4.0 → 3.8 % on the pair rule) for 2.3× the bytes.
             if gridding {
-                let (placed, phi_i) =
+                let (placed, phi_i, slices) =
                     azimuths::place(brdf, &ndf, &layout, most_slices(&layout, nch), progress)?;
                 layout.theta_i = placed.theta_i;
                 layout.phi_i = phi_i;
+                // The file is the grid placement encoded last, slice by slice (encoding it
+                // again took 0.27 s of a 5.3 s write).
+                let warps = warps::with_warps(slices.vndf, &layout)?;
+                (ndf, warps, Some(slices.values))
+            } else {
+                let warps = warps::vndf(&ndf, &layout)?;
+                (ndf, warps, None)
             }
-            let warps = warps::vndf(&ndf, &layout)?;
-            (ndf, warps)
         }
     };
     let keep = opts
@@ -496,7 +501,10 @@ pub fn encode(brdf: &dyn Brdf, opts: &Options, progress: &dyn Progress) -> Resul
         .as_ref()
         .filter(|p| p.resolution == layout.n && same_channels(&p.values.0, brdf.channels()))
         .map(|p| p.values.1.as_slice());
-    let values = values::sample(brdf, &ndf, &warps, &layout, keep, progress)?;
+    let values = match placed {
+        Some(v) => v,
+        None => values::sample(brdf, &ndf, &warps, &layout, keep, progress)?,
+    };
     if values.data.iter().all(|&v| v == 0.0) {
         return Err(Error::arg(
             "source",

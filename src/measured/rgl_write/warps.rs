@@ -72,8 +72,8 @@ pub fn given(p: &super::Parameterization, layout: &Layout) -> Result<Vndf> {
     with_warps(p.vndf.clone(), layout)
 }
 
-/// Builds the readers' warp of every slice.
-fn with_warps(data: Vec<f32>, layout: &Layout) -> Result<Vndf> {
+/// Builds the readers' warp of every slice of `data` (φi × θi × rows × columns).
+pub fn with_warps(data: Vec<f32>, layout: &Layout) -> Result<Vndf> {
     let [ny, nx] = layout.vndf;
     let plane = nx * ny;
     let nt = layout.theta_i.len();
