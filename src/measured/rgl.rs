@@ -58,6 +58,47 @@ fn warp_of(planes: Planes, file: &TensorFile, field: &Field) -> Result<Warp> {
     })
 }
 
+/// An [`RglBrdf`] at one incident direction ([`RglBrdf::at_incidence`]).
+pub(crate) struct AtIncidence<'a> {
+    file: &'a RglBrdf,
+    wi: DVec3,
+    /// `None` where `wi` is below the horizon or not near unit length: `eval` is the file's.
+    inc: Option<Incident>,
+}
+
+impl AtIncidence<'_> {
+    /// The file's `eval(wi, wo)`, bit for bit.
+    #[inline]
+    pub(crate) fn eval(&self, wo: DVec3, out: &mut [f32]) {
+        let v2 = wo.length_squared();
+        match &self.inc {
+            Some(inc) if geometry::is_near_unit_l2(v2) => {
+                let out = &mut out[..self.file.channels.len()];
+                out.fill(0.0);
+                if wo.z > 0.0
+                    && let Some(p) = self.file.outgoing(inc, geometry::unit_or_near(wo, v2))
+                {
+                    self.file.finish(p, out);
+                }
+            }
+            _ => self.file.eval(self.wi, wo, out),
+        }
+    }
+}
+
+/// What a lookup derives from the incident direction alone ([`RglBrdf::at_incidence`]).
+#[derive(Clone, Copy)]
+struct Incident {
+    /// The direction after the φ reduction's flips.
+    wi: DVec3,
+    /// The flips (signs of x and y), applied to the outgoing direction too.
+    signs: Option<(f64, f64)>,
+    phi_i: f64,
+    k: Corners,
+    /// σ(ωi) when the file has the Jacobian convention.
+    sigma: f64,
+}
+
 /// Interval index `i` (clamped to [0, n−2]) with `values[i]` ≤ x, and the weight of `i + 1`
 /// (clamped to [0, 1]). A single value gives (0, 0) — no interpolation.
 #[inline]
@@ -541,32 +582,65 @@ impl RglBrdf {
     /// The warped point, the corners and the Jacobian factor for a pair; `None` → value 0.
     #[inline]
     fn prepare(&self, wi: DVec3, wo: DVec3) -> Option<([f64; 2], Corners, f64, f64)> {
-        let (mut wi, mut wo) = geometry::upper_pair(wi, wo)?;
-        let cos_o = wo.z;
+        let (wi, wo) = geometry::upper_pair(wi, wo)?;
+        self.outgoing(&self.incident(wi), wo)
+    }
+
+    /// What [`prepare`](Self::prepare) derives from the incident direction alone (`wi` as
+    /// `upper_pair` returns it).
+    #[inline]
+    fn incident(&self, mut wi: DVec3) -> Incident {
+        let mut signs = None;
         if self.reduction >= 2 {
             let sy = wi.y;
             let sx = if self.reduction == 4 { wi.x } else { sy };
             wi.x = mulsign_neg(wi.x, sx);
             wi.y = mulsign_neg(wi.y, sy);
+            signs = Some((sx, sy));
+        }
+        let theta_i = elevation(wi);
+        let phi_i = wi.y.atan2(wi.x);
+        let u_wi = [theta2u(theta_i), phi2u(phi_i)];
+        let k = self.corners(phi_i, theta_i);
+        let sigma = if self.jacobian {
+            bilinear(&self.sigma, &NO_PARAMS, 0, 0, u_wi)
+        } else {
+            1.0
+        };
+        Incident {
+            wi,
+            signs,
+            phi_i,
+            k,
+            sigma,
+        }
+    }
+
+    /// [`prepare`](Self::prepare) of `wo` (as `upper_pair` returns it) for an incidence.
+    #[inline]
+    fn outgoing(&self, inc: &Incident, mut wo: DVec3) -> Option<([f64; 2], Corners, f64, f64)> {
+        let cos_o = wo.z;
+        if let Some((sx, sy)) = inc.signs {
             wo.x = mulsign_neg(wo.x, sx);
             wo.y = mulsign_neg(wo.y, sy);
         }
-        let wm = geometry::normalize(wi + wo)?;
-        let theta_i = elevation(wi);
-        let phi_i = wi.y.atan2(wi.x);
+        let wm = geometry::normalize(inc.wi + wo)?;
         let theta_m = elevation(wm);
         let phi_m = wm.y.atan2(wm.x);
-        let u_wi = [theta2u(theta_i), phi2u(phi_i)];
         let mut u_wm = [
             theta2u(theta_m),
-            phi2u(if self.isotropic { phi_m - phi_i } else { phi_m }),
+            phi2u(if self.isotropic {
+                phi_m - inc.phi_i
+            } else {
+                phi_m
+            }),
         ];
         u_wm[1] -= u_wm[1].floor();
-        let k = self.corners(phi_i, theta_i);
+        let k = inc.k;
         let sample = self.vndf.invert(u_wm, &k);
         let scale = if self.jacobian {
             let ndf = bilinear(&self.ndf, &NO_PARAMS, 0, 0, u_wm);
-            let sigma = bilinear(&self.sigma, &NO_PARAMS, 0, 0, u_wi);
+            let sigma = inc.sigma;
             if sigma.is_nan() || sigma <= 0.0 {
                 return None;
             }
@@ -575,6 +649,40 @@ impl RglBrdf {
             1.0
         };
         Some((sample, k, scale, cos_o))
+    }
+
+    /// This file at one incident direction: [`AtIncidence::eval`] is `eval(wi, wo)` to the bit,
+    /// with what depends on `wi` alone (its azimuth and elevation, the slices around it, σ)
+    /// found once. The RGL writer's placement measures albedos of the file it reads back,
+    /// thousands of outgoing directions per incidence (session 42).
+    pub(crate) fn at_incidence(&self, wi: DVec3) -> AtIncidence<'_> {
+        let l2 = wi.length_squared();
+        // `upper_pair` treats each direction alone when both are near unit length.
+        let inc = (wi.z > 0.0 && geometry::is_near_unit_l2(l2))
+            .then(|| self.incident(geometry::unit_or_near(wi, l2)));
+        AtIncidence {
+            file: self,
+            wi,
+            inc,
+        }
+    }
+
+    /// The channels of a prepared pair (`out` zeroed).
+    #[inline]
+    fn finish(&self, (sample, k, scale, cos_o): ([f64; 2], Corners, f64, f64), out: &mut [f32]) {
+        for (o, mix) in out.iter_mut().zip(&self.out_map) {
+            let v = mix.apply(|c| self.out_channel(sample, &k, c));
+            let f = v * scale / cos_o;
+            // Negative ndf/sigma (only in corrupt files) or NaN must not leak out; a value
+            // beyond f32 (measured f_r grows like 1/cos θo: 3.7e99 at cos 1e-100) saturates, as
+            // the original Phong's does, rather than dropping to 0 where `eval_wavelength`
+            // gives it.
+            *o = if f > 0.0 {
+                f.min(f32::MAX as f64) as f32
+            } else {
+                0.0
+            };
+        }
     }
 
     /// Output channel `c`'s value before the cosine: the file's channel, or for a spectral file
@@ -722,21 +830,8 @@ impl Brdf for RglBrdf {
         let n = self.channels.len();
         let out = &mut out[..n];
         out.fill(0.0);
-        let Some((sample, k, scale, cos_o)) = self.prepare(wi, wo) else {
-            return;
-        };
-        for (o, mix) in out.iter_mut().zip(&self.out_map) {
-            let v = mix.apply(|c| self.out_channel(sample, &k, c));
-            let f = v * scale / cos_o;
-            // Negative ndf/sigma (only in corrupt files) or NaN must not leak out; a value
-            // beyond f32 (measured f_r grows like 1/cos θo: 3.7e99 at cos 1e-100) saturates, as
-            // the original Phong's does, rather than dropping to 0 where `eval_wavelength`
-            // gives it.
-            *o = if f > 0.0 {
-                f.min(f32::MAX as f64) as f32
-            } else {
-                0.0
-            };
+        if let Some(p) = self.prepare(wi, wo) {
+            self.finish(p, out);
         }
     }
 

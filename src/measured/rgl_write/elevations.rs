@@ -314,7 +314,7 @@ const WHOLE_CIRCLE: Azimuths = Azimuths {
 /// azimuths `az`: error and reference integrated over that range of incidences, or per unit
 /// solid angle where the range is a single elevation or azimuth.
 pub(super) fn measure(
-    file: &dyn Brdf,
+    file: &RglBrdf,
     src: &dyn Brdf,
     a: f64,
     b: f64,
@@ -407,7 +407,7 @@ pub(super) fn measure(
 /// the rule and one turn of each node (session 42: this walk, and `Turned`'s sine and cosine
 /// of the light at every evaluation, were a fifth of an anisotropic file's placement).
 fn albedos(
-    file: &dyn Brdf,
+    file: &RglBrdf,
     src: &dyn Brdf,
     light: f64,
     theta: f64,
@@ -425,10 +425,13 @@ fn albedos(
     };
     let (mut x, mut y) = ([0.0f64; MAX_CHANNELS], [0.0f64; MAX_CHANNELS]);
     let (mut fa, mut fb) = ([0.0f32; MAX_CHANNELS], [0.0f32; MAX_CHANNELS]);
+    // mirror_rule's incident direction, as it makes it.
+    let (st, ct) = theta.sin_cos();
+    let at = file.at_incidence(turn(glam::DVec3::new(st, 0.0, ct)));
     mirror_rule(theta, nphi.max(1), gx, gw, None, |wi, wo, w| {
         let weight = w * wo.z;
         let (ti, to) = (turn(wi), turn(wo));
-        file.eval(ti, to, &mut fa[..c]);
+        at.eval(to, &mut fa[..c]);
         src.eval(ti, to, &mut fb[..c]);
         for ch in 0..c {
             x[ch] += weight * fa[ch] as f64;

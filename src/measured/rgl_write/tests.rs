@@ -763,3 +763,59 @@ fn an_anisotropic_file_is_its_layout_encoded_from_scratch() {
     assert!(bits(&f.values) == bits(&v.data), "values differ");
     assert_eq!(f.valid, v.valid);
 }
+
+#[test]
+fn a_file_at_one_incidence_evaluates_as_the_file_to_the_bit() {
+    // `at_incidence` finds once what `eval` derives from wi alone; its values must be `eval`'s
+    // bit for bit (placement's albedos, hence the bytes of a written file, depend on them), for
+    // isotropic files and an anisotropic one, and directions of any length or side.
+    let aniso = encode(
+        &*model(
+            r#"{"model": "ggx", "alpha_x": 0.1, "alpha_y": 0.4}"#,
+            &Channels::Rgb,
+        ),
+        &Options {
+            phi_i: Some(5),
+            theta_i: Some(4),
+            resolution: Some(16),
+            ..Options::default()
+        },
+        &Silent,
+    )
+    .unwrap();
+    let t = TensorFile::from_bytes("aniso.bsdf", aniso.to_bytes()).unwrap();
+    let mut files = vec![RglBrdf::from_tensor(&t, None).unwrap()];
+    files.extend(
+        rgl_files()
+            .iter()
+            .take(2)
+            .map(|p| RglBrdf::open(p).unwrap()),
+    );
+    let mut rng = crate::rng::Pcg32::with_stream(42, 7);
+    let mut dir = |scale: f64| {
+        let z = 2.0 * rng.next_f64() - 0.2;
+        let p = std::f64::consts::TAU * rng.next_f64();
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        glam::DVec3::new(s * p.cos(), s * p.sin(), z) * scale
+    };
+    let (mut a, mut b) = ([0.0f32; 3], [0.0f32; 3]);
+    let mut nonzero = 0;
+    for file in &files {
+        for k in 0..40 {
+            // Unit, a renderer's f32 directions, and far from unit length.
+            let scale = [1.0, 1.0 + 3e-8, 2.5][k % 3];
+            let wi = dir(scale);
+            let at = file.at_incidence(wi);
+            for j in 0..200 {
+                let wo = dir([1.0, 1.0 - 2e-8, 0.3][j % 3]);
+                at.eval(wo, &mut a);
+                file.eval(wi, wo, &mut b);
+                for ch in 0..3 {
+                    assert_eq!(a[ch].to_bits(), b[ch].to_bits(), "{wi:?} {wo:?} {ch}");
+                }
+                nonzero += usize::from(b[0] > 0.0);
+            }
+        }
+    }
+    assert!(nonzero > 1000, "{nonzero}");
+}
