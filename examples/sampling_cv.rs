@@ -257,7 +257,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             if let Some(q) = quantity {
                 req = req.quantity(q);
             }
-            req.run(&BakeTarget::file(out.to_string_lossy()))?;
+            req.run(&BakeTarget::file(&out))?;
             let mut b = source::open_table(&out, &Default::default())?;
             if mid {
                 midway(&format!("{name} table"), &b, fixed);

@@ -27,6 +27,7 @@
 //! # Ok::<(), brdftab::Error>(())
 //! ```
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 
 use xxhash_rust::xxh3::Xxh3;
@@ -74,7 +75,8 @@ pub fn default_dir() -> Result<PathBuf> {
 ///
 /// # Errors
 /// A source file that cannot be read ([`Error::Io`] naming it).
-pub fn key(source: &str, settings: &BakeSettings) -> Result<String> {
+pub fn key(source: impl AsRef<OsStr>, settings: &BakeSettings) -> Result<String> {
+    let source = source.as_ref();
     let mut h = Xxh3::new();
     let mut part = |b: &[u8]| {
         h.update(&(b.len() as u64).to_le_bytes());
@@ -89,15 +91,18 @@ pub fn key(source: &str, settings: &BakeSettings) -> Result<String> {
     part(env!("CARGO_PKG_VERSION").as_bytes());
     let kind = source::classify(source);
     part(kind.name().as_bytes());
-    let inline = kind == SourceKind::Spec && source.trim_start().starts_with('{');
+    let inline = kind == SourceKind::Spec && crate::store::name::is_inline(source);
     if inline {
-        part(source.trim().as_bytes());
+        match source.to_str() {
+            Some(s) => part(s.trim().as_bytes()),
+            None => part(source.as_encoded_bytes().trim_ascii()),
+        }
     } else {
         let (file, name) = match kind {
             SourceKind::Table => crate::store::db::split_source(source)?,
-            _ => (source, None),
+            _ => (Path::new(source), None),
         };
-        part(&content_hash(Path::new(file))?.to_le_bytes());
+        part(&content_hash(file)?.to_le_bytes());
         part(name.unwrap_or("").as_bytes());
     }
     let mut s = settings.clone();
@@ -135,7 +140,7 @@ fn content_hash(path: &Path) -> Result<u128> {
 /// # Errors
 /// No cache directory, a directory that cannot be created, and whatever the bake fails with.
 pub fn bake_cached(
-    source: &str,
+    source: impl AsRef<OsStr>,
     settings: &BakeSettings,
     dir: Option<&Path>,
     refresh: bool,
@@ -147,7 +152,7 @@ pub fn bake_cached(
 /// [`Progress::cancelled`](crate::progress::Progress::cancelled); the cache is then left
 /// without the table).
 pub fn bake_cached_with(
-    source: &str,
+    source: impl AsRef<OsStr>,
     settings: &BakeSettings,
     dir: Option<&Path>,
     refresh: bool,
@@ -157,6 +162,7 @@ pub fn bake_cached_with(
         Some(d) => d.to_path_buf(),
         None => default_dir()?,
     };
+    let source = source.as_ref();
     // Settings are checked before any file is read or written.
     settings.request(source)?;
     let path = dir.join(format!("{}.btdb", key(source, settings)?));
@@ -172,8 +178,7 @@ pub fn bake_cached_with(
     }
     let mut s = settings.clone();
     s.replace = true;
-    let out = path.to_string_lossy();
-    crate::request::bake(source, &out, &s, progress)?;
+    crate::request::bake(source, &path, &s, progress)?;
     Ok(Cached { path, hit: false })
 }
 
@@ -214,7 +219,7 @@ mod tests {
         std::fs::write(&f, r#"{"model": "lambert", "kd": 0.6}"#).unwrap();
         assert_ne!(k, key(&fs, &small()).unwrap(), "edited in place: a new key");
         assert_ne!(key(SPEC, &small()).unwrap(), key(&fs, &small()).unwrap());
-        assert!(key(&d.path().join("nope.bsdf").to_string_lossy(), &small()).is_err());
+        assert!(key(d.path().join("nope.bsdf"), &small()).is_err());
     }
 
     #[test]

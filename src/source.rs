@@ -88,11 +88,13 @@ pub fn classify(source: impl AsRef<OsStr>) -> SourceKind {
 
 /// Classifies an output string by its characters alone, as writing splits it
 /// ([`crate::store::name::parse_source`]): `DB#NAME` is a table of a database, otherwise the
-/// extension decides (`.binary`: a MERL file, `.bsdf`: an RGL file, other names: a table).
-pub fn classify_output(output: &str) -> SourceKind {
-    match crate::store::name::parse_source("output", output) {
+/// extension decides (`.binary`: a MERL file, `.bsdf`: an RGL file, other names: a table). An
+/// output that is not UTF-8 is split on its bytes ([`crate::store::name::parse_output_os`]).
+pub fn classify_output(output: impl AsRef<OsStr>) -> SourceKind {
+    let output = output.as_ref();
+    match crate::store::name::parse_output_os("output", output) {
         Ok((_, Some(_))) => SourceKind::Table,
-        _ => classify_name(output.as_bytes()),
+        _ => classify_name(output.as_encoded_bytes()),
     }
 }
 
@@ -454,7 +456,7 @@ mod tests {
         for kind in ["json", "binary", "bsdf"] {
             assert_eq!(classify(format!("db.btdb#t.{kind}")), SourceKind::Table);
             assert_eq!(
-                classify_output(&format!("db.btdb#t.{kind}")),
+                classify_output(format!("db.btdb#t.{kind}")),
                 SourceKind::Table
             );
         }

@@ -82,7 +82,7 @@ fn a_files_ratio_counts_every_table_also_when_one_is_asked_for() {
             .unwrap();
     }
     let whole = info::file_info(db).unwrap();
-    let one = info::file_info(&format!("{db}#a")).unwrap();
+    let one = info::file_info(format!("{db}#a")).unwrap();
     let tables = whole["tables"].as_array().unwrap();
     let values: u64 = tables.iter().map(|t| t["values"].as_u64().unwrap()).sum();
     let bytes = whole["bytes"].as_u64().unwrap();
@@ -185,7 +185,7 @@ fn empty_table_names_and_control_characters_are_argument_errors_on_every_road() 
         "{e}"
     );
     // The store's own entry points keep the same rule.
-    request::bake(LAMBERT, &format!("{db}#ok"), &settings, &Silent).unwrap();
+    request::bake(LAMBERT, format!("{db}#ok"), &settings, &Silent).unwrap();
     let s = brdftab::store::Store::open(&db).unwrap();
     let e = brdftab::store::db::import(d.join("n.btdb"), &s, "ok", "\0", false);
     assert_eq!(field(e), "name");

@@ -24,7 +24,7 @@ fn bake_default(dir: &Path, file: &str) -> (String, brdftab::bake::BakeReport) {
         .to_string_lossy()
         .into_owned();
     let r = BakeRequest::new(&rgl)
-        .run(&BakeTarget::File(out.clone()))
+        .run(&BakeTarget::File(out.clone().into()))
         .unwrap();
     (out, r)
 }

@@ -2,7 +2,10 @@
 //! not UTF-8 opens, bakes and converts as any other — each kind, and `DB#NAME` of a database
 //! whose path is not UTF-8. Until then every entry point took `&str`: such a file could not be
 //! named at all (the CLI refused the argument, Python raised ValueError, the C ABI returned
-//! NULL with "`source` is not valid UTF-8").
+//! NULL with "`source` is not valid UTF-8"). Every output and every other path (session 42):
+//! `request::{bake, convert, save_table, import_npy}` write to `DB#NAME` or a file whose path is
+//! not UTF-8, `BakeTarget` holds a path, `store::info` and `measured::info` read such files, and
+//! the cache of baked tables lives in such a directory.
 #![cfg(unix)]
 
 use std::ffi::{OsStr, OsString};
@@ -141,7 +144,7 @@ fn bake_and_convert_read_a_source_whose_name_is_not_utf8() {
     };
     let lib = d.join("lib.btdb");
     let lib = lib.to_str().unwrap();
-    request::convert(&merl, &format!("{lib}#m"), &settings, &Silent).unwrap();
+    request::convert(&merl, format!("{lib}#m"), &settings, &Silent).unwrap();
     assert_eq!(eval(format!("{lib}#m")).unwrap(), a);
     let bsdf = d.join("m.bsdf");
     request::convert(&merl, bsdf.to_str().unwrap(), &settings, &Silent).unwrap();
@@ -187,5 +190,132 @@ fn errors_show_a_name_that_is_not_utf8_lossily() {
     match brdftab::open(OsStr::from_bytes(b"{\"model\": \"lambert\", \"kd\": \xe9}")) {
         Err(Error::InvalidArgument { name, .. }) => assert_eq!(name, "source"),
         r => panic!("{:?}", r.map(|b| b.describe())),
+    }
+}
+
+/// Every output of the request layer, in a directory whose name is not UTF-8: a `.btdb` file and
+/// `DB#NAME` (bake, convert, `save_table`, `import_npy`), a raw table, a MERL and an RGL file;
+/// `info` of each, whose `file` shows the path lossily. Before session 42 outputs were `&str`
+/// (such a path could not be passed), and the cache wrote its table to the lossy name
+/// (`caf\u{FFFD}`, a directory that does not exist).
+#[test]
+fn every_output_is_written_to_a_path_that_is_not_utf8() {
+    let d = TempDir::new("non-utf8-out");
+    let dir = latin1(d.path(), "dir");
+    std::fs::create_dir(&dir).unwrap();
+    let settings = request::BakeSettings {
+        preset: Some("small".into()),
+        ..Default::default()
+    };
+    let want = eval(LAMBERT).unwrap();
+    // Within the log16 codec's 1e-3 (twice over for a table re-encoded from a table).
+    let close = |source: &OsStr| {
+        for (g, w) in eval(source).unwrap().iter().zip(&want) {
+            assert!((g - w).abs() <= 2.1e-3 * w, "{source:?}: {g} vs {w}");
+        }
+    };
+    let (file, lib) = (dir.join("t.btdb"), dir.join("lib.btdb"));
+    let r = request::bake(LAMBERT, &file, &settings, &Silent).unwrap();
+    assert_eq!(r.written, Some(BakeTarget::file(&file)));
+    assert_eq!(r.output, file.display().to_string());
+    close(file.as_os_str());
+    let r = request::bake(LAMBERT, db_name(&lib, "b"), &settings, &Silent).unwrap();
+    assert_eq!(r.written, Some(BakeTarget::db(&lib, "b")));
+    assert!(
+        r.output.ends_with("caf\u{FFFD}-dir/lib.btdb#b"),
+        "{}",
+        r.output
+    );
+    close(&db_name(&lib, "b"));
+    assert_eq!(
+        BakeTarget::parse(db_name(&lib, "b"), None, true).unwrap(),
+        BakeTarget::Db {
+            path: lib.clone(),
+            name: "b".into(),
+            replace: true
+        }
+    );
+    assert_eq!(
+        brdftab::source::classify_output(db_name(&lib, "x.bsdf")),
+        SourceKind::Table
+    );
+
+    // convert: to DB#NAME, a raw table, a MERL and an RGL file.
+    let convert = ConvertSettings {
+        pairs: Some(0),
+        ..Default::default()
+    };
+    let (raw, merl, bsdf) = (dir.join("t.f32"), dir.join("m.binary"), dir.join("m.bsdf"));
+    for out in [db_name(&lib, "c"), raw.clone().into(), merl.clone().into()] {
+        request::convert(&file, &out, &convert, &Silent).unwrap();
+        close(&out);
+    }
+    request::convert(LAMBERT, &bsdf, &convert, &Silent).unwrap();
+    assert!(eval(&bsdf).is_ok());
+
+    // save_table and import_npy: the values of `t.btdb`, exported and imported beside it.
+    let table = brdftab::source::open_table(&file, &Default::default()).unwrap();
+    let table = table.to_table().unwrap();
+    let save = request::SaveSettings::default();
+    request::save_table(&table, db_name(&lib, "s"), other(), &save).unwrap();
+    close(&db_name(&lib, "s"));
+    let st = brdftab::store::Store::open(&file)
+        .unwrap()
+        .single()
+        .unwrap();
+    let npy = dir.join("t.npy");
+    brdftab::store::export::npy(&st, &npy, None).unwrap();
+    let v = request::import_npy(&npy, db_name(&lib, "s"), db_name(&lib, "i"), &save, true);
+    assert_eq!(v.unwrap()["tables"][0]["name"], "i");
+    close(&db_name(&lib, "i"));
+
+    // info of each kind: `file` is the path, lossily.
+    use brdftab::store::info;
+    let shown = |v: serde_json::Value| v["file"].as_str().unwrap_or_default().to_owned();
+    assert_eq!(
+        shown(info::file_info(&file).unwrap()),
+        file.display().to_string()
+    );
+    let v = info::file_info(db_name(&lib, "c")).unwrap();
+    assert_eq!(
+        (shown(v.clone()), &v["tables"][0]["name"]),
+        (lib.display().to_string(), &"c".into())
+    );
+    assert_eq!(info::list(&lib).unwrap().len(), 4);
+    assert_eq!(info::table_info(&lib, "b").unwrap()["name"], "b");
+    assert_eq!(
+        shown(info::table_file_info(&raw).unwrap().0),
+        raw.display().to_string()
+    );
+    for m in [&merl, &bsdf] {
+        assert_eq!(
+            shown(brdftab::measured::info::info(m).unwrap()),
+            m.display().to_string()
+        );
+        let text = brdftab::measured::info::describe(m).unwrap();
+        assert!(text.contains("caf\u{FFFD}-dir"), "{text}");
+    }
+
+    // The cache of baked tables in such a directory: baked there, then found there.
+    let cache = dir.join("cache");
+    let c = brdftab::cache::bake_cached(LAMBERT, &settings, Some(&cache), false).unwrap();
+    assert!(
+        !c.hit && c.path.starts_with(&cache) && c.path.is_file(),
+        "{:?}",
+        c.path
+    );
+    close(c.path.as_os_str());
+    let again = brdftab::cache::bake_cached(&file, &settings, Some(&cache), false).unwrap();
+    assert!(!again.hit && again.path != c.path);
+    assert!(
+        brdftab::cache::bake_cached(&file, &settings, Some(&cache), false)
+            .unwrap()
+            .hit
+    );
+}
+
+fn other() -> brdftab::store::Source {
+    brdftab::store::Source::Other {
+        description: "values".into(),
     }
 }

@@ -158,7 +158,7 @@ fn info_of_a_whole_database_decodes_no_chunk() {
         "{v}"
     );
     // One table of it is sized, as a file holding one table is.
-    let one = info::file_info(&format!("{p}#u")).unwrap();
+    let one = info::file_info(format!("{p}#u")).unwrap();
     assert!(
         one["tables"][0]["sampling_bytes"]
             .as_u64()

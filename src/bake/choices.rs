@@ -2,6 +2,9 @@
 //! ([`SymmetryChoice`]) and where the table goes ([`BakeTarget`]), each parsed from the strings
 //! the CLI, Python and C hosts pass. Plain values: nothing here opens a source or bakes.
 
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+
 use crate::error::{Error, Result};
 use crate::table::Symmetry;
 use crate::table::presets::Preset;
@@ -118,31 +121,31 @@ impl std::str::FromStr for SymmetryChoice {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum BakeTarget {
     /// A single-table brdftab file, replaced atomically.
-    File(String),
+    File(PathBuf),
     /// Table `name` of database `path` (created if absent).
     Db {
         /// The database file.
-        path: String,
+        path: PathBuf,
         /// The table's name.
         name: String,
         /// Replace a table of that name (otherwise an existing name is an error).
         replace: bool,
     },
     /// A raw (uncompressed f32) table file.
-    Raw(String),
+    Raw(PathBuf),
     /// A MERL `.binary` file: the source resampled as MERL cell means, in RGB (the grid,
     /// symmetry and codec of the request do not apply; the format fixes them).
-    Merl(String),
+    Merl(PathBuf),
 }
 
 impl BakeTarget {
     /// A single-table file.
-    pub fn file(path: impl Into<String>) -> BakeTarget {
+    pub fn file(path: impl Into<PathBuf>) -> BakeTarget {
         BakeTarget::File(path.into())
     }
 
     /// A new table of a database.
-    pub fn db(path: impl Into<String>, name: impl Into<String>) -> BakeTarget {
+    pub fn db(path: impl Into<PathBuf>, name: impl Into<String>) -> BakeTarget {
         BakeTarget::Db {
             path: path.into(),
             name: name.into(),
@@ -152,24 +155,29 @@ impl BakeTarget {
 
     /// Reads an output string the way `convert` does: `DB#NAME` is a database entry, a `.btdb`
     /// file a single-table file (or, with `name`, an entry of that database), anything else a
-    /// raw table file.
-    pub fn parse(output: &str, name: Option<&str>, replace: bool) -> Result<BakeTarget> {
-        let (path, entry) = crate::store::name::parse_source("output", output)?;
-        Ok(
-            match (entry.or(name), path.to_ascii_lowercase().ends_with(".btdb")) {
-                (Some(n), _) => BakeTarget::Db {
-                    path: path.into(),
-                    name: n.into(),
-                    replace,
-                },
-                (None, true) => BakeTarget::File(path.into()),
-                (None, false) => BakeTarget::Raw(path.into()),
+    /// raw table file. The output need not be UTF-8 (a file name is bytes): `DB#NAME` is split
+    /// on its bytes ([`crate::store::name::parse_output_os`]).
+    pub fn parse(
+        output: impl AsRef<OsStr>,
+        name: Option<&str>,
+        replace: bool,
+    ) -> Result<BakeTarget> {
+        let (path, entry) = crate::store::name::parse_output_os("output", output.as_ref())?;
+        let btdb = path.as_os_str().as_encoded_bytes();
+        let btdb = btdb.len() >= 5 && btdb[btdb.len() - 5..].eq_ignore_ascii_case(b".btdb");
+        Ok(match (entry.or(name), btdb) {
+            (Some(n), _) => BakeTarget::Db {
+                path: path.into(),
+                name: n.into(),
+                replace,
             },
-        )
+            (None, true) => BakeTarget::File(path.into()),
+            (None, false) => BakeTarget::Raw(path.into()),
+        })
     }
 
     /// The file written.
-    pub fn path(&self) -> &str {
+    pub fn path(&self) -> &Path {
         match self {
             BakeTarget::File(p)
             | BakeTarget::Raw(p)

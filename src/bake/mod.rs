@@ -13,7 +13,7 @@
 //! let out = dir.join("lambert.btdb");
 //! let report = BakeRequest::new(r#"{"model": "lambert", "kd": [0.1, 0.2, 0.3]}"#)
 //!     .preset(Preset::Small)
-//!     .run(&BakeTarget::file(out.to_str().unwrap()))?;
+//!     .run(&BakeTarget::file(&out))?;
 //! assert_eq!(report.name, "lambert");
 //! assert_eq!(report.info["codec"]["quant"], "log16");
 //! # std::fs::remove_dir_all(&dir)?;

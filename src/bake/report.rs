@@ -19,7 +19,8 @@ pub struct BakeReport {
     pub source: String,
     /// The table's name.
     pub name: String,
-    /// What was written: a file, `DB#NAME`, or a raw file.
+    /// What was written: a file, `DB#NAME`, or a raw file, as text (a path that is not UTF-8
+    /// shown lossily; [`written`](Self::written) is the path itself).
     pub output: String,
     /// The grid baked on.
     pub grid: Grid,

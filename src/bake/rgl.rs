@@ -27,17 +27,17 @@ pub struct Converted {
 pub fn to_rgl(
     source: impl AsRef<std::ffi::OsStr>,
     channels: Option<Channels>,
-    output: &str,
+    output: impl AsRef<std::path::Path>,
     opts: &rgl_write::Options,
     pairs: usize,
     progress: &dyn Progress,
 ) -> Result<Converted> {
-    let source = source.as_ref();
+    let (source, output) = (source.as_ref(), output.as_ref());
     let open = OpenOptions {
         channels,
         ..Default::default()
     };
-    crate::files::refuse_input(std::path::Path::new(output), &[source])?;
+    crate::files::refuse_input(output, &[source])?;
     let brdf = source::open_with(source, &open)?;
     crate::table::fill::tabulable(brdf.as_ref())?;
     let opts = opts.clone().reuse_source_file(source)?;

@@ -32,7 +32,7 @@ impl BakeRequest {
         self.validate()?;
         // An output that is not a regular file (a FIFO, a device, a directory), before any
         // work and before a database there is read.
-        crate::files::check_output(&crate::files::resolve_links(Path::new(target.path()))?)?;
+        crate::files::check_output(&crate::files::resolve_links(target.path())?)?;
         self.refuse_overwrite(target)?;
         let name = match (target, &self.name) {
             // `DB#NAME` with another `name` setting: which one the user meant is unknown, and
@@ -109,7 +109,7 @@ impl BakeRequest {
             let mut report =
                 self.report_for(src.as_ref(), &Grid::merl(Channels::Rgb), None, t0, true);
             report.name = stem(path);
-            report.output = path.clone();
+            report.output = path.display().to_string();
             report.written = Some(target.clone());
             return Ok(report);
         }
@@ -152,8 +152,8 @@ impl BakeRequest {
         }
         report.name = name.clone();
         report.output = match target {
-            BakeTarget::Db { path, .. } => format!("{path}#{name}"),
-            t => t.path().to_owned(),
+            BakeTarget::Db { path, .. } => format!("{}#{name}", path.display()),
+            t => t.path().display().to_string(),
         };
         report.written = Some(target.clone());
         if matches!(target, BakeTarget::File(_) | BakeTarget::Db { .. }) {
@@ -185,7 +185,7 @@ impl BakeRequest {
         {
             return Ok(());
         }
-        crate::files::refuse_input(std::path::Path::new(target.path()), &[&self.source])
+        crate::files::refuse_input(target.path(), &[&self.source])
     }
 
     fn stream(
@@ -289,11 +289,11 @@ mod tests {
         let raw = d.join("ct.tbl").to_str().unwrap().to_owned();
         let r1 = req.run(&BakeTarget::file(&file)).unwrap();
         let merl = d.join("ct.binary").to_str().unwrap().to_owned();
-        let rm = req.run(&BakeTarget::Merl(merl.clone())).unwrap();
+        let rm = req.run(&BakeTarget::Merl(merl.clone().into())).unwrap();
         assert!(rm.merl_cells && rm.output == merl);
         assert!(crate::measured::MerlBrdf::open(&merl).is_ok());
         let r2 = req.run(&BakeTarget::db(&dbp, "ct")).unwrap();
-        let r3 = req.run(&BakeTarget::Raw(raw.clone())).unwrap();
+        let r3 = req.run(&BakeTarget::Raw(raw.clone().into())).unwrap();
         assert_eq!(r1.name, "ct");
         assert_eq!(r2.output, format!("{dbp}#ct"));
         assert_eq!(r1.info["values"], r2.info["values"]);
@@ -312,7 +312,7 @@ mod tests {
         // A second add of the same name is refused; with replace it succeeds.
         assert!(req.run(&BakeTarget::db(&dbp, "ct")).is_err());
         let replace = BakeTarget::Db {
-            path: dbp.clone(),
+            path: dbp.clone().into(),
             name: "ct".into(),
             replace: true,
         };
@@ -441,7 +441,7 @@ mod tests {
         let db = d.join("lib.btdb").to_str().unwrap().to_owned();
         let req = BakeRequest::new(r#"{"model":"lambert","kd":0.5}"#).preset(Preset::Small);
         let target = |replace| BakeTarget::Db {
-            path: db.clone(),
+            path: db.clone().into(),
             name: "matte".into(),
             replace,
         };

@@ -3,6 +3,7 @@
 //! description, dimensions, channels, sha256.
 
 use std::fmt::Write as _;
+use std::path::Path;
 
 use serde_json::{Value, json};
 
@@ -10,31 +11,40 @@ use super::{MerlBrdf, RglBrdf, merl, tensor::TensorFile};
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
 
-/// The description of the measured file at `path`, one `key: value` line each.
-pub fn describe(path: &str) -> Result<String> {
-    let lower = path.to_ascii_lowercase();
-    if lower.ends_with(".binary") {
+/// The description of the measured file at `path`, one `key: value` line each (a path that is
+/// not UTF-8 is shown lossily).
+pub fn describe(path: impl AsRef<Path>) -> Result<String> {
+    let path = path.as_ref();
+    if ends_with(path, ".binary") {
         describe_merl(path)
-    } else if lower.ends_with(".bsdf") {
+    } else if ends_with(path, ".bsdf") {
         describe_rgl(path)
     } else {
         Err(Error::Unsupported(format!(
-            "{path}: not a measured file (.binary, .bsdf)"
+            "{}: not a measured file (.binary, .bsdf)",
+            path.display()
         )))
     }
+}
+
+/// Whether `path` ends in `ext` in any case (on its bytes: a name need not be UTF-8).
+fn ends_with(path: &Path, ext: &str) -> bool {
+    let b = path.as_os_str().as_encoded_bytes();
+    b.len() >= ext.len() && b[b.len() - ext.len()..].eq_ignore_ascii_case(ext.as_bytes())
 }
 
 /// [`describe`] as JSON: `file`, `format` (`merl` or `rgl`), `bytes`, `channels`, `sha256`,
 /// and per format: MERL `material` (the published name, or null), `dims` (θh, θd, φd),
 /// `unmeasured` and `cells`; RGL `description`, `kind`, `isotropic`, `reduction`, `phi_i`,
 /// `theta_i`, `resolution`, `vndf_resolution` and `fields` (name, type, offset).
-pub fn info(path: &str) -> Result<Value> {
-    let lower = path.to_ascii_lowercase();
-    if lower.ends_with(".binary") {
+pub fn info(path: impl AsRef<Path>) -> Result<Value> {
+    let path = path.as_ref();
+    let file = path.display().to_string();
+    if ends_with(path, ".binary") {
         let sha = merl::sha256_file(path)?;
         let m = MerlBrdf::open(path)?;
         Ok(json!({
-            "file": path,
+            "file": file,
             "format": "merl",
             "bytes": merl::FILE_SIZE,
             "material": merl::material_of(&sha),
@@ -44,7 +54,7 @@ pub fn info(path: &str) -> Result<Value> {
             "cells": merl::SAMPLES,
             "sha256": sha,
         }))
-    } else if lower.ends_with(".bsdf") {
+    } else if ends_with(path, ".bsdf") {
         let t = TensorFile::open(path)?;
         let b = RglBrdf::from_tensor(&t, None)?;
         let s = b.summary();
@@ -54,7 +64,7 @@ pub fn info(path: &str) -> Result<Value> {
             .map(|f| json!({"name": f.name, "type": f.describe(), "offset": f.offset}))
             .collect();
         Ok(json!({
-            "file": path,
+            "file": file,
             "format": "rgl",
             "bytes": t.size(),
             "description": s.description,
@@ -74,11 +84,11 @@ pub fn info(path: &str) -> Result<Value> {
     }
 }
 
-fn describe_merl(path: &str) -> Result<String> {
+fn describe_merl(path: &Path) -> Result<String> {
     let sha = merl::sha256_file(path)?;
     let m = MerlBrdf::open(path)?;
     let mut o = String::new();
-    let _ = writeln!(o, "file:        {path}");
+    let _ = writeln!(o, "file:        {}", path.display());
     let _ = writeln!(
         o,
         "format:      MERL BRDF database (.binary, Matusik et al. 2003)"
@@ -112,12 +122,12 @@ fn describe_merl(path: &str) -> Result<String> {
     Ok(o)
 }
 
-fn describe_rgl(path: &str) -> Result<String> {
+fn describe_rgl(path: &Path) -> Result<String> {
     let t = TensorFile::open(path)?;
     let b = RglBrdf::from_tensor(&t, None)?;
     let s = b.summary();
     let mut o = String::new();
-    let _ = writeln!(o, "file:        {path}");
+    let _ = writeln!(o, "file:        {}", path.display());
     let _ = writeln!(
         o,
         "format:      RGL-EPFL tensor file (.bsdf, Dupuy & Jakob 2018), {} bytes",

@@ -162,7 +162,7 @@ impl BakeSettings {
 /// source, baking and writing fail with.
 pub fn bake(
     source: impl AsRef<std::ffi::OsStr>,
-    output: &str,
+    output: impl AsRef<std::ffi::OsStr>,
     settings: &BakeSettings,
     progress: &dyn Progress,
 ) -> Result<BakeReport> {

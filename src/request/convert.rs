@@ -1,6 +1,8 @@
 //! [`ConvertSettings`] and [`convert`]: any SOURCE into a MERL file, an RGL `.bsdf` file or a
 //! table, the output's kind chosen by its name — the one conversion every host runs.
 
+use std::ffi::OsStr;
+
 use serde::{Deserialize, Serialize};
 
 use super::bake::BakeSettings;
@@ -77,11 +79,11 @@ pub enum ConvertOutput {
 /// the source and writing the output fail with.
 pub fn convert(
     source: impl AsRef<std::ffi::OsStr>,
-    output: &str,
+    output: impl AsRef<std::ffi::OsStr>,
     settings: &ConvertSettings,
     progress: &dyn Progress,
 ) -> Result<ConvertOutput> {
-    let source = source.as_ref();
+    let (source, output) = (source.as_ref(), output.as_ref());
     let mut req = settings.bake.request(source)?;
     let pairs = settings.pairs.unwrap_or(DEFAULT_PAIRS);
     // Checked before the bake, not after it: the comparison's own check (per channel count)
@@ -96,7 +98,7 @@ pub fn convert(
     refuse_unused(settings, kind, output)?;
     match kind {
         SourceKind::Merl => Ok(ConvertOutput::Merl(
-            req.run_with(&BakeTarget::Merl(output.to_owned()), progress)?,
+            req.run_with(&BakeTarget::Merl(output.into()), progress)?,
         )),
         SourceKind::Rgl => {
             let opts = rgl_write::Options {
@@ -154,7 +156,7 @@ fn accuracy_interp(s: Option<&str>) -> Result<Option<Interp>> {
 /// Refuses a setting the output's kind does not use: it was dropped without a word (a MERL
 /// `.binary` asked for `wavelengths` came out RGB; a `.bsdf` asked for a codec or a preset
 /// ignored it).
-fn refuse_unused(settings: &ConvertSettings, kind: SourceKind, output: &str) -> Result<()> {
+fn refuse_unused(settings: &ConvertSettings, kind: SourceKind, output: &OsStr) -> Result<()> {
     let b = &settings.bake;
     let table = [
         ("preset", b.preset.is_some()),
@@ -195,7 +197,7 @@ fn refuse_unused(settings: &ConvertSettings, kind: SourceKind, output: &str) -> 
     match unused.into_iter().find(|(_, given)| *given) {
         Some((field, _)) => Err(crate::Error::arg(
             field,
-            format!("does not apply to {output}, {what}"),
+            format!("does not apply to {}, {what}", output.to_string_lossy()),
         )),
         None => Ok(()),
     }

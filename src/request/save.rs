@@ -6,6 +6,7 @@
 //! with a bake's codec settings and its output rule (a `.btdb` file replaced atomically, or
 //! `DB#NAME`), so `brdftab import`, Python's `Table.save` and any later host store them alike.
 
+use std::ffi::OsStr;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
@@ -84,12 +85,12 @@ impl SaveSettings {
 /// ([`Error::Encode`]: f16 beyond ±65504), and whatever writing fails with.
 pub fn save_table(
     table: &Table,
-    output: &str,
+    output: impl AsRef<OsStr>,
     source: store::Source,
     settings: &SaveSettings,
 ) -> Result<serde_json::Value> {
     let codec = settings.codec()?;
-    let (path, name) = match target(output, settings.replace)? {
+    let (path, name) = match target(&output, settings.replace)? {
         BakeTarget::Db {
             path,
             name,
@@ -130,20 +131,22 @@ pub fn save_table(
 /// stored node; and what [`save_table`] fails with.
 pub fn import_npy(
     array: &Path,
-    like: &str,
-    output: &str,
+    like: impl AsRef<OsStr>,
+    output: impl AsRef<OsStr>,
     settings: &SaveSettings,
     calibration: bool,
 ) -> Result<serde_json::Value> {
     // Settings and output before any file is read.
     settings.codec()?;
-    let out_path = target(output, settings.replace)?.path().to_owned();
-    if crate::files::same_file(Path::new(&out_path), array) {
+    let like = like.as_ref();
+    let out_path = target(&output, settings.replace)?.path().to_owned();
+    if crate::files::same_file(&out_path, array) {
         return Err(Error::arg(
             "output",
             format!(
-                "{out_path} is the array being imported: writing the table there would replace \
-                 it (write to another file)"
+                "{} is the array being imported: writing the table there would replace \
+                 it (write to another file)",
+                out_path.display()
             ),
         ));
     }
@@ -165,7 +168,7 @@ pub fn import_npy(
                 "an array of shape {:?}; the table {} holds an array of shape {shape:?} (its \
                  stored axes and channels, as its .npy export writes them)",
                 h.shape,
-                excerpt(like)
+                excerpt(&like.to_string_lossy())
             ),
         ));
     }
@@ -190,7 +193,10 @@ pub fn import_npy(
     let name = array
         .file_name()
         .map_or_else(|| file.clone(), |n| n.to_string_lossy().into_owned());
-    let description = format!("values from {name} on the grid of {like}");
+    let description = format!(
+        "values from {name} on the grid of {}",
+        like.to_string_lossy()
+    );
     let table = Table::from_array(grid, &shape, data, description.clone())?;
     save_table(
         &table,
@@ -201,21 +207,24 @@ pub fn import_npy(
 }
 
 /// Where [`bake()`](super::bake()) and [`save_table`] write `output`; a `DB#NAME` with an empty or invalid name is an argument
-/// error naming `output` ([`crate::store::name`]).
-pub fn target(output: &str, replace: bool) -> Result<BakeTarget> {
-    Ok(match crate::store::name::parse_source("output", output)? {
-        (path, Some(name)) => BakeTarget::Db {
-            path: path.into(),
-            name: name.into(),
-            replace,
+/// error naming `output` ([`crate::store::name`]). The output need not be UTF-8: `DB#NAME` is
+/// split on its bytes ([`crate::store::name::parse_output_os`]).
+pub fn target(output: impl AsRef<OsStr>, replace: bool) -> Result<BakeTarget> {
+    Ok(
+        match crate::store::name::parse_output_os("output", output.as_ref())? {
+            (path, Some(name)) => BakeTarget::Db {
+                path: path.into(),
+                name: name.into(),
+                replace,
+            },
+            (path, None) => BakeTarget::File(path.into()),
         },
-        (path, None) => BakeTarget::File(path.into()),
-    })
+    )
 }
 
 /// The grid of the table SOURCE `like`; anything that is not a stored table is an error naming
 /// `like`.
-fn like_grid(like: &str) -> Result<Grid> {
+fn like_grid(like: &OsStr) -> Result<Grid> {
     let kind = source::classify(like);
     if kind != SourceKind::Table {
         return Err(Error::arg(
@@ -223,7 +232,7 @@ fn like_grid(like: &str) -> Result<Grid> {
             format!(
                 "{} is a {} source, not a stored table (a table file or DB#NAME): its grid is \
                  the table's",
-                excerpt(like),
+                excerpt(&like.to_string_lossy()),
                 kind.name()
             ),
         ));
@@ -332,7 +341,7 @@ mod tests {
         let info = save_table(&t, &entry, other("a"), &SaveSettings::default()).unwrap();
         assert_eq!(info["tables"][0]["codec"]["quant"], "log16");
         assert_eq!(info["tables"].as_array().unwrap().len(), 1);
-        save_table(&t, &format!("{db}#b"), other("b"), &lossless()).unwrap();
+        save_table(&t, format!("{db}#b"), other("b"), &lossless()).unwrap();
         let again = save_table(&doubled, &entry, other("a"), &lossless()).unwrap_err();
         assert!(matches!(again, Error::Duplicate { .. }), "{again}");
         let replace = SaveSettings {
@@ -346,7 +355,7 @@ mod tests {
             name: Some("mine".into()),
             ..lossless()
         };
-        let info = save_table(&t, &d.file("x.btdb"), other("x"), &named).unwrap();
+        let info = save_table(&t, d.file("x.btdb"), other("x"), &named).unwrap();
         assert_eq!(info["tables"][0]["name"], "mine");
     }
 
@@ -368,7 +377,7 @@ mod tests {
                 r => panic!("{json}: {r:?}"),
             }
         }
-        match save_table(&t, &format!("{out}#"), other("x"), &lossless()) {
+        match save_table(&t, format!("{out}#"), other("x"), &lossless()) {
             Err(Error::InvalidArgument { name, .. }) => assert_eq!(name, "output"),
             r => panic!("{r:?}"),
         }

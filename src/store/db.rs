@@ -279,7 +279,10 @@ pub fn verify(path: impl AsRef<Path>) -> Result<usize> {
 /// Splits SOURCE `DB#NAME` into the path and the optional table name; an empty name
 /// (`x.btdb#`) or one [`super::name::check`] refuses is an argument error naming `source`. A
 /// string that names an existing file as a whole (`a#b.btdb`) is that file
-/// ([`super::name::parse_input`]).
-pub fn split_source(source: &str) -> Result<(&str, Option<&str>)> {
-    super::name::parse_input("source", source)
+/// ([`super::name::parse_input`]). SOURCE need not be UTF-8 (a `&str`, `OsStr` or `Path`; split
+/// on its bytes: [`super::name::parse_input_os`]).
+pub fn split_source<S: AsRef<std::ffi::OsStr> + ?Sized>(
+    source: &S,
+) -> Result<(&Path, Option<&str>)> {
+    super::name::parse_input_os("source", source.as_ref())
 }

@@ -13,7 +13,9 @@
 //! holds, also when `tables` reports one of them) and `tables` per file. The last two say
 //! how the raw values (`export`, Python's `Table.values`) become f_r.
 
+use std::ffi::OsStr;
 use std::fmt::Write as _;
+use std::path::Path;
 
 use serde_json::{Value, json};
 
@@ -114,7 +116,7 @@ fn sampling_resolution(
 }
 
 /// The summary of table `name` of the file at `path`.
-pub fn table_info(path: &str, name: &str) -> Result<Value> {
+pub fn table_info(path: impl AsRef<Path>, name: &str) -> Result<Value> {
     table_summary(&Store::open(path)?, name)
 }
 
@@ -123,7 +125,7 @@ pub fn table_info(path: &str, name: &str) -> Result<Value> {
 /// decoded. (Sizing each table's sampler made `db list` of a database of 1,000 tables of
 /// 576 values take 94 s, and decoded every chunk of every table with a one-array kernel:
 /// [`table_summary`] and `info` of one table report it.)
-pub fn list(path: &str) -> Result<Vec<Value>> {
+pub fn list(path: impl AsRef<Path>) -> Result<Vec<Value>> {
     let s = Store::open(path)?;
     s.tables()
         .iter()
@@ -131,9 +133,10 @@ pub fn list(path: &str) -> Result<Vec<Value>> {
         .collect()
 }
 
-/// What `info` reports of `FILE` (every table) or `DB#NAME` (that table).
-pub fn file_info(source: &str) -> Result<Value> {
-    let (path, name) = db::split_source(source)?;
+/// What `info` reports of `FILE` (every table) or `DB#NAME` (that table); SOURCE need not be
+/// UTF-8 ([`db::split_source`]).
+pub fn file_info(source: impl AsRef<OsStr>) -> Result<Value> {
+    let (path, name) = db::split_source(source.as_ref())?;
     file_info_at(path, name)
 }
 
@@ -141,8 +144,10 @@ pub fn file_info(source: &str) -> Result<Value> {
 /// `name`, or every table for `None`. `sampling_bytes` is reported of one table (`name`, or a
 /// file holding one table): sizing a sampler builds it (0.1 s for the smallest table, every
 /// chunk of a one-array table decoded), and `info` of a database of 1,000 small tables took
-/// 94 s (session 39). A database of several tables is reported as [`list`] reads it.
-pub fn file_info_at(path: &str, name: Option<&str>) -> Result<Value> {
+/// 94 s (session 39). A database of several tables is reported as [`list`] reads it. `file` is
+/// the path as text (lossily when it is not UTF-8).
+pub fn file_info_at(path: impl AsRef<Path>, name: Option<&str>) -> Result<Value> {
+    let path = path.as_ref();
     let s = Store::open(path)?;
     let names: Vec<String> = match name {
         Some(n) => vec![n.to_owned()],
@@ -161,7 +166,7 @@ pub fn file_info_at(path: &str, name: Option<&str>) -> Result<Value> {
         .map(|e| s.table(&e.name).map(|t| t.header().values))
         .sum::<Result<u64>>()?;
     Ok(json!({
-        "file": path,
+        "file": path.display().to_string(),
         "format": "btdb",
         "bytes": s.file_len(),
         "ratio_to_f32": values as f64 * 4.0 / s.file_len().max(1) as f64,
@@ -177,7 +182,8 @@ pub type TextFn = fn(&Value) -> String;
 /// renders it as text: a brdftab file or `DB#NAME` ([`file_info`], [`file_text`]) or a raw
 /// table ([`raw_info`], [`raw_text`]). A `DB#NAME` is a database's table even when DB is
 /// missing, so that the error names DB (not a raw file `DB#NAME`).
-pub fn table_file_info(source: &str) -> Result<(Value, TextFn)> {
+pub fn table_file_info(source: impl AsRef<OsStr>) -> Result<(Value, TextFn)> {
+    let source = source.as_ref();
     let (path, name) = db::split_source(source)?;
     if name.is_some() || super::tables::is_store_file(path) {
         Ok((file_info(source)?, file_text))
@@ -187,14 +193,15 @@ pub fn table_file_info(source: &str) -> Result<(Value, TextFn)> {
 }
 
 /// What `info` reports of a raw table file (`format` = `raw`).
-pub fn raw_info(path: &str) -> Result<Value> {
+pub fn raw_info(path: impl AsRef<Path>) -> Result<Value> {
+    let path = path.as_ref();
     let t = Table::open_raw(path)?;
     let g = t.grid();
     let bytes = std::fs::metadata(path)
         .map_err(|e| Error::io(path, e))?
         .len();
     Ok(json!({
-        "file": path,
+        "file": path.display().to_string(),
         "format": "raw",
         "description": t.description(),
         "grid": g,

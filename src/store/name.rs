@@ -104,13 +104,31 @@ pub fn parse_input_os<'a>(field: &str, source: &'a OsStr) -> Result<(&'a Path, O
     if let Some(s) = source.to_str() {
         return parse_input(field, s).map(|(p, n)| (Path::new(p), n));
     }
+    split_os(field, source, true)
+}
+
+/// [`parse_source`] of an output that need not be UTF-8: split by the string rule alone (an
+/// output never looks on disk), on the bytes for a string that is not UTF-8, as
+/// [`parse_input_os`] splits a SOURCE.
+pub fn parse_output_os<'a>(field: &str, output: &'a OsStr) -> Result<(&'a Path, Option<&'a str>)> {
+    if let Some(s) = output.to_str() {
+        return parse_source(field, s).map(|(p, n)| (Path::new(p), n));
+    }
+    split_os(field, output, false)
+}
+
+/// The `DB#NAME` split of a string that is not UTF-8, on its bytes: the whole string when it
+/// has no `#`, when the part after the last `#` holds a `/`, or (`read`) when something exists
+/// on disk under the whole string; else the path before the `#` as the bytes it is and the
+/// name after it, which must be UTF-8 and pass [`check`].
+fn split_os<'a>(field: &str, source: &'a OsStr, read: bool) -> Result<(&'a Path, Option<&'a str>)> {
     let whole = Ok((Path::new(source), None));
     let bytes = source.as_encoded_bytes();
     let Some(i) = bytes.iter().rposition(|&b| b == b'#') else {
         return whole;
     };
     let name = &bytes[i + 1..];
-    if name.contains(&b'/') || std::fs::metadata(source).is_ok() {
+    if name.contains(&b'/') || (read && std::fs::metadata(source).is_ok()) {
         return whole;
     }
     let shown = format!("{:?}", source.to_string_lossy());
@@ -231,6 +249,46 @@ mod tests {
         std::fs::write(&db, b"x").unwrap();
         let s = format!("{db}#t");
         assert_eq!(parse_input("source", &s).unwrap(), (db.as_str(), Some("t")));
+    }
+
+    /// An output that is not UTF-8 splits on its bytes by the string rule, whatever exists on
+    /// disk (a SOURCE that is read is looked up whole first).
+    #[cfg(unix)]
+    #[test]
+    fn an_output_that_is_not_utf8_splits_by_the_string_rule() {
+        use std::os::unix::ffi::OsStrExt;
+        let d = crate::testkit::TempDir::new("name-out-os");
+        let whole = d.path().join(OsStr::from_bytes(b"caf\xe9.btdb#m"));
+        std::fs::write(&whole, b"x").unwrap();
+        let db = d.path().join(OsStr::from_bytes(b"caf\xe9.btdb"));
+        let s = whole.as_os_str();
+        assert_eq!(
+            parse_output_os("output", s).unwrap(),
+            (db.as_path(), Some("m"))
+        );
+        assert_eq!(
+            parse_input_os("source", s).unwrap(),
+            (whole.as_path(), None)
+        );
+        let dir = OsStr::from_bytes(b"d#\xe9/x.btdb");
+        assert_eq!(
+            parse_output_os("output", dir).unwrap(),
+            (Path::new(dir), None)
+        );
+        // Refused, the string shown lossily where the message quotes it.
+        for (bad, quoted) in [
+            (&b"caf\xe9.btdb#"[..], true),
+            (b"caf\xe9.btdb#\xe9", true),
+            (b"caf\xe9.btdb#a\tb", false),
+        ] {
+            let e = parse_output_os("output", OsStr::from_bytes(bad)).unwrap_err();
+            assert_eq!(e.to_string().contains("caf\u{FFFD}"), quoted, "{e}");
+            assert_eq!(field_of(e), "output");
+        }
+        assert_eq!(
+            parse_output_os("output", OsStr::new("x.btdb#m")).unwrap(),
+            (Path::new("x.btdb"), Some("m"))
+        );
     }
 
     fn e_msg(s: &str) -> String {

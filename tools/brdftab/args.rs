@@ -2,6 +2,8 @@
 //! error's field (`max_depth`) named as the flag (`--max-depth`) — the library's errors name
 //! settings, never flags (DESIGN: one request layer), so the CLI translates them.
 
+use std::ffi::{OsStr, OsString};
+use std::path::Path;
 use std::process::ExitCode;
 
 use clap::{ArgMatches, Command};
@@ -94,8 +96,57 @@ pub fn one_line(msg: &str) -> String {
     out
 }
 
+/// A path or SOURCE argument as the user typed it: the bytes of the command line (on Linux a
+/// file name need not be UTF-8), passed to the library as an `OsStr`/`Path` and shown with
+/// U+FFFD for the bytes that are not UTF-8 (`Display`). Its own type, rather than `OsString`,
+/// so that a command prints it as it printed a `String` argument.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct PathArg(pub OsString);
+
+impl From<OsString> for PathArg {
+    fn from(s: OsString) -> PathArg {
+        PathArg(s)
+    }
+}
+
+impl std::fmt::Display for PathArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0.to_string_lossy())
+    }
+}
+
+impl std::ops::Deref for PathArg {
+    type Target = Path;
+
+    fn deref(&self) -> &Path {
+        Path::new(&self.0)
+    }
+}
+
+impl AsRef<OsStr> for PathArg {
+    fn as_ref(&self) -> &OsStr {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for PathArg {
+    fn as_ref(&self) -> &Path {
+        Path::new(&self.0)
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    #[cfg(unix)]
+    #[test]
+    fn a_path_argument_keeps_its_bytes_and_shows_them_lossily() {
+        use std::os::unix::ffi::OsStringExt;
+        let p = super::PathArg::from(std::ffi::OsString::from_vec(b"caf\xe9.btdb".to_vec()));
+        assert_eq!(p.0.as_encoded_bytes(), b"caf\xe9.btdb");
+        assert_eq!(p.to_string(), "caf\u{FFFD}.btdb");
+        assert_eq!(p.extension().and_then(|e| e.to_str()), Some("btdb"));
+    }
+
     #[test]
     fn usage_errors_are_one_line() {
         let msg = "error: unexpected argument '-o' found\n\n  tip: to pass '-o' as a value, use \

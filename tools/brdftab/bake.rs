@@ -17,7 +17,7 @@ pub struct BakeArgs {
     pub source: std::ffi::OsString,
     /// Output table file (`.btdb`), or `DB#NAME`.
     #[arg(short, long)]
-    pub output: String,
+    pub output: brdftab_tools::args::PathArg,
     #[command(flatten)]
     pub settings: BakeSettings,
 }

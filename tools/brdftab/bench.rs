@@ -13,12 +13,12 @@ use brdftab_tools::text::{or_unknown, print_out};
 pub struct BenchArgs {
     /// Any SOURCE: a spec, a table (`FILE.btdb`, `DB#NAME`), a MERL or RGL file (not with --measured).
     #[arg(required_unless_present = "measured", conflicts_with = "measured")]
-    source: Option<String>,
+    source: Option<brdftab_tools::args::PathArg>,
     /// Instead of one source: bake every RGL `.bsdf` file of DIR (default: $BRDFTAB_RGL_DIR,
     /// else the shipped data/rgl) with the defaults and compare each table with the file's own
     /// evaluation in the same run — error, bytes, resident memory, ns per lookup, batch rate.
     #[arg(long, value_name = "DIR", num_args = 0..=1, default_missing_value = "")]
-    measured: Option<String>,
+    measured: Option<brdftab_tools::args::PathArg>,
     /// Number of random pairs.
     #[arg(long, default_value_t = 1_000_000)]
     pairs: usize,
@@ -30,16 +30,16 @@ pub struct BenchArgs {
 }
 
 /// `brdftab bench --measured`.
-fn measured(dir: &str, a: &BenchArgs) -> Result<()> {
+fn measured(dir: &std::path::Path, a: &BenchArgs) -> Result<()> {
     use brdftab_tools::report::measured;
-    let dir = match dir {
-        "" => brdftab::measured::data::rgl_dir().ok_or_else(|| {
+    let dir = match dir.to_str() {
+        Some("") => brdftab::measured::data::rgl_dir().ok_or_else(|| {
             Error::NotFound(format!(
                 "no RGL directory (searched {:?})",
                 brdftab::measured::data::rgl_dirs()
             ))
         })?,
-        d => std::path::PathBuf::from(d),
+        _ => dir.to_path_buf(),
     };
     // The native file is timed on a quarter of the pairs.
     if a.pairs < 4 {
@@ -94,7 +94,7 @@ pub fn bench(a: BenchArgs) -> Result<()> {
         return measured(d, &a);
     }
     let interp = a.open.interp.as_deref().unwrap_or("auto");
-    let src = brdftab::request::open(a.source.as_deref().unwrap_or_default(), &a.open)?;
+    let src = brdftab::request::open(a.source.clone().unwrap_or_default(), &a.open)?;
     let t = timing::lookups(src.as_ref(), a.pairs, 5)?;
     let mut o = String::new();
     if a.json {

@@ -16,7 +16,7 @@ pub struct ConvertArgs {
     /// The output: an RGL `.bsdf` (loads in Mitsuba 3 and pbrt-v4), a MERL `.binary` (the
     /// source's mean over each MERL cell), a table database entry `DB#NAME` (or a
     /// `.btdb` file, named after the input), or a raw table file.
-    output: String,
+    output: brdftab_tools::args::PathArg,
     #[command(flatten)]
     settings: ConvertSettings,
 }

@@ -25,7 +25,7 @@ enum DbCommand {
     Rm(RmArgs),
     /// Rename table OLD of DB to NEW (refused when DB holds a table NEW).
     Rename {
-        db: String,
+        db: brdftab_tools::args::PathArg,
         old: String,
         new: String,
     },
@@ -42,7 +42,7 @@ enum DbCommand {
     .long_help(None::<&str>)))]
 struct AddArgs {
     /// The database file.
-    db: String,
+    db: brdftab_tools::args::PathArg,
     /// The source: a model spec (inline JSON or .json), a table, a MERL or RGL file.
     source: std::ffi::OsString,
     #[command(flatten)]
@@ -52,7 +52,7 @@ struct AddArgs {
 #[derive(Args)]
 struct ListArgs {
     /// The database file.
-    db: String,
+    db: brdftab_tools::args::PathArg,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -61,7 +61,7 @@ struct ListArgs {
 #[derive(Args)]
 struct RmArgs {
     /// The database file.
-    db: String,
+    db: brdftab_tools::args::PathArg,
     /// The table to remove.
     name: String,
 }
@@ -69,7 +69,7 @@ struct RmArgs {
 #[derive(Args)]
 struct VerifyArgs {
     /// The database file.
-    db: String,
+    db: brdftab_tools::args::PathArg,
 }
 
 /// `brdftab db ...`.
@@ -83,7 +83,7 @@ pub fn run(a: DbArgs) -> Result<()> {
                 .ok_or_else(|| Error::arg("--name", "db add needs --name NAME"))?;
             let req = a.bake.request(&a.source)?;
             let target = BakeTarget::Db {
-                path: a.db.clone(),
+                path: a.db.to_path_buf(),
                 name,
                 replace: a.bake.replace,
             };
@@ -99,7 +99,7 @@ pub fn run(a: DbArgs) -> Result<()> {
     }
 }
 
-fn list(path: &str, as_json: bool) -> Result<()> {
+fn list(path: &std::path::Path, as_json: bool) -> Result<()> {
     let rows = store::info::list(path)?;
     if as_json {
         let json = serde_json::to_string_pretty(&rows).unwrap_or_default();

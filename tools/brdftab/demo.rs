@@ -58,7 +58,7 @@ const ACCURACY_PAIRS: usize = 50_000;
 /// A source of the demo: table name, SOURCE string, whether it is measured, the opened BRDF.
 struct Source {
     name: String,
-    source: String,
+    source: std::ffi::OsString,
     measured: bool,
     brdf: Box<dyn Brdf + Send + Sync>,
 }
@@ -92,10 +92,10 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         db.display()
     ))?;
     let bar = brdftab_tools::progress::Bar::values();
-    let target = |name: &str| BakeTarget::db(db.display().to_string(), name);
+    let target = |name: &str| BakeTarget::db(&db, name);
     let mut seconds = Vec::new();
     for s in &sources {
-        let req = BakeRequest::new(s.source.as_str()).channels(Channels::Rgb);
+        let req = BakeRequest::new(&s.source).channels(Channels::Rgb);
         let req = match preset {
             // The library's defaults: what a user gets from `brdftab bake SOURCE`.
             None => req,
@@ -229,7 +229,7 @@ fn sources(rgl: Option<&std::path::Path>) -> Result<Vec<Source>> {
     let mut v = Vec::new();
     for (name, spec) in BAKED_MODELS {
         let brdf = brdftab::ModelSpec::parse(spec)?.build(&Channels::Rgb)?;
-        let (name, source) = (name.to_string(), spec.to_string());
+        let (name, source) = (name.to_string(), spec.into());
         v.push(Source {
             name,
             source,

@@ -10,14 +10,14 @@ use clap::Args;
 #[derive(Args)]
 pub struct ExportArgs {
     /// The table: a brdftab file, or `DB#NAME`.
-    source: String,
+    source: brdftab_tools::args::PathArg,
     /// Write the dense table as .npy (shape = stored grid dims + channels, float32): the stored
     /// quantity as `info` names it (f_r, f_r cos θo or f_r cos θi cos θo; before a calibration).
     #[arg(long)]
-    npy: Option<String>,
+    npy: Option<brdftab_tools::args::PathArg>,
     /// Write a 2D slice as OpenEXR (channels as EXR channels): a `.exr` file.
     #[arg(long, requires = "slice")]
-    exr: Option<String>,
+    exr: Option<brdftab_tools::args::PathArg>,
     /// The --exr slice: `X,Y[:I0,I1,I2,I3]` — the stored axes along x and y, then an index for
     /// every stored axis (as many as `info` lists before the channels; those at X and Y are
     /// ignored); without them, the others at index 0.
@@ -44,7 +44,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     if let Some(out) = &a.exr {
         brdftab_tools::output::check(out, "--exr", &["exr"])?;
     }
-    let (path, name) = db::split_source(&a.source)?;
+    let (path, name) = db::split_source(&*a.source)?;
     let s = Store::open(path)?;
     let t = match name {
         Some(n) => s.table(n)?,
@@ -128,10 +128,10 @@ pub struct ImportArgs {
     /// The table (file or DB#NAME) whose grid — layout, symmetry, stored quantity, albedo
     /// calibration — the values are on.
     #[arg(long)]
-    like: String,
+    like: brdftab_tools::args::PathArg,
     /// Output: a table file (`.btdb`, replaced atomically) or DB#NAME.
     #[arg(short, long)]
-    output: String,
+    output: brdftab_tools::args::PathArg,
     /// The values are another material's: drop the --like table's albedo calibration (its
     /// factors were measured for the like table's own values).
     #[arg(long)]

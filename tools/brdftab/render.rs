@@ -14,7 +14,7 @@ use brdftab_tools::outln;
 #[derive(Args)]
 pub struct RenderArgs {
     /// The material: a model spec (inline JSON or .json), a table, a MERL or RGL file.
-    source: String,
+    source: brdftab_tools::args::PathArg,
     /// Output image, .png (8-bit sRGB) or .exr (linear f32).
     #[arg(short, long)]
     output: PathBuf,
@@ -36,7 +36,7 @@ pub struct RenderArgs {
     /// Environment: `sky` (smooth procedural), `white` (constant 1, the furnace), `none`, or a
     /// lat-long FILE.exr as pbrt-v3 reads it (z up: row 0 = zenith, φ = 2πu from +x to +y).
     #[arg(long, default_value = "sky")]
-    env: String,
+    env: brdftab_tools::args::PathArg,
     /// Extra light: none, point or area (a small spherical light).
     #[arg(long, default_value = "none")]
     light: String,
@@ -55,7 +55,7 @@ pub struct RenderArgs {
     /// (SOURCE left, OTHER right), OUT-diff.png as the false-colour difference, and print the
     /// relative RMSE of SOURCE against OTHER.
     #[arg(long)]
-    compare: Option<String>,
+    compare: Option<brdftab_tools::args::PathArg>,
     /// Seed for the --compare render (default: the same seed). Comparing a SOURCE with itself
     /// under another seed measures the noise floor.
     #[arg(long, requires = "compare")]
@@ -143,7 +143,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     brdftab_tools::output::check(&a.output, "--output", &["png", "exr"])?;
     let opts = options(&a)?;
     let brdf = brdftab::request::open(&a.source, &a.open)?;
-    let img = render_one(brdf.as_ref(), &opts, &a.source)?;
+    let img = render_one(brdf.as_ref(), &opts, &a.source.to_string())?;
     let Some(other) = &a.compare else {
         return preview::write_auto(&img, &a.output, opts.exposure);
     };
@@ -152,7 +152,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
         seed: a.compare_seed.unwrap_or(opts.seed),
         ..opts.clone()
     };
-    let img_b = render_one(brdf_b.as_ref(), &opts_b, other)?;
+    let img_b = render_one(brdf_b.as_ref(), &opts_b, &other.to_string())?;
     let r = preview::compare(&img, &img_b)?;
     let pair = Image::hstack(&[&img, &img_b], 4, 0.0)?;
     preview::write_auto(&pair, &a.output, opts.exposure)?;

@@ -21,7 +21,7 @@ pub struct SliceArgs {
     source: std::ffi::OsString,
     /// Output image: `.exr` (linear f32) or `.png` (log scale, viridis, colorbar).
     #[arg(short, long)]
-    output: String,
+    output: brdftab_tools::args::PathArg,
     /// Which slice.
     #[arg(long, value_enum, default_value = "halfdiff")]
     kind: SliceKind,

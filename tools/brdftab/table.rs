@@ -13,7 +13,7 @@ use brdftab_tools::text::print_out;
 pub struct InfoArgs {
     /// A brdftab file (`FILE.btdb`, or one table of it as `DB#NAME`), a raw table file, a MERL
     /// `.binary` or an RGL `.bsdf`.
-    source: String,
+    source: brdftab_tools::args::PathArg,
     /// Print JSON.
     #[arg(long)]
     json: bool,

@@ -17,7 +17,7 @@ const WORKERS: usize = 16;
 pub struct ViewArgs {
     /// Materials: model specs, table files, databases (every table), DB#NAME, MERL or RGL files.
     #[arg(required = true)]
-    sources: Vec<String>,
+    sources: Vec<brdftab_tools::args::PathArg>,
     /// The port (0: any free port; the URL printed says which).
     #[arg(long, default_value_t = 8127)]
     port: u16,

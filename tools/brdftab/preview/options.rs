@@ -100,11 +100,15 @@ impl Sampling {
 }
 
 impl EnvChoice {
-    /// Parses `sky`, `white` (constant 1, the furnace), `none`, or a lat-long `.exr` file.
-    pub fn parse(s: &str) -> Result<EnvChoice> {
-        if s.to_ascii_lowercase().ends_with(".exr") {
+    /// Parses `sky`, `white` (constant 1, the furnace), `none`, or a lat-long `.exr` file (whose
+    /// name need not be UTF-8).
+    pub fn parse(s: impl AsRef<std::ffi::OsStr>) -> Result<EnvChoice> {
+        let s = s.as_ref();
+        let b = s.as_encoded_bytes();
+        if b.len() >= 4 && b[b.len() - 4..].eq_ignore_ascii_case(b".exr") {
             return Ok(EnvChoice::Map(Arc::new(Environment::from_exr(s)?)));
         }
+        let s = &*s.to_string_lossy();
         let c = [
             ("sky", EnvChoice::Sky),
             ("white", EnvChoice::Constant([1.0; 3])),

@@ -139,12 +139,11 @@ fn row(f: &Path, opts: &MeasuredOptions) -> Result<MeasuredRow> {
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let path = f.to_string_lossy().into_owned();
+    // By their paths, not as text: a directory whose name is not UTF-8 would not be found.
     let out = opts.dir.join(format!("{file}.btdb"));
-    let out_s = out.to_string_lossy().into_owned();
-    let report = BakeRequest::new(path.as_str()).run(&BakeTarget::File(out_s.clone()))?;
-    let native = source::open(&path)?;
-    let table = source::open_table(&out_s, &OpenOptions::default())?;
+    let report = BakeRequest::new(f).run(&BakeTarget::File(out.clone()))?;
+    let native = source::open(f)?;
+    let table = source::open_table(&out, &OpenOptions::default())?;
     let cap = 80f64.to_radians();
     let w = Weight::CosInCosOut;
     let e1 = compare_weighted(&table, native.as_ref(), opts.error_pairs, 1, cap, w)?;

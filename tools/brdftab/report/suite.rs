@@ -97,11 +97,12 @@ impl SourceDef {
         }
     }
 
-    /// The source as a SOURCE string ([`brdftab::source`]): the spec's JSON or the file's path.
-    pub fn source(&self) -> String {
+    /// The source as a SOURCE ([`brdftab::source`]): the spec's JSON or the file's path (as
+    /// the bytes it is: a directory whose name is not UTF-8 is found).
+    pub fn source(&self) -> std::ffi::OsString {
         match &self.kind {
-            Origin::Model(spec) => spec.to_json(),
-            Origin::Rgl(path) => path.display().to_string(),
+            Origin::Model(spec) => spec.to_json().into(),
+            Origin::Rgl(path) => path.clone().into_os_string(),
         }
     }
 

@@ -37,7 +37,7 @@ pub struct Server {
 
 impl Server {
     /// Opens every SOURCE and binds `addr` (port 0 picks a free port).
-    pub fn bind(sources: &[String], addr: SocketAddr) -> Result<Server> {
+    pub fn bind<S: AsRef<std::ffi::OsStr>>(sources: &[S], addr: SocketAddr) -> Result<Server> {
         let registry = Arc::new(Registry::open(sources)?);
         let listener = TcpListener::bind(addr).map_err(|e| Error::io(format!("bind {addr}"), e))?;
         let addr = listener

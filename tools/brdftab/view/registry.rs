@@ -9,6 +9,7 @@
 //! name whose hash differs is another measurement: it is not paired, and the list says why.
 
 use std::collections::HashMap;
+use std::ffi::{OsStr, OsString};
 use std::path::Path;
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -44,10 +45,11 @@ pub struct Registry {
 
 impl Registry {
     /// Opens every SOURCE (a database lists its tables); fails on the first that does not open.
-    pub fn open(sources: &[String]) -> Result<Registry> {
+    /// A SOURCE need not be UTF-8 (a `String`, `OsString` or `PathBuf`: a file name is bytes).
+    pub fn open<S: AsRef<OsStr>>(sources: &[S]) -> Result<Registry> {
         let mut materials = Vec::new();
         for s in sources {
-            for (name, source, summary, at) in entries(s)? {
+            for (name, source, summary, at) in entries(s.as_ref())? {
                 materials.push(material(&name, &source, summary, at.as_ref())?);
             }
         }
@@ -83,10 +85,10 @@ impl Registry {
 
 /// The (name, SOURCE, store summary, (file, table) of a store's entry) of every material
 /// SOURCE `s` holds.
-type Entry = (String, String, Option<Value>, Option<(String, String)>);
+type Entry = (String, OsString, Option<Value>, Option<(OsString, String)>);
 
 /// The materials SOURCE `s` holds (a database: each of its tables, or the one it names).
-fn entries(s: &str) -> Result<Vec<Entry>> {
+fn entries(s: &OsStr) -> Result<Vec<Entry>> {
     let (path, name) = db::split_source(s)?;
     if classify(s) != SourceKind::Table || !tables::is_store_file(path) {
         return Ok(vec![(display_name(s), s.to_owned(), None, None)]);
@@ -99,33 +101,36 @@ fn entries(s: &str) -> Result<Vec<Entry>> {
         .into_iter()
         .map(|r| {
             let n = r["name"].as_str().unwrap_or_default().to_owned();
-            let at = (path.to_owned(), n.clone());
-            (n.clone(), format!("{path}#{n}"), Some(r), Some(at))
+            let at = (path.as_os_str().to_owned(), n.clone());
+            let mut source = at.0.clone();
+            source.push(format!("#{n}"));
+            (n.clone(), source, Some(r), Some(at))
         })
         .collect())
 }
 
 /// A short name for a SOURCE that is not a database entry: the model of a spec, else the file
 /// name.
-fn display_name(s: &str) -> String {
-    if s.trim_start().starts_with('{') {
+fn display_name(s: &OsStr) -> String {
+    if s.to_string_lossy().trim_start().starts_with('{') {
         return brdftab::source::spec(s)
             .map(|m| m.name().to_owned())
             .unwrap_or_else(|_| "spec".to_owned());
     }
     Path::new(s)
         .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .unwrap_or_else(|| s.to_owned())
+        .unwrap_or(s)
+        .to_string_lossy()
+        .into_owned()
 }
 
 /// Opens one material and describes it; a store's entry by its file and table name (`at`), so
 /// that a file named like the `FILE#NAME` string beside it is not what opens.
 fn material(
     name: &str,
-    source: &str,
+    source: &OsStr,
     summary: Option<Value>,
-    at: Option<&(String, String)>,
+    at: Option<&(OsString, String)>,
 ) -> Result<Material> {
     let kind = classify(source);
     let brdf: Shared = match at {
@@ -159,7 +164,8 @@ fn material(
         info["ratio"] = s["ratio_to_f32"].clone();
         info["codec"] = s["codec"].clone();
         info["provenance"] = s["source"].clone();
-        let dir = Path::new(brdftab::store::name::path_of(source)).parent();
+        let dir = db::split_source(source).map_or(Path::new(source), |(p, _)| p);
+        let dir = dir.parent();
         let note;
         (paired, measured_source, note) = provenance_source(&s["source"], dir, brdf.channels());
         if let Some(n) = note {
@@ -188,10 +194,10 @@ fn provenance_source(
     channels: &Channels,
 ) -> (Option<Shared>, bool, Option<String>) {
     let opts = OpenOptions::new().channels(channels.clone());
-    let open = |s: &str| brdftab::open_with(s, &opts).ok().map(Arc::from);
+    let open = |s: &OsStr| brdftab::open_with(s, &opts).ok().map(Arc::from);
     match p["kind"].as_str() {
         Some("model") => {
-            let opened = open(&p["spec"].to_string());
+            let opened = open(p["spec"].to_string().as_ref());
             (opened, false, None)
         }
         Some("measured") => {
@@ -199,15 +205,14 @@ fn provenance_source(
                 return (None, false, None);
             };
             let path = dir.unwrap_or(Path::new(".")).join(file);
-            let Some(path) = path
-                .to_str()
-                .filter(|p| classify(p).is_measured() && Path::new(p).is_file())
-            else {
+            if !(classify(&path).is_measured() && path.is_file()) {
                 return (None, true, None);
-            };
+            }
             let recorded = p["sha256"].as_str().unwrap_or_default();
-            match sha256_file(path) {
-                Ok(sha) if sha.eq_ignore_ascii_case(recorded) => (open(path), true, None),
+            match sha256_file(&path) {
+                Ok(sha) if sha.eq_ignore_ascii_case(recorded) => {
+                    (open(path.as_os_str()), true, None)
+                }
                 Ok(_) => (
                     None,
                     true,
