@@ -139,7 +139,7 @@ int brdftab_albedo_at(const brdftab_brdf *b, double theta, double phi, double *a
 /* Opens SOURCE with {"interp": "auto"|"nearest"|"linear", "wavelengths": [..], "eager": bool}. */
 brdftab_brdf *brdftab_open_json(const char *source, const char *settings_json);
 /* Bakes SOURCE into OUTPUT like `brdftab bake`: DB#NAME is a table of that database, any other
- * name a brdftab (.btdb) file. 0 or -1. */
+ * name a brdftab (.btdb) file. OUTPUT's bytes, like SOURCE's, need not be UTF-8. 0 or -1. */
 int brdftab_bake(const char *source, const char *output, const char *settings_json);
 /* Converts SOURCE into OUTPUT (.bsdf, MERL .binary, DB#NAME, .btdb, raw table, by its name)
  * like `brdftab convert`. 0 or -1. */

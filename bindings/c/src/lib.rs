@@ -218,9 +218,10 @@ unsafe fn text<'a>(p: *const c_char, what: &str) -> Result<&'a str, String> {
         .map_err(|_| format!("`{what}` is not valid UTF-8"))
 }
 
-/// A caller's SOURCE argument with its bytes as they are (`what` names it in errors): on Unix
-/// a file name is bytes, and one that is not UTF-8 opens as any other (inline JSON must still
-/// be UTF-8, which the library checks). Elsewhere it must be UTF-8.
+/// A caller's SOURCE or OUTPUT argument with its bytes as they are (`what` names it in
+/// errors): on Unix a file name is bytes, and one that is not UTF-8 is read or written as any
+/// other (inline JSON must still be UTF-8, which the library checks). Elsewhere it must be
+/// UTF-8.
 ///
 /// # Safety
 /// `p` is NULL or a NUL-terminated string.

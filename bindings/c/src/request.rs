@@ -57,7 +57,12 @@ pub unsafe extern "C" fn brdftab_bake(
 ) -> c_int {
     guard(|| {
         // SAFETY (all three): the caller's contract.
-        let (source, output) = unsafe { (source_text(source, "source")?, text(output, "output")?) };
+        let (source, output) = unsafe {
+            (
+                source_text(source, "source")?,
+                source_text(output, "output")?,
+            )
+        };
         let s: BakeSettings = unsafe { settings(settings_json) }?;
         request::bake(source, output, &s, &Silent)
             .map(drop)
@@ -78,7 +83,12 @@ pub unsafe extern "C" fn brdftab_convert(
 ) -> c_int {
     guard(|| {
         // SAFETY (all three): the caller's contract.
-        let (source, output) = unsafe { (source_text(source, "source")?, text(output, "output")?) };
+        let (source, output) = unsafe {
+            (
+                source_text(source, "source")?,
+                source_text(output, "output")?,
+            )
+        };
         let s: ConvertSettings = unsafe { settings(settings_json) }?;
         request::convert(source, output, &s, &Silent)
             .map(drop)

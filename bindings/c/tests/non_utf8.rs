@@ -1,6 +1,8 @@
 //! The C ABI passes a SOURCE's bytes through unchanged (session 41): a file whose name is not
 //! UTF-8 opens, bakes and converts (`brdftab_open`, `brdftab_bake`, `brdftab_convert`; they
 //! returned NULL / -1 with "`source` is not valid UTF-8"), and a missing one is named lossily.
+//! And an OUTPUT's (session 42): `brdftab_bake` and `brdftab_convert` write to a file or
+//! `DB#NAME` whose path is not UTF-8 (they returned -1 with "`output` is not valid UTF-8").
 #![cfg(unix)]
 
 use std::ffi::{CStr, CString, OsString};
@@ -83,4 +85,62 @@ fn a_source_whose_name_is_not_utf8_opens_bakes_and_converts() {
 
     let e = eval(&c_path(&latin1(&d, "missing.btdb"))).unwrap_err();
     assert!(e.contains("caf\u{FFFD}-missing.btdb"), "{e}");
+}
+
+/// `path` + `#name`, as bytes.
+fn c_entry(path: &Path, name: &str) -> CString {
+    let mut b = path.as_os_str().as_bytes().to_vec();
+    b.extend_from_slice(format!("#{name}").as_bytes());
+    CString::new(b).unwrap()
+}
+
+#[test]
+fn bake_and_convert_write_to_outputs_whose_names_are_not_utf8() {
+    let d = TempDir::new("c-non-utf8-out");
+    let json = r#"{"model": "lambert", "kd": [0.1, 0.2, 0.3]}"#;
+    let spec = CString::new(json).unwrap();
+    let want = eval(&spec).unwrap();
+    let (table, lib, bsdf) = (
+        latin1(&d, "t.btdb"),
+        latin1(&d, "lib.btdb"),
+        latin1(&d, "t.bsdf"),
+    );
+    let settings = CString::new(r#"{"preset": "small"}"#).unwrap();
+    let pairs = CString::new(r#"{"pairs": 0}"#).unwrap();
+    let small_rgl = CString::new(r#"{"pairs": 0, "resolution": 8, "theta_i": 3, "phi_i": 1}"#);
+    let small_rgl = small_rgl.unwrap();
+    // SAFETY (each call): valid NUL-terminated strings.
+    let runs = [
+        unsafe { brdftab_bake(spec.as_ptr(), c_path(&table).as_ptr(), settings.as_ptr()) },
+        unsafe {
+            brdftab_bake(
+                spec.as_ptr(),
+                c_entry(&lib, "b").as_ptr(),
+                settings.as_ptr(),
+            )
+        },
+        unsafe {
+            brdftab_convert(
+                c_path(&table).as_ptr(),
+                c_entry(&lib, "c").as_ptr(),
+                pairs.as_ptr(),
+            )
+        },
+        unsafe { brdftab_convert(spec.as_ptr(), c_path(&bsdf).as_ptr(), small_rgl.as_ptr()) },
+    ];
+    assert_eq!(runs, [0; 4], "{}", last_error());
+    // The constant within log16's 1e-3, twice over for the table converted from a table.
+    for source in [c_path(&table), c_entry(&lib, "b"), c_entry(&lib, "c")] {
+        for (a, b) in eval(&source).unwrap().iter().zip(&want) {
+            assert!((a - b).abs() <= 2.1e-3 * b, "{source:?}: {a} vs {b}");
+        }
+    }
+    assert!(eval(&c_path(&bsdf)).is_ok());
+    // A directory that does not exist: -1, named lossily.
+    let missing = latin1(&d, "none").join("t.btdb");
+    // SAFETY: valid NUL-terminated strings.
+    let r = unsafe { brdftab_bake(spec.as_ptr(), c_path(&missing).as_ptr(), settings.as_ptr()) };
+    assert_eq!(r, -1);
+    let e = last_error();
+    assert!(e.contains("caf\u{FFFD}-none"), "{e}");
 }
