@@ -7,15 +7,17 @@ use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 
 use crate::errors::{guard, lib_err, unlocked};
+use crate::values::path_arg;
 
 /// The names of the tables of database `path`, in file order: its table of contents, read
 /// with the GIL released (listing 5,000 tables held it for 0.27 s, also reading every table's
 /// header, which `info` reads and the names do not need).
 #[pyfunction]
-pub(crate) fn db_names(py: Python<'_>, path: &str) -> PyResult<Vec<String>> {
+pub(crate) fn db_names(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
     guard(|| {
+        let path = path_arg(path, "path")?;
         unlocked(py, || {
-            let s = brdftab::store::Store::open(path)?;
+            let s = brdftab::store::Store::open(&path)?;
             Ok(s.tables().iter().map(|e| e.name.clone()).collect())
         })?
         .map_err(lib_err)
@@ -32,15 +34,26 @@ pub(crate) fn _check_table_name(name: &str) -> PyResult<()> {
 /// Removes table `name` from database `path`, with the GIL released: the database is
 /// rewritten, after waiting for its lock (another writer's turn).
 #[pyfunction]
-pub(crate) fn db_remove(py: Python<'_>, path: &str, name: &str) -> PyResult<()> {
-    guard(|| unlocked(py, || brdftab::store::db::remove(path, name))?.map_err(lib_err))
+pub(crate) fn db_remove(py: Python<'_>, path: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
+    guard(|| {
+        let path = path_arg(path, "path")?;
+        unlocked(py, || brdftab::store::db::remove(&path, name))?.map_err(lib_err)
+    })
 }
 
 /// Renames table `old` of database `path` to `new`, with the GIL released as `db_remove` does:
 /// the database is rewritten after waiting for its lock.
 #[pyfunction]
-pub(crate) fn db_rename(py: Python<'_>, path: &str, old: &str, new: &str) -> PyResult<()> {
-    guard(|| unlocked(py, || brdftab::store::db::rename(path, old, new))?.map_err(lib_err))
+pub(crate) fn db_rename(
+    py: Python<'_>,
+    path: &Bound<'_, PyAny>,
+    old: &str,
+    new: &str,
+) -> PyResult<()> {
+    guard(|| {
+        let path = path_arg(path, "path")?;
+        unlocked(py, || brdftab::store::db::rename(&path, old, new))?.map_err(lib_err)
+    })
 }
 
 /// Adds the table of a single-table file's bytes (what `bake` writes to a `.btdb` path) to
@@ -54,7 +67,7 @@ pub(crate) fn db_rename(py: Python<'_>, path: &str, old: &str, new: &str) -> PyR
 #[pyo3(signature = (path, name, data, replace=false))]
 pub(crate) fn db_import(
     py: Python<'_>,
-    path: &str,
+    path: &Bound<'_, PyAny>,
     name: &str,
     data: Bound<'_, PyBytes>,
     replace: bool,
@@ -64,6 +77,7 @@ pub(crate) fn db_import(
             eager: false,
             ..Default::default()
         };
+        let path = path_arg(path, "path")?;
         let data = pyo3::pybacked::PyBackedBytes::from(data);
         unlocked(py, || {
             let s = brdftab::store::Store::from_bytes("the bytes", data, opts)?;
@@ -81,7 +95,7 @@ pub(crate) fn db_import(
                     ));
                 }
             };
-            brdftab::store::db::import(path, &s, &from, name, replace)
+            brdftab::store::db::import(&path, &s, &from, name, replace)
         })?
         .map_err(lib_err)
     })

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{guard, interruptible, lib_err};
-use crate::values::{ser, settings_of, source_arg, text_arg, to_py};
+use crate::values::{path_arg, ser, settings_of, to_py};
 
 fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyAny>> {
     let info = if r.info.is_null() {
@@ -47,8 +47,8 @@ pub(crate) fn bake(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let (source, output) = (source_arg(source, "source")?, text_arg(output, "output")?);
-        let (source, output) = (source.as_os_str(), output.as_str());
+        let (source, output) = (path_arg(source, "source")?, path_arg(output, "output")?);
+        let (source, output) = (source.as_os_str(), output.as_os_str());
         let settings: BakeSettings = settings_of(options)?;
         let r =
             interruptible(py, |p| request::bake(source, output, &settings, p))?.map_err(lib_err)?;
@@ -67,9 +67,9 @@ pub(crate) fn _check_bake_options(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<()> {
     guard(|| {
-        let source = text_arg(source, "source")?;
+        let source = path_arg(source, "source")?;
         let settings: BakeSettings = settings_of(options)?;
-        settings.request(source.as_str()).map_err(lib_err)?;
+        settings.request(&source).map_err(lib_err)?;
         Ok(())
     })
 }
@@ -79,27 +79,34 @@ pub(crate) fn _check_bake_options(
 /// settings and the library's version, in `cache_dir` (default `$BRDFTAB_CACHE_DIR`, else
 /// `$XDG_CACHE_HOME/brdftab`, else `~/.cache/brdftab`). Safe under concurrent calls from many
 /// processes. `refresh=True` bakes again (for a cached file that failed to open). Returns
-/// `{"path": str, "hit": bool}`; open the table with `brdftab.open(path)`. Ctrl-C stops the bake
-/// (KeyboardInterrupt; nothing is cached).
+/// `{"path": str, "hit": bool}`; open the table with `brdftab.open(path)`. SOURCE and
+/// `cache_dir` are str, bytes or os.PathLike; `path` is the `os.fsdecode` str of the file's
+/// name (it need not be UTF-8). Ctrl-C stops the bake (KeyboardInterrupt; nothing is cached).
 #[pyfunction]
 #[pyo3(signature = (source, cache_dir=None, refresh=false, **options))]
 pub(crate) fn bake_cached(
     py: Python<'_>,
     source: &Bound<'_, PyAny>,
-    cache_dir: Option<std::path::PathBuf>,
+    cache_dir: Option<&Bound<'_, PyAny>>,
     refresh: bool,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let source = text_arg(source, "source")?;
-        let source = source.as_str();
+        let source = path_arg(source, "source")?;
+        let dir = match cache_dir.filter(|d| !d.is_none()) {
+            Some(d) => Some(std::path::PathBuf::from(path_arg(d, "cache_dir")?)),
+            None => None,
+        };
         let settings: BakeSettings = settings_of(options)?;
         let c = interruptible(py, |p| {
-            brdftab::cache::bake_cached_with(source, &settings, cache_dir.as_deref(), refresh, p)
+            brdftab::cache::bake_cached_with(&source, &settings, dir.as_deref(), refresh, p)
         })?
         .map_err(lib_err)?;
-        let v = serde_json::json!({"path": c.path.to_string_lossy(), "hit": c.hit});
-        to_py(py, &v)
+        let d = pyo3::types::PyDict::new(py);
+        // The path itself (os.fsdecode's str): a lossy one would name another file.
+        d.set_item("path", c.path.into_os_string())?;
+        d.set_item("hit", c.hit)?;
+        Ok(d.into_any().unbind())
     })
 }
 
@@ -117,8 +124,8 @@ pub(crate) fn convert(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let (source, output) = (source_arg(source, "source")?, text_arg(output, "output")?);
-        let (source, output) = (source.as_os_str(), output.as_str());
+        let (source, output) = (path_arg(source, "source")?, path_arg(output, "output")?);
+        let (source, output) = (source.as_os_str(), output.as_os_str());
         let settings: ConvertSettings = settings_of(options)?;
         let out = interruptible(py, |p| request::convert(source, output, &settings, p))?
             .map_err(lib_err)?;
@@ -133,7 +140,7 @@ pub(crate) fn convert(
             ConvertOutput::Rgl(r) => {
                 let f = &r.written.fields;
                 serde_json::json!({
-                    "output": output,
+                    "output": output.to_string_lossy(),
                     "format": "rgl",
                     "source": r.source,
                     "bytes": r.written.bytes,
@@ -184,7 +191,7 @@ pub(crate) fn fit(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let source = source_arg(source, "source")?;
+        let source = path_arg(source, "source")?;
         let settings: FitSettings = settings_of(options)?;
         let result =
             interruptible(py, |p| request::fit(&source, model, &settings, p))?.map_err(lib_err)?;

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 
 use crate::brdf::PyBrdf;
 use crate::errors::{guard, lib_err, unlocked};
-use crate::values::{channels_of, ser, source_arg, text_arg, to_py};
+use crate::values::{channels_of, path_arg, ser, to_py};
 
 /// Opens SOURCE (a spec, table, `DB#NAME`, MERL `.binary` or RGL `.bsdf`) as a `Brdf`. A path
 /// is a `str`, `bytes` or an `os.PathLike` (`bake`, `convert`, `check` and `fit` take the same):
@@ -29,7 +29,7 @@ pub(crate) fn open(
     eager: bool,
 ) -> PyResult<PyBrdf> {
     guard(|| {
-        let source = source_arg(source, "source")?;
+        let source = path_arg(source, "source")?;
         let channels = channels_of(wavelengths)?;
         unlocked(py, || PyBrdf::open(&source, interp, channels, eager))?
     })
@@ -46,7 +46,7 @@ pub(crate) fn _reopen(
     eager: bool,
 ) -> PyResult<PyBrdf> {
     guard(|| {
-        let source = source_arg(source, "source")?;
+        let source = path_arg(source, "source")?;
         let ch = wavelengths
             .map(Channels::wavelengths)
             .transpose()
@@ -64,7 +64,7 @@ pub(crate) fn check(
     wavelengths: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let source = source_arg(source, "source")?;
+        let source = path_arg(source, "source")?;
         let opts = OpenOptions {
             channels: channels_of(wavelengths)?,
             ..OpenOptions::default()
@@ -82,12 +82,13 @@ pub(crate) fn check(
 }
 
 /// What `brdftab info --json` reports of a brdftab file (`FILE`), one table (`DB#NAME`) or a
-/// measured file (MERL `.binary`, RGL `.bsdf`). The GIL is released while the file is read.
+/// measured file (MERL `.binary`, RGL `.bsdf`): a `str`, `bytes` or `os.PathLike`, whose name
+/// need not be UTF-8 (`file` shows it with U+FFFD). The GIL is released while the file is read.
 #[pyfunction]
 pub(crate) fn info(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
     guard(|| {
-        let source = text_arg(source, "source")?;
-        let source = source.as_str();
+        let source = path_arg(source, "source")?;
+        let source = source.as_os_str();
         use brdftab::SourceKind;
         let v = unlocked(py, || match brdftab::classify(source) {
             SourceKind::Merl | SourceKind::Rgl => brdftab::measured::info::info(source),
@@ -101,6 +102,6 @@ pub(crate) fn info(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<Py<PyA
 /// `DB#NAME` is a table whatever its name ends with. For the Mitsuba plugin, which chooses a
 /// lookup by kind before it opens anything.
 #[pyfunction]
-pub(crate) fn _source_kind(source: &str) -> &'static str {
-    brdftab::source::classify(source).name()
+pub(crate) fn _source_kind(source: &Bound<'_, PyAny>) -> PyResult<&'static str> {
+    Ok(brdftab::source::classify(path_arg(source, "source")?).name())
 }

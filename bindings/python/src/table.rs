@@ -20,7 +20,7 @@ use pyo3::types::{PyDict, PyTuple};
 use crate::arrays::f32_array;
 use crate::brdf::PyBrdf;
 use crate::errors::{Error, guard, lib_err, unlocked};
-use crate::values::{settings_of, text_arg, to_py};
+use crate::values::{path_arg, settings_of, to_py};
 
 /// A decoded table (`Brdf.table()`): its values as a numpy array sharing the table's memory,
 /// and its grid.
@@ -149,8 +149,9 @@ impl PyTable {
         })
     }
 
-    /// Writes the table to `output`: a `.btdb` file (replaced atomically) or "DB#NAME" (a
-    /// table of a database, created if absent; an existing name needs `replace=True`). The
+    /// Writes the table to `output` (a `str`, `bytes` or `os.PathLike`; the name need not be
+    /// UTF-8): a `.btdb` file (replaced atomically) or "DB#NAME" (a table of a database,
+    /// created if absent; an existing name needs `replace=True`). The
     /// keywords are those of `brdftab.bake` that say how a table is stored: `codec` ("f32"
     /// keeps the values bit for bit; default "log16", 1e-3 relative), `codec_tolerance`,
     /// `floor`, `level`, `exhaustive`, `name` (default: the file's stem) and `replace`. The
@@ -164,7 +165,7 @@ impl PyTable {
         options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Py<PyAny>> {
         guard(|| {
-            let output = text_arg(output, "output")?;
+            let output = path_arg(output, "output")?;
             let settings: SaveSettings = settings_of(options)?;
             let source = Source::Other {
                 description: self.table.description().to_owned(),

@@ -13,42 +13,13 @@ use pyo3::types::{PyDict, PyTuple};
 
 use crate::errors::{Error, lib_err};
 
-/// A SOURCE or OUTPUT argument: a `str` (a spec, a path, `DB#NAME`) or an `os.PathLike`
-/// whose `os.fspath` is a `str` (a `pathlib.Path`); anything else is a `TypeError`.
-pub(crate) fn text_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<String> {
-    use pyo3::types::PyString;
-    // A str that is not UTF-8: a file name of undecodable bytes (surrogate escapes).
-    let utf8 = |p: &Bound<'_, PyAny>| {
-        p.extract::<String>().map_err(|_| {
-            PyValueError::new_err(format!(
-                "{what}: a path that is not valid UTF-8 is not supported (rename the file)"
-            ))
-        })
-    };
-    if obj.is_instance_of::<PyString>() {
-        return utf8(obj);
-    }
-    if obj.hasattr("__fspath__")? {
-        let p = obj.py().import("os")?.call_method1("fspath", (obj,))?;
-        if p.is_instance_of::<PyString>() {
-            return utf8(&p);
-        }
-        return Err(PyTypeError::new_err(format!(
-            "{what}: a bytes path is not supported; pass a str"
-        )));
-    }
-    Err(PyTypeError::new_err(format!(
-        "{what}: expected a str or an os.PathLike, got {}",
-        obj.get_type().name()?
-    )))
-}
-
-/// A SOURCE argument as the library takes one (session 41: a file name need not be UTF-8): a
-/// `str` (a spec, a path, `DB#NAME`), `bytes`, or an `os.PathLike` of either, as `os.fspath`
-/// gives them. A `str` is encoded as `os.fsencode` does, so a file name of undecodable bytes
-/// (which Python holds with surrogate escapes) reaches the library as those bytes; anything
-/// else is a `TypeError`. (A SOURCE that was not UTF-8 was a `ValueError`, bytes a `TypeError`.)
-pub(crate) fn source_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<std::ffi::OsString> {
+/// A SOURCE, OUTPUT or other path argument as the library takes one (a file name need not be
+/// UTF-8: SOURCEs since session 41, every other path since session 42): a `str` (a spec, a
+/// path, `DB#NAME`), `bytes`, or an `os.PathLike` of either, as `os.fspath` gives them. A `str`
+/// is encoded as `os.fsencode` does, so a file name of undecodable bytes (which Python holds
+/// with surrogate escapes) reaches the library as those bytes; anything else is a `TypeError`.
+/// (A path that was not UTF-8 was a `ValueError`, bytes a `TypeError`.)
+pub(crate) fn path_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<std::ffi::OsString> {
     use pyo3::types::{PyBytes, PyString};
     let os = obj.py().import("os")?;
     let path = if obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyBytes>() {

@@ -316,6 +316,65 @@ def test_a_source_whose_name_is_not_utf8(tmp_path):
         brdftab.open(os.fsencode(tmp_path) + b"/caf\xe9-missing.btdb")
 
 
+def test_every_path_may_be_bytes_that_are_not_utf8(tmp_path):
+    """Every path argument — bake's and convert's OUTPUT (a file and DB#NAME), Table.save's,
+    info's SOURCE, bake_cached's cache_dir, a Database's path and every method of it — takes a
+    name that is not UTF-8, as bytes, a str of surrogate escapes (os.fsdecode) or a pathlib.Path
+    (before session 42: ValueError "not valid UTF-8" for the str, TypeError for bytes). What
+    the library reports of such a file ("file") shows it lossily (U+FFFD); the paths it hands
+    back to be opened (bake_cached's "path", Database.path and .source) are os.fsdecode's."""
+    d = os.fsencode(tmp_path) + b"/caf\xe9"
+    os.mkdir(d)
+    wi, wo = upper(20, 7), upper(20, 8)
+    want = brdftab.open(LAMBERT).eval(wi, wo)
+    shown = os.fsdecode(d).encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+    assert "caf\ufffd" in shown
+    forms = {"bytes": lambda b: b, "str": os.fsdecode,
+             "path": lambda b: pathlib.Path(os.fsdecode(b))}
+    for k, form in forms.items():
+        f = d + f"/{k}".encode()
+        # bake and convert to a file and to DB#NAME; info of each
+        info = brdftab.bake(LAMBERT, form(f + b".btdb"), preset="small")
+        assert info["file"] == f"{shown}/{k}.btdb"
+        for out in [f + b".btdb", f + b"-lib.btdb#m"]:
+            if out.endswith(b"#m"):
+                brdftab.convert(form(f + b".btdb"), form(out), pairs=0)
+            np.testing.assert_allclose(brdftab.open(out).eval(wi, wo), want, rtol=2.1e-3)
+            got = brdftab.info(form(out))
+            assert got["file"].startswith(f"{shown}/{k}") and len(got["tables"]) == 1
+        conv = brdftab.convert(LAMBERT, form(f + b".bsdf"), resolution=8, theta_i=3, phi_i=1,
+                               pairs=0)
+        assert conv["output"] == f"{shown}/{k}.bsdf"
+        assert brdftab.info(form(f + b".bsdf"))["format"] == "rgl"
+        # Table.save
+        t = brdftab.open(f + b".btdb").table()
+        assert t.save(form(f + b"-saved.btdb"), codec="f32")["file"] == f"{shown}/{k}-saved.btdb"
+        np.testing.assert_array_equal(brdftab.open(f + b"-saved.btdb").eval(wi, wo),
+                                      brdftab.open(f + b".btdb").eval(wi, wo))
+        # a Database and every method of it
+        db = brdftab.Database(form(f + b"-db.btdb"))
+        assert db.path == os.fsdecode(f + b"-db.btdb") and len(db) == 0
+        db.add(LAMBERT, "a", preset="small")
+        with open(f + b".btdb", "rb") as fh:
+            db.add_bytes("b", fh.read())
+        db.rename("a", "c")
+        assert db.names() == ["c", "b"] and "c" in db and list(db) == ["c", "b"]
+        np.testing.assert_allclose(db.open("c").eval(wi, wo), want, rtol=2.1e-3)
+        assert brdftab.open(db.source("b")).eval(wi, wo).tolist() == \
+            brdftab.open(f + b".btdb").eval(wi, wo).tolist()
+        assert db.info()["file"] == f"{shown}/{k}-db.btdb"
+        db.remove("c")
+        assert db.names() == ["b"]
+        # bake_cached in such a directory: the path it gives opens
+        c = brdftab.bake_cached(form(f + b".btdb"), cache_dir=form(f + b"-cache"), preset="small")
+        assert c["path"].startswith(os.fsdecode(f + b"-cache/")) and not c["hit"]
+        np.testing.assert_allclose(brdftab.open(c["path"]).eval(wi, wo), want, rtol=2.1e-3)
+        again = brdftab.bake_cached(form(f + b".btdb"), form(f + b"-cache"), preset="small")
+        assert again == {"path": c["path"], "hit": True}
+    with pytest.raises(brdftab.Error, match="caf\ufffd/none.btdb"):
+        brdftab.info(d + b"/none.btdb")
+
+
 def test_info_describes_measured_files_as_the_cli_does(cli, paper):
     """brdftab.info on an RGL file: the CLI's `info --json` (it used to raise "wrong magic")."""
     got = brdftab.info(paper)
@@ -324,7 +383,7 @@ def test_info_describes_measured_files_as_the_cli_does(cli, paper):
 
 
 class _BytesPath:
-    """An os.PathLike whose path is bytes (a SOURCE may be one; a Database path may not)."""
+    """An os.PathLike whose path is bytes (any path argument may be one)."""
 
     def __init__(self, p):
         self.p = str(p).encode()
@@ -399,17 +458,18 @@ def test_a_database_has_a_length_and_iterates_over_its_names(tmp_path):
     assert len(db) == 1 and list(db) == ["shiny"]
 
 
-def test_a_database_path_is_a_str_or_a_pathlike_of_one(tmp_path, monkeypatch):
+def test_a_database_path_is_a_str_bytes_or_a_pathlike(tmp_path, monkeypatch):
     """Database(path) took str(path) of anything: Database(b"m.btdb").add(...) wrote a file
     named "b'm.btdb'", Database(3) a file "3". Now it refuses what `open` and `bake` refuse,
-    naming the argument; and `source(name)` checks the name as add, open and remove do."""
+    naming the argument, and takes what they take (bytes since session 42: the path as
+    os.fsdecode gives it); and `source(name)` checks the name as add, open and remove do."""
     monkeypatch.chdir(tmp_path)
-    for bad, match in [(b"m.btdb", "path: expected a str"), (3, "path: expected a str"),
-                       (None, "path: expected a str"), (_BytesPath("m.btdb"), "path: a bytes")]:
-        with pytest.raises(TypeError, match=match):
+    for bad in [3, None, 1.5]:
+        with pytest.raises(TypeError, match="path: expected a str, bytes or an os.PathLike"):
             brdftab.Database(bad).add(LAMBERT, "a", preset="small")
     assert not list(tmp_path.iterdir())
-    assert brdftab.Database(pathlib.Path("m.btdb")).path == "m.btdb"
+    for p in [pathlib.Path("m.btdb"), b"m.btdb", _BytesPath("m.btdb"), "m.btdb"]:
+        assert brdftab.Database(p).path == "m.btdb"
     with pytest.raises(ValueError, match="name"):
         brdftab.Database("m.btdb").source("a#b")
     with pytest.raises(TypeError, match="name"):

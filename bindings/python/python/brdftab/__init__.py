@@ -63,8 +63,9 @@ class Database:
     """
 
     def __init__(self, path):
-        # A str or an os.PathLike of one, as every SOURCE and OUTPUT (str() of anything else
-        # made a path of its repr: Database(b"m.btdb") wrote a file named "b'm.btdb'").
+        # A str, bytes or an os.PathLike of either, as every SOURCE and OUTPUT (str() of
+        # anything else made a path of its repr: Database(b"m.btdb") wrote a file named
+        # "b'm.btdb'"); kept as the str os.fsdecode gives (a name need not be UTF-8).
         self.path = _path_arg(path, "path")
 
     def __repr__(self):
@@ -157,14 +158,13 @@ class Database:
 
 
 def _path_arg(path, what):
-    """A path argument as the extension takes one: a str, or an os.PathLike whose path is a
-    str; anything else is a TypeError naming `what`."""
-    if isinstance(path, (str, _os.PathLike)):
-        p = _os.fspath(path)
-        if isinstance(p, str):
-            return p
-        raise TypeError(f"{what}: a bytes path is not supported; pass a str")
-    raise TypeError(f"{what}: expected a str or an os.PathLike, got {type(path).__name__}")
+    """A path argument as the extension takes one — a str, bytes, or an os.PathLike of either —
+    as the str ``os.fsdecode`` gives (bytes that are not UTF-8 held as surrogate escapes, which
+    the extension encodes back to those bytes); anything else is a TypeError naming `what`."""
+    if isinstance(path, (str, bytes, _os.PathLike)):
+        return _os.fsdecode(_os.fspath(path))
+    raise TypeError(
+        f"{what}: expected a str, bytes or an os.PathLike, got {type(path).__name__}")
 
 
 def _check_name(name):

@@ -27,8 +27,9 @@ __all__ = [
 _ArrayLike = npt.ArrayLike
 _Wavelengths = Union[None, str, Sequence[float]]
 # A SOURCE: a str (a spec, a path, DB#NAME) or a path as os.fspath gives one, bytes included (a
-# file name need not be UTF-8).
+# file name need not be UTF-8). Every OUTPUT and other path is one too (_Path).
 _Source = Union[str, bytes, PathLike[str], PathLike[bytes]]
+_Path = _Source
 
 class Error(Exception):
     """An error of the brdftab library; the message is the library's."""
@@ -181,7 +182,7 @@ class Table:
         NaN or infinite stored value, is a ValueError naming `values` and the index."""
     def save(
         self,
-        output: str | PathLike[str],
+        output: _Path,
         *,
         codec: str | None = ...,
         codec_tolerance: float | None = ...,
@@ -235,7 +236,7 @@ def rgb_basis(nm: _ArrayLike) -> npt.NDArray[np.float64]:
     is not a wavelength (a finite number > 0) is a ValueError."""
 def check(source: _Source, *, wavelengths: _Wavelengths = None) -> dict[str, Any]:
     """The plausibility report of SOURCE as a dict with the keys of `brdftab check --json`."""
-def info(source: str | PathLike[str]) -> dict[str, Any]:
+def info(source: _Source) -> dict[str, Any]:
     """What `brdftab info --json` reports of a table file (or, for DB#NAME, of one table): "file", "format", "bytes", "ratio_to_f32",
     "table_count" (the tables the file holds) and "tables", one dict per table with "name", "source", "parameterization", "symmetry",
     "channels", "units", "codec", "tool", "shape", "values", "chunks", "bytes", "ratio_to_f32",
@@ -247,7 +248,7 @@ def info(source: str | PathLike[str]) -> dict[str, Any]:
     "isotropic", "reduction", "phi_i", "theta_i", "resolution", "vndf_resolution", "fields"."""
 def bake(
     source: _Source,
-    output: str | PathLike[str],
+    output: _Path,
     *,
     preset: str | None = ...,
     grid: str | None = ...,
@@ -272,18 +273,19 @@ def bake(
     with DB#NAME it may only repeat NAME (another name is an error). Returns `brdftab info
     --json`. Ctrl-C stops it (KeyboardInterrupt; OUTPUT is left as it was)."""
 def bake_cached(
-    source: str | PathLike[str],
-    cache_dir: str | PathLike[str] | None = None,
+    source: _Source,
+    cache_dir: _Path | None = None,
     refresh: bool = False,
     **options: Any,
 ) -> dict[str, Any]:
     """The table of SOURCE baked with `options` (the keywords of `bake`), from the cache of
     baked tables (keyed by the source's content, the settings and the library's version) or
-    baked into it now. Returns {"path": str, "hit": bool}. Ctrl-C stops the bake
+    baked into it now. Returns {"path": str, "hit": bool}: "path" is the str os.fsdecode gives
+    of the file's name (a cache_dir need not be UTF-8). Ctrl-C stops the bake
     (KeyboardInterrupt; nothing is cached)."""
 def convert(
     source: _Source,
-    output: str | PathLike[str],
+    output: _Path,
     *,
     pairs: int | None = ...,
     interp: str | None = ...,
@@ -326,7 +328,9 @@ class Database:
     names (none for a file not created yet)."""
 
     path: str
-    def __init__(self, path: Union[str, PathLike[str]]) -> None: ...
+    def __init__(self, path: _Path) -> None:
+        """A handle on the database at `path` (a str, bytes or os.PathLike); `path` keeps it
+        as the str os.fsdecode gives (a file name need not be UTF-8)."""
     def __repr__(self) -> str: ...
     def __reduce__(self) -> tuple[Any, tuple[Any, ...]]: ...
     def __eq__(self, other: object) -> bool: ...
@@ -337,7 +341,7 @@ class Database:
     def __len__(self) -> int: ...
     def __iter__(self) -> Iterator[str]: ...
     def add(
-        self, source: str | PathLike[str], name: str, *, replace: bool = False, **options: Any
+        self, source: _Source, name: str, *, replace: bool = False, **options: Any
     ) -> dict[str, Any]:
         """Bakes SOURCE into table NAME (the database is created if absent); takes the keywords
         of `bake`. Returns what `brdftab info --json DB#NAME` reports."""
