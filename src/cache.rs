@@ -172,7 +172,7 @@ pub fn bake_cached_with(
     std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     // One bake per key at a time: a process (or thread) that finds the bake under way waits
     // for it and is then a hit, rather than baking the same table beside it.
-    let _lock = crate::store::db::lock(&path)?;
+    let _lock = crate::store::db::lock_with(&path, progress)?;
     if !refresh && path.is_file() {
         return Ok(Cached { path, hit: true });
     }

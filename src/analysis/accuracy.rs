@@ -22,6 +22,7 @@ use serde::Serialize;
 use crate::analysis::mirror_pairs::MirrorMixture;
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
+use crate::progress::{Progress, Silent};
 use crate::rng::Pcg32;
 use crate::spectrum::MAX_CHANNELS;
 
@@ -152,6 +153,20 @@ pub fn compare_region(
     region: Region,
     weight: Weight,
 ) -> Result<Accuracy> {
+    compare_region_with(approx, reference, pairs, seed, region, weight, &Silent)
+}
+
+/// [`compare_region`], asking `progress` to stop before each block of 4096 pairs
+/// ([`Progress::cancelled`]: [`Error::Cancelled`]).
+pub fn compare_region_with(
+    approx: &dyn Brdf,
+    reference: &dyn Brdf,
+    pairs: usize,
+    seed: u64,
+    region: Region,
+    weight: Weight,
+    progress: &dyn Progress,
+) -> Result<Accuracy> {
     region.check()?;
     let mixture = match region {
         Region::Cap(t) => MirrorMixture::new(t, None),
@@ -178,6 +193,7 @@ pub fn compare_region(
         (0..blocks)
             .into_par_iter()
             .map(|b| {
+                crate::progress::check(progress)?;
                 let mut rng = Pcg32::with_stream(seed, b as u64);
                 let n = BLOCK.min(pairs - b * BLOCK);
                 let mut e2 = vec![0.0; c];
@@ -204,10 +220,10 @@ pub fn compare_region(
                         worst.push((err.abs(), r.abs(), wi, wo));
                     }
                 }
-                (e2, r2, f2, worst)
+                Ok((e2, r2, f2, worst))
             })
-            .collect()
-    });
+            .collect::<Result<_>>()
+    })?;
     // Either side failed while it was read (a corrupt table chunk): its zeros are no result.
     approx.health()?;
     reference.health()?;

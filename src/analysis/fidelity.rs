@@ -28,10 +28,11 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::analysis::accuracy::{Region, Weight, compare_region};
+use crate::analysis::accuracy::{Region, Weight, compare_region_with};
 use crate::analysis::pair_rule::{PairRule, PairRuleOptions, RuleError, mirror_rule};
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
+use crate::progress::{Progress, Silent};
 use crate::quadrature::gauss_legendre;
 use crate::spectrum::MAX_CHANNELS;
 
@@ -148,7 +149,18 @@ pub fn measure(
     reference: &dyn Brdf,
     opts: &FidelityOptions,
 ) -> Result<Fidelity> {
-    FidelityReference::new(reference, opts)?.measure(approx)
+    measure_with(approx, reference, opts, &Silent)
+}
+
+/// [`measure`], asking `progress` to stop between blocks of pairs and albedo angles
+/// ([`Progress::cancelled`]: [`Error::Cancelled`]).
+pub fn measure_with(
+    approx: &dyn Brdf,
+    reference: &dyn Brdf,
+    opts: &FidelityOptions,
+    progress: &dyn Progress,
+) -> Result<Fidelity> {
+    FidelityReference::new_with(reference, opts, progress)?.measure_with(approx, progress)
 }
 
 /// What [`measure`] needs of the source, computed once for several tables of it (the accuracy
@@ -164,33 +176,49 @@ pub struct FidelityReference<'a> {
 impl<'a> FidelityReference<'a> {
     /// The source's side of the figures of `opts`.
     pub fn new(reference: &'a dyn Brdf, opts: &FidelityOptions) -> Result<FidelityReference<'a>> {
+        Self::new_with(reference, opts, &Silent)
+    }
+
+    /// [`new`](Self::new), asking `progress` to stop between blocks of the work.
+    pub fn new_with(
+        reference: &'a dyn Brdf,
+        opts: &FidelityOptions,
+        progress: &dyn Progress,
+    ) -> Result<FidelityReference<'a>> {
         let cap = opts.cap_deg.to_radians();
         Ok(FidelityReference {
             reference,
-            rule: PairRule::new(reference, cap, &PairRuleOptions::default())?,
-            albedo: albedo_curve(reference, opts)?,
+            rule: PairRule::new_with(reference, cap, &PairRuleOptions::default(), progress)?,
+            albedo: albedo_curve_with(reference, opts, progress)?,
             opts: opts.clone(),
         })
     }
 
     /// The figures of `approx` against the source.
     pub fn measure(&self, approx: &dyn Brdf) -> Result<Fidelity> {
+        self.measure_with(approx, &Silent)
+    }
+
+    /// [`measure`](Self::measure), asking `progress` to stop between blocks of the work.
+    pub fn measure_with(&self, approx: &dyn Brdf, progress: &dyn Progress) -> Result<Fidelity> {
         let opts = &self.opts;
         let cap = opts.cap_deg.to_radians();
         let w = Weight::CosInCosOut;
+        let (n, seed) = (opts.pairs, opts.seed);
         let rmse = |r: Region| -> Result<f64> {
-            Ok(compare_region(approx, self.reference, opts.pairs, opts.seed, r, w)?.rel_rmse)
+            Ok(compare_region_with(approx, self.reference, n, seed, r, w, progress)?.rel_rmse)
         };
         let in_cap = rmse(Region::Cap(cap))?;
         let whole = rmse(Region::Cap(std::f64::consts::FRAC_PI_2))?;
         let grazing = rmse(Region::Band(cap))?;
-        let albedo = worst_albedo(&albedo_curve(approx, opts)?, &self.albedo, opts);
+        let curve = albedo_curve_with(approx, opts, progress)?;
+        let albedo = worst_albedo(&curve, &self.albedo, opts);
         Ok(Fidelity {
             cap: in_cap,
             whole,
             grazing,
             albedo,
-            rule: self.rule.error(approx)?,
+            rule: self.rule.error_with(approx, progress)?,
         })
     }
 }
@@ -198,6 +226,15 @@ impl<'a> FidelityReference<'a> {
 /// The albedo curve of `brdf` at [`FidelityOptions::albedo_thetas_deg`] ([`mirror_albedo`],
 /// the mean over [`FidelityOptions::albedo_azimuths`]).
 pub fn albedo_curve(brdf: &dyn Brdf, opts: &FidelityOptions) -> Result<AlbedoCurve> {
+    albedo_curve_with(brdf, opts, &Silent)
+}
+
+/// [`albedo_curve`], asking `progress` to stop before each angle.
+pub fn albedo_curve_with(
+    brdf: &dyn Brdf,
+    opts: &FidelityOptions,
+    progress: &dyn Progress,
+) -> Result<AlbedoCurve> {
     let c = brdf.channels().len();
     if c > MAX_CHANNELS {
         return Err(Error::arg("channels", format!("{c} channels")));
@@ -205,10 +242,10 @@ pub fn albedo_curve(brdf: &dyn Brdf, opts: &FidelityOptions) -> Result<AlbedoCur
     check_rule(opts)?;
     let turns = light_azimuths(opts.albedo_azimuths);
     let share = 1.0 / turns.len() as f64;
-    Ok(opts
-        .albedo_thetas_deg
+    opts.albedo_thetas_deg
         .par_iter()
         .map(|&t| {
+            crate::progress::check(progress)?;
             let mut a = vec![0.0; c];
             for &phi in &turns {
                 let s = mirror_albedo(
@@ -221,9 +258,9 @@ pub fn albedo_curve(brdf: &dyn Brdf, opts: &FidelityOptions) -> Result<AlbedoCur
                     *a += share * s;
                 }
             }
-            a
+            Ok(a)
         })
-        .collect())
+        .collect()
 }
 
 /// Refuses an albedo rule without nodes.

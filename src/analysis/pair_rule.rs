@@ -165,6 +165,18 @@ impl PairRule {
     /// The rule for pairs split at `boundary` (radians from the normal; 80° for the fidelity
     /// figures), with `reference` evaluated at its nodes.
     pub fn new(reference: &dyn Brdf, boundary: f64, opts: &PairRuleOptions) -> Result<PairRule> {
+        Self::new_with(reference, boundary, opts, &crate::progress::Silent)
+    }
+
+    /// [`new`](Self::new), asking `progress` to stop before each block of 1024 of the
+    /// reference's evaluations ([`crate::progress::Progress::cancelled`]:
+    /// [`crate::Error::Cancelled`]).
+    pub fn new_with(
+        reference: &dyn Brdf,
+        boundary: f64,
+        opts: &PairRuleOptions,
+        progress: &dyn crate::progress::Progress,
+    ) -> Result<PairRule> {
         Region::Band(boundary).check()?;
         let c = reference.channels().len();
         if c > MAX_CHANNELS || opts.theta_order == 0 || opts.nphi == 0 || opts.order == 0 {
@@ -220,12 +232,14 @@ impl PairRule {
             reference_values
                 .par_chunks_mut(c.max(1) * 1024)
                 .zip(nodes.par_chunks(1024))
-                .for_each(|(out, ns)| {
+                .try_for_each(|(out, ns)| {
+                    crate::progress::check(progress)?;
                     for (o, n) in out.chunks_exact_mut(c.max(1)).zip(ns) {
                         reference.eval(n.wi, n.wo, o);
                     }
+                    Ok::<_, Error>(())
                 })
-        });
+        })?;
         let mut ref2 = [0.0; 2];
         for (n, v) in nodes.iter().zip(reference_values.chunks_exact(c.max(1))) {
             let s: f64 = v.iter().map(|&x| (x as f64).powi(2)).sum();
@@ -251,6 +265,16 @@ impl PairRule {
 
     /// The relative RMSEs of `approx` against the reference over the three regions.
     pub fn error(&self, approx: &dyn Brdf) -> Result<RuleError> {
+        self.error_with(approx, &crate::progress::Silent)
+    }
+
+    /// [`error`](Self::error), asking `progress` to stop before each block of 1024 pairs
+    /// ([`crate::progress::Progress::cancelled`]: [`crate::Error::Cancelled`]).
+    pub fn error_with(
+        &self,
+        approx: &dyn Brdf,
+        progress: &dyn crate::progress::Progress,
+    ) -> Result<RuleError> {
         let c = self.channels;
         if approx.channels().len() != c {
             return Err(Error::arg(
@@ -263,6 +287,7 @@ impl PairRule {
                 .par_chunks(1024)
                 .zip(self.reference.par_chunks(1024 * c.max(1)))
                 .map(|(ns, rv)| {
+                    crate::progress::check(progress)?;
                     let mut f = [0f32; MAX_CHANNELS];
                     let mut e = [0.0f64; 2];
                     for (n, r) in ns.iter().zip(rv.chunks_exact(c.max(1))) {
@@ -270,10 +295,10 @@ impl PairRule {
                         let s: f64 = (0..c).map(|k| (f[k] as f64 - r[k] as f64).powi(2)).sum();
                         e[usize::from(!n.inside)] += n.weight * s;
                     }
-                    e
+                    Ok(e)
                 })
-                .reduce(|| [0.0; 2], |a, b| [a[0] + b[0], a[1] + b[1]])
-        });
+                .try_reduce(|| [0.0; 2], |a, b| Ok([a[0] + b[0], a[1] + b[1]]))
+        })?;
         let ratio = |e: f64, r: f64| if r > 0.0 { (e / r).sqrt() } else { 0.0 };
         Ok(RuleError {
             cap: ratio(e2[0], self.ref2[0]),

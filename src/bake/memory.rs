@@ -8,7 +8,7 @@ use crate::brdf::Brdf;
 use crate::error::Result;
 use crate::progress::{Progress, Stage};
 use crate::source::{self, OpenOptions};
-use crate::table::calibration::calibrate;
+use crate::table::calibration::calibrate_with;
 use crate::table::{BakeOptions, Table};
 
 use super::BakeRequest;
@@ -108,7 +108,7 @@ impl BakeRequest {
         src.health()?;
         if let Some(a) = &albedo {
             let _stage = Stage::begin(progress, "calibrating albedo", 0);
-            table = calibrate(table, a)?;
+            table = calibrate_with(table, a, progress)?;
             src.health()?;
         }
         let grid = table.grid().clone();

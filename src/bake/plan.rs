@@ -157,7 +157,11 @@ impl BakeRequest {
                 || self.calibrates_model_table())
         {
             progress.note("integrating the source's albedo");
-            Some(AlbedoReference::new(src, &CalibrationOptions::default())?)
+            Some(AlbedoReference::new_with(
+                src,
+                &CalibrationOptions::default(),
+                progress,
+            )?)
         } else {
             None
         };
@@ -177,7 +181,7 @@ impl BakeRequest {
                     search = Some(s);
                     g
                 }
-                None => self.resolve_grid(src, sym)?,
+                None => self.resolve_grid_with(src, sym, progress)?,
             },
         };
         Ok(Plan {
@@ -286,6 +290,17 @@ impl BakeRequest {
 
     /// The grid this request bakes `src` on.
     pub fn resolve_grid(&self, src: &dyn Brdf, sym: Symmetry) -> Result<Grid> {
+        self.resolve_grid_with(src, sym, &Silent)
+    }
+
+    /// [`resolve_grid`](Self::resolve_grid), asking `progress` to stop while an adaptive
+    /// grid's warps are fitted.
+    fn resolve_grid_with(
+        &self,
+        src: &dyn Brdf,
+        sym: Symmetry,
+        progress: &dyn Progress,
+    ) -> Result<Grid> {
         let ch = src.channels().clone();
         if self.adaptive() {
             let nodes = match self.grid {
@@ -295,7 +310,8 @@ impl BakeRequest {
             if self.param.is_some_and(|p| p != Param::HalfDiff) {
                 return Err(Error::arg("grid", "an adaptive grid is halfdiff"));
             }
-            return adaptive::adaptive_grid(src, sym, &self.adaptive_options(src, nodes));
+            let opts = self.adaptive_options(src, nodes);
+            return adaptive::adaptive_grid_with(src, sym, &opts, progress);
         }
         match self.grid {
             GridChoice::Merl => {

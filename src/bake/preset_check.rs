@@ -6,14 +6,14 @@
 
 use std::time::Instant;
 
-use crate::analysis::accuracy::{Region, Weight, compare_region};
+use crate::analysis::accuracy::{Region, Weight, compare_region_with};
 use crate::analysis::fidelity::AlbedoError;
 use crate::brdf::Brdf;
 use crate::error::Result;
-use crate::progress::{Progress, Silent, Stage};
+use crate::progress::{Progress, Quiet, Stage};
 use crate::source::{self, SourceKind};
 use crate::table::calibration::{
-    ANISOTROPIC_AZIMUTHS, AlbedoReference, CalibrationOptions, calibrate,
+    ANISOTROPIC_AZIMUTHS, AlbedoReference, CalibrationOptions, calibrate_with,
 };
 use crate::table::presets::Preset;
 use crate::table::{BakeOptions, Param, Quantity, Table, TabulatedBrdf};
@@ -171,7 +171,10 @@ impl BakeRequest {
             },
             ..Default::default()
         };
-        let albedo = |t: &dyn Brdf| crate::analysis::fidelity::albedo_error(t, src, &fid);
+        let albedo = |t: &dyn Brdf| {
+            crate::progress::check(progress)?;
+            crate::analysis::fidelity::albedo_error(t, src, &fid)
+        };
         // Over random pairs, the same pairs for every table (half near the mirror direction,
         // weighted back to uniform, `compare_region`: uniform pairs alone made a sharp lobe's
         // figure depend on whether one landed on its peak): f_r cos θi, but f_r cos θi cos θo
@@ -184,7 +187,8 @@ impl BakeRequest {
         };
         let rmse_weighted = |t: &dyn Brdf, w: Weight| {
             let whole = Region::Cap(std::f64::consts::FRAC_PI_2);
-            compare_region(t, src, PRESET_CHECK_PAIRS, 1, whole, w).map(|a| a.rel_rmse)
+            compare_region_with(t, src, PRESET_CHECK_PAIRS, 1, whole, w, progress)
+                .map(|a| a.rel_rmse)
         };
         let rmse = |t: &dyn Brdf| rmse_weighted(t, weight);
         // The error of the whole-hemisphere f_r cos θi cos θo ([`PRESET_RMSE_TOLERANCE`]).
@@ -203,7 +207,7 @@ impl BakeRequest {
             let (adaptive, _) = self
                 .clone()
                 .target_error(MODEL_FALLBACK_TARGET_ERROR)
-                .table_of(src, &Silent)?;
+                .table_of(src, &Quiet(progress))?;
             let adaptive = TabulatedBrdf::from_table(adaptive);
             let (a, ac, r) = (albedo(&adaptive)?, rmse_cc(&adaptive)?, rmse(&adaptive)?);
             if ac < pc && a.worst <= PRESET_ALBEDO_TOLERANCE && within_slack(r, rp) {
@@ -238,7 +242,7 @@ impl BakeRequest {
             let (adaptive, _) = self
                 .clone()
                 .target_error(MODEL_FALLBACK_TARGET_ERROR)
-                .table_of(src, &Silent)?;
+                .table_of(src, &Quiet(progress))?;
             let adaptive = TabulatedBrdf::from_table(adaptive);
             done = consider(Fallback::Adaptive, albedo(&adaptive)?, rmse(&adaptive)?);
         }
@@ -249,8 +253,8 @@ impl BakeRequest {
                 two_sided: !sym.reciprocal,
                 ..CalibrationOptions::default()
             };
-            let reference = AlbedoReference::new(src, &copts)?;
-            let calibrated = calibrate(preset, &reference)?;
+            let reference = AlbedoReference::new_with(src, &copts, progress)?;
+            let calibrated = calibrate_with(preset, &reference, progress)?;
             let tab = TabulatedBrdf::from_table(calibrated.clone());
             let (a, r) = (albedo(&tab)?, rmse(&tab)?);
             drop(tab);
@@ -331,6 +335,7 @@ impl BakeRequest {
 mod tests {
     use super::*;
     use crate::bake::{BakeTarget, tmp};
+    use crate::progress::Silent;
 
     #[test]
     fn a_model_asked_to_store_f_r_cos_out_bakes_on_the_default_grid() {

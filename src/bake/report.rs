@@ -124,15 +124,28 @@ impl Accuracy {
     /// Compares `table` with `source` on `pairs` random pairs (seed 1); zero pairs is an
     /// argument error (its zero error read as a perfect match).
     pub fn measure(table: &dyn Brdf, source: &dyn Brdf, pairs: usize) -> Result<Accuracy> {
+        Self::measure_with(table, source, pairs, &crate::progress::Silent)
+    }
+
+    /// [`measure`](Self::measure), asking `progress` to stop before each block of pairs
+    /// ([`crate::progress::Progress::cancelled`]: [`crate::Error::Cancelled`]).
+    pub fn measure_with(
+        table: &dyn Brdf,
+        source: &dyn Brdf,
+        pairs: usize,
+        progress: &dyn crate::progress::Progress,
+    ) -> Result<Accuracy> {
         if pairs == 0 {
             return Err(crate::Error::arg("pairs", "0: no pairs to measure on"));
         }
         // Both cosines: f_r cos θi has no finite RMS for measured data, Ward or Cook-Torrance
         // (the figure the struct's fields say; it read f_r cos θi until session 26).
-        use crate::analysis::accuracy::{Weight, compare_weighted};
+        use crate::analysis::accuracy::{Region, Weight, compare_region_with};
         let w = Weight::CosInCosOut;
-        let all = compare_weighted(table, source, pairs, 1, std::f64::consts::FRAC_PI_2, w)?;
-        let cap = compare_weighted(table, source, pairs, 1, 80f64.to_radians(), w)?;
+        let cmp =
+            |t: f64| compare_region_with(table, source, pairs, 1, Region::Cap(t), w, progress);
+        let all = cmp(std::f64::consts::FRAC_PI_2)?;
+        let cap = cmp(80f64.to_radians())?;
         Ok(Accuracy {
             pairs: all.pairs,
             rel_rmse: all.rel_rmse,

@@ -42,16 +42,27 @@ pub fn to_rgl(
     crate::table::fill::tabulable(brdf.as_ref())?;
     let opts = opts.clone().reuse_source_file(source)?;
     let t = std::time::Instant::now();
-    let written = rgl_write::write(&*brdf, output, &opts, progress)?;
-    let seconds = t.elapsed().as_secs_f64();
+    let fields = rgl_write::encode(&*brdf, &opts, progress)?;
+    // A source that failed while it was read (a corrupt table chunk) gave zeros: write nothing.
+    brdf.health()?;
+    let bytes = fields.to_bytes();
+    let mut seconds = t.elapsed().as_secs_f64();
+    // The file's error is measured on its bytes before they are written, so that a stop asked
+    // during the report (seconds) leaves `output` as it was.
     let error = match pairs {
         0 => None,
-        n => Some(rgl_write::report(
-            &crate::measured::RglBrdf::open(output)?,
-            &*brdf,
-            n,
-            1,
-        )?),
+        n => {
+            let tf = crate::measured::tensor::TensorFile::from_bytes(output, bytes.clone())?;
+            let file = crate::measured::RglBrdf::from_tensor(&tf, None)?;
+            Some(rgl_write::report_with(&file, &*brdf, n, 1, progress)?)
+        }
+    };
+    let t = std::time::Instant::now();
+    crate::files::write_atomic(std::path::Path::new(output), &bytes)?;
+    seconds += t.elapsed().as_secs_f64();
+    let written = rgl_write::Written {
+        bytes: bytes.len(),
+        fields,
     };
     Ok(Converted {
         written,

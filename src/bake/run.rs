@@ -118,11 +118,25 @@ impl BakeRequest {
             Some(c) => Ok(c),
             None => self.table_unchecked(src.as_ref(), progress),
         };
-        let (mut report, table) = match target {
+        // The accuracy report is measured before the output is committed, so that a stop
+        // asked during it (seconds for a conversion's 200 000 pairs) leaves the output as it
+        // was: a table built whole is measured in memory, a streamed one in a staging file
+        // beside the output, renamed (or imported) into place once measured.
+        let pairs = self.accuracy_pairs;
+        let measure = |tab: TabulatedBrdf| -> Result<Accuracy> {
+            let interp = self
+                .accuracy_interp
+                .unwrap_or_else(|| Interp::default_for(tab.grid()));
+            Accuracy::measure_with(&tab.with_interp(interp), src.as_ref(), pairs, progress)
+        };
+        let (mut report, accuracy) = match target {
             BakeTarget::Raw(path) => {
                 let (table, r) = built(checked)?;
+                let a = (pairs > 0)
+                    .then(|| measure(TabulatedBrdf::from_table(table.clone())))
+                    .transpose()?;
                 table.save_raw(path)?;
-                (r, Some(table))
+                (r, a)
             }
             // Tables built whole before they are written: MERL cells, and calibrated tables
             // (the calibration needs every value; measured and adaptive tables are small).
@@ -132,6 +146,9 @@ impl BakeRequest {
                 || self.calibrates_model_table() =>
             {
                 let (table, r) = built(checked)?;
+                let a = (pairs > 0)
+                    .then(|| measure(TabulatedBrdf::from_table(table.clone())))
+                    .transpose()?;
                 match target {
                     BakeTarget::Db { path, replace, .. } => {
                         tables::save(path, &name, provenance, &table, self.codec, *replace)?
@@ -140,7 +157,19 @@ impl BakeRequest {
                     // (a value the codec cannot hold, a full disk) leaves the old file as it was.
                     t => tables::save_file(t.path(), &name, provenance, &table, self.codec)?,
                 }
-                (r, Some(table))
+                (r, a)
+            }
+            _ if pairs > 0 => {
+                let staging = Staging::beside(target.path())?;
+                let file = BakeTarget::File(staging.0.to_string_lossy().into_owned());
+                let r = self.stream(src.as_ref(), &file, &name, provenance, progress)?;
+                let a = measure(crate::store::tables::open_brdf_at(
+                    file.path(),
+                    Some(&name),
+                    false,
+                )?)?;
+                staging.commit(target, &name)?;
+                (r, Some(a))
             }
             _ => (
                 self.stream(src.as_ref(), target, &name, provenance, progress)?,
@@ -159,19 +188,7 @@ impl BakeRequest {
         if matches!(target, BakeTarget::File(_) | BakeTarget::Db { .. }) {
             report.info = crate::store::info::table_info(target.path(), &name)?;
         }
-        if self.accuracy_pairs > 0 {
-            // The written table by its path and name: a `DB#NAME` string would be looked up
-            // whole first, and a file of that name beside the output read instead.
-            let tab = match table {
-                Some(t) => TabulatedBrdf::from_table(t),
-                None => crate::store::tables::open_brdf_at(target.path(), Some(&name), false)?,
-            };
-            let interp = self
-                .accuracy_interp
-                .unwrap_or_else(|| Interp::default_for(tab.grid()));
-            let tab = tab.with_interp(interp);
-            report.accuracy = Some(Accuracy::measure(&tab, src.as_ref(), self.accuracy_pairs)?);
-        }
+        report.accuracy = accuracy;
         Ok(report)
     }
 
@@ -239,6 +256,38 @@ impl BakeRequest {
         report.forced = baked.forced.filter(|_| !assumed);
         report.target = search;
         Ok(report)
+    }
+}
+
+/// A streamed table written beside its output before it is measured (removed when dropped
+/// unless committed): a stop during the accuracy report leaves the output as it was.
+struct Staging(std::path::PathBuf);
+
+impl Staging {
+    fn beside(output: &str) -> Result<Staging> {
+        let out = crate::files::resolve_links(Path::new(output))?;
+        Ok(Staging(crate::files::temp_path(&out)?))
+    }
+
+    /// Moves the measured table into `target`: renamed over a file, imported (its chunks
+    /// copied as they are) into a database.
+    fn commit(self, target: &BakeTarget, name: &str) -> Result<()> {
+        match target {
+            BakeTarget::Db { path, replace, .. } => {
+                let store = crate::store::Store::open(&self.0)?;
+                db::import(path, &store, name, name, *replace)
+            }
+            t => {
+                let out = crate::files::resolve_links(Path::new(t.path()))?;
+                std::fs::rename(&self.0, &out).map_err(|e| Error::io(&out, e))
+            }
+        }
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
     }
 }
 

@@ -23,6 +23,32 @@ pub struct Lock {
 /// Takes the exclusive writer lock of the database at `path` (blocks until free); a symbolic
 /// link's is its target's.
 pub fn lock(path: &Path) -> Result<Lock> {
+    let (f, lp) = lock_file(path)?;
+    f.lock().map_err(|e| Error::io(&lp, e))?;
+    Ok(Lock { _file: f })
+}
+
+/// How often [`lock_with`] tries a lock held by another writer.
+const LOCK_POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// [`lock`], waiting for a lock held by another writer (another process's bake of the same
+/// cached table: minutes) in tries [`LOCK_POLL`] apart, between which it asks `progress` to
+/// stop ([`crate::progress::Progress::cancelled`]: [`Error::Cancelled`]).
+pub fn lock_with(path: &Path, progress: &dyn crate::progress::Progress) -> Result<Lock> {
+    let (f, lp) = lock_file(path)?;
+    loop {
+        match f.try_lock() {
+            Ok(()) => return Ok(Lock { _file: f }),
+            Err(std::fs::TryLockError::WouldBlock) => {}
+            Err(std::fs::TryLockError::Error(e)) => return Err(Error::io(&lp, e)),
+        }
+        crate::progress::check(progress)?;
+        std::thread::sleep(LOCK_POLL);
+    }
+}
+
+/// The lock file of the database at `path`, open for writing, and its path.
+fn lock_file(path: &Path) -> Result<(File, PathBuf)> {
     let path = &crate::files::resolve_links(path)?;
     // A database is written through a new file renamed over it: a pipe or a device there, or
     // a directory that is not one, is refused before the lock, in output terms.
@@ -42,8 +68,7 @@ pub fn lock(path: &Path) -> Result<Lock> {
         .write(true)
         .open(&lp)
         .map_err(|e| Error::io(&lp, e))?;
-    f.lock().map_err(|e| Error::io(&lp, e))?;
-    Ok(Lock { _file: f })
+    Ok((f, lp))
 }
 
 /// Opens an existing database, or `None` when the file does not exist.

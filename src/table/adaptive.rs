@@ -72,6 +72,17 @@ fn vars(opts: &AdaptiveOptions) -> [WarpVar; 3] {
 /// An adaptive grid for `src` (isotropic; `symmetry` must be isotropic and bilateral, and may
 /// be reciprocal): θh, θd and φd warped by the source's own variation (see the module docs).
 pub fn adaptive_grid(src: &dyn Brdf, symmetry: Symmetry, opts: &AdaptiveOptions) -> Result<Grid> {
+    adaptive_grid_with(src, symmetry, opts, &crate::progress::Silent)
+}
+
+/// [`adaptive_grid`], asking `progress` to stop while the warps are fitted
+/// ([`fit_warps_with`]).
+pub fn adaptive_grid_with(
+    src: &dyn Brdf,
+    symmetry: Symmetry,
+    opts: &AdaptiveOptions,
+    progress: &dyn crate::progress::Progress,
+) -> Result<Grid> {
     if !(symmetry.isotropic && symmetry.bilateral) {
         return Err(Error::arg(
             "grid",
@@ -86,7 +97,7 @@ pub fn adaptive_grid(src: &dyn Brdf, symmetry: Symmetry, opts: &AdaptiveOptions)
         ));
     }
     within_memory(opts.nodes, src.channels().len())?;
-    let warps = fit_warps(src, phi_hi(symmetry), opts)?;
+    let warps = fit_warps_with(src, phi_hi(symmetry), opts, progress)?;
     grid_with_warps(src.channels().clone(), symmetry, opts.nodes, warps)?
         .with_quantity(opts.quantity)
 }
@@ -158,6 +169,17 @@ pub fn grid_with_warps(
 
 /// The three warps (θh, θd, φd over [0, `phi_hi`]) of `src`.
 pub fn fit_warps(src: &dyn Brdf, phi_hi: f64, opts: &AdaptiveOptions) -> Result<[Warp; 3]> {
+    fit_warps_with(src, phi_hi, opts, &crate::progress::Silent)
+}
+
+/// [`fit_warps`], asking `progress` to stop before each θh row of the fine tensor
+/// ([`crate::progress::Progress::cancelled`]: [`crate::Error::Cancelled`]).
+pub fn fit_warps_with(
+    src: &dyn Brdf,
+    phi_hi: f64,
+    opts: &AdaptiveOptions,
+    progress: &dyn crate::progress::Progress,
+) -> Result<[Warp; 3]> {
     let [mh, md, mp] = opts.fine;
     let c = src.channels().len();
     let his = [FRAC_PI_2, FRAC_PI_2, phi_hi];
@@ -175,7 +197,8 @@ pub fn fit_warps(src: &dyn Brdf, phi_hi: f64, opts: &AdaptiveOptions) -> Result<
         f.par_chunks_mut(row)
             .zip(w.par_chunks_mut(md * mp))
             .enumerate()
-            .for_each(|(ih, (fr, wr))| {
+            .try_for_each(|(ih, (fr, wr))| {
+                crate::progress::check(progress)?;
                 let th = ang(0, ih);
                 for id in 0..md {
                     let td = ang(1, id);
@@ -207,8 +230,9 @@ pub fn fit_warps(src: &dyn Brdf, phi_hi: f64, opts: &AdaptiveOptions) -> Result<
                         };
                     }
                 }
+                Ok(())
             })
-    });
+    })?;
     for x in f.iter_mut() {
         if !x.is_finite() || *x < 0.0 {
             // Unmeasured (negative) or invalid: no variation from it.

@@ -40,6 +40,7 @@ use crate::analysis::fidelity::{Reversed, Turned, light_azimuths, mirror_albedo}
 use crate::analysis::pair_rule::mirror_rule;
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
+use crate::progress::{Progress, Silent};
 use crate::quadrature::gauss_legendre;
 use crate::simd::F4;
 use crate::spectrum::MAX_CHANNELS;
@@ -429,6 +430,16 @@ pub struct AlbedoReference {
 impl AlbedoReference {
     /// The albedos of `reference` at the nodes of `opts`.
     pub fn new(reference: &dyn Brdf, opts: &CalibrationOptions) -> Result<AlbedoReference> {
+        Self::new_with(reference, opts, &Silent)
+    }
+
+    /// [`new`](Self::new), asking `progress` to stop between nodes
+    /// ([`Progress::cancelled`]: [`Error::Cancelled`]).
+    pub fn new_with(
+        reference: &dyn Brdf,
+        opts: &CalibrationOptions,
+        progress: &dyn Progress,
+    ) -> Result<AlbedoReference> {
         let c = reference.channels().len();
         if c == 0 || c > MAX_CHANNELS {
             return Err(Error::arg(
@@ -440,9 +451,9 @@ impl AlbedoReference {
             return Err(Error::arg("calibration", "needs at least two nodes"));
         }
         Ok(AlbedoReference {
-            albedo_in: node_albedos(reference, opts),
+            albedo_in: node_albedos(reference, opts, progress)?,
             albedo_out: if opts.two_sided {
-                node_albedos(&Reversed(reference), opts)
+                node_albedos(&Reversed(reference), opts, progress)?
             } else {
                 Vec::new()
             },
@@ -482,8 +493,12 @@ fn azimuths(brdf: &dyn Brdf) -> Vec<f64> {
 }
 
 /// Per node of `opts`, the albedo of `brdf` per channel (nodes × channels), the mean over
-/// [`azimuths`].
-fn node_albedos(brdf: &dyn Brdf, opts: &CalibrationOptions) -> Vec<f64> {
+/// [`azimuths`]. Asks `progress` to stop before each node.
+fn node_albedos(
+    brdf: &dyn Brdf,
+    opts: &CalibrationOptions,
+    progress: &dyn Progress,
+) -> Result<Vec<f64>> {
     let c = brdf.channels().len();
     let t_end = opts.t_end() as f64;
     let turns = azimuths(brdf);
@@ -491,6 +506,7 @@ fn node_albedos(brdf: &dyn Brdf, opts: &CalibrationOptions) -> Vec<f64> {
         (0..opts.nodes)
             .into_par_iter()
             .map(|i| {
+                crate::progress::check(progress)?;
                 let theta = Calibration::node_theta(i, opts.nodes, t_end);
                 let mut row = vec![0.0f64; c];
                 for &phi in &turns {
@@ -499,19 +515,23 @@ fn node_albedos(brdf: &dyn Brdf, opts: &CalibrationOptions) -> Vec<f64> {
                         *r += a / turns.len() as f64;
                     }
                 }
-                row
+                Ok(row)
             })
-            .collect()
-    });
-    rows.into_iter().flatten().collect()
+            .collect::<Result<_>>()
+    })?;
+    Ok(rows.into_iter().flatten().collect())
 }
 
 /// The transport of `brdf` from each node's direction onto the axis: `m[(i·nodes + j)·c + k]`
 /// = ∫ f_r cos θo · hat_j(t_o) dωo for wi at node i, where hat_j is node j's linear
 /// interpolation weight (what a factor on node j multiplies). Summed over j it is node i's
 /// albedo; with k_out applied, node i's albedo is `Σ_j m[i][j] k_out[j]`. The mean over
-/// [`azimuths`], as the reference's albedos.
-fn transport(brdf: &dyn Brdf, opts: &CalibrationOptions) -> Vec<f64> {
+/// [`azimuths`], as the reference's albedos. Asks `progress` to stop before each node.
+fn transport(
+    brdf: &dyn Brdf,
+    opts: &CalibrationOptions,
+    progress: &dyn Progress,
+) -> Result<Vec<f64>> {
     let c = brdf.channels().len();
     let n = opts.nodes;
     let t_end = opts.t_end() as f64;
@@ -523,6 +543,7 @@ fn transport(brdf: &dyn Brdf, opts: &CalibrationOptions) -> Vec<f64> {
         (0..n)
             .into_par_iter()
             .map(|i| {
+                crate::progress::check(progress)?;
                 let theta = Calibration::node_theta(i, n, t_end);
                 let mut row = vec![0.0f64; n * c];
                 let mut f = [0f32; MAX_CHANNELS];
@@ -541,11 +562,11 @@ fn transport(brdf: &dyn Brdf, opts: &CalibrationOptions) -> Vec<f64> {
                         }
                     });
                 }
-                row
+                Ok(row)
             })
-            .collect()
-    });
-    rows.into_iter().flatten().collect()
+            .collect::<Result<_>>()
+    })?;
+    Ok(rows.into_iter().flatten().collect())
 }
 
 /// The range [`calibrate`] keeps each factor in: a correction beyond a factor of 2 is not a bias
@@ -614,6 +635,16 @@ fn balance_symmetric(k: &mut [f32], m: &[f64], reference: &[f64], c: usize) -> f
 /// in either keeps the factor 1 there; factors stay within [1/[`FIT_LIMIT`], [`FIT_LIMIT`]].
 /// Any calibration the table had is replaced.
 pub fn calibrate(table: Table, reference: &AlbedoReference) -> Result<Table> {
+    calibrate_with(table, reference, &Silent)
+}
+
+/// [`calibrate`], asking `progress` to stop between the table's nodes
+/// ([`Progress::cancelled`]: [`Error::Cancelled`]).
+pub fn calibrate_with(
+    table: Table,
+    reference: &AlbedoReference,
+    progress: &dyn Progress,
+) -> Result<Table> {
     let c = table.grid().channels().len();
     if reference.channels != c {
         return Err(Error::arg(
@@ -631,7 +662,7 @@ pub fn calibrate(table: Table, reference: &AlbedoReference) -> Result<Table> {
     let n = opts.nodes * c;
     let ones = vec![1.0f32; n];
     let mut k_in = ones.clone();
-    let m_in = transport(&plain, opts);
+    let m_in = transport(&plain, opts, progress)?;
     let k_out = if grid.symmetry().reciprocal {
         // One factor for both directions, k(θi) k(θo), so the table stays reciprocal: the
         // symmetric scaling k ← √(k · a / (M k)) (the damped form of k = a / (M k), which
@@ -644,7 +675,7 @@ pub fn calibrate(table: Table, reference: &AlbedoReference) -> Result<Table> {
         }
         Some(k_in.clone())
     } else if opts.two_sided {
-        let m_out = transport(&Reversed(&plain), opts);
+        let m_out = transport(&Reversed(&plain), opts, progress)?;
         let mut k_out = ones;
         for _ in 0..opts.rounds.max(1) {
             let a = balance(&mut k_in, &m_in, &k_out, &reference.albedo_in, c);

@@ -20,7 +20,7 @@ use crate::brdf::Brdf;
 use crate::error::{Error, Result};
 use crate::progress::{Progress, Stage};
 use crate::table::adaptive::{self, AdaptiveOptions};
-use crate::table::calibration::{AlbedoReference, calibrate};
+use crate::table::calibration::{AlbedoReference, calibrate_with};
 use crate::table::symmetry::Symmetry;
 use crate::table::{BakeOptions, Grid, TabulatedBrdf, bake};
 
@@ -145,7 +145,7 @@ impl TargetSearch {
 /// The smallest grid of [`LADDER`] whose table meets `opts` against `src` (see the module
 /// docs), with what was measured. `symmetry` must be isotropic and bilateral; `force` bakes
 /// without verifying it (an assumed symmetry). With `albedo`, every candidate is calibrated to
-/// it ([`calibrate`]) before it is judged, as the final table will be. When no grid meets the
+/// it ([`calibrate_with`]) before it is judged, as the final table will be. When no grid meets the
 /// target, the largest is returned with `met: false`. Reports a stage `"searching grid"` on
 /// `progress` (of unknown length), noting each grid as it is tried.
 pub fn search(
@@ -171,9 +171,9 @@ pub fn search(
     }
     let _stage = Stage::begin(progress, "searching grid", 0);
     progress.note("fitting warps");
-    let warps = adaptive::fit_warps(src, adaptive::phi_hi(symmetry), adaptive_opts)?;
+    let warps = adaptive::fit_warps_with(src, adaptive::phi_hi(symmetry), adaptive_opts, progress)?;
     progress.note("evaluating the source on the rule");
-    let rule = PairRule::new(src, opts.cap_deg.to_radians(), &opts.rule)?;
+    let rule = PairRule::new_with(src, opts.cap_deg.to_radians(), &opts.rule, progress)?;
     let grid_of = |nodes| {
         adaptive::grid_with_warps(src.channels().clone(), symmetry, nodes, warps.clone())
             .and_then(|g| g.with_quantity(adaptive_opts.quantity))
@@ -191,9 +191,9 @@ pub fn search(
         progress.note(&format!("{h}x{d}x{p}"));
         let (mut t, _) = bake(src, &grid_of(LADDER[k])?, &bake_opts)?;
         if let Some(a) = albedo {
-            t = calibrate(t, a)?;
+            t = calibrate_with(t, a, progress)?;
         }
-        let e = rule.error(&TabulatedBrdf::from_table(t))?;
+        let e = rule.error_with(&TabulatedBrdf::from_table(t), progress)?;
         tried.push((LADDER[k], e.cap, e.grazing));
         progress.set(tried.len() as u64);
         Ok(opts.score(&e))

@@ -118,11 +118,19 @@ impl Grid {
     }
 }
 
-/// Runs `jobs` on the file in parallel.
-fn run(file: &RglBrdf, src: &dyn Brdf, jobs: &[Job]) -> Vec<Errors> {
+/// Runs `jobs` on the file in parallel, asking `progress` to stop before each.
+fn run(
+    file: &RglBrdf,
+    src: &dyn Brdf,
+    jobs: &[Job],
+    progress: &dyn Progress,
+) -> Result<Vec<Errors>> {
     crate::par::install(|| {
         jobs.par_iter()
-            .map(|j| measure(file, src, j.a, j.b, &j.az, j.seed))
+            .map(|j| {
+                crate::progress::check(progress)?;
+                Ok(measure(file, src, j.a, j.b, &j.az, j.seed))
+            })
             .collect()
     })
 }
@@ -155,7 +163,7 @@ pub fn place(
         "placing azimuths and elevations",
         max_slices as u64,
     );
-    let mut file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache)?;
+    let mut file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache, progress)?;
     let (np, nt) = (g.phi.len(), g.theta.len());
     let mut seed = 1u64;
     let mut next_seed = || {
@@ -166,21 +174,22 @@ pub fn place(
         .flat_map(|i| (0..nt - 1).map(move |j| (i, j)))
         .map(|(i, j)| g.cell_job(i, j, next_seed()))
         .collect();
-    let r = run(&file, brdf, &jobs);
+    let r = run(&file, brdf, &jobs, progress)?;
     g.cell = r.chunks(nt - 1).map(<[Errors]>::to_vec).collect();
     let jobs: Vec<Job> = (0..np - 1)
         .flat_map(|i| (0..nt).map(move |j| (i, j)))
         .map(|(i, j)| g.at_theta_job(i, j, next_seed()))
         .collect();
-    let r = run(&file, brdf, &jobs);
+    let r = run(&file, brdf, &jobs, progress)?;
     g.at_theta = r.chunks(nt).map(<[Errors]>::to_vec).collect();
     let jobs: Vec<Job> = (0..np)
         .flat_map(|i| (0..nt - 1).map(move |j| (i, j)))
         .map(|(i, j)| g.at_phi_job(i, j, next_seed()))
         .collect();
-    let r = run(&file, brdf, &jobs);
+    let r = run(&file, brdf, &jobs, progress)?;
     g.at_phi = r.chunks(nt - 1).map(<[Errors]>::to_vec).collect();
     loop {
+        crate::progress::check(progress)?;
         let (np, nt) = (g.phi.len(), g.theta.len());
         progress.set((np * nt) as u64);
         let (mut cells, mut floors) = (Vec::new(), Vec::new());
@@ -273,7 +282,7 @@ pub fn place(
             Ok(j) => {
                 let mid = 0.5 * (g.theta[j] + g.theta[j + 1]);
                 g.theta.insert(j + 1, mid);
-                file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache)?;
+                file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache, progress)?;
                 let mut jobs = Vec::new();
                 for i in 0..np - 1 {
                     jobs.push(g.cell_job(i, j, next_seed()));
@@ -284,7 +293,7 @@ pub fn place(
                     jobs.push(g.at_phi_job(i, j, next_seed()));
                     jobs.push(g.at_phi_job(i, j + 1, next_seed()));
                 }
-                let r = run(&file, brdf, &jobs);
+                let r = run(&file, brdf, &jobs, progress)?;
                 for i in 0..np - 1 {
                     g.cell[i].splice(j..=j, [r[3 * i], r[3 * i + 1]]);
                     g.at_theta[i].insert(j + 1, r[3 * i + 2]);
@@ -297,7 +306,7 @@ pub fn place(
             Err(i) => {
                 let mid = 0.5 * (g.phi[i] + g.phi[i + 1]);
                 g.phi.insert(i + 1, mid);
-                file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache)?;
+                file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache, progress)?;
                 let mut jobs = Vec::new();
                 for k in [i, i + 1] {
                     for j in 0..nt - 1 {
@@ -310,7 +319,7 @@ pub fn place(
                 for j in 0..nt - 1 {
                     jobs.push(g.at_phi_job(i + 1, j, next_seed()));
                 }
-                let r = run(&file, brdf, &jobs);
+                let r = run(&file, brdf, &jobs, progress)?;
                 let row = (nt - 1) + nt;
                 let (left, right) = (&r[..row], &r[row..2 * row]);
                 g.cell
@@ -324,7 +333,8 @@ pub fn place(
 }
 
 /// The file of `base` with azimuths `phi` and elevations `theta`, read back by brdftab's RGL
-/// reader; slices not in `cache` are encoded (in parallel) and kept there.
+/// reader; slices not in `cache` are encoded (in parallel) and kept there. Asks `progress` to
+/// stop before each slice.
 fn reader(
     brdf: &dyn Brdf,
     ndf: &Ndf,
@@ -332,6 +342,7 @@ fn reader(
     phi: &[f64],
     theta: &[f64],
     cache: &mut HashMap<(u64, u64), Slice>,
+    progress: &dyn Progress,
 ) -> Result<RglBrdf> {
     let plane = base.n * base.n;
     let missing: Vec<(f64, f64)> = phi
@@ -343,6 +354,7 @@ fn reader(
         missing
             .par_iter()
             .map(|&(p, t)| {
+                crate::progress::check(progress)?;
                 let layout = Layout {
                     theta_i: vec![t as f32],
                     phi_i: vec![p as f32],

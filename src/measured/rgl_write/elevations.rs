@@ -34,7 +34,7 @@ use crate::error::Result;
 use crate::geometry;
 use crate::measured::RglBrdf;
 use crate::measured::tensor::TensorFile;
-use crate::progress::Silent;
+use crate::progress::Quiet;
 use crate::quadrature::gauss_legendre;
 use crate::rng::Pcg32;
 use crate::spectrum::MAX_CHANNELS;
@@ -167,22 +167,34 @@ pub fn place(
         .collect();
     let mut cache: HashMap<u64, Slice> = HashMap::new();
     let _stage = crate::progress::Stage::begin(progress, "placing elevations", max as u64);
-    let mut file = reader(brdf, ndf, base, &theta, &mut cache)?;
+    let mut file = reader(brdf, ndf, base, &theta, &mut cache, progress)?;
+    let check = || crate::progress::check(progress);
     let mut at: Vec<Errors> = (0..theta.len())
-        .map(|k| measure(&file, brdf, theta[k], theta[k], &WHOLE_CIRCLE, k as u64))
-        .collect();
+        .map(|k| {
+            check()?;
+            Ok(measure(
+                &file,
+                brdf,
+                theta[k],
+                theta[k],
+                &WHOLE_CIRCLE,
+                k as u64,
+            ))
+        })
+        .collect::<Result<_>>()?;
     let mut iv: Vec<Errors> = (0..theta.len() - 1)
         .map(|k| {
-            measure(
+            check()?;
+            Ok(measure(
                 &file,
                 brdf,
                 theta[k],
                 theta[k + 1],
                 &WHOLE_CIRCLE,
                 100 + k as u64,
-            )
+            ))
         })
-        .collect();
+        .collect::<Result<_>>()?;
     let floors = |theta: &[f64], at: &[Errors]| -> Vec<Errors> {
         (0..theta.len() - 1)
             .map(|k| floor_of(&at[k], &at[k + 1], theta[k], theta[k + 1]))
@@ -220,23 +232,27 @@ pub fn place(
         };
         let mid = 0.5 * (theta[j] + theta[j + 1]);
         theta.insert(j + 1, mid);
-        file = reader(brdf, ndf, base, &theta, &mut cache)?;
+        file = reader(brdf, ndf, base, &theta, &mut cache, progress)?;
         let seed = theta.len() as u64 * 1000;
+        check()?;
         at.insert(j + 1, measure(&file, brdf, mid, mid, &WHOLE_CIRCLE, seed));
+        check()?;
         let left = measure(&file, brdf, theta[j], mid, &WHOLE_CIRCLE, seed + 1);
+        check()?;
         let right = measure(&file, brdf, mid, theta[j + 2], &WHOLE_CIRCLE, seed + 2);
         iv.splice(j..=j, [left, right]);
     }
 }
 
 /// The file of `base` with elevations `theta`, read back by brdftab's RGL reader; slices
-/// not in `cache` are encoded and kept there.
+/// not in `cache` are encoded and kept there (`progress` asked to stop as each is sampled).
 fn reader(
     brdf: &dyn Brdf,
     ndf: &Ndf,
     base: &Layout,
     theta: &[f64],
     cache: &mut HashMap<u64, Slice>,
+    progress: &dyn Progress,
 ) -> Result<RglBrdf> {
     let nch = brdf.channels().len();
     let (np, n) = (base.phi_i.len(), base.n);
@@ -251,7 +267,7 @@ fn reader(
             ..base.clone()
         };
         let w = warps::vndf(ndf, &layout)?;
-        let v = values::sample(brdf, ndf, &w, &layout, None, &Silent)?;
+        let v = values::sample(brdf, ndf, &w, &layout, None, &Quiet(progress))?;
         let valid = super::container::unpack_bits(&v.valid, np * plane);
         cache.insert(
             t.to_bits(),

@@ -90,7 +90,7 @@ use crate::brdf::Brdf;
 use crate::error::{Error, Result};
 
 pub use container::Fields;
-pub use report::{Report, report};
+pub use report::{Report, report, report_with};
 
 /// The incident elevations (radians) of the published isotropic files (0°, 27.7°, 39.9°, 49.9°,
 /// 59.3°, 68.6°, 78.5°, 90°), used when 8 are asked for.

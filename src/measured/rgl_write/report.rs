@@ -72,7 +72,21 @@ impl Brdf for CosO<'_> {
 /// Compares `written` (normally the file read back by [`RglBrdf`](crate::measured::RglBrdf))
 /// against `source` over `pairs` random pairs (seed `seed`).
 pub fn report(written: &dyn Brdf, source: &dyn Brdf, pairs: usize, seed: u64) -> Result<Report> {
-    let a = accuracy::compare_cap(&CosO(written), &CosO(source), pairs, seed, MAX_THETA)?;
+    report_with(written, source, pairs, seed, &crate::progress::Silent)
+}
+
+/// [`report`], asking `progress` to stop between blocks of the work
+/// ([`crate::progress::Progress::cancelled`]: [`crate::Error::Cancelled`]).
+pub fn report_with(
+    written: &dyn Brdf,
+    source: &dyn Brdf,
+    pairs: usize,
+    seed: u64,
+    progress: &dyn crate::progress::Progress,
+) -> Result<Report> {
+    let (w, s) = (&CosO(written), &CosO(source));
+    let (cap, cos) = (accuracy::Region::Cap(MAX_THETA), accuracy::Weight::CosIn);
+    let a = accuracy::compare_region_with(w, s, pairs, seed, cap, cos, progress)?;
     let opts = FidelityOptions {
         pairs,
         seed,
@@ -83,6 +97,6 @@ pub fn report(written: &dyn Brdf, source: &dyn Brdf, pairs: usize, seed: u64) ->
         rel_rmse: a.rel_rmse,
         per_channel: a.per_channel,
         max_rel: a.max_rel,
-        fidelity: fidelity::measure(written, source, &opts)?,
+        fidelity: fidelity::measure_with(written, source, &opts, progress)?,
     })
 }
