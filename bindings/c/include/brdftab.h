@@ -147,6 +147,31 @@ int brdftab_convert(const char *source, const char *output, const char *settings
 /* Fits MODEL ("ggx", "lambert+ggx" or a JSON spec) to SOURCE; the result as JSON (as
  * `brdftab fit --json`), freed with brdftab_free_string; NULL on failure. */
 char *brdftab_fit(const char *source, const char *model, const char *settings_json);
+/* A progress monitor for the long calls below (as Open Image Denoise's
+ * oidnSetFilterProgressMonitorFunction): called with the host's user pointer and n, the
+ * fraction done in [0, 1], non-decreasing (the furthest any stage of the operation has got: an
+ * indication for a bar, not a time estimate); return nonzero to go on, 0 to stop.
+ *   - It is called only on the thread that made the call, never concurrently: the host's
+ *     monitor need not be thread-safe (the work runs on other threads meanwhile).
+ *   - First with n = 0 before any work (0 there stops before anything is read or written),
+ *     then about every 50 ms while the work runs, and once with n = 1 when it succeeded (its
+ *     answer then ignored); after it returned 0, not again.
+ *   - A stopped call returns -1 (NULL for a fit) with "cancelled" in brdftab_last_error(),
+ *     within about 0.3 s of the 0, and writes nothing: OUTPUT (a file, a database's table)
+ *     is left as it was, and no temporary file stays. An operation that finishes before it
+ *     sees the request returns its result as if it had not been stopped.
+ *   - It must return: a monitor that longjmps or throws out of the call leaves the library's
+ *     threads working on memory that is gone (undefined behaviour, the host's to avoid).
+ * A NULL monitor makes each call the one without _monitored. */
+typedef int (*brdftab_progress_fn)(void *user, double n);
+/* brdftab_bake, brdftab_convert and brdftab_fit reporting to `progress` with `user`, and
+ * stopped when it returns 0 (above). */
+int brdftab_bake_monitored(const char *source, const char *output, const char *settings_json,
+                           brdftab_progress_fn progress, void *user);
+int brdftab_convert_monitored(const char *source, const char *output, const char *settings_json,
+                              brdftab_progress_fn progress, void *user);
+char *brdftab_fit_monitored(const char *source, const char *model, const char *settings_json,
+                            brdftab_progress_fn progress, void *user);
 /* Frees a string returned by brdftab; NULL is a no-op. */
 void brdftab_free_string(char *s);
 /* The version of the library, e.g. "0.1.0" (static). */

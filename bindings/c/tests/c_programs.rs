@@ -368,6 +368,35 @@ fn the_examples_build_and_print_what_the_library_computes() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("transmits"));
 }
 
+/// The monitored bake, convert and fit (tests/monitor_test.c): a monitor's 0 at its first
+/// call or while the work runs gives -1 with "cancelled" soon after, and no file in the
+/// directory but the one bake that was not stopped (no output, no temporary or staging file, no
+/// database lock file); the monitor is called on the caller's thread only, n non-decreasing in
+/// [0, 1], 1 last on success.
+#[test]
+fn a_monitor_stops_bakes_conversions_and_fits_leaving_no_file() {
+    let dir = TempDir::new("c-monitor");
+    let exe = std::env::temp_dir().join(format!("monitor_test_{}", std::process::id()));
+    compile(
+        "cc",
+        &["-std=c11", "-D_POSIX_C_SOURCE=200809L"],
+        &Path::new(CRATE).join("tests/monitor_test.c"),
+        &exe,
+    );
+    let out = run(Command::new(&exe).arg(dir.path()));
+    let _ = std::fs::remove_file(&exe);
+    for what in ["convert-bsdf", "convert-db"] {
+        assert!(out.contains(&format!("latency {what} ")), "{out}");
+    }
+    let mut left: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["done.btdb"], "{out}");
+    brdftab::open(dir.join("done.btdb").to_str().unwrap()).unwrap();
+}
+
 #[test]
 fn the_header_declares_exactly_the_exported_functions() {
     let header = std::fs::read_to_string(Path::new(CRATE).join("include/brdftab.h")).unwrap();
