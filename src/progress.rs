@@ -159,9 +159,12 @@ mod tests {
     }
 
     /// Cancelled from the first report that starts with `trigger` on (`begin WHAT`,
-    /// `end WHAT`, `note WHAT`); keeps the reports made after it.
+    /// `end WHAT`, `note WHAT`), once `grace` questions after it have been answered no; keeps
+    /// the reports made after it.
     struct CancelAt {
         trigger: &'static str,
+        grace: usize,
+        asked: std::sync::atomic::AtomicUsize,
         on: std::sync::atomic::AtomicBool,
         stages: std::sync::Mutex<Vec<String>>,
         after: std::sync::Mutex<Vec<String>>,
@@ -169,8 +172,13 @@ mod tests {
 
     impl CancelAt {
         fn new(trigger: &'static str) -> CancelAt {
+            Self::after(trigger, 0)
+        }
+        fn after(trigger: &'static str, grace: usize) -> CancelAt {
             CancelAt {
                 trigger,
+                grace,
+                asked: Default::default(),
                 on: Default::default(),
                 stages: Default::default(),
                 after: Default::default(),
@@ -207,7 +215,8 @@ mod tests {
             self.event(format!("note {what}"));
         }
         fn cancelled(&self) -> bool {
-            self.on.load(std::sync::atomic::Ordering::Relaxed)
+            use std::sync::atomic::Ordering::Relaxed;
+            self.on.load(Relaxed) && self.asked.fetch_add(1, Relaxed) >= self.grace
         }
     }
 
@@ -257,6 +266,13 @@ mod tests {
             }
             stopped_leaving_nothing(r, &dir);
         }
+        // Past the transports of both directions (one question per node each), in the rounds
+        // of the fit (up to 2000, 0.5-0.8 s, which asked nothing).
+        let nodes = crate::table::calibration::CalibrationOptions::default().nodes;
+        let dir = crate::testkit::TempDir::new("cancel_measured");
+        let p = CancelAt::after("begin calibrating albedo", 2 * nodes);
+        let r = request::bake(&src, &dir.file("t.btdb"), &Default::default(), &p);
+        stopped_leaving_nothing(r, &dir);
     }
 
     /// A conversion's accuracy report (2 s for 2 M pairs, after the table was written) stops

@@ -638,8 +638,8 @@ pub fn calibrate(table: Table, reference: &AlbedoReference) -> Result<Table> {
     calibrate_with(table, reference, &Silent)
 }
 
-/// [`calibrate`], asking `progress` to stop between the table's nodes
-/// ([`Progress::cancelled`]: [`Error::Cancelled`]).
+/// [`calibrate`], asking `progress` to stop between the table's nodes and between rounds of
+/// the fit ([`Progress::cancelled`]: [`Error::Cancelled`]).
 pub fn calibrate_with(
     table: Table,
     reference: &AlbedoReference,
@@ -669,6 +669,7 @@ pub fn calibrate_with(
         // alone would oscillate between two scalings).
         let reference = reference.mean_albedo();
         for _ in 0..opts.rounds.max(1) {
+            crate::progress::check(progress)?;
             if balance_symmetric(&mut k_in, &m_in, &reference, c) < 1e-7 {
                 break;
             }
@@ -678,6 +679,7 @@ pub fn calibrate_with(
         let m_out = transport(&Reversed(&plain), opts, progress)?;
         let mut k_out = ones;
         for _ in 0..opts.rounds.max(1) {
+            crate::progress::check(progress)?;
             let a = balance(&mut k_in, &m_in, &k_out, &reference.albedo_in, c);
             let b = balance(&mut k_out, &m_out, &k_in, &reference.albedo_out, c);
             if a.max(b) < 1e-7 {
