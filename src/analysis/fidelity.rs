@@ -16,8 +16,9 @@
 //!
 //! The three relative RMSEs are those of pairs uniform in solid angle, estimated from pairs half
 //! of which are drawn near the mirror direction and weighted back to uniform
-//! ([`compare_region`]): with uniform pairs alone a near-mirror peak made the figure a lottery
-//! (`cg_sunflower`'s grazing band 1.5–5.0 % over five seeds of 100 000 pairs; now 1.75–1.94 %).
+//! ([`compare_region`](crate::analysis::accuracy::compare_region)): with uniform pairs alone a
+//! near-mirror peak made the figure a lottery (`cg_sunflower`'s grazing band 1.5–5.0 % over
+//! five seeds of 100 000 pairs; now 1.75–1.94 %).
 //!
 //! The albedo quadrature is a fixed product rule in polar coordinates about the mirror direction
 //! (geometric α segments down to 0.25°, Gauss-Legendre in each, the horizon as the last

@@ -32,7 +32,7 @@ pub fn lock(path: &Path) -> Result<Lock> {
 const LOCK_POLL: std::time::Duration = std::time::Duration::from_millis(50);
 
 /// [`lock`], waiting for a lock held by another writer (another process's bake of the same
-/// cached table: minutes) in tries [`LOCK_POLL`] apart, between which it asks `progress` to
+/// cached table: minutes) in tries 50 ms apart, between which it asks `progress` to
 /// stop ([`crate::progress::Progress::cancelled`]: [`Error::Cancelled`]).
 pub fn lock_with(path: &Path, progress: &dyn crate::progress::Progress) -> Result<Lock> {
     let (f, lp) = lock_file(path)?;
