@@ -161,7 +161,7 @@ impl BakeRequest {
             }
             _ if pairs > 0 => {
                 let staging = Staging::beside(target.path())?;
-                let file = BakeTarget::File(staging.0.to_string_lossy().into_owned());
+                let file = BakeTarget::File(staging.name());
                 let r = self.stream(src.as_ref(), &file, &name, provenance, progress)?;
                 let a = measure(crate::store::tables::open_brdf_at(
                     file.path(),
@@ -264,9 +264,21 @@ impl BakeRequest {
 struct Staging(std::path::PathBuf);
 
 impl Staging {
+    /// Beside the file `output` names (where it is a link, beside its target, which the
+    /// commit renames over) — beside `output` itself when that target's name is not UTF-8, as
+    /// the bake's own paths must be.
     fn beside(output: &str) -> Result<Staging> {
         let out = crate::files::resolve_links(Path::new(output))?;
-        Ok(Staging(crate::files::temp_path(&out)?))
+        let staging = crate::files::temp_path(&out)?;
+        if staging.to_str().is_some() {
+            return Ok(Staging(staging));
+        }
+        Ok(Staging(crate::files::temp_path(Path::new(output))?))
+    }
+
+    /// The staging file's name (UTF-8: [`beside`](Self::beside)).
+    fn name(&self) -> String {
+        self.0.to_string_lossy().into_owned()
     }
 
     /// Moves the measured table into `target`: renamed over a file, imported (its chunks
@@ -325,6 +337,40 @@ mod tests {
     use crate::bake::{SymmetryChoice, codec, tmp};
     use crate::source::OpenOptions;
     use crate::table::presets::Preset;
+
+    /// A measured (accuracy-reporting) streamed bake through a link into a directory whose
+    /// name is not UTF-8: the staging file goes beside the link (a lossy UTF-8 spelling of the
+    /// target's directory named no directory) and is renamed over the target.
+    #[cfg(unix)]
+    #[test]
+    fn a_measured_bake_through_a_link_into_a_non_utf8_directory_is_staged_beside_the_link() {
+        use std::os::unix::ffi::OsStrExt;
+        let d = tmp("staging_non_utf8");
+        let odd = d.join(std::ffi::OsStr::from_bytes(b"dir\xff"));
+        std::fs::create_dir(&odd).unwrap();
+        let link = d.join("t.btdb");
+        std::os::unix::fs::symlink(odd.join("t.btdb"), &link).unwrap();
+        let mut req = BakeRequest::new(r#"{"model":"ggx","alpha":0.3}"#).preset(Preset::Small);
+        req.accuracy_pairs = 4096;
+        let link = link.to_str().unwrap().to_owned();
+        let r = req.run(&BakeTarget::file(&link)).unwrap();
+        assert!(r.accuracy.is_some());
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert!(odd.join("t.btdb").is_file());
+        crate::open(&link).unwrap();
+        let mut left: Vec<_> = std::fs::read_dir(d.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        left.sort();
+        assert_eq!(left.len(), 2, "{left:?}"); // the directory and the link, no staging file
+        assert_eq!(std::fs::read_dir(&odd).unwrap().count(), 1);
+    }
 
     #[test]
     fn file_db_and_raw_targets_give_the_same_table() {
