@@ -264,7 +264,7 @@ mod tests {
         ] {
             let dir = crate::testkit::TempDir::new("cancel_measured");
             let p = CancelAt::new(trigger);
-            let r = request::bake(&src, &dir.file("t.btdb"), &Default::default(), &p);
+            let r = request::bake(&src, dir.file("t.btdb"), &Default::default(), &p);
             if let Some(next) = next {
                 assert!(!p.went_on_to(next), "{trigger}: went on to {next}");
             }
@@ -275,7 +275,7 @@ mod tests {
         let nodes = crate::table::calibration::CalibrationOptions::default().nodes;
         let dir = crate::testkit::TempDir::new("cancel_measured");
         let p = CancelAt::after("begin calibrating albedo", 2 * nodes);
-        let r = request::bake(&src, &dir.file("t.btdb"), &Default::default(), &p);
+        let r = request::bake(&src, dir.file("t.btdb"), &Default::default(), &p);
         stopped_leaving_nothing(r, &dir);
     }
 
@@ -288,7 +288,7 @@ mod tests {
         let s: request::ConvertSettings = request::from_json(r#"{"preset": "small"}"#).unwrap();
         for out in ["t.btdb", "db.btdb#t"] {
             let dir = crate::testkit::TempDir::new("cancel_accuracy");
-            let r = request::convert(spec, &dir.file(out), &s, &CancelAt::new("end baking"));
+            let r = request::convert(spec, dir.file(out), &s, &CancelAt::new("end baking"));
             stopped_leaving_nothing(r.map(|_| ()), &dir);
         }
         // Measured in a staging file, then committed: the report and the table as before.
@@ -320,7 +320,7 @@ mod tests {
         let ward = r#"{"model": "ward", "ks": 0.5, "alpha_x": 0.1, "alpha_y": 0.3}"#;
         let dir = crate::testkit::TempDir::new("cancel_bsdf");
         let p = CancelAt::new("begin placing azimuths");
-        let r = request::convert(ward, &dir.file("w.bsdf"), &Default::default(), &p);
+        let r = request::convert(ward, dir.file("w.bsdf"), &Default::default(), &p);
         assert!(
             !p.went_on_to("begin sampling"),
             "went on to sample the values"
@@ -329,7 +329,7 @@ mod tests {
         let lambert = r#"{"model": "lambert", "kd": 0.5}"#;
         let r = request::convert(
             lambert,
-            &dir.file("l.bsdf"),
+            dir.file("l.bsdf"),
             &Default::default(),
             &CancelAt::new("end sampling"),
         );

@@ -52,13 +52,16 @@ pub fn to_rgl(
     let error = match pairs {
         0 => None,
         n => {
-            let tf = crate::measured::tensor::TensorFile::from_bytes(output, bytes.clone())?;
+            let tf = crate::measured::tensor::TensorFile::from_bytes(
+                output.to_string_lossy(),
+                bytes.clone(),
+            )?;
             let file = crate::measured::RglBrdf::from_tensor(&tf, None)?;
             Some(rgl_write::report_with(&file, &*brdf, n, 1, progress)?)
         }
     };
     let t = std::time::Instant::now();
-    crate::files::write_atomic(std::path::Path::new(output), &bytes)?;
+    crate::files::write_atomic(output, &bytes)?;
     seconds += t.elapsed().as_secs_f64();
     let written = rgl_write::Written {
         bytes: bytes.len(),

@@ -120,8 +120,9 @@ impl BakeRequest {
         };
         // The accuracy report is measured before the output is committed, so that a stop
         // asked during it (seconds for a conversion's 200 000 pairs) leaves the output as it
-        // was: a table built whole is measured in memory, a streamed one in a staging file
-        // beside the output, renamed (or imported) into place once measured.
+        // was: the table as stored (the codec's rounding included) is measured in a staging
+        // file beside the output, renamed (or imported) into place once measured. A raw
+        // table's f32 values are the table's own, measured in memory.
         let pairs = self.accuracy_pairs;
         let measure = |tab: TabulatedBrdf| -> Result<Accuracy> {
             let interp = self
@@ -146,22 +147,32 @@ impl BakeRequest {
                 || self.calibrates_model_table() =>
             {
                 let (table, r) = built(checked)?;
-                let a = (pairs > 0)
-                    .then(|| measure(TabulatedBrdf::from_table(table.clone())))
-                    .transpose()?;
-                match target {
-                    BakeTarget::Db { path, replace, .. } => {
-                        tables::save(path, &name, provenance, &table, self.codec, *replace)?
+                if pairs > 0 {
+                    // Measured as stored (the codec's rounding included), in a staging file.
+                    let staging = Staging::beside(target.path())?;
+                    tables::save_file(staging.path(), &name, provenance, &table, self.codec)?;
+                    drop(table);
+                    let stored =
+                        crate::store::tables::open_brdf_at(staging.path(), Some(&name), false)?;
+                    let a = measure(stored)?;
+                    staging.commit(target, &name)?;
+                    (r, Some(a))
+                } else {
+                    match target {
+                        BakeTarget::Db { path, replace, .. } => {
+                            tables::save(path, &name, provenance, &table, self.codec, *replace)?
+                        }
+                        // Replaced atomically, as a streamed bake replaces it: a write that
+                        // fails (a value the codec cannot hold, a full disk) leaves the old
+                        // file as it was.
+                        t => tables::save_file(t.path(), &name, provenance, &table, self.codec)?,
                     }
-                    // Replaced atomically, as a streamed bake replaces it: a write that fails
-                    // (a value the codec cannot hold, a full disk) leaves the old file as it was.
-                    t => tables::save_file(t.path(), &name, provenance, &table, self.codec)?,
+                    (r, None)
                 }
-                (r, a)
             }
             _ if pairs > 0 => {
                 let staging = Staging::beside(target.path())?;
-                let file = BakeTarget::File(staging.name());
+                let file = BakeTarget::File(staging.path().to_path_buf());
                 let r = self.stream(src.as_ref(), &file, &name, provenance, progress)?;
                 let a = measure(crate::store::tables::open_brdf_at(
                     file.path(),
@@ -265,20 +276,15 @@ struct Staging(std::path::PathBuf);
 
 impl Staging {
     /// Beside the file `output` names (where it is a link, beside its target, which the
-    /// commit renames over) — beside `output` itself when that target's name is not UTF-8, as
-    /// the bake's own paths must be.
-    fn beside(output: &str) -> Result<Staging> {
-        let out = crate::files::resolve_links(Path::new(output))?;
-        let staging = crate::files::temp_path(&out)?;
-        if staging.to_str().is_some() {
-            return Ok(Staging(staging));
-        }
-        Ok(Staging(crate::files::temp_path(Path::new(output))?))
+    /// commit renames over: the same file system).
+    fn beside(output: &Path) -> Result<Staging> {
+        let out = crate::files::resolve_links(output)?;
+        Ok(Staging(crate::files::temp_path(&out)?))
     }
 
-    /// The staging file's name (UTF-8: [`beside`](Self::beside)).
-    fn name(&self) -> String {
-        self.0.to_string_lossy().into_owned()
+    /// The staging file's path.
+    fn path(&self) -> &Path {
+        &self.0
     }
 
     /// Moves the measured table into `target`: renamed over a file, imported (its chunks
@@ -290,7 +296,7 @@ impl Staging {
                 db::import(path, &store, name, name, *replace)
             }
             t => {
-                let out = crate::files::resolve_links(Path::new(t.path()))?;
+                let out = crate::files::resolve_links(t.path())?;
                 std::fs::rename(&self.0, &out).map_err(|e| Error::io(&out, e))
             }
         }
@@ -339,11 +345,11 @@ mod tests {
     use crate::table::presets::Preset;
 
     /// A measured (accuracy-reporting) streamed bake through a link into a directory whose
-    /// name is not UTF-8: the staging file goes beside the link (a lossy UTF-8 spelling of the
-    /// target's directory named no directory) and is renamed over the target.
+    /// name is not UTF-8: the staging file goes beside the link's target, whose name is bytes,
+    /// and is renamed over it; nothing is left beside the link.
     #[cfg(unix)]
     #[test]
-    fn a_measured_bake_through_a_link_into_a_non_utf8_directory_is_staged_beside_the_link() {
+    fn a_measured_bake_through_a_link_into_a_non_utf8_directory_is_staged_beside_its_target() {
         use std::os::unix::ffi::OsStrExt;
         let d = tmp("staging_non_utf8");
         let odd = d.join(std::ffi::OsStr::from_bytes(b"dir\xff"));
@@ -600,6 +606,35 @@ mod tests {
             let acc = r.accuracy.unwrap();
             // log16 ≤ 1e-3 relative on a constant, as above.
             assert!(acc.max_rel <= 1e-3, "{target:?}: {acc:?}");
+        }
+    }
+
+    /// The accuracy report of a table built whole is that of the table as written — the
+    /// codec's rounding included — to the bit: measured in memory before the codec, a log16
+    /// table at a 1e-2 tolerance read as if it were stored exactly.
+    #[test]
+    fn the_accuracy_report_of_a_table_built_whole_is_of_the_stored_table() {
+        let d = tmp("as_stored");
+        let req = BakeRequest::new(r#"{"model":"ggx","alpha":0.3}"#)
+            .preset(Preset::Small)
+            .quantity(Quantity::FrCosOut) // built whole before it is written
+            .codec(codec("log16:1e-2", None, None, None, false).unwrap())
+            .accuracy(2000);
+        for target in [
+            BakeTarget::file(d.join("t.btdb")),
+            BakeTarget::db(d.join("db.btdb"), "t"),
+        ] {
+            let r = req.run(&target).unwrap();
+            let got = r.accuracy.unwrap();
+            let src = crate::open(r#"{"model":"ggx","alpha":0.3}"#).unwrap();
+            let stored = tables::open_brdf_at(target.path(), Some("t"), false).unwrap();
+            let interp = Interp::default_for(stored.grid());
+            let want = Accuracy::measure(&stored.with_interp(interp), src.as_ref(), 2000).unwrap();
+            assert_eq!(
+                (got.rel_rmse, got.max_rel),
+                (want.rel_rmse, want.max_rel),
+                "{target:?}"
+            );
         }
     }
 
