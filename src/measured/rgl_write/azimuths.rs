@@ -21,8 +21,10 @@
 //! cell's albedo at its middle azimuth). The figure farthest past its bar, where more slices
 //! can lower it, decides: of splitting an elevation interval (a slice per azimuth) or an
 //! azimuth interval (a slice per elevation), the one whose error above its slices' is largest
-//! per slice added is split in the middle. It stops when no figure qualifies or when no split
-//! fits `max_slices`.
+//! per slice added is split in the middle — for a bilateral source (unchanged under φ → −φ of
+//! both directions) together with its mirror image, so that the file keeps the symmetry the
+//! estimates' noise alone would break. It stops when no figure qualifies or when no split fits
+//! `max_slices`.
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -164,6 +166,7 @@ pub fn place(
         max_slices as u64,
     );
     let mut file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache, progress)?;
+    let mirror = brdf.flags().bilateral;
     let (np, nt) = (g.phi.len(), g.theta.len());
     let mut seed = 1u64;
     let mut next_seed = || {
@@ -252,16 +255,27 @@ pub fn place(
                 (gain / np as f64, j)
             })
             .max_by(|a, b| a.0.total_cmp(&b.0));
+        // A bilateral source's error at −φi is its error at φi: its azimuths are split in
+        // mirrored pairs (the start is even about 0, a node), so that the file keeps the
+        // symmetry where the two estimates' noise alone would pick a side.
+        let pair = |i: usize| (mirror && np - 2 - i != i).then(|| np - 2 - i);
         let by_phi = (0..np - 1)
             .filter(|&i| {
-                g.phi[i + 1] - g.phi[i] > 2.0 * MIN_PHI_STEP && (np + 1) * nt <= max_slices
+                let added = if pair(i).is_some() { 2 } else { 1 };
+                g.phi[i + 1] - g.phi[i] > 2.0 * MIN_PHI_STEP && (np + added) * nt <= max_slices
             })
             .map(|i| {
-                let gains = (0..nt - 1).map(|j| excess(&g.cell[i][j], &g.floors(i, j).1));
-                let gain = if worst == 3 {
-                    gains.fold(0.0, f64::max)
-                } else {
-                    gains.sum()
+                let gain_of = |i: usize| {
+                    let gains = (0..nt - 1).map(|j| excess(&g.cell[i][j], &g.floors(i, j).1));
+                    if worst == 3 {
+                        gains.fold(0.0, f64::max)
+                    } else {
+                        gains.sum()
+                    }
+                };
+                let gain = match pair(i) {
+                    Some(m) => 0.5 * (gain_of(i) + gain_of(m)),
+                    None => gain_of(i),
                 };
                 (gain / nt as f64, i)
             })
@@ -304,29 +318,42 @@ pub fn place(
                 }
             }
             Err(i) => {
-                let mid = 0.5 * (g.phi[i] + g.phi[i + 1]);
-                g.phi.insert(i + 1, mid);
-                file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache, progress)?;
-                let mut jobs = Vec::new();
-                for k in [i, i + 1] {
-                    for j in 0..nt - 1 {
-                        jobs.push(g.cell_job(k, j, next_seed()));
-                    }
-                    for j in 0..nt {
-                        jobs.push(g.at_theta_job(k, j, next_seed()));
-                    }
+                // Original indices of the split intervals, ascending; each gains its middle.
+                let mut split = vec![i];
+                split.extend(pair(i));
+                split.sort_unstable();
+                for &k in split.iter().rev() {
+                    g.phi.insert(k + 1, 0.5 * (g.phi[k] + g.phi[k + 1]));
                 }
-                for j in 0..nt - 1 {
-                    jobs.push(g.at_phi_job(i + 1, j, next_seed()));
+                file = reader(brdf, ndf, base, &g.phi, &g.theta, &mut cache, progress)?;
+                // Per split, at its new index k: both halves' cells and elevations, then the
+                // new azimuth over each elevation interval.
+                let mut jobs = Vec::new();
+                for (n, &k) in split.iter().enumerate() {
+                    let k = k + n;
+                    for k in [k, k + 1] {
+                        for j in 0..nt - 1 {
+                            jobs.push(g.cell_job(k, j, next_seed()));
+                        }
+                        for j in 0..nt {
+                            jobs.push(g.at_theta_job(k, j, next_seed()));
+                        }
+                    }
+                    for j in 0..nt - 1 {
+                        jobs.push(g.at_phi_job(k + 1, j, next_seed()));
+                    }
                 }
                 let r = run(&file, brdf, &jobs, progress)?;
                 let row = (nt - 1) + nt;
-                let (left, right) = (&r[..row], &r[row..2 * row]);
-                g.cell
-                    .splice(i..=i, [left[..nt - 1].to_vec(), right[..nt - 1].to_vec()]);
-                g.at_theta
-                    .splice(i..=i, [left[nt - 1..].to_vec(), right[nt - 1..].to_vec()]);
-                g.at_phi.insert(i + 1, r[2 * row..].to_vec());
+                for (n, &k) in split.iter().enumerate().rev() {
+                    let r = &r[n * (2 * row + nt - 1)..(n + 1) * (2 * row + nt - 1)];
+                    let (left, right) = (&r[..row], &r[row..2 * row]);
+                    g.cell
+                        .splice(k..=k, [left[..nt - 1].to_vec(), right[..nt - 1].to_vec()]);
+                    g.at_theta
+                        .splice(k..=k, [left[nt - 1..].to_vec(), right[nt - 1..].to_vec()]);
+                    g.at_phi.insert(k + 1, r[2 * row..].to_vec());
+                }
             }
         }
     }
