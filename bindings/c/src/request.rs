@@ -56,19 +56,8 @@ pub unsafe extern "C" fn brdftab_bake(
     output: *const c_char,
     settings_json: *const c_char,
 ) -> c_int {
-    guard(|| {
-        // SAFETY (all three): the caller's contract.
-        let (source, output) = unsafe {
-            (
-                source_text(source, "source")?,
-                source_text(output, "output")?,
-            )
-        };
-        let s: BakeSettings = unsafe { settings(settings_json) }?;
-        request::bake(source, output, &s, &Silent)
-            .map(drop)
-            .map_err(|e| e.to_string())
-    })
+    // SAFETY: the caller's contract; no monitor.
+    unsafe { brdftab_bake_monitored(source, output, settings_json, None, std::ptr::null_mut()) }
 }
 
 /// Converts SOURCE into OUTPUT like `brdftab convert` (a `.bsdf`, a MERL `.binary`, `DB#NAME`,
@@ -82,19 +71,8 @@ pub unsafe extern "C" fn brdftab_convert(
     output: *const c_char,
     settings_json: *const c_char,
 ) -> c_int {
-    guard(|| {
-        // SAFETY (all three): the caller's contract.
-        let (source, output) = unsafe {
-            (
-                source_text(source, "source")?,
-                source_text(output, "output")?,
-            )
-        };
-        let s: ConvertSettings = unsafe { settings(settings_json) }?;
-        request::convert(source, output, &s, &Silent)
-            .map(drop)
-            .map_err(|e| e.to_string())
-    })
+    // SAFETY: the caller's contract; no monitor.
+    unsafe { brdftab_convert_monitored(source, output, settings_json, None, std::ptr::null_mut()) }
 }
 
 /// Fits MODEL (`"ggx"`, `"lambert+ggx"` or a JSON spec) to SOURCE with fit settings as JSON;
@@ -228,7 +206,12 @@ pub unsafe extern "C" fn brdftab_bake_monitored(
 ) -> c_int {
     guard(|| {
         // SAFETY (all three): the caller's contract.
-        let (source, output) = unsafe { (source_text(source, "source")?, text(output, "output")?) };
+        let (source, output) = unsafe {
+            (
+                source_text(source, "source")?,
+                source_text(output, "output")?,
+            )
+        };
         let s: BakeSettings = unsafe { settings(settings_json) }?;
         monitored(progress, user, |p| {
             request::bake(source, output, &s, p).map(drop)
@@ -250,7 +233,12 @@ pub unsafe extern "C" fn brdftab_convert_monitored(
 ) -> c_int {
     guard(|| {
         // SAFETY (all three): the caller's contract.
-        let (source, output) = unsafe { (source_text(source, "source")?, text(output, "output")?) };
+        let (source, output) = unsafe {
+            (
+                source_text(source, "source")?,
+                source_text(output, "output")?,
+            )
+        };
         let s: ConvertSettings = unsafe { settings(settings_json) }?;
         monitored(progress, user, |p| {
             request::convert(source, output, &s, p).map(drop)

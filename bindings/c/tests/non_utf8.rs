@@ -94,6 +94,11 @@ fn c_entry(path: &Path, name: &str) -> CString {
     CString::new(b).unwrap()
 }
 
+/// A host's monitor that never stops the work.
+unsafe extern "C" fn go_on(_user: *mut std::ffi::c_void, _n: f64) -> std::ffi::c_int {
+    1
+}
+
 #[test]
 fn bake_and_convert_write_to_outputs_whose_names_are_not_utf8() {
     let d = TempDir::new("c-non-utf8-out");
@@ -105,6 +110,7 @@ fn bake_and_convert_write_to_outputs_whose_names_are_not_utf8() {
         latin1(&d, "lib.btdb"),
         latin1(&d, "t.bsdf"),
     );
+    let monitored = latin1(&d, "m.btdb");
     let settings = CString::new(r#"{"preset": "small"}"#).unwrap();
     let pairs = CString::new(r#"{"pairs": 0}"#).unwrap();
     let small_rgl = CString::new(r#"{"pairs": 0, "resolution": 8, "theta_i": 3, "phi_i": 1}"#);
@@ -127,10 +133,35 @@ fn bake_and_convert_write_to_outputs_whose_names_are_not_utf8() {
             )
         },
         unsafe { brdftab_convert(spec.as_ptr(), c_path(&bsdf).as_ptr(), small_rgl.as_ptr()) },
+        // The monitored calls too (they required a UTF-8 OUTPUT when first merged).
+        unsafe {
+            brdftab_bake_monitored(
+                spec.as_ptr(),
+                c_path(&monitored).as_ptr(),
+                settings.as_ptr(),
+                Some(go_on),
+                std::ptr::null_mut(),
+            )
+        },
+        unsafe {
+            brdftab_convert_monitored(
+                c_path(&table).as_ptr(),
+                c_entry(&lib, "m").as_ptr(),
+                pairs.as_ptr(),
+                Some(go_on),
+                std::ptr::null_mut(),
+            )
+        },
     ];
-    assert_eq!(runs, [0; 4], "{}", last_error());
+    assert_eq!(runs, [0; 6], "{}", last_error());
     // The constant within log16's 1e-3, twice over for the table converted from a table.
-    for source in [c_path(&table), c_entry(&lib, "b"), c_entry(&lib, "c")] {
+    for source in [
+        c_path(&table),
+        c_entry(&lib, "b"),
+        c_entry(&lib, "c"),
+        c_path(&monitored),
+        c_entry(&lib, "m"),
+    ] {
         for (a, b) in eval(&source).unwrap().iter().zip(&want) {
             assert!((a - b).abs() <= 2.1e-3 * b, "{source:?}: {a} vs {b}");
         }
