@@ -3,7 +3,7 @@
 //! ([`brdftab::request`]): `{"target_error": 0.005, "codec": "f16"}`. NULL or `""` settings are
 //! the defaults; an unknown field is an error naming it.
 
-use std::ffi::{CString, c_char, c_int, c_void};
+use std::ffi::{CString, OsStr, c_char, c_int, c_void};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use brdftab::progress::{Progress, Silent};
@@ -190,6 +190,36 @@ fn monitored<T: Send>(
     }
 }
 
+/// A bake or conversion of SOURCE into OUTPUT (their bytes as they are) with settings as JSON,
+/// run under the host's monitor: 0, or -1 with the reason.
+///
+/// # Safety
+/// As [`brdftab_bake_monitored`].
+unsafe fn write_request<S, R>(
+    source: *const c_char,
+    output: *const c_char,
+    settings_json: *const c_char,
+    progress: brdftab_progress_fn,
+    user: *mut c_void,
+    run: impl FnOnce(&OsStr, &OsStr, &S, &dyn Progress) -> brdftab::Result<R> + Send,
+) -> c_int
+where
+    S: serde::de::DeserializeOwned + serde::Serialize + Default + Sync,
+    R: Send,
+{
+    guard(|| {
+        // SAFETY (all three): the caller's contract.
+        let (source, output) = unsafe {
+            (
+                source_text(source, "source")?,
+                source_text(output, "output")?,
+            )
+        };
+        let s: S = unsafe { settings(settings_json) }?;
+        monitored(progress, user, |p| run(source, output, &s, p).map(drop))
+    })
+}
+
 /// [`brdftab_bake`] reporting to, and stoppable by, the host's monitor `progress` (called on
 /// this thread only: see the header). A stopped bake returns -1 with "cancelled" and leaves
 /// OUTPUT as it was. NULL `progress` is [`brdftab_bake`].
@@ -204,19 +234,17 @@ pub unsafe extern "C" fn brdftab_bake_monitored(
     progress: brdftab_progress_fn,
     user: *mut c_void,
 ) -> c_int {
-    guard(|| {
-        // SAFETY (all three): the caller's contract.
-        let (source, output) = unsafe {
-            (
-                source_text(source, "source")?,
-                source_text(output, "output")?,
-            )
-        };
-        let s: BakeSettings = unsafe { settings(settings_json) }?;
-        monitored(progress, user, |p| {
-            request::bake(source, output, &s, p).map(drop)
-        })
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        write_request(
+            source,
+            output,
+            settings_json,
+            progress,
+            user,
+            |s, o, x: &BakeSettings, p| request::bake(s, o, x, p),
+        )
+    }
 }
 
 /// [`brdftab_convert`] with the host's monitor, as [`brdftab_bake_monitored`].
@@ -231,19 +259,17 @@ pub unsafe extern "C" fn brdftab_convert_monitored(
     progress: brdftab_progress_fn,
     user: *mut c_void,
 ) -> c_int {
-    guard(|| {
-        // SAFETY (all three): the caller's contract.
-        let (source, output) = unsafe {
-            (
-                source_text(source, "source")?,
-                source_text(output, "output")?,
-            )
-        };
-        let s: ConvertSettings = unsafe { settings(settings_json) }?;
-        monitored(progress, user, |p| {
-            request::convert(source, output, &s, p).map(drop)
-        })
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        write_request(
+            source,
+            output,
+            settings_json,
+            progress,
+            user,
+            |s, o, x: &ConvertSettings, p| request::convert(s, o, x, p),
+        )
+    }
 }
 
 /// [`brdftab_fit`] with the host's monitor, as [`brdftab_bake_monitored`]: NULL with
