@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{guard, interruptible, lib_err};
-use crate::values::{path_arg, ser, settings_of, to_py};
+use crate::values::{exact_path, path_arg, ser, settings_of, to_py};
 
 fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyAny>> {
     let info = if r.info.is_null() {
@@ -30,7 +30,11 @@ fn report_dict(py: Python<'_>, r: &brdftab::bake::BakeReport) -> PyResult<Py<PyA
         // is looked up whole first (a file of that name beside the database would be read).
         r.output_info().map_err(lib_err)?
     };
-    to_py(py, &info)
+    let d = to_py(py, &info)?;
+    if let Some(t) = &r.written {
+        exact_path(d.bind(py), "file", &[t.path().as_os_str()])?;
+    }
+    Ok(d)
 }
 
 /// Bakes SOURCE into OUTPUT: a `.btdb` file, or `DB#NAME` (a table of a database). The
@@ -171,10 +175,13 @@ pub(crate) fn convert(
                 });
                 let d = to_py(py, &d)?;
                 d.bind(py).set_item("info", report_dict(py, &r)?)?;
+                exact_path(d.bind(py), "output", &[output])?;
                 return Ok(d);
             }
         };
-        to_py(py, &d)
+        let d = to_py(py, &d)?;
+        exact_path(d.bind(py), "output", &[output])?;
+        Ok(d)
     })
 }
 

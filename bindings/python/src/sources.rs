@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 
 use crate::brdf::PyBrdf;
 use crate::errors::{guard, lib_err, unlocked};
-use crate::values::{channels_of, path_arg, ser, to_py};
+use crate::values::{channels_of, exact_path, file_part, path_arg, ser, to_py};
 
 /// Opens SOURCE (a spec, table, `DB#NAME`, MERL `.binary` or RGL `.bsdf`) as a `Brdf`. A path
 /// is a `str`, `bytes` or an `os.PathLike` (`bake`, `convert`, `check` and `fit` take the same):
@@ -83,7 +83,7 @@ pub(crate) fn check(
 
 /// What `brdftab info --json` reports of a brdftab file (`FILE`), one table (`DB#NAME`) or a
 /// measured file (MERL `.binary`, RGL `.bsdf`): a `str`, `bytes` or `os.PathLike`, whose name
-/// need not be UTF-8 (`file` shows it with U+FFFD). The GIL is released while the file is read.
+/// need not be UTF-8 (`file` is then the `str` `os.fsdecode` gives, which opens). The GIL is released while the file is read.
 #[pyfunction]
 pub(crate) fn info(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
     guard(|| {
@@ -94,7 +94,9 @@ pub(crate) fn info(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<Py<PyA
             SourceKind::Merl | SourceKind::Rgl => brdftab::measured::info::info(source),
             _ => brdftab::store::info::file_info(source),
         })?;
-        to_py(py, &v.map_err(lib_err)?)
+        let d = to_py(py, &v.map_err(lib_err)?)?;
+        exact_path(d.bind(py), "file", &[source, file_part(source)])?;
+        Ok(d)
     })
 }
 

@@ -20,7 +20,7 @@ use pyo3::types::{PyDict, PyTuple};
 use crate::arrays::f32_array;
 use crate::brdf::PyBrdf;
 use crate::errors::{Error, guard, lib_err, unlocked};
-use crate::values::{path_arg, settings_of, to_py};
+use crate::values::{exact_path, file_part, path_arg, settings_of, to_py};
 
 /// A decoded table (`Brdf.table()`): its values as a numpy array sharing the table's memory,
 /// and its grid.
@@ -173,7 +173,9 @@ impl PyTable {
             let t = &self.table;
             let info = unlocked(py, || request::save_table(t, &output, source, &settings))?
                 .map_err(lib_err)?;
-            to_py(py, &info)
+            let d = to_py(py, &info)?;
+            exact_path(d.bind(py), "file", &[file_part(&output)])?;
+            Ok(d)
         })
     }
 

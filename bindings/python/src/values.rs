@@ -156,6 +156,30 @@ fn json_of(key: &str, v: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
     )))
 }
 
+/// Gives back in `d[key]` the exact name of a path the library's JSON shows lossily (a file
+/// name that is not UTF-8 has U+FFFD there): the first of `candidates` whose lossy form is the
+/// value, as the `str` `os.fsdecode` gives (surrogate escapes), so that a path handed back in a
+/// report opens. A value no candidate shows stays as it is.
+pub(crate) fn exact_path(
+    d: &Bound<'_, PyAny>,
+    key: &str,
+    candidates: &[&std::ffi::OsStr],
+) -> PyResult<()> {
+    let Ok(shown) = d.get_item(key).and_then(|v| v.extract::<String>()) else {
+        return Ok(());
+    };
+    if let Some(c) = candidates.iter().find(|c| c.to_string_lossy() == shown) {
+        d.set_item(key, c)?;
+    }
+    Ok(())
+}
+
+/// The file part of a path that may be `DB#NAME` (split by the library's output rule), or the
+/// path itself where that rule refuses it.
+pub(crate) fn file_part(path: &std::ffi::OsStr) -> &std::ffi::OsStr {
+    brdftab::store::name::parse_output_os("output", path).map_or(path, |(p, _)| p.as_os_str())
+}
+
 /// A serde_json value as a Python object (through `json.loads`: dicts, lists, floats, ...).
 pub(crate) fn to_py(py: Python<'_>, v: &serde_json::Value) -> PyResult<Py<PyAny>> {
     let s = serde_json::to_string(v).map_err(|e| Error::new_err(e.to_string()))?;
