@@ -273,6 +273,7 @@ impl Calibration {
     /// `x` times k_in at cell `cell[0]` with fraction `frac[0]` and k_out at `cell[1]`,
     /// `frac[1]` (cells at most the last; see [`Calibration::rgb_axis`]): the interpolation
     /// of [`Calibration::apply_rgb`].
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub(crate) fn apply_rgb_cells(&self, cell: [u32; 2], frac: [f32; 2], x: F4) -> F4 {
         Self::times(x, self.factors_rgb_cells(cell, frac))

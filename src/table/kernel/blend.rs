@@ -3,7 +3,7 @@
 //! values and weighted. Three channels in four-lane registers ([`Kernel::eval_rgb`],
 //! [`Kernel::blend_rows`], also the eight-lane path's blend), any count four at a time
 //! ([`Kernel::blend_lanes`]), and the scalar reference both are tested against
-//! ([`Kernel::blend`]).
+//! (`Kernel::blend`).
 //!
 //! Why a file of its own: this is the arithmetic of every lookup, all `#[inline(always)]`
 //! into the entry points in the parent module (`Kernel::eval`, `rgb_f16c`,
@@ -14,7 +14,7 @@ use super::packed::Packed;
 use crate::simd::F4;
 
 impl Kernel {
-    /// [`Kernel::blend`] for three channels on four-lane registers ([`F4`]): the three axes'
+    /// `Kernel::blend` for three channels on four-lane registers ([`F4`]): the three axes'
     /// knot and node arithmetic in one register, then each of the four (θh, θd) corner rows
     /// as two four-lane loads (RGB of the two φd corners; the fourth lane is ignored). Computes
     /// the same operations as `blend::<3>`, which stays as its reference (tested equal).
@@ -111,7 +111,7 @@ impl Kernel {
         acc * F4::splat(values.unscale)
     }
 
-    /// [`Kernel::blend`] for any number of channels, four at a time: each corner row's two φd
+    /// `Kernel::blend` for any number of channels, four at a time: each corner row's two φd
     /// corners (`channels` values each, adjacent) are read as runs of four-lane loads — f16
     /// codes expanded four at once (`F16C`) or exact values (`EXACT`) — instead of one value
     /// and one conversion at a time (one lookup of a seven-wavelength measured table: 140 → 79 ns).
@@ -202,7 +202,9 @@ impl Kernel {
     }
 
     /// Trilinear blend of the eight corners; `N` > 0: exactly N channels in registers. The
-    /// reference of [`Kernel::eval_rgb`] (which computes the same operations in lanes).
+    /// reference of [`Kernel::eval_rgb`] (which computes the same operations in lanes) and of
+    /// [`Kernel::blend_lanes`]; the lookups call those, so it is built for the tests only.
+    #[cfg(test)]
     #[inline(always)]
     pub(super) fn blend<const N: usize>(&self, v: [f32; 3], out: &mut [f32], values: &Packed) {
         let c = if N > 0 { N } else { self.channels };

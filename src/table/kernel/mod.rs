@@ -93,6 +93,8 @@ pub struct Kernel {
     /// truncation bound), n − 1 and n − 1.5 per axis; lane 3 is unused (0).
     lanes: [F4; 4],
     /// The CPU has F16C (checked once, at construction): RGB lookups expand codes with it.
+    /// (x86-64 only: elsewhere codes are expanded with integer operations.)
+    #[cfg(target_arch = "x86_64")]
     f16c: bool,
     /// Per axis the variable from which lookups take the general path (resampled axes; 2 on
     /// warped ones, never; lane 3: 2).
@@ -195,6 +197,7 @@ impl Kernel {
             quarter: s.reciprocal,
             h_quarter_power,
             channels,
+            #[cfg(target_arch = "x86_64")]
             f16c: has_f16c(),
             cut: F4::new(cut[0], cut[1], cut[2], cut[3]),
             resampled,
@@ -361,17 +364,17 @@ impl Kernel {
         let v = [v0, v1, v2];
         // The calibration's cells first: they need only the cosines (see `rgb`).
         let cells = (self.calibration.as_ref()).map(|c| c.cells(cos[0], cos[1]));
+        // Four channels per lane group on every target ([`F4`]: SSE2 on x86-64, four plain f32
+        // elsewhere, left to LLVM to vectorize); only the F16C expansion is x86-64's.
         #[cfg(target_arch = "x86_64")]
-        if self.exact {
-            self.blend_lanes::<false, true>(v, out, values);
-        } else if self.f16c {
+        if !self.exact && self.f16c {
             // SAFETY: `f16c` is set only when the CPU has F16C (`has_f16c`).
             unsafe { self.blend_lanes_f16c(v, out, values) };
         } else {
-            self.blend::<0>(v, out, values);
+            self.blend_lanes_plain(v, out, values);
         }
         #[cfg(not(target_arch = "x86_64"))]
-        self.blend::<0>(v, out, values);
+        self.blend_lanes_plain(v, out, values);
         let out = &mut out[..self.channels];
         if self.quantity != Quantity::Fr {
             // In f32, as the RGB lookup does (one rule for every channel count).
@@ -442,6 +445,17 @@ impl Kernel {
         x
     }
 
+    /// [`Kernel::blend_lanes`] without F16C: exact values, or f16 codes expanded with integer
+    /// operations ([`F4::from_f16_normal`]).
+    #[inline(always)]
+    fn blend_lanes_plain(&self, v: [f32; 3], out: &mut [f32], values: &Packed) {
+        if self.exact {
+            self.blend_lanes::<false, true>(v, out, values);
+        } else {
+            self.blend_lanes::<false, false>(v, out, values);
+        }
+    }
+
     /// [`Kernel::blend_lanes`] expanding f16 codes with F16C.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "f16c")]
@@ -450,16 +464,10 @@ impl Kernel {
     }
 }
 
-/// Whether the CPU has F16C (x86-64 only).
+/// Whether the CPU has F16C.
+#[cfg(target_arch = "x86_64")]
 fn has_f16c() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("f16c")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
+    std::is_x86_feature_detected!("f16c")
 }
 
 /// The adaptive-grid cases the kernel's tests bake (reciprocity, stored quantity, θh's
