@@ -17,6 +17,8 @@ use glam::DVec3;
 
 /// CPU time of `clock` in seconds: the whole process (every rayon worker) or the calling
 /// thread. On a shared machine the wall clock measures the neighbours as much as the code.
+/// (Off Unix — the figures are taken on Linux — both are wall time: [`cpu_of`] below.)
+#[cfg(unix)]
 fn cpu_of(clock: libc::clockid_t) -> f64 {
     let mut t = libc::timespec {
         tv_sec: 0,
@@ -26,12 +28,25 @@ fn cpu_of(clock: libc::clockid_t) -> f64 {
     t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
 }
 
+/// Wall time since the first call, in seconds, in place of a CPU clock.
+#[cfg(not(unix))]
+fn cpu_of(_clock: ()) -> f64 {
+    static START: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+    START.get_or_init(Instant::now).elapsed().as_secs_f64()
+}
+
 fn cpu() -> f64 {
-    cpu_of(libc::CLOCK_PROCESS_CPUTIME_ID)
+    #[cfg(unix)]
+    return cpu_of(libc::CLOCK_PROCESS_CPUTIME_ID);
+    #[cfg(not(unix))]
+    cpu_of(())
 }
 
 fn thread_cpu() -> f64 {
-    cpu_of(libc::CLOCK_THREAD_CPUTIME_ID)
+    #[cfg(unix)]
+    return cpu_of(libc::CLOCK_THREAD_CPUTIME_ID);
+    #[cfg(not(unix))]
+    cpu_of(())
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

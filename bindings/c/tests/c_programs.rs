@@ -1,5 +1,11 @@
 //! Builds the C test program and the examples with the system compiler against the built
 //! library, runs them, and compares what they print with the Rust API on the same sources.
+//!
+//! Linux only: the programs are built with `cc`/`g++` and GNU ld's flags against
+//! `libbrdftab_c.so`, and checked with `readelf` and `nm` (ELF). The C ABI itself is the same
+//! on every target; its Rust-side tests (`non_utf8.rs` on Unix, the crate's unit tests) and
+//! the library's run elsewhere (README.md, "Platforms").
+#![cfg(target_os = "linux")]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

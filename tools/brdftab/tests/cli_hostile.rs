@@ -15,6 +15,14 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// Makes a FIFO at `p` (Unix only: the FIFO cases are Unix's; a directory's run everywhere).
+#[cfg(unix)]
+fn mkfifo(p: &Path) {
+    let c = std::ffi::CString::new(s(p)).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+}
+
 const CT: &str = r#"{"model": "cook_torrance", "m": 0.3}"#;
 
 /// Bakes a small table to `good` and writes a copy with one bit of chunk 0 flipped to `bad`.
@@ -107,13 +115,17 @@ fn a_corrupt_chunk_read_lazily_is_an_error_everywhere() {
 #[test]
 fn a_fifo_or_a_directory_as_source_is_refused_at_once() {
     let d = TempDir::new("hostile-fifo");
-    let fifo = d.join("pipe.btdb");
-    let c = std::ffi::CString::new(s(&fifo)).unwrap();
-    // SAFETY: a valid NUL-terminated path.
-    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
     let dir = d.join("dir.bsdf");
     std::fs::create_dir(&dir).unwrap();
-    for src in [&fifo, &dir] {
+    #[allow(unused_mut)] // a FIFO only on Unix
+    let mut sources = vec![dir];
+    #[cfg(unix)]
+    sources.push({
+        let fifo = d.join("pipe.btdb");
+        mkfifo(&fifo);
+        fifo
+    });
+    for src in &sources {
         for args in [
             vec!["info", s(src)],
             vec!["eval", s(src)],
@@ -129,19 +141,22 @@ fn a_fifo_or_a_directory_as_source_is_refused_at_once() {
             assert!(t0.elapsed() < Duration::from_secs(20), "{args:?} was slow");
         }
     }
-    let fifo_json = d.join("spec.json");
-    let c = std::ffi::CString::new(s(&fifo_json)).unwrap();
-    // SAFETY: as above.
-    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
-    let r = brdftab(&["eval", s(&fifo_json)]);
-    assert!(!r.ok && r.stderr.contains("a FIFO"), "{}", r.stderr);
+    #[cfg(unix)]
+    {
+        let fifo_json = d.join("spec.json");
+        mkfifo(&fifo_json);
+        let r = brdftab(&["eval", s(&fifo_json)]);
+        assert!(!r.ok && r.stderr.contains("a FIFO"), "{}", r.stderr);
+    }
 }
 
-/// An output that is a FIFO (or a directory) is refused at once by every writer, before any
-/// work, and left as it is: the atomic rename used to replace a FIFO (as root, `/dev/null`
-/// itself) with a plain file, and the image writers blocked on it until killed.
+/// An output that is a FIFO is refused at once by every writer, before any work, and left as
+/// it is: the atomic rename used to replace a FIFO (as root, `/dev/null` itself) with a plain
+/// file, and the image writers blocked on it until killed. (FIFOs are Unix's; a directory's
+/// case runs everywhere: the next test.)
+#[cfg(unix)]
 #[test]
-fn a_fifo_or_a_directory_as_output_is_refused_and_kept() {
+fn a_fifo_as_output_is_refused_and_kept() {
     let d = TempDir::new("hostile-fifo-out");
     let (good, _) = good_and_bad(d.path());
     let rgl = brdftab::measured::data::rgl_dir().expect("data/rgl ships");
@@ -154,9 +169,7 @@ fn a_fifo_or_a_directory_as_output_is_refused_and_kept() {
         "t.btdb", "t.npy", "t.png", "t.exr", "t.bsdf", "t.binary", "db.btdb",
     ] {
         let fifo = d.join(name);
-        let c = std::ffi::CString::new(s(&fifo)).unwrap();
-        // SAFETY: a valid NUL-terminated path.
-        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        mkfifo(&fifo);
         let f = s(&fifo);
         let args: Vec<Vec<&str>> = match name {
             "t.btdb" => vec![
@@ -189,6 +202,13 @@ fn a_fifo_or_a_directory_as_output_is_refused_and_kept() {
             assert!(m.file_type().is_fifo(), "{a:?} replaced the FIFO");
         }
     }
+}
+
+/// A directory or an empty path as output is refused, on every OS.
+#[test]
+fn a_directory_or_an_empty_path_as_output_is_refused() {
+    let d = TempDir::new("hostile-dir-out");
+    let lam = r#"{"model": "lambert", "kd": 0.3}"#;
     let r = brdftab(&["bake", lam, "--preset", "small", "-o", s(d.path())]);
     assert!(!r.ok && r.stderr.contains("is a directory"), "{}", r.stderr);
     let r = brdftab(&["bake", lam, "--preset", "small", "-o", ""]);
@@ -206,11 +226,17 @@ fn an_output_that_is_the_input_is_refused_and_the_input_kept() {
     let p = d.join("p.bsdf");
     std::fs::copy(rgl.join("paper_white_rgb.bsdf"), &p).unwrap();
     let before = std::fs::read(&p).unwrap();
-    // The same file, spelled three ways (and through a symlink).
-    let link = d.join("link.bsdf");
-    std::os::unix::fs::symlink(&p, &link).unwrap();
+    // The same file, spelled three ways (and through a symlink, where links are Unix's).
     let dotted = d.join(".").join("p.bsdf");
-    for out in [&p, &dotted, &link] {
+    #[allow(unused_mut)]
+    let mut outs = vec![p.clone(), dotted];
+    #[cfg(unix)]
+    outs.push({
+        let link = d.join("link.bsdf");
+        std::os::unix::fs::symlink(&p, &link).unwrap();
+        link
+    });
+    for out in &outs {
         let r = brdftab(&["convert", s(&p), s(out), "--pairs", "0"]);
         assert!(!r.ok && r.stderr.contains("is the input"), "{}", r.stderr);
     }
@@ -292,6 +318,9 @@ fn a_missing_output_directory_is_named_not_an_internal_file() {
     }
 }
 
+/// Linux only: the sweep tells a dead writer by its missing `/proc/PID` (`files::temp_path`);
+/// elsewhere stale temporary files are left.
+#[cfg(target_os = "linux")]
 #[test]
 fn temporary_files_of_killed_writers_are_removed_by_the_next_write() {
     let d = TempDir::new("hostile-stale");
