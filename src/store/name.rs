@@ -59,12 +59,13 @@ pub fn check(field: &str, name: &str) -> Result<()> {
 
 /// Splits a SOURCE or output string `DB#NAME` into the path and the table name (`None` for a
 /// plain path), by the string alone: the rule of outputs (a SOURCE that is read goes through
-/// [`parse_input`]). The name is what follows the last `#`, unless it holds a `/` (then the
-/// whole string is a path with a `#` in a directory name). An empty name (`x.btdb#`) or one that
-/// breaks [`check`] is an [`Error::InvalidArgument`] naming `field`.
+/// [`parse_input`]). The name is what follows the last `#`, unless it holds a `/` (on Windows
+/// also a `\`, its other separator): then the whole string is a path with a `#` in a
+/// directory name. An empty name (`x.btdb#`) or one that breaks [`check`] is an
+/// [`Error::InvalidArgument`] naming `field`.
 pub fn parse_source<'a>(field: &str, source: &'a str) -> Result<(&'a str, Option<&'a str>)> {
     match source.rsplit_once('#') {
-        Some((_, n)) if n.contains('/') => Ok((source, None)),
+        Some((_, n)) if n.contains(std::path::is_separator) => Ok((source, None)),
         Some((p, n)) => {
             check_split(field, &format!("{source:?}"), n)?;
             Ok((p, Some(n)))
@@ -118,9 +119,9 @@ pub fn parse_output_os<'a>(field: &str, output: &'a OsStr) -> Result<(&'a Path, 
 }
 
 /// The `DB#NAME` split of a string that is not UTF-8, on its bytes: the whole string when it
-/// has no `#`, when the part after the last `#` holds a `/`, or (`read`) when something exists
-/// on disk under the whole string; else the path before the `#` as the bytes it is and the
-/// name after it, which must be UTF-8 and pass [`check`].
+/// has no `#`, when the part after the last `#` holds a separator (`/`; `\` too on Windows),
+/// or (`read`) when something exists on disk under the whole string; else the path before the
+/// `#` as the bytes it is and the name after it, which must be UTF-8 and pass [`check`].
 fn split_os<'a>(field: &str, source: &'a OsStr, read: bool) -> Result<(&'a Path, Option<&'a str>)> {
     let whole = Ok((Path::new(source), None));
     let bytes = source.as_encoded_bytes();
@@ -128,7 +129,8 @@ fn split_os<'a>(field: &str, source: &'a OsStr, read: bool) -> Result<(&'a Path,
         return whole;
     };
     let name = &bytes[i + 1..];
-    if name.contains(&b'/') || (read && std::fs::metadata(source).is_ok()) {
+    let separator = name.iter().any(|&b| std::path::is_separator(b as char));
+    if separator || (read && std::fs::metadata(source).is_ok()) {
         return whole;
     }
     let shown = format!("{:?}", source.to_string_lossy());
@@ -253,7 +255,8 @@ mod tests {
 
     /// An output that is not UTF-8 splits on its bytes by the string rule, whatever exists on
     /// disk (a SOURCE that is read is looked up whole first).
-    #[cfg(unix)]
+    // Not on Apple's file systems, which refuse a name that is not UTF-8 (APFS: EILSEQ).
+    #[cfg(all(unix, not(target_vendor = "apple")))]
     #[test]
     fn an_output_that_is_not_utf8_splits_by_the_string_rule() {
         use std::os::unix::ffi::OsStrExt;
@@ -289,6 +292,37 @@ mod tests {
             parse_output_os("output", OsStr::new("x.btdb#m")).unwrap(),
             (Path::new("x.btdb"), Some("m"))
         );
+    }
+
+    /// On Windows `\` separates directories as `/` does: a `#` in a directory's name is no
+    /// `DB#NAME` split there either (`C:\scans#2\x.btdb` was table `2\x.btdb` of `C:\scans`).
+    #[cfg(windows)]
+    #[test]
+    fn a_backslash_after_the_hash_is_a_path_on_windows() {
+        use std::os::windows::ffi::OsStringExt;
+        let p = r"C:\scans#2\x.btdb";
+        assert_eq!(parse_source("output", p).unwrap(), (p, None));
+        assert_eq!(parse_input("source", p).unwrap(), (p, None));
+        assert_eq!(
+            parse_source("output", r"C:\lib.btdb#t").unwrap(),
+            (r"C:\lib.btdb", Some("t"))
+        );
+        // Not UTF-8 (an unpaired surrogate): the same rule on the bytes.
+        let w: Vec<u16> = [0xD800]
+            .into_iter()
+            .chain("#2\\x.btdb".encode_utf16())
+            .collect();
+        let odd = std::ffi::OsString::from_wide(&w);
+        assert_eq!(
+            parse_output_os("output", &odd).unwrap(),
+            (Path::new(&odd), None)
+        );
+        let w: Vec<u16> = [0xD800]
+            .into_iter()
+            .chain(".btdb#t".encode_utf16())
+            .collect();
+        let db = std::ffi::OsString::from_wide(&w);
+        assert_eq!(parse_output_os("output", &db).unwrap().1, Some("t"));
     }
 
     fn e_msg(s: &str) -> String {
