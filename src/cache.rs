@@ -239,6 +239,7 @@ mod tests {
         let mut f = [0.0f32; 3];
         t.eval(glam::DVec3::Z, glam::DVec3::Z, &mut f);
         assert!((f[0] - 0.5).abs() < 1e-3, "Lambert: f_r = kd, {f:?}");
+        drop(t); // Windows refuses to write a file this process holds mapped
         std::fs::write(&a.path, b"not a table").unwrap();
         let c = bake_cached(SPEC, &small(), Some(d.path()), true).unwrap();
         assert!(!c.hit);

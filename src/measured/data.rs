@@ -134,7 +134,8 @@ mod tests {
         let msg = e.to_string();
         assert!(matches!(e, Error::NotFound(_)), "{msg}");
         assert!(
-            msg.contains("no_such_material.bsdf") && msg.contains("data/rgl"),
+            msg.contains("no_such_material.bsdf")
+                && msg.contains(&Path::new("data").join("rgl").display().to_string()),
             "{msg}"
         );
     }

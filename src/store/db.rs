@@ -205,6 +205,9 @@ pub fn put(
         }
     }
     emit(&mut w, &mut new)?;
+    // The old file closed (unmapped) before the new one is renamed over it: Windows refuses
+    // to replace a file this process holds mapped ("Access denied").
+    drop(old);
     w.finish()
 }
 
@@ -242,6 +245,7 @@ pub fn remove(path: impl AsRef<Path>, name: &str) -> Result<()> {
     for e in s.tables().iter().filter(|e| e.name != name) {
         copy_table(&s, e, &mut w)?;
     }
+    drop(s); // closed before the rename over it (see `put`)
     w.finish()
 }
 
@@ -284,6 +288,7 @@ pub fn rename(path: impl AsRef<Path>, old: &str, new: &str) -> Result<()> {
         copy_chunks(&t, &mut w)?;
         w.end_table()?;
     }
+    drop(s); // closed before the rename over it (see `put`)
     w.finish()
 }
 
