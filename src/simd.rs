@@ -402,29 +402,17 @@ mod tests {
         );
     }
 
-    /// Renderers set x86's DAZ and FTZ for speed (Embree asks for it, Cycles does): every f16
-    /// subnormal code must still read its value, on the SSE2 path as on F16C.
-    #[cfg(target_arch = "x86_64")]
-    #[test]
-    fn f16_lanes_are_exact_when_the_thread_flushes_subnormals() {
+    /// Every finite f16 code read four at a time and one at a time between `flush_on()` and
+    /// `flush_off()` (a mode that reads subnormal inputs as 0), against the half crate's values
+    /// read before: bit-equal.
+    #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
+    fn f16_reads_are_exact_while(flush_on: impl FnOnce(), flush_off: impl FnOnce()) {
         let bits: Vec<u16> = (0..0x7c00).chain(0x8000..0xfc00).collect();
         let want: Vec<f32> = bits
             .iter()
             .map(|&b| half::f16::from_bits(b).to_f32())
             .collect();
-        let read_csr = || {
-            let mut v = 0u32;
-            // SAFETY: stmxcsr stores the 4-byte MXCSR at the address of `v`.
-            unsafe { std::arch::asm!("stmxcsr [{}]", in(reg) &mut v) };
-            v
-        };
-        let write_csr = |v: u32| {
-            // SAFETY: ldmxcsr loads MXCSR from `v`; only the DAZ/FTZ bits differ from the
-            // thread's own value, and the test restores it.
-            unsafe { std::arch::asm!("ldmxcsr [{}]", in(reg) &v) };
-        };
-        let old = read_csr();
-        write_csr(old | 0x8040); // FTZ | DAZ
+        flush_on();
         // The mode is on: a subnormal input reads 0.
         let flushed = std::hint::black_box(f32::from_bits(1)) * 2.0 == 0.0;
         let mut got = Vec::with_capacity(bits.len());
@@ -439,10 +427,9 @@ mod tests {
         for &b in &bits {
             one.push(f16_bits_to_f32(std::hint::black_box(b)));
         }
-        write_csr(old);
-        assert!(flushed, "DAZ did not take effect");
-        let n = got.len();
-        for k in 0..n {
+        flush_off();
+        assert!(flushed, "the flush-to-zero mode did not take effect");
+        for k in 0..got.len() {
             assert_eq!(
                 got[k].to_bits(),
                 want[k].to_bits(),
@@ -458,6 +445,47 @@ mod tests {
                 bits[k]
             );
         }
+    }
+
+    /// Renderers set x86's DAZ and FTZ for speed (Embree asks for it, Cycles does): every f16
+    /// subnormal code must still read its value, on the SSE2 path as on F16C.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn f16_lanes_are_exact_when_the_thread_flushes_subnormals() {
+        let read_csr = || {
+            let mut v = 0u32;
+            // SAFETY: stmxcsr stores the 4-byte MXCSR at the address of `v`.
+            unsafe { std::arch::asm!("stmxcsr [{}]", in(reg) &mut v) };
+            v
+        };
+        let write_csr = |v: u32| {
+            // SAFETY: ldmxcsr loads MXCSR from `v`; only the DAZ/FTZ bits differ from the
+            // thread's own value, and the test restores it.
+            unsafe { std::arch::asm!("ldmxcsr [{}]", in(reg) &v) };
+        };
+        let old = read_csr();
+        f16_reads_are_exact_while(|| write_csr(old | 0x8040), || write_csr(old)); // FTZ | DAZ
+    }
+
+    /// Arm's FZ (FPCR bit 24) flushes subnormal f32 inputs and outputs to zero, as renderers
+    /// set it for speed: the integer expansion that serves every target but x86-64 reads every
+    /// f16 code exactly under it.
+    #[cfg(target_arch = "aarch64")]
+    #[test]
+    fn f16_lanes_are_exact_when_the_thread_flushes_subnormals() {
+        let read = || {
+            let v: u64;
+            // SAFETY: reads this thread's FPCR, no memory access.
+            unsafe { std::arch::asm!("mrs {}, fpcr", out(reg) v) };
+            v
+        };
+        let write = |v: u64| {
+            // SAFETY: writes this thread's FPCR; only FZ differs from the thread's own value,
+            // and the test restores it.
+            unsafe { std::arch::asm!("msr fpcr, {}", in(reg) v) };
+        };
+        let old = read();
+        f16_reads_are_exact_while(|| write(old | 1 << 24), || write(old));
     }
 
     #[test]
