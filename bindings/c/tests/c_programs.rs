@@ -48,6 +48,23 @@ fn run(cmd: &mut Command) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
+/// A command running the test program `exe`: directly, or under the wrapper in
+/// `BRDFTAB_C_TEST_WRAPPER` (its words split on whitespace: `tools/memcheck.sh valgrind-c`
+/// runs every C and C++ program of this file under valgrind's memcheck this way; the wrapper
+/// must log elsewhere than stderr, which some tests read).
+fn program(exe: impl AsRef<std::ffi::OsStr>) -> Command {
+    let wrapper = std::env::var("BRDFTAB_C_TEST_WRAPPER").unwrap_or_default();
+    let mut words = wrapper.split_whitespace();
+    match words.next() {
+        Some(w) => {
+            let mut c = Command::new(w);
+            c.args(words).arg(exe);
+            c
+        }
+        None => Command::new(exe),
+    }
+}
+
 /// Compiles `src` (C or C++) against the shared library into `exe`.
 fn compile(compiler: &str, extra: &[&str], src: &Path, exe: &Path) {
     let lib = lib_dir();
@@ -117,7 +134,7 @@ fn check_source(exe: &Path, dir: &Path, source: &str) {
         .collect();
     std::fs::write(&input, text).unwrap();
     let output = dir.join("out.txt");
-    run(Command::new(exe).arg(source).arg(&input).arg(&output));
+    run(program(exe).arg(source).arg(&input).arg(&output));
     let brdf = brdftab::open(source).unwrap();
     let c = brdf.channels().len();
     let out = std::fs::read_to_string(&output).unwrap();
@@ -198,7 +215,7 @@ fn requests_with_json_settings_do_what_the_rust_request_layer_does() {
         &Path::new(CRATE).join("tests/request_test.c"),
         &exe,
     );
-    let out = run(Command::new(&exe).arg(dir.path()));
+    let out = run(program(&exe).arg(dir.path()));
     let line = |label: &str| {
         out.lines()
             .find_map(|l| l.strip_prefix(&format!("{label} ")))
@@ -295,7 +312,7 @@ fn the_examples_build_and_print_what_the_library_computes() {
     // slice.c, against the shared and against the static library.
     let slice = dir.join("slice");
     compile("cc", &["-std=c11"], &ex.join("slice.c"), &slice);
-    let text = run(Command::new(&slice).arg(&table).arg("4"));
+    let text = run(program(&slice).arg(&table).arg("4"));
     let rows: Vec<Vec<f64>> = text
         .lines()
         .filter(|l| !l.starts_with('#'))
@@ -316,7 +333,7 @@ fn the_examples_build_and_print_what_the_library_computes() {
         .arg(lib.join("libbrdftab_c.a"))
         .args(["-lpthread", "-ldl", "-lm", "-o"])
         .arg(&slice_static));
-    assert_eq!(run(Command::new(&slice_static).arg(&table).arg("4")), text);
+    assert_eq!(run(program(&slice_static).arg(&table).arg("4")), text);
 
     // The pbrt-v4-style BxDF over the C++ wrapper: a Monte Carlo albedo from Sample_f agrees
     // with the library's quadrature albedo (Lambert: the estimator's weight is exactly kd·π
@@ -345,7 +362,7 @@ fn the_examples_build_and_print_what_the_library_computes() {
         // back-side pair), so the adapter sees the front's lobe at 30° (it sampled nothing there,
         // mc 0, when it was front-side only).
         for theta in ["30", "150"] {
-            let out = run(Command::new(&bxdf).arg(src).arg(theta));
+            let out = run(program(&bxdf).arg(src).arg(theta));
             let mut it = out.lines();
             let mc = nums(it.next().unwrap().trim_start_matches("mc"));
             let line = it.next().unwrap();
@@ -362,11 +379,11 @@ fn the_examples_build_and_print_what_the_library_computes() {
         }
     }
     // A bad SOURCE: the C++ wrapper throws with the library's message; exit 1.
-    let out = Command::new(&bxdf).arg("/no/such.btdb").output().unwrap();
+    let out = program(&bxdf).arg("/no/such.btdb").output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/no/such.btdb"));
     // A refractor: the adapter reflects only, so it refuses the source (it rendered black).
-    let out = Command::new(&bxdf)
+    let out = program(&bxdf)
         .arg(r#"{"model":"refractor","eta":1.5}"#)
         .output()
         .unwrap();
@@ -389,7 +406,7 @@ fn a_monitor_stops_bakes_conversions_and_fits_leaving_no_file() {
         &Path::new(CRATE).join("tests/monitor_test.c"),
         &exe,
     );
-    let out = run(Command::new(&exe).arg(dir.path()));
+    let out = run(program(&exe).arg(dir.path()));
     let _ = std::fs::remove_file(&exe);
     for what in ["convert-bsdf", "convert-db"] {
         assert!(out.contains(&format!("latency {what} ")), "{out}");
@@ -459,7 +476,7 @@ fn calls_from_many_threads_on_one_handle_agree_with_one_thread() {
         paper.to_str().unwrap(),
         r#"{"model":"sum","terms":[{"model":"lambert","kd":0.05},{"model":"mirror","fresnel":{"conductor":"Au"}}]}"#,
     ] {
-        run(Command::new(&exe).arg(src));
+        run(program(&exe).arg(src));
     }
 }
 
@@ -486,7 +503,7 @@ fn the_cpp_wrapper_takes_empty_batches_from_empty_vectors() {
         extra.extend(ubsan);
     }
     compile("g++", &extra, &src, &exe);
-    assert_eq!(run(&mut Command::new(&exe)).trim(), "ok");
+    assert_eq!(run(&mut program(&exe)).trim(), "ok");
 }
 
 /// The header's version macros, the pkg-config file's `Version` and the library's
@@ -602,7 +619,7 @@ int main(void) {
     run(Command::new("sh").arg("-c").arg(&script));
     for exe in ["app", "app-static"] {
         // Without cargo's LD_LIBRARY_PATH: the program finds the installed library (or none).
-        let out = run(Command::new(app.join(exe)).env_remove("LD_LIBRARY_PATH"));
+        let out = run(program(app.join(exe)).env_remove("LD_LIBRARY_PATH"));
         assert_eq!(out.trim(), "0.5 0.5 0.5", "{exe}");
     }
     let needed = |exe: &str| run(Command::new("readelf").arg("-d").arg(app.join(exe)));
@@ -644,7 +661,7 @@ fn hostile_input_through_the_c_abi_is_an_error_or_zero_never_a_crash() {
     let bad = dir.join("bad.btdb");
     corrupt_copy(&table, &bad);
     for good in [&table[..], r#"{"model":"ggx","alpha":0.3}"#] {
-        let out = Command::new(&exe).arg(good).arg(&bad).output().unwrap();
+        let out = program(&exe).arg(good).arg(&bad).output().unwrap();
         assert!(
             out.status.success(),
             "{good}: {:?}\n{}",
