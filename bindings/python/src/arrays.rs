@@ -50,7 +50,7 @@ fn real_array<'py, T: Element>(
 ) -> PyResult<PyReadonlyArrayDyn<'py, T>> {
     refuse_masked(obj, name)?;
     if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'py, T>>() {
-        return Ok(a);
+        return aligned(a, name, dtype);
     }
     let py = obj.py();
     if obj.is_none() || obj.is_instance_of::<pyo3::types::PyString>() {
@@ -91,7 +91,47 @@ fn real_array<'py, T: Element>(
     let arr = np
         .call_method("asarray", (&obj, dtype), Some(&kw))
         .map_err(not_real)?;
-    arr.extract::<PyReadonlyArrayDyn<'py, T>>()
+    let arr = arr
+        .extract::<PyReadonlyArrayDyn<'py, T>>()
+        .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))?;
+    aligned(arr, name, dtype)
+}
+
+/// Whether `a`'s data is aligned for `T`.
+fn is_aligned<T: Element>(a: &PyReadonlyArrayDyn<'_, T>) -> bool {
+    use numpy::PyArrayMethods;
+    a.data().is_aligned()
+}
+
+/// `a` when its data is aligned for `T`, else an aligned C-ordered copy by numpy
+/// (`numpy.require(a, dtype, "CA")`); no memory for the copy is a `MemoryError` naming `name`.
+/// A numpy array can be misaligned (`np.frombuffer` at an odd offset); every reader of a
+/// borrowed array — `as_slice`, `as_array`, rows read in place as `[DVec3]` — makes a `&[T]` or
+/// an ndarray view of its data, which must be aligned: a misaligned one is undefined behaviour
+/// (a build with debug assertions aborts on it: "slice::from_raw_parts requires the pointer to
+/// be aligned"), even where x86 reads the numbers right.
+fn aligned<'py, T: Element>(
+    a: PyReadonlyArrayDyn<'py, T>,
+    name: &str,
+    dtype: &str,
+) -> PyResult<PyReadonlyArrayDyn<'py, T>> {
+    if is_aligned(&a) {
+        return Ok(a);
+    }
+    let py = a.py();
+    let kw = pyo3::types::PyDict::new(py);
+    kw.set_item("requirements", "CA")?;
+    let copy = py
+        .import("numpy")?
+        .call_method("require", (a.as_any(), dtype), Some(&kw))
+        .map_err(|e| {
+            if e.is_instance_of::<PyMemoryError>(py) {
+                PyMemoryError::new_err(format!("{name}: no memory for an aligned copy ({e})"))
+            } else {
+                e
+            }
+        })?;
+    copy.extract::<PyReadonlyArrayDyn<'py, T>>()
         .map_err(|e| PyTypeError::new_err(format!("{name}: {e}")))
 }
 
@@ -137,7 +177,6 @@ pub(crate) fn shape_str(shape: &[usize]) -> String {
 pub(crate) struct Rows<'py, T> {
     /// Keeps the numpy array (and its read borrow) alive while `ptr` or `narrow` is used.
     _array: Held<'py>,
-    owned: Vec<T>,
     /// Rows in place as `T` (float64), or null.
     ptr: *const T,
     /// Rows in place as `W` f32 each (float32), or null.
@@ -194,7 +233,8 @@ fn narrow_rows<'py>(obj: &Bound<'py, PyAny>, w: usize) -> Option<PyReadonlyArray
     }
     let a = obj.extract::<PyReadonlyArrayDyn<'py, f32>>().ok()?;
     let shaped = a.shape().last() == Some(&w);
-    (shaped && a.is_c_contiguous()).then_some(a)
+    // A misaligned one goes the general way too (converted to float64 by numpy: `aligned`).
+    (shaped && a.is_c_contiguous() && is_aligned(&a)).then_some(a)
 }
 
 /// A 2-d float64 array's numbers where they are: entry (i, j) at `ptr + i·row + j·col` (strides
@@ -257,7 +297,6 @@ impl<'py, T: Row> Rows<'py, T> {
                 narrow: flat.as_ptr(),
                 ptr: std::ptr::null(),
                 strided: None,
-                owned: Vec::new(),
                 len: flat.len() / w,
                 lead: a.shape()[..a.ndim() - 1].to_vec(),
                 _array: Held::F32 { _a: a },
@@ -282,7 +321,6 @@ impl<'py, T: Row> Rows<'py, T> {
                 len: a.shape()[0],
                 lead,
                 _array: Held::F64 { _a: a },
-                owned: Vec::new(),
                 ptr: std::ptr::null(),
                 narrow: std::ptr::null(),
                 strided: Some(st),
@@ -298,27 +336,11 @@ impl<'py, T: Row> Rows<'py, T> {
         let flat = a
             .as_slice()
             .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
+        // `f64_array` gives aligned data (`aligned`), so the rows are read in place.
         let len = flat.len() / w;
-        let aligned = (flat.as_ptr() as usize).is_multiple_of(std::mem::align_of::<T>());
-        let (owned, ptr) = if aligned {
-            (Vec::new(), flat.as_ptr() as *const T)
-        } else {
-            // A misaligned buffer (e.g. a view into bytes): copied, once; a copy beyond memory
-            // is a `MemoryError`, not an abort.
-            let mut v: Vec<T> = Vec::new();
-            v.try_reserve_exact(flat.len() / w).map_err(|_| {
-                PyMemoryError::new_err(format!(
-                    "{name}: no memory for an aligned copy of {} rows",
-                    flat.len() / w
-                ))
-            })?;
-            v.extend(flat.chunks_exact(w).map(T::from));
-            let p = v.as_ptr();
-            (v, p)
-        };
+        let ptr = flat.as_ptr() as *const T;
         Ok(Rows {
             _array: Held::F64 { _a: a },
-            owned,
             ptr,
             narrow: std::ptr::null(),
             strided: None,
@@ -335,9 +357,6 @@ impl<'py, T: Row> Rows<'py, T> {
     /// The rows as they are held: `[T]`, float32 numbers or float64 at strides (shared across
     /// threads).
     pub(crate) fn view(&self) -> View<'_, T> {
-        if !self.owned.is_empty() {
-            return View::Wide(&self.owned);
-        }
         if let Some(s) = self.strided {
             return View::Strided(s, self.len);
         }

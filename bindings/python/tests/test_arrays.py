@@ -112,6 +112,35 @@ def test_broadcast_views_are_read_in_place():
     assert b.albedo(0.7).shape == (3,) and b.albedo([]).shape == (0, 3)
 
 
+def misaligned(a):
+    """A copy of `a` whose data starts one byte past an aligned address (numpy's `aligned` flag
+    off), as `np.frombuffer` at an odd offset makes."""
+    raw = np.zeros(a.nbytes + 1, np.uint8)
+    b = np.frombuffer(raw.data, dtype=a.dtype, count=a.size, offset=1).reshape(a.shape)
+    b[...] = a
+    assert not b.flags.aligned
+    return b
+
+
+def test_misaligned_arrays_of_every_kind_read_as_their_aligned_copies(tmp_path):
+    """float64 and float32 rows, wavelengths and a table's values in a misaligned buffer: each
+    was borrowed as a `&[f64]`/`&[f32]` slice or an ndarray view of misaligned data, undefined
+    behaviour in Rust (an extension built with debug assertions aborted the interpreter:
+    "slice::from_raw_parts requires the pointer to be aligned"). Now numpy copies them aligned
+    first, and each result equals the aligned input's."""
+    b = brdftab.open(GGX)
+    for dt in (np.float64, np.float32):
+        wi, wo, u = WI.astype(dt), WO.astype(dt), U.astype(dt)
+        np.testing.assert_array_equal(b.eval(misaligned(wi), misaligned(wo)), b.eval(wi, wo))
+        for got, want in zip(b.sample(misaligned(wo), misaligned(u)), b.sample(wo, u)):
+            np.testing.assert_array_equal(got, want)
+    np.testing.assert_array_equal(brdftab.rgb_basis(misaligned(NM)), brdftab.rgb_basis(NM))
+    out = str(tmp_path / "t.btdb")
+    brdftab.bake('{"model": "lambert", "kd": 0.5}', out, preset="small", codec="f32")
+    t = brdftab.open(out).table()
+    np.testing.assert_array_equal(t.with_values(misaligned(t.values)).values, t.values)
+
+
 def test_a_misaligned_input_beyond_memory_is_a_memory_error():
     """A misaligned float64 view (of bytes at an odd offset) is copied into aligned rows; with
     no memory left for the copy the interpreter aborted ("memory allocation of 480000000 bytes
