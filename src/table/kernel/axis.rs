@@ -84,8 +84,10 @@ impl Axis {
         Some((Axis::from_knots(&s, n), vcut))
     }
 
-    /// The knot lines of s given at K + 1 knots uniform in v, for an axis of `n` nodes.
+    /// The knot lines of s given at K + 1 knots uniform in v (K ≥ 1: `line` relies on it), for
+    /// an axis of `n` nodes.
     fn from_knots(s: &[f64], n: usize) -> Axis {
+        assert!(s.len() >= 2, "an axis needs two knots");
         let lines = s
             .windows(2)
             .enumerate()
@@ -109,8 +111,10 @@ impl Axis {
     pub(super) fn line(&self, j: i32) -> &[f32; 2] {
         let j = (j as u32).min(self.kmax) as usize;
         debug_assert!(j < self.lines.len());
-        // SAFETY: `lines` has kmax + 1 entries (`Axis::from_knots`, the only constructor, sets
-        // kmax to their count − 1; neither changes afterwards), and j ≤ kmax.
+        // SAFETY: `lines` has kmax + 1 ≥ 1 entries (`Axis::from_knots`, the only constructor,
+        // sets kmax to their count − 1; neither changes afterwards), and j ≤ kmax. From K + 1
+        // ≥ 2 knots: a warp has 2 to 65536 (`Warp::new`, which a table file's warps are read
+        // through too), a resampled axis RESAMPLED_KNOTS + 1.
         unsafe { self.lines.get_unchecked(j) }
     }
 
