@@ -4,13 +4,13 @@
 //! Why a module: a batch call's cost should be the library's. Directions arrive as `(..., 3)`
 //! arrays (any leading shape, broadcast against each other by numpy's rules; results take the
 //! broadcast shape); a C-contiguous, aligned float64 array is read in place as `[DVec3]` (glam's `DVec3`
-//! is `#[repr(C)]` of three f64, as the C ABI reads `double[n][3]`); a C-contiguous float32
+//! is `#[repr(C)]` of three f64, as the C ABI reads `double[n][3]`); a C-contiguous, aligned float32
 //! array — what Mitsuba, PyTorch and most renderers' buffers hold — is read in place too, each
 //! block of rows widened to f64 as the block is evaluated (the same values numpy's `astype`
 //! gives, without an n-sized float64 copy before the call); a float64 `(n, W)` array at other
 //! strides — Fortran order (`np.array([x, y, z]).T`), reversed (`a[::-1]`), every other row, the
 //! first columns of a wider array — is read in place too, each block of rows gathered as it is
-//! evaluated; anything else — an N-d strided view, integers, a list — is converted by numpy once. Results are written straight into the numpy
+//! evaluated; anything else — an N-d strided view, a misaligned buffer, integers, a list — is converted by numpy once. Results are written straight into the numpy
 //! arrays returned, with the GIL released, so a large call's memory is its output.
 
 use brdftab::batch::{BLOCK, blocks};
