@@ -44,12 +44,15 @@
 
 pub mod pairs;
 pub mod params;
+mod problem;
+#[cfg(test)]
+mod tests;
 
 use std::cell::Cell;
 use std::time::Instant;
 
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use levenberg_marquardt::LevenbergMarquardt;
+use nalgebra::DVector;
 use serde::Serialize;
 use serde_json::Value as Json;
 
@@ -57,10 +60,10 @@ use crate::brdf::Brdf;
 use crate::error::{Error, Result};
 use crate::rng::Pcg32;
 use crate::spec::ModelSpec;
-use crate::spectrum::Channels;
 
 pub use pairs::Pairs;
 pub use params::{Bounds, ColorMode, Param, ParamRequest, Scale};
+use problem::{Problem, eval_cos, from_free, spec_from_json, to_free, transform};
 
 /// Number of uniform pairs on which the final `rmse` is measured.
 pub const ACCURACY_PAIRS: usize = 20_000;
@@ -292,10 +295,6 @@ pub fn with_fresnel(spec: &ModelSpec, fresnel: &crate::fresnel::FresnelSpec) -> 
     spec_from_json(json)
 }
 
-fn spec_from_json(json: Json) -> Result<ModelSpec> {
-    ModelSpec::parse(&json.to_string())
-}
-
 /// Cosine-weighted relative RMSE of `model` against `source` over `pairs`:
 /// sqrt(Σ (f̂ − f)² cos² θi / Σ f² cos² θi), summed over every channel. Both must have the same
 /// channel count.
@@ -327,20 +326,6 @@ fn rel_rmse(model: &[f64], target: &[f64]) -> f64 {
     } else {
         f64::INFINITY
     }
-}
-
-/// f·cos θi for every pair and channel (pair-major), NaN/inf mapped to 0.
-fn eval_cos(b: &dyn Brdf, pairs: &Pairs) -> Vec<f64> {
-    let c = b.channels().len();
-    let mut buf = vec![0.0f32; pairs.len() * c];
-    b.eval_batch(&pairs.wi, &pairs.wo, &mut buf);
-    buf.iter()
-        .enumerate()
-        .map(|(k, &v)| {
-            let x = v as f64 * pairs.wi[k / c].z;
-            if x.is_finite() { x } else { 0.0 }
-        })
-        .collect()
 }
 
 /// Fits the parameters of `init` to `source`; see the module docs.
@@ -568,330 +553,4 @@ pub fn fit_with_progress(
         seconds: clock.elapsed().as_secs_f64(),
         starts,
     })
-}
-
-fn transform(y: f64, log: bool) -> f64 {
-    if log { y.max(0.0).ln_1p() } else { y }
-}
-
-fn to_free(params: &[Param], x: &[f64]) -> Vec<f64> {
-    let mut out = Vec::with_capacity(x.len());
-    let mut off = 0;
-    for p in params {
-        for &v in &x[off..off + p.width] {
-            out.push(p.bounds.to_free(v));
-        }
-        off += p.width;
-    }
-    out
-}
-
-fn from_free(params: &[Param], t: &[f64]) -> Vec<f64> {
-    let mut out = Vec::with_capacity(t.len());
-    let mut off = 0;
-    for p in params {
-        for &v in &t[off..off + p.width] {
-            out.push(p.bounds.from_free(v));
-        }
-        off += p.width;
-    }
-    out
-}
-
-/// The least-squares problem LM sees: free variables `t`, residuals per pair and channel.
-struct Problem<'a> {
-    base: Json,
-    params: &'a [Param],
-    channels: &'a Channels,
-    pairs: &'a Pairs,
-    /// Transformed targets (f cos θi, or its log), pair-major.
-    target: Vec<f64>,
-    log: bool,
-    /// 1/sqrt(number of residuals), so the objective is a mean.
-    scale: f64,
-    t: DVector<f64>,
-    iterations: Cell<usize>,
-    evaluations: Cell<usize>,
-    /// The host's request to stop ([`crate::progress::Progress::cancelled`]): the model's
-    /// values are then `None`, which ends the optimizer's start at its next evaluation.
-    cancel: &'a (dyn Fn() -> bool + Sync),
-}
-
-/// Central-difference step in the free variables.
-const FD_STEP: f64 = 1e-3;
-
-impl Problem<'_> {
-    fn spec_at(&self, t: &DVector<f64>) -> Result<ModelSpec> {
-        let mut json = self.base.clone();
-        let x = from_free(self.params, t.as_slice());
-        let mut off = 0;
-        for p in self.params {
-            params::write(&mut json, p, &x[off..off + p.width], self.channels)?;
-            off += p.width;
-        }
-        spec_from_json(json)
-    }
-
-    /// Transformed model values f̂ cos θi at `t`, or `None` if the model cannot be built.
-    fn model_values(&self, t: &DVector<f64>) -> Option<Vec<f64>> {
-        self.evaluations.set(self.evaluations.get() + 1);
-        if (self.cancel)() {
-            return None;
-        }
-        let spec = self.spec_at(t).ok()?;
-        spec.validate().ok()?;
-        let mut terms = Vec::new();
-        flatten(&spec, 1.0, self.channels, &mut terms).ok()?;
-        let mut v = vec![0.0; self.target.len()];
-        for (w, term) in &terms {
-            for (a, b) in v.iter_mut().zip(eval_cos(term.as_ref(), self.pairs)) {
-                *a += w * b;
-            }
-        }
-        Some(v.into_iter().map(|y| transform(y, self.log)).collect())
-    }
-}
-
-/// The terms of a (nested) sum with their combined weights, each built on its own: a `Sum`
-/// precomputes albedo tables for its sampler when built, which a fit that only evaluates would pay
-/// for at every step.
-fn flatten(
-    spec: &ModelSpec,
-    weight: f64,
-    channels: &Channels,
-    out: &mut Vec<(f64, Box<dyn Brdf + Send + Sync>)>,
-) -> Result<()> {
-    match spec {
-        ModelSpec::Sum { terms, weights } => {
-            for (i, t) in terms.iter().enumerate() {
-                let w = weights.as_ref().map_or(1.0, |w| w[i]);
-                flatten(t, weight * w, channels, out)?;
-            }
-        }
-        other => out.push((weight, crate::spec::build(other, channels)?)),
-    }
-    Ok(())
-}
-
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.t.copy_from(x);
-    }
-
-    fn params(&self) -> DVector<f64> {
-        self.t.clone()
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        let m = self.model_values(&self.t)?;
-        Some(DVector::from_iterator(
-            m.len(),
-            m.iter()
-                .zip(&self.target)
-                .map(|(a, b)| (a - b) * self.scale),
-        ))
-    }
-
-    /// Central differences. A per-channel value (width = channel count) is perturbed in all its
-    /// channels at once: channel k of f̂ depends only on channel k of the value (values are
-    /// resolved per channel), so one pair of evaluations gives all its columns — the classic
-    /// colouring of a sparse Jacobian — instead of one pair per channel.
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        self.iterations.set(self.iterations.get() + 1);
-        let n = self.t.len();
-        let m = self.target.len();
-        let c = self.channels.len();
-        let inv = self.scale / (2.0 * FD_STEP);
-        let mut j = DMatrix::zeros(m, n);
-        let mut off = 0;
-        for p in self.params {
-            let (mut tp, mut tm) = (self.t.clone(), self.t.clone());
-            for k in off..off + p.width {
-                tp[k] += FD_STEP;
-                tm[k] -= FD_STEP;
-            }
-            let fp = self.model_values(&tp)?;
-            let fm = self.model_values(&tm)?;
-            for (row, (a, b)) in fp.iter().zip(&fm).enumerate() {
-                let col = if p.width == 1 { off } else { off + row % c };
-                j[(row, col)] = (a - b) * inv;
-            }
-            off += p.width;
-        }
-        Some(j)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn build(json: &str) -> Box<dyn Brdf + Send + Sync> {
-        ModelSpec::parse(json)
-            .unwrap()
-            .build(&Channels::Rgb)
-            .unwrap()
-    }
-
-    fn quick() -> FitOptions {
-        FitOptions {
-            pairs: 400,
-            starts: 3,
-            ..Default::default()
-        }
-    }
-
-    #[test]
-    fn a_pair_count_beyond_the_bound_is_an_argument_error_not_an_abort() {
-        // 10^10 pairs allocated 240 GB (an abort); usize::MAX overflowed (a panic).
-        let src = build(r#"{"model": "lambert", "kd": 0.5}"#);
-        for pairs in [10_000_000_000, usize::MAX, MAX_RESIDUALS / 3 + 1] {
-            let opts = FitOptions { pairs, ..quick() };
-            let e = fit(src.as_ref(), &preset("lambert").unwrap(), &opts).unwrap_err();
-            assert!(
-                matches!(e, Error::InvalidArgument { ref name, .. } if name == "pairs"),
-                "{pairs}: {e}"
-            );
-        }
-    }
-
-    #[test]
-    fn lambert_recovers_kd_per_channel() {
-        let src = build(r#"{"model": "lambert", "kd": [0.1, 0.2, 0.05]}"#);
-        let r = fit(src.as_ref(), &preset("lambert").unwrap(), &quick()).unwrap();
-        let ModelSpec::Lambert { kd } = &r.spec else {
-            panic!("{:?}", r.spec)
-        };
-        let v = kd.resolve(&Channels::Rgb);
-        for (a, b) in v.iter().zip([0.1, 0.2, 0.05]) {
-            assert!((a - b).abs() < 1e-4 * b, "{v:?}");
-        }
-        assert!(r.rmse < 1e-4, "{}", r.rmse);
-        assert_eq!(r.starts.len(), 3);
-        // The fitted spec is valid JSON that parses back and builds.
-        let back = ModelSpec::parse(&r.spec.to_json()).unwrap();
-        back.build(&Channels::Rgb).unwrap();
-    }
-
-    #[test]
-    fn grey_mode_fits_the_mean() {
-        let src = build(r#"{"model": "lambert", "kd": [0.1, 0.2, 0.3]}"#);
-        let opts = FitOptions {
-            color: ColorMode::Grey,
-            ..quick()
-        };
-        let r = fit(src.as_ref(), &preset("lambert").unwrap(), &opts).unwrap();
-        assert!(
-            matches!(r.spec, ModelSpec::Lambert { kd: crate::Value::Grey(k) } if (k - 0.2).abs() < 1e-4)
-        );
-    }
-
-    /// A term the source does not have heads for its lower bound of 0; on the way its value
-    /// passed below 1e-12, which a spec refuses, and the start was dropped (every start of
-    /// Lambert fitted with lambert+ggx failed). Now such a value is 0 and every start ends.
-    #[test]
-    fn a_term_heading_for_zero_does_not_lose_its_start() {
-        let src = build(r#"{"model": "lambert", "kd": 0.2}"#);
-        let r = fit(src.as_ref(), &preset("lambert+ggx").unwrap(), &quick()).unwrap();
-        for s in &r.starts {
-            assert!(s.objective.is_finite(), "{s:?}");
-        }
-        assert!(r.rmse < 1e-3, "{}", r.rmse);
-        let b = Bounds::linear(0.0, 1.0);
-        assert_eq!(b.from_unit(1e-14), 0.0);
-        assert_eq!(b.from_unit(1e-11), 1e-11);
-        assert_eq!(Bounds::linear(-1.0, 1.0).from_unit(0.5 + 1e-14), 0.0);
-    }
-
-    #[test]
-    fn bounds_are_respected() {
-        let src = build(r#"{"model": "lambert", "kd": 0.25}"#);
-        let opts = FitOptions {
-            params: vec!["kd=0.01:0.05".parse::<ParamRequest>().unwrap()],
-            ..quick()
-        };
-        let r = fit(src.as_ref(), &preset("lambert").unwrap(), &opts).unwrap();
-        let v = &r.params[0].value;
-        assert!(v.iter().all(|&k| (0.01..=0.05).contains(&k)), "{v:?}");
-        assert!(v.iter().all(|&k| k > 0.049), "{v:?}");
-        assert!(r.params[0].at_bound);
-        for s in &r.starts {
-            assert!(s.fitted.iter().all(|&k| (0.01..=0.05).contains(&k)));
-            assert!(s.initial.iter().all(|&k| (0.01..=0.05).contains(&k)));
-        }
-    }
-
-    #[test]
-    fn log_space_fit_recovers_kd() {
-        let src = build(r#"{"model": "lambert", "kd": 0.3}"#);
-        let opts = FitOptions {
-            log: true,
-            ..quick()
-        };
-        let r = fit(src.as_ref(), &preset("lambert").unwrap(), &opts).unwrap();
-        assert!(r.log);
-        assert!(
-            r.params[0].value.iter().all(|k| (k - 0.3).abs() < 1e-4),
-            "{:?}",
-            r.params
-        );
-    }
-
-    #[test]
-    fn presets_parse_and_unknown_names_fail() {
-        for name in [
-            "lambert+cook_torrance",
-            "lambert+ggx",
-            "lambert+blinn_phong",
-            "lambert+ward",
-            "ggx",
-            "reciprocal_phong",
-        ] {
-            let s = preset(name).unwrap();
-            assert_eq!(s.name(), if name.contains('+') { "sum" } else { name });
-        }
-        assert!(preset("mirror").is_err());
-        assert!(preset("lambert+bogus").is_err());
-        assert_eq!(
-            preset(r#"{"model": "lambert", "kd": 0.2}"#).unwrap().name(),
-            "lambert"
-        );
-    }
-
-    #[test]
-    fn bad_options_are_errors() {
-        let src = build(r#"{"model": "lambert", "kd": 0.25}"#);
-        let l = preset("lambert").unwrap();
-        assert!(
-            fit(
-                src.as_ref(),
-                &l,
-                &FitOptions {
-                    pairs: 0,
-                    ..quick()
-                }
-            )
-            .is_err()
-        );
-        assert!(
-            fit(
-                src.as_ref(),
-                &l,
-                &FitOptions {
-                    starts: 0,
-                    ..quick()
-                }
-            )
-            .is_err()
-        );
-        let o = FitOptions {
-            params: vec![ParamRequest::new("terms[1].m")],
-            ..quick()
-        };
-        assert!(fit(src.as_ref(), &l, &o).is_err());
-    }
 }
