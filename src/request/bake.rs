@@ -17,14 +17,14 @@ use crate::table::{Param, fill};
 #[cfg_attr(feature = "clap", derive(clap::Args))]
 pub struct BakeSettings {
     /// Grid size preset: small, medium or large (default: a MERL file's own cells for MERL
-    /// sources, for RGL files the smallest adaptive grid within 0.7 % (see target_error),
-    /// medium otherwise — unless a model's medium table misses its albedo by over 1 %, then
+    /// sources, for RGL files the smallest adaptive grid within the default error target,
+    /// 0.7 %, medium otherwise — unless a model's medium table misses its albedo by over 1 %, then
     /// the adaptive grid of a 0.2 % target or the medium table calibrated).
     #[cfg_attr(feature = "clap", arg(long))]
     pub preset: Option<String>,
     /// Full grid sizes θ1xφ1xθ2xφ2 (e.g. 90x360x90x360), `merl`, or `adaptive[:NHxNDxNP]`
     /// (halfdiff θh, θd and stored φd nodes placed by the source's own variation; isotropic
-    /// bilateral sources; default 128x48x25, or what target_error picks); overrides preset.
+    /// bilateral sources; default 128x48x25, or what an error target picks); overrides preset.
     #[cfg_attr(feature = "clap", arg(long))]
     pub grid: Option<String>,
     /// Parameterization: halfdiff (default) or inout.

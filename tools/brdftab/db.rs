@@ -25,8 +25,11 @@ enum DbCommand {
     Rm(RmArgs),
     /// Rename table OLD of DB to NEW (refused when DB holds a table NEW).
     Rename {
+        /// The database file.
         db: brdftab_tools::args::PathArg,
+        /// The table's name.
         old: String,
+        /// Its new name.
         new: String,
     },
     /// Check every checksum and decode every chunk of DB.
