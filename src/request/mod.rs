@@ -6,9 +6,11 @@
 //! non-default feature `clap` the structs derive `clap::Args`, so the CLI parses into them
 //! directly), Python's keyword arguments are these fields (`brdftab.bake(src, out,
 //! target_error=0.005)`), and the C ABI takes them as a JSON object
-//! (`{"target_error": 0.005}`). Each settings type validates once, in its `request`/`options`
-//! method, and turns into the library's typed request ([`BakeRequest`](crate::bake::BakeRequest),
-//! [`FitOptions`](crate::fit::FitOptions), [`OpenOptions`](crate::source::OpenOptions)); errors
+//! (`{"target_error": 0.005}`). Each settings type validates once ([`BakeSettings::request`],
+//! [`FitSettings::options`], [`OpenSettings::options`], [`SaveSettings::codec`]; a conversion's
+//! own fields in [`convert`]) and turns into the library's typed request
+//! ([`BakeRequest`](crate::bake::BakeRequest), [`FitOptions`](crate::fit::FitOptions),
+//! [`OpenOptions`](crate::source::OpenOptions), a [`Codec`](crate::codec::Codec)); errors
 //! name the field (`Error::InvalidArgument { name: "target_error", .. }`), and a host renders
 //! that name in its own terms (the CLI as `--target-error`).
 //!
