@@ -90,6 +90,51 @@ fn the_top_level_help_says_what_the_tool_does() {
     );
 }
 
+/// Every subcommand's help names each positional argument with a description, and speaks of
+/// flags rather than the library's field names (`db rename --help` listed `<DB> <OLD> <NEW>`
+/// bare; `bake --help` said "see target_error" where the flag is `--target-error`).
+#[test]
+fn every_help_describes_its_arguments_in_the_users_words() {
+    let commands = "eval models bake export import info bench render slice convert albedo check \
+                    demo accuracy fit sample pdf view db:add db:list db:rm db:rename db:verify";
+    for cmd in commands.split_whitespace() {
+        let cmd: Vec<&str> = cmd.split(':').collect();
+        let o = brdftab(&[&cmd[..], &["--help"]].concat());
+        assert!(o.ok, "{cmd:?}: {}", o.stderr);
+        for field in [
+            "target_error",
+            "max_depth",
+            "codec_tolerance",
+            "symmetry_tolerance",
+        ] {
+            assert!(
+                !o.stdout.contains(field),
+                "{cmd:?} says `{field}`: {}",
+                o.stdout
+            );
+        }
+        let Some((_, args)) = o.stdout.split_once("Arguments:\n") else {
+            continue;
+        };
+        // Short help: `  <SOURCE>  text`; long help (`slice`): the text on the next line.
+        let lines: Vec<&str> = args
+            .lines()
+            .take_while(|l| !l.starts_with("Options:"))
+            .collect();
+        for (i, line) in lines.iter().enumerate() {
+            let line = line.trim();
+            if !line.starts_with(['<', '[']) {
+                continue;
+            }
+            let end = line.find(['>', ']']).expect(line) + 1;
+            let next = lines.get(i + 1).map_or("", |l| l.trim());
+            let described = !line[end..].trim_start_matches("...").trim().is_empty()
+                || !(next.is_empty() || next.starts_with(['<', '[']));
+            assert!(described, "{cmd:?}: `{line}` has no help: {}", o.stdout);
+        }
+    }
+}
+
 #[test]
 fn usage_says_what_is_required() {
     let o = brdftab(&["bake", "--help"]);
