@@ -3,8 +3,9 @@
 //
 //   #include "brdftab.hpp"
 //   brdftab::Brdf b("materials.btdb#gold");
+//   std::vector<brdftab::Vec3> wi(n), wo(n);         // the C ABI's n x 3 doubles
 //   std::vector<float> f(n * b.channels());
-//   b.eval(n, wi.data(), wo.data(), f.data());      // wi, wo: n x 3 doubles
+//   b.eval(n, wi.data(), wo.data(), f.data());
 #pragma once
 
 #include <cstddef>
