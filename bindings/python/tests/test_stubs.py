@@ -7,9 +7,12 @@ import ast
 import inspect
 import pathlib
 import re
+import subprocess
+import sys
 
 import brdftab
 import brdftab.mitsuba
+from conftest import unavailable
 
 PKG = pathlib.Path(brdftab.__file__).parent
 MODULES = [brdftab, brdftab.mitsuba]
@@ -121,3 +124,45 @@ def test_docstrings_read_as_python_docs_not_rustdoc():
     assert _rustdoc_links("see [`Foo`](crate::bar), [a table](self::t), [Foo] and [a::b]") == [
         "[`Foo`]", "](self::", "[Foo]", "[a::b]"]
     assert _rustdoc_links('`grid["stored_shape"] + [c]`, ["R", "G", "B"], [0, 1)') == []
+
+
+# A program that passes each call what its docstring and the README say it takes: bytes, str or
+# pathlib.Path paths; any buffer to `Database.add_bytes` (its docstring names bytearray,
+# memoryview and mmap). Type-checked, not run.
+USES = """
+import array, mmap, pathlib
+import numpy as np
+import brdftab
+
+db = brdftab.Database(pathlib.Path("m.btdb"))
+brdftab.Database(b"m.btdb").add('{"model": "lambert", "kd": 0.5}', "matte", preset="small")
+with open("t.btdb", "rb") as fh:
+    db.add_bytes("a", fh.read())
+    db.add_bytes("b", bytearray(b"x"))
+    db.add_bytes("c", memoryview(b"x"))
+    db.add_bytes("d", mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ))
+    db.add_bytes("e", array.array("B", b"x"))
+b = brdftab.open(b"t.btdb", interp="linear")
+f = b.eval(np.zeros((4, 3), np.float32), [0.0, 0.0, 1.0])
+t = b.table()
+t.save(pathlib.Path("u.btdb"), codec="f32")
+brdftab.bake_cached("t.btdb", cache_dir=pathlib.Path("cache"), preset="small")
+brdftab.info(pathlib.Path("t.btdb"))
+"""
+
+
+def test_the_stubs_accept_what_the_docstrings_say_each_call_takes(tmp_path):
+    """mypy checks a program that passes the documented argument types against the installed
+    stubs: the stub of `Database.add_bytes` took bytes | bytearray | memoryview, so mypy
+    refused the mmap its docstring names (and any other buffer, an array.array)."""
+    try:
+        import mypy  # noqa: F401
+    except ImportError:
+        unavailable("no mypy (pip install mypy)")
+    (tmp_path / "uses.py").write_text(USES, encoding="utf-8")
+    # From the program's directory: mypy finds the installed package (py.typed), not a copy
+    # under the working directory.
+    r = subprocess.run([sys.executable, "-m", "mypy", "--no-incremental", "uses.py"],
+                       cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "Success" in r.stdout

@@ -5,6 +5,7 @@ from typing import Any, Iterator, Literal, Sequence, Union, final, overload
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import Buffer
 
 __version__: str
 
@@ -345,12 +346,11 @@ class Database:
     ) -> dict[str, Any]:
         """Bakes SOURCE into table NAME (the database is created if absent); takes the keywords
         of `bake`. Returns what `brdftab info --json DB#NAME` reports."""
-    def add_bytes(
-        self, name: str, data: Union[bytes, bytearray, memoryview], *, replace: bool = False
-    ) -> None:
+    def add_bytes(self, name: str, data: Buffer, *, replace: bool = False) -> None:
         """Adds the table in a single-table .btdb file's bytes as NAME (chunks copied as they
         are); an existing NAME is an error unless replace. bytes are read in place; another
-        buffer is copied into bytes first (MemoryError if that does not fit)."""
+        buffer (bytearray, memoryview, mmap, ...) is copied into bytes first (MemoryError if
+        that does not fit)."""
     def remove(self, name: str) -> None:
         """Removes table NAME."""
     def rename(self, old: str, new: str) -> None:
