@@ -50,6 +50,7 @@ pub use preset_check::{
 };
 pub use report::{Accuracy, BakeReport};
 pub use rgl::{Converted, to_rgl};
+pub(crate) use run::refuse_name_conflict;
 pub use run::{source_stem, stem};
 
 use crate::codec::Codec;

@@ -35,18 +35,10 @@ impl BakeRequest {
         crate::files::check_output(&crate::files::resolve_links(target.path())?)?;
         self.refuse_overwrite(target)?;
         let name = match (target, &self.name) {
-            // `DB#NAME` with another `name` setting: which one the user meant is unknown, and
-            // taking either silently wrote a table the other road could not find.
-            (BakeTarget::Db { name, .. }, Some(n)) if n != name => {
-                return Err(Error::arg(
-                    "name",
-                    format!(
-                        "{n:?} conflicts with the output's table name {name:?} (DB#NAME names \
-                         the table itself: drop the name setting or make them agree)"
-                    ),
-                ));
+            (BakeTarget::Db { name, .. }, setting) => {
+                refuse_name_conflict(setting.as_deref(), name)?;
+                name.clone()
             }
-            (BakeTarget::Db { name, .. }, _) => name.clone(),
             (_, Some(n)) => n.clone(),
             (t, None) => stem(t.path()),
         };
@@ -306,6 +298,25 @@ impl Staging {
 impl Drop for Staging {
     fn drop(&mut self) {
         let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+/// A `name` setting beside a `DB#NAME` output must repeat NAME: which one the user meant is
+/// unknown, and taking either silently wrote a table the other road could not find. The rule of
+/// a bake and of [`crate::request::save_table`] (`brdftab import`, Python's `Table.save`).
+///
+/// # Errors
+/// [`Error::InvalidArgument`] naming `name` when `setting` is another name than `db_name`.
+pub(crate) fn refuse_name_conflict(setting: Option<&str>, db_name: &str) -> Result<()> {
+    match setting {
+        Some(n) if n != db_name => Err(Error::arg(
+            "name",
+            format!(
+                "{n:?} conflicts with the output's table name {db_name:?} (DB#NAME names the \
+                 table itself: drop the name setting or make them agree)"
+            ),
+        )),
+        _ => Ok(()),
     }
 }
 

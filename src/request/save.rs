@@ -44,7 +44,7 @@ pub struct SaveSettings {
     #[cfg_attr(feature = "clap", arg(long))]
     pub exhaustive: bool,
     /// Table name inside the file (default: the output file's stem; `DB#NAME` names it
-    /// itself).
+    /// itself, and another name beside it is an error).
     #[cfg_attr(feature = "clap", arg(long))]
     pub name: Option<String>,
     /// Replace an existing table of that name (database outputs).
@@ -80,7 +80,8 @@ impl SaveSettings {
 /// written ([`store::info::file_info`]).
 ///
 /// # Errors
-/// Invalid settings or output ([`Error::InvalidArgument`] naming the field), an existing
+/// Invalid settings or output ([`Error::InvalidArgument`] naming the field; `name` for a name
+/// setting beside a `DB#NAME` output that is not NAME, as in a bake), an existing
 /// table of that name without `replace` ([`Error::Duplicate`]), values the codec cannot encode
 /// ([`Error::Encode`]: f16 beyond ±65504), and whatever writing fails with.
 pub fn save_table(
@@ -96,6 +97,7 @@ pub fn save_table(
             name,
             replace,
         } => {
+            bake::refuse_name_conflict(settings.name.as_deref(), &name)?;
             tables::save(&path, &name, source, table, codec, replace)?;
             (path, name)
         }
@@ -357,6 +359,24 @@ mod tests {
         };
         let info = save_table(&t, d.file("x.btdb"), other("x"), &named).unwrap();
         assert_eq!(info["tables"][0]["name"], "mine");
+        // Beside `DB#NAME`, a name setting may only repeat NAME, as in a bake: `Table.save(
+        // "db#c", name="mine")` wrote table `c` and dropped `mine` without a word.
+        let err = save_table(&t, format!("{db}#c"), other("c"), &named).unwrap_err();
+        match err {
+            Error::InvalidArgument { name, .. } => assert_eq!(name, "name"),
+            e => panic!("{e}"),
+        }
+        assert_eq!(
+            Store::open(&db).unwrap().tables().len(),
+            2,
+            "nothing written"
+        );
+        let same = SaveSettings {
+            name: Some("c".into()),
+            ..lossless()
+        };
+        let info = save_table(&t, format!("{db}#c"), other("c"), &same).unwrap();
+        assert_eq!(info["tables"][0]["name"], "c");
     }
 
     #[test]

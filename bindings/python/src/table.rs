@@ -154,9 +154,10 @@ impl PyTable {
     /// created if absent; an existing name needs `replace=True`). The
     /// keywords are those of `brdftab.bake` that say how a table is stored: `codec` ("f32"
     /// keeps the values bit for bit; default "log16", 1e-3 relative), `codec_tolerance`,
-    /// `floor`, `level`, `exhaustive`, `name` (default: the file's stem) and `replace`. The
-    /// provenance is the table's description. Returns what `brdftab info --json OUTPUT`
-    /// reports.
+    /// `floor`, `level`, `exhaustive`, `name` (a `.btdb` file's table, default the file's
+    /// stem; beside "DB#NAME" it may only repeat NAME, another is a `ValueError`) and
+    /// `replace`. The provenance is the table's description. Returns what `brdftab info --json
+    /// OUTPUT` reports.
     #[pyo3(signature = (output, **options))]
     fn save(
         &self,

@@ -52,6 +52,12 @@ def test_own_values_save_and_open_as_the_original(tmp_path):
     info = same.save(f"{db}#a", replace=True, codec="f32")
     assert info["tables"][0]["name"] == "a"
     np.testing.assert_array_equal(brdftab.open(f"{db}#a").eval(WI, WO), f)
+    # Beside DB#NAME, `name` may only repeat NAME, as in `bake`: save(f"{db}#b", name="c")
+    # wrote table b and dropped c without a word.
+    with pytest.raises(ValueError, match='"c" conflicts with the output\'s table name "b"'):
+        same.save(f"{db}#b", name="c")
+    assert brdftab.Database(db).names() == ["a"]
+    assert same.save(f"{db}#b", name="b")["tables"][0]["name"] == "b"
 
 
 @pytest.mark.parametrize("options", [{"preset": "small"}, {"grid": "adaptive:24x12x7"}])

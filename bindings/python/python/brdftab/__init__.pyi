@@ -195,7 +195,8 @@ class Table:
     ) -> dict[str, Any]:
         """Writes the table to OUTPUT, a .btdb file (replaced atomically) or DB#NAME (an
         existing name needs replace=True), with the storage keywords of `bake` (codec "f32"
-        keeps the values bit for bit; default "log16", 1e-3 relative). Returns
+        keeps the values bit for bit; default "log16", 1e-3 relative; `name` names a .btdb
+        file's table, and with DB#NAME may only repeat NAME). Returns
         `brdftab info --json OUTPUT`."""
     def open(self, interp: str = "auto") -> Brdf:
         """The table as a Brdf, in memory ("auto": nearest on a grid of MERL cells, linear
