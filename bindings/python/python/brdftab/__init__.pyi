@@ -98,7 +98,8 @@ class Brdf:
         lobe's reflectance there over its pdf, the probability of choosing that lobe).
 
         One wo of shape (3,) with u of shape (2,): wi (3,), pdf 0-d, weight (c,) — one pair's
-        shapes, as in `eval`."""
+        shapes, as in `eval`. A wo below the horizon, NaN, infinite or zero draws nothing (wi,
+        pdf and weight 0); a u outside [0, 1) (NaN included) is a ValueError."""
     @overload
     def sample(
         self, wo: _ArrayLike, u: _ArrayLike, *, nm: _ArrayLike | None = None, delta: Literal[True]
