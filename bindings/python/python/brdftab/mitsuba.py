@@ -602,8 +602,8 @@ class JitTable:
             self.wavelengths = [float(x[:-2]) for x in self.channel_names]
         self.Float64 = dr.float64_array_t(mi.Float)
         self.UInt = mi.UInt32
-        # The albedo calibration (table/calibration.rs): per-channel factors k_in(θi) and
-        # k_out(θo) on nodes uniform in t = sqrt(1 - cos θ), channels innermost.
+        # The albedo calibration (src/table/calibration/mod.rs): per-channel factors k_in(θi)
+        # and k_out(θo) on nodes uniform in t = sqrt(1 - cos θ), channels innermost.
         self.calibration = None
         cal = layout.get("calibration")
         if cal is not None:
@@ -793,7 +793,7 @@ class JitTable:
             pd = dr.select(pd < 0, pd + tau, pd)
         return [th, ph, td, pd]
 
-    # -- GridLayout: stored axes (grid.rs, StoredAxis) -----------------------------------------
+    # -- GridLayout: stored axes (table/grid/axis.rs, StoredAxis) -------------------------------
     @staticmethod
     def _cell_coordinate(ax, x, exact):
         import drjit as dr
@@ -965,8 +965,8 @@ class JitTable:
         return self._calibrate(Fl(iz), Fl(oz), out)
 
     def _calibrate(self, iz, oz, out):
-        """Times the calibration's k_in(θi) k_out(θo) (calibration.rs, ``Calibration::apply``):
-        on each, t = sqrt(1 - cos θ) in float32, s = min(t (n - 1)/t_end, n - 1), linear between
+        """Times the calibration's k_in(θi) k_out(θo) (``Calibration::apply`` in
+        src/table/calibration/mod.rs): on each, t = sqrt(1 - cos θ) in float32, s = min(t (n - 1)/t_end, n - 1), linear between
         nodes ⌊s⌋ and the next."""
         import drjit as dr
 
