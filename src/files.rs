@@ -13,6 +13,9 @@
 //! - Outputs are written atomically through a temporary file beside them ([`temp_path`],
 //!   [`write_atomic`]); an output directory that does not exist is reported with the user's
 //!   path, and temporary files that killed writers left behind are removed by the next write.
+//! - The rename that ends an atomic write ([`rename_over`]) is retried for up to 2 s on Windows
+//!   while it is refused: Windows refuses to replace a file that any handle holds open, and
+//!   every reader holds one for as long as its read takes.
 //! - A database reached through a symbolic link is updated where the link points
 //!   ([`resolve_links`]): the rename of an atomic write would otherwise replace the link with a
 //!   file, and the database itself would not get the change.
@@ -200,11 +203,58 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = temp_path(path)?;
     let r = std::fs::write(&tmp, bytes)
         .map_err(|e| Error::io(path, e))
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
+        .and_then(|()| rename_over(&tmp, path).map_err(|e| Error::io(path, e)));
     if r.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
     r
+}
+
+/// Renames the finished temporary file `tmp` over `path`, the last step of every atomic write.
+/// On Windows `std::fs::rename` (`MoveFileExW`, then a POSIX-semantics rename that NTFS on
+/// Windows 10 1607+ alone accepts) is refused while any handle holds `path` open — a reader of
+/// the same database reading it into memory, an antivirus scan — so a refusal is retried for up
+/// to [`RENAME_PATIENCE`] before it is the error (session 44: under Wine 8 every writer of
+/// `tests/concurrency.rs` failed so while a reader kept opening the database). On Unix a rename
+/// replaces an open file, and is done once.
+pub(crate) fn rename_over(tmp: &Path, path: &Path) -> std::io::Result<()> {
+    #[cfg(windows)]
+    return retry_while_refused(RENAME_PATIENCE, || std::fs::rename(tmp, path));
+    #[cfg(not(windows))]
+    std::fs::rename(tmp, path)
+}
+
+/// How long [`rename_over`] retries a refused rename on Windows: readers hold a database's
+/// handle for the time of one read (milliseconds for a database of a few MB); Go's `cmd/go`
+/// (`robustio`) gives the same errors 2 s as well.
+#[cfg_attr(not(windows), allow(dead_code))]
+pub(crate) const RENAME_PATIENCE: std::time::Duration = std::time::Duration::from_secs(2);
+
+/// Runs `op` until it succeeds, fails otherwise than refused (`PermissionDenied`: Windows'
+/// `ERROR_ACCESS_DENIED`; or `ERROR_SHARING_VIOLATION`), or `patience` has passed since its
+/// first try (then with its last error), sleeping 1, 2, 4, ... ms (at most 50 ms) between
+/// tries.
+#[cfg_attr(not(windows), allow(dead_code))] // used on Windows; tested everywhere
+fn retry_while_refused(
+    patience: std::time::Duration,
+    mut op: impl FnMut() -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    const ERROR_SHARING_VIOLATION: i32 = 32;
+    let start = std::time::Instant::now();
+    let mut wait = std::time::Duration::from_millis(1);
+    loop {
+        match op() {
+            Err(e)
+                if (e.kind() == std::io::ErrorKind::PermissionDenied
+                    || (cfg!(windows) && e.raw_os_error() == Some(ERROR_SHARING_VIOLATION)))
+                    && start.elapsed() < patience =>
+            {
+                std::thread::sleep(wait);
+                wait = (wait * 2).min(std::time::Duration::from_millis(50));
+            }
+            r => return r,
+        }
+    }
 }
 
 /// The file a change of `path` must replace: `path`, or where it is a symbolic link the file
@@ -297,6 +347,43 @@ fn parent(p: &Path) -> PathBuf {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_refused_rename_is_retried_until_it_succeeds_or_the_patience_runs_out() {
+        use std::io::{Error, ErrorKind};
+        use std::time::{Duration, Instant};
+        let mut tries = 0;
+        let r = super::retry_while_refused(Duration::from_secs(2), || {
+            tries += 1;
+            match tries {
+                1..=3 => Err(Error::from(ErrorKind::PermissionDenied)),
+                _ => Ok(()),
+            }
+        });
+        assert_eq!((r.is_ok(), tries), (true, 4));
+        // Refused for ever: the last refusal, once the patience has passed (and not long after:
+        // the last sleep is at most 50 ms).
+        let (start, patience) = (Instant::now(), Duration::from_millis(100));
+        tries = 0;
+        let r = super::retry_while_refused(patience, || {
+            tries += 1;
+            Err(Error::from(ErrorKind::PermissionDenied))
+        });
+        let took = start.elapsed();
+        assert_eq!(r.unwrap_err().kind(), ErrorKind::PermissionDenied);
+        assert!(
+            took >= patience && took < Duration::from_secs(2),
+            "{took:?}"
+        );
+        assert!(tries > 1);
+        // Any other error is returned at once.
+        tries = 0;
+        let r = super::retry_while_refused(Duration::from_secs(2), || {
+            tries += 1;
+            Err(Error::from(ErrorKind::NotFound))
+        });
+        assert_eq!((r.unwrap_err().kind(), tries), (ErrorKind::NotFound, 1));
+    }
+
     use super::*;
 
     #[test]

@@ -230,6 +230,144 @@ fn database_add_replace_remove_list_verify() {
     assert!(stray.is_empty(), "{stray:?}");
 }
 
+/// A database that readers hold open — stores, a table of each not yet read, a lazily decoded
+/// `TabulatedBrdf` (Python's `brdftab.open("x.btdb#b")` kept alive) — is still written by every
+/// change through another handle, each writer renaming a new file over it: every reader keeps
+/// reading the version it opened, chunks it had not touched included, and an open after the
+/// changes sees the new version. On Windows a store holds nothing of the file
+/// (`Store::open` reads it into memory there): a memory map kept the writers from replacing
+/// the file, each failing with "Access denied" (session 43, under Wine).
+#[test]
+fn a_database_held_open_by_readers_is_still_written_and_each_reader_keeps_its_version() {
+    use brdftab::Brdf;
+    use brdftab::store::tables;
+    use brdftab::table::{Grid, Mapping, Param, Symmetry, Table, TabulatedBrdf};
+    use glam::DVec3;
+    let d = TempDir::new("store-held-open");
+    let p = d.join("lib.btdb");
+    let grid = Grid::with_sizes(
+        Param::HalfDiff,
+        [8, 1, 8, 16],
+        [Mapping::Sqrt, Mapping::Uniform],
+        Channels::Rgb,
+        Symmetry {
+            isotropic: true,
+            reciprocal: true,
+            bilateral: true,
+        },
+    )
+    .unwrap();
+    let table = |k: f64| {
+        Table::from_fn(grid.clone(), "held", move |_, a, out| {
+            for (c, o) in out.iter_mut().enumerate() {
+                *o = (k + a[0].cos() + 0.5 * a[2].sin()) as f32 * (1.0 + c as f32);
+            }
+        })
+    };
+    let codec = Codec {
+        quant: Quant::F32, // lossless: a stored table evaluates as the table itself
+        level: 1,
+        ..Codec::default()
+    };
+    let save = |name: &str, k: f64| {
+        let source = Source::Other {
+            description: "held".into(),
+        };
+        tables::save(&p, name, source, &table(k), codec, true).unwrap()
+    };
+    save("a", 1.0);
+    save("b", 2.0);
+    save("c", 3.0);
+    let source = format!("{}#b", p.display());
+    let (wi, wo) = (DVec3::new(0.3, 0.1, 0.9), DVec3::new(-0.2, 0.4, 0.8));
+    let eval = |f: &dyn Brdf| {
+        let mut v = [0f32; 3];
+        f.eval(wi, wo, &mut v);
+        v
+    };
+    let names = |s: &Store| {
+        s.tables()
+            .iter()
+            .map(|e| e.name.clone())
+            .collect::<Vec<_>>()
+    };
+    let old_b = eval(&TabulatedBrdf::from_table(table(2.0)));
+    let old_values = Store::open(&p).unwrap().table("b").unwrap().read_all();
+    let old_values = old_values.unwrap();
+
+    // The readers, none of which has read a chunk yet. A map is kept only where it does not
+    // keep the file from being replaced.
+    let held_brdf = tables::open_brdf(&source, false).unwrap();
+    assert_eq!(held_brdf.loaded_chunks(), 0);
+    let opts = StoreOptions::default();
+    #[allow(unused_mut)]
+    let mut stores = vec![
+        ("open", Store::open(&p).unwrap()),
+        ("in memory", Store::open_in_memory(&p, opts).unwrap()),
+    ];
+    #[cfg(not(windows))]
+    stores.push(("mapped", Store::open_mapped(&p, opts).unwrap()));
+    let held: Vec<_> = stores.iter().map(|(_, s)| s.table("b").unwrap()).collect();
+
+    // Another handle replaces, adds, removes and renames.
+    save("b", 20.0);
+    save("d", 4.0);
+    db::remove(&p, "a").unwrap();
+    db::rename(&p, "c", "c2").unwrap();
+
+    // Every reader reads the version it opened.
+    assert_eq!(eval(&held_brdf), old_b);
+    for ((how, s), t) in stores.iter().zip(&held) {
+        assert_eq!(names(s), ["a", "b", "c"], "{how}");
+        assert_eq!(t.read_all().unwrap(), old_values, "{how}");
+        assert_eq!(s.verify().unwrap(), 3 * 8, "{how}");
+    }
+    // A new open sees the new version.
+    let now = Store::open(&p).unwrap();
+    assert_eq!(names(&now), ["b", "c2", "d"]);
+    let new_b = eval(&tables::open_brdf(&source, false).unwrap());
+    assert_eq!(new_b, eval(&TabulatedBrdf::from_table(table(20.0))));
+    assert_ne!(new_b, old_b);
+    assert_eq!(
+        now.table("c2").unwrap().read_all().unwrap(),
+        stores[0].1.table("c").unwrap().read_all().unwrap()
+    );
+}
+
+/// `Store::open_in_memory` keeps nothing of the file open once it returns (what lets writers
+/// replace a database on Windows, where `Store::open` is it); a map keeps the file mapped.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_store_read_into_memory_holds_no_descriptor_or_map_of_its_file() {
+    let d = TempDir::new("store-in-memory");
+    let p = d.join("held.btdb");
+    add(&p, "a", Quant::F16, 0.0);
+    let real = std::fs::canonicalize(&p).unwrap();
+    let fds = || {
+        std::fs::read_dir("/proc/self/fd")
+            .unwrap()
+            .filter_map(|e| std::fs::read_link(e.ok()?.path()).ok())
+            .filter(|l| *l == real)
+            .count()
+    };
+    let maps = || {
+        let maps = std::fs::read_to_string("/proc/self/maps").unwrap();
+        maps.lines()
+            .filter(|l| l.ends_with(real.to_str().unwrap()))
+            .count()
+    };
+    let s = Store::open_in_memory(&p, StoreOptions::default()).unwrap();
+    let t = s.table("a").unwrap();
+    assert_eq!((fds(), maps()), (0, 0));
+    let m = Store::open_mapped(&p, StoreOptions::default()).unwrap();
+    assert_eq!(maps(), 1, "the check sees a map where there is one");
+    assert_eq!(
+        t.read_all().unwrap(),
+        m.table("a").unwrap().read_all().unwrap()
+    );
+    assert_eq!(s.file_len(), m.file_len());
+}
+
 #[test]
 fn cache_respects_its_memory_bound_and_eager_decodes_everything() {
     let d = TempDir::new("store-cache");

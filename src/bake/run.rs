@@ -289,7 +289,7 @@ impl Staging {
             }
             t => {
                 let out = crate::files::resolve_links(t.path())?;
-                std::fs::rename(&self.0, &out).map_err(|e| Error::io(&out, e))
+                crate::files::rename_over(&self.0, &out).map_err(|e| Error::io(&out, e))
             }
         }
     }

@@ -205,8 +205,9 @@ pub fn put(
         }
     }
     emit(&mut w, &mut new)?;
-    // The old file closed (unmapped) before the new one is renamed over it: Windows refuses
-    // to replace a file this process holds mapped ("Access denied").
+    // The old store dropped before the new file is renamed over it: one that mapped the file
+    // (`Store::open_mapped`; `Store::open` reads it into memory on Windows) would keep Windows
+    // from replacing it ("Access denied").
     drop(old);
     w.finish()
 }

@@ -27,7 +27,7 @@ pub fn npy(table: &StoredTable, out: impl AsRef<Path>, offset: NodeOffset<'_>) -
     crate::files::refuse_input(path, &[table.file()])?;
     let tmp = crate::files::temp_path(path)?;
     let r = npy_to(table, &tmp, path, offset)
-        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
+        .and_then(|()| crate::files::rename_over(&tmp, path).map_err(|e| Error::io(path, e)));
     if r.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }

@@ -5,8 +5,8 @@
 //! chunks (slabs of its outermost axis, λ innermost), so a lookup decodes only the chunks it
 //! touches and whole-table reads decode in parallel.
 //!
-//! - [`Store::open`] maps the file and checks its superblock and table of contents; nothing else
-//!   is read. [`Store::table`] reads and checks one table's header and chunk index.
+//! - [`Store::open`] maps the file (on Windows: reads it into memory, [`Store::open_in_memory`])
+//!   and checks its superblock and table of contents; nothing else is decoded. [`Store::table`] reads and checks one table's header and chunk index.
 //! - [`StoredTable::chunk`] decodes a chunk on first touch into a thread-safe cache bounded in
 //!   memory ([`StoreOptions::cache_bytes`]), or every chunk up front with [`StoreOptions::eager`].
 //! - [`Writer`] streams chunks into a new file and replaces the destination atomically;
@@ -45,7 +45,9 @@
 //! ```
 //!
 //! Files are never modified in place — every write produces a new file and renames it — so a
-//! reader that has a file open keeps seeing the version it opened (it maps the old inode).
+//! reader that has a file open keeps seeing the version it opened (on Unix it maps the old
+//! inode; on Windows, which refuses to replace a mapped file, it holds a copy in memory and
+//! nothing of the file: a database any reader holds open can still be written).
 
 pub mod db;
 pub mod export;
@@ -136,9 +138,62 @@ impl Store {
         Self::open_with(path, StoreOptions::default())
     }
 
-    /// Opens a file: maps it and checks the superblock and table of contents.
+    /// Opens a file and checks the superblock and table of contents. On Unix the file is
+    /// mapped ([`Store::open_mapped`]); on Windows it is read into memory
+    /// ([`Store::open_in_memory`]), so that no handle or mapping of it stays open: Windows
+    /// refuses to replace a mapped file, and a database held open by any reader could otherwise
+    /// not be added to, replaced in or removed from (the writers rename a new file over it).
     pub fn open_with(path: impl AsRef<Path>, opts: StoreOptions) -> Result<Store> {
-        let path = path.as_ref().to_path_buf();
+        #[cfg(windows)]
+        return Self::open_in_memory(path, opts);
+        #[cfg(not(windows))]
+        Self::open_mapped(path, opts)
+    }
+
+    /// Opens a file through a read-only memory map (what [`Store::open_with`] does on Unix):
+    /// pages are read as lookups touch them, and a reader keeps the version it opened when a
+    /// writer renames a new file over it. On Windows the map keeps the file from being replaced
+    /// or removed until the store and every table opened from it are dropped.
+    pub fn open_mapped(path: impl AsRef<Path>, opts: StoreOptions) -> Result<Store> {
+        let (path, name, f, _) = Self::open_file(path.as_ref())?;
+        // SAFETY: brdftab never modifies a file in place (writers rename a new file over it), so
+        // the mapped bytes do not change under us. A foreign process truncating the file could
+        // still fault; that is the usual caveat of memory maps.
+        let map = unsafe { memmap2::Mmap::map(&f) }.map_err(|e| Error::io(&path, e))?;
+        Self::from_backing(path, name, Backing::Map(map), opts)
+    }
+
+    /// Opens a file by reading all of it into memory and closing it (what [`Store::open_with`]
+    /// does on Windows): the store holds no handle or mapping of the file, so writers may
+    /// replace or remove it at once, the store keeping the version it read. A database of N
+    /// bytes costs N bytes of memory per open store; tables' chunks are still decoded on first
+    /// touch (or up front with [`StoreOptions::eager`]).
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming `path` when it cannot be read or its size does not fit in memory;
+    /// the errors of [`Store::open_with`].
+    pub fn open_in_memory(path: impl AsRef<Path>, opts: StoreOptions) -> Result<Store> {
+        let (path, name, f, len) = Self::open_file(path.as_ref())?;
+        let mut bytes = Vec::new();
+        let reserved = usize::try_from(len)
+            .ok()
+            .and_then(|n| bytes.try_reserve_exact(n).ok());
+        if reserved.is_none() {
+            let e = std::io::Error::new(
+                std::io::ErrorKind::OutOfMemory,
+                format!("its {len} bytes do not fit in memory"),
+            );
+            return Err(Error::io(&path, e));
+        }
+        std::io::Read::read_to_end(&mut &f, &mut bytes).map_err(|e| Error::io(&path, e))?;
+        drop(f); // closed before the store exists: nothing of the file stays open
+        Self::from_backing(path, name, Backing::Bytes(Box::new(bytes)), opts)
+    }
+
+    /// The open file (a regular file, at least a superblock long), its path, its name for
+    /// messages and its length.
+    fn open_file(path: &Path) -> Result<(PathBuf, String, std::fs::File, u64)> {
+        let path = path.to_path_buf();
         let name = path.display().to_string();
         crate::files::require_regular(&path)?; // before the open: a FIFO would block it
         let f = std::fs::File::open(&path).map_err(|e| Error::io(&path, e))?;
@@ -151,11 +206,7 @@ impl Store {
                 Ok(_) => Error::format(&name, Some("superblock"), None, "truncated"),
             });
         }
-        // SAFETY: brdftab never modifies a file in place (writers rename a new file over it), so
-        // the mapped bytes do not change under us. A foreign process truncating the file could
-        // still fault; that is the usual caveat of memory maps.
-        let map = unsafe { memmap2::Mmap::map(&f) }.map_err(|e| Error::io(&path, e))?;
-        Self::from_backing(path, name, Backing::Map(map), opts)
+        Ok((path, name, f, len))
     }
 
     /// Opens a file held in memory (`name` is used in error messages): a `Vec<u8>`, or a buffer

@@ -254,7 +254,7 @@ impl Writer {
         f.write_all(&sb.to_bytes()).map_err(io)?;
         f.sync_all().map_err(io)?;
         drop(f);
-        std::fs::rename(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))?;
+        crate::files::rename_over(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))?;
         sync_dir(&parent(&self.path))?;
         self.tmp = PathBuf::new(); // nothing to clean up
         Ok(())

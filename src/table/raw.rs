@@ -98,7 +98,7 @@ impl RawWriter {
             ));
         }
         self.w.flush().map_err(|e| Error::io(&self.path, e))?;
-        std::fs::rename(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))
+        crate::files::rename_over(&self.tmp, &self.path).map_err(|e| Error::io(&self.path, e))
     }
 }
 
