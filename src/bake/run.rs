@@ -321,12 +321,13 @@ pub(crate) fn refuse_name_conflict(setting: Option<&str>, db_name: &str) -> Resu
 }
 
 /// A file name's stem, the default name of a table (`table` when it has none). `path` is a
-/// path, not a `DB#NAME` (a SOURCE's file is [`crate::store::name::path_of`]); a `#` in the stem
-/// (a file named `scan#2.bsdf`), which a table name cannot hold, becomes `_`.
+/// path, not a `DB#NAME` (a SOURCE's file is [`crate::store::name::path_of`]); a `#` or `\` in
+/// the stem (a file named `scan#2.bsdf`, or `a\b.bsdf` on Unix), which a table name cannot
+/// hold, becomes `_`.
 pub fn stem(path: impl AsRef<Path>) -> String {
     path.as_ref()
         .file_stem()
-        .map(|s| s.to_string_lossy().replace('#', "_"))
+        .map(|s| s.to_string_lossy().replace(['#', '\\'], "_"))
         .unwrap_or_else(|| "table".into())
 }
 
@@ -538,6 +539,16 @@ mod tests {
             "paper_white_rgb"
         );
         assert_eq!(source_stem("lib.btdb#gold"), "gold");
+    }
+
+    /// A file's stem with a character no table name holds (`#`; `\`, a file name's character
+    /// on Unix) names its table with `_` there, a name every platform opens.
+    #[test]
+    fn a_stem_holds_no_character_a_table_name_refuses() {
+        assert_eq!(stem("scans/x#2.bsdf"), "x_2");
+        #[cfg(unix)]
+        assert_eq!(stem(r"scans/a\b.bsdf"), "a_b");
+        crate::store::name::check("name", &stem(r"a\b#c.bsdf")).unwrap();
     }
 
     #[test]

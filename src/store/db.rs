@@ -128,7 +128,7 @@ pub fn refuse_dropping_tables(path: impl AsRef<Path>) -> Result<()> {
 /// Copies table `e` of `from` into `w` without decoding (checksums are checked on the way).
 fn copy_table(from: &Store, e: &TocEntry, w: &mut Writer) -> Result<()> {
     let t = from.table(&e.name)?;
-    w.begin_table(t.header().clone())?;
+    w.begin_kept_table(t.header().clone())?;
     copy_chunks(&t, w)?;
     w.end_table()
 }
@@ -316,4 +316,78 @@ pub fn split_source<S: AsRef<std::ffi::OsStr> + ?Sized>(
     source: &S,
 ) -> Result<(&Path, Option<&str>)> {
     super::name::parse_input_os("source", source.as_ref())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Channels;
+    use crate::codec::{Codec, Quant};
+    use crate::store::Source;
+
+    fn header(name: &str) -> TableHeader {
+        let source = Source::Other {
+            description: "names".into(),
+        };
+        let codec = Codec {
+            quant: Quant::F32,
+            ..Codec::default()
+        };
+        TableHeader::new(name, source, vec![1, 2, 2, 3], Channels::Rgb, codec)
+    }
+
+    fn put_table(path: &Path, name: &str, v: f32) -> Result<()> {
+        put(path, header(name), false, |w| w.chunk(&[v; 12]))
+    }
+
+    fn names(path: &Path) -> Vec<String> {
+        let s = Store::open(path).unwrap();
+        s.tables().iter().map(|e| e.name.clone()).collect()
+    }
+
+    fn refused(r: Result<()>) {
+        match r {
+            Err(Error::InvalidArgument { name, msg }) => {
+                assert_eq!(name, "name");
+                assert!(msg.contains(r"contains `\`"), "{msg}");
+            }
+            r => panic!("{r:?}"),
+        }
+    }
+
+    /// A table name with `\` is refused wherever a table is made or renamed — a database
+    /// written on Linux opens on Windows by every name — while a table an earlier version
+    /// stored so is kept through every rewrite of its database and can be renamed.
+    #[test]
+    fn a_backslash_is_refused_in_new_names_and_kept_in_stored_ones() {
+        let d = crate::testkit::TempDir::new("db-backslash");
+        let p = d.path().join("lib.btdb");
+        refused(put_table(&p, r"a\b", 1.0));
+        assert!(!p.exists(), "refused before the database is written");
+        put_table(&p, "ok", 1.0).unwrap();
+        let bytes = std::fs::read(&p).unwrap();
+        refused(rename(&p, "ok", r"o\k"));
+        let from = Store::open(&p).unwrap();
+        refused(import(&p, &from, "ok", r"c\d", false));
+        assert_eq!(std::fs::read(&p).unwrap(), bytes, "the database untouched");
+
+        // Written as an earlier version wrote it: kept by every rewrite, read by name.
+        let mut w = Writer::create(&p).unwrap();
+        w.begin_kept_table(header(r"a\b")).unwrap();
+        w.chunk(&[2.0; 12]).unwrap();
+        w.end_table().unwrap();
+        w.finish().unwrap();
+        put_table(&p, "c", 3.0).unwrap();
+        remove(&p, "c").unwrap();
+        assert_eq!(names(&p), [r"a\b"]);
+        let s = Store::open(&p).unwrap();
+        assert_eq!(s.table(r"a\b").unwrap().read_all().unwrap(), [2.0; 12]);
+        #[cfg(not(windows))]
+        {
+            let source = format!("{}#a\\b", p.display());
+            assert_eq!(split_source(&source).unwrap(), (p.as_path(), Some(r"a\b")));
+        }
+        rename(&p, r"a\b", "a_b").unwrap();
+        assert_eq!(names(&p), ["a_b"]);
+    }
 }

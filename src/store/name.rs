@@ -9,8 +9,17 @@
 //! A table name holds a character other than white space (an empty or blank name is invisible
 //! in `db list`), and no `#` (it ends the path of `DB#NAME`), no `/` (a
 //! `DB#NAME` whose name part has a `/` is read as a path with a `#` in a directory, so such a
-//! table could be written but never opened by name) and no control character (NUL, tab,
-//! newline, ...: invisible or cut short in listings, C strings and terminals).
+//! table could be written but never opened by name), no `\` (the same on Windows, where it
+//! separates directories: a database written on Linux must open on Windows by every name) and
+//! no control character (NUL, tab, newline, ...: invisible or cut short in listings, C strings
+//! and terminals).
+//!
+//! Names are checked where they are made — [`check`]: a put, a rename, an import's new name, a
+//! bake's or a save's name, an output's `DB#NAME`. A table an earlier version stored under a
+//! name with `\` is kept as it is: copied when its database is rewritten, removed or renamed
+//! by name, and found by a `DB#NAME` that is read ([`parse_input`]) on Unix; on Windows, where
+//! such a `DB#NAME` is a path, through the calls that take the name apart (`Store::table`,
+//! `brdftab db rename DB OLD NEW`, which gives it a name of the rule).
 //!
 //! # A `#` in a file's own name
 //!
@@ -32,6 +41,15 @@ use crate::error::{Error, Result};
 /// Checks a table name against the rule above; the error names `field` (`name`, or the
 /// `source`/`output` the name was read from).
 pub fn check(field: &str, name: &str) -> Result<()> {
+    match name.contains('\\') {
+        true => Err(refused(field, name, "contains `\\`")),
+        false => check_stored(field, name),
+    }
+}
+
+/// The rule of a name that a database holds already: [`check`]'s but for `\`, which earlier
+/// versions allowed (such a table is read, copied and renamed, never made anew).
+pub(crate) fn check_stored(field: &str, name: &str) -> Result<()> {
     let bad = if name.is_empty() {
         Some("is empty")
     } else if name.chars().all(char::is_whitespace) {
@@ -47,14 +65,18 @@ pub fn check(field: &str, name: &str) -> Result<()> {
     };
     match bad {
         None => Ok(()),
-        Some(why) => Err(Error::arg(
-            field,
-            format!(
-                "table name {name:?} {why}: a table name has a character other than white \
-                 space, and no `#`, `/` or control characters"
-            ),
-        )),
+        Some(why) => Err(refused(field, name, why)),
     }
+}
+
+fn refused(field: &str, name: &str, why: &str) -> Error {
+    Error::arg(
+        field,
+        format!(
+            "table name {name:?} {why}: a table name has a character other than white space, \
+             and no `#`, `/`, `\\` or control characters"
+        ),
+    )
 }
 
 /// Splits a SOURCE or output string `DB#NAME` into the path and the table name (`None` for a
@@ -64,10 +86,22 @@ pub fn check(field: &str, name: &str) -> Result<()> {
 /// directory name. An empty name (`x.btdb#`) or one that breaks [`check`] is an
 /// [`Error::InvalidArgument`] naming `field`.
 pub fn parse_source<'a>(field: &str, source: &'a str) -> Result<(&'a str, Option<&'a str>)> {
+    split(field, source, Rule::New)
+}
+
+/// Which names a `DB#NAME` split takes: an output's must be one a table may be made with
+/// ([`check`]); a SOURCE that is read may name a table stored before `\` was refused.
+#[derive(Clone, Copy)]
+enum Rule {
+    New,
+    Stored,
+}
+
+fn split<'a>(field: &str, source: &'a str, rule: Rule) -> Result<(&'a str, Option<&'a str>)> {
     match source.rsplit_once('#') {
         Some((_, n)) if n.contains(std::path::is_separator) => Ok((source, None)),
         Some((p, n)) => {
-            check_split(field, &format!("{source:?}"), n)?;
+            check_split(field, &format!("{source:?}"), n, rule)?;
             Ok((p, Some(n)))
         }
         None => Ok((source, None)),
@@ -75,14 +109,17 @@ pub fn parse_source<'a>(field: &str, source: &'a str) -> Result<(&'a str, Option
 }
 
 /// The name of a `DB#NAME` split, `shown` being the whole string as errors quote it.
-fn check_split(field: &str, shown: &str, name: &str) -> Result<()> {
+fn check_split(field: &str, shown: &str, name: &str, rule: Rule) -> Result<()> {
     if name.is_empty() {
         return Err(Error::arg(
             field,
             format!("{shown}: no table name after `#` (DB#NAME)"),
         ));
     }
-    check(field, name)
+    match rule {
+        Rule::New => check(field, name),
+        Rule::Stored => check_stored(field, name),
+    }
 }
 
 /// Whether SOURCE is inline JSON rather than a path: its first character after white space is
@@ -121,7 +158,8 @@ pub fn parse_output_os<'a>(field: &str, output: &'a OsStr) -> Result<(&'a Path, 
 /// The `DB#NAME` split of a string that is not UTF-8, on its bytes: the whole string when it
 /// has no `#`, when the part after the last `#` holds a separator (`/`; `\` too on Windows),
 /// or (`read`) when something exists on disk under the whole string; else the path before the
-/// `#` as the bytes it is and the name after it, which must be UTF-8 and pass [`check`].
+/// `#` as the bytes it is and the name after it, which must be UTF-8 and pass [`check`] (when
+/// `read`, the stored names' rule: a `\` taken, as [`parse_input`] takes it).
 fn split_os<'a>(field: &str, source: &'a OsStr, read: bool) -> Result<(&'a Path, Option<&'a str>)> {
     let whole = Ok((Path::new(source), None));
     let bytes = source.as_encoded_bytes();
@@ -140,7 +178,8 @@ fn split_os<'a>(field: &str, source: &'a OsStr, read: bool) -> Result<(&'a Path,
             format!("{shown}: the table name after `#` is not UTF-8 (DB#NAME)"),
         )
     })?;
-    check_split(field, &shown, name)?;
+    let rule = if read { Rule::Stored } else { Rule::New };
+    check_split(field, &shown, name, rule)?;
     // SAFETY: `bytes` came from `as_encoded_bytes` and is cut immediately before an ASCII `#`,
     // a valid UTF-8 substring, as `from_encoded_bytes_unchecked` requires.
     let path = unsafe { OsStr::from_encoded_bytes_unchecked(&bytes[..i]) };
@@ -149,12 +188,13 @@ fn split_os<'a>(field: &str, source: &'a OsStr, read: bool) -> Result<(&'a Path,
 
 /// Splits a SOURCE that is read: the whole string when something exists on disk under it (a
 /// file named `a#b.btdb`: see the module docs), else [`parse_source`]'s split, whose errors name
-/// `field`.
+/// `field` — but for a name with `\`, which it takes (on Unix: on Windows a `\` after the `#`
+/// makes the string a path): a table an earlier version stored so is read by its name.
 pub fn parse_input<'a>(field: &str, source: &'a str) -> Result<(&'a str, Option<&'a str>)> {
     if source.contains('#') && std::fs::metadata(Path::new(source)).is_ok() {
         return Ok((source, None));
     }
-    parse_source(field, source)
+    split(field, source, Rule::Stored)
 }
 
 /// The path part of a SOURCE string, for callers that only look (which file a string reads, a
@@ -323,6 +363,38 @@ mod tests {
             .collect();
         let db = std::ffi::OsString::from_wide(&w);
         assert_eq!(parse_output_os("output", &db).unwrap().1, Some("t"));
+    }
+
+    /// `\` is refused in a name made anew, on every platform (on Windows `DB#a\b` is a path,
+    /// so a table `a\b` written on Linux could not be opened there by name); a SOURCE that is
+    /// read still names a table an earlier version stored so.
+    #[test]
+    fn a_backslash_is_refused_in_new_names_and_read_in_stored_ones() {
+        for name in [r"a\b", r"\", r"gold\"] {
+            let e = check("name", name).unwrap_err();
+            assert!(e.to_string().contains(r"contains `\`"), "{name:?}: {e}");
+            assert_eq!(field_of(e), "name", "{name:?}");
+            check_stored("name", name).unwrap();
+        }
+        for bad in ["", " ", "a#b", "a/b", "a\tb"] {
+            assert!(check_stored("name", bad).is_err(), "{bad:?}");
+        }
+        #[cfg(not(windows))]
+        {
+            let e = parse_source("output", r"x.btdb#a\b").unwrap_err();
+            assert_eq!(field_of(e), "output");
+            assert_eq!(
+                parse_input("source", r"x.btdb#a\b").unwrap(),
+                ("x.btdb", Some(r"a\b"))
+            );
+        }
+        #[cfg(windows)]
+        for s in [
+            parse_source("output", r"x.btdb#a\b"),
+            parse_input("source", r"x.btdb#a\b"),
+        ] {
+            assert_eq!(s.unwrap(), (r"x.btdb#a\b", None));
+        }
     }
 
     fn e_msg(s: &str) -> String {

@@ -82,12 +82,24 @@ impl Writer {
     }
 
     /// Starts a table. Its chunks follow with [`Writer::chunk`] (or [`Writer::encoded_chunk`]),
-    /// then [`Writer::end_table`].
+    /// then [`Writer::end_table`]. Its name must keep the table-name rule
+    /// ([`super::name::check`]).
     pub fn begin_table(&mut self, header: TableHeader) -> Result<()> {
+        super::name::check("name", &header.name)?;
+        self.begin(header)
+    }
+
+    /// [`Writer::begin_table`] of a table copied from a database, whose name an earlier
+    /// version may have stored with a `\` (kept, as [`super::name`] says).
+    pub(crate) fn begin_kept_table(&mut self, header: TableHeader) -> Result<()> {
+        super::name::check_stored("name", &header.name)?;
+        self.begin(header)
+    }
+
+    fn begin(&mut self, header: TableHeader) -> Result<()> {
         if self.table.is_some() {
             return Err(Error::arg("table", "the previous table was not ended"));
         }
-        super::name::check("name", &header.name)?;
         if self.names().any(|n| n == header.name) {
             return Err(Error::Duplicate {
                 container: self.path.display().to_string(),

@@ -25,7 +25,8 @@ pub(crate) fn db_names(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Vec<
 }
 
 /// Checks a table name against the library's rule (the one the CLI and the C ABI apply):
-/// `ValueError` naming `name` for an empty name or one with `#`, `/` or a control character.
+/// `ValueError` naming `name` for an empty name or one with `#`, `/`, `\` or a control
+/// character.
 #[pyfunction]
 pub(crate) fn _check_table_name(name: &str) -> PyResult<()> {
     guard(|| brdftab::store::name::check("name", name).map_err(lib_err))

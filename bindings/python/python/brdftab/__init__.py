@@ -170,6 +170,6 @@ def _path_arg(path, what):
 def _check_name(name):
     if not isinstance(name, str):
         raise TypeError(f"name: expected a string, got {type(name).__name__}")
-    # The library's rule (non-empty; no '#', '/' or control characters): ValueError naming
-    # `name`, in the words the CLI and the C ABI use.
+    # The library's rule (non-empty; no '#', '/', '\\' or control characters): ValueError
+    # naming `name`, in the words the CLI and the C ABI use.
     _native._check_table_name(name)
