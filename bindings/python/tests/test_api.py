@@ -486,7 +486,7 @@ def test_table_names_follow_the_librarys_rule(tmp_path):
     stored as given (a table named "\\0", a file named `n.btdb#`); the library's one rule
     refuses them, naming the field."""
     db = brdftab.Database(tmp_path / "n.btdb")
-    for name in ["", "\0", "a\tb", "red\x1b[0m", "a/b", "a#b"]:
+    for name in ["", "\0", "a\tb", "red\x1b[0m", "a/b", "a#b", "a\\b"]:
         with pytest.raises(ValueError, match="name"):
             db.add(LAMBERT, name, preset="small")
         with pytest.raises(ValueError, match="name"):
