@@ -6,7 +6,8 @@
 //! touches and whole-table reads decode in parallel.
 //!
 //! - [`Store::open`] maps the file (on Windows: reads it into memory, [`Store::open_in_memory`])
-//!   and checks its superblock and table of contents; nothing else is decoded. [`Store::table`] reads and checks one table's header and chunk index.
+//!   and checks its superblock and table of contents; nothing else is decoded. [`Store::table`]
+//!   reads and checks one table's header and chunk index.
 //! - [`StoredTable::chunk`] decodes a chunk on first touch into a thread-safe cache bounded in
 //!   memory ([`StoreOptions::cache_bytes`]), or every chunk up front with [`StoreOptions::eager`].
 //! - [`Writer`] streams chunks into a new file and replaces the destination atomically;
