@@ -547,6 +547,31 @@ def test_convert_writes_bsdf_like_the_cli(tmp_path, cli):
     assert brdftab.open(a).channels == ["R", "G", "B"]
 
 
+def test_interp_is_the_one_lookups_use(tmp_path, paper):
+    """`Brdf.interp` says how lookups interpolate, not what was asked: a MERL file reads its
+    cells (nearest) unless linear is asked, an RGL file its format's linear warps, a table
+    opened at given wavelengths keeps its grid's choice."""
+    merl = str(tmp_path / "ggx.binary")
+    brdftab.convert(GGX, merl)
+    assert brdftab.open(merl).interp == "nearest"
+    assert brdftab.open(merl, interp="nearest").interp == "nearest"
+    linear = brdftab.open(merl, interp="linear")
+    assert linear.interp == "linear"
+    # the linear lookup differs from the cell's value between cell centres
+    wi, wo = upper(256), upper(256, 1)
+    assert not np.array_equal(linear.eval(wi, wo), brdftab.open(merl).eval(wi, wo))
+    for asked in ("auto", "nearest", "linear"):
+        assert brdftab.open(paper, interp=asked).interp == "linear"
+    assert brdftab.open(LAMBERT, interp="nearest").interp == "nearest"  # nothing to interpolate
+    spectral = f"{tmp_path}/s.btdb#spectral"
+    brdftab.bake(LAMBERT, spectral, preset="small", wavelengths=[450, 550, 650])
+    t = brdftab.open(spectral, wavelengths=[450, 550, 650])
+    assert t.interp == brdftab.open(spectral).interp == "linear"
+    assert brdftab.open(spectral, wavelengths=[450, 550, 650], interp="nearest").interp == "nearest"
+    with pytest.raises(brdftab.Error, match="channels"):
+        brdftab.open(spectral, wavelengths=[500, 600])
+
+
 def test_fit_is_cli_json(cli):
     src = '{"model": "lambert", "kd": 0.3}'
     got = brdftab.fit(src, "lambert", pairs=300, starts=2)
@@ -590,7 +615,8 @@ def _eval_in_worker(args):
 def test_pickle_and_multiprocessing(paper):
     b = brdftab.open(paper, interp="nearest")
     c = pickle.loads(pickle.dumps(b))
-    assert c.source == paper and c.interp == "nearest"
+    # An RGL file is read with its format's own (linear) interpolation whatever was asked.
+    assert c.source == paper and c.interp == b.interp == "linear"
     wi, wo = upper(64), upper(64, 1)
     np.testing.assert_array_equal(c.eval(wi, wo), b.eval(wi, wo))
     s = pickle.loads(pickle.dumps(brdftab.open(LAMBERT, wavelengths=[500, 600])))

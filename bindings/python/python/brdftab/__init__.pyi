@@ -69,8 +69,10 @@ class Brdf:
         os.fsdecode gives it)."""
     @property
     def interp(self) -> str:
-        """The interpolation of a table ("linear" or "nearest"; with interp="auto", the one the
-        table's grid chose), or the interpolation asked for when the source is no table."""
+        """The interpolation lookups use: a table's ("linear" or "nearest"; with interp="auto",
+        the one its grid chose), a MERL file's ("nearest", its cells, unless "linear" was
+        asked), an RGL file's ("linear", its format's own, whatever was asked); for an analytic
+        model, which interpolates nothing, the interpolation asked for."""
     def describe(self) -> str:
         """A one-line description (model and parameters, or table and source)."""
     def eval(self, wi: _ArrayLike, wo: _ArrayLike) -> npt.NDArray[np.float32]:

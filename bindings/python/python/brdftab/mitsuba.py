@@ -1174,8 +1174,6 @@ class JitBrdftabBSDF(_Common):
         ``brdftab.Table`` (``auto``: the library's default for its grid)."""
         if hasattr(table, "values"):
             return table.device_layout(self.interp)
-        if table.interp not in ("linear", "nearest"):
-            return table.table().device_layout(self.interp)
         return table.device_layout()
 
     def _table(self, options):

@@ -61,16 +61,23 @@ impl PyBrdf {
             channels: channels.clone(),
             ..settings.options().map_err(lib_err)?
         };
-        let (inner, table): (Arc<dyn Brdf + Send + Sync>, _) =
-            if source::classify(source) == SourceKind::Table && channels.is_none() {
-                let t = Arc::new(source::open_table(source, &opts).map_err(lib_err)?);
+        // A table is kept as one (its interpolation, `table()`) unless it is stored with other
+        // channels than those asked for: then `open_with` says why it cannot be opened.
+        let table = match source::classify(source) {
+            SourceKind::Table => Some(source::open_table(source, &opts).map_err(lib_err)?)
+                .filter(|t| channels.as_ref().is_none_or(|c| c == t.channels())),
+            _ => None,
+        };
+        let (inner, table): (Arc<dyn Brdf + Send + Sync>, _) = match table {
+            Some(t) => {
+                let t = Arc::new(t);
                 (t.clone(), Some(t))
-            } else {
-                (
-                    Arc::from(brdftab::open_with(source, &opts).map_err(lib_err)?),
-                    None,
-                )
-            };
+            }
+            None => (
+                Arc::from(brdftab::open_with(source, &opts).map_err(lib_err)?),
+                None,
+            ),
+        };
         Ok(PyBrdf {
             inner,
             table,
@@ -149,13 +156,19 @@ impl PyBrdf {
         self.source.clone()
     }
 
-    /// The interpolation of a table ("linear" or "nearest"; with `interp="auto"`, the one the
-    /// table's grid chose), or the interpolation asked for when the source is no table.
+    /// The interpolation lookups use: a table's ("linear" or "nearest"; with `interp="auto"`,
+    /// the one its grid chose), a MERL file's ("nearest", its cells, unless "linear" was
+    /// asked), an RGL file's ("linear", its format's own, whatever was asked); for an
+    /// analytic model, which interpolates nothing, the interpolation asked for.
     #[getter]
     fn interp(&self) -> String {
-        match &self.table {
-            Some(t) => format!("{:?}", t.interp()).to_ascii_lowercase(),
-            None => self.interp.clone(),
+        if let Some(t) = &self.table {
+            return format!("{:?}", t.interp()).to_ascii_lowercase();
+        }
+        match (source::classify(&self.source), self.interp.as_str()) {
+            (_, "linear") | (SourceKind::Rgl, _) => "linear".into(),
+            (SourceKind::Merl, _) => "nearest".into(),
+            _ => self.interp.clone(),
         }
     }
 
