@@ -131,22 +131,30 @@ fn answer(brdf: &dyn brdftab::Brdf, body: String) -> Result<Response, Response> 
     Ok(Response::json(body))
 }
 
-/// `/api/polar?theta_i=DEG&n=N&ch=C`.
+/// The incident azimuth φi of a view (`phi_i=DEG` in [−180°, 180°], 0 when absent): the
+/// plane of incidence's azimuth, the light at φi + 180° ([`eval::polar`]).
+fn phi_i(q: &Query) -> Result<f64, Response> {
+    q.num("phi_i", 0.0, -180.0, 180.0)
+}
+
+/// `/api/polar?theta_i=DEG&phi_i=DEG&n=N&ch=C`.
 pub fn polar(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let t = target(reg, q)?;
     let ti = q.num("theta_i", 30.0, 0.0, 89.9)?;
+    let pi = phi_i(q)?;
     let n = q.count("n", 181, 2, 2001)?;
-    let body = eval::polar(t.brdf.as_ref(), ti, n, q.channel()?).to_string();
+    let body = eval::polar(t.brdf.as_ref(), ti, pi, n, q.channel()?).to_string();
     answer(t.brdf.as_ref(), body)
 }
 
-/// `/api/lobe?theta_i=DEG&nt=N&np=N&ch=C`.
+/// `/api/lobe?theta_i=DEG&phi_i=DEG&nt=N&np=N&ch=C`.
 pub fn lobe(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let t = target(reg, q)?;
     let ti = q.num("theta_i", 30.0, 0.0, 89.9)?;
+    let pi = phi_i(q)?;
     let nt = q.count("nt", 24, 2, 96)?;
     let np = q.count("np", 48, 3, 192)?;
-    let body = eval::lobe(t.brdf.as_ref(), ti, nt, np, q.channel()?).to_string();
+    let body = eval::lobe(t.brdf.as_ref(), ti, pi, nt, np, q.channel()?).to_string();
     answer(t.brdf.as_ref(), body)
 }
 
@@ -169,28 +177,40 @@ pub fn sphere(reg: &Registry, q: &Query) -> Result<Response, Response> {
     answer(t.brdf.as_ref(), v.to_string())
 }
 
-/// The value of `f` on the target, cached under `what` for registered materials.
+/// The value of `f` on the target, cached under `what(target)` for registered materials.
 fn cached_view(
     reg: &Registry,
     q: &Query,
-    what: &str,
+    what: impl FnOnce(&dyn brdftab::Brdf) -> String,
     f: impl FnOnce(&(dyn brdftab::Brdf + Sync)) -> String,
 ) -> Result<Response, Response> {
     let t = target(reg, q)?;
     let body = match t.key {
         Some(k) => reg
-            .cached(format!("{what}:{k}"), || f(t.brdf.as_ref()))
+            .cached(format!("{}:{k}", what(t.brdf.as_ref())), || {
+                f(t.brdf.as_ref())
+            })
             .to_string(),
         None => f(t.brdf.as_ref()),
     };
     answer(t.brdf.as_ref(), body)
 }
 
-/// `/api/albedo?ch=C`: the albedo curve.
+/// `/api/albedo?phi_i=DEG&ch=C`: the albedo curve for light at azimuth φi + 180°. An
+/// isotropic material's is the same at every φi: it is computed (and cached) once, at φi = 0.
 pub fn albedo(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let ch = q.channel()?;
-    let what = format!("albedo-{}", ch.name());
-    cached_view(reg, q, &what, |b| eval::albedo(b, ch).to_string())
+    let asked = phi_i(q)?;
+    // `+ 0.0`: -0 and 0 are one key.
+    let pi = |b: &dyn brdftab::Brdf| {
+        if b.flags().isotropic {
+            0.0
+        } else {
+            asked + 0.0
+        }
+    };
+    let what = |b: &dyn brdftab::Brdf| format!("albedo-{}-{}", ch.name(), pi(b));
+    cached_view(reg, q, what, |b| eval::albedo(b, pi(b), ch).to_string())
 }
 
 /// `/api/plausibility`: positivity, reciprocity and energy conservation (the demo's quick
@@ -199,22 +219,27 @@ pub fn albedo(reg: &Registry, q: &Query) -> Result<Response, Response> {
 ///
 /// [`Brdf::albedo`]: brdftab::Brdf::albedo
 pub fn plausibility(reg: &Registry, q: &Query) -> Result<Response, Response> {
-    cached_view(reg, q, "plausibility", |b| {
-        let opts = plausibility::Options {
-            pairs: 4000,
-            thetas_deg: vec![0.0, 30.0, 60.0, 85.0],
-            albedo: None,
-            ..Default::default()
-        };
-        match plausibility::check(b, &opts) {
-            Ok(r) => {
-                let mut v = serde_json::to_value(&r).unwrap_or_default();
-                v["plausible"] = json!(r.plausible());
-                v.to_string()
+    cached_view(
+        reg,
+        q,
+        |_| "plausibility".into(),
+        |b| {
+            let opts = plausibility::Options {
+                pairs: 4000,
+                thetas_deg: vec![0.0, 30.0, 60.0, 85.0],
+                albedo: None,
+                ..Default::default()
+            };
+            match plausibility::check(b, &opts) {
+                Ok(r) => {
+                    let mut v = serde_json::to_value(&r).unwrap_or_default();
+                    v["plausible"] = json!(r.plausible());
+                    v.to_string()
+                }
+                Err(e) => json!({ "error": e.to_string() }).to_string(),
             }
-            Err(e) => json!({ "error": e.to_string() }).to_string(),
-        }
-    })
+        },
+    )
 }
 
 /// `/api/compare?m=ID`: a table against its source, as the demo measures it (cos-weighted
@@ -301,7 +326,7 @@ mod tests {
     #[test]
     fn a_source_that_failed_answers_its_error_not_its_zeros() {
         let failed = Failed(Channels::Rgb);
-        let body = eval::polar(&failed, 30.0, 5, Channel::Y).to_string();
+        let body = eval::polar(&failed, 30.0, 0.0, 5, Channel::Y).to_string();
         let r = answer(&failed, body).unwrap_err();
         assert_eq!(r.status, 500);
         assert!(String::from_utf8_lossy(&r.body).contains("checksum"));
@@ -309,7 +334,7 @@ mod tests {
             .unwrap()
             .build(&Channels::Rgb)
             .unwrap();
-        let body = eval::polar(lambert.as_ref(), 30.0, 5, Channel::Y).to_string();
+        let body = eval::polar(lambert.as_ref(), 30.0, 0.0, 5, Channel::Y).to_string();
         assert_eq!(answer(lambert.as_ref(), body).unwrap().status, 200);
     }
 
@@ -329,7 +354,7 @@ mod tests {
         );
         for (b, want) in [(&smooth, false), (&mirror, true), (&sum, true)] {
             assert_eq!(
-                eval::polar(b.as_ref(), 30.0, 5, Channel::Y)["delta"],
+                eval::polar(b.as_ref(), 30.0, 0.0, 5, Channel::Y)["delta"],
                 want,
                 "{}",
                 b.describe()

@@ -13,7 +13,7 @@
 //! value a plot can show.
 
 use brdftab::Brdf;
-use brdftab::analysis::albedo::albedo_curve;
+use brdftab::analysis::albedo::albedo_curve_at;
 use brdftab::geometry::{self, HalfDiff};
 use brdftab::spectrum::Channels;
 use glam::DVec3;
@@ -130,16 +130,22 @@ fn centre(k: usize, n: usize, lo: f64, hi: f64) -> f64 {
     lo + (hi - lo) * (k as f64 + 0.5) / n as f64
 }
 
-/// The in-plane polar curve: light at θi on the −x side, the viewer at the centres of `n` cells
-/// of θo ∈ [−90°, 90°] in the plane of incidence (positive θo towards the mirror direction).
-pub fn polar(brdf: &dyn Brdf, theta_i_deg: f64, n: usize, ch: Channel) -> Value {
-    let wi = geometry::spherical(theta_i_deg.to_radians(), std::f64::consts::PI);
+/// The in-plane polar curve in the plane of incidence at azimuth φi (`phi_i_deg`, from the
+/// local x axis, along which an anisotropic model's α_x runs): light at θi on the far side of
+/// the normal (azimuth φi + 180°), the viewer at the centres of `n` cells of θo ∈ [−90°, 90°] in
+/// that plane, positive θo towards the mirror direction (azimuth φi). φi = 0 is the x–z plane
+/// with the light on the −x side. The answer carries `phi_i` and the material's `isotropic`
+/// flag (φi changes nothing for an isotropic material but the directions' rounding).
+pub fn polar(brdf: &dyn Brdf, theta_i_deg: f64, phi_i_deg: f64, n: usize, ch: Channel) -> Value {
+    let phi = phi_i_deg.to_radians();
+    // `phi + PI` and `phi + 0.0`: at φi = 0 the very directions of the x–z plane.
+    let wi = geometry::spherical(theta_i_deg.to_radians(), phi + std::f64::consts::PI);
     let thetas: Vec<f64> = (0..n).map(|k| centre(k, n, -90.0, 90.0)).collect();
     let wo: Vec<DVec3> = thetas
         .iter()
         .map(|t| {
-            let phi = if *t < 0.0 { std::f64::consts::PI } else { 0.0 };
-            geometry::spherical(t.abs().to_radians(), phi)
+            let side = if *t < 0.0 { std::f64::consts::PI } else { 0.0 };
+            geometry::spherical(t.abs().to_radians(), phi + side)
         })
         .collect();
     let f = eval_pairs(brdf, &vec![wi; n], &wo);
@@ -147,7 +153,10 @@ pub fn polar(brdf: &dyn Brdf, theta_i_deg: f64, n: usize, ch: Channel) -> Value 
     let per_channel: Vec<Vec<f32>> = (0..c)
         .map(|ch| f.iter().skip(ch).step_by(c).copied().collect())
         .collect();
-    json!({ "theta_o": thetas, "y": components(brdf, &f, ch), "channel": ch.name(), "f": per_channel, "delta": has_delta(brdf) })
+    json!({
+        "theta_o": thetas, "phi_i": phi_i_deg, "y": components(brdf, &f, ch), "channel": ch.name(),
+        "f": per_channel, "delta": has_delta(brdf), "isotropic": brdf.flags().isotropic,
+    })
 }
 
 /// Whether `brdf` has a delta lobe (a mirror or refractor, alone or as a term of a sum): f_r
@@ -157,23 +166,32 @@ pub fn has_delta(brdf: &dyn Brdf) -> bool {
     f.delta || f.lobes.delta
 }
 
-/// The lobe for light at (θi, φ = 180°): channel `ch` of f_r over the outgoing hemisphere on an
-/// `nt` × `np` grid of (θo at the centres of `nt` cells of [0°, 90°], φo ∈ [0°, 360°)), row by
-/// row; `theta_o` lists the rows' angles.
-pub fn lobe(brdf: &dyn Brdf, theta_i_deg: f64, nt: usize, np: usize, ch: Channel) -> Value {
-    let wi = geometry::spherical(theta_i_deg.to_radians(), std::f64::consts::PI);
+/// The lobe for light at (θi, φi + 180°): channel `ch` of f_r over the outgoing hemisphere on
+/// an `nt` × `np` grid of (θo at the centres of `nt` cells of [0°, 90°], φo = φi + 360° j / `np`),
+/// row by row; `theta_o` lists the rows' angles. The columns start at the plane of incidence's
+/// mirror side whatever φi (`phi_i`, in the answer, is where the page turns them to).
+pub fn lobe(
+    brdf: &dyn Brdf,
+    theta_i_deg: f64,
+    phi_i_deg: f64,
+    nt: usize,
+    np: usize,
+    ch: Channel,
+) -> Value {
+    let phi = phi_i_deg.to_radians();
+    let wi = geometry::spherical(theta_i_deg.to_radians(), phi + std::f64::consts::PI);
     let rows: Vec<f64> = (0..nt).map(|i| centre(i, nt, 0.0, 90.0)).collect();
     let mut wo = Vec::with_capacity(nt * np);
     for t in rows.iter().map(|t| t.to_radians()) {
         for j in 0..np {
             wo.push(geometry::spherical(
                 t,
-                std::f64::consts::TAU * j as f64 / np as f64,
+                phi + std::f64::consts::TAU * j as f64 / np as f64,
             ));
         }
     }
     let f = eval_pairs(brdf, &vec![wi; wo.len()], &wo);
-    json!({ "nt": nt, "np": np, "theta_o": rows, "y": components(brdf, &f, ch), "channel": ch.name() })
+    json!({ "nt": nt, "np": np, "theta_o": rows, "phi_i": phi_i_deg, "y": components(brdf, &f, ch), "channel": ch.name() })
 }
 
 /// The MERL-style θh × θd slice at φd = 90°: `n` × `n` values of channel `ch`, θh along rows' columns
@@ -245,17 +263,20 @@ pub fn sphere(
     json!({ "size": size, "rgb": rgb })
 }
 
-/// The directional albedo at θ′ = 0°, 5°, ..., 85°, 89° (azimuth 0) per channel and its
-/// luminance: the library's [`Brdf::albedo`], as `brdftab albedo` gives it (closed forms where a
-/// model has one, delta lobes' reflectance, the bounded quadrature of data).
-pub fn albedo(brdf: &(dyn Brdf + Sync), ch: Channel) -> Value {
+/// The directional albedo at θ′ = 0°, 5°, ..., 85°, 89° per channel and its luminance, for
+/// light at azimuth φi + 180° (as [`polar`] and [`lobe`] place it; the library's
+/// [`albedo_curve_at`] names the light's own azimuth): the library's [`Brdf::albedo`], as
+/// `brdftab albedo` gives it (closed forms where a model has one, delta lobes' reflectance, the
+/// bounded quadrature of data). The answer carries `phi_i` and the `isotropic` flag.
+pub fn albedo(brdf: &(dyn Brdf + Sync), phi_i_deg: f64, ch: Channel) -> Value {
+    let light = phi_i_deg.to_radians() + std::f64::consts::PI;
     let mut deg: Vec<f64> = (0..18).map(|k| 5.0 * k as f64).collect();
     deg.push(89.0);
     let a: Vec<Vec<f64>> = brdftab::par::install(|| {
         deg.par_iter()
             .map(|d| {
                 let rad = d.to_radians();
-                albedo_curve(brdf, &[rad]).map_or_else(|_| vec![], |mut c| c.remove(0))
+                albedo_curve_at(brdf, &[rad], light).map_or_else(|_| vec![], |mut c| c.remove(0))
             })
             .collect()
     });
@@ -267,7 +288,10 @@ pub fn albedo(brdf: &(dyn Brdf + Sync), ch: Channel) -> Value {
             seen.component(&f, ch) as f64
         })
         .collect();
-    json!({ "theta": deg, "y": y, "a": a, "channel": ch.name() })
+    json!({
+        "theta": deg, "phi_i": phi_i_deg, "y": y, "a": a, "channel": ch.name(),
+        "isotropic": brdf.flags().isotropic,
+    })
 }
 
 #[cfg(test)]
@@ -302,7 +326,7 @@ mod tests {
         assert!(a.iter().any(|x| x.as_i64().unwrap() > 100));
         // A flat spectrum's luminance is its value (the photometric weights sum to 1).
         let grey = build(r#"{"model": "lambert", "kd": 0.2}"#, &ch);
-        for y in polar(grey.as_ref(), 30.0, 8, Channel::Y)["y"]
+        for y in polar(grey.as_ref(), 30.0, 0.0, 8, Channel::Y)["y"]
             .as_array()
             .unwrap()
         {
