@@ -36,6 +36,7 @@ GOLD = '{"model": "cook_torrance", "m": 0.3, "fresnel": {"conductor": "Au"}}'
 PLASTIC = ('{"model": "sum", "terms": [{"model": "lambert", "kd": [0.05, 0.12, 0.2]}, '
            '{"model": "ggx", "alpha": 0.15, "fresnel": {"schlick": 0.04}}]}')
 
+WARD = '{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.4}'
 GLAZED = ('{"model": "sum", "terms": [{"model": "lambert", "kd": 0.2}, '
           '{"model": "mirror", "fresnel": {"schlick": 0.04}}]}')
 
@@ -98,21 +99,30 @@ def main():
         finally:
             server.kill()
             server.wait()
-        # Four materials: the database's two, a sum with a mirror term and a Lambert.
-        server, url = start_server(a.brdftab, db, [GLAZED, '{"model": "lambert", "kd": 0.3}'])
         try:
-            check_delta_and_four_curves(driver, url)
-            check_spheres_of_four(driver, url)
-            check_a_narrow_window(driver, url)
-            check_a_colour_slider(driver, url)
-            check_a_spec_that_is_not_an_object(driver, url)
-            check_a_channel(driver, url)
-            check_a_late_report(driver, url)
+            # Four materials: the database's two, a sum with a mirror term and a Lambert.
+            server, url = start_server(a.brdftab, db, [GLAZED, '{"model": "lambert", "kd": 0.3}'])
+            try:
+                check_delta_and_four_curves(driver, url)
+                check_spheres_of_four(driver, url)
+                check_a_narrow_window(driver, url)
+                check_a_colour_slider(driver, url)
+                check_a_spec_that_is_not_an_object(driver, url)
+                check_a_channel(driver, url)
+                check_a_late_report(driver, url)
+            finally:
+                server.kill()
+                server.wait()
+            # An anisotropic Ward beside an isotropic Lambert: the φi slider.
+            server, url = start_server(a.brdftab, WARD, ['{"model": "lambert", "kd": 0.3}'])
+            try:
+                check_phi_i(driver, url)
+            finally:
+                server.kill()
+                server.wait()
         finally:
             if driver is not None:
                 driver.quit()
-            server.kill()
-            server.wait()
     print("1 passed, 0 failed")
 
 
@@ -400,6 +410,38 @@ def check_a_late_report(driver, url):
     driver.find_elements(By.CSS_SELECTOR, "#materials li")[1].click()
     time.sleep(2.5)
     assert len(rows(driver)) == 1 and rows(driver)[0].startswith("gold"), rows(driver)
+    errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+    assert not errors, f"console errors: {errors}"
+
+
+def check_phi_i(driver, url):
+    """φi turns the plane of incidence of an anisotropic material (Ward α = 0.1 × 0.4): its polar
+    curve changes and the URL keeps φi; with only isotropic materials shown the slider is
+    disabled, saying why, and with one anisotropic among them it is enabled again."""
+    wait = waiter(driver)
+    points = lambda d: d.execute_script(
+        "return [...document.querySelectorAll('#polar polyline')].map((p) => p.getAttribute('points'));")
+    slider = lambda d: d.find_element(By.ID, "phi-i")
+    driver.get("about:blank")
+    driver.get(url.split("#")[0] + "#m=0")
+    wait.until(lambda d: len(points(d)) == 1 and slider(d).is_enabled())
+    assert "φi" in driver.find_element(By.ID, "phi-i-label").get_attribute("title")
+    before = points(driver)
+    for _ in range(90):
+        slider(driver).send_keys(Keys.ARROW_RIGHT)
+    wait.until(lambda d: "pi=90" in d.current_url and "φi = 90°" in " ".join(texts(d, "#polar text")))
+    # The plane along α_y (the wide axis): the curve is another one, not a redrawn copy.
+    wait.until(lambda d: points(d) != before)
+    assert driver.find_element(By.ID, "phi-i-val").text == "90°"
+    wait.until(lambda d: "φi = 90°" in " ".join(texts(d, "#albedo text")))
+    # The Lambert alone: nothing to turn.
+    items = lambda d: d.find_elements(By.CSS_SELECTOR, "#materials li")
+    items(driver)[1].click()
+    items(driver)[0].click()
+    wait.until(lambda d: "m=1&" in d.current_url and not slider(d).is_enabled())
+    assert "isotropic" in driver.find_element(By.ID, "phi-i-label").get_attribute("title")
+    items(driver)[0].click()
+    wait.until(lambda d: slider(d).is_enabled())
     errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
     assert not errors, f"console errors: {errors}"
 

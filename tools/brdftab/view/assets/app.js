@@ -4,13 +4,13 @@
 
 const $ = (id) => document.getElementById(id);
 // What a hash that does not name a setting means.
-const DEFAULTS = { ti: 30, scale: "linear", ch: "y", cos: false, src: false, lt: 40, lp: 135, ev: 0, yaw: -0.7, pitch: 1.05 };
+const DEFAULTS = { ti: 30, pi: 0, scale: "linear", ch: "y", cos: false, src: false, lt: 40, lp: 135, ev: 0, yaw: -0.7, pitch: 1.05 };
 // The channels a view can show: the luminance, or a linear sRGB component (a spectrum's
 // projection).
 const CHANNELS = { y: "luminance Y", r: "R", g: "G", b: "B" };
 const state = Object.assign({ sel: [], spec: "", on: false }, DEFAULTS);
 // The settings with a slider: a hash value is clamped to its range and step.
-const SLIDERS = { ti: "theta-i", lt: "light-theta", lp: "light-phi", ev: "exposure" };
+const SLIDERS = { ti: "theta-i", pi: "phi-i", lt: "light-theta", lp: "light-phi", ev: "exposure" };
 let materials = [], models = [];
 const gen = {}; // newest request per view: older answers are dropped
 const data = { polar: [], lobe: [] };
@@ -51,7 +51,7 @@ function readHash() {
 
 function writeHash() {
   const h = [`m=${state.sel.join(",")}`];
-  for (const k of ["ti", "scale", "lt", "lp", "ev"]) h.push(`${k}=${state[k]}`);
+  for (const k of ["ti", "pi", "scale", "lt", "lp", "ev"]) h.push(`${k}=${state[k]}`);
   h.push(`yaw=${state.yaw.toFixed(2)}`, `pitch=${state.pitch.toFixed(2)}`);
   if (state.ch !== "y") h.push(`ch=${state.ch}`);
   if (state.cos) h.push("cos=1");
@@ -112,32 +112,46 @@ function polarSeries() {
 // spectrum projected).
 const quantity = (cos) => (cos ? "f_r cos θo" : "f_r") + `, ${CHANNELS[state.ch]} (1/sr)`;
 
+// The φi the shown answers were computed at (the slider's until one answers).
+const answeredPhi = (items) => (items.length ? items[0].v.phi_i : state.pi);
+
 function drawPolar() {
-  polarPlot($("polar"), polarSeries(), { log: state.scale === "log", thetaI: state.ti, label: quantity(state.cos) });
+  polarPlot($("polar"), polarSeries(), { log: state.scale === "log", thetaI: state.ti, phiI: answeredPhi(data.polar), label: quantity(state.cos) });
 }
 
 function drawLobe() {
   const weigh = (v, y) => y.map((f, k) => (state.cos ? f * Math.cos((v.theta_o[Math.floor(k / v.np)] * Math.PI) / 180) : f));
-  const lobes = data.lobe.map(({ e, v }) => ({ nt: v.nt, np: v.np, theta: v.theta_o, color: e.color, dash: e.dash, r: weigh(v, v.y) }));
+  const lobes = data.lobe.map(({ e, v }) => ({ nt: v.nt, np: v.np, theta: v.theta_o, phi: v.phi_i, color: e.color, dash: e.dash, r: weigh(v, v.y) }));
   // The difference of each table and its source, thin.
   for (const [a, b] of withSource(data.lobe)) {
     const d = a.v.y.map((f, k) => Math.abs(f - b.v.y[k]));
-    lobes.push({ nt: a.v.nt, np: a.v.np, theta: a.v.theta_o, color: a.e.color, dash: "1 2", width: 0.4, r: weigh(a.v, d) });
+    lobes.push({ nt: a.v.nt, np: a.v.np, theta: a.v.theta_o, phi: a.v.phi_i, color: a.e.color, dash: "1 2", width: 0.4, r: weigh(a.v, d) });
   }
-  lobePlot($("lobe"), lobes, { yaw: state.yaw, pitch: state.pitch, log: state.scale === "log", thetaI: state.ti, label: quantity(state.cos) });
+  lobePlot($("lobe"), lobes, { yaw: state.yaw, pitch: state.pitch, log: state.scale === "log", thetaI: state.ti, phiI: answeredPhi(data.lobe), label: quantity(state.cos) });
+}
+
+// What φi is, and why it is off when every material shown is isotropic (they look the same
+// from every azimuth).
+const PHI_HELP = "φi: the azimuth of the plane of incidence from the material's x axis (the tangent of α_x): " +
+  "the light comes from φi + 180° and reflects towards φi. It sets the polar plot's plane, the lobe's light " +
+  "and the albedo curve's light; the lit sphere has its own light φ.";
+function phiControl(isotropic) {
+  $("phi-i").disabled = isotropic;
+  $("phi-i-label").title = isotropic ? "every material shown is isotropic: φi changes nothing" : PHI_HELP;
 }
 
 async function fastViews() {
   const t0 = performance.now();
-  const p = view("polar", `theta_i=${state.ti}&n=180&ch=${state.ch}`, (list, got) => {
+  const p = view("polar", `theta_i=${state.ti}&phi_i=${state.pi}&n=180&ch=${state.ch}`, (list, got) => {
     data.polar = list.map((e, k) => ({ e, v: got[k] }));
+    if (got.length) phiControl(got.every((v) => v.isotropic));
     // A mirror or refraction lobe is a delta: f_r has none of it, the albedo has it all.
     const delta = list.filter((e, k) => got[k].delta).map((e) => e.label);
     document.querySelector('.panel[data-plot="polar"] .note').textContent = delta.length
       ? `${delta.join(", ")}: the delta (mirror/refraction) lobe is not drawn; the albedo counts it` : "";
     drawPolar();
   });
-  const l = view("lobe", `theta_i=${state.ti}&nt=19&np=36&ch=${state.ch}`, (list, got) => {
+  const l = view("lobe", `theta_i=${state.ti}&phi_i=${state.pi}&nt=19&np=36&ch=${state.ch}`, (list, got) => {
     data.lobe = list.map((e, k) => ({ e, v: got[k] }));
     drawLobe();
   });
@@ -187,14 +201,16 @@ function sliceView() {
 }
 
 function albedoView() {
-  return view("albedo", `ch=${state.ch}`, (list, got) => {
+  return view("albedo", `phi_i=${state.pi}&ch=${state.ch}`, (list, got) => {
     const items = list.map((e, k) => ({ e, v: got[k] }));
     const series = items.map(({ e, v }) => ({ x: v.theta, y: v.y, color: e.color, dash: e.dash }));
     // The difference of each table and its source, thin.
     for (const [a, b] of withSource(items)) {
       series.push({ x: a.v.theta, y: a.v.y.map((f, k) => Math.abs(f - b.v.y[k])), color: a.e.color, dash: "1 2", width: 1 });
     }
-    linePlot($("albedo"), series, { x0: 0, x1: 90, dx: 15, xlabel: `θ′ (${state.ch === "y" ? "luminance" : CHANNELS[state.ch]})` });
+    // An isotropic material's curve is the one of every φi (the server computes it at 0).
+    const phi = answeredPhi(items.filter((x) => !x.v.isotropic));
+    linePlot($("albedo"), series, { x0: 0, x1: 90, dx: 15, xlabel: `θ′ at φi = ${phi}° (${state.ch === "y" ? "luminance" : CHANNELS[state.ch]})` });
   });
 }
 
@@ -217,6 +233,7 @@ function redrawAll() {
 function syncControls() {
   for (const [k, id] of Object.entries(SLIDERS)) $(id).value = state[k];
   $("theta-i-val").textContent = `${state.ti}°`;
+  $("phi-i-val").textContent = `${state.pi}°`;
   $("scale").value = state.scale;
   $("channel").value = state.ch;
   $("cosine").checked = state.cos;
@@ -226,11 +243,20 @@ function syncControls() {
 
 function bind() {
   syncControls();
+  phiControl(true);
   const range = (id, key, fast) => {
     $(id).addEventListener("input", () => { state[key] = +$(id).value; writeHash(); fast(true); });
     $(id).addEventListener("change", () => fast(false));
   };
   range("theta-i", "ti", () => { $("theta-i-val").textContent = `${state.ti}°`; fastViews(); });
+  // φi: the polar plot and the lobe as it moves, the albedo curve (slow) once it rests.
+  let albedoTimer = null;
+  range("phi-i", "pi", () => {
+    $("phi-i-val").textContent = `${state.pi}°`;
+    fastViews();
+    clearTimeout(albedoTimer);
+    albedoTimer = setTimeout(albedoView, 300);
+  });
   range("light-theta", "lt", (drag) => sphereView(drag ? 48 : 128));
   range("light-phi", "lp", (drag) => sphereView(drag ? 48 : 128));
   range("exposure", "ev", (drag) => sphereView(drag ? 48 : 128));

@@ -82,6 +82,11 @@ function polarPlot(svg, series, opts) {
   el("line", { x1: cx, y1: cy, x2: cx - R * Math.sin(ti), y2: cy - R * Math.cos(ti), stroke: "#999", "stroke-dasharray": "4 3" }, svg);
   text(svg, 4, 12, (opts.log ? "log, " : "") + scaleNote(sc, "grazing samples"));
   text(svg, 4, 24, opts.label);
+  // Which plane this is: the plane of incidence at φi, the light on the left.
+  if (opts.phiI !== undefined) {
+    const light = opts.phiI + 180 > 180 ? opts.phiI - 180 : opts.phiI + 180;
+    text(svg, 4, 236, `plane φi = ${opts.phiI}° (light from ${light}°)`, { class: "plane" });
+  }
   for (const ser of series) {
     const pts = ser.x.map((t, k) => {
       const r = (t * Math.PI) / 180, v = R * s(ser.y[k]);
@@ -111,7 +116,7 @@ function linePlot(svg, series, opts) {
     text(svg, 2, Y(y) + 3, y.toPrecision(2));
   }
   for (let x = opts.x0; x <= opts.x1; x += opts.dx) text(svg, X(x) - 6, T + H + 12, `${x}°`);
-  text(svg, L + W - 60, T + H + 26, opts.xlabel);
+  text(svg, L + W, T + H + 26, opts.xlabel, { "text-anchor": "end" });
   for (const ser of series) {
     const pts = ser.x.map((x, k) => `${X(x).toFixed(1)},${Y(ser.y[k]).toFixed(1)}`);
     el("polyline", { points: pts.join(" "), fill: "none", stroke: ser.color, "stroke-width": ser.width || 1.5, "stroke-dasharray": ser.dash || "" }, svg);
@@ -166,7 +171,8 @@ function heatmap(svg, n, y, opts) {
   if (clip) text(svg, L, T + S + 52, clip);
 }
 
-// The 3D lobe: r(θo, φo) along each outgoing direction, rotated by yaw/pitch, projected.
+// The 3D lobe: r(θo, φo) along each outgoing direction, rotated by yaw/pitch, projected. A
+// lobe's columns start at its φi (`l.phi`, degrees from x): the light is at φi + 180°, dashed.
 function lobePlot(svg, lobes, view) {
   clear(svg);
   const cx = 160, cy = 150, R = 120;
@@ -185,11 +191,17 @@ function lobePlot(svg, lobes, view) {
     text(svg, c, d, name);
   };
   axis(1, 0, 0, "x"); axis(0, 1, 0, "y"); axis(0, 0, 1, "n");
+  if (view.phiI !== undefined) {
+    const t = (view.thetaI * Math.PI) / 180, p = ((view.phiI + 180) * Math.PI) / 180;
+    const [a, b] = project(0, 0, 0), [c, d] = project(Math.sin(t) * Math.cos(p), Math.sin(t) * Math.sin(p), Math.cos(t));
+    el("line", { x1: a, y1: b, x2: c, y2: d, stroke: "#999", "stroke-dasharray": "4 3" }, svg);
+    text(svg, c, d, "light");
+  }
   text(svg, 4, 12, (view.log ? "log, " : "") + scaleNote(sc, "grazing samples"));
   if (view.label) text(svg, 4, 24, view.label);
   for (const l of lobes) {
     const pt = (i, j) => {
-      const t = (l.theta[i] * Math.PI) / 180, p = (2 * Math.PI * j) / l.np, r = s(l.r[i * l.np + j]);
+      const t = (l.theta[i] * Math.PI) / 180, p = ((l.phi || 0) * Math.PI) / 180 + (2 * Math.PI * j) / l.np, r = s(l.r[i * l.np + j]);
       return project(r * Math.sin(t) * Math.cos(p), r * Math.sin(t) * Math.sin(p), r * Math.cos(t));
     };
     const lines = [];
