@@ -15,15 +15,20 @@ pub struct ConvertArgs {
     input: std::ffi::OsString,
     /// The output: an RGL `.bsdf` (loads in Mitsuba 3 and pbrt-v4), a MERL `.binary` (the
     /// source's mean over each MERL cell), a table database entry `DB#NAME` (or a
-    /// `.btdb` file, named after the input), or a raw table file.
-    output: brdftab_tools::args::PathArg,
+    /// `.btdb` file, named after the input), or a raw table file (or `-o OUTPUT`, as `bake`).
+    #[arg(required_unless_present = "to", conflicts_with = "to")]
+    output: Option<brdftab_tools::args::PathArg>,
+    /// The output, as `bake -o` takes it: the same as OUTPUT.
+    #[arg(short = 'o', long = "output", id = "to", value_name = "OUTPUT")]
+    to: Option<brdftab_tools::args::PathArg>,
     #[command(flatten)]
     settings: ConvertSettings,
 }
 
 /// Converts between formats and prints what was written.
 pub fn convert(a: ConvertArgs) -> Result<()> {
-    match request::convert(&a.input, &a.output, &a.settings, &Bar::values())? {
+    let out = a.output.or(a.to).unwrap_or_default(); // clap requires one of them
+    match request::convert(&a.input, &out, &a.settings, &Bar::values())? {
         ConvertOutput::Merl(r) => errln!(
             "{}: {} on the MERL grid (90 × 90 × 180 cells: the mean of the source over each, or \
              its own cells when it is on that grid) in {:.2} s",
@@ -35,7 +40,7 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
             let f = &r.written.fields;
             errln!(
                 "{}: {} as an RGL tensor file ({} φi × {} θi, {n}×{n} table, {} bytes, {:.2} s)",
-                a.output,
+                out,
                 r.source,
                 f.phi_i.len(),
                 f.theta_i.len(),

@@ -178,6 +178,31 @@ fn usage_says_what_is_required() {
     assert!(o.stderr.contains("cannot be used with"), "{}", o.stderr);
 }
 
+/// `convert` takes its output as `bake` and `render` do (`-o OUTPUT`) as well as positionally:
+/// the same file either way, one of them required, not both.
+#[test]
+fn convert_takes_its_output_positionally_or_as_bake_does() {
+    let d = TempDir::new("args-convert-o");
+    let (a, b) = (d.file("a.bsdf"), d.file("b.bsdf"));
+    let small = [
+        "--theta-i",
+        "2",
+        "--resolution",
+        "8",
+        "--ndf-resolution",
+        "16",
+    ];
+    let run = |out: &[&str]| {
+        brdftab(&[&["convert", LAMBERT][..], out, &small, &["--pairs", "0"]].concat())
+    };
+    assert!(run(&[&a]).ok);
+    let o = run(&["-o", &b]);
+    assert!(o.ok, "{}", o.stderr);
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    refused(&run(&[&a, "--output", &b]), &["cannot be used with"]);
+    refused(&run(&[]), &["OUTPUT"]);
+}
+
 #[test]
 fn negative_numbers_reach_the_range_checks() {
     let d = TempDir::new("args-negative");
