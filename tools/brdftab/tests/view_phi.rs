@@ -216,6 +216,13 @@ fn the_albedo_curve_has_its_light_at_phi_i_plus_180() {
     let g90 = get_json(&v, "/api/albedo?m=1&phi_i=90");
     let g0 = get_json(&v, "/api/albedo?m=1&phi_i=0");
     assert_eq!(g90["a"], g0["a"]);
+    // Azimuths are taken to 0.1° (so a client cannot fill the cache with curves): 45.04° is
+    // the curve at 45°, 45.06° the one at 45.1° (where Ward's albedo turns fastest with φ).
+    let near = get_json(&v, "/api/albedo?m=0&phi_i=45.04");
+    assert_eq!(near["a"], get_json(&v, "/api/albedo?m=0&phi_i=45")["a"]);
+    let next = get_json(&v, "/api/albedo?m=0&phi_i=45.06");
+    assert_eq!(next["a"], get_json(&v, "/api/albedo?m=0&phi_i=45.1")["a"]);
+    assert_ne!(next["a"], near["a"]);
 }
 
 /// `phi_i` is checked as `theta_i` is: a number in [−180, 180], else a 400 that says so.

@@ -196,17 +196,18 @@ fn cached_view(
     answer(t.brdf.as_ref(), body)
 }
 
-/// `/api/albedo?phi_i=DEG&ch=C`: the albedo curve for light at azimuth φi + 180°. An
+/// `/api/albedo?phi_i=DEG&ch=C`: the albedo curve for light at azimuth φi + 180° (φi to 0.1°). An
 /// isotropic material's is the same at every φi: it is computed (and cached) once, at φi = 0.
 pub fn albedo(reg: &Registry, q: &Query) -> Result<Response, Response> {
     let ch = q.channel()?;
     let asked = phi_i(q)?;
-    // `+ 0.0`: -0 and 0 are one key.
+    // To 0.1° (the slider's step is 1°), so a material's curves cached are at most 3601 per
+    // channel however many azimuths a client asks for; `+ 0.0`: -0 and 0 are one key.
     let pi = |b: &dyn brdftab::Brdf| {
         if b.flags().isotropic {
             0.0
         } else {
-            asked + 0.0
+            (asked * 10.0).round() / 10.0 + 0.0
         }
     };
     let what = |b: &dyn brdftab::Brdf| format!("albedo-{}-{}", ch.name(), pi(b));
