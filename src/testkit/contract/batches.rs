@@ -7,8 +7,6 @@ use super::{Contract, Log, close, eval};
 use crate::brdf::Brdf;
 use crate::spectrum::MAX_CHANNELS;
 
-/// `eval_batch` against `eval` and `sample_batch` against `sample`, pair by pair
-/// (unnormalized, below-horizon and, for sampling, non-finite views included).
 /// `eval_at_wavelengths` is `eval_wavelength` at each wavelength (as f32), bit for bit, on
 /// pairs of every kind: wavelengths inside, between and outside the channels, one and many.
 fn at_wavelengths(brdf: &dyn Brdf, pairs: &[(DVec3, DVec3)], log: &mut Log) {
@@ -86,6 +84,9 @@ fn at_non_wavelengths(brdf: &dyn Brdf, pairs: &[(DVec3, DVec3)], log: &mut Log) 
     }
 }
 
+/// `eval_batch` against `eval` and `sample_batch` against `sample`, pair by pair
+/// (unnormalized, below-horizon and, for sampling, non-finite views included), after the
+/// wavelength checks above.
 pub(super) fn batches(brdf: &dyn Brdf, opts: &Contract, pairs: &[(DVec3, DVec3)], log: &mut Log) {
     at_wavelengths(brdf, pairs, log);
     at_non_wavelengths(brdf, pairs, log);
