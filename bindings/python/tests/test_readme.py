@@ -1,5 +1,6 @@
-"""The package's README (bindings/python/README.md, its PyPI page) as a new user reads it: every
-Python block runs as written, from a directory laid out as the repository's root."""
+"""The package's README (bindings/python/README.md, its PyPI page) and the repository's as a new
+user reads them: every Python block runs as written, from a directory laid out as the
+repository's root."""
 
 import os
 import re
@@ -12,9 +13,9 @@ from conftest import ROOT, unavailable
 README = ROOT / "bindings" / "python" / "README.md"
 
 
-def blocks():
-    """The README's ```python blocks, in order."""
-    return re.findall(r"^```python\n(.*?)^```", README.read_text(encoding="utf-8"), re.M | re.S)
+def blocks(readme=README):
+    """A README's ```python blocks, in order."""
+    return re.findall(r"^```python\n(.*?)^```", readme.read_text(encoding="utf-8"), re.M | re.S)
 
 
 @pytest.fixture
@@ -62,3 +63,11 @@ def test_mitsuba_block_runs_as_written(repo_root):
     assert r == g == b and r > 0
     r, g, b = img[128, 128]
     assert r > b and g > b, img[128, 128]
+
+
+def test_the_repository_readme_python_block_runs_as_written(repo_root, capsys):
+    (block,) = blocks(ROOT / "README.md")
+    exec(compile(block, str(ROOT / "README.md"), "exec"), {})  # noqa: S102
+    printed = capsys.readouterr().out
+    values = printed.strip().strip("[]").split()  # numpy's print of a (3,) array
+    assert len(values) == 3 and all(float(v) > 0 for v in values), printed
