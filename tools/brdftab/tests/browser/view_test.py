@@ -440,6 +440,18 @@ def check_phi_i(driver, url):
     items(driver)[0].click()
     wait.until(lambda d: "m=1&" in d.current_url and not slider(d).is_enabled())
     assert "isotropic" in driver.find_element(By.ID, "phi-i-label").get_attribute("title")
+    # With the slider disabled, the URL's φi = 90° turns nothing: the plots say φi = 0° and the
+    # lobe is the one drawn at φi = 0 (a Lambert's values are the same at every azimuth).
+    lobe = lambda d: d.find_element(By.ID, "lobe").get_attribute("innerHTML")
+    wait.until(lambda d: "φi = 0°" in " ".join(texts(d, "#polar text")))
+    wait.until(lambda d: "φi = 0°" in " ".join(texts(d, "#albedo text")))
+    turned = lobe(driver)
+    assert "pi=90" in driver.current_url
+    driver.get("about:blank")
+    driver.get(url.split("#")[0] + "#m=1")
+    wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#lobe path") and not slider(d).is_enabled())
+    time.sleep(0.5)
+    assert lobe(driver) == turned, "an isotropic lobe turned with the disabled slider's φi"
     items(driver)[0].click()
     wait.until(lambda d: slider(d).is_enabled())
     errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]

@@ -112,8 +112,13 @@ function polarSeries() {
 // spectrum projected).
 const quantity = (cos) => (cos ? "f_r cos θo" : "f_r") + `, ${CHANNELS[state.ch]} (1/sr)`;
 
-// The φi the shown answers were computed at (the slider's until one answers).
-const answeredPhi = (items) => (items.length ? items[0].v.phi_i : state.pi);
+// Whether every material shown is isotropic (set from the polar answers, with the slider).
+// Then φi changes nothing, and the plots are drawn at φi = 0 whatever the URL's `pi` says, as
+// the disabled slider promises: the same surface, not turned.
+let isotropicOnly = true;
+
+// The φi the shown answers were computed at (the slider's until one answers), as drawn.
+const answeredPhi = (items) => (isotropicOnly ? 0 : items.length ? items[0].v.phi_i : state.pi);
 
 function drawPolar() {
   polarPlot($("polar"), polarSeries(), { log: state.scale === "log", thetaI: state.ti, phiI: answeredPhi(data.polar), label: quantity(state.cos) });
@@ -121,11 +126,12 @@ function drawPolar() {
 
 function drawLobe() {
   const weigh = (v, y) => y.map((f, k) => (state.cos ? f * Math.cos((v.theta_o[Math.floor(k / v.np)] * Math.PI) / 180) : f));
-  const lobes = data.lobe.map(({ e, v }) => ({ nt: v.nt, np: v.np, theta: v.theta_o, phi: v.phi_i, color: e.color, dash: e.dash, r: weigh(v, v.y) }));
+  const phi = (v) => (isotropicOnly ? 0 : v.phi_i);
+  const lobes = data.lobe.map(({ e, v }) => ({ nt: v.nt, np: v.np, theta: v.theta_o, phi: phi(v), color: e.color, dash: e.dash, r: weigh(v, v.y) }));
   // The difference of each table and its source, thin.
   for (const [a, b] of withSource(data.lobe)) {
     const d = a.v.y.map((f, k) => Math.abs(f - b.v.y[k]));
-    lobes.push({ nt: a.v.nt, np: a.v.np, theta: a.v.theta_o, phi: a.v.phi_i, color: a.e.color, dash: "1 2", width: 0.4, r: weigh(a.v, d) });
+    lobes.push({ nt: a.v.nt, np: a.v.np, theta: a.v.theta_o, phi: phi(a.v), color: a.e.color, dash: "1 2", width: 0.4, r: weigh(a.v, d) });
   }
   lobePlot($("lobe"), lobes, { yaw: state.yaw, pitch: state.pitch, log: state.scale === "log", thetaI: state.ti, phiI: answeredPhi(data.lobe), label: quantity(state.cos) });
 }
@@ -136,6 +142,7 @@ const PHI_HELP = "φi: the azimuth of the plane of incidence from the material's
   "the light comes from φi + 180° and reflects towards φi. It sets the polar plot's plane, the lobe's light " +
   "and the albedo curve's light; the lit sphere has its own light φ.";
 function phiControl(isotropic) {
+  isotropicOnly = isotropic;
   $("phi-i").disabled = isotropic;
   $("phi-i-label").title = isotropic ? "every material shown is isotropic: φi changes nothing" : PHI_HELP;
 }
@@ -144,7 +151,12 @@ async function fastViews() {
   const t0 = performance.now();
   const p = view("polar", `theta_i=${state.ti}&phi_i=${state.pi}&n=180&ch=${state.ch}`, (list, got) => {
     data.polar = list.map((e, k) => ({ e, v: got[k] }));
-    if (got.length) phiControl(got.every((v) => v.isotropic));
+    if (got.length) {
+      const was = isotropicOnly;
+      phiControl(got.every((v) => v.isotropic));
+      // A lobe that answered first was drawn for the other state.
+      if (was !== isotropicOnly && data.lobe.length) drawLobe();
+    }
     // A mirror or refraction lobe is a delta: f_r has none of it, the albedo has it all.
     const delta = list.filter((e, k) => got[k].delta).map((e) => e.label);
     document.querySelector('.panel[data-plot="polar"] .note').textContent = delta.length
@@ -209,7 +221,8 @@ function albedoView() {
       series.push({ x: a.v.theta, y: a.v.y.map((f, k) => Math.abs(f - b.v.y[k])), color: a.e.color, dash: "1 2", width: 1 });
     }
     // An isotropic material's curve is the one of every φi (the server computes it at 0).
-    const phi = answeredPhi(items.filter((x) => !x.v.isotropic));
+    const turned = items.filter((x) => !x.v.isotropic);
+    const phi = turned.length ? turned[0].v.phi_i : 0;
     linePlot($("albedo"), series, { x0: 0, x1: 90, dx: 15, xlabel: `θ′ at φi = ${phi}° (${state.ch === "y" ? "luminance" : CHANNELS[state.ch]})` });
   });
 }
