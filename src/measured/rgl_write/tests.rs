@@ -1,6 +1,8 @@
 //! Writer tests: round trips through brdftab's reader, the error bars, bad input.
 
+use super::build::same_channels;
 use super::*;
+use crate::error::Error;
 use crate::measured::RglBrdf;
 use crate::measured::tensor::TensorFile;
 use crate::progress::Silent;
