@@ -506,9 +506,9 @@ fn the_cpp_wrapper_takes_empty_batches_from_empty_vectors() {
     assert_eq!(run(&mut program(&exe)).trim(), "ok");
 }
 
-/// The header's version macros, the pkg-config file's `Version` and the library's
-/// `brdftab_version()` are the crate's version (hostile_test.c compares the macros with the
-/// library at run time).
+/// The header's version macros, the pkg-config file's `Version`, the CMake package's version
+/// (and the major.minor its compatibility rule accepts) and the library's `brdftab_version()`
+/// are the crate's version (hostile_test.c compares the macros with the library at run time).
 #[test]
 fn the_header_and_the_pkg_config_file_carry_the_crates_version() {
     let version = env!("CARGO_PKG_VERSION");
@@ -531,6 +531,17 @@ fn the_header_and_the_pkg_config_file_carry_the_crates_version() {
         pc.lines().any(|l| l == format!("Version: {version}")),
         "{pc}"
     );
+    let cmake =
+        std::fs::read_to_string(Path::new(CRATE).join("cmake/brdftabConfigVersion.cmake")).unwrap();
+    for line in [
+        format!("set(PACKAGE_VERSION \"{version}\")"),
+        format!(
+            "if(PACKAGE_FIND_VERSION_MAJOR EQUAL {} AND PACKAGE_FIND_VERSION_MINOR EQUAL {}",
+            parts[0], parts[1]
+        ),
+    ] {
+        assert!(cmake.lines().any(|l| l == line), "`{line}` in {cmake}");
+    }
     // SAFETY: brdftab_version returns a static NUL-terminated string.
     let lib = unsafe { std::ffi::CStr::from_ptr(brdftab_c::brdftab_version()) };
     assert_eq!(lib.to_str().unwrap(), version);
@@ -561,30 +572,8 @@ fn the_header_compiles_cleanly_as_c89_c99_and_cpp17() {
     }
 }
 
-/// The README's install block and build block (bindings/c/README.md, **Install**) run as a
-/// user runs them — with PREFIX a scratch directory and LIB where this test run's libraries
-/// are — and the programs they build (shared with an rpath, static from the archive) run.
-#[test]
-fn the_readmes_install_and_pkg_config_flow_works_as_written() {
-    let readme = std::fs::read_to_string(Path::new(CRATE).join("README.md")).unwrap();
-    let from = readme
-        .find("**Install**")
-        .expect("README.md: the **Install** section");
-    let blocks: Vec<&str> = readme[from..]
-        .split("```sh\n")
-        .skip(1)
-        .take(2)
-        .map(|b| b.split("```").next().unwrap())
-        .collect();
-    assert_eq!(blocks.len(), 2, "README.md: the install and build blocks");
-    let (install, build) = (blocks[0], blocks[1]);
-    let dir = TempDir::new("c-install");
-    let prefix = dir.join("prefix");
-    let app = dir.join("app");
-    std::fs::create_dir(&app).unwrap();
-    std::fs::write(
-        app.join("app.c"),
-        r#"#include <stdio.h>
+/// The program the README's build blocks build (`app.c`): one Lambert lookup, printed.
+const APP_C: &str = r#"#include <stdio.h>
 #include <brdftab.h>
 int main(void) {
     double wi[3] = {0, 0.6, 0.8}, wo[3] = {0, 0, 1};
@@ -598,10 +587,37 @@ int main(void) {
     brdftab_close(b);
     return 0;
 }
-"#,
-    )
-    .unwrap();
-    let mut install = install.to_owned();
+"#;
+
+/// The README's **Install** section: its first `lang` blocks from there on, in order.
+fn readme_blocks(lang: &str, n: usize) -> Vec<String> {
+    let readme = std::fs::read_to_string(Path::new(CRATE).join("README.md")).unwrap();
+    let from = readme
+        .find("**Install**")
+        .expect("README.md: the **Install** section");
+    let blocks: Vec<String> = readme[from..]
+        .split(&format!("```{lang}\n"))
+        .skip(1)
+        .take(n)
+        .map(|b| b.split("```").next().unwrap().to_owned())
+        .collect();
+    assert_eq!(
+        blocks.len(),
+        n,
+        "README.md: {n} {lang} blocks after **Install**"
+    );
+    blocks
+}
+
+/// Runs the README's install block as a user runs it — with PREFIX `dir`/prefix and LIB where
+/// this test run's libraries are — then `then` from `dir`/app, which holds `app.c`. Returns
+/// the prefix and the app directory.
+fn install_as_the_readme_says(dir: &Path, then: &str) -> (PathBuf, PathBuf) {
+    let prefix = dir.join("prefix");
+    let app = dir.join("app");
+    std::fs::create_dir(&app).unwrap();
+    std::fs::write(app.join("app.c"), APP_C).unwrap();
+    let mut install = readme_blocks("sh", 1).remove(0);
     for (line, value) in [
         ("PREFIX=/usr/local\n", prefix.clone()),
         ("LIB=target/release\n", lib_dir()),
@@ -612,19 +628,38 @@ int main(void) {
     }
     let root = Path::new(CRATE).join("../..");
     let script = format!(
-        "set -eu\ncd '{}'\n{install}cd '{}'\n{build}",
+        "set -eu\ncd '{}'\n{install}cd '{}'\n{then}",
         root.display(),
         app.display()
     );
     run(Command::new("sh").arg("-c").arg(&script));
-    for exe in ["app", "app-static"] {
-        // Without cargo's LD_LIBRARY_PATH: the program finds the installed library (or none).
-        let out = run(program(app.join(exe)).env_remove("LD_LIBRARY_PATH"));
-        assert_eq!(out.trim(), "0.5 0.5 0.5", "{exe}");
+    (prefix, app)
+}
+
+/// `exe` run without cargo's LD_LIBRARY_PATH (it finds the installed library or none) prints
+/// the Lambert's value; with `shared`, it records the library as `libbrdftab_c.so` (no
+/// prefix's path), else it holds the archive's code.
+fn check_app(exe: &Path, shared: bool) {
+    let out = run(program(exe).env_remove("LD_LIBRARY_PATH"));
+    assert_eq!(out.trim(), "0.5 0.5 0.5", "{}", exe.display());
+    let dynamic = run(Command::new("readelf").arg("-d").arg(exe));
+    if shared {
+        assert!(dynamic.contains("[libbrdftab_c.so]"), "{dynamic}");
+    } else {
+        assert!(!dynamic.contains("libbrdftab_c"), "{dynamic}");
     }
-    let needed = |exe: &str| run(Command::new("readelf").arg("-d").arg(app.join(exe)));
-    assert!(needed("app").contains("[libbrdftab_c.so]"));
-    assert!(!needed("app-static").contains("libbrdftab_c"));
+}
+
+/// The README's install block and build block (bindings/c/README.md, **Install**) run as a
+/// user runs them — with PREFIX a scratch directory and LIB where this test run's libraries
+/// are — and the programs they build (shared with an rpath, static from the archive) run.
+#[test]
+fn the_readmes_install_and_pkg_config_flow_works_as_written() {
+    let build = readme_blocks("sh", 2).remove(1);
+    let dir = TempDir::new("c-install");
+    let (prefix, app) = install_as_the_readme_says(dir.path(), &build);
+    check_app(&app.join("app"), true);
+    check_app(&app.join("app-static"), false);
     // Installed without the release profile's debug line tables (before session 43 the
     // shared library was 54 MB, 48 of them DWARF; the archive 143 MB).
     for lib in ["libbrdftab_c.so", "libbrdftab_c.a"] {
@@ -633,6 +668,71 @@ int main(void) {
             .arg(prefix.join("lib").join(lib)));
         assert!(sections.contains(".text"), "{lib}: {sections}");
         assert!(!sections.contains(".debug_info"), "{lib} carries DWARF");
+    }
+}
+
+/// The README's CMake project (bindings/c/README.md, after **Install**) against the prefix its
+/// install block fills, configured and built with cmake as a user would: both programs run,
+/// the shared one recording `libbrdftab_c.so`. The version file accepts 0.1 and no version,
+/// and refuses 0.2 and 0.1.1; the prefix moved elsewhere still works (the package finds its
+/// files relative to itself).
+#[test]
+#[ignore = "needs cmake: .ci/run installs it and runs this test"]
+fn the_readmes_cmake_project_finds_the_installed_library() {
+    let cmake = readme_blocks("cmake", 1).remove(0);
+    let dir = TempDir::new("c-cmake");
+    let (prefix, app) = install_as_the_readme_says(dir.path(), "");
+    std::fs::write(app.join("CMakeLists.txt"), &cmake).unwrap();
+    let configure = |src: &Path, build: &Path, prefix: &Path| {
+        Command::new("cmake")
+            .arg("-S")
+            .arg(src)
+            .arg("-B")
+            .arg(build)
+            .arg(format!("-DCMAKE_PREFIX_PATH={}", prefix.display()))
+            .output()
+            .unwrap_or_else(|e| panic!("cmake: {e} (apt-get install cmake)"))
+    };
+    let check = |prefix: &Path, build: &Path| {
+        let out = configure(&app, build, prefix);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        run(Command::new("cmake").arg("--build").arg(build));
+        check_app(&build.join("app"), true);
+        check_app(&build.join("app-static"), false);
+    };
+    check(&prefix, &dir.join("build"));
+    // Moved: the same files under another prefix (the old one gone).
+    let moved = dir.join("moved");
+    std::fs::rename(&prefix, &moved).unwrap();
+    check(&moved, &dir.join("build-moved"));
+    // Versions: none and 0.1.0 accepted; 0.2 and 0.1.1 (newer than installed) refused.
+    for (want, ok) in [
+        ("", true),
+        ("0.1.0", true),
+        ("0.2", false),
+        ("0.1.1", false),
+    ] {
+        let src = dir.join(format!("v{want}"));
+        std::fs::create_dir(&src).unwrap();
+        std::fs::write(
+            src.join("CMakeLists.txt"),
+            format!(
+                "cmake_minimum_required(VERSION 3.16)\nproject(v C)\n\
+                 find_package(brdftab {want} CONFIG REQUIRED)\n"
+            ),
+        )
+        .unwrap();
+        let out = configure(&src, &src.join("build"), &moved);
+        assert_eq!(
+            out.status.success(),
+            ok,
+            "find_package(brdftab {want}): {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
 }
 
