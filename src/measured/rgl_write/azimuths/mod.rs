@@ -26,22 +26,21 @@
 //! estimates' noise alone would break. It stops when no figure qualifies or when no split fits
 //! `max_slices`.
 
+mod grid;
+mod slices;
+
+use grid::{Grid, Job, run};
+pub use slices::Encoded;
+use slices::{encoded, reader};
+
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
-use rayon::prelude::*;
-
-use super::elevations::{
-    self, Azimuths, Errors, IMPROVABLE, MARGIN, MIN_STEP, Placement, Slice, figures, floor_over,
-    measure,
-};
+use super::elevations::{self, Errors, IMPROVABLE, MARGIN, MIN_STEP, Placement, Slice, figures};
 use super::ndf::Ndf;
-use super::{Layout, Progress, values, warps};
+use super::{Layout, Progress, Values, container, fields_of};
 use crate::brdf::Brdf;
 use crate::error::Result;
-use crate::measured::RglBrdf;
-use crate::measured::tensor::TensorFile;
-use crate::progress::Silent;
 
 /// Azimuths placement starts from (evenly over [−π, π], both ends included: 8 intervals).
 pub const START_PHI: usize = 9;
@@ -61,87 +60,11 @@ pub fn even_azimuths(n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// One measurement to make: elevations (`a`, `b`) and azimuths `az`.
-#[derive(Clone, Copy)]
-struct Job {
-    a: f64,
-    b: f64,
-    az: Azimuths,
-    seed: u64,
-}
-
-/// The grid and what was measured on it.
-struct Grid {
-    phi: Vec<f64>,
-    theta: Vec<f64>,
-    /// Cells, `[azimuth interval][elevation interval]`.
-    cell: Vec<Vec<Errors>>,
-    /// Each elevation over each azimuth interval, `[azimuth interval][elevation]`.
-    at_theta: Vec<Vec<Errors>>,
-    /// Each azimuth over each elevation interval, `[azimuth][elevation interval]`.
-    at_phi: Vec<Vec<Errors>>,
-}
-
-impl Grid {
-    /// The job over elevations `a`–`b` and azimuths `from`–`to` (the light midway).
-    fn job(a: f64, b: f64, from: f64, to: f64, seed: u64) -> Job {
-        let light = 0.5 * (from + to);
-        let az = Azimuths {
-            from,
-            to,
-            light,
-            rule: ALBEDO_RULE,
-        };
-        Job { a, b, az, seed }
-    }
-    fn cell_job(&self, i: usize, j: usize, seed: u64) -> Job {
-        let (t, p) = (&self.theta, &self.phi);
-        Self::job(t[j], t[j + 1], p[i], p[i + 1], seed)
-    }
-    fn at_theta_job(&self, i: usize, j: usize, seed: u64) -> Job {
-        let (t, p) = (&self.theta, &self.phi);
-        Self::job(t[j], t[j], p[i], p[i + 1], seed)
-    }
-    fn at_phi_job(&self, i: usize, j: usize, seed: u64) -> Job {
-        let (t, p) = (&self.theta, &self.phi);
-        Self::job(t[j], t[j + 1], p[i], p[i], seed)
-    }
-    /// Solid angle of cell (`i`, `j`).
-    fn area(&self, i: usize, j: usize) -> f64 {
-        (self.phi[i + 1] - self.phi[i]) * (self.theta[j].cos() - self.theta[j + 1].cos())
-    }
-    /// The slice-limited errors of cell (`i`, `j`) along elevations and along azimuths.
-    fn floors(&self, i: usize, j: usize) -> (Errors, Errors) {
-        let area = self.area(i, j);
-        (
-            floor_over(&self.at_theta[i][j], &self.at_theta[i][j + 1], area),
-            floor_over(&self.at_phi[i][j], &self.at_phi[i + 1][j], area),
-        )
-    }
-}
-
-/// Runs `jobs` on the file in parallel, asking `progress` to stop before each.
-fn run(
-    file: &RglBrdf,
-    src: &dyn Brdf,
-    jobs: &[Job],
-    progress: &dyn Progress,
-) -> Result<Vec<Errors>> {
-    crate::par::install(|| {
-        jobs.par_iter()
-            .map(|j| {
-                crate::progress::check(progress)?;
-                Ok(measure(file, src, j.a, j.b, &j.az, j.seed))
-            })
-            .collect()
-    })
-}
-
 /// Chooses the incident azimuths and elevations of an anisotropic `brdf` (at most
 /// `max_slices` slices), with `base` giving every other part of the layout. Returns the
 /// placement (its `theta_i`), the azimuths, and the chosen grid's VNDF slices and values as
 /// placement encoded them (φi-major, the file's order), which are the file's: each slice is
-/// encoded alone, as [`warps::vndf`] and [`values::sample`] encode it in the whole layout.
+/// encoded alone, as [`warps::vndf`](super::warps::vndf) and [`values::sample`](super::values::sample) encode it in the whole layout.
 pub fn place(
     brdf: &dyn Brdf,
     ndf: &Ndf,
@@ -356,92 +279,5 @@ pub fn place(
                 }
             }
         }
-    }
-}
-
-/// The file of `base` with azimuths `phi` and elevations `theta`, read back by brdftab's RGL
-/// reader; slices not in `cache` are encoded (in parallel) and kept there. Asks `progress` to
-/// stop before each slice.
-fn reader(
-    brdf: &dyn Brdf,
-    ndf: &Ndf,
-    base: &Layout,
-    phi: &[f64],
-    theta: &[f64],
-    cache: &mut HashMap<(u64, u64), Slice>,
-    progress: &dyn Progress,
-) -> Result<RglBrdf> {
-    let plane = base.n * base.n;
-    let missing: Vec<(f64, f64)> = phi
-        .iter()
-        .flat_map(|&p| theta.iter().map(move |&t| (p, t)))
-        .filter(|(p, t)| !cache.contains_key(&(p.to_bits(), t.to_bits())))
-        .collect();
-    let fresh = crate::par::install(|| {
-        missing
-            .par_iter()
-            .map(|&(p, t)| {
-                crate::progress::check(progress)?;
-                let layout = Layout {
-                    theta_i: vec![t as f32],
-                    phi_i: vec![p as f32],
-                    ..base.clone()
-                };
-                let w = warps::vndf(ndf, &layout)?;
-                let v = values::sample(brdf, ndf, &w, &layout, None, &Silent)?;
-                let valid = super::container::unpack_bits(&v.valid, plane);
-                Ok((
-                    (p.to_bits(), t.to_bits()),
-                    Slice {
-                        vndf: w.data,
-                        values: v.data,
-                        valid,
-                    },
-                ))
-            })
-            .collect::<Result<Vec<_>>>()
-    })?;
-    cache.extend(fresh);
-    let Encoded { vndf, values } = encoded(phi, theta, cache);
-    let layout = Layout {
-        theta_i: theta.iter().map(|&t| t as f32).collect(),
-        phi_i: phi.iter().map(|&p| p as f32).collect(),
-        ..base.clone()
-    };
-    let fields = super::fields_of(String::new(), &layout, ndf, vndf, values, brdf.channels());
-    let tf = TensorFile::from_bytes("(placing azimuths)", fields.to_bytes())?;
-    RglBrdf::from_tensor_unhashed(&tf)
-}
-
-/// The VNDF slices and values of a grid, in the file's order (φi-major).
-pub struct Encoded {
-    /// φi × θi × rows × columns.
-    pub vndf: Vec<f32>,
-    /// The values and their valid bits.
-    pub values: super::Values,
-}
-
-/// The grid `phi` × `theta` of slices in `cache` (every one of them there).
-fn encoded(phi: &[f64], theta: &[f64], cache: &HashMap<(u64, u64), Slice>) -> Encoded {
-    let slices: Vec<&Slice> = (phi.iter())
-        .flat_map(|&p| {
-            theta
-                .iter()
-                .map(move |&t| &cache[&(p.to_bits(), t.to_bits())])
-        })
-        .collect();
-    let valid: Vec<bool> = slices
-        .iter()
-        .flat_map(|s| s.valid.iter().copied())
-        .collect();
-    Encoded {
-        vndf: slices.iter().flat_map(|s| s.vndf.iter().copied()).collect(),
-        values: super::Values {
-            data: slices
-                .iter()
-                .flat_map(|s| s.values.iter().copied())
-                .collect(),
-            valid: super::container::pack_bits(&valid),
-        },
     }
 }
