@@ -64,7 +64,8 @@ pub fn even_azimuths(n: usize) -> Vec<f64> {
 /// `max_slices` slices), with `base` giving every other part of the layout. Returns the
 /// placement (its `theta_i`), the azimuths, and the chosen grid's VNDF slices and values as
 /// placement encoded them (φi-major, the file's order), which are the file's: each slice is
-/// encoded alone, as [`warps::vndf`](super::warps::vndf) and [`values::sample`](super::values::sample) encode it in the whole layout.
+/// encoded alone, as [`warps::vndf`](super::warps::vndf) and
+/// [`values::sample`](super::values::sample) encode it in the whole layout.
 pub fn place(
     brdf: &dyn Brdf,
     ndf: &Ndf,
