@@ -7,6 +7,9 @@
 //!
 //! `cargo bench --bench codec` (set `BRDFTAB_BENCH_REPS` to change repetitions, default 5).
 
+#[allow(dead_code)] // only its clock: this bench times by hand, not through criterion
+mod common;
+
 use std::io::Cursor;
 use std::time::{Duration, Instant};
 
@@ -69,13 +72,12 @@ fn cook_torrance_table(sizes: Option<[usize; 4]>) -> Table {
     })
 }
 
-/// CPU time of the calling thread (Linux: /proc/thread-self/schedstat), for throughput figures
-/// that do not depend on how busy the shared machine is.
+/// CPU time of the calling thread ([`common::thread_cpu_ns`]), for throughput figures that do
+/// not depend on how busy the shared machine is. (Not `/proc/thread-self/schedstat`: the
+/// running thread's runtime there advances only at scheduler ticks, so a decompression of a
+/// few milliseconds read as 1, 2 or 3 ticks and its MB/s landed on a few values.)
 fn thread_cpu() -> Option<Duration> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    Some(Duration::from_nanos(
-        s.split_whitespace().next()?.parse().ok()?,
-    ))
+    Some(Duration::from_nanos(common::thread_cpu_ns()))
 }
 
 /// Best-of-N single-threaded CPU time of `f`.
