@@ -1,4 +1,5 @@
 use super::*;
+use std::f64::consts::{FRAC_PI_2, PI};
 
 fn sym(i: bool, r: bool, b: bool) -> Symmetry {
     Symmetry {
