@@ -45,6 +45,9 @@
 pub mod pairs;
 pub mod params;
 mod problem;
+mod report;
+mod rmse;
+mod start;
 #[cfg(test)]
 mod tests;
 
@@ -53,8 +56,6 @@ use std::time::Instant;
 
 use levenberg_marquardt::LevenbergMarquardt;
 use nalgebra::DVector;
-use serde::Serialize;
-use serde_json::Value as Json;
 
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
@@ -63,7 +64,11 @@ use crate::spec::ModelSpec;
 
 pub use pairs::Pairs;
 pub use params::{Bounds, ColorMode, Param, ParamRequest, Scale};
-use problem::{Problem, eval_cos, from_free, spec_from_json, to_free, transform};
+use problem::{Problem, eval_cos, from_free, to_free, transform};
+pub use report::{FitResult, FittedParam, StartResult};
+use rmse::rel_rmse;
+pub use rmse::relative_rmse;
+pub use start::{preset, with_fresnel};
 
 /// Number of uniform pairs on which the final `rmse` is measured.
 pub const ACCURACY_PAIRS: usize = 20_000;
@@ -111,220 +116,6 @@ impl Default for FitOptions {
             color: ColorMode::PerChannel,
             max_iterations: 100,
         }
-    }
-}
-
-/// A fitted parameter's final value(s).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FittedParam {
-    /// Path into the spec.
-    pub path: String,
-    /// One value per channel, or one.
-    pub value: Vec<f64>,
-    /// The bounds in force.
-    pub bounds: Bounds,
-    /// True when a value ended within 0.1% (of the range, in its scale) of a bound.
-    pub at_bound: bool,
-}
-
-/// The outcome of one start.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct StartResult {
-    /// Parameter values at the start (flattened, in parameter order).
-    pub initial: Vec<f64>,
-    /// Parameter values at the end.
-    pub fitted: Vec<f64>,
-    /// The least-squares objective ½ Σ r² / (pairs · channels) at the end.
-    pub objective: f64,
-    /// Relative RMSE on the fitting pairs.
-    pub rmse: f64,
-    /// LM iterations (Jacobian evaluations).
-    pub iterations: usize,
-    /// Model evaluations over all pairs (residual vectors, including those of the Jacobians).
-    pub evaluations: usize,
-    /// Why LM stopped.
-    pub termination: String,
-}
-
-/// The result of [`fit`].
-#[derive(Debug, Clone, Serialize)]
-pub struct FitResult {
-    /// The fitted spec (valid, builds, usable as a SOURCE).
-    pub spec: ModelSpec,
-    /// Cosine-weighted relative RMSE of the fitted spec against the source on held-out pairs
-    /// drawn like the fitting pairs (see the module docs).
-    pub rmse: f64,
-    /// `analysis::accuracy::compare` on uniform pairs over the whole hemisphere: relative RMSE.
-    pub rmse_uniform: f64,
-    /// `analysis::accuracy::compare`: maximum relative error.
-    pub max_rel_uniform: f64,
-    /// Relative RMSE on the fitting pairs.
-    pub rmse_fit: f64,
-    /// The objective of the best start.
-    pub objective: f64,
-    /// LM iterations of the best start.
-    pub iterations: usize,
-    /// Model evaluations over all starts.
-    pub evaluations: usize,
-    /// Index of the best start.
-    pub best_start: usize,
-    /// The fitted parameters.
-    pub params: Vec<FittedParam>,
-    /// Every start.
-    pub starts: Vec<StartResult>,
-    /// Number of pairs.
-    pub pairs: usize,
-    /// Log-space residuals were used.
-    pub log: bool,
-    /// Wall-clock time of the fit in seconds.
-    pub seconds: f64,
-}
-
-impl FitResult {
-    /// One line per parameter whose value ended at a bound (`kd = [..] ended at a bound of
-    /// 0..0.38 (...)`): the data pushed against it, and a wider `--params` range may fit
-    /// better. What the CLI notes on stderr.
-    ///
-    /// A value held at a lower bound of 0 (a `kd` or `ks` of 0) is another case: the data
-    /// would take it below 0, which no bound may allow, so the note does not suggest wider
-    /// bounds. It says what this means: the source has no such term, or the model lacks
-    /// something the source has and the term was given up to make room. (A lambert+ggx fit to
-    /// the clear-coated RGL paint `cc_ibiza_sunset` ends with `kd = 0`, the true minimum of
-    /// the loss — scipy's bounded least squares on the same pairs agrees to 8 digits — because
-    /// its lobe has no Fresnel term for the clear coat's grazing rise; with `--fresnel schlick`
-    /// the diffuse term comes back, kd ≈ (0.13, 0.002, 0.05), and the RMSE falls from 0.55 to
-    /// 0.19.)
-    pub fn bound_notes(&self) -> Vec<String> {
-        (self.params.iter().filter(|p| p.at_bound))
-            .map(|p| {
-                let at_zero = p.bounds.lo == 0.0
-                    && (p.value.iter())
-                        .filter(|&&v| !(1e-3..=1.0 - 1e-3).contains(&p.bounds.to_unit(v)))
-                        .all(|&v| p.bounds.to_unit(v) < 0.5);
-                if at_zero {
-                    format!(
-                        "{} = {:?} ended at its lower bound 0: the data would take it below 0. \
-                         The source has no such term, or the model lacks something the source \
-                         has (a Fresnel term: --fresnel schlick; another lobe) and gave this \
-                         term up to make room",
-                        p.path, p.value
-                    )
-                } else {
-                    format!(
-                        "{} = {:?} ended at a bound of {}..{} (--params {}=LO:HI moves it)",
-                        p.path, p.value, p.bounds.lo, p.bounds.hi, p.path
-                    )
-                }
-            })
-            .collect()
-    }
-}
-
-/// Default starting spec for a model name, or a sum of them joined with `+`
-/// (`lambert+cook_torrance`, `lambert+ggx`, `lambert+blinn_phong`, `lambert+ward`, `ggx`, ...).
-/// An inline JSON spec (starting with `{`) is parsed and used as given. Fresnel terms are
-/// `"none"`: a fitted `ks` then absorbs the average reflectance.
-pub fn preset(name: &str) -> Result<ModelSpec> {
-    let name = name.trim();
-    if name.starts_with('{') {
-        return ModelSpec::parse(name);
-    }
-    let one = |n: &str| -> Result<Json> {
-        Ok(match n.trim() {
-            "lambert" => serde_json::json!({"model": "lambert", "kd": 0.1}),
-            "oren_nayar" => serde_json::json!({"model": "oren_nayar", "kd": 0.1, "sigma": 0.3}),
-            m @ ("phong" | "reciprocal_phong" | "max_phong") => {
-                serde_json::json!({"model": m, "ks": 1.0, "n": 20.0})
-            }
-            "pumped_phong" => {
-                serde_json::json!({"model": "pumped_phong", "ks": 1.0, "n": 20.0, "x": "mean"})
-            }
-            "blinn_phong" => serde_json::json!({"model": "blinn_phong", "ks": 0.5, "n": 50.0}),
-            "cook_torrance" => serde_json::json!({"model": "cook_torrance", "m": 0.3, "ks": 0.5}),
-            "ggx" => serde_json::json!({"model": "ggx", "alpha": 0.3, "ks": 0.5}),
-            "ward" => {
-                serde_json::json!({"model": "ward", "ks": 0.2, "alpha_x": 0.2, "alpha_y": 0.2})
-            }
-            other => {
-                return Err(Error::arg(
-                    "model",
-                    format!(
-                        "`{other}` cannot be fit; use lambert, oren_nayar, phong, reciprocal_phong, \
-                         max_phong, pumped_phong, blinn_phong, cook_torrance, ggx, ward, sums of \
-                         them with `+`, or a JSON spec"
-                    ),
-                ));
-            }
-        })
-    };
-    let terms = name.split('+').map(one).collect::<Result<Vec<_>>>()?;
-    let json = if terms.len() == 1 {
-        terms.into_iter().next().unwrap_or_default()
-    } else {
-        serde_json::json!({"model": "sum", "terms": terms})
-    };
-    spec_from_json(json)
-}
-
-/// `spec` with the Fresnel term of every microfacet lobe (`cook_torrance`, `ggx`) replaced by
-/// `fresnel` — e.g. `{"schlick": 0.04}` so that a fit also finds F0, or `{"eta": 1.5}` for a
-/// dielectric index. Presets use `"none"` (k_s absorbs the reflectance).
-pub fn with_fresnel(spec: &ModelSpec, fresnel: &crate::fresnel::FresnelSpec) -> Result<ModelSpec> {
-    fn walk(v: &mut Json, f: &Json) {
-        let Some(obj) = v.as_object_mut() else { return };
-        if matches!(
-            obj.get("model").and_then(Json::as_str),
-            Some("cook_torrance" | "ggx")
-        ) {
-            obj.insert("fresnel".into(), f.clone());
-        }
-        if let Some(Json::Array(terms)) = obj.get_mut("terms") {
-            for t in terms {
-                walk(t, f);
-            }
-        }
-    }
-    let to_json = |x: serde_json::Result<Json>| {
-        x.map_err(|e| Error::Json {
-            context: "spec".into(),
-            source: e,
-        })
-    };
-    let mut json = to_json(serde_json::to_value(spec))?;
-    walk(&mut json, &to_json(serde_json::to_value(fresnel))?);
-    spec_from_json(json)
-}
-
-/// Cosine-weighted relative RMSE of `model` against `source` over `pairs`:
-/// sqrt(Σ (f̂ − f)² cos² θi / Σ f² cos² θi), summed over every channel. Both must have the same
-/// channel count.
-pub fn relative_rmse(source: &dyn Brdf, model: &dyn Brdf, pairs: &Pairs) -> Result<f64> {
-    let c = source.channels().len();
-    if model.channels().len() != c {
-        return Err(Error::arg(
-            "model",
-            format!("{} channels, the source has {c}", model.channels().len()),
-        ));
-    }
-    let f = eval_cos(source, pairs);
-    let g = eval_cos(model, pairs);
-    // Zeros from a source that failed while it was read (a corrupt table chunk) are its error.
-    source.health()?;
-    Ok(rel_rmse(&g, &f))
-}
-
-fn rel_rmse(model: &[f64], target: &[f64]) -> f64 {
-    let (mut num, mut den) = (0.0, 0.0);
-    for (a, b) in model.iter().zip(target) {
-        num += (a - b) * (a - b);
-        den += b * b;
-    }
-    if den > 0.0 {
-        (num / den).sqrt()
-    } else if num == 0.0 {
-        0.0
-    } else {
-        f64::INFINITY
     }
 }
 
