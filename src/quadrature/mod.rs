@@ -10,6 +10,12 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use crate::geometry;
 use crate::spectrum::MAX_CHANNELS;
 
+mod legendre;
+mod lobe;
+
+pub use legendre::gauss_legendre;
+use lobe::lobe_centre;
+
 /// Accuracy settings of `hemisphere`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
@@ -209,60 +215,6 @@ pub fn hemisphere(
     }
 }
 
-/// Finds the direction of the reflection lobe of `g` (f·cos θo summed over channels) and a coarse
-/// estimate of the albedo (a midpoint sum over the probe grid; ~0 for a lobe it misses).
-fn lobe_centre(
-    g: &mut impl FnMut(DVec3, &mut usize) -> f64,
-    wi: DVec3,
-    evals: &mut usize,
-) -> (DVec3, f64) {
-    const NT: usize = LOBE_NT;
-    const NP: usize = LOBE_NP;
-    let mirror = geometry::reflect_z(wi);
-    let g_mirror = g(mirror, evals);
-    let (mut best, mut best_t, mut best_p) = (f64::NEG_INFINITY, 0.0, 0.0);
-    let mut sum = 0.0;
-    let (dt, dp) = (FRAC_PI_2 / NT as f64, TAU / NP as f64);
-    for i in 0..NT {
-        let t = (i as f64 + 0.5) * dt;
-        for j in 0..NP {
-            let p = (j as f64 + 0.5) * dp;
-            let v = g(geometry::spherical(t, p), evals);
-            if v.is_finite() {
-                sum += v * t.sin() * dt * dp;
-                if v > best {
-                    (best, best_t, best_p) = (v, t, p);
-                }
-            }
-        }
-    }
-    // The grid's sum alone: a lobe it misses leaves the floors small and the relative
-    // criterion in charge. (A floor of 1e-3 · g(mirror) stood in for a missed lobe's albedo,
-    // but a sharp lobe's peak grows like 1/cos θi at grazing: for Cook-Torrance m = 0.001 at
-    // 89.99° it made the absolute tolerance 0.05 and the albedo 0.053 instead of 0.983.)
-    let scale = sum.max(f64::MIN_POSITIVE);
-    if g_mirror.is_nan() || best <= 2.0 * g_mirror {
-        return (mirror, scale);
-    }
-    // Pattern search from the best grid node, halving the step.
-    let (mut st, mut sp) = (dt, dp);
-    for _ in 0..24 {
-        let mut moved = false;
-        for (a, b) in [(st, 0.0), (-st, 0.0), (0.0, sp), (0.0, -sp)] {
-            let (t, p) = ((best_t + a).clamp(0.0, FRAC_PI_2 - 1e-6), best_p + b);
-            let v = g(geometry::spherical(t, p), evals);
-            if v > best {
-                (best, best_t, best_p, moved) = (v, t, p, true);
-            }
-        }
-        if !moved {
-            st *= 0.5;
-            sp *= 0.5;
-        }
-    }
-    (geometry::spherical(best_t, best_p), scale)
-}
-
 // Gauss-Kronrod 7/15 abscissae (non-negative half) and weights (QUADPACK's qk15).
 const XGK: [f64; 8] = [
     0.991_455_371_120_812_6,
@@ -389,33 +341,4 @@ fn adaptive<F: FnMut(f64, &mut [f64], &mut usize)>(
         segs.push((m, b, e2));
         vals.extend_from_slice(&tmp[..c]);
     }
-}
-
-/// Gauss-Legendre nodes and weights on [-1, 1] (Newton iteration on the Legendre polynomial).
-pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut x = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    for i in 0..n.div_ceil(2) {
-        let mut z = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 0.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, 0.0);
-            for j in 0..n {
-                let p2 = p1;
-                p1 = p0;
-                p0 = ((2 * j + 1) as f64 * z * p1 - j as f64 * p2) / (j + 1) as f64;
-            }
-            dp = n as f64 * (z * p0 - p1) / (z * z - 1.0);
-            let z1 = z;
-            z = z1 - p0 / dp;
-            if (z - z1).abs() < 1e-15 {
-                break;
-            }
-        }
-        x[i] = -z;
-        x[n - 1 - i] = z;
-        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-        w[n - 1 - i] = w[i];
-    }
-    (x, w)
 }
