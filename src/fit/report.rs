@@ -38,7 +38,7 @@ pub struct StartResult {
     pub termination: String,
 }
 
-/// The result of [`fit`].
+/// The result of [`fit`](super::fit).
 #[derive(Debug, Clone, Serialize)]
 pub struct FitResult {
     /// The fitted spec (valid, builds, usable as a SOURCE).
