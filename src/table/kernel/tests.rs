@@ -6,12 +6,15 @@
 //! blends, projection, calibration). The storage format's test is in `packed`, the eight-lane
 //! path's in `x8`.
 
+#[cfg(target_arch = "x86_64")]
+use super::build::has_f16c;
 use super::*;
 use crate::brdf::Brdf;
 use crate::rng::Pcg32;
 use crate::spec::ModelSpec;
 use crate::spectrum::Channels;
 use crate::table::adaptive::adaptive_grid;
+use crate::table::grid::Mapping;
 use crate::table::symmetry::Symmetry;
 use crate::table::warp::Warp;
 use crate::table::{BakeOptions, TabulatedBrdf, bake, lookup::Interp, lookup::Lookup};
