@@ -356,6 +356,31 @@ mod tests {
         assert!(!path.exists());
     }
 
+    /// A bake into `DB#NAME` while another writer holds the database's lock stops when asked:
+    /// it blocked in the lock (until the other writer was done; a streamed bake into the same
+    /// database holds it for the whole bake) without asking.
+    #[test]
+    fn a_bake_into_a_locked_database_stops_when_asked() {
+        use crate::request;
+        let dir = crate::testkit::TempDir::new("cancel_db_lock");
+        let db = dir.join("lib.btdb");
+        let _held = crate::store::db::lock(&db).unwrap();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let target = format!("{}#lambert", db.display());
+        std::thread::spawn(move || {
+            let spec = r#"{"model": "lambert", "kd": 0.5}"#;
+            // The stop comes once the bake's stage has begun: after the plan, at the lock.
+            let stop = CancelAt::new("begin baking");
+            let small: request::BakeSettings =
+                request::from_json(r#"{"preset": "small"}"#).unwrap();
+            let r = request::bake(spec, &target, &small, &stop);
+            let _ = tx.send(r.map(|_| ()));
+        });
+        let r = rx.recv_timeout(std::time::Duration::from_secs(20));
+        assert!(matches!(r, Ok(Err(Error::Cancelled))), "{r:?}");
+        assert!(!db.exists(), "no database written");
+    }
+
     #[test]
     fn a_stage_ends_on_early_return() {
         let log = Log::default();

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 
 use super::{Store, TableHeader, TocEntry, Writer};
 use crate::error::{Error, Result};
+use crate::progress::Progress;
 
 /// Holds the database's writer lock while alive.
 pub struct Lock {
@@ -125,17 +126,33 @@ pub fn refuse_dropping_tables(path: impl AsRef<Path>) -> Result<()> {
     }
 }
 
+/// The host that may ask a change to stop: `None` for the calls without one, which wait for
+/// another writer's lock blocked rather than in polls.
+type Stop<'a> = Option<&'a dyn Progress>;
+
+/// The writer lock, waited for in polls that ask `stop` when there is one ([`lock_with`]).
+fn lock_for(path: &Path, stop: Stop<'_>) -> Result<Lock> {
+    match stop {
+        Some(p) => lock_with(path, p),
+        None => lock(path),
+    }
+}
+
 /// Copies table `e` of `from` into `w` without decoding (checksums are checked on the way).
-fn copy_table(from: &Store, e: &TocEntry, w: &mut Writer) -> Result<()> {
+fn copy_table(from: &Store, e: &TocEntry, w: &mut Writer, stop: Stop<'_>) -> Result<()> {
     let t = from.table(&e.name)?;
     w.begin_kept_table(t.header().clone())?;
-    copy_chunks(&t, w)?;
+    copy_chunks(&t, w, stop)?;
     w.end_table()
 }
 
-/// The encoded chunks of `t`, checksums checked, into the table `w` has begun.
-fn copy_chunks(t: &super::StoredTable, w: &mut Writer) -> Result<()> {
+/// The encoded chunks of `t`, checksums checked, into the table `w` has begun; asks `stop`
+/// before each (a database of many tables is copied whole by every change).
+fn copy_chunks(t: &super::StoredTable, w: &mut Writer, stop: Stop<'_>) -> Result<()> {
     for i in 0..t.chunk_count() {
+        if let Some(p) = stop {
+            crate::progress::check(p)?;
+        }
         w.encoded_chunk(t.raw_chunk(i)?, t.chunk_values(i) as u64)?;
     }
     Ok(())
@@ -152,10 +169,36 @@ pub fn import(
     as_name: &str,
     replace: bool,
 ) -> Result<()> {
+    import_inner(path.as_ref(), from, name, as_name, replace, None)
+}
+
+/// [`import`], asking `progress` to stop as [`put_with`] does.
+///
+/// # Errors
+/// Those of [`import`], and [`Error::Cancelled`] (the database as it was).
+pub fn import_with(
+    path: impl AsRef<Path>,
+    from: &Store,
+    name: &str,
+    as_name: &str,
+    replace: bool,
+    progress: &dyn Progress,
+) -> Result<()> {
+    import_inner(path.as_ref(), from, name, as_name, replace, Some(progress))
+}
+
+fn import_inner(
+    path: &Path,
+    from: &Store,
+    name: &str,
+    as_name: &str,
+    replace: bool,
+    stop: Stop<'_>,
+) -> Result<()> {
     let t = from.table(name)?;
     let mut header = t.header().clone();
     header.name = as_name.to_owned();
-    put(path, header, replace, |w| copy_chunks(&t, w))
+    put_inner(path, header, replace, stop, |w| copy_chunks(&t, w, stop))
 }
 
 /// Adds a table to the database at `path` (created if absent). `write` receives the writer with
@@ -168,11 +211,38 @@ pub fn put(
     replace: bool,
     write: impl FnOnce(&mut Writer) -> Result<()>,
 ) -> Result<()> {
+    put_inner(path.as_ref(), header, replace, None, write)
+}
+
+/// [`put`] for a host that may ask it to stop ([`Progress::cancelled`]): while it waits for
+/// another writer's lock (another process's streamed bake into the same database holds it for
+/// the whole bake) and between the chunks of the other tables it copies. `write` asks for
+/// itself, as a bake does.
+///
+/// # Errors
+/// Those of [`put`], and [`Error::Cancelled`]: the database is as it was, and no temporary
+/// file is left.
+pub fn put_with(
+    path: impl AsRef<Path>,
+    header: TableHeader,
+    replace: bool,
+    progress: &dyn Progress,
+    write: impl FnOnce(&mut Writer) -> Result<()>,
+) -> Result<()> {
+    put_inner(path.as_ref(), header, replace, Some(progress), write)
+}
+
+fn put_inner(
+    user: &Path, // the name errors give
+    header: TableHeader,
+    replace: bool,
+    stop: Stop<'_>,
+    write: impl FnOnce(&mut Writer) -> Result<()>,
+) -> Result<()> {
     // Before the lock file or the database is touched.
     super::name::check("name", &header.name)?;
-    let user = path.as_ref(); // the name errors give
     let path = &crate::files::resolve_links(user)?;
-    let _lock = lock(path)?;
+    let _lock = lock_for(path, stop)?;
     let old = existing(path)?;
     let name = header.name.clone();
     if let Some(s) = &old
@@ -200,7 +270,7 @@ pub fn put(
             if e.name == name {
                 emit(&mut w, &mut new)?;
             } else {
-                copy_table(s, e, &mut w)?;
+                copy_table(s, e, &mut w, stop)?;
             }
         }
     }
@@ -244,7 +314,7 @@ pub fn remove(path: impl AsRef<Path>, name: &str) -> Result<()> {
     }
     let mut w = Writer::create(path)?;
     for e in s.tables().iter().filter(|e| e.name != name) {
-        copy_table(&s, e, &mut w)?;
+        copy_table(&s, e, &mut w, None)?;
     }
     drop(s); // closed before the rename over it (see `put`)
     w.finish()
@@ -279,14 +349,14 @@ pub fn rename(path: impl AsRef<Path>, old: &str, new: &str) -> Result<()> {
     let mut w = Writer::create(path)?;
     for e in s.tables() {
         if e.name != old {
-            copy_table(&s, e, &mut w)?;
+            copy_table(&s, e, &mut w, None)?;
             continue;
         }
         let t = s.table(old)?;
         let mut header = t.header().clone();
         header.name = new.to_owned();
         w.begin_table(header)?;
-        copy_chunks(&t, &mut w)?;
+        copy_chunks(&t, &mut w, None)?;
         w.end_table()?;
     }
     drop(s); // closed before the rename over it (see `put`)
@@ -353,6 +423,52 @@ mod tests {
             }
             r => panic!("{r:?}"),
         }
+    }
+
+    /// Asks to stop from the `after`-th question on.
+    struct StopAfter(std::sync::atomic::AtomicUsize, usize);
+
+    impl Progress for StopAfter {
+        fn cancelled(&self) -> bool {
+            self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed) >= self.1
+        }
+    }
+
+    /// A change asked to stop while it copies the other tables returns `Cancelled` and leaves
+    /// the database byte for byte as it was, with no temporary file beside it; one never asked
+    /// asks once per copied chunk.
+    #[test]
+    fn a_change_stopped_in_its_copy_leaves_the_database_as_it_was() {
+        let d = crate::testkit::TempDir::new("db-stop-copy");
+        let p = d.path().join("lib.btdb");
+        for (i, name) in ["a", "b", "c"].into_iter().enumerate() {
+            put_table(&p, name, i as f32).unwrap();
+        }
+        let bytes = std::fs::read(&p).unwrap();
+        let files = || std::fs::read_dir(d.path()).unwrap().count();
+        let before = files(); // the database and its lock file
+        for after in 0..3 {
+            let stop = StopAfter(Default::default(), after);
+            let r = put_with(&p, header("d"), false, &stop, |w| w.chunk(&[9.0; 12]));
+            assert!(matches!(r, Err(Error::Cancelled)), "{after}: {r:?}");
+            let from = Store::open(&p).unwrap();
+            let r = import_with(&p, &from, "a", "e", false, &stop);
+            assert!(matches!(r, Err(Error::Cancelled)), "{after}: {r:?}");
+            assert_eq!(
+                std::fs::read(&p).unwrap(),
+                bytes,
+                "{after}: the database untouched"
+            );
+            assert_eq!(files(), before, "{after}: no temporary file left");
+        }
+        let never = StopAfter(Default::default(), usize::MAX);
+        put_with(&p, header("d"), false, &never, |w| w.chunk(&[9.0; 12])).unwrap();
+        let asked = never.0.load(std::sync::atomic::Ordering::Relaxed);
+        assert_eq!(
+            asked, 3,
+            "one question per copied chunk (three one-chunk tables)"
+        );
+        assert_eq!(names(&p), ["a", "b", "c", "d"]);
     }
 
     /// A table name with `\` is refused wherever a table is made or renamed — a database

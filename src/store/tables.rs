@@ -89,6 +89,23 @@ pub fn save(
     db::put(path, header, replace, |w| write_table_chunks(w, table))
 }
 
+/// [`save`] into a database, asking `progress` to stop while it waits for another writer's
+/// lock and copies the other tables ([`db::put_with`]).
+pub(crate) fn save_with(
+    path: &Path,
+    name: &str,
+    source: Source,
+    table: &Table,
+    codec: Codec,
+    replace: bool,
+    progress: &dyn crate::progress::Progress,
+) -> Result<()> {
+    let header = TableHeader::for_grid(name, source, table.grid(), codec);
+    db::put_with(path, header, replace, progress, |w| {
+        write_table_chunks(w, table)
+    })
+}
+
 /// Writes `table` as `name`, the one table of a new brdftab file that replaces whatever is at
 /// `path` atomically (a failed write leaves the old file as it was), encoding its chunks in
 /// parallel.

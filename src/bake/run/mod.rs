@@ -153,13 +153,13 @@ impl BakeRequest {
                     let stored =
                         crate::store::tables::open_brdf_at(staging.path(), Some(&name), false)?;
                     let a = measure(stored)?;
-                    staging.commit(target, &name)?;
+                    staging.commit(target, &name, progress)?;
                     (r, Some(a))
                 } else {
                     match target {
-                        BakeTarget::Db { path, replace, .. } => {
-                            tables::save(path, &name, provenance, &table, self.codec, *replace)?
-                        }
+                        BakeTarget::Db { path, replace, .. } => tables::save_with(
+                            path, &name, provenance, &table, self.codec, *replace, progress,
+                        )?,
                         // Replaced atomically, as a streamed bake replaces it: a write that
                         // fails (a value the codec cannot hold, a full disk) leaves the old
                         // file as it was.
@@ -177,7 +177,7 @@ impl BakeRequest {
                     Some(&name),
                     false,
                 )?)?;
-                staging.commit(target, &name)?;
+                staging.commit(target, &name, progress)?;
                 (r, Some(a))
             }
             _ => (
@@ -250,7 +250,9 @@ impl BakeRequest {
             src.health()
         };
         match target {
-            BakeTarget::Db { path, replace, .. } => db::put(path, header, *replace, write)?,
+            BakeTarget::Db { path, replace, .. } => {
+                db::put_with(path, header, *replace, progress, write)?
+            }
             t => {
                 let mut w = Writer::create(t.path())?;
                 w.begin_table(header)?;

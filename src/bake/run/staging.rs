@@ -26,12 +26,18 @@ impl Staging {
     }
 
     /// Moves the measured table into `target`: renamed over a file, imported (its chunks
-    /// copied as they are) into a database.
-    pub(super) fn commit(self, target: &BakeTarget, name: &str) -> Result<()> {
+    /// copied as they are) into a database — a copy `progress` may stop, the database then
+    /// as it was.
+    pub(super) fn commit(
+        self,
+        target: &BakeTarget,
+        name: &str,
+        progress: &dyn crate::progress::Progress,
+    ) -> Result<()> {
         match target {
             BakeTarget::Db { path, replace, .. } => {
                 let store = crate::store::Store::open(&self.0)?;
-                db::import(path, &store, name, name, *replace)
+                db::import_with(path, &store, name, name, *replace, progress)
             }
             t => {
                 let out = crate::files::resolve_links(t.path())?;
