@@ -4,7 +4,8 @@ DELAY s after the call starts, to its KeyboardInterrupt, and the files the call 
     python bindings/python/bench/sigint.py CASE DELAY [DELAY ...]
 
 CASE: bake_rgl, convert_btdb, convert_bsdf_aniso, convert_bsdf_iso, fit, cache_lock (a child
-process holds the cached table's lock). A DELAY past the call's end reports its duration.
+process holds the cached table's lock), db_lock (a child holds the lock of the database a bake
+into DB#NAME writes). A DELAY past the call's end reports its duration.
 """
 import os, pathlib, signal, sys, threading, time, tempfile, subprocess
 import brdftab
@@ -24,6 +25,7 @@ CASES = {
     "convert_bsdf_iso": lambda: brdftab.convert(D + "satin_rosaline_rgb.bsdf", out("d.bsdf"), resolution=48),
     "fit": lambda: brdftab.fit(D + "satin_rosaline_rgb.bsdf", "ggx"),
     "cache_lock": None,
+    "db_lock": None,
 }
 def cache_lock():
     cd = out("cache")
@@ -42,6 +44,21 @@ def cache_lock():
     finally:
         holder.kill(); holder.wait()
 CASES["cache_lock"] = cache_lock
+def hold(lock_path):
+    """A child process holding the writer lock `lock_path` (as another writer would)."""
+    holder = subprocess.Popen([sys.executable, "-c",
+        "import fcntl,sys,time; f=open(sys.argv[1],'a'); fcntl.flock(f, fcntl.LOCK_EX); print('held', flush=True); time.sleep(600)", lock_path],
+        stdout=subprocess.PIPE)
+    holder.stdout.readline()
+    return holder
+def db_lock():
+    # another writer's streamed bake into the same database holds its lock for the whole bake
+    holder = hold(out(".lib.btdb.lock"))
+    try:
+        return brdftab.bake('{"model": "lambert", "kd": 0.5}', out("lib.btdb") + "#lambert", preset="small")
+    finally:
+        holder.kill(); holder.wait()
+CASES["db_lock"] = db_lock
 case = sys.argv[1]
 for d in map(float, sys.argv[2:]):
     sent = [None]
