@@ -3,7 +3,7 @@
 Why a module: the plugin drew its half vectors with Mitsuba's ``MarginalContinuous2D1``: two
 binary searches over CDFs interpolated between conditioning slices, a dozen dependent gathers,
 about 70 % of a sample's time. The library draws the same densities with alias tables
-(Rust ``src/table/alias2d.rs``) and exports them (``Brdf.sampling_nodes()["alias"]``, Rust
+(Rust ``src/table/alias2d/``) and exports them (``Brdf.sampling_nodes()["alias"]``, Rust
 ``brdftab::table::AliasTables``); this is that draw on Dr.Jit arrays, so the plugin runs the
 library's sampling structure itself, not a warp of its own on the same nodes:
 

@@ -3,7 +3,7 @@ plugin's JIT variants.
 
 Why a module: the plugin used to sample wo from 2D distributions of its own (16 slices over
 θi, a cosine mixture) whose weights reached 20–170 near the normal and the horizon. This is
-the design of ``src/table/sampling.rs`` (see its module docs) on the densities the library
+the design of ``src/table/sampling/`` (see its module docs) on the densities the library
 exports (:meth:`brdftab.Brdf.sampling_nodes`, adjoint: conditioned on wi, ∝ f_r cos θo):
 
 - the unit square (s, y) ↦ half vector h, θh = (π/2)(a s + (1 − a) s²) (a = the nodes' ``linear``), φh = 2π y − π relative

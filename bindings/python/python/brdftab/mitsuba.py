@@ -56,7 +56,7 @@ luminance, as Mitsuba reads RGB inputs there.
   (``Table.device_layout``, Rust ``src/table/device.rs``: the kernel's knot lines and packed
   values, or a dense grid with its folds and axis mappings) and evaluates that layout in Dr.Jit
   operations (:class:`JitTable`), tested equal to the Rust lookup to 1e-5 for every table kind.
-  Sampling is the library's (``src/table/sampling.rs``): wo is drawn as the mirror image of
+  Sampling is the library's (``src/table/sampling/``): wo is drawn as the mirror image of
   wi about a half vector from conditional 2D warps of f_r cos θo over the half vector, on the
   node densities the library exports (``Brdf.sampling_nodes``), conditioned on θi (and φi for
   anisotropic tables), drawn with the library's own alias tables (``brdftab._alias2d``), with
