@@ -1,3 +1,6 @@
+//! Tests of the trait's provided methods: batches (with the draws' delta flags, at
+//! wavelengths) equal one-pair calls, and a draw at no wavelengths still draws.
+
 use super::*;
 use crate::batch::{BLOCK, PARALLEL, SampleOut};
 use crate::models::lambert::Lambert;

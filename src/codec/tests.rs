@@ -1,3 +1,6 @@
+//! Tests of the codec pipeline: round trips within each quantizer's bound (property tests on
+//! adversarial values), and damaged or garbage chunks refused, never a panic.
+
 use super::*;
 use proptest::prelude::*;
 

@@ -1,3 +1,6 @@
+//! Tests of the fit: known parameters recovered (per channel, grey, in log space), bounds
+//! kept, and bad options and pair counts refused as errors.
+
 use super::*;
 use crate::spectrum::Channels;
 

@@ -1,3 +1,6 @@
+//! Tests of the spec schema: every listed example round-trips, the declaration and the enum
+//! agree, and a bad spec's error names its field and path.
+
 use super::json::SERIALIZED;
 use super::*;
 

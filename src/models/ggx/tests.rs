@@ -1,3 +1,7 @@
+//! Tests of GGX against the math: the NDF's normalization and closed-form peak, the
+//! trigonometric formulas, symmetries and reciprocity, the white furnace, and chi-square tests
+//! of its samplers.
+
 use super::*;
 use crate::analysis::albedo::gauss_legendre;
 use crate::models::test_util::*;

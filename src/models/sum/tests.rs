@@ -1,3 +1,6 @@
+//! Tests of the weighted sum: its value is the weighted terms', its flags and albedo follow
+//! the terms', and its mixture sampler (delta terms included) passes chi-square.
+
 use super::*;
 use crate::fresnel::FresnelSpec;
 use crate::geometry;

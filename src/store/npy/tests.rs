@@ -1,3 +1,6 @@
+//! Tests of the `.npy` header and reader: the exports' header reads back, other layouts and
+//! dtypes are refused by name, and mutated or truncated files are refused, never a panic.
+
 use super::*;
 
 /// An `.npy` file of `version` with header dict `dict` (padded as numpy pads) and `data`.

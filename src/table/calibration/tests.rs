@@ -1,3 +1,7 @@
+//! Tests of the albedo calibration: a biased table gets its reference's albedos (reciprocal
+//! and anisotropic references included), the lane forms equal the plain one, malformed
+//! calibrations are refused.
+
 use super::*;
 use crate::analysis::fidelity::{Reversed, mirror_albedo};
 use crate::brdf::Brdf;

@@ -1,3 +1,6 @@
+//! Tests of grids: the lecture's node counts, the stored layout's order and offsets, MERL's
+//! indices, coordinate round trips, the JSON form, and inconsistent grids refused.
+
 use super::*;
 use std::f64::consts::{FRAC_PI_2, PI};
 

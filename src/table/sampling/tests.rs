@@ -1,3 +1,6 @@
+//! Tests of the table sampler's pieces against plain references in the paper's terms: the
+//! half-vector map and its Jacobian, `pdf` and `sample`, the nodes and their adjoint.
+
 use super::half_map::{LINEAR, s_of_theta};
 use super::*;
 use crate::rng::Pcg32;

@@ -1,3 +1,6 @@
+//! Tests of the contract checker itself: each flaw planted in a test BRDF is caught by its
+//! check, and Lambert passes.
+
 use super::*;
 use crate::brdf::{BrdfSample, Flags};
 use crate::spectrum::Channels;
