@@ -36,7 +36,7 @@ pub use bake::{BakeSettings, bake};
 pub use convert::{ConvertOutput, ConvertSettings, convert};
 pub use fit::{FitSettings, fit};
 pub use open::{OpenSettings, open};
-pub use save::{SaveSettings, import_npy, save_table};
+pub use save::{SaveSettings, import_npy, save_table, save_table_with};
 pub use values::{ErrorTarget, Names, Wavelengths};
 
 use serde::Serialize;

@@ -299,11 +299,22 @@ pub fn write_table(
 /// Removes table `name`. Errors with [`Error::NotFound`] if it or the database is absent
 /// (naming the tables the database holds).
 pub fn remove(path: impl AsRef<Path>, name: &str) -> Result<()> {
-    let user = path.as_ref(); // the name errors give
+    remove_inner(path.as_ref(), name, None)
+}
+
+/// [`remove`], asking `progress` to stop as [`put_with`] does.
+///
+/// # Errors
+/// Those of [`remove`], and [`Error::Cancelled`] (the database as it was).
+pub fn remove_with(path: impl AsRef<Path>, name: &str, progress: &dyn Progress) -> Result<()> {
+    remove_inner(path.as_ref(), name, Some(progress))
+}
+
+fn remove_inner(user: &Path, name: &str, stop: Stop<'_>) -> Result<()> {
     let path = &crate::files::resolve_links(user)?;
     // A missing database is reported before the lock, which would leave its lock file behind.
     crate::files::require_regular(user)?;
-    let _lock = lock(path)?;
+    let _lock = lock_for(path, stop)?;
     let s = Store::open(path)?;
     if !s.tables().iter().any(|t| t.name == name) {
         return Err(super::no_table(
@@ -314,7 +325,7 @@ pub fn remove(path: impl AsRef<Path>, name: &str) -> Result<()> {
     }
     let mut w = Writer::create(path)?;
     for e in s.tables().iter().filter(|e| e.name != name) {
-        copy_table(&s, e, &mut w, None)?;
+        copy_table(&s, e, &mut w, stop)?;
     }
     drop(s); // closed before the rename over it (see `put`)
     w.finish()
@@ -331,12 +342,28 @@ pub fn remove(path: impl AsRef<Path>, name: &str) -> Result<()> {
 /// already (`old` itself included), [`Error::InvalidArgument`] (`name`) for a `new` the rule
 /// refuses — each before the database is rewritten.
 pub fn rename(path: impl AsRef<Path>, old: &str, new: &str) -> Result<()> {
+    rename_inner(path.as_ref(), old, new, None)
+}
+
+/// [`rename`], asking `progress` to stop as [`put_with`] does.
+///
+/// # Errors
+/// Those of [`rename`], and [`Error::Cancelled`] (the database as it was).
+pub fn rename_with(
+    path: impl AsRef<Path>,
+    old: &str,
+    new: &str,
+    progress: &dyn Progress,
+) -> Result<()> {
+    rename_inner(path.as_ref(), old, new, Some(progress))
+}
+
+fn rename_inner(user: &Path, old: &str, new: &str, stop: Stop<'_>) -> Result<()> {
     super::name::check("name", new)?;
-    let user = path.as_ref(); // the name errors give
     let path = &crate::files::resolve_links(user)?;
     // A missing database is reported before the lock, which would leave its lock file behind.
     crate::files::require_regular(user)?;
-    let _lock = lock(path)?;
+    let _lock = lock_for(path, stop)?;
     let s = Store::open(path)?;
     let container = user.display().to_string();
     if !s.tables().iter().any(|t| t.name == old) {
@@ -349,14 +376,14 @@ pub fn rename(path: impl AsRef<Path>, old: &str, new: &str) -> Result<()> {
     let mut w = Writer::create(path)?;
     for e in s.tables() {
         if e.name != old {
-            copy_table(&s, e, &mut w, None)?;
+            copy_table(&s, e, &mut w, stop)?;
             continue;
         }
         let t = s.table(old)?;
         let mut header = t.header().clone();
         header.name = new.to_owned();
         w.begin_table(header)?;
-        copy_chunks(&t, &mut w, None)?;
+        copy_chunks(&t, &mut w, stop)?;
         w.end_table()?;
     }
     drop(s); // closed before the rename over it (see `put`)
@@ -453,6 +480,14 @@ mod tests {
             assert!(matches!(r, Err(Error::Cancelled)), "{after}: {r:?}");
             let from = Store::open(&p).unwrap();
             let r = import_with(&p, &from, "a", "e", false, &stop);
+            assert!(matches!(r, Err(Error::Cancelled)), "{after}: {r:?}");
+            drop(from);
+            // Removing or renaming one of three copies the other two, one chunk each.
+            let stop = StopAfter(Default::default(), after.min(1));
+            let r = remove_with(&p, "c", &stop);
+            assert!(matches!(r, Err(Error::Cancelled)), "{after}: {r:?}");
+            let stop = StopAfter(Default::default(), after);
+            let r = rename_with(&p, "a", "z", &stop);
             assert!(matches!(r, Err(Error::Cancelled)), "{after}: {r:?}");
             assert_eq!(
                 std::fs::read(&p).unwrap(),

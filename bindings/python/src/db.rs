@@ -6,7 +6,7 @@
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 
-use crate::errors::{guard, lib_err, unlocked};
+use crate::errors::{guard, interruptible, lib_err, unlocked};
 use crate::values::path_arg;
 
 /// The names of the tables of database `path`, in file order: its table of contents, read
@@ -33,17 +33,18 @@ pub(crate) fn _check_table_name(name: &str) -> PyResult<()> {
 }
 
 /// Removes table `name` from database `path`, with the GIL released: the database is
-/// rewritten, after waiting for its lock (another writer's turn).
+/// rewritten, after waiting for its lock (another writer's turn). Ctrl-C stops it, in that
+/// wait too (`KeyboardInterrupt`, the database as it was).
 #[pyfunction]
 pub(crate) fn db_remove(py: Python<'_>, path: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
     guard(|| {
         let path = path_arg(path, "path")?;
-        unlocked(py, || brdftab::store::db::remove(&path, name))?.map_err(lib_err)
+        interruptible(py, |p| brdftab::store::db::remove_with(&path, name, p))?.map_err(lib_err)
     })
 }
 
 /// Renames table `old` of database `path` to `new`, with the GIL released as `db_remove` does:
-/// the database is rewritten after waiting for its lock.
+/// the database is rewritten after waiting for its lock; Ctrl-C stops it.
 #[pyfunction]
 pub(crate) fn db_rename(
     py: Python<'_>,
@@ -53,12 +54,13 @@ pub(crate) fn db_rename(
 ) -> PyResult<()> {
     guard(|| {
         let path = path_arg(path, "path")?;
-        unlocked(py, || brdftab::store::db::rename(&path, old, new))?.map_err(lib_err)
+        interruptible(py, |p| brdftab::store::db::rename_with(&path, old, new, p))?.map_err(lib_err)
     })
 }
 
 /// Adds the table of a single-table file's bytes (what `bake` writes to a `.btdb` path) to
-/// database `path` as `name`, copying its encoded chunks (no re-encoding; checksums checked).
+/// database `path` as `name`, copying its encoded chunks (no re-encoding; checksums checked),
+/// after waiting for the database's lock; Ctrl-C stops it.
 ///
 /// `data` is read where it is: a `bytes` object is immutable, and the `PyBackedBytes` keeps it
 /// alive while the store reads it. (It was extracted into a `Vec<u8>`, a copy whose allocation
@@ -80,7 +82,7 @@ pub(crate) fn db_import(
         };
         let path = path_arg(path, "path")?;
         let data = pyo3::pybacked::PyBackedBytes::from(data);
-        unlocked(py, || {
+        interruptible(py, |p| {
             let s = brdftab::store::Store::from_bytes("the bytes", data, opts)?;
             let from = match s.tables() {
                 [t] => t.name.clone(),
@@ -96,7 +98,7 @@ pub(crate) fn db_import(
                     ));
                 }
             };
-            brdftab::store::db::import(&path, &s, &from, name, replace)
+            brdftab::store::db::import_with(&path, &s, &from, name, replace, p)
         })?
         .map_err(lib_err)
     })

@@ -19,7 +19,7 @@ use pyo3::types::{PyDict, PyTuple};
 
 use crate::arrays::f32_array;
 use crate::brdf::PyBrdf;
-use crate::errors::{Error, guard, lib_err, unlocked};
+use crate::errors::{Error, guard, interruptible, lib_err, unlocked};
 use crate::values::{exact_path, file_part, path_arg, settings_of, to_py};
 
 /// A decoded table (`Brdf.table()`): its values as a numpy array sharing the table's memory,
@@ -172,8 +172,10 @@ impl PyTable {
                 description: self.table.description().to_owned(),
             };
             let t = &self.table;
-            let info = unlocked(py, || request::save_table(t, &output, source, &settings))?
-                .map_err(lib_err)?;
+            let info = interruptible(py, |p| {
+                request::save_table_with(t, &output, source, &settings, p)
+            })?
+            .map_err(lib_err)?;
             let d = to_py(py, &info)?;
             exact_path(d.bind(py), "file", &[file_part(&output)])?;
             Ok(d)

@@ -145,6 +145,54 @@ def test_a_tables_node_coordinates_and_lookup_copy_release_the_gil(tmp_path):
     assert sum(inside) > 0, f"open: no other thread ran during calls of {ms} ms"
 
 
+def test_ctrl_c_stops_every_wait_for_a_database_lock(tmp_path):
+    """Another writer holds the database's lock (a streamed bake into the same database holds
+    it for its whole bake): a bake into ``DB#NAME``, ``Table.save`` into one, and
+    ``Database.remove``, ``rename`` and ``add_bytes`` wait for it, and Ctrl-C stops each wait
+    (they waited until the lock was free, Ctrl-C pending), leaving the database as it was. In a
+    child process, which holds the lock itself and would hang on the old code."""
+    one = tmp_path / "one.btdb"
+    brdftab.bake('{"model": "lambert", "kd": 0.5}', str(one), preset="small")
+    path = tmp_path / "m.btdb"
+    db = brdftab.Database(path)
+    db.add_bytes("a", one.read_bytes())
+    calls = {
+        "bake": f"brdftab.bake(SPEC, {str(path) + '#b'!r}, preset='small')",
+        "save": f"brdftab.open({str(one)!r}).table().save({str(path) + '#c'!r})",
+        "remove": "db.remove('a')",
+        "rename": "db.rename('a', 'z')",
+        "add_bytes": f"db.add_bytes('d', open({str(one)!r}, 'rb').read())",
+    }
+    code = f"""
+import fcntl, os, signal, sys, threading, time, brdftab
+signal.signal(signal.SIGINT, signal.default_int_handler)  # a background job's child ignores it
+SPEC = '{{"model": "lambert", "kd": 0.5}}'
+db = brdftab.Database({str(path)!r})
+lock = open({str(tmp_path / ".m.btdb.lock")!r}, "w")
+fcntl.flock(lock, fcntl.LOCK_EX)   # another writer's turn, never ended
+for name, call in {calls!r}.items():
+    threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    t0 = time.perf_counter()
+    try:
+        exec(call)
+        print(name, "returned", flush=True)
+    except KeyboardInterrupt:
+        print(name, "interrupted", round(time.perf_counter() - t0, 3), flush=True)
+"""
+    before = path.read_bytes()
+    try:
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                           timeout=60)
+    except subprocess.TimeoutExpired as e:
+        raise AssertionError(f"a wait for the lock did not stop: {e.stdout}") from None
+    lines = [l.split() for l in r.stdout.splitlines()]
+    assert [l[:2] for l in lines] == [[n, "interrupted"] for n in calls], r.stdout + r.stderr
+    # Within a few of the 50 ms polls after the signal (0.3 s), not at a lock's release.
+    assert all(float(l[2]) < 5.0 for l in lines), r.stdout
+    assert path.read_bytes() == before
+    assert db.names() == ["a"]
+
+
 def test_listing_and_removing_tables_release_the_gil(tmp_path):
     """`Database.names` (and so `in`, `len` and iteration) reads the table of contents without
     the GIL: another thread runs meanwhile. (It held it, reading every table's header too: 30 ms

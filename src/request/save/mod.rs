@@ -90,6 +90,23 @@ pub fn save_table(
     source: store::Source,
     settings: &SaveSettings,
 ) -> Result<serde_json::Value> {
+    save_table_with(table, output, source, settings, &crate::progress::Silent)
+}
+
+/// [`save_table`] for a host that may ask it to stop: into `DB#NAME`, while it waits for
+/// another writer's lock and copies the database's other tables
+/// ([`store::db::put_with`]).
+///
+/// # Errors
+/// Those of [`save_table`], and [`Error::Cancelled`]: the output as
+/// it was.
+pub fn save_table_with(
+    table: &Table,
+    output: impl AsRef<OsStr>,
+    source: store::Source,
+    settings: &SaveSettings,
+    progress: &dyn crate::progress::Progress,
+) -> Result<serde_json::Value> {
     let codec = settings.codec()?;
     let (path, name) = match target(&output, settings.replace)? {
         BakeTarget::Db {
@@ -98,7 +115,7 @@ pub fn save_table(
             replace,
         } => {
             bake::refuse_name_conflict(settings.name.as_deref(), &name)?;
-            tables::save(&path, &name, source, table, codec, replace)?;
+            tables::save_with(&path, &name, source, table, codec, replace, progress)?;
             (path, name)
         }
         t => {

@@ -127,13 +127,16 @@ class Database:
         _native.db_import(self.path, name, data, replace)
 
     def remove(self, name):
-        """Removes table NAME."""
+        """Removes table NAME; the database is rewritten atomically, after waiting for its lock
+        with the GIL released (Ctrl-C stops the wait: ``KeyboardInterrupt``, the database as it
+        was)."""
         _check_name(name)
         _native.db_remove(self.path, name)
 
     def rename(self, old, new):
         """Renames table OLD to NEW; the table keeps its place and its stored bytes. The
-        database is rewritten atomically, after waiting for its lock with the GIL released.
+        database is rewritten atomically, after waiting for its lock with the GIL released
+        (Ctrl-C stops the wait, as in :meth:`remove`).
         :class:`Error` (not found) when the database or OLD is absent; :class:`Error` when the
         database holds a table NEW already; ``ValueError`` for a name the rule refuses."""
         _check_name(old)

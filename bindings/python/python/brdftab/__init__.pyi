@@ -356,10 +356,11 @@ class Database:
         buffer (bytearray, memoryview, mmap, ...) is copied into bytes first (MemoryError if
         that does not fit)."""
     def remove(self, name: str) -> None:
-        """Removes table NAME."""
+        """Removes table NAME (atomic; GIL released while waiting for the lock, a wait Ctrl-C
+        stops)."""
     def rename(self, old: str, new: str) -> None:
         """Renames table OLD to NEW (its place and stored bytes kept; atomic, GIL released
-        while waiting for the lock). Error when OLD or the database is absent or NEW is
+        while waiting for the lock, a wait Ctrl-C stops). Error when OLD or the database is absent or NEW is
         taken; ValueError for a name the rule refuses."""
     def open(self, name: str, **options: Any) -> Brdf:
         """Opens table NAME as a Brdf (the keywords of `open`)."""
