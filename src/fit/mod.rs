@@ -59,15 +59,14 @@ use nalgebra::DVector;
 
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
-use crate::rng::Pcg32;
 use crate::spec::ModelSpec;
 
 pub use pairs::Pairs;
 pub use params::{Bounds, ColorMode, Param, ParamRequest, Scale};
 use problem::{Problem, eval_cos, from_free, to_free, transform};
 pub use report::{FitResult, FittedParam, StartResult};
-use rmse::rel_rmse;
 pub use rmse::relative_rmse;
+use start::StartPoints;
 pub use start::{preset, with_fresnel};
 
 /// Number of uniform pairs on which the final `rmse` is measured.
@@ -132,40 +131,7 @@ pub fn fit_with_progress(
     progress: &dyn crate::progress::Progress,
 ) -> Result<FitResult> {
     let clock = Instant::now();
-    if opts.pairs == 0 {
-        return Err(Error::arg("pairs", "at least one pair is needed"));
-    }
-    let c = source.channels().len();
-    if opts.pairs.checked_mul(c).is_none_or(|n| n > MAX_RESIDUALS) {
-        return Err(Error::arg(
-            "pairs",
-            format!(
-                "{} pairs × {c} channels: at most {MAX_RESIDUALS} residuals ({} pairs of {c} \
-                 channels)",
-                opts.pairs,
-                MAX_RESIDUALS / c.max(1)
-            ),
-        ));
-    }
-    if opts.starts == 0 {
-        return Err(Error::arg("starts", "at least one start is needed"));
-    }
-    if !(0.0..=1.0).contains(&opts.specular_fraction) {
-        return Err(Error::arg("specular_fraction", "must be in [0, 1]"));
-    }
-    if source.flags().delta {
-        return Err(Error::Unsupported(
-            "fitting a delta (mirror/refractor) source: eval is 0 everywhere".into(),
-        ));
-    }
-    // A sum's delta term is invisible to eval: a fit would match the other terms only.
-    if source.flags().lobes.delta {
-        return Err(Error::Unsupported(
-            "fitting a source with a delta term (mirror/refractor): eval does not see the delta, \
-             so the fit would match the other terms only; fit those"
-                .into(),
-        ));
-    }
+    check(source, opts)?;
     let channels = source.channels().clone();
     let mut base = serde_json::to_value(init).map_err(|e| Error::Json {
         context: "spec".into(),
@@ -206,31 +172,7 @@ pub fn fit_with_progress(
     for p in &params {
         first.extend(params::read(&mut base, p, &channels)?);
     }
-    let mut rng = Pcg32::with_stream(opts.seed, 0x5354_4152);
-    let lhs: Vec<Vec<usize>> = params
-        .iter()
-        .map(|_| {
-            let k = opts.starts.saturating_sub(1);
-            let mut perm: Vec<usize> = (0..k).collect();
-            for i in (1..k).rev() {
-                perm.swap(i, rng.below(i as u32 + 1) as usize);
-            }
-            perm
-        })
-        .collect();
-    let start_values = |s: usize| -> Vec<f64> {
-        if s == 0 {
-            // The spec's own values, pulled inside the bounds.
-            return from_free(&params, &to_free(&params, &first));
-        }
-        let k = (opts.starts - 1) as f64;
-        let mut v = Vec::with_capacity(n_free);
-        for (pi, p) in params.iter().enumerate() {
-            let u = 0.05 + 0.9 * (lhs[pi][s - 1] as f64 + 0.5) / k;
-            v.extend(std::iter::repeat_n(p.bounds.from_unit(u), p.width));
-        }
-        v
-    };
+    let start_points = StartPoints::new(&params, first, opts.starts, opts.seed);
 
     let lm = LevenbergMarquardt::new()
         .with_ftol(1e-10)
@@ -243,7 +185,7 @@ pub fn fit_with_progress(
     let mut evaluations = 0;
     let _stage = crate::progress::Stage::begin(progress, "fitting", opts.starts as u64);
     for s in 0..opts.starts {
-        let x0 = start_values(s);
+        let x0 = start_points.values(&params, s);
         let t0 = DVector::from_vec(to_free(&params, &x0));
         problem.t = t0;
         problem.iterations.set(0);
@@ -252,25 +194,7 @@ pub fn fit_with_progress(
         problem = p;
         crate::progress::check(progress)?;
         // The objective as LM reports it may belong to a rejected step; recompute at the end point.
-        let end = problem.model_values(&problem.t);
-        let (objective, rmse) = match &end {
-            Some(m) => {
-                let obj = 0.5
-                    * m.iter()
-                        .zip(&problem.target)
-                        .map(|(a, b)| (a - b) * (a - b))
-                        .sum::<f64>()
-                    * problem.scale
-                    * problem.scale;
-                let lin: Vec<f64> = if opts.log {
-                    m.iter().map(|&y| y.exp_m1()).collect()
-                } else {
-                    m.clone()
-                };
-                (obj, rel_rmse(&lin, &target_lin))
-            }
-            None => (f64::INFINITY, f64::INFINITY),
-        };
+        let (objective, rmse) = problem.score(&problem.t, &target_lin);
         evaluations += problem.evaluations.get();
         starts.push(StartResult {
             initial: x0,
@@ -308,25 +232,7 @@ pub fn fit_with_progress(
     let rmse = relative_rmse(source, model.as_ref(), &held_out)?;
     let acc =
         crate::analysis::accuracy::compare(model.as_ref(), source, ACCURACY_PAIRS, opts.seed)?;
-    let x = from_free(&params, t_best.as_slice());
-    let mut off = 0;
-    let fitted = params
-        .iter()
-        .map(|p| {
-            let value = x[off..off + p.width].to_vec();
-            let t = &t_best.as_slice()[off..off + p.width];
-            off += p.width;
-            FittedParam {
-                path: p.path.clone(),
-                at_bound: value.iter().zip(t).any(|(&v, _)| {
-                    let u = p.bounds.to_unit(v);
-                    !(1e-3..=1.0 - 1e-3).contains(&u)
-                }),
-                value,
-                bounds: p.bounds,
-            }
-        })
-        .collect();
+    let fitted = FittedParam::all(&params, t_best.as_slice());
     let b = &starts[best_start];
     Ok(FitResult {
         spec,
@@ -344,4 +250,43 @@ pub fn fit_with_progress(
         seconds: clock.elapsed().as_secs_f64(),
         starts,
     })
+}
+
+/// The options and source a fit refuses, before any work.
+fn check(source: &dyn Brdf, opts: &FitOptions) -> Result<()> {
+    if opts.pairs == 0 {
+        return Err(Error::arg("pairs", "at least one pair is needed"));
+    }
+    let c = source.channels().len();
+    if opts.pairs.checked_mul(c).is_none_or(|n| n > MAX_RESIDUALS) {
+        return Err(Error::arg(
+            "pairs",
+            format!(
+                "{} pairs × {c} channels: at most {MAX_RESIDUALS} residuals ({} pairs of {c} \
+                 channels)",
+                opts.pairs,
+                MAX_RESIDUALS / c.max(1)
+            ),
+        ));
+    }
+    if opts.starts == 0 {
+        return Err(Error::arg("starts", "at least one start is needed"));
+    }
+    if !(0.0..=1.0).contains(&opts.specular_fraction) {
+        return Err(Error::arg("specular_fraction", "must be in [0, 1]"));
+    }
+    if source.flags().delta {
+        return Err(Error::Unsupported(
+            "fitting a delta (mirror/refractor) source: eval is 0 everywhere".into(),
+        ));
+    }
+    // A sum's delta term is invisible to eval: a fit would match the other terms only.
+    if source.flags().lobes.delta {
+        return Err(Error::Unsupported(
+            "fitting a source with a delta term (mirror/refractor): eval does not see the delta, \
+             so the fit would match the other terms only; fit those"
+                .into(),
+        ));
+    }
+    Ok(())
 }

@@ -4,6 +4,8 @@
 use serde::Serialize;
 
 use super::Bounds;
+use super::params::Param;
+use super::problem::from_free;
 use crate::spec::ModelSpec;
 
 /// A fitted parameter's final value(s).
@@ -17,6 +19,31 @@ pub struct FittedParam {
     pub bounds: Bounds,
     /// True when a value ended within 0.1% (of the range, in its scale) of a bound.
     pub at_bound: bool,
+}
+
+impl FittedParam {
+    /// The parameters `params` at the free variables `t` of a fit (one entry per parameter,
+    /// `at_bound` where a value's position in its bounds is within 10⁻³ of either end).
+    pub(super) fn all(params: &[Param], t: &[f64]) -> Vec<FittedParam> {
+        let x = from_free(params, t);
+        let mut off = 0;
+        params
+            .iter()
+            .map(|p| {
+                let value = x[off..off + p.width].to_vec();
+                off += p.width;
+                FittedParam {
+                    path: p.path.clone(),
+                    at_bound: value.iter().any(|&v| {
+                        let u = p.bounds.to_unit(v);
+                        !(1e-3..=1.0 - 1e-3).contains(&u)
+                    }),
+                    value,
+                    bounds: p.bounds,
+                }
+            })
+            .collect()
+    }
 }
 
 /// The outcome of one start.

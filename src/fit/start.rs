@@ -1,10 +1,13 @@
 //! A fit's starting specs: the default [`preset`] of a model name or sum, and [`with_fresnel`],
-//! which gives a spec's microfacet lobes a Fresnel term to fit.
+//! which gives a spec's microfacet lobes a Fresnel term to fit; and the points its starts begin
+//! from ([`StartPoints`]: the spec's own values, then a Latin hypercube over the bounds).
 
 use serde_json::Value as Json;
 
-use super::problem::spec_from_json;
+use super::params::Param;
+use super::problem::{from_free, spec_from_json, to_free};
 use crate::error::{Error, Result};
+use crate::rng::Pcg32;
 use crate::spec::ModelSpec;
 
 /// Default starting spec for a model name, or a sum of them joined with `+`
@@ -80,4 +83,52 @@ pub fn with_fresnel(spec: &ModelSpec, fresnel: &crate::fresnel::FresnelSpec) -> 
     let mut json = to_json(serde_json::to_value(spec))?;
     walk(&mut json, &to_json(serde_json::to_value(fresnel))?);
     spec_from_json(json)
+}
+
+/// Where a fit's starts begin: start 0 at the spec's own values (pulled inside the bounds),
+/// starts 1.. on a Latin hypercube over the bounds (positions 5 %–95 %, one stratum per start
+/// along every parameter; the channels of one field share a position).
+pub(super) struct StartPoints {
+    /// The spec's own values, flattened in parameter order.
+    first: Vec<f64>,
+    /// Per parameter, the stratum of starts 1.. (a permutation of 0..starts − 1).
+    strata: Vec<Vec<usize>>,
+    starts: usize,
+}
+
+impl StartPoints {
+    /// The points of `starts` starts for `params` whose spec holds `first`, permuted by `seed`.
+    pub(super) fn new(params: &[Param], first: Vec<f64>, starts: usize, seed: u64) -> Self {
+        let mut rng = Pcg32::with_stream(seed, 0x5354_4152);
+        let strata = params
+            .iter()
+            .map(|_| {
+                let k = starts.saturating_sub(1);
+                let mut perm: Vec<usize> = (0..k).collect();
+                for i in (1..k).rev() {
+                    perm.swap(i, rng.below(i as u32 + 1) as usize);
+                }
+                perm
+            })
+            .collect();
+        StartPoints {
+            first,
+            strata,
+            starts,
+        }
+    }
+
+    /// The parameter values start `s` begins from (flattened in parameter order).
+    pub(super) fn values(&self, params: &[Param], s: usize) -> Vec<f64> {
+        if s == 0 {
+            return from_free(params, &to_free(params, &self.first));
+        }
+        let k = (self.starts - 1) as f64;
+        let mut v = Vec::with_capacity(self.first.len());
+        for (pi, p) in params.iter().enumerate() {
+            let u = 0.05 + 0.9 * (self.strata[pi][s - 1] as f64 + 0.5) / k;
+            v.extend(std::iter::repeat_n(p.bounds.from_unit(u), p.width));
+        }
+        v
+    }
 }
