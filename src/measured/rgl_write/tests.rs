@@ -21,6 +21,24 @@ fn model(spec: &str, ch: &Channels) -> Box<dyn Brdf> {
     ModelSpec::parse(spec).unwrap().build(ch).unwrap()
 }
 
+/// The anisotropic GGX copper that the placement tests write.
+const GGX_ANISO: &str =
+    r#"{"model": "ggx", "alpha_x": 0.05, "alpha_y": 0.2, "fresnel": {"conductor": "Cu"}}"#;
+
+/// [`GGX_ANISO`] written with the default options (RGB), encoded once for the three tests that
+/// read it (about 5 s of CPU each).
+fn ggx_aniso_file() -> &'static Fields {
+    static FILE: std::sync::OnceLock<Fields> = std::sync::OnceLock::new();
+    FILE.get_or_init(|| {
+        encode(
+            &*model(GGX_ANISO, &Channels::Rgb),
+            &Options::default(),
+            &Silent,
+        )
+        .unwrap()
+    })
+}
+
 /// Encodes, reads back from bytes, reports.
 fn roundtrip(src: &dyn Brdf, opts: &Options, pairs: usize) -> (Fields, RglBrdf, Report) {
     let f = encode(src, opts, &Silent).unwrap();
@@ -659,14 +677,19 @@ fn anisotropic_files_meet_the_bars_their_placement_reaches() {
     // "Anisotropic files placed over azimuths and elevations") must at least be lower than the
     // even layout's.
     let ward = r#"{"model": "ward", "ks": 0.3, "alpha_x": 0.1, "alpha_y": 0.3}"#;
-    let ggx =
-        r#"{"model": "ggx", "alpha_x": 0.05, "alpha_y": 0.2, "fresnel": {"conductor": "Cu"}}"#;
+    let ggx = GGX_ANISO;
     let opts = crate::analysis::fidelity::FidelityOptions {
         pairs: 20_000,
         ..Default::default()
     };
-    let written = |src: &dyn Brdf, o: &Options| {
-        let f = encode(src, o, &Silent).unwrap();
+    let written = |src: &dyn Brdf, o: &Options, spec: &str| {
+        let encoded;
+        let f = if spec == GGX_ANISO && *o == Options::default() {
+            ggx_aniso_file()
+        } else {
+            encoded = encode(src, o, &Silent).unwrap();
+            &encoded
+        };
         let bytes = f.to_bytes();
         let t = TensorFile::from_bytes("mem.bsdf", bytes.clone()).unwrap();
         let back = RglBrdf::from_tensor(&t, None).unwrap();
@@ -675,12 +698,12 @@ fn anisotropic_files_meet_the_bars_their_placement_reaches() {
     };
     for spec in [ward, ggx] {
         let src = model(spec, &Channels::Rgb);
-        let (fid, np, nt, bytes) = written(&*src, &Options::default());
+        let (fid, np, nt, bytes) = written(&*src, &Options::default(), spec);
         let even = Options {
             phi_i: Some(17),
             ..Options::default()
         };
-        let (old, ..) = written(&*src, &even);
+        let (old, ..) = written(&*src, &even, spec);
         let ctx = format!(
             "{spec}: {np} azimuths × {nt} elevations, {bytes} bytes: {fid:?}\n  even: {old:?}"
         );
@@ -752,11 +775,8 @@ fn an_anisotropic_file_is_its_layout_encoded_from_scratch() {
     // Placement's own encoding of the grid it chose is the file (session 42: it was encoded
     // again, 0.27 s of a 5.3 s write): the VNDF slices, values and valid bits equal those that
     // `warps::vndf` and `values::sample` give for the whole layout, bit for bit.
-    let src = model(
-        r#"{"model": "ggx", "alpha_x": 0.05, "alpha_y": 0.2, "fresnel": {"conductor": "Cu"}}"#,
-        &Channels::Rgb,
-    );
-    let f = encode(&*src, &Options::default(), &Silent).unwrap();
+    let src = model(GGX_ANISO, &Channels::Rgb);
+    let f = ggx_aniso_file();
     let mut layout = Options::default().layout(false).unwrap();
     layout.vndf = [GRID_VNDF; 2];
     layout.phi_i = f.phi_i.clone();
@@ -778,12 +798,9 @@ fn a_bilateral_sources_azimuths_are_placed_in_mirrored_pairs() {
     // at −φi is its error at φi. Placed one azimuth at a time on noisy estimates the file held
     // +112.5° and not −112.5° (session 42: its −150…−90° bins read 6.7–8.8 % in the grazing
     // band against 3.0–3.9 % on the mirror side); split in mirrored pairs, φ_k = −φ_(n−1−k).
-    let src = model(
-        r#"{"model": "ggx", "alpha_x": 0.05, "alpha_y": 0.2, "fresnel": {"conductor": "Cu"}}"#,
-        &Channels::Rgb,
-    );
+    let src = model(GGX_ANISO, &Channels::Rgb);
     assert!(src.flags().bilateral);
-    let f = encode(&*src, &Options::default(), &Silent).unwrap();
+    let f = ggx_aniso_file();
     let n = f.phi_i.len();
     assert!(n > azimuths::START_PHI, "{:?}", f.phi_i);
     for k in 0..n {
