@@ -100,7 +100,9 @@ pub fn incidence_at(theta: f64, phi: f64) -> crate::Result<DVec3> {
 /// [`Brdf::albedo`] (so closed forms are used where a model has one): `curve[k][channel]`.
 ///
 /// Every angle must lie in [0, π/2) ([`incidence`]), or the whole curve is an
-/// [`Error::InvalidArgument`](crate::Error::InvalidArgument) naming `theta`.
+/// [`Error::InvalidArgument`](crate::Error::InvalidArgument) naming `theta`. A source that
+/// failed while it was read ([`Brdf::health`]: a table chunk that did not decode) is its error,
+/// not a curve of zeros.
 pub fn albedo_curve<B: Brdf + ?Sized>(brdf: &B, thetas: &[f64]) -> crate::Result<Vec<Vec<f64>>> {
     albedo_curve_at(brdf, thetas, 0.0)
 }
@@ -118,14 +120,16 @@ pub fn albedo_curve_at<B: Brdf + ?Sized>(
         .iter()
         .map(|&t| incidence_at(t, phi))
         .collect::<crate::Result<Vec<_>>>()?;
-    Ok(dirs
+    let curve = dirs
         .into_iter()
         .map(|wi| {
             let mut a = vec![0.0; c];
             brdf.albedo(wi, &mut a);
             a
         })
-        .collect())
+        .collect();
+    brdf.health()?;
+    Ok(curve)
 }
 
 /// Directional albedo with explicit accuracy settings, returning the error estimate and cost.

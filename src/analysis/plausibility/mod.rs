@@ -172,7 +172,8 @@ impl Report {
 ///
 /// # Errors
 /// [`Error::InvalidArgument`] (`thetas_deg`) for an incidence angle outside [0°, 90°) or not a
-/// number.
+/// number; the source's own error ([`Brdf::health`]) when it failed while it was read (a table
+/// chunk that did not decode reads as zeros, and a report of those would be wrong).
 pub fn check(brdf: &dyn Brdf, opts: &Options) -> Result<Report> {
     if let Some(t) = opts.thetas_deg.iter().find(|t| !(0.0..90.0).contains(*t)) {
         return Err(Error::arg(
@@ -258,6 +259,7 @@ pub fn check(brdf: &dyn Brdf, opts: &Options) -> Result<Report> {
             });
         }
     }
+    brdf.health()?;
     let names = channels.names();
     Ok(Report {
         source: brdf.describe(),
