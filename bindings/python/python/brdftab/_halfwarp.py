@@ -23,6 +23,18 @@ from __future__ import annotations
 
 import math
 
+#: Below this s a half vector is at the pole (sampling.rs ``POLE_S``): its density is the limit
+#: there, read at s = ``POLE_S``, y = ½, where the map's Jacobian (0 at the pole) is not yet 0.
+POLE_S = 1e-9
+
+#: A pair whose sum ŵi + ŵo is shorter than this has no half vector float32 can tell: at the
+#: mirror direction the fold's other preimage (wo mirrored below the horizon) sums with wi to
+#: the rounding of wo (~1e-7), whose "half vector" is noise and whose density (over 2 |sum|)
+#: read 300 where the direction's own is 21 (paper_white). Its density is taken as 0 there, in
+#: :meth:`HalfVectorSampler.sample` and :meth:`HalfVectorSampler.pdf` alike: a solid angle of
+#: ~1e-12 sr, whose share of any draw is below float32's resolution of u.
+MIN_SUM = 1e-6
+
 class HalfVectorSampler:
     """Draws wo given wi ∝ f_r(wi, wo) cos θo from the library's node densities."""
 
@@ -103,6 +115,19 @@ class HalfVectorSampler:
         a = self.linear
         return sin_th * (0.5 * math.pi) * (a + 2.0 * (1.0 - a) * s) * (2 * math.pi)
 
+    def _at_pole(self, u, sin_th):
+        """(u, sin θh) where the density of ``u`` is read: ``u`` itself, or within s <
+        :data:`POLE_S` of the pole (the mirror direction, where the Jacobian is 0 and the
+        density its limit) (``POLE_S``, ½) as sampling.rs ``pole_density`` reads it."""
+        import drjit as dr
+        import mitsuba as mi
+
+        pole = u.x < POLE_S
+        a = self.linear
+        sin_pole = math.sin(0.5 * math.pi * POLE_S * (a + (1.0 - a) * POLE_S))
+        return (mi.Point2f(dr.select(pole, POLE_S, u.x), dr.select(pole, 0.5, u.y)),
+                dr.select(pole, sin_pole, sin_th))
+
     def _square_of(self, h):
         import drjit as dr
         import mitsuba as mi
@@ -121,8 +146,8 @@ class HalfVectorSampler:
         wi, wo (DESIGN: as ``dot(wi, h)`` it cancels at a grazing view)."""
         import drjit as dr
 
-        ok = active & (n > 0) & (h.z > 0)
-        u, sin_th = self._square_of(h)
+        ok = active & (n > MIN_SUM) & (h.z > 0)
+        u, sin_th = self._at_pole(*self._square_of(h))
         # 4 (wi·h) = 2 n.
         d = self.warp.eval(u, corners, ok) / (2.0 * n * self._jacobian(u.x, sin_th))
         return dr.select(ok & dr.isfinite(d), d, 0.0)
@@ -170,7 +195,10 @@ class HalfVectorSampler:
         # the rounding of wo would leave sample's pdf and pdf(wi, wo) apart), the other's from
         # its sum (0 where its half vector is below the horizon).
         (hd, nd), (hm, nm) = self._sums(wi, wo)
-        here = pdf_sq / (2.0 * dr.select(folded, nm, nd) * self._jacobian(p.x, sin_th))
+        pole = p.x < POLE_S
+        q, sin_q = self._at_pole(p, sin_th)
+        pdf_sq = dr.select(pole, self.warp.eval(q, corners, ok & pole), pdf_sq)
+        here = pdf_sq / (2.0 * dr.select(folded, nm, nd) * self._jacobian(q.x, sin_q))
         other = self._density_at(self._rot(dr.select(folded, hd, hm), c, s),
                                  dr.select(folded, nd, nm), corners, ok)
         pdf = here + other

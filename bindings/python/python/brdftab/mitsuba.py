@@ -201,6 +201,23 @@ def _sampling_res_prop(props):
     return n
 
 
+def _cache_dir_prop(props):
+    """The ``cache_dir`` property: None (the library's default cache) or a directory's path as
+    a string; anything else is refused in every variant (the scalar ones took ``cache_dir: 5``
+    that the JIT ones refused with a bare TypeError)."""
+    v = _prop(props, "cache_dir")
+    if v is None:
+        return None
+    if isinstance(v, os.PathLike):
+        v = os.fspath(v)
+    if not isinstance(v, str) or not v.strip():
+        raise ValueError(
+            f"brdftab plugin: `cache_dir` must be a directory's path (a non-empty string), got "
+            f"{type(v).__name__} {v!r}"
+        )
+    return v
+
+
 def _check_bake_props(props, source):
     """Refuses ``preset``/``grid`` values the JIT variants' bake would refuse, without baking."""
     options = {k: str(_prop(props, k)) for k in ("preset", "grid") if _prop(props, k) is not None}
@@ -373,6 +390,7 @@ class ScalarBrdftabBSDF(_Common):
         # `preset`/`grid` as the bake would take them (a scene with `preset: "huge"` loaded
         # here and failed in a JIT variant).
         _bool_prop(props, "cache", True)
+        _cache_dir_prop(props)
         _sampling_res_prop(props)
         _check_bake_props(props, self.source)
 
@@ -427,7 +445,8 @@ class ScalarBrdftabBSDF(_Common):
 
         bs = mi.BSDFSample3f()
         wi = self._vec(si.wi)
-        u = [min(float(sample2[0]), 0.99999994), min(float(sample2[1]), 0.99999994)]
+        # Within [0, 1): a NaN becomes 0 (max keeps its first argument when the other is NaN).
+        u = [max(0.0, min(float(x), 0.99999994)) for x in (sample2[0], sample2[1])]
         if not (wi[2] > 0) or not active or not self._enabled(ctx, False):
             return bs, mi.Spectrum(0.0)
         # A spectral variant asks for the weights at the path's wavelengths (a mirror's
@@ -555,6 +574,25 @@ def _unit(v, keep_unit):
         near = dr.abs(n2 - 1.0) <= 2.0**-40
         u = [dr.select(near, c, x) for c, x in zip(v, u)]
     return u, n2 > 0
+
+
+def _finite(w):
+    """Where every component of the direction ``w`` is finite (a NaN or infinite one makes its
+    f_r 0, but 0 · NaN is NaN: the callers' ``active`` drops such lanes, 0 being the NaN rule
+    of every host)."""
+    import drjit as dr
+
+    return dr.isfinite(w.x) & dr.isfinite(w.y) & dr.isfinite(w.z)
+
+
+def _normalize(w):
+    """``dr.normalize(w)`` that holds for any finite nonzero ``w``: scaled by its largest
+    component first, so a tiny (or huge) direction whose float32 |w|² underflows (overflows)
+    keeps its direction, as the library and the scalar variants take it."""
+    import drjit as dr
+
+    m = dr.maximum(dr.maximum(dr.abs(w.x), dr.abs(w.y)), dr.abs(w.z))
+    return dr.normalize(w / m)
 
 
 #: The version of the library's device layout (``Table.device_layout()``) this code implements.
@@ -1121,7 +1159,7 @@ class JitBrdftabBSDF(_Common):
         # The cache of baked tables: property `cache` (default true), `cache_dir` (default
         # $BRDFTAB_CACHE_DIR, $XDG_CACHE_HOME/brdftab or ~/.cache/brdftab).
         self.cache = _bool_prop(props, "cache", True)
-        self.cache_dir = _prop(props, "cache_dir")
+        self.cache_dir = _cache_dir_prop(props)
         options = {}
         for key in ("preset", "grid"):
             v = _prop(props, key)
@@ -1204,6 +1242,16 @@ class JitBrdftabBSDF(_Common):
             # (f32: the values an in-memory bake gives), so a scene loads a material's table
             # from disk after its first bake.
             options = {"param": "halfdiff", "codec": "f32", **options}
+            if self.cache_dir is not None:
+                # A directory that cannot be made is the property's error (the cache's own
+                # said "/proc/x: No such file or directory (os error 2)", naming no property).
+                try:
+                    os.makedirs(self.cache_dir, exist_ok=True)
+                except OSError as e:
+                    raise brdftab.Error(
+                        f"brdftab plugin: `cache_dir` {self.cache_dir!r}: cannot be made a "
+                        f"directory ({e.strerror or e})"
+                    ) from e
             for refresh in (False, True):
                 hit = brdftab.bake_cached(self.source, self.cache_dir, refresh, **options)
                 try:
@@ -1276,13 +1324,13 @@ class JitBrdftabBSDF(_Common):
         import drjit as dr
 
         f = self._f(wo, wi, lam, active) if adjoint else self._f(wi, wo, lam, active)
-        return dr.select(active, f * dr.normalize(wo).z, 0.0)
+        return dr.select(active, f * _normalize(wo).z, 0.0)
 
     def eval(self, ctx, si, wo, active=True):
         """f_r · cos θ(wo) from the table (0 below either horizon)."""
         import mitsuba as mi
 
-        active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
+        active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0) & _finite(si.wi) & _finite(wo)
         if self.delta or not self._enabled(ctx, True):
             return mi.Spectrum(0.0)
         adjoint = self._adjoint(ctx)
@@ -1297,13 +1345,13 @@ class JitBrdftabBSDF(_Common):
     def _pdf(self, wi, wo, active):
         import drjit as dr
 
-        return self.sampler.pdf(dr.normalize(wi), dr.normalize(wo), active)
+        return self.sampler.pdf(_normalize(wi), _normalize(wo), active)
 
     def pdf(self, ctx, si, wo, active=True):
         """The density of :meth:`sample` drawing wo given ``si.wi``."""
         import mitsuba as mi
 
-        active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
+        active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0) & _finite(si.wi) & _finite(wo)
         if self.delta or not self._enabled(ctx, True):
             return mi.Float(0.0)
         return self._when(active, si, (si.wi, wo, active),
@@ -1314,7 +1362,7 @@ class JitBrdftabBSDF(_Common):
         """``(eval(...), pdf(...))`` in one table lookup."""
         import mitsuba as mi
 
-        active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0)
+        active = mi.Bool(active) & (si.wi.z > 0) & (wo.z > 0) & _finite(si.wi) & _finite(wo)
         if self.delta or not self._enabled(ctx, True):
             return mi.Spectrum(0.0), mi.Float(0.0)
         adjoint = self._adjoint(ctx)
@@ -1331,13 +1379,13 @@ class JitBrdftabBSDF(_Common):
         import drjit as dr
         import mitsuba as mi
 
-        active = mi.Bool(active) & (si.wi.z > 0)
+        active = mi.Bool(active) & (si.wi.z > 0) & _finite(si.wi)
         if not self._enabled(ctx, False):
             return dr.zeros(mi.BSDFSample3f), mi.Spectrum(0.0)
         adjoint = self._adjoint(ctx)
 
         def on(wi, u, a, lam):
-            wo, pdf = self.sampler.sample(dr.normalize(wi), u, a)
+            wo, pdf = self.sampler.sample(_normalize(wi), u, a)
             ok = a & (wo.z > 0) & (pdf > 0)
             value = self._value(wi, wo, lam, ok, adjoint)
             return wo, pdf, dr.select(ok, value / dr.maximum(pdf, 1e-20), 0.0)
