@@ -98,6 +98,29 @@ pub fn classify_output(output: impl AsRef<OsStr>) -> SourceKind {
     }
 }
 
+/// Refuses `path` as the name of a brdftab table file written by a bake or a save when its
+/// name reads as a measured file's: `.bsdf` (an RGL file) or `.binary` (a MERL file). Sources
+/// are told apart by their extension ([`classify`]), so such a table would not open again as
+/// what it is (`m.bsdf` read as an RGL tensor file, `m.binary` as a truncated MERL file).
+///
+/// # Errors
+/// [`Error::InvalidArgument`](crate::Error::InvalidArgument) naming `output`.
+pub fn check_table_output(path: &std::path::Path) -> crate::Result<()> {
+    let what = match classify_name(path.as_os_str().as_encoded_bytes()) {
+        SourceKind::Rgl => "an RGL file",
+        SourceKind::Merl => "a MERL file",
+        _ => return Ok(()),
+    };
+    Err(crate::Error::arg(
+        "output",
+        format!(
+            "{}: the name reads as {what}, but a brdftab table is written: give it a .btdb \
+             name (a conversion writes RGL .bsdf and MERL .binary files)",
+            path.display()
+        ),
+    ))
+}
+
 /// By the name's form and extension only (its bytes: the extensions are ASCII).
 fn classify_name(source: &[u8]) -> SourceKind {
     let s = source.trim_ascii_start();

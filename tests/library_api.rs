@@ -123,6 +123,55 @@ fn a_table_named_like_a_measured_file_opens_as_the_table() {
 }
 
 #[test]
+fn a_table_file_is_not_written_under_a_measured_files_name() {
+    // A bake or save to `m.bsdf` or `m.binary` wrote a brdftab table that the library then
+    // read as an RGL or MERL file and refused (the MERL reader as a truncated file with a
+    // header of 1146372745 × 436866370 × 1).
+    let d = TempDir::new("api-measured-name");
+    let req = BakeRequest::new(LAMBERT).preset(Preset::Small);
+    for name in ["m.bsdf", "m.binary", "M.BSDF"] {
+        let p = d.join(name);
+        for target in [BakeTarget::File(p.clone()), BakeTarget::Raw(p.clone())] {
+            let e = req.run(&target);
+            assert_eq!(field(e), "output", "{name}");
+            assert!(!p.exists(), "{name}");
+        }
+    }
+    // Saved from a table: refused alike; `.btdb` and `DB#NAME` (the name is the table's) are
+    // written.
+    let source = lambert();
+    let grid = Preset::Small
+        .grid(None, brdftab::table::Symmetry::default(), Channels::Rgb)
+        .unwrap();
+    let (table, _) = brdftab::table::bake(source.as_ref(), &grid, &Default::default()).unwrap();
+    let settings = brdftab::request::SaveSettings::default();
+    let src = || brdftab::store::Source::Model {
+        spec: serde_json::json!({"model": "lambert"}),
+    };
+    for name in ["s.bsdf", "s.binary"] {
+        let p = d.join(name);
+        let e = brdftab::request::save_table(&table, &p, src(), &settings);
+        assert_eq!(field(e), "output", "{name}");
+        assert!(!p.exists(), "{name}");
+    }
+    let db = format!("{}#s.bsdf", d.join("s.btdb").display());
+    brdftab::request::save_table(&table, &db, src(), &settings).unwrap();
+    assert_eq!(brdftab::classify(&db), brdftab::SourceKind::Table);
+    // A table copied to such a name is read as what its name says and refused as such, with
+    // what the file is.
+    let btdb = d.join("s.btdb");
+    for name in ["c.bsdf", "c.binary"] {
+        let p = d.join(name);
+        std::fs::copy(&btdb, &p).unwrap();
+        let e = brdftab::open(p.to_str().unwrap())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("but a brdftab table (its signature)"), "{e}");
+    }
+}
+
+#[test]
 fn a_taken_name_is_a_duplicate_error_naming_no_flag() {
     let d = TempDir::new("api-dup");
     let db = d.join("x.btdb").display().to_string();

@@ -36,6 +36,10 @@ impl BakeRequest {
     /// [`run`](Self::run), reporting progress.
     pub fn run_with(&self, target: &BakeTarget, progress: &dyn Progress) -> Result<BakeReport> {
         self.validate()?;
+        // A table file named like a measured file would not open again as a table.
+        if let BakeTarget::File(p) | BakeTarget::Raw(p) = target {
+            crate::source::check_table_output(p)?;
+        }
         // An output that is not a regular file (a FIFO, a device, a directory), before any
         // work and before a database there is read.
         crate::files::check_output(&crate::files::resolve_links(target.path())?)?;

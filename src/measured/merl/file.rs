@@ -6,6 +6,20 @@ use super::{FILE_SIZE, MerlBrdf, RES_PHI_D, RES_THETA_D, RES_THETA_H, SAMPLES, S
 use crate::error::{Error, Result};
 use crate::spectrum::Channels;
 
+/// A brdftab table given a `.binary` name is the likely mistake behind a file that starts with
+/// the table signature: said so, where its header read as MERL dimensions (1146372745 ×
+/// 436866370 × 1) and its size as a truncation said nothing of what the file is.
+fn table_error(file: &str, head: &[u8]) -> Option<Error> {
+    (head.get(..8) == Some(&crate::store::format::MAGIC[..])).then(|| {
+        Error::format(
+            file,
+            None,
+            Some(0),
+            "not a MERL file but a brdftab table (its signature): give it a .btdb name",
+        )
+    })
+}
+
 impl MerlBrdf {
     /// Reads a `.binary` file; checks its size and header before reading the samples.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
@@ -15,12 +29,15 @@ impl MerlBrdf {
         let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
         if meta.len() != FILE_SIZE {
             // Read the header anyway (if present) for a more helpful message.
-            let header = std::fs::File::open(path).ok().and_then(|mut f| {
+            let head = std::fs::File::open(path).ok().and_then(|mut f| {
                 use std::io::Read;
                 let mut h = [0u8; 12];
-                f.read_exact(&mut h).ok().map(|_| dims(&h))
+                f.read_exact(&mut h).ok().map(|_| h)
             });
-            return Err(size_error(&file, meta.len(), header));
+            if let Some(e) = head.as_ref().and_then(|h| table_error(&file, h)) {
+                return Err(e);
+            }
+            return Err(size_error(&file, meta.len(), head.map(|h| dims(&h))));
         }
         let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
         Self::from_bytes(file, &bytes)
@@ -36,6 +53,9 @@ impl MerlBrdf {
                 Some(0),
                 format!("truncated: {} bytes, the header alone has 12", bytes.len()),
             ));
+        }
+        if let Some(e) = table_error(&name, bytes) {
+            return Err(e);
         }
         let d = dims(&bytes[..12]);
         if d != [RES_THETA_H as i32, RES_THETA_D as i32, RES_PHI_D as i32] {

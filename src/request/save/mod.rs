@@ -120,6 +120,7 @@ pub fn save_table_with(
         }
         t => {
             let path = t.path().to_owned();
+            crate::source::check_table_output(&path)?;
             store::db::refuse_dropping_tables(&path)?;
             let name = settings.name.clone().unwrap_or_else(|| bake::stem(&path));
             tables::save_file(&path, &name, source, table, codec)?;
