@@ -104,7 +104,7 @@ pub fn classify_output(output: impl AsRef<OsStr>) -> SourceKind {
 /// what it is (`m.bsdf` read as an RGL tensor file, `m.binary` as a truncated MERL file).
 ///
 /// # Errors
-/// [`Error::InvalidArgument`](crate::Error::InvalidArgument) naming `output`.
+/// [`Error::InvalidArgument`] naming `output`.
 pub fn check_table_output(path: &std::path::Path) -> crate::Result<()> {
     let what = match classify_name(path.as_os_str().as_encoded_bytes()) {
         SourceKind::Rgl => "an RGL file",
