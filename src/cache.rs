@@ -16,8 +16,9 @@
 //!   (the library's atomic write), so a reader sees no file or a whole one; and it runs under
 //!   a writer lock whose empty `.<key>.btdb.lock` file stays beside the table, so processes
 //!   asking for the same key at once bake it once: the others wait and get the hit.
-//! - A cached file that no longer opens (truncated, a chunk failing its checksum when read)
-//!   is re-baked by asking again with `refresh`.
+//! - A cached file whose structure no longer reads (emptied, truncated, its header or index
+//!   damaged) is not a hit: it is baked again. One whose chunk fails its checksum when read
+//!   (found only by decoding it) is re-baked by asking again with `refresh`.
 //!
 //! ```no_run
 //! use brdftab::cache;
@@ -179,20 +180,30 @@ pub fn bake_cached_with(
     // Settings are checked before any file is read or written.
     settings.request(source)?;
     let path = dir.join(format!("{}.btdb", key(source, settings)?));
-    if !refresh && path.is_file() {
+    if !refresh && intact(&path) {
         return Ok(Cached { path, hit: true });
     }
     std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     // One bake per key at a time: a process (or thread) that finds the bake under way waits
     // for it and is then a hit, rather than baking the same table beside it.
     let _lock = crate::store::db::lock_with(&path, progress)?;
-    if !refresh && path.is_file() {
+    if !refresh && intact(&path) {
         return Ok(Cached { path, hit: true });
     }
     let mut s = settings.clone();
     s.replace = true;
     crate::request::bake(source, &path, &s, progress)?;
     Ok(Cached { path, hit: false })
+}
+
+/// Whether the cached table at `path` is there and its structure reads: superblock, table of
+/// contents, one table's header and chunk index within the file (what opening it checks; the
+/// chunks' checksums are checked when they are decoded).
+fn intact(path: &Path) -> bool {
+    path.is_file()
+        && crate::store::Store::open(path)
+            .and_then(|s| s.single())
+            .is_ok()
 }
 
 #[cfg(test)]
@@ -289,6 +300,23 @@ mod tests {
         assert_ne!(k, key(&fs, &small()).unwrap(), "edited in place: a new key");
         assert_ne!(key(SPEC, &small()).unwrap(), key(&fs, &small()).unwrap());
         assert!(key(d.path().join("nope.bsdf"), &small()).is_err());
+    }
+
+    #[test]
+    fn a_cached_file_whose_structure_does_not_read_is_baked_again() {
+        // It was a hit, which a host then failed to open.
+        let d = TempDir::new("cache-broken");
+        let a = bake_cached(SPEC, &small(), Some(d.path()), false).unwrap();
+        let whole = std::fs::read(&a.path).unwrap();
+        let broken: [&[u8]; 3] = [b"", &whole[..100], &whole[..whole.len() - 1]];
+        for bytes in broken {
+            std::fs::write(&a.path, bytes).unwrap();
+            let b = bake_cached(SPEC, &small(), Some(d.path()), false).unwrap();
+            assert!(!b.hit, "{} bytes", bytes.len());
+            assert!(crate::open(&b.path).is_ok());
+        }
+        let c = bake_cached(SPEC, &small(), Some(d.path()), false).unwrap();
+        assert!(c.hit);
     }
 
     #[test]

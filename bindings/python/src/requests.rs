@@ -82,7 +82,8 @@ pub(crate) fn _check_bake_options(
 /// tables or baked into it now (the library's `cache` module): keyed by the source's content, the
 /// settings and the library's version, in `cache_dir` (default `$BRDFTAB_CACHE_DIR`, else
 /// `$XDG_CACHE_HOME/brdftab`, else `~/.cache/brdftab`). Safe under concurrent calls from many
-/// processes. `refresh=True` bakes again (for a cached file that failed to open). Returns
+/// processes. A cached file whose structure does not read (emptied, truncated) is baked again;
+/// `refresh=True` bakes again whatever is there (for one whose chunk failed its checksum). Returns
 /// `{"path": str, "hit": bool}`; open the table with `brdftab.open(path)`. SOURCE and
 /// `cache_dir` are str, bytes or os.PathLike; `path` is the `os.fsdecode` str of the file's
 /// name (it need not be UTF-8). Ctrl-C stops the bake (KeyboardInterrupt; nothing is cached).

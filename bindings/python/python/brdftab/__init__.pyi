@@ -285,7 +285,9 @@ def bake_cached(
 ) -> dict[str, Any]:
     """The table of SOURCE baked with `options` (the keywords of `bake`), from the cache of
     baked tables (keyed by the source's content, the settings and the library's version) or
-    baked into it now. Returns {"path": str, "hit": bool}: "path" is the str os.fsdecode gives
+    baked into it now. A cached file whose structure does not read (emptied, truncated) is
+    baked again; `refresh=True` bakes again whatever is there (for one whose chunk failed its
+    checksum when read). Returns {"path": str, "hit": bool}: "path" is the str os.fsdecode gives
     of the file's name (a cache_dir need not be UTF-8). Ctrl-C stops the bake
     (KeyboardInterrupt; nothing is cached)."""
 def convert(
