@@ -626,6 +626,29 @@ def test_pickle_and_multiprocessing(paper):
     np.testing.assert_array_equal(np.concatenate(outs), b.eval(wi, wo))
 
 
+def test_a_pickle_opens_its_file_from_any_working_directory(tmp_path, monkeypatch):
+    """A Brdf or Database opened by a relative path pickled that path: a worker in another
+    working directory (Dask, Ray) failed with "not found"."""
+    (tmp_path / "here").mkdir()
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "here")
+    brdftab.bake(LAMBERT, "rel.btdb", preset="small")
+    db = brdftab.Database("db.btdb")
+    db.add(LAMBERT, "matte", preset="small")
+    wi, wo = upper(8), upper(8, 1)
+    pickled = [pickle.dumps(brdftab.open(s)) for s in ("rel.btdb", "db.btdb#matte")]
+    want = brdftab.open("rel.btdb").eval(wi, wo)
+    copy_of_db = pickle.dumps(db)
+    # Equal to a handle on the same file by another spelling of its path.
+    assert db == brdftab.Database("./db.btdb") == brdftab.Database(str(tmp_path / "here/db.btdb"))
+    monkeypatch.chdir(tmp_path / "elsewhere")
+    for p in pickled:
+        np.testing.assert_array_equal(pickle.loads(p).eval(wi, wo), want)
+    assert pickle.loads(copy_of_db).names() == ["matte"]
+    # An inline spec stays a spec.
+    assert pickle.loads(pickle.dumps(brdftab.open(LAMBERT))).source == LAMBERT
+
+
 # ---- bad input -----------------------------------------------------------------------------
 
 def test_bad_sources(tmp_path):

@@ -67,21 +67,26 @@ class Database:
         # anything else made a path of its repr: Database(b"m.btdb") wrote a file named
         # "b'm.btdb'"); kept as the str os.fsdecode gives (a name need not be UTF-8).
         self.path = _path_arg(path, "path")
+        # The file, whatever the working directory becomes: what a pickled copy names (a
+        # relative path failed in workers that run elsewhere: Dask, Ray, a spawned process
+        # that changes directory) and what equality compares.
+        self._abs = _os.path.abspath(self.path)
 
     def __repr__(self):
         return f"brdftab.Database({self.path!r})"
 
     def __reduce__(self):
-        return (Database, (self.path,))
+        return (Database, (self._abs,))
 
     def __eq__(self, other):
-        # A handle on a path, as a pathlib.Path: equal when the paths are (a pickled copy too).
+        # A handle on a file: equal when the paths name it alike, made absolute and normalized
+        # as os.path.abspath does ("./m.btdb" and "m.btdb"; a pickled copy too).
         if not isinstance(other, Database):
             return NotImplemented
-        return self.path == other.path
+        return self._abs == other._abs
 
     def __hash__(self):
-        return hash((Database, self.path))
+        return hash((Database, self._abs))
 
     def names(self):
         """The table names, in file order (the table of contents; :meth:`info` reads each

@@ -43,7 +43,8 @@ class Brdf:
     either byte order, any strides; complex, object and string dtypes are a TypeError). A
     numpy.ma masked array with masked entries is a ValueError (fill or drop them first); one
     without is read as its data. A result beyond memory is numpy's MemoryError. Pickles by its
-    source and options; `copy.copy` and `copy.deepcopy` give the object itself (immutable).
+    source (its file's path made absolute, so a copy opens the same file from any working
+    directory) and options; `copy.copy` and `copy.deepcopy` give the object itself (immutable).
 
     eval, pdf and sample run with the GIL released and to their end, as numpy's ufuncs do:
     Ctrl-C raises KeyboardInterrupt when the call returns (10^7 pairs: seconds); albedo stops
@@ -330,9 +331,11 @@ def fit(
     Ctrl-C stops it (KeyboardInterrupt)."""
 
 class Database:
-    """A brdftab database: many named tables in one .btdb file. Pickles by its path; equal to
-    another Database of the same path. len(db), name in db and for name in db are its tables'
-    names (none for a file not created yet)."""
+    """A brdftab database: many named tables in one .btdb file. Pickles by its absolute path
+    (a copy opens the same file from any working directory); equal to another Database whose
+    path names the same file once made absolute and normalized (os.path.abspath: "./m.btdb"
+    and "m.btdb"). len(db), name in db and for name in db are its tables' names (none for a
+    file not created yet)."""
 
     path: str
     def __init__(self, path: _Path) -> None:

@@ -26,8 +26,8 @@ use crate::values::{ser, wavelengths_of};
 /// `.binary` or an RGL `.bsdf` file. Directions are in the local frame (z = normal), both
 /// pointing away from the surface; `wi` is the direction to the light, `wo` to the viewer.
 /// Array arguments are anything numpy reads as real numbers; a `numpy.ma` masked array with
-/// masked entries is a `ValueError` (fill or drop them first). Pickles by its source and
-/// options; `copy.copy` and `copy.deepcopy` give the object itself (it is immutable).
+/// masked entries is a `ValueError` (fill or drop them first). Pickles by its source (its
+/// file's path made absolute) and options; `copy.copy` and `copy.deepcopy` give the object itself (it is immutable).
 /// `eval`, `pdf` and `sample` run with the GIL released and to their end, as numpy's ufuncs
 /// do: Ctrl-C raises KeyboardInterrupt when the call returns (10^7 pairs: seconds); `albedo`
 /// stops between angles.
@@ -365,12 +365,40 @@ impl PyBrdf {
         let module = py.import("brdftab._native")?;
         let f = module.getattr("_reopen")?;
         let args = (
-            self.source.clone(),
+            absolute_source(&self.source),
             self.interp.clone(),
             self.wavelengths.clone(),
             self.eager,
         )
             .into_pyobject(py)?;
         Ok(PyTuple::new(py, [f, args.into_any()])?.unbind())
+    }
+}
+
+/// SOURCE with its file part made absolute (`DB#NAME`'s `#NAME` and inline specs as they are):
+/// what a pickled `Brdf` reopens, so that a worker in another working directory (Dask, Ray, a
+/// spawned process that changes directory) opens the same file. A name that cannot be made
+/// absolute, or whose `#NAME` part is not UTF-8, stays as it is.
+fn absolute_source(source: &std::ffi::OsStr) -> std::ffi::OsString {
+    use std::path::Path;
+    use brdftab::store::name;
+    if source.as_encoded_bytes().trim_ascii_start().starts_with(b"{") {
+        return source.to_owned();
+    }
+    let file = name::parse_input_os("source", source).map_or(Path::new(source), |(p, _)| p);
+    if file.is_absolute() {
+        return source.to_owned();
+    }
+    let rest = source
+        .as_encoded_bytes()
+        .get(file.as_os_str().len()..)
+        .and_then(|b| std::str::from_utf8(b).ok());
+    match (std::path::absolute(file), rest) {
+        (Ok(abs), Some(rest)) => {
+            let mut out = abs.into_os_string();
+            out.push(rest);
+            out
+        }
+        _ => source.to_owned(),
     }
 }
