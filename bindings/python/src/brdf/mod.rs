@@ -380,9 +380,13 @@ impl PyBrdf {
 /// spawned process that changes directory) opens the same file. A name that cannot be made
 /// absolute, or whose `#NAME` part is not UTF-8, stays as it is.
 fn absolute_source(source: &std::ffi::OsStr) -> std::ffi::OsString {
-    use std::path::Path;
     use brdftab::store::name;
-    if source.as_encoded_bytes().trim_ascii_start().starts_with(b"{") {
+    use std::path::Path;
+    if source
+        .as_encoded_bytes()
+        .trim_ascii_start()
+        .starts_with(b"{")
+    {
         return source.to_owned();
     }
     let file = name::parse_input_os("source", source).map_or(Path::new(source), |(p, _)| p);
