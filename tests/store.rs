@@ -1054,6 +1054,51 @@ fn the_analyses_of_a_table_with_a_damaged_chunk_are_its_error() {
 }
 
 #[test]
+#[cfg(unix)]
+fn a_file_cut_short_or_rewritten_in_place_while_open_is_an_error_not_a_crash() {
+    // `Store::open` mapped the file on Unix: another program truncating it in place
+    // (`cp other.btdb db.btdb`) made the next chunk read a SIGBUS, which killed the process
+    // (Python: "Fatal Python error: Bus error"). It now reads at offsets.
+    let d = TempDir::new("store-cut-short");
+    let p = d.join("l.btdb");
+    let other = d.join("o.btdb");
+    for (path, kd) in [(&p, 0.3), (&other, 0.6)] {
+        brdftab::BakeRequest::new(format!(r#"{{"model": "lambert", "kd": {kd}}}"#))
+            .preset(brdftab::table::presets::Preset::Small)
+            .name("l")
+            .run(&brdftab::BakeTarget::file(path.to_str().unwrap()))
+            .unwrap();
+    }
+    let whole = std::fs::read(&p).unwrap();
+    for cut in [100, whole.len() / 2] {
+        std::fs::write(&p, &whole).unwrap();
+        let st = Store::open(&p).unwrap();
+        let t = st.table("l").unwrap();
+        // In place, as `cp` and `truncate` do: the same inode, shorter.
+        let f = std::fs::OpenOptions::new().write(true).open(&p).unwrap();
+        f.set_len(cut as u64).unwrap();
+        let e = t.read_all().unwrap_err();
+        assert!(
+            matches!(&e, Error::Format { msg, .. } if msg.contains("cut short")),
+            "{cut}: {e}"
+        );
+    }
+    // Rewritten in place with another table's bytes: its chunks fail their checksums.
+    std::fs::write(&p, &whole).unwrap();
+    let st = Store::open(&p).unwrap();
+    let t = st.table("l").unwrap();
+    let mut f = std::fs::OpenOptions::new().write(true).open(&p).unwrap();
+    std::io::Write::write_all(&mut f, &std::fs::read(&other).unwrap()).unwrap();
+    f.set_len(std::fs::read(&other).unwrap().len() as u64)
+        .unwrap();
+    let e = t.read_all().unwrap_err();
+    assert!(
+        matches!(&e, Error::Checksum { .. } | Error::Format { .. }),
+        "{e}"
+    );
+}
+
+#[test]
 fn a_damaged_chunk_read_lazily_stays_a_checksum_error() {
     let d = TempDir::new("store-lazy-checksum");
     let b = lambert_with_a_damaged_chunk(&d);

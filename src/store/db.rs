@@ -153,7 +153,7 @@ fn copy_chunks(t: &super::StoredTable, w: &mut Writer, stop: Stop<'_>) -> Result
         if let Some(p) = stop {
             crate::progress::check(p)?;
         }
-        w.encoded_chunk(t.raw_chunk(i)?, t.chunk_values(i) as u64)?;
+        w.encoded_chunk(&t.raw_chunk(i)?, t.chunk_values(i) as u64)?;
     }
     Ok(())
 }
@@ -275,9 +275,9 @@ fn put_inner(
         }
     }
     emit(&mut w, &mut new)?;
-    // The old store dropped before the new file is renamed over it: one that mapped the file
-    // (`Store::open_mapped`; `Store::open` reads it into memory on Windows) would keep Windows
-    // from replacing it ("Access denied").
+    // The old store dropped before the new file is renamed over it: one that held the file
+    // open or mapped (`Store::open_reading`, `Store::open_mapped`; `Store::open` reads it into
+    // memory on Windows) would keep Windows from replacing it ("Access denied").
     drop(old);
     w.finish()
 }

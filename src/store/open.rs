@@ -1,6 +1,7 @@
 //! An open brdftab file ([`Store`]): the file mapped or read, its superblock and table of
 //! contents checked, and a table's header and chunk index read on request.
 
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -35,27 +36,42 @@ impl Store {
         Self::open_with(path, StoreOptions::default())
     }
 
-    /// Opens a file and checks the superblock and table of contents. On Unix the file is
-    /// mapped ([`Store::open_mapped`]); on Windows it is read into memory
+    /// Opens a file and checks the superblock and table of contents. On Unix the file stays
+    /// open and is read where its records and chunks lie when they are needed
+    /// ([`Store::open_reading`]); on Windows it is read into memory
     /// ([`Store::open_in_memory`]), so that no handle or mapping of it stays open: Windows
-    /// refuses to replace a mapped file, and a database held open by any reader could otherwise
+    /// refuses to replace an open file, and a database held open by any reader could otherwise
     /// not be added to, replaced in or removed from (the writers rename a new file over it).
     pub fn open_with(path: impl AsRef<Path>, opts: StoreOptions) -> Result<Store> {
         #[cfg(windows)]
         return Self::open_in_memory(path, opts);
         #[cfg(not(windows))]
-        Self::open_mapped(path, opts)
+        Self::open_reading(path, opts)
     }
 
-    /// Opens a file through a read-only memory map (what [`Store::open_with`] does on Unix):
-    /// pages are read as lookups touch them, and a reader keeps the version it opened when a
-    /// writer renames a new file over it. On Windows the map keeps the file from being replaced
-    /// or removed until the store and every table opened from it are dropped.
+    /// Opens a file that stays open and is read at offsets (`pread`) as its table headers,
+    /// indices and chunks are needed (what [`Store::open_with`] does on Unix): a reader keeps
+    /// the version it opened when a writer renames a new file over it, and a file another
+    /// program truncates or rewrites in place while it is open (`cp new.btdb db.btdb`) gives
+    /// the chunks read after that an error (cut short, or a checksum mismatch), where a memory
+    /// map of it ([`Store::open_mapped`]) kills the process with SIGBUS at the first page past
+    /// the new end. Each chunk's compressed bytes are copied once, when it is decoded.
+    pub fn open_reading(path: impl AsRef<Path>, opts: StoreOptions) -> Result<Store> {
+        let (path, name, f, len) = Self::open_file(path.as_ref())?;
+        Self::from_backing(path, name, Backing::File { file: f, len }, opts)
+    }
+
+    /// Opens a file through a read-only memory map: pages are read as lookups touch them, and a
+    /// reader keeps the version it opened when a writer renames a new file over it. Another
+    /// program truncating the file while it is mapped makes the next read of a page past the
+    /// new end a SIGBUS, which kills the process ([`Store::open_reading`], the default on Unix,
+    /// gives an error instead). On Windows the map keeps the file from being replaced or
+    /// removed until the store and every table opened from it are dropped.
     pub fn open_mapped(path: impl AsRef<Path>, opts: StoreOptions) -> Result<Store> {
         let (path, name, f, _) = Self::open_file(path.as_ref())?;
         // SAFETY: brdftab never modifies a file in place (writers rename a new file over it), so
         // the mapped bytes do not change under us. A foreign process truncating the file could
-        // still fault; that is the usual caveat of memory maps.
+        // still fault; that is the usual caveat of memory maps, and why this is not the default.
         let map = unsafe { memmap2::Mmap::map(&f) }.map_err(|e| Error::io(&path, e))?;
         Self::from_backing(path, name, Backing::Map(map), opts)
     }
@@ -129,9 +145,10 @@ impl Store {
         map: Backing,
         opts: StoreOptions,
     ) -> Result<Store> {
-        let sb = Superblock::parse(&name, &map)?;
-        let toc_bytes = format::block(&name, &map, &sb.toc, &Section::Toc, format::MAX_JSON_LEN)?;
-        let toc: Toc = format::json(&name, "table of contents", toc_bytes)?;
+        let head = map.read(&name, 0, map.len().min(format::SUPERBLOCK_LEN as u64))?;
+        let sb = Superblock::parse_head(&name, &head, map.len())?;
+        let toc_bytes = map.block(&name, &sb.toc, &Section::Toc, format::MAX_JSON_LEN)?;
+        let toc: Toc = format::json(&name, "table of contents", &toc_bytes)?;
         let mut seen = std::collections::HashSet::new();
         for t in &toc.tables {
             if !seen.insert(t.name.as_str()) {
@@ -160,7 +177,7 @@ impl Store {
 
     /// The size of the file in bytes.
     pub fn file_len(&self) -> u64 {
-        self.map.len() as u64
+        self.map.len()
     }
 
     /// The tables, in file order.
@@ -202,16 +219,15 @@ impl Store {
 
     fn table_at(&self, i: usize, e: &TocEntry) -> Result<StoredTable> {
         let what = |s: &str| format!("table `{}` {s}", e.name);
-        let hb = format::block(
+        let hb = self.map.block(
             &self.name,
-            &self.map,
             &e.header,
             &Section::Header {
                 table: e.name.clone(),
             },
             format::MAX_JSON_LEN,
         )?;
-        let header: TableHeader = format::json(&self.name, &what("header"), hb)?;
+        let header: TableHeader = format::json(&self.name, &what("header"), &hb)?;
         if header.name != e.name {
             return Err(Error::format(
                 &self.name,
@@ -220,16 +236,15 @@ impl Store {
                 format!("header names the table `{}`", header.name),
             ));
         }
-        let ib = format::block(
+        let ib = self.map.block(
             &self.name,
-            &self.map,
             &e.index,
             &Section::Index {
                 table: e.name.clone(),
             },
-            self.map.len() as u64,
+            self.map.len(),
         )?;
-        let index = format::check_table(&self.name, self.map.len() as u64, &header, ib, e.chunks)?;
+        let index = format::check_table(&self.name, self.map.len(), &header, &ib, e.chunks)?;
         let starts = index
             .iter()
             .scan(0u64, |acc, e| {
@@ -270,20 +285,105 @@ impl Store {
     }
 }
 
-/// The bytes of an open file: a read-only memory map, or bytes in memory.
+/// The bytes of an open file: the file itself read at offsets, a read-only memory map, or
+/// bytes in memory.
 pub enum Backing {
+    /// An open file, read at offsets as its parts are needed ([`Store::open_reading`]); `len`
+    /// is its length when it was opened.
+    File {
+        /// The file.
+        file: std::fs::File,
+        /// Its length in bytes when opened.
+        len: u64,
+    },
     /// A memory-mapped file.
     Map(memmap2::Mmap),
     /// Bytes in memory, owned by the store (a `Vec<u8>`) or by a host (a Python `bytes`).
     Bytes(Box<dyn AsRef<[u8]> + Send + Sync>),
 }
 
-impl std::ops::Deref for Backing {
-    type Target = [u8];
-    fn deref(&self) -> &[u8] {
+impl Backing {
+    /// The length of the file (as opened) or of the bytes.
+    pub fn len(&self) -> u64 {
         match self {
-            Backing::Map(m) => m,
-            Backing::Bytes(b) => (**b).as_ref(),
+            Backing::File { len, .. } => *len,
+            Backing::Map(m) => m.len() as u64,
+            Backing::Bytes(b) => (**b).as_ref().len() as u64,
         }
     }
+
+    /// True for an empty file.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The `len` bytes at `offset` (within [`Backing::len`]: the caller has checked the range);
+    /// `file` names the file in errors. A file cut short since it was opened (another program
+    /// truncated or rewrote it in place) is an [`Error::Format`] saying so.
+    pub fn read(&self, file: &str, offset: u64, len: u64) -> Result<Cow<'_, [u8]>> {
+        let range = || offset as usize..(offset + len) as usize;
+        match self {
+            Backing::Map(m) => Ok(Cow::Borrowed(&m[range()])),
+            Backing::Bytes(b) => Ok(Cow::Borrowed(&(**b).as_ref()[range()])),
+            Backing::File { file: f, .. } => {
+                let mut buf = vec![0u8; len as usize];
+                read_exact_at(f, &mut buf, offset).map_err(|e| {
+                    if e.kind() == std::io::ErrorKind::UnexpectedEof {
+                        Error::format(
+                            file,
+                            None,
+                            Some(offset),
+                            format!(
+                                "the file ends before byte {}: it was cut short after it was \
+                                 opened (rewritten in place by another program?)",
+                                offset + len
+                            ),
+                        )
+                    } else {
+                        Error::io(Path::new(file), e)
+                    }
+                })?;
+                Ok(Cow::Owned(buf))
+            }
+        }
+    }
+
+    /// The bytes of `block`, checked: inside the file after the superblock, at most `max`
+    /// bytes, and matching its checksum.
+    pub(crate) fn block(
+        &self,
+        file: &str,
+        block: &format::Block,
+        what: &Section,
+        max: u64,
+    ) -> Result<Cow<'_, [u8]>> {
+        format::check_range(file, self.len(), block, what, max)?;
+        let b = self.read(file, block.offset, block.len)?;
+        format::check_sum(file, &b, block, what)?;
+        Ok(b)
+    }
+}
+
+/// Fills `buf` from `file` at `offset` (`pread`), whatever the file's cursor.
+#[cfg(unix)]
+fn read_exact_at(file: &std::fs::File, buf: &mut [u8], offset: u64) -> std::io::Result<()> {
+    std::os::unix::fs::FileExt::read_exact_at(file, buf, offset)
+}
+
+/// Fills `buf` from `file` at `offset` (`ReadFile` at an offset).
+#[cfg(windows)]
+fn read_exact_at(file: &std::fs::File, mut buf: &mut [u8], mut offset: u64) -> std::io::Result<()> {
+    use std::os::windows::fs::FileExt;
+    while !buf.is_empty() {
+        match file.seek_read(buf, offset) {
+            Ok(0) => return Err(std::io::ErrorKind::UnexpectedEof.into()),
+            Ok(n) => {
+                buf = &mut buf[n..];
+                offset += n as u64;
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
 }

@@ -53,8 +53,9 @@ impl StoredTable {
         self.index.iter().map(|e| e.len).sum()
     }
 
-    /// The checksummed bytes of chunk `i` as stored (encoded).
-    pub fn raw_chunk(&self, i: usize) -> Result<&[u8]> {
+    /// The checksummed bytes of chunk `i` as stored (encoded): borrowed from a map or bytes in
+    /// memory, read from an open file.
+    pub fn raw_chunk(&self, i: usize) -> Result<std::borrow::Cow<'_, [u8]>> {
         let e = self.index.get(i).ok_or_else(|| {
             Error::arg(
                 "chunk",
@@ -65,8 +66,8 @@ impl StoredTable {
                 ),
             )
         })?;
-        let b = &self.map[e.offset as usize..(e.offset + e.len) as usize];
-        let computed = format::xxh3(b);
+        let b = self.map.read(&self.file, e.offset, e.len)?;
+        let computed = format::xxh3(&b);
         if computed != e.xxh3 {
             return Err(Error::Checksum {
                 file: self.file.clone(),
@@ -109,7 +110,7 @@ impl StoredTable {
     /// Decodes chunk `i` (bypassing the cache).
     pub fn decode_chunk(&self, i: usize) -> Result<Vec<f32>> {
         let b = self.raw_chunk(i)?;
-        codec::decode(b, self.index[i].values as usize).map_err(|e| self.in_chunk(e, i))
+        codec::decode(&b, self.index[i].values as usize).map_err(|e| self.in_chunk(e, i))
     }
 
     fn in_chunk(&self, e: Error, i: usize) -> Error {

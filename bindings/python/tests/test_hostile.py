@@ -91,6 +91,27 @@ def test_check_and_albedo_of_a_corrupt_table_are_its_error(tmp_path):
         brdftab.open(str(table), eager=False).albedo([0.0, 0.5, 1.0])
 
 
+def test_a_lazy_table_whose_file_is_cut_short_in_place_raises(tmp_path):
+    """A table opened with eager=False read its chunks through a memory map: another program
+    truncating the file in place (`cp other.btdb db.btdb`) killed Python with SIGBUS at the
+    next lookup. Run in a child process, so a regression fails this test, not the run."""
+    table = tmp_path / "q.btdb"
+    brdftab.bake(GGX, str(table), preset="small")
+    code = (
+        "import brdftab, sys\n"
+        f"b = brdftab.open({str(table)!r}, eager=False)\n"
+        f"open({str(table)!r}, 'r+b').truncate(100)\n"
+        "try:\n"
+        "    b.eval([[0.3, 0.1, 0.9]], [[-0.3, 0.0, 0.95]])\n"
+        "except brdftab.Error as e:\n"
+        "    print(e); sys.exit(0)\n"
+        "sys.exit(1)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, (r.returncode, r.stderr)
+    assert "cut short" in r.stdout, r.stdout
+
+
 def test_bake_and_save_refuse_a_measured_files_name(tmp_path):
     """`bake(SPEC, "m.bsdf")` wrote a brdftab table that then opened as an RGL file and was
     refused ("m.binary": as a truncated MERL file)."""

@@ -16,9 +16,24 @@ pub fn block<'a>(
     what: &Section,
     max: u64,
 ) -> Result<&'a [u8]> {
+    check_range(file, data.len() as u64, block, what, max)?;
+    let b = &data[block.offset as usize..(block.offset + block.len) as usize];
+    check_sum(file, b, block, what)?;
+    Ok(b)
+}
+
+/// Checks that `block` lies inside a file of `file_len` bytes, after the superblock, and is at
+/// most `max` bytes long.
+pub fn check_range(
+    file: &str,
+    file_len: u64,
+    block: &Block,
+    what: &Section,
+    max: u64,
+) -> Result<()> {
     let end = block.offset.checked_add(block.len);
     match end {
-        Some(end) if block.offset >= SUPERBLOCK_LEN as u64 && end <= data.len() as u64 => {}
+        Some(end) if block.offset >= SUPERBLOCK_LEN as u64 && end <= file_len => {}
         _ => {
             return Err(Error::format(
                 file,
@@ -26,9 +41,7 @@ pub fn block<'a>(
                 Some(block.offset),
                 format!(
                     "range {}+{} lies outside the file ({} bytes)",
-                    block.offset,
-                    block.len,
-                    data.len()
+                    block.offset, block.len, file_len
                 ),
             ));
         }
@@ -41,7 +54,11 @@ pub fn block<'a>(
             format!("{} bytes is more than the {max} allowed", block.len),
         ));
     }
-    let b = &data[block.offset as usize..(block.offset + block.len) as usize];
+    Ok(())
+}
+
+/// Checks the bytes `b` read for `block` against its checksum.
+pub fn check_sum(file: &str, b: &[u8], block: &Block, what: &Section) -> Result<()> {
     let computed = xxh3(b);
     if computed != block.xxh3 {
         return Err(Error::Checksum {
@@ -51,7 +68,7 @@ pub fn block<'a>(
             computed,
         });
     }
-    Ok(b)
+    Ok(())
 }
 
 /// Parses JSON from a file block, naming the file and block on error.

@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 mod check;
 mod superblock;
 
-pub use check::{block, check_table, json};
+pub use check::{block, check_range, check_sum, check_table, json};
 pub use superblock::Superblock;
 
 use crate::codec::{Codec, Layout};

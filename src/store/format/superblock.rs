@@ -32,6 +32,13 @@ impl Superblock {
 
     /// Parses and checks the superblock of a file of `data.len()` bytes.
     pub fn parse(file: &str, data: &[u8]) -> Result<Superblock> {
+        Self::parse_head(file, data, data.len() as u64)
+    }
+
+    /// Parses and checks the superblock from `head`, the first bytes (at least the
+    /// superblock's, or the whole file if shorter) of a file of `file_len` bytes.
+    pub fn parse_head(file: &str, head: &[u8], file_len: u64) -> Result<Superblock> {
+        let data = head;
         if data.len() < 8 || data[0..8] != MAGIC {
             let what = if data.len() < 8 && MAGIC.starts_with(data) {
                 "truncated before the end of the magic"
@@ -90,14 +97,14 @@ impl Superblock {
             },
             file_len: u64_at(40),
         };
-        if sb.file_len != data.len() as u64 {
+        if sb.file_len != file_len {
             return Err(Error::format(
                 file,
                 Some("file length"),
                 Some(40),
                 format!(
-                    "the file is {} bytes but was written as {} (truncated or appended to)",
-                    data.len(),
+                    "the file is {file_len} bytes but was written as {} (truncated or appended \
+                     to)",
                     sb.file_len
                 ),
             ));
