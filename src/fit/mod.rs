@@ -194,7 +194,7 @@ pub fn fit_with_progress(
         problem = p;
         crate::progress::check(progress)?;
         // The objective as LM reports it may belong to a rejected step; recompute at the end point.
-        let (objective, rmse) = problem.score(&problem.t, &target_lin);
+        let (objective, rmse) = rmse::score(&problem, &problem.t, &target_lin);
         evaluations += problem.evaluations.get();
         starts.push(StartResult {
             initial: x0,

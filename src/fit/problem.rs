@@ -78,28 +78,6 @@ impl Problem<'_> {
     }
 
     /// Transformed model values f̂ cos θi at `t`, or `None` if the model cannot be built.
-    /// The objective ½ Σ r² / (pairs · channels) and the relative RMSE against `target_lin`
-    /// (the source's f_r cos θi, linear) of the model at `t`; both infinite where the model
-    /// does not build or evaluate there.
-    pub(super) fn score(&self, t: &DVector<f64>, target_lin: &[f64]) -> (f64, f64) {
-        let Some(m) = self.model_values(t) else {
-            return (f64::INFINITY, f64::INFINITY);
-        };
-        let obj = 0.5
-            * m.iter()
-                .zip(&self.target)
-                .map(|(a, b)| (a - b) * (a - b))
-                .sum::<f64>()
-            * self.scale
-            * self.scale;
-        let lin: Vec<f64> = if self.log {
-            m.iter().map(|&y| y.exp_m1()).collect()
-        } else {
-            m
-        };
-        (obj, super::rmse::rel_rmse(&lin, target_lin))
-    }
-
     pub(super) fn model_values(&self, t: &DVector<f64>) -> Option<Vec<f64>> {
         self.evaluations.set(self.evaluations.get() + 1);
         if (self.cancel)() {

@@ -1,8 +1,10 @@
 //! The fit's error measure: the cosine-weighted relative RMSE of a model against a source
-//! ([`relative_rmse`]) on a set of pairs.
+//! ([`relative_rmse`]) on a set of pairs, and a start's score (its objective and that RMSE).
+
+use nalgebra::DVector;
 
 use super::Pairs;
-use super::problem::eval_cos;
+use super::problem::{Problem, eval_cos};
 use crate::brdf::Brdf;
 use crate::error::{Error, Result};
 
@@ -37,4 +39,26 @@ pub(super) fn rel_rmse(model: &[f64], target: &[f64]) -> f64 {
     } else {
         f64::INFINITY
     }
+}
+
+/// The objective ½ Σ r² / (pairs · channels) and the relative RMSE against `target_lin`
+/// (the source's f_r cos θi, linear) of the model at `t`; both infinite where the model
+/// does not build or evaluate there.
+pub(super) fn score(problem: &Problem<'_>, t: &DVector<f64>, target_lin: &[f64]) -> (f64, f64) {
+    let Some(m) = problem.model_values(t) else {
+        return (f64::INFINITY, f64::INFINITY);
+    };
+    let obj = 0.5
+        * m.iter()
+            .zip(&problem.target)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+        * problem.scale
+        * problem.scale;
+    let lin: Vec<f64> = if problem.log {
+        m.iter().map(|&y| y.exp_m1()).collect()
+    } else {
+        m
+    };
+    (obj, rel_rmse(&lin, target_lin))
 }
