@@ -99,7 +99,8 @@ pub fn classify_output(output: impl AsRef<OsStr>) -> SourceKind {
 }
 
 /// Refuses `path` as the name of a brdftab table file written by a bake or a save when its
-/// name reads as a measured file's: `.bsdf` (an RGL file) or `.binary` (a MERL file). Sources
+/// name reads as another kind of source: `.bsdf` (an RGL file), `.binary` (a MERL file) or
+/// `.json` (a model spec). Sources
 /// are told apart by their extension ([`classify`]), so such a table would not open again as
 /// what it is (`m.bsdf` read as an RGL tensor file, `m.binary` as a truncated MERL file).
 ///
@@ -109,7 +110,8 @@ pub fn check_table_output(path: &std::path::Path) -> crate::Result<()> {
     let what = match classify_name(path.as_os_str().as_encoded_bytes()) {
         SourceKind::Rgl => "an RGL file",
         SourceKind::Merl => "a MERL file",
-        _ => return Ok(()),
+        SourceKind::Spec => "a model spec",
+        SourceKind::Table => return Ok(()),
     };
     Err(crate::Error::arg(
         "output",

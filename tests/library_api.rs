@@ -129,7 +129,7 @@ fn a_table_file_is_not_written_under_a_measured_files_name() {
     // header of 1146372745 × 436866370 × 1).
     let d = TempDir::new("api-measured-name");
     let req = BakeRequest::new(LAMBERT).preset(Preset::Small);
-    for name in ["m.bsdf", "m.binary", "M.BSDF"] {
+    for name in ["m.bsdf", "m.binary", "M.BSDF", "m.json"] {
         let p = d.join(name);
         for target in [BakeTarget::File(p.clone()), BakeTarget::Raw(p.clone())] {
             let e = req.run(&target);

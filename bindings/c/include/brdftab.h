@@ -154,8 +154,8 @@ char *brdftab_fit(const char *source, const char *model, const char *settings_js
  *   - It is called only on the thread that made the call, never concurrently: the host's
  *     monitor need not be thread-safe (the work runs on other threads meanwhile).
  *   - First with n = 0 before any work (0 there stops before anything is read or written),
- *     then about every 50 ms while the work runs, and once with n = 1 when it succeeded (its
- *     answer then ignored); after it returned 0, not again.
+ *     then about every 50 ms while the work runs (n at most 0.999 then), and once with n = 1
+ *     when it succeeded (its answer then ignored); after it returned 0, not again.
  *   - A stopped call returns -1 (NULL for a fit) with "cancelled" in brdftab_last_error(),
  *     within about 0.3 s of the 0, and writes nothing: OUTPUT (a file, a database's table)
  *     is left as it was, and no temporary file stays. An operation that finishes before it

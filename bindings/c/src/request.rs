@@ -110,6 +110,9 @@ pub type brdftab_progress_fn = Option<unsafe extern "C" fn(user: *mut c_void, n:
 /// stop is seen: the library then stops within a unit of work, ~0.3 s at most).
 const MONITOR_INTERVAL: std::time::Duration = std::time::Duration::from_millis(50);
 
+/// The largest fraction reported while the work runs: 1 is reported once, when it succeeded.
+const RUNNING_MAX: f64 = 0.999;
+
 /// What a monitored operation reports, read by the calling thread: the largest fraction any
 /// stage has reached (f64 bits, non-negative, so their order is the numbers'), the current
 /// stage's total, and the host's request to stop.
@@ -167,7 +170,9 @@ fn monitored<T: Send>(
             match rx.recv_timeout(MONITOR_INTERVAL) {
                 Ok(r) => break r,
                 Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
-                    let n = f64::from_bits(m.fraction.load(Ordering::Relaxed));
+                    // Below 1 while the work runs: a stage that finished (the source's albedo
+                    // integrated) reached 1 with the bake still ahead, and a host reads 1 as done.
+                    let n = f64::from_bits(m.fraction.load(Ordering::Relaxed)).min(RUNNING_MAX);
                     if asking && !ask(n) {
                         m.stop.store(true, Ordering::Relaxed);
                         asking = false;

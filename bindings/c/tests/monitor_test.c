@@ -34,6 +34,7 @@ typedef struct {
     int calls;
     double last;
     int decreasing, out_of_range, other_thread;
+    int ones; /* calls with n = 1: one, the last, for a call that succeeded */
     pthread_t caller;
     double stopped_at; /* when it answered 0 */
 } Watch;
@@ -45,6 +46,7 @@ static int monitor(void *user, double n) {
     if (!(n >= 0.0 && n <= 1.0)) w->out_of_range = 1;
     if (!pthread_equal(pthread_self(), w->caller)) w->other_thread = 1;
     w->last = n;
+    if (n == 1.0) w->ones++;
     if (w->calls == w->stop_at) {
         w->stopped_at = now();
         return 0;
@@ -124,13 +126,15 @@ int main(int argc, char **argv) {
     rc = brdftab_bake_monitored(GGX, done, "{\"preset\": \"small\"}", monitor, &w);
     CHECK(rc == 0, "bake: %s", brdftab_last_error());
     CHECK(w.calls >= 2 && w.last == 1.0, "bake: %d calls, last n %g", w.calls, w.last);
+    /* n reached 1 while a bake still ran (a finished stage): 1 only once it succeeded. */
+    CHECK(w.ones == 1, "bake: n = 1 in %d calls", w.ones);
     check_watch("bake", &w);
     printf("bake calls %d\n", w.calls);
     w = watch(0);
     fit = brdftab_fit_monitored(GGX, "ggx", "{\"pairs\": 300, \"starts\": 2}", monitor, &w);
     CHECK(fit != NULL && strstr(fit, "\"spec\"") != NULL, "fit: %s",
           fit ? fit : brdftab_last_error());
-    CHECK(w.last == 1.0, "fit: last n %g", w.last);
+    CHECK(w.last == 1.0 && w.ones == 1, "fit: last n %g, n = 1 in %d calls", w.last, w.ones);
     check_watch("fit", &w);
     brdftab_free_string(fit);
     rc = brdftab_bake_monitored(GGX, done, "{\"preset\": \"small\", \"gird\": 1}", NULL, NULL);
